@@ -1,0 +1,114 @@
+/* Geometry and rig types of the bake side: tet meshes, surfaces, skeletons, weights,
+ * clips, and a whole character (what the reference simulator and the bake consume).
+ *
+ * Conventions:
+ *  - Indices are 0-based int32; coordinates are double, xyz interleaved.
+ *  - Tets are positively oriented: det[x1-x0, x2-x0, x3-x0] > 0.
+ *  - Surface triangles are counter-clockwise seen from outside (outward normals).
+ *  - A rigid transform is 12 doubles: R row-major (9) then t (3); it maps a rest-space
+ *    point p to R p + t. A bone's transform maps rest space to world space (the
+ *    skinning transform), so the rest pose is the identity for every bone.
+ *  - Every owned pointer is malloc'd; the *_free functions release it and zero the
+ *    struct; freeing a zeroed struct is a no-op.
+ */
+#ifndef SW_MESH_H
+#define SW_MESH_H
+
+#include <stdint.h>
+
+#include "sw_error.h"
+
+typedef struct sw_tetmesh {
+    int32_t nverts, ntets;
+    double *X;     /* 3*nverts rest positions */
+    int32_t *tets; /* 4*ntets vertex ids */
+} sw_tetmesh;
+
+typedef struct sw_trimesh {
+    int32_t nverts, ntris;
+    double *X;     /* 3*nverts */
+    int32_t *tris; /* 3*ntris */
+} sw_trimesh;
+
+/* Boundary of a tet mesh: triangles over the tet mesh's own vertex ids. */
+typedef struct sw_surface {
+    int32_t ntris;
+    int32_t *tris;  /* 3*ntris tet-mesh vertex ids, outward CCW */
+    int32_t nverts; /* distinct vertices on the surface */
+    int32_t *verts; /* nverts tet-mesh vertex ids, ascending */
+} sw_surface;
+
+typedef struct sw_skeleton {
+    int32_t njoints;
+    double *joints; /* 3*njoints rest positions */
+    int32_t nbones;
+    int32_t *bones;  /* 2*nbones: (head joint, tail joint) */
+    int32_t *parent; /* nbones: parent bone (whose tail is this bone's head) or -1 */
+    /* Bones keep their file order (weights columns follow it); parents may come after
+     * children, but the hierarchy has no cycles (sw_skeleton_validate checks). */
+} sw_skeleton;
+
+/* Skin weights: w[v*nbones + b], each row non-negative and summing to 1. */
+typedef struct sw_weights {
+    int32_t nverts, nbones;
+    double *w;
+} sw_weights;
+
+/* An animation as per-frame bone transforms (rest -> world). */
+typedef struct sw_clip {
+    int32_t nbones, nframes;
+    double fps;
+    double *T; /* nframes * nbones * 12 */
+} sw_clip;
+
+/* Everything the reference simulator needs for one character. */
+typedef struct sw_character {
+    char name[64];
+    sw_tetmesh mesh;
+    sw_skeleton skel;
+    sw_weights weights;
+    int32_t *bone_of_vertex; /* nverts: bone driving this vertex rigidly, or -1 (free flesh) */
+    sw_clip clip;
+    double youngs;  /* Young's modulus E */
+    double poisson; /* Poisson ratio nu */
+    double density; /* mass per unit rest volume */
+} sw_character;
+
+void sw_tetmesh_free(sw_tetmesh *m);
+void sw_trimesh_free(sw_trimesh *m);
+void sw_surface_free(sw_surface *s);
+void sw_skeleton_free(sw_skeleton *s);
+void sw_weights_free(sw_weights *w);
+void sw_clip_free(sw_clip *c);
+void sw_character_free(sw_character *c);
+
+/* Signed volume of tet (a,b,c,d): det[b-a, c-a, d-a] / 6. */
+double sw_tet_signed_volume(const double *a, const double *b, const double *c, const double *d);
+
+/* Validates a tet mesh: counts positive, indices in range, coordinates finite, no
+ * tet with a repeated vertex, every tet of positive volume above `min_volume`
+ * (pass 0 for "strictly positive"). The message names the first offending item. */
+sinew_result sw_tetmesh_validate(const sw_tetmesh *m, double min_volume, sw_error *err);
+
+/* Forward kinematics. `local` holds per bone a rotation (9, row-major) about the
+ * bone's head joint, expressed in rest space and applied after the parent's
+ * transform: T_b(x) = T_parent(h_b + L_b (x - h_b)); every root bone also gets
+ * `root_translation` (3, may be NULL). The skeleton must pass sw_skeleton_validate
+ * (at most SW_MAX_BONES bones). Writes 12*nbones to T. */
+void sw_forward_kinematics(const sw_skeleton *s, const double *local, const double *root_translation,
+                           double *T);
+
+#define SW_MAX_BONES 1024
+
+/* Checks joints finite, bone joint ids in range, parents in range, no cycles, and at
+ * most SW_MAX_BONES bones. */
+sinew_result sw_skeleton_validate(const sw_skeleton *s, sw_error *err);
+
+/* Linear blend skinning of rest positions X (3*n) with weights W (n x nbones) and
+ * bone transforms T (12*nbones) into x (3*n). */
+void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, double *x);
+
+/* Applies rigid transform T (12) to p (3) into out (3); out may alias p. */
+void sw_transform_point(const double *T, const double *p, double *out);
+
+#endif

@@ -1,0 +1,15 @@
+/* Robust 3x3 singular value decomposition and polar decomposition.
+ * Row-major 3x3 matrices. No allocation, deterministic, branch-light. */
+#ifndef SW_SVD3_H
+#define SW_SVD3_H
+
+/* A = U diag(s) V^T with U, V proper rotations (det +1) and s sorted by decreasing
+ * absolute value... precisely: s[0] >= s[1] >= |s[2]|, where only s[2] may be
+ * negative (when det A < 0): the "rotation-variant" SVD of Irving et al. 2004.
+ * Handles rank-deficient, zero and nearly-degenerate A. */
+void sw_svd3(const double A[9], double U[9], double s[3], double V[9]);
+
+/* Polar decomposition A = R S with R a proper rotation, R = U V^T from sw_svd3
+ * (so for inverted A, S is symmetric but indefinite). S may be NULL. */
+void sw_polar3(const double A[9], double R[9], double S[9]);
+#endif
