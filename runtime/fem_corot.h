@@ -41,3 +41,5 @@ double sw_corot_eval(const double x[12], const double DmInv[9], double vol, doub
 
 /* Lumped mass: adds density*vol/4 to each of the tet's four vertices' entry of mass. */
 void sw_lumped_mass_add(const int32_t tet[4], double density, double vol, double *mass);
+
+#endif

@@ -1,0 +1,161 @@
+/* Co-rotational linear tetrahedra (thesis eq. 2.3): energy, forces and Hessian of
+ *   Psi(F) = mu ||F - R||_F^2 + lambda/2 tr^2(R^T F - I).
+ * With the rotation-variant SVD F = U diag(s) V^T (R = U V^T) this is an isotropic
+ * function of the signed singular values,
+ *   Psi(s) = mu sum (s_i - 1)^2 + lambda/2 (sum s_i - 3)^2,
+ * so P = dPsi/dF = U diag(dPsi/ds) V^T and dP/dF has a closed-form eigen system
+ * (Teran et al. 2005; Smith et al. 2019): three "scaling" modes U diag(v) V^T from
+ * the 3x3 block d2Psi/ds2, and per singular-value pair (i, j) a "flip" and a "twist"
+ * mode U (e_i e_j^T +- e_j e_i^T) V^T / sqrt(2). The element Hessian is
+ * K = vol B^T (dP/dF) B = vol sum_k lambda_k g_k g_k^T with g_k = B^T vec(Q_k), and the
+ * McAdams et al. 2011 definiteness fix clamps the lambda_k at zero. */
+#include "fem_corot.h"
+
+#include "mat3.h"
+#include "svd3.h"
+
+#include <math.h>
+
+/* Twist eigenvalues divide by s_i + s_j, which is >= 0 for the rotation-variant SVD
+ * (s_0 >= s_1 >= |s_2|) and vanishes only when the element is flattened with two
+ * singular values of opposite sign: there R itself is not differentiable and the exact
+ * Hessian is unbounded. Clamping the denominator (as Teran et al. 2005 do) keeps K finite. */
+static const double COROT_MIN_PAIR_SUM = 1e-6;
+
+void sw_lame(double youngs, double poisson, double *mu, double *lambda) {
+    *mu = youngs / (2.0 * (1.0 + poisson));
+    *lambda = youngs * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
+}
+
+int sw_tet_rest(const double X[12], double DmInv[9], double *vol) {
+    double Dm[9];
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < 3; ++k)
+            Dm[3 * a + k] = X[3 * (k + 1) + a] - X[a];
+    double det = sw_m3_det(Dm);
+    if (!isfinite(det) || !(fabs(det) >= 1e-300)) return 0;
+    double inv[9] = {
+        (Dm[4] * Dm[8] - Dm[5] * Dm[7]) / det, (Dm[2] * Dm[7] - Dm[1] * Dm[8]) / det,
+        (Dm[1] * Dm[5] - Dm[2] * Dm[4]) / det, (Dm[5] * Dm[6] - Dm[3] * Dm[8]) / det,
+        (Dm[0] * Dm[8] - Dm[2] * Dm[6]) / det, (Dm[2] * Dm[3] - Dm[0] * Dm[5]) / det,
+        (Dm[3] * Dm[7] - Dm[4] * Dm[6]) / det, (Dm[1] * Dm[6] - Dm[0] * Dm[7]) / det,
+        (Dm[0] * Dm[4] - Dm[1] * Dm[3]) / det,
+    };
+    for (int i = 0; i < 9; ++i)
+        if (!isfinite(inv[i])) return 0;
+    for (int i = 0; i < 9; ++i)
+        DmInv[i] = inv[i];
+    *vol = fabs(det) / 6.0;
+    return 1;
+}
+
+void sw_lumped_mass_add(const int32_t tet[4], double density, double vol, double *mass) {
+    double m = density * vol * 0.25;
+    for (int i = 0; i < 4; ++i)
+        mass[tet[i]] += m;
+}
+
+/* dF/dx as a 4x3 table D: F = sum_n x_n D[n]^T, so d(F_cb)/d(x_n)_c = D[n][b]. Row 0 is
+ * minus the sum of the others (translations leave F unchanged). */
+static void shape_gradients(const double DmInv[9], double D[12]) {
+    for (int b = 0; b < 3; ++b) {
+        D[3 + b] = DmInv[b];
+        D[6 + b] = DmInv[3 + b];
+        D[9 + b] = DmInv[6 + b];
+        D[b] = -(DmInv[b] + DmInv[3 + b] + DmInv[6 + b]);
+    }
+}
+
+/* g = B^T vec(Q): g[3n + c] = sum_b Q[c][b] D[n][b]. */
+static void pull_to_nodes(const double Q[9], const double D[12], double g[12]) {
+    for (int n = 0; n < 4; ++n)
+        for (int c = 0; c < 3; ++c)
+            g[3 * n + c] =
+                Q[3 * c] * D[3 * n] + Q[3 * c + 1] * D[3 * n + 1] + Q[3 * c + 2] * D[3 * n + 2];
+}
+
+/* Adds vol * lam * (B^T vec(U M V^T)) (B^T vec(U M V^T))^T to K. */
+static void add_mode(const double U[9], const double M[9], const double V[9], const double D[12],
+                     double w, double K[144]) {
+    if (w == 0.0) return;
+    double UM[9], Q[9], g[12];
+    sw_m3_mul(U, M, UM);
+    sw_m3_mul_nt(UM, V, Q);
+    pull_to_nodes(Q, D, g);
+    /* w * (g_i g_j): the same rounding for (i, j) and (j, i), so K is exactly symmetric. */
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j)
+            K[12 * i + j] += w * (g[i] * g[j]);
+}
+
+/* K = vol B^T (dP/dF) B through the analytic eigen system of dP/dF. */
+static void corot_hessian(const double U[9], const double s[3], const double V[9],
+                          const double D[12], double vol, double mu, double lambda, uint32_t flags,
+                          double K[144]) {
+    int project = (flags & SW_COROT_PROJECT_PSD) != 0;
+    double e = s[0] + s[1] + s[2] - 3.0;
+    for (int i = 0; i < 144; ++i)
+        K[i] = 0.0;
+
+    /* Scaling block d2Psi/ds2 = 2 mu I + lambda 1 1^T: eigenvalue 2mu + 3lambda along
+     * (1,1,1)/sqrt(3), 2mu on its orthogonal complement. */
+    static const double r3 = 0.57735026918962576451, r2 = 0.70710678118654752440,
+                        r6 = 0.40824829046386301637;
+    const double dirs[3][3] = {{r3, r3, r3}, {r2, -r2, 0.0}, {r6, r6, -2.0 * r6}};
+    double lam_scale[3] = {2.0 * mu + 3.0 * lambda, 2.0 * mu, 2.0 * mu};
+    for (int k = 0; k < 3; ++k) {
+        double lam = project && lam_scale[k] < 0.0 ? 0.0 : lam_scale[k];
+        double M[9] = {dirs[k][0], 0, 0, 0, dirs[k][1], 0, 0, 0, dirs[k][2]};
+        add_mode(U, M, V, D, vol * lam, K);
+    }
+
+    /* Pair (i, j): flip eigenvalue (psi_i - psi_j)/(s_i - s_j) = 2mu exactly (no division,
+     * so equal singular values are harmless); twist eigenvalue (psi_i + psi_j)/(s_i + s_j)
+     * = 2mu + (2 lambda e - 4 mu)/(s_i + s_j), zero at any rotation of the rest state. */
+    static const int pair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+    for (int k = 0; k < 3; ++k) {
+        int i = pair[k][0], j = pair[k][1];
+        double sum = fmax(s[i] + s[j], COROT_MIN_PAIR_SUM);
+        double lam_twist = 2.0 * mu + (2.0 * lambda * e - 4.0 * mu) / sum;
+        double lam_flip = 2.0 * mu;
+        if (project) {
+            lam_twist = fmax(lam_twist, 0.0);
+            lam_flip = fmax(lam_flip, 0.0);
+        }
+        double M[9] = {0};
+        M[3 * i + j] = r2;
+        M[3 * j + i] = -r2;
+        add_mode(U, M, V, D, vol * lam_twist, K);
+        M[3 * j + i] = r2;
+        add_mode(U, M, V, D, vol * lam_flip, K);
+    }
+}
+
+double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
+                     double lambda, double f[12], double K[144], uint32_t flags) {
+    double Ds[9], F[9], U[9], s[3], V[9], D[12];
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < 3; ++k)
+            Ds[3 * a + k] = x[3 * (k + 1) + a] - x[a];
+    sw_m3_mul(Ds, DmInv, F); /* F = Ds Dm^-1 */
+    sw_svd3(F, U, s, V);
+    double e = s[0] + s[1] + s[2] - 3.0;
+    double d0 = s[0] - 1.0, d1 = s[1] - 1.0, d2 = s[2] - 1.0;
+    double psi = mu * (d0 * d0 + d1 * d1 + d2 * d2) + 0.5 * lambda * e * e; /* eq. 2.3 */
+    shape_gradients(DmInv, D);
+    if (f) {
+        /* P = U diag(dPsi/ds) V^T = 2mu (F - R) + lambda tr(R^T F - I) R. */
+        double dpsi[3] = {2.0 * mu * d0 + lambda * e, 2.0 * mu * d1 + lambda * e,
+                          2.0 * mu * d2 + lambda * e};
+        double UP[9], P[9], g[12];
+        for (int r = 0; r < 3; ++r)
+            for (int c = 0; c < 3; ++c)
+                UP[3 * r + c] = U[3 * r + c] * dpsi[c];
+        sw_m3_mul_nt(UP, V, P);
+        pull_to_nodes(P, D, g); /* dE/dx = vol B^T vec(P) */
+        for (int i = 0; i < 12; ++i)
+            f[i] = -vol * g[i];
+    }
+    if (K) corot_hessian(U, s, V, D, vol, mu, lambda, flags, K);
+    return vol * psi;
+}

@@ -1,0 +1,48 @@
+/* Small static-inline 3x3 helpers for the material kernels (svd3.c, fem_corot.c).
+ * Row-major 3x3 matrices, 3-vectors as double[3]. Private to the runtime. */
+#ifndef SW_MAT3_H
+#define SW_MAT3_H
+
+/* C = A B (C may not alias A or B). */
+static inline void sw_m3_mul(const double A[9], const double B[9], double C[9]) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            C[3 * i + j] = A[3 * i] * B[j] + A[3 * i + 1] * B[3 + j] + A[3 * i + 2] * B[6 + j];
+}
+
+/* C = A B^T (C may not alias A or B). */
+static inline void sw_m3_mul_nt(const double A[9], const double B[9], double C[9]) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            C[3 * i + j] =
+                A[3 * i] * B[3 * j] + A[3 * i + 1] * B[3 * j + 1] + A[3 * i + 2] * B[3 * j + 2];
+}
+
+/* C = A^T B (C may not alias A or B). */
+static inline void sw_m3_mul_tn(const double A[9], const double B[9], double C[9]) {
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            C[3 * i + j] = A[i] * B[j] + A[3 + i] * B[3 + j] + A[6 + i] * B[6 + j];
+}
+
+static inline double sw_m3_det(const double A[9]) {
+    return A[0] * (A[4] * A[8] - A[5] * A[7]) - A[1] * (A[3] * A[8] - A[5] * A[6]) +
+           A[2] * (A[3] * A[7] - A[4] * A[6]);
+}
+
+static inline void sw_m3_identity(double A[9]) {
+    for (int i = 0; i < 9; ++i)
+        A[i] = (i % 4 == 0) ? 1.0 : 0.0;
+}
+
+static inline double sw_v3_dot(const double a[3], const double b[3]) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static inline void sw_v3_cross(const double a[3], const double b[3], double c[3]) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+#endif
