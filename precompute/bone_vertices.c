@@ -1,0 +1,296 @@
+/* Which vertices each bone drives rigidly ("inside the bone"). The reference simulator
+ * prescribes these from the bone transforms; every other vertex is free flesh.
+ *
+ * A bone's flesh radius is estimated as the distance from its segment to the nearest
+ * surface vertex that the bone dominates (by skin weight). Interior vertices dominated by
+ * the bone and closer to the segment than SW_BONE_RADIUS_FRACTION of that radius are
+ * driven by it. Each bone then gets at least four non-coplanar driven vertices (adding
+ * the nearest free interior vertices), so a bone's rigid motion is always fully pinned
+ * down and no domain is left floating. Surface vertices are never driven: they carry the
+ * secondary motion we are simulating. Everything is ordered by (distance, index), so the
+ * result is deterministic. */
+#include "character_io.h"
+
+#include "mesh_io.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SW_BONE_RADIUS_FRACTION 0.4
+#define SW_BONE_MIN_DRIVEN 4
+#define SW_BONE_REACH 2.0
+
+static double point_segment_distance(const double *p, const double *a, const double *b) {
+    double ab[3], ap[3], ab2 = 0, t = 0, d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        ab[i] = b[i] - a[i];
+        ap[i] = p[i] - a[i];
+        ab2 += ab[i] * ab[i];
+        t += ab[i] * ap[i];
+    }
+    t = ab2 > 0 ? t / ab2 : 0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    for (int i = 0; i < 3; ++i) {
+        double d = ap[i] - t * ab[i];
+        d2 += d * d;
+    }
+    return sqrt(d2);
+}
+
+static double bone_distance(const sw_tetmesh *m, const sw_skeleton *s, int32_t v, int32_t b) {
+    return point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
+                                  s->joints + 3 * s->bones[2 * b + 1]);
+}
+
+static void sub3(const double *a, const double *b, double *c) {
+    for (int i = 0; i < 3; ++i)
+        c[i] = a[i] - b[i];
+}
+
+static double dot3(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+
+static void cross3(const double *a, const double *b, double *c) {
+    c[0] = a[1] * b[2] - a[2] * b[1];
+    c[1] = a[2] * b[0] - a[0] * b[2];
+    c[2] = a[0] * b[1] - a[1] * b[0];
+}
+
+/* Affine rank of the listed vertices (-1 none, 0 point, 1 line, 2 plane, 3 space), found
+ * greedily: the point farthest from the first, then the largest triangle, then the
+ * largest tet, each compared with the set's extent (1e-3 relative). */
+static int affine_rank(const sw_tetmesh *m, const int32_t *ids, int32_t n) {
+    if (n < 2) return n - 1; /* empty: -1 */
+    const double *a = m->X + 3 * ids[0];
+    double e1[3] = {0, 0, 0}, L2 = 0, A2 = 0, nrm[3] = {0, 0, 0}, vol = 0;
+    for (int32_t i = 1; i < n; ++i) {
+        double d[3];
+        sub3(m->X + 3 * ids[i], a, d);
+        if (dot3(d, d) > L2) {
+            L2 = dot3(d, d);
+            memcpy(e1, d, sizeof d);
+        }
+    }
+    if (!(L2 > 0)) return 0;
+    for (int32_t i = 1; i < n; ++i) {
+        double d[3], c[3];
+        sub3(m->X + 3 * ids[i], a, d);
+        cross3(e1, d, c);
+        if (dot3(c, c) > A2) {
+            A2 = dot3(c, c);
+            memcpy(nrm, c, sizeof c);
+        }
+    }
+    if (!(A2 > 1e-6 * L2 * L2)) return 1; /* all within 1e-3 L of a line */
+    for (int32_t i = 1; i < n; ++i) {
+        double d[3];
+        sub3(m->X + 3 * ids[i], a, d);
+        vol = fmax(vol, fabs(dot3(nrm, d)));
+    }
+    return vol > 1e-3 * sqrt(L2) * sqrt(A2) ? 3 : 2; /* a point 1e-3 L off the plane */
+}
+
+typedef struct cand {
+    int tier; /* lower tiers are taken first */
+    double d;
+    int32_t v;
+} cand;
+
+static int cand_cmp(const void *pa, const void *pb) {
+    const cand *a = pa, *b = pb;
+    if (a->tier != b->tier) return a->tier < b->tier ? -1 : 1;
+    if (a->d != b->d) return a->d < b->d ? -1 : 1;
+    return (a->v > b->v) - (a->v < b->v);
+}
+
+/* Last resort for bone b when the shared pass left it short: free interior vertices
+ * within its reach first, then the nearest free vertices of any kind, surface included.
+ * A coarse mesh can have no interior vertex anywhere near a thin limb (the elephant's
+ * legs); driving the limb's own skin is then better than driving flesh far away or
+ * leaving the limb undriven. A candidate is only taken when it raises the set's
+ * affine rank, so a flat set gains one vertex off its plane rather than every nearer
+ * vertex in that plane (rank 3 implies at least SW_BONE_MIN_DRIVEN = 4 vertices). */
+static sinew_result top_up(const sw_tetmesh *m, const sw_skeleton *s, const unsigned char *surf,
+                           double reach, int32_t *bov, int32_t b, int32_t *ids, cand *c,
+                           sw_error *err) {
+    int32_t n = 0, nc = 0;
+    for (int32_t v = 0; v < m->nverts; ++v)
+        if (bov[v] == b) ids[n++] = v;
+    int rank = affine_rank(m, ids, n);
+    if (n >= SW_BONE_MIN_DRIVEN && rank == 3) return SINEW_OK;
+    for (int32_t v = 0; v < m->nverts; ++v) {
+        if (bov[v] != -1) continue;
+        double d = bone_distance(m, s, v, b);
+        c[nc++] = (cand){!surf[v] && d <= reach ? 0 : 1, d, v};
+    }
+    qsort(c, (size_t)nc, sizeof *c, cand_cmp);
+    for (int32_t k = 0; k < nc; ++k) {
+        ids[n] = c[k].v;
+        int r = affine_rank(m, ids, n + 1);
+        if (r <= rank) continue;
+        bov[c[k].v] = b;
+        rank = r;
+        if (++n >= SW_BONE_MIN_DRIVEN && rank == 3) return SINEW_OK;
+    }
+    return sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                        "bone %d: only %d free vertices can be driven by it and they do not span "
+                        "3-D (the mesh has too few vertices for %d bones)",
+                        b, n, s->nbones);
+}
+
+/* Whether bone b already has enough driven vertices; fills ids with them. */
+static int satisfied(const sw_tetmesh *m, const int32_t *bov, int32_t b, int32_t *ids, int32_t *n,
+                     int *rank) {
+    *n = 0;
+    for (int32_t v = 0; v < m->nverts; ++v)
+        if (bov[v] == b) ids[(*n)++] = v;
+    *rank = affine_rank(m, ids, *n);
+    return *n >= SW_BONE_MIN_DRIVEN && *rank == 3;
+}
+
+typedef struct pair {
+    double d;
+    int32_t v, b;
+} pair;
+
+static int pair_cmp(const void *pa, const void *pb) {
+    const pair *a = pa, *b = pb;
+    if (a->d != b->d) return a->d < b->d ? -1 : 1;
+    if (a->b != b->b) return a->b < b->b ? -1 : 1;
+    return (a->v > b->v) - (a->v < b->v);
+}
+
+/* One shared pass over (vertex, bone) pairs of the bones still short of vertices,
+ * nearest pair first: on a coarse mesh with few interior vertices this hands each free
+ * vertex to the closest bone that needs it instead of to whichever bone asks first.
+ * Candidates are each needy bone's SW_BONE_TOPUP_CANDIDATES nearest free interior
+ * vertices within its reach; bones still short afterwards fall back to top_up. */
+#define SW_BONE_TOPUP_CANDIDATES 32
+static sinew_result shared_top_up(const sw_tetmesh *m, const sw_skeleton *s,
+                                  const unsigned char *surf, const double *reach, int32_t *bov,
+                                  int32_t *ids, cand *c, sw_error *err) {
+    int32_t n, nneedy = 0, np = 0;
+    int rank;
+    for (int32_t b = 0; b < s->nbones; ++b)
+        nneedy += !satisfied(m, bov, b, ids, &n, &rank);
+    if (nneedy == 0) return SINEW_OK;
+    pair *p = malloc(sizeof(pair) * (size_t)nneedy * SW_BONE_TOPUP_CANDIDATES);
+    if (!p) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "bone vertices: out of memory");
+    for (int32_t b = 0; b < s->nbones; ++b) {
+        if (satisfied(m, bov, b, ids, &n, &rank)) continue;
+        int32_t nc = 0;
+        for (int32_t v = 0; v < m->nverts; ++v)
+            if (!surf[v] && bov[v] == -1) {
+                double d = bone_distance(m, s, v, b);
+                if (d <= reach[b]) c[nc++] = (cand){0, d, v};
+            }
+        qsort(c, (size_t)nc, sizeof *c, cand_cmp);
+        for (int32_t k = 0; k < nc && k < SW_BONE_TOPUP_CANDIDATES; ++k)
+            p[np++] = (pair){c[k].d, c[k].v, b};
+    }
+    qsort(p, (size_t)np, sizeof *p, pair_cmp);
+    for (int32_t k = 0; k < np; ++k) {
+        if (bov[p[k].v] != -1 || satisfied(m, bov, p[k].b, ids, &n, &rank)) continue;
+        ids[n] = p[k].v;
+        if (affine_rank(m, ids, n + 1) <= rank) continue;
+        bov[p[k].v] = p[k].b;
+    }
+    free(p);
+    return SINEW_OK;
+}
+
+/* Flesh radius of each bone: the distance from its segment to the nearest surface
+ * vertex it dominates, counting only vertices beside the segment (projecting strictly
+ * inside it), since joints at the tips of limbs sit at or beyond the skin. Falls back
+ * to any dominated surface vertex, then to any surface vertex. */
+static void flesh_radii(const sw_tetmesh *m, const sw_skeleton *s, const unsigned char *surf,
+                        const int32_t *dom, double *radius) {
+    for (int32_t b = 0; b < s->nbones; ++b) {
+        const double *h = s->joints + 3 * s->bones[2 * b], *t = s->joints + 3 * s->bones[2 * b + 1];
+        double ax[3], L2, beside = INFINITY, own = INFINITY, any = INFINITY;
+        sub3(t, h, ax);
+        L2 = dot3(ax, ax);
+        for (int32_t v = 0; v < m->nverts; ++v) {
+            if (!surf[v]) continue;
+            double d = bone_distance(m, s, v, b), hv[3];
+            any = fmin(any, d);
+            if (dom[v] != b) continue;
+            own = fmin(own, d);
+            sub3(m->X + 3 * v, h, hv);
+            double u = dot3(hv, ax);
+            if (u > 0 && u < L2) beside = fmin(beside, d);
+        }
+        radius[b] = isfinite(beside) ? beside : (isfinite(own) ? own : any);
+    }
+}
+
+static sinew_result check_inputs(const sw_tetmesh *m, const sw_skeleton *s, const sw_weights *w,
+                                 const int32_t *bov, sw_error *err) {
+    if (!m || !s || !w || !bov || !w->w)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "bone vertices: NULL argument");
+    sinew_result rc = sw_tetmesh_validate(m, 0.0, err);
+    if (rc) return rc;
+    if ((rc = sw_skeleton_validate(s, err))) return rc;
+    if (w->nverts != m->nverts || w->nbones != s->nbones)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "bone vertices: weights are %d x %d but the mesh has %d vertices and "
+                            "the skeleton %d bones",
+                            w->nverts, w->nbones, m->nverts, s->nbones);
+    return SINEW_OK;
+}
+
+sinew_result sw_select_bone_vertices(const sw_tetmesh *m, const sw_skeleton *s, const sw_weights *w,
+                                     int32_t *bone_of_vertex, sw_error *err) {
+    sinew_result rc = check_inputs(m, s, w, bone_of_vertex, err);
+    if (rc) return rc;
+    sw_surface surface = {0};
+    if ((rc = sw_tetmesh_surface(m, &surface, err))) return rc;
+    int32_t n = m->nverts;
+    unsigned char *surf = calloc((size_t)n, 1);
+    int32_t *dom = malloc(sizeof(int32_t) * (size_t)n);
+    int32_t *ids = malloc(sizeof(int32_t) * (size_t)n);
+    cand *c = malloc(sizeof(cand) * (size_t)n);
+    double *radius = malloc(sizeof(double) * (size_t)s->nbones);
+    if (!surf || !dom || !ids || !c || !radius) {
+        rc = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "bone vertices: out of memory");
+        goto done;
+    }
+    for (int32_t k = 0; k < surface.nverts; ++k)
+        surf[surface.verts[k]] = 1;
+    /* a vertex no tet uses is never driven: mark it taken (bov -2) until the end */
+    for (int32_t v = 0; v < n; ++v)
+        ids[v] = 0;
+    for (int32_t k = 0; k < 4 * m->ntets; ++k)
+        ids[m->tets[k]] = 1;
+    for (int32_t v = 0; v < n; ++v) { /* dominant bone; ties go to the lower index */
+        const double *row = w->w + (size_t)v * w->nbones;
+        dom[v] = 0;
+        for (int32_t b = 1; b < w->nbones; ++b)
+            if (row[b] > row[dom[v]]) dom[v] = b;
+    }
+    flesh_radii(m, s, surf, dom, radius);
+    for (int32_t v = 0; v < n; ++v) {
+        bone_of_vertex[v] = ids[v] ? -1 : -2;
+        if (ids[v] && !surf[v] &&
+            bone_distance(m, s, v, dom[v]) <= SW_BONE_RADIUS_FRACTION * radius[dom[v]])
+            bone_of_vertex[v] = dom[v];
+    }
+    /* a bone reaches interior vertices up to SW_BONE_REACH flesh radii from it */
+    for (int32_t b = 0; b < s->nbones; ++b)
+        radius[b] *= SW_BONE_REACH;
+    rc = shared_top_up(m, s, surf, radius, bone_of_vertex, ids, c, err);
+    for (int32_t b = 0; b < s->nbones && !rc; ++b)
+        rc = top_up(m, s, surf, radius[b], bone_of_vertex, b, ids, c, err);
+    for (int32_t v = 0; v < n; ++v)
+        if (rc || bone_of_vertex[v] < 0) bone_of_vertex[v] = -1;
+done:
+    sw_surface_free(&surface);
+    free(surf);
+    free(dom);
+    free(ids);
+    free(c);
+    free(radius);
+    return rc;
+}

@@ -1,0 +1,92 @@
+/* Inverse-distance skin weights, for assets that ship none (the bake computes the
+ * heat-diffusion weights of DESIGN.md §8; these only need to be plausible and smooth). */
+#include "character_io.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+/* Distance from p to the segment a-b (a point when a == b). */
+static double point_segment_distance(const double *p, const double *a, const double *b) {
+    double ab[3], ap[3], ab2 = 0, t = 0, d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        ab[i] = b[i] - a[i];
+        ap[i] = p[i] - a[i];
+        ab2 += ab[i] * ab[i];
+        t += ab[i] * ap[i];
+    }
+    t = ab2 > 0 ? t / ab2 : 0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    for (int i = 0; i < 3; ++i) {
+        double d = ap[i] - t * ab[i];
+        d2 += d * d;
+    }
+    return sqrt(d2);
+}
+
+/* Length of the diagonal of the box around the mesh and the joints: the scale that
+ * makes the distance clamp relative. */
+static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t v = 0; v < m->nverts; ++v)
+        for (int i = 0; i < 3; ++i) {
+            lo[i] = fmin(lo[i], m->X[3 * v + i]);
+            hi[i] = fmax(hi[i], m->X[3 * v + i]);
+        }
+    for (int32_t j = 0; j < s->njoints; ++j)
+        for (int i = 0; i < 3; ++i) {
+            lo[i] = fmin(lo[i], s->joints[3 * j + i]);
+            hi[i] = fmax(hi[i], s->joints[3 * j + i]);
+        }
+    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+}
+
+sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton *s, sw_weights *out,
+                                         sw_error *err) {
+    if (!out)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "inverse-distance weights: out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!m || !s)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "inverse-distance weights: NULL input");
+    if (m->nverts < 1 || !m->X)
+        return sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                            "inverse-distance weights: mesh has no vertices");
+    sinew_result rc = sw_skeleton_validate(s, err);
+    if (rc) return rc;
+    for (int32_t v = 0; v < 3 * m->nverts; ++v)
+        if (!isfinite(m->X[v]))
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                "inverse-distance weights: vertex %d is not finite", v / 3);
+    double *w = malloc(sizeof(double) * (size_t)m->nverts * (size_t)s->nbones);
+    if (!w)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                            "inverse-distance weights: out of memory");
+    /* A vertex on a segment would divide by zero: distances are clamped to a tiny
+     * fraction of the model size, which makes that bone's weight ~1. */
+    double eps = 1e-9 * scene_diagonal(m, s);
+    if (!(eps > 0)) eps = 1e-300;
+    for (int32_t v = 0; v < m->nverts; ++v) {
+        double *row = w + (size_t)v * s->nbones, dmin = INFINITY, sum = 0;
+        for (int32_t b = 0; b < s->nbones; ++b) {
+            row[b] = fmax(point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
+                                                 s->joints + 3 * s->bones[2 * b + 1]),
+                          eps);
+            dmin = fmin(dmin, row[b]);
+        }
+        /* w ~ 1/d^4, computed as (dmin/d)^4 so nothing over- or underflows at any scale. */
+        for (int32_t b = 0; b < s->nbones; ++b) {
+            double r = dmin / row[b];
+            row[b] = (r * r) * (r * r);
+            sum += row[b];
+        }
+        for (int32_t b = 0; b < s->nbones; ++b)
+            row[b] /= sum;
+    }
+    out->nverts = m->nverts;
+    out->nbones = s->nbones;
+    out->w = w;
+    return SINEW_OK;
+}
