@@ -1,2 +1,0 @@
-/* placeholder so the library has a source until samples.c lands */
-typedef int sw_samples_placeholder;
