@@ -1,0 +1,559 @@
+/* Full-space self-contact: detection (thesis §3.3.1 "Collision Resolution",
+ * DESIGN.md §8) and the penalty of eqs. 3.4-3.6. */
+#include "selfcontact.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bvh.h"
+
+/* A vertex counts as inside a tet when all its barycentrics are >= -this. */
+#define SC_BARY_TOL 1e-12
+/* Rest depths below this fraction of the triangle's longest edge are touching, not
+ * penetration: a vertex lying on the other surface up to round-off has no normal. */
+#define SC_TOUCH_TOL 1e-10
+
+struct sw_selfcontact {
+    int32_t nverts, ntets, ntris, nsurf;
+    double *X;        /* 3*nverts rest positions (copy) */
+    int32_t *tets;    /* 4*ntets (copy) */
+    int32_t *tris;    /* 3*ntris (copy) */
+    int32_t *surf;    /* nsurf surface vertex ids, ascending (copy) */
+    double *ring;     /* nsurf: rest area of the surface triangles around the vertex */
+    double *tri_area; /* ntris rest areas */
+    double *tri_edge; /* ntris longest rest edges */
+    double rest_diag; /* rest bounding-box diagonal: finite radius of the rest query */
+    double neighbour_factor;
+    int32_t max_contacts;
+    sw_bvh tri_bvh;                   /* static: rest surface triangles */
+    sw_bvh tet_bvh;                   /* topology from the rest pose, refit per detect */
+    sw_contact *list;                 /* nsurf: per-range slices during detect, then the list */
+    int32_t *range_count, *range_end; /* nsurf, indexed by the first item of a range */
+    int32_t count, dropped;
+    double max_depth;
+};
+
+static void sub3(const double *a, const double *b, double *o) {
+    o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
+}
+static void cross3(const double *a, const double *b, double *o) {
+    o[0] = a[1] * b[2] - a[2] * b[1];
+    o[1] = a[2] * b[0] - a[0] * b[2];
+    o[2] = a[0] * b[1] - a[1] * b[0];
+}
+static double dot3(const double *a, const double *b) {
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
+}
+static double det3(const double *a, const double *b, const double *c) {
+    double t[3];
+    cross3(b, c, t);
+    return dot3(a, t);
+}
+
+void sw_selfcontact_destroy(sw_selfcontact *sc) {
+    if (!sc) return;
+    free(sc->X);
+    free(sc->tets);
+    free(sc->tris);
+    free(sc->surf);
+    free(sc->ring);
+    free(sc->tri_area);
+    free(sc->tri_edge);
+    sw_bvh_free(&sc->tri_bvh);
+    sw_bvh_free(&sc->tet_bvh);
+    free(sc->list);
+    free(sc->range_count);
+    free(sc->range_end);
+    free(sc);
+}
+
+/* Index of vertex v in the ascending surface vertex list, or -1. */
+static int32_t surf_index(const int32_t *surf, int32_t n, int32_t v) {
+    int32_t lo = 0, hi = n;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (surf[mid] < v)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return (lo < n && surf[lo] == v) ? lo : -1;
+}
+
+static sinew_result validate(const sw_tetmesh *m, const sw_surface *s, double factor,
+                             int32_t max_contacts, sw_error *err) {
+    if (!m || !s)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "sw_selfcontact_create: mesh or surface is NULL");
+    if (m->nverts < 4 || m->ntets < 1 || !m->X || !m->tets)
+        return sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                            "sw_selfcontact_create: empty tet mesh (%d vertices, %d tets)",
+                            (int)m->nverts, (int)m->ntets);
+    if (s->ntris < 1 || s->nverts < 3 || !s->tris || !s->verts)
+        return sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                            "sw_selfcontact_create: empty surface (%d triangles, %d vertices)",
+                            (int)s->ntris, (int)s->nverts);
+    if (!isfinite(factor) || factor < 0)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "sw_selfcontact_create: neighbour_factor %g must be finite and >= 0",
+                            factor);
+    if (max_contacts < 0)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "sw_selfcontact_create: max_contacts %d is negative",
+                            (int)max_contacts);
+    for (int32_t i = 0; i < 3 * m->nverts; ++i)
+        if (!isfinite(m->X[i]))
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                "sw_selfcontact_create: rest position of vertex %d is not finite",
+                                (int)(i / 3));
+    for (int32_t i = 0; i < 4 * m->ntets; ++i)
+        if (m->tets[i] < 0 || m->tets[i] >= m->nverts)
+            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                                "sw_selfcontact_create: tet %d vertex %d out of range [0, %d)",
+                                (int)(i / 4), (int)m->tets[i], (int)m->nverts);
+    for (int32_t i = 0; i < s->nverts; ++i) {
+        if (s->verts[i] < 0 || s->verts[i] >= m->nverts)
+            return sw_error_set(
+                err, SINEW_ERROR_INVALID_ARGUMENT,
+                "sw_selfcontact_create: surface vertex %d (id %d) out of range [0, %d)", (int)i,
+                (int)s->verts[i], (int)m->nverts);
+        if (i > 0 && s->verts[i] <= s->verts[i - 1])
+            return sw_error_set(
+                err, SINEW_ERROR_INVALID_ARGUMENT,
+                "sw_selfcontact_create: surface vertex ids not strictly ascending at %d", (int)i);
+    }
+    for (int32_t t = 0; t < s->ntris; ++t) {
+        const int32_t *v = s->tris + 3 * (size_t)t;
+        for (int k = 0; k < 3; ++k)
+            if (surf_index(s->verts, s->nverts, v[k]) < 0)
+                return sw_error_set(
+                    err, SINEW_ERROR_INVALID_ARGUMENT,
+                    "sw_selfcontact_create: surface triangle %d vertex %d is not in the "
+                    "surface vertex list",
+                    (int)t, (int)v[k]);
+        double e1[3], e2[3], nrm[3];
+        sub3(m->X + 3 * (size_t)v[1], m->X + 3 * (size_t)v[0], e1);
+        sub3(m->X + 3 * (size_t)v[2], m->X + 3 * (size_t)v[0], e2);
+        cross3(e1, e2, nrm);
+        if (!(dot3(nrm, nrm) > 0))
+            return sw_error_set(
+                err, SINEW_ERROR_DEGENERATE,
+                "sw_selfcontact_create: surface triangle %d (%d %d %d) has zero rest area", (int)t,
+                (int)v[0], (int)v[1], (int)v[2]);
+    }
+    return SINEW_OK;
+}
+
+/* Rest areas and edges of the surface: ka of eq. 3.4 needs the one-ring area of the
+ * vertex and the area of the triangle; the neighbour rule the longest edge. */
+static void rest_measures(sw_selfcontact *sc) {
+    for (int32_t t = 0; t < sc->ntris; ++t) {
+        const int32_t *v = sc->tris + 3 * (size_t)t;
+        const double *a = sc->X + 3 * (size_t)v[0], *b = sc->X + 3 * (size_t)v[1],
+                     *c = sc->X + 3 * (size_t)v[2];
+        double e[3][3], nrm[3];
+        sub3(b, a, e[0]);
+        sub3(c, b, e[1]);
+        sub3(a, c, e[2]);
+        cross3(e[0], e[2], nrm);
+        double area = 0.5 * sqrt(dot3(nrm, nrm)), longest = 0;
+        for (int k = 0; k < 3; ++k) {
+            double l = sqrt(dot3(e[k], e[k]));
+            if (l > longest) longest = l;
+        }
+        sc->tri_area[t] = area;
+        sc->tri_edge[t] = longest;
+        for (int k = 0; k < 3; ++k)
+            sc->ring[surf_index(sc->surf, sc->nsurf, v[k])] += area;
+    }
+}
+
+sinew_result sw_selfcontact_create(const sw_tetmesh *mesh, const sw_surface *surf,
+                                   double neighbour_factor, int32_t max_contacts,
+                                   sw_selfcontact **out, sw_error *err) {
+    if (!out)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "sw_selfcontact_create: out is NULL");
+    *out = NULL;
+    sinew_result r = validate(mesh, surf, neighbour_factor, max_contacts, err);
+    if (r != SINEW_OK) return r;
+    sw_selfcontact *sc = calloc(1, sizeof *sc);
+    if (!sc)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "sw_selfcontact_create: out of memory");
+    sc->nverts = mesh->nverts;
+    sc->ntets = mesh->ntets;
+    sc->ntris = surf->ntris;
+    sc->nsurf = surf->nverts;
+    sc->neighbour_factor = neighbour_factor;
+    sc->max_contacts = max_contacts;
+    size_t nv = (size_t)sc->nverts, nt = (size_t)sc->ntets, nf = (size_t)sc->ntris,
+           ns = (size_t)sc->nsurf;
+    sc->X = malloc(3 * nv * sizeof(double));
+    sc->tets = malloc(4 * nt * sizeof(int32_t));
+    sc->tris = malloc(3 * nf * sizeof(int32_t));
+    sc->surf = malloc(ns * sizeof(int32_t));
+    sc->ring = calloc(ns, sizeof(double));
+    sc->tri_area = malloc(nf * sizeof(double));
+    sc->tri_edge = malloc(nf * sizeof(double));
+    sc->list = malloc(ns * sizeof(sw_contact));
+    sc->range_count = calloc(ns, sizeof(int32_t));
+    sc->range_end = calloc(ns, sizeof(int32_t));
+    /* build-time boxes: triangles, then (reused) tets */
+    double *box = malloc(6 * (nf > nt ? nf : nt) * sizeof(double));
+    if (!sc->X || !sc->tets || !sc->tris || !sc->surf || !sc->ring || !sc->tri_area ||
+        !sc->tri_edge || !sc->list || !sc->range_count || !sc->range_end || !box) {
+        free(box);
+        sw_selfcontact_destroy(sc);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "sw_selfcontact_create: out of memory");
+    }
+    memcpy(sc->X, mesh->X, 3 * nv * sizeof(double));
+    memcpy(sc->tets, mesh->tets, 4 * nt * sizeof(int32_t));
+    memcpy(sc->tris, surf->tris, 3 * nf * sizeof(int32_t));
+    memcpy(sc->surf, surf->verts, ns * sizeof(int32_t));
+    rest_measures(sc);
+
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (size_t i = 0; i < nv; ++i)
+        for (int k = 0; k < 3; ++k) {
+            if (sc->X[3 * i + k] < lo[k]) lo[k] = sc->X[3 * i + k];
+            if (sc->X[3 * i + k] > hi[k]) hi[k] = sc->X[3 * i + k];
+        }
+    double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
+    /* Every rest point lies in the bounding box, so this radius always finds the
+     * closest surface triangle, yet it is finite (STYLE.md §6). */
+    sc->rest_diag = 1.01 * sqrt(dot3(diag, diag)) + 1e-300;
+
+    sw_bvh_element_boxes(sc->tris, 3, sc->X, 0, sc->ntris, box);
+    r = sw_bvh_build(sc->ntris, box, &sc->tri_bvh, err);
+    if (r == SINEW_OK) {
+        sw_bvh_element_boxes(sc->tets, 4, sc->X, 0, sc->ntets, box);
+        r = sw_bvh_build(sc->ntets, box, &sc->tet_bvh, err);
+    }
+    free(box);
+    if (r != SINEW_OK) {
+        sw_selfcontact_destroy(sc);
+        return r;
+    }
+    *out = sc;
+    return SINEW_OK;
+}
+
+/* ---- detection ---------------------------------------------------------------- */
+
+typedef struct {
+    const sw_selfcontact *sc;
+    const double *x;
+    int32_t p;        /* the surface vertex */
+    const double *xp; /* its deformed position */
+    /* best candidate so far: deepest rest point, ties to the lowest tet id */
+    int32_t tet;
+    double rest_depth;
+    sw_bvh_closest hit;
+} vertex_query;
+
+/* Barycentrics of p in the deformed tet t; 0 when the tet is flat. */
+static int tet_barycentrics(const double *x, const int32_t *v, const double *p, double b[4]) {
+    const double *x0 = x + 3 * (size_t)v[0], *x1 = x + 3 * (size_t)v[1], *x2 = x + 3 * (size_t)v[2],
+                 *x3 = x + 3 * (size_t)v[3];
+    double e1[3], e2[3], e3[3], q0[3], q1[3], q2[3], q3[3];
+    sub3(x1, x0, e1);
+    sub3(x2, x0, e2);
+    sub3(x3, x0, e3);
+    double vol = det3(e1, e2, e3);
+    if (!(vol != 0) || !isfinite(vol)) return 0;
+    sub3(x0, p, q0);
+    sub3(x1, p, q1);
+    sub3(x2, p, q2);
+    sub3(x3, p, q3);
+    /* Each weight is the signed volume of the tet with its vertex replaced by p. */
+    b[0] = det3(q1, q2, q3) / vol;
+    b[1] = -det3(q0, q2, q3) / vol;
+    b[2] = det3(q0, q1, q3) / vol;
+    b[3] = -det3(q0, q1, q2) / vol;
+    return 1;
+}
+
+static int visit_tet(void *ctx, int32_t t) {
+    vertex_query *q = ctx;
+    const sw_selfcontact *sc = q->sc;
+    const int32_t *v = sc->tets + 4 * (size_t)t;
+    /* Tets incident to p always contain it; they are its own flesh, not a contact. */
+    if (v[0] == q->p || v[1] == q->p || v[2] == q->p || v[3] == q->p) return 0;
+    double b[4];
+    if (!tet_barycentrics(q->x, v, q->xp, b)) return 0;
+    for (int k = 0; k < 4; ++k)
+        if (!(b[k] >= -SC_BARY_TOL)) return 0;
+    /* §3.3.1: the penetrating vertex's rest position, by barycentric interpolation in
+     * the rest pose of the tet it entered, then its closest rest-surface point. */
+    double Xr[3] = {0, 0, 0};
+    for (int k = 0; k < 4; ++k)
+        for (int c = 0; c < 3; ++c)
+            Xr[c] += b[k] * sc->X[3 * (size_t)v[k] + c];
+    sw_bvh_closest hit;
+    if (!sw_bvh_closest_triangle(&sc->tri_bvh, sc->X, sc->tris, Xr, sc->rest_diag, &hit)) return 0;
+    const int32_t *tv = sc->tris + 3 * (size_t)hit.tri;
+    if (tv[0] == q->p || tv[1] == q->p || tv[2] == q->p) return 0;
+    double edge = sc->tri_edge[hit.tri];
+    if (hit.dist <= SC_TOUCH_TOL * edge) return 0;
+    /* Neighbour rule (DESIGN.md §8): a triangle close to p in rest space is p's own
+     * neighbourhood folding, not a contact. */
+    double beta[3], Q[3];
+    const double *Xp = sc->X + 3 * (size_t)q->p;
+    sw_closest_point_triangle(Xp, sc->X + 3 * (size_t)tv[0], sc->X + 3 * (size_t)tv[1],
+                              sc->X + 3 * (size_t)tv[2], beta, Q);
+    double dQ[3];
+    sub3(Q, Xp, dQ);
+    if (sqrt(dot3(dQ, dQ)) < sc->neighbour_factor * edge) return 0;
+    if (q->tet < 0 || hit.dist > q->rest_depth || (hit.dist == q->rest_depth && t < q->tet)) {
+        q->tet = t;
+        q->rest_depth = hit.dist;
+        q->hit = hit;
+    }
+    return 0;
+}
+
+/* Fills c from the chosen triangle: v_s, d, n, depth, ka (eqs. 3.4-3.5). */
+static void make_contact(const sw_selfcontact *sc, const double *x, int32_t si,
+                         const vertex_query *q, sw_contact *c) {
+    const int32_t *tv = sc->tris + 3 * (size_t)q->hit.tri;
+    memset(c, 0, sizeof *c);
+    c->p = q->p;
+    double vs[3] = {0, 0, 0};
+    for (int k = 0; k < 3; ++k) {
+        c->tri[k] = tv[k];
+        c->beta[k] = q->hit.beta[k];
+        for (int j = 0; j < 3; ++j)
+            vs[j] += c->beta[k] * x[3 * (size_t)tv[k] + j];
+    }
+    c->ka = 0.25 * (sc->ring[si] + sc->tri_area[q->hit.tri]);
+    double d[3];
+    sub3(vs, q->xp, d);
+    double len = sqrt(dot3(d, d));
+    c->depth = len;
+    if (len > 0 && isfinite(len)) {
+        for (int j = 0; j < 3; ++j)
+            c->n[j] = d[j] / len;
+        return;
+    }
+    /* v_s == v_p: the direction is undefined; the triangle's outward normal is where
+     * v_s - v_p points for any nearby penetration (deformed, else rest). */
+    double e1[3], e2[3], nrm[3];
+    for (int pass = 0; pass < 2; ++pass) {
+        const double *P = pass == 0 ? x : sc->X;
+        sub3(P + 3 * (size_t)tv[1], P + 3 * (size_t)tv[0], e1);
+        sub3(P + 3 * (size_t)tv[2], P + 3 * (size_t)tv[0], e2);
+        cross3(e1, e2, nrm);
+        double l = sqrt(dot3(nrm, nrm));
+        if (l > 0 && isfinite(l)) {
+            for (int j = 0; j < 3; ++j)
+                c->n[j] = nrm[j] / l;
+            return;
+        }
+    }
+}
+
+typedef struct {
+    sw_selfcontact *sc;
+    const double *x;
+} detect_ctx;
+
+static void boxes_range(void *ctx, int64_t begin, int64_t end, int worker) {
+    (void)worker;
+    detect_ctx *d = ctx;
+    sw_bvh_refit_elements(&d->sc->tet_bvh, d->sc->tets, 4, d->x, (int32_t)begin, (int32_t)end);
+}
+
+/* One range of surface vertices writes its contacts compactly from list[begin]: the
+ * range owns slots [begin, end) since each vertex yields at most one contact. */
+static void detect_range(void *ctx, int64_t begin, int64_t end, int worker) {
+    (void)worker;
+    detect_ctx *d = ctx;
+    sw_selfcontact *sc = d->sc;
+    int32_t n = 0;
+    for (int64_t i = begin; i < end; ++i) {
+        vertex_query q;
+        q.sc = sc;
+        q.x = d->x;
+        q.p = sc->surf[i];
+        q.xp = d->x + 3 * (size_t)q.p;
+        q.tet = -1;
+        q.rest_depth = 0;
+        sw_bvh_query_point(&sc->tet_bvh, q.xp, visit_tet, &q);
+        if (q.tet >= 0) make_contact(sc, d->x, (int32_t)i, &q, &sc->list[begin + n++]);
+    }
+    sc->range_count[begin] = n;
+    sc->range_end[begin] = (int32_t)end;
+}
+
+/* Deepest first, ties by vertex id: the order that decides who is kept. */
+static int deeper(const sw_contact *a, const sw_contact *b) {
+    return a->depth > b->depth || (a->depth == b->depth && a->p < b->p);
+}
+static int lower_vertex(const sw_contact *a, const sw_contact *b) {
+    return a->p < b->p;
+}
+
+/* In-place heap sort (qsort may allocate; detect must not). */
+static void sift(sw_contact *a, int32_t n, int32_t i,
+                 int (*before)(const sw_contact *, const sw_contact *)) {
+    for (;;) {
+        int32_t l = 2 * i + 1, r = l + 1, m = i;
+        if (l < n && before(&a[m], &a[l])) m = l;
+        if (r < n && before(&a[m], &a[r])) m = r;
+        if (m == i) return;
+        sw_contact t = a[i];
+        a[i] = a[m];
+        a[m] = t;
+        i = m;
+    }
+}
+static void heap_sort(sw_contact *a, int32_t n,
+                      int (*before)(const sw_contact *, const sw_contact *)) {
+    for (int32_t i = n / 2 - 1; i >= 0; --i)
+        sift(a, n, i, before);
+    for (int32_t e = n - 1; e > 0; --e) {
+        sw_contact t = a[0];
+        a[0] = a[e];
+        a[e] = t;
+        sift(a, e, 0, before);
+    }
+}
+
+int32_t sw_selfcontact_detect(sw_selfcontact *sc, const double *x, sw_pool *pool) {
+    if (!sc) return 0;
+    sc->count = 0;
+    sc->dropped = 0;
+    sc->max_depth = 0;
+    if (!x) return 0;
+    detect_ctx d = {sc, x};
+    sw_pool_parallel_for(pool, sc->ntets, boxes_range, &d);
+    sw_bvh_refit_nodes(&sc->tet_bvh);
+    sw_pool_parallel_for(pool, sc->nsurf, detect_range, &d);
+    /* Concatenate the ranges in order; the result is the list in surface vertex
+     * order whatever the partition (hence the thread count) was. */
+    int32_t n = 0;
+    for (int32_t pos = 0; pos < sc->nsurf; pos = sc->range_end[pos]) {
+        int32_t c = sc->range_count[pos];
+        if (c > 0 && n != pos)
+            memmove(sc->list + n, sc->list + pos, (size_t)c * sizeof(sw_contact));
+        n += c;
+    }
+    int32_t cap = sc->max_contacts > 0 ? sc->max_contacts : sc->nsurf;
+    if (n > cap) {
+        /* Over budget: keep the deepest (ties by vertex id), back in vertex order. */
+        heap_sort(sc->list, n, deeper);
+        sc->dropped = n - cap;
+        n = cap;
+        heap_sort(sc->list, n, lower_vertex);
+    }
+    sc->count = n;
+    for (int32_t i = 0; i < n; ++i)
+        if (sc->list[i].depth > sc->max_depth) sc->max_depth = sc->list[i].depth;
+    return n;
+}
+
+const sw_contact *sw_selfcontact_list(const sw_selfcontact *sc, int32_t *count) {
+    if (count) *count = sc ? sc->count : 0;
+    return sc ? sc->list : NULL;
+}
+
+double sw_selfcontact_max_depth(const sw_selfcontact *sc) {
+    return sc ? sc->max_depth : 0;
+}
+
+/* ---- penalty (eqs. 3.4-3.6) ------------------------------------------------------
+ * With n and beta frozen, d = J x where J = [-I, beta_0 I, beta_1 I, beta_2 I] acts on
+ * (x_p, x_t0, x_t1, x_t2); each contact is a quadratic 1/2 k J^T N J. Written over four
+ * slots (vertex, coefficient) so a vertex appearing twice is still exact. */
+
+static void slots(const sw_contact *c, int32_t v[4], double a[4]) {
+    v[0] = c->p, a[0] = -1;
+    for (int k = 0; k < 3; ++k)
+        v[k + 1] = c->tri[k], a[k + 1] = c->beta[k];
+}
+
+/* N u, N = (1 - alpha) n n^T + alpha I (eq. 3.5). */
+static void apply_N(const double *n, double alpha, const double *u, double *o) {
+    double s = (1 - alpha) * dot3(n, u);
+    for (int j = 0; j < 3; ++j)
+        o[j] = s * n[j] + alpha * u[j];
+}
+
+static void contact_d(const sw_contact *c, const double *x, double d[3]) {
+    int32_t v[4];
+    double a[4];
+    slots(c, v, a);
+    d[0] = d[1] = d[2] = 0;
+    for (int s = 0; s < 4; ++s)
+        for (int j = 0; j < 3; ++j)
+            d[j] += a[s] * x[3 * (size_t)v[s] + j];
+}
+
+double sw_contact_energy(const sw_contact *c, int32_t n, const double *x, double kc, double alpha) {
+    double e = 0;
+    for (int32_t i = 0; i < n; ++i) {
+        double d[3], Nd[3];
+        contact_d(&c[i], x, d);
+        apply_N(c[i].n, alpha, d, Nd);
+        e += 0.5 * kc * c[i].ka * dot3(d, Nd);
+    }
+    return e;
+}
+
+void sw_contact_add_forces(const sw_contact *c, int32_t n, const double *x, double kc, double alpha,
+                           double *f) {
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t v[4];
+        double a[4], d[3], Nd[3];
+        slots(&c[i], v, a);
+        contact_d(&c[i], x, d);
+        apply_N(c[i].n, alpha, d, Nd);
+        double k = kc * c[i].ka;
+        /* eq. 3.4 (a = -1 gives f_p = k N d) and eq. 3.6 (f_i = -beta_i k N d). */
+        for (int s = 0; s < 4; ++s)
+            for (int j = 0; j < 3; ++j)
+                f[3 * (size_t)v[s] + j] -= a[s] * k * Nd[j];
+    }
+}
+
+void sw_contact_add_diag(const sw_contact *c, int32_t n, double kc, double alpha, double *diag) {
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t v[4];
+        double a[4];
+        slots(&c[i], v, a);
+        double k = kc * c[i].ka;
+        double N[9];
+        for (int r = 0; r < 3; ++r)
+            for (int q = 0; q < 3; ++q)
+                N[3 * r + q] = (1 - alpha) * c[i].n[r] * c[i].n[q] + (r == q ? alpha : 0);
+        for (int s = 0; s < 4; ++s) {
+            int seen = 0;
+            for (int u = 0; u < s; ++u)
+                seen |= v[u] == v[s];
+            if (seen) continue;
+            double coef = 0; /* total coefficient of this vertex in J */
+            for (int u = s; u < 4; ++u)
+                if (v[u] == v[s]) coef += a[u];
+            double *D = diag + 9 * (size_t)v[s];
+            for (int m = 0; m < 9; ++m)
+                D[m] += k * coef * coef * N[m];
+        }
+    }
+}
+
+void sw_contact_apply_hessian(const sw_contact *c, int32_t n, double kc, double alpha,
+                              const double *v, double *y) {
+    for (int32_t i = 0; i < n; ++i) {
+        double Jv[3], NJv[3];
+        contact_d(&c[i], v, Jv);
+        apply_N(c[i].n, alpha, Jv, NJv);
+        int32_t vs[4];
+        double a[4];
+        slots(&c[i], vs, a);
+        double k = kc * c[i].ka;
+        for (int s = 0; s < 4; ++s)
+            for (int j = 0; j < 3; ++j)
+                y[3 * (size_t)vs[s] + j] += a[s] * k * NJv[j];
+    }
+}
