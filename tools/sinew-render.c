@@ -1,0 +1,334 @@
+/* sinew-render: ray-traced pictures of surfaces (DESIGN.md §7), so a person can look at
+ * what the simulator or the runtime produced.
+ *
+ *   sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [--width W] [--height H]
+ *   sinew-render --frames DIR [--grid N] --out IMAGE.png [...]
+ *
+ * One OBJ gives one picture; several give a contact sheet (one tile each, left to
+ * right, top to bottom) all seen by the same camera, which frames the union of their
+ * bounding boxes, so motion between tiles is real motion. --frames takes the
+ * frame_NNNN.obj files that `sinew-fullsim --out DIR` writes and picks at most N x N
+ * evenly spaced ones (first and last included). */
+#include <dirent.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+#include <unistd.h>
+
+#include "mesh_io.h"
+#include "png_write.h"
+#include "render.h"
+
+#define GAP 4 /* pixels between tiles of a contact sheet */
+
+typedef struct {
+    const char **objs;
+    int nobjs;
+    const char *frames_dir, *out;
+    int width, height, grid, supersample, threads, ground, quiet;
+    int azimuth, elevation;
+} options;
+
+static void usage(FILE *f) {
+    fprintf(f, "usage: sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [options]\n"
+               "       sinew-render --frames DIR --out IMAGE.png [--grid N] [options]\n"
+               "  --obj FILE      a Wavefront OBJ surface; several make a contact sheet\n"
+               "  --frames DIR    every DIR/frame_NNNN.obj (as written by sinew-fullsim --out)\n"
+               "  --grid N        with --frames: at most N x N evenly spaced frames (default 4)\n"
+               "  --out FILE      the PNG to write (written to FILE.tmp, then renamed)\n"
+               "  --width W       image width in pixels (default 640, contact sheet 1280)\n"
+               "  --height H      image height in pixels (default 480, contact sheet 960)\n"
+               "  --supersample S S x S rays a pixel, 1..4 (default 2)\n"
+               "  --azimuth DEG   camera turned from the front (+Z, Y up) toward +X (default 35)\n"
+               "  --elevation DEG camera height above the horizon, -89..89 (default 20)\n"
+               "  --threads T     render threads (default: all cores)\n"
+               "  --no-ground     no checkered ground plane\n"
+               "  --quiet         no summary line on stderr\n");
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out) {
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || *end || end == s || v < lo || v > hi) return 0;
+    *out = (int)v;
+    return 1;
+}
+
+static int parse_args(int argc, char **argv, options *o) {
+    memset(o, 0, sizeof *o);
+    o->grid = 4;
+    o->supersample = 2;
+    o->ground = 1;
+    o->azimuth = 35;
+    o->elevation = 20;
+    long nproc = sysconf(_SC_NPROCESSORS_ONLN);
+    o->threads = nproc > 0 ? (nproc > 64 ? 64 : (int)nproc) : 1;
+    o->objs = calloc((size_t)argc, sizeof *o->objs);
+    if (!o->objs) {
+        fprintf(stderr, "sinew-render: out of memory\n");
+        return 0;
+    }
+    struct {
+        const char *flag;
+        int lo, hi, *dst;
+    } ints[] = {{"--width", 1, SW_PNG_MAX_DIM, &o->width},
+                {"--height", 1, SW_PNG_MAX_DIM, &o->height},
+                {"--grid", 1, 64, &o->grid},
+                {"--supersample", 1, 4, &o->supersample},
+                {"--threads", 1, 64, &o->threads},
+                {"--azimuth", -360, 360, &o->azimuth},
+                {"--elevation", -89, 89, &o->elevation}};
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        int matched = 0;
+        for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) {
+            if (strcmp(a, ints[k].flag)) continue;
+            matched = 1;
+            if (!next || !parse_int(next, ints[k].lo, ints[k].hi, ints[k].dst)) {
+                fprintf(stderr, "sinew-render: %s wants an integer in %d..%d, got '%s'\n", a,
+                        ints[k].lo, ints[k].hi, next ? next : "(nothing)");
+                return 0;
+            }
+            ++i;
+        }
+        if (matched) continue;
+        if (!strcmp(a, "--obj") && next) {
+            o->objs[o->nobjs++] = argv[++i];
+        } else if (!strcmp(a, "--frames") && next) {
+            o->frames_dir = argv[++i];
+        } else if (!strcmp(a, "--out") && next) {
+            o->out = argv[++i];
+        } else if (!strcmp(a, "--no-ground")) {
+            o->ground = 0;
+        } else if (!strcmp(a, "--quiet")) {
+            o->quiet = 1;
+        } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            free(o->objs);
+            exit(0);
+        } else {
+            fprintf(stderr, "sinew-render: unknown or incomplete argument '%s'\n", a);
+            return 0;
+        }
+    }
+    if (!o->out || (o->nobjs == 0) == (o->frames_dir == NULL)) {
+        fprintf(stderr, "sinew-render: need --out and either --obj (one or more) or --frames\n");
+        return 0;
+    }
+    return 1;
+}
+
+/* ---- --frames: frame_NNNN.obj files, sorted by number, evenly thinned --------------- */
+
+typedef struct {
+    long number;
+    char *path;
+} frame_file;
+
+static int cmp_frame(const void *a, const void *b) {
+    long x = ((const frame_file *)a)->number, y = ((const frame_file *)b)->number;
+    return (x > y) - (x < y);
+}
+
+/* Returns the frame number of "frame_<digits>.obj", or -1. */
+static long frame_number(const char *name) {
+    if (strncmp(name, "frame_", 6)) return -1;
+    const char *d = name + 6, *e = d;
+    while (*e >= '0' && *e <= '9')
+        ++e;
+    if (e == d || e - d > 9 || strcmp(e, ".obj")) return -1;
+    return strtol(d, NULL, 10);
+}
+
+static void free_frames(frame_file *f, int n) {
+    for (int i = 0; i < n; ++i)
+        free(f[i].path);
+    free(f);
+}
+
+static int list_frames(const char *dir, frame_file **out, int *count) {
+    *out = NULL;
+    *count = 0;
+    DIR *d = opendir(dir);
+    if (!d) {
+        fprintf(stderr, "sinew-render: %s: cannot open directory (%s)\n", dir, strerror(errno));
+        return 0;
+    }
+    frame_file *f = NULL;
+    int n = 0, cap = 0, ok = 1;
+    struct dirent *e;
+    while (ok && (e = readdir(d))) {
+        long num = frame_number(e->d_name);
+        if (num < 0) continue;
+        if (n == cap) {
+            cap = cap ? 2 * cap : 64;
+            frame_file *g = realloc(f, (size_t)cap * sizeof *g);
+            if (!g) {
+                ok = 0;
+                break;
+            }
+            f = g;
+        }
+        size_t len = strlen(dir) + strlen(e->d_name) + 2;
+        f[n].path = malloc(len);
+        if (!f[n].path) {
+            ok = 0;
+            break;
+        }
+        snprintf(f[n].path, len, "%s/%s", dir, e->d_name);
+        f[n++].number = num;
+    }
+    closedir(d);
+    if (!ok) {
+        fprintf(stderr, "sinew-render: out of memory listing %s\n", dir);
+        free_frames(f, n);
+        return 0;
+    }
+    if (n == 0) {
+        fprintf(stderr, "sinew-render: %s: no frame_NNNN.obj files\n", dir);
+        free(f);
+        return 0;
+    }
+    qsort(f, (size_t)n, sizeof *f, cmp_frame);
+    *out = f;
+    *count = n;
+    return 1;
+}
+
+/* ---- rendering ------------------------------------------------------------------------ */
+
+/* A thin bar along a tile's bottom edge showing where the tile lies in the sequence. */
+static void progress_bar(uint8_t *tile, int w, int h, double frac) {
+    int filled = (int)lrint(frac * (w - 1)) + 1;
+    for (int y = h - 3; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            uint8_t *px = tile + 3 * ((size_t)y * w + x);
+            uint8_t v = x < filled ? 60 : 200;
+            px[0] = x < filled ? 200 : v;
+            px[1] = px[2] = v;
+        }
+}
+
+static int render_all(const options *o, const char **paths, int n) {
+    sw_trimesh *m = calloc((size_t)n, sizeof *m);
+    uint8_t *tile = NULL, *sheet = NULL;
+    int ok = m != NULL;
+    sw_error err;
+    sw_error_clear(&err);
+    double bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
+    long long total_tris = 0;
+    for (int i = 0; ok && i < n; ++i) {
+        double lo[3], hi[3];
+        if (sw_read_obj(paths[i], &m[i], &err) ||
+            sw_render_bbox(m[i].nverts, m[i].X, lo, hi, &err)) {
+            fprintf(stderr, "sinew-render: %s\n", err.msg);
+            ok = 0;
+            break;
+        }
+        total_tris += m[i].ntris;
+        for (int k = 0; k < 3; ++k) {
+            if (lo[k] < bmin[k]) bmin[k] = lo[k];
+            if (hi[k] > bmax[k]) bmax[k] = hi[k];
+        }
+    }
+    int cols = (int)ceil(sqrt((double)n)), rows = (n + cols - 1) / cols;
+    int W = o->width ? o->width : (n > 1 ? 1280 : 640);
+    int H = o->height ? o->height : (n > 1 ? 960 : 480);
+    int gap = n > 1 ? GAP : 0;
+    int tw = (W - gap * (cols + 1)) / cols, th = (H - gap * (rows + 1)) / rows;
+    if (ok && (tw < 8 || th < 8)) {
+        fprintf(stderr, "sinew-render: %d x %d is too small for %d x %d tiles\n", W, H, cols, rows);
+        ok = 0;
+    }
+    sw_render_params p = sw_render_params_default(tw, th);
+    p.supersample = o->supersample;
+    p.threads = o->threads;
+    p.ground = o->ground;
+    p.view_azimuth_deg = o->azimuth;
+    p.view_elevation_deg = o->elevation;
+    if (ok && sw_render_frame_camera(&p, bmin, bmax, &err)) {
+        fprintf(stderr, "sinew-render: %s\n", err.msg);
+        ok = 0;
+    }
+    if (ok) {
+        tile = malloc((size_t)tw * th * 3);
+        sheet = malloc((size_t)W * H * 3);
+        if (!tile || !sheet) {
+            fprintf(stderr, "sinew-render: out of memory for a %d x %d image\n", W, H);
+            ok = 0;
+        }
+    }
+    struct timespec t0, t1;
+    clock_gettime(CLOCK_MONOTONIC, &t0);
+    if (ok) memset(sheet, 64, (size_t)W * H * 3); /* dark grey gutters */
+    for (int i = 0; ok && i < n; ++i) {
+        if (sw_render_surface(&p, m[i].nverts, m[i].X, m[i].ntris, m[i].tris, NULL, tile, &err)) {
+            fprintf(stderr, "sinew-render: %s: %s\n", paths[i], err.msg);
+            ok = 0;
+            break;
+        }
+        if (n > 1) progress_bar(tile, tw, th, (double)i / (double)(n - 1));
+        int x0 = gap + (i % cols) * (tw + gap), y0 = gap + (i / cols) * (th + gap);
+        for (int y = 0; y < th; ++y)
+            memcpy(sheet + 3 * ((size_t)(y0 + y) * W + x0), tile + 3 * (size_t)y * tw,
+                   3 * (size_t)tw);
+    }
+    clock_gettime(CLOCK_MONOTONIC, &t1);
+    if (ok && sw_write_png(o->out, W, H, sheet, &err)) {
+        fprintf(stderr, "sinew-render: %s\n", err.msg);
+        ok = 0;
+    }
+    if (ok && !o->quiet) {
+        double ms =
+            1e3 * (double)(t1.tv_sec - t0.tv_sec) + 1e-6 * (double)(t1.tv_nsec - t0.tv_nsec);
+        fprintf(stderr,
+                "sinew-render: wrote %s (%d x %d, %d tile%s of %d x %d, %lld triangles, "
+                "%.1f ms rendering on %d thread%s)\n",
+                o->out, W, H, n, n == 1 ? "" : "s", tw, th, total_tris, ms, o->threads,
+                o->threads == 1 ? "" : "s");
+    }
+    for (int i = 0; m && i < n; ++i)
+        sw_trimesh_free(&m[i]);
+    free(m);
+    free(tile);
+    free(sheet);
+    return ok;
+}
+
+int main(int argc, char **argv) {
+    options o;
+    if (!parse_args(argc, argv, &o)) {
+        usage(stderr);
+        free(o.objs);
+        return 2;
+    }
+    int ok;
+    if (o.frames_dir) {
+        frame_file *f;
+        int nf;
+        ok = list_frames(o.frames_dir, &f, &nf);
+        if (ok) {
+            /* k evenly spaced picks from nf frames, first and last included. */
+            int k = nf < o.grid * o.grid ? nf : o.grid * o.grid;
+            const char **pick = malloc((size_t)k * sizeof *pick);
+            if (!pick) {
+                fprintf(stderr, "sinew-render: out of memory\n");
+                ok = 0;
+            } else {
+                for (int i = 0; i < k; ++i)
+                    pick[i] = f[k == 1 ? 0 : (int)lrint((double)i * (nf - 1) / (k - 1))].path;
+                ok = render_all(&o, pick, k);
+                free(pick);
+            }
+            free_frames(f, nf);
+        }
+    } else {
+        ok = render_all(&o, o.objs, o.nobjs);
+    }
+    free(o.objs);
+    return ok ? 0 : 1;
+}
