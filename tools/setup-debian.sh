@@ -1,0 +1,55 @@
+#!/usr/bin/env bash
+# Installs the Debian packages sinew needs to build and test, only those missing.
+# Idempotent and silent when everything is present. Runs as root (CI machines have no
+# sudo); falls back to sudo only when not root and sudo exists.
+set -euo pipefail
+
+packages=(
+    build-essential  # gcc, g++, make, binutils (nm, readelf for the ABI tests)
+    cmake
+    pkg-config
+    libembree-dev    # static world colliders (DESIGN.md §4.5)
+    libccd-dev       # convex contact (MPR)
+    libopenblas-dev  # bake-time dense linear algebra
+    liblapacke-dev
+    libassimp-dev    # glTF/FBX import in the bake (DESIGN.md §5)
+)
+
+installed() {
+    # dpkg -s also succeeds for removed-but-configured packages; require "installed".
+    dpkg -s "$1" 2>/dev/null | grep -q '^Status: .* installed$'
+}
+
+missing=()
+for p in "${packages[@]}"; do
+    installed "$p" || missing+=("$p")
+done
+[ "${#missing[@]}" -eq 0 ] && exit 0
+
+if [ "$(id -u)" -eq 0 ]; then
+    as_root=()
+elif command -v sudo >/dev/null 2>&1; then
+    as_root=(sudo)
+else
+    echo "setup-debian: need root (or sudo) to install: ${missing[*]}" >&2
+    exit 1
+fi
+
+echo "setup-debian: installing ${missing[*]}"
+# apt and dpkg chatter goes to a log that is shown only when something fails.
+log=$(mktemp)
+trap 'rm -f "$log"' EXIT
+run() {
+    if ! ${as_root[@]+"${as_root[@]}"} env DEBIAN_FRONTEND=noninteractive "$@" >"$log" 2>&1; then
+        cat "$log" >&2
+        echo "setup-debian: failed: $*" >&2
+        exit 1
+    fi
+}
+run apt-get update
+run apt-get install -y --no-install-recommends "${missing[@]}"
+
+for p in "${missing[@]}"; do
+    installed "$p" || { echo "setup-debian: $p still not installed" >&2; exit 1; }
+done
+echo "setup-debian: done"
