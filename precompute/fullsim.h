@@ -1,0 +1,119 @@
+/* The full-space reference simulator (thesis §2.1, §3.1): co-rotational linear tets,
+ * vertices inside bones driven kinematically by the skeleton, quasistatic Newton or
+ * implicit dynamics (backward Euler or Newmark average acceleration) with Rayleigh
+ * damping, penalty self-contact (eqs. 3.4-3.6) and a ground plane.
+ *
+ * Every step minimises one incremental potential over the free vertices,
+ *   Phi(x) = E(x) + Ec(x) + Eg(x) + c_m/2 |x - xhat|_M^2 + c_d/2 |x - x_n|_D^2
+ *            - s (x - x_n)^T D v_n - f_ext^T x,
+ * with D = alpha M + beta K(x_n) frozen at the start of the step (Rayleigh), so a
+ * backtracking line search on Phi makes Newton robust:
+ *   quasistatic:    c_m = c_d = s = 0;
+ *   backward Euler: c_m = 1/h^2, xhat = x_n + h v_n, c_d = 1/h, s = 0;
+ *   Newmark (1/4, 1/2): c_m = 4/h^2, xhat = x_n + h v_n + h^2/4 a_n, c_d = 2/h, s = 1.
+ * The Newton system (K + Kc + Kg + c_m M + c_d D) dx = -grad Phi is solved by
+ * block-Jacobi PCG, warm-started from the previous Newton update; assembly and the
+ * matrix product run on a pthread pool. Self-contacts are detected once per contact
+ * round and frozen while Newton converges (re-detecting every iteration makes Newton
+ * chase a changing energy and stall); the step's contact set only grows, so a contact
+ * resolved in one round keeps acting (as a spring to its surface point) until the
+ * next step starts a fresh set. Results are bitwise identical for any thread
+ * count: every reduction has a fixed order. */
+#ifndef SW_FULLSIM_H
+#define SW_FULLSIM_H
+
+#include "selfcontact.h"
+#include "sw_mesh.h"
+
+typedef enum sw_integrator {
+    SW_QUASISTATIC = 0,
+    SW_BACKWARD_EULER = 1,
+    SW_NEWMARK = 2
+} sw_integrator;
+
+/* Which element Hessian Newton uses. Clamping compressed elements' negative
+ * eigenvalues (McAdams 2011) keeps every solve SPD but slows Newton to a linear rate
+ * (measured ~0.4 per iteration on a bent cylinder); the exact Hessian converges
+ * quadratically wherever the global Hessian is positive definite. */
+typedef enum sw_hessian_mode {
+    SW_HESSIAN_ADAPTIVE = 0,  /* exact; projected for an iteration whose PCG meets negative
+                                 curvature (default) */
+    SW_HESSIAN_PROJECTED = 1, /* always projected to PSD */
+    SW_HESSIAN_EXACT = 2      /* always exact, truncated PCG (Newton-CG) */
+} sw_hessian_mode;
+
+typedef struct sw_fullsim_params {
+    sw_integrator integrator;
+    double dt;             /* seconds per step (default 1/30) */
+    double rayleigh_alpha; /* mass damping (default 0.01, thesis §2.1.3) */
+    double rayleigh_beta;  /* stiffness damping (default 0.001) */
+    double gravity[3];     /* default 0: the reference isolates the skin's own physics */
+    int self_contact;      /* penalty self-contact forces on (default 1) */
+    double contact_k;      /* kc of eq. 3.4 (default 1e6, DESIGN.md §8) */
+    double contact_alpha;  /* anisotropy alpha of eq. 3.5 (default 0.5) */
+    double neighbour_factor; /* DESIGN.md §8 (default 1.8) */
+    int ground;            /* ground plane y = ground_height on (default 0) */
+    double ground_height;
+    double ground_k; /* penalty per unit rest area (default contact_k) */
+    sw_hessian_mode hessian; /* default SW_HESSIAN_ADAPTIVE */
+    int contact_rounds; /* self-contact: detect, freeze the contacts, converge Newton on
+                           that smooth energy, re-detect and add new penetrations; stop
+                           when none is new or after this many rounds (default 8) */
+    int max_newton;  /* per step (default 20) */
+    double newton_rtol; /* stop when |grad| <= rtol * |grad at first iterate| (1e-4) */
+    double pcg_rtol;    /* PCG relative residual (default 1e-3) */
+    int pcg_max;        /* default 1000 */
+    int threads;        /* 0: all cores */
+} sw_fullsim_params;
+
+sw_fullsim_params sw_fullsim_params_default(void);
+
+typedef struct sw_fullsim_stats {
+    int newton_iters;
+    int pcg_iters;        /* summed over the step's Newton iterations */
+    int projected_iters;  /* Newton iterations that fell back to the projected Hessian */
+    int contact_rounds;   /* contact rounds used (0 without self-contact) */
+    double grad_norm0;    /* |grad Phi| at the first iterate */
+    double grad_norm;     /* at exit */
+    int converged;
+    int32_t contacts;     /* penetrating vertices at the final positions */
+    double max_penetration; /* deepest self-penetration at the final iterate (world units) */
+    double ground_penetration; /* deepest vertex below the ground plane */
+    double seconds;       /* wall time of the step */
+    double energy_elastic; /* E(x) at exit */
+    double energy_kinetic; /* 1/2 v^T M v at exit (0 in quasistatic) */
+    double grad_history[32]; /* |grad Phi| after k Newton updates (k < 32; a contact round
+                                re-detection overwrites its entry) */
+} sw_fullsim_stats;
+
+typedef struct sw_fullsim sw_fullsim;
+
+/* The character must outlive the simulator. Starts at the rest shape, at rest. */
+sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p, sw_fullsim **out,
+                               sw_error *err);
+void sw_fullsim_destroy(sw_fullsim *sim);
+
+/* One step towards the pose given by bone transforms T (12*nbones, rest -> world).
+ * Returns SINEW_ERROR_NOT_FINITE (state restored to the previous step) when T or
+ * the solve produced a non-finite value, SINEW_ERROR_NOT_CONVERGED when Newton hit
+ * max_newton without reaching its tolerance (the state is kept: it is the best
+ * iterate), SINEW_OK otherwise. */
+sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats *stats);
+
+/* Current positions / velocities (3*nverts). */
+const double *sw_fullsim_positions(const sw_fullsim *sim);
+double *sw_fullsim_velocities(sw_fullsim *sim);
+/* Overwrites the state (e.g. to start an oscillation test from a perturbed shape);
+ * v may be NULL (zero). Accelerations are set consistent with x: M a = f(x) + M g
+ * (damping and contact forces left out). */
+void sw_fullsim_set_state(sw_fullsim *sim, const double *x, const double *v);
+
+/* The surface (boundary triangles) the simulator uses. */
+const sw_surface *sw_fullsim_surface(const sw_fullsim *sim);
+/* Lumped vertex masses (nverts). */
+const double *sw_fullsim_masses(const sw_fullsim *sim);
+/* Number of vertices driven by bones. */
+int32_t sw_fullsim_driven_count(const sw_fullsim *sim);
+/* Elastic energy E(x) of the current positions. */
+double sw_fullsim_elastic_energy(sw_fullsim *sim);
+#endif

@@ -1,0 +1,288 @@
+/* The full-space reference simulator: rigid invariance, Newton's quadratic
+ * convergence, energy behaviour of the integrators, self-contact and ground
+ * penetration, determinism across thread counts, and error paths. */
+#include <stdint.h>
+
+#include "fullsim.h"
+#include "samples.h"
+#include "sw_test.h"
+
+static const double *frame_T(const sw_character *c, int f) {
+    return c->clip.T + (size_t)f * 12 * c->clip.nbones;
+}
+
+static int all_finite(const double *a, int64_t n) {
+    for (int64_t i = 0; i < n; ++i)
+        if (!isfinite(a[i])) return 0;
+    return 1;
+}
+
+/* Every bone at one rigid transform: the solution is the rigidly moved rest shape. */
+TEST(rigid_pose_gives_rigid_shape_and_zero_energy) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("cylinder", 1500, 3, &c, &err) == SINEW_OK);
+    sw_fullsim *sim;
+    ENSURE(sw_fullsim_create(&c, NULL, &sim, &err) == SINEW_OK);
+    double th = 0.6, T[12] = {cos(th), -sin(th), 0, sin(th), cos(th), 0, 0, 0, 1, 0.3, -2.0, 5.0};
+    double *Tb = malloc(sizeof(double) * 12 * c.skel.nbones);
+    for (int b = 0; b < c.skel.nbones; ++b) memcpy(Tb + 12 * b, T, sizeof T);
+    sw_fullsim_stats st;
+    ENSURE(sw_fullsim_step(sim, Tb, &st) == SINEW_OK);
+    const double *x = sw_fullsim_positions(sim);
+    double err_max = 0;
+    for (int v = 0; v < c.mesh.nverts; ++v) {
+        double p[3];
+        sw_transform_point(T, c.mesh.X + 3 * v, p);
+        for (int i = 0; i < 3; ++i) err_max = fmax(err_max, fabs(p[i] - x[3 * v + i]));
+    }
+    ENSUREF(err_max < 1e-9, "max deviation from the rigid motion %g", err_max);
+    ENSURE(st.energy_elastic < 1e-12 * c.youngs);
+    ENSURE(st.contacts == 0 && st.max_penetration == 0);
+    free(Tb);
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+/* Near a solution Newton's error squares each iteration (exact Hessian, tight PCG). */
+TEST(newton_converges_quadratically) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("cylinder", 1500, 9, &c, &err) == SINEW_OK);
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.self_contact = 0;
+    p.hessian = SW_HESSIAN_EXACT;
+    p.newton_rtol = 1e-13;
+    p.pcg_rtol = 1e-13;
+    p.pcg_max = 20000;
+    p.max_newton = 30;
+    p.threads = 1;
+    sw_fullsim *sim;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_OK);
+    sw_fullsim_stats st;
+    sinew_result r = sw_fullsim_step(sim, frame_T(&c, 1), &st); /* a mild bend */
+    ENSUREF(r == SINEW_OK || st.grad_norm < 1e-9 * st.grad_norm0, "result %d, |g| %g -> %g", r,
+            st.grad_norm0, st.grad_norm);
+    ENSURE(st.newton_iters >= 2);
+    /* Relative gradients e_k; quadratic: log e_{k+1} ~ 2 log e_k once e_k is small. */
+    int checked = 0;
+    for (int k = 0; k + 1 <= st.newton_iters && k + 1 < 32; ++k) {
+        double ek = st.grad_history[k] / st.grad_norm0, ek1 = st.grad_history[k + 1] / st.grad_norm0;
+        fprintf(stderr, "    newton %d: |g|/|g0| = %.3e\n", k + 1, ek1);
+        if (ek < 1e-2 && ek1 > 1e-12) {
+            ENSUREF(log10(ek1) <= 1.6 * log10(ek), "e_k = %.3e -> e_k+1 = %.3e is not quadratic", ek,
+                    ek1);
+            checked++;
+        }
+    }
+    ENSUREF(checked >= 1, "no iterate in the quadratic regime was observed");
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+/* Starts an undamped free oscillation from a breathing displacement of the flesh. */
+static sw_fullsim *oscillating(sw_character *c, sw_integrator integ, double dt, sw_error *err) {
+    if (sw_sample_make("cylinder", 1500, 2, c, err) != SINEW_OK) return NULL;
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.integrator = integ;
+    p.dt = dt;
+    p.rayleigh_alpha = p.rayleigh_beta = 0;
+    p.self_contact = 0;
+    p.newton_rtol = 1e-9;
+    p.pcg_rtol = 1e-10;
+    p.pcg_max = 5000;
+    sw_fullsim *sim;
+    if (sw_fullsim_create(c, &p, &sim, err) != SINEW_OK) return NULL;
+    int32_t n = c->mesh.nverts;
+    double *x = malloc(sizeof(double) * 3 * n);
+    for (int32_t v = 0; v < n; ++v) {
+        const double *X = c->mesh.X + 3 * v;
+        double r = sqrt(X[1] * X[1] + X[2] * X[2]), s = c->bone_of_vertex[v] >= 0 ? 0.0 : 0.04 * r;
+        x[3 * v] = X[0];
+        x[3 * v + 1] = X[1] * (1 + s);
+        x[3 * v + 2] = X[2] * (1 + s);
+    }
+    sw_fullsim_set_state(sim, x, NULL);
+    free(x);
+    return sim;
+}
+
+TEST(newmark_keeps_energy_of_undamped_oscillation) {
+    sw_character c;
+    sw_error err;
+    sw_fullsim *sim = oscillating(&c, SW_NEWMARK, 2e-3, &err);
+    ENSUREF(sim, "%s", err.msg);
+    double *I = calloc((size_t)12 * c.skel.nbones, sizeof(double));
+    for (int b = 0; b < c.skel.nbones; ++b) I[12 * b] = I[12 * b + 4] = I[12 * b + 8] = 1;
+    double e0 = sw_fullsim_elastic_energy(sim), worst = 0, kin_max = 0;
+    ENSURE(e0 > 0);
+    for (int s = 0; s < 150; ++s) {
+        sw_fullsim_stats st;
+        sinew_result r = sw_fullsim_step(sim, I, &st);
+        ENSUREF(r == SINEW_OK, "step %d: %s, |g| %.3g -> %.3g after %d Newton iterations", s,
+                sinew_result_string(r), st.grad_norm0, st.grad_norm, st.newton_iters);
+        double e = st.energy_elastic + st.energy_kinetic;
+        worst = fmax(worst, fabs(e - e0) / e0);
+        kin_max = fmax(kin_max, st.energy_kinetic / e0);
+    }
+    fprintf(stderr, "    Newmark: max |E - E0|/E0 = %.4f, peak kinetic share %.2f\n", worst, kin_max);
+    ENSUREF(kin_max > 0.3, "the flesh barely moved (kinetic share %.3f)", kin_max);
+    ENSUREF(worst < 0.03, "energy drifted by %.2f%%", 100 * worst);
+    free(I);
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+TEST(backward_euler_never_gains_energy) {
+    sw_character c;
+    sw_error err;
+    sw_fullsim *sim = oscillating(&c, SW_BACKWARD_EULER, 2e-3, &err);
+    ENSUREF(sim, "%s", err.msg);
+    double *I = calloc((size_t)12 * c.skel.nbones, sizeof(double));
+    for (int b = 0; b < c.skel.nbones; ++b) I[12 * b] = I[12 * b + 4] = I[12 * b + 8] = 1;
+    double prev = sw_fullsim_elastic_energy(sim), e0 = prev;
+    for (int s = 0; s < 60; ++s) {
+        sw_fullsim_stats st;
+        ENSURE(sw_fullsim_step(sim, I, &st) == SINEW_OK);
+        double e = st.energy_elastic + st.energy_kinetic;
+        ENSUREF(e <= prev * (1 + 1e-6), "step %d gained energy: %.9g -> %.9g", s, prev, e);
+        prev = e;
+    }
+    ENSURE(prev < e0);
+    free(I);
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+/* Runs the finger's clip to its peak fold; returns the max penetration over frames. */
+static double finger_penetration(int self_contact, int threads, double **x_out, int *ok) {
+    sw_character c;
+    sw_error err;
+    *ok = 0;
+    if (sw_sample_make("finger", 3000, 5, &c, &err) != SINEW_OK) return -1;
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.self_contact = self_contact;
+    p.threads = threads;
+    sw_fullsim *sim;
+    if (sw_fullsim_create(&c, &p, &sim, &err) != SINEW_OK) {
+        sw_character_free(&c);
+        return -1;
+    }
+    double worst = 0;
+    int finite = 1;
+    for (int f = 0; f <= c.clip.nframes / 2; ++f) {
+        sw_fullsim_stats st;
+        sinew_result r = sw_fullsim_step(sim, frame_T(&c, f), &st);
+        finite = finite && r != SINEW_ERROR_NOT_FINITE &&
+                 all_finite(sw_fullsim_positions(sim), 3 * (int64_t)c.mesh.nverts);
+        worst = fmax(worst, st.max_penetration);
+        fprintf(stderr, "    frame %d: newton %d, pcg %d, contacts %d, penetration %.4g\n", f,
+                st.newton_iters, st.pcg_iters, st.contacts, st.max_penetration);
+    }
+    if (x_out) {
+        *x_out = malloc(sizeof(double) * 3 * c.mesh.nverts);
+        memcpy(*x_out, sw_fullsim_positions(sim), sizeof(double) * 3 * c.mesh.nverts);
+    }
+    *ok = finite;
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+    return worst;
+}
+
+TEST(self_contact_removes_most_penetration_of_folded_finger) {
+    int ok_off, ok_on;
+    double off = finger_penetration(0, 0, NULL, &ok_off);
+    double on = finger_penetration(1, 0, NULL, &ok_on);
+    fprintf(stderr, "    max penetration: without self-contact %.4g, with %.4g (ratio %.3f)\n", off,
+            on, on / off);
+    ENSURE(ok_off && ok_on);
+    ENSUREF(off > 0.02, "the fold does not self-intersect (%.4g): the test would prove nothing", off);
+    ENSUREF(on <= 0.1 * off, "penetration %.4g is more than 10%% of %.4g", on, off);
+}
+
+TEST(threads_do_not_change_results) {
+    double *x1 = NULL, *x2 = NULL;
+    int ok1, ok2;
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 5, &c, &err) == SINEW_OK);
+    size_t bytes = sizeof(double) * 3 * c.mesh.nverts;
+    sw_character_free(&c);
+    finger_penetration(1, 1, &x1, &ok1);
+    finger_penetration(1, 2, &x2, &ok2);
+    ENSURE(ok1 && ok2 && x1 && x2);
+    ENSUREF(memcmp(x1, x2, bytes) == 0, "1 and 2 threads differ");
+    free(x1);
+    free(x2);
+}
+
+TEST(ground_plane_pushes_flesh_out) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("capsule", 2000, 2, &c, &err) == SINEW_OK);
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.ground = 1;
+    p.ground_height = -0.4; /* the capsule's underside reaches -0.5 at rest */
+    sw_fullsim *sim;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_OK);
+    sw_fullsim_stats st;
+    sinew_result r = sw_fullsim_step(sim, frame_T(&c, 0), &st);
+    ENSURE(r == SINEW_OK || r == SINEW_ERROR_NOT_CONVERGED);
+    fprintf(stderr, "    ground penetration %.4g (0.1 before), %d Newton iterations\n",
+            st.ground_penetration, st.newton_iters);
+    ENSUREF(st.ground_penetration < 0.01, "still %.4g below the ground", st.ground_penetration);
+    ENSURE(st.energy_elastic > 0); /* the flesh was squashed, not moved rigidly */
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+TEST(bad_input_is_rejected_and_state_kept) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("cylinder", 1500, 3, &c, &err) == SINEW_OK);
+    sw_fullsim *sim = NULL;
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.dt = 0;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_ERROR_INVALID_ARGUMENT && !sim);
+    ENSURE(strstr(err.msg, "dt"));
+    p = sw_fullsim_params_default();
+    p.gravity[1] = NAN;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_ERROR_INVALID_ARGUMENT);
+    p = sw_fullsim_params_default();
+    p.contact_alpha = 2;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_ERROR_INVALID_ARGUMENT);
+    /* no bone-driven vertex: singular */
+    int32_t *keep = c.bone_of_vertex;
+    c.bone_of_vertex = calloc((size_t)c.mesh.nverts, sizeof(int32_t));
+    for (int v = 0; v < c.mesh.nverts; ++v) c.bone_of_vertex[v] = -1;
+    ENSURE(sw_fullsim_create(&c, NULL, &sim, &err) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(strstr(err.msg, "singular"));
+    free(c.bone_of_vertex);
+    c.bone_of_vertex = keep;
+    /* a NaN pose: error, and the state stays the last good one */
+    ENSURE(sw_fullsim_create(&c, NULL, &sim, &err) == SINEW_OK);
+    sw_fullsim_stats st;
+    ENSURE(sw_fullsim_step(sim, frame_T(&c, 1), &st) == SINEW_OK);
+    size_t bytes = sizeof(double) * 3 * c.mesh.nverts;
+    double *before = malloc(bytes);
+    memcpy(before, sw_fullsim_positions(sim), bytes);
+    double *T = malloc(sizeof(double) * 12 * c.skel.nbones);
+    memcpy(T, frame_T(&c, 2), sizeof(double) * 12 * c.skel.nbones);
+    T[3] = NAN;
+    ENSURE(sw_fullsim_step(sim, T, &st) == SINEW_ERROR_NOT_FINITE);
+    ENSURE(memcmp(before, sw_fullsim_positions(sim), bytes) == 0);
+    T[3] = INFINITY;
+    ENSURE(sw_fullsim_step(sim, T, &st) == SINEW_ERROR_NOT_FINITE);
+    ENSURE(sw_fullsim_step(sim, frame_T(&c, 2), &st) == SINEW_OK); /* and it goes on */
+    free(T);
+    free(before);
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy), CASE(newton_converges_quadratically),
+             CASE(newmark_keeps_energy_of_undamped_oscillation),
+             CASE(backward_euler_never_gains_energy),
+             CASE(self_contact_removes_most_penetration_of_folded_finger),
+             CASE(threads_do_not_change_results), CASE(ground_plane_pushes_flesh_out),
+             CASE(bad_input_is_rejected_and_state_kept))
