@@ -139,6 +139,23 @@ static int is_sample(const char *name) {
     return 0;
 }
 
+/* mkdir -p: creates dir and its missing parents; 1 when dir exists afterwards. */
+static int make_dirs(const char *dir) {
+    char path[4096];
+    size_t n = strlen(dir);
+    if (n == 0 || n >= sizeof path) return 0;
+    memcpy(path, dir, n + 1);
+    for (size_t i = 1; i <= n; ++i)
+        if (path[i] == '/' || path[i] == '\0') {
+            char c = path[i];
+            path[i] = '\0';
+            if (mkdir(path, 0777) != 0 && errno != EEXIST) return 0;
+            path[i] = c;
+        }
+    struct stat st;
+    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode);
+}
+
 static int cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);
@@ -197,7 +214,13 @@ int main(int argc, char **argv) {
     double *scratch = NULL;
     int32_t *tris = NULL;
     if (o.out_dir) {
-        mkdir(o.out_dir, 0777);
+        if (!make_dirs(o.out_dir)) {
+            fprintf(stderr, "sinew-fullsim: cannot create output folder '%s': %s\n", o.out_dir,
+                    strerror(errno));
+            sw_fullsim_destroy(sim);
+            sw_character_free(&ch);
+            return 1;
+        }
         scratch = malloc((size_t)surf->nverts * 3 * sizeof(double));
         tris = malloc((size_t)surf->ntris * 3 * sizeof(int32_t));
         if (!scratch || !tris) {
@@ -233,8 +256,11 @@ int main(int argc, char **argv) {
                 f + 1, frames, ms[f], st.newton_iters, st.pcg_iters, st.grad_norm0, st.grad_norm,
                 st.contacts, st.max_penetration,
                 r == SINEW_OK ? "" : r == SINEW_ERROR_NOT_CONVERGED ? "  (not converged)" : "  FAILED");
-        if (o.out_dir && !write_frame(o.out_dir, f, surf, sw_fullsim_positions(sim), scratch, tris, &err))
+        if (o.out_dir && !write_frame(o.out_dir, f, surf, sw_fullsim_positions(sim), scratch, tris, &err)) {
             fprintf(stderr, "sinew-fullsim: %s\n", err.msg);
+            failed++;
+            break;
+        }
     }
     double median = 0;
     if (ms && frames > 0) {
