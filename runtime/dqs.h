@@ -1,0 +1,31 @@
+/* Dual-quaternion skinning (Kavan et al. 2008), shared by the bake and the step.
+ * Quaternions are (w, x, y, z). A bone's dual quaternion is built from its rigid
+ * transform (12 doubles, R row-major then t, rest -> world). Blending flips every
+ * influence onto the hemisphere of the first (heaviest) one before summing, so that
+ * antipodal quaternions q and -q (the same rotation) never cancel. The blended dual
+ * quaternion is normalised and converted to a rotation R (a proper rotation matrix)
+ * and a translation t: the skinned point is R p + t. No allocation. */
+#ifndef SW_DQS_H
+#define SW_DQS_H
+
+#include <stdint.h>
+
+typedef struct sw_dualquat {
+    double r[4]; /* rotation part, unit */
+    double d[4]; /* dual part: 0.5 * (0, t) * r */
+} sw_dualquat;
+
+/* Dual quaternion of a rigid transform T (12). R must be a rotation (det +1). */
+void sw_dq_from_transform(const double T[12], sw_dualquat *dq);
+
+/* Blends k influences (bone ids into `bones`, weights >= 0; zero weights are
+ * skipped) into the skinning rotation R (9, row-major) and translation t (3). When
+ * the weights sum to zero the identity is returned. */
+void sw_dqs_blend(const sw_dualquat *bones, const int32_t *ids, const double *weights, int k,
+                  double R[9], double t[3]);
+
+/* Skins n points: x = R_v X + t_v with each point's k influences (ids, weights:
+ * k per point). */
+void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int32_t *ids,
+                 const double *weights, int k, double *x);
+#endif
