@@ -193,10 +193,8 @@ int main(int argc, char **argv) {
     sw_character ch;
     memset(&ch, 0, sizeof ch);
     sinew_result r;
-    if (is_sample(o.scene))
-        r = sw_sample_make(o.scene, o.tets, o.frames > 0 ? o.frames : 30, &ch, &err);
-    else
-        r = sw_character_from_dataset(o.data_dir, o.scene, o.frames > 0 ? o.frames : 60, &ch, &err);
+    r = sw_scene_make(o.scene, o.tets, o.frames > 0 ? o.frames : (is_sample(o.scene) ? 30 : 60),
+                      o.data_dir, &ch, NULL, &err);
     if (r != SINEW_OK) {
         fprintf(stderr, "sinew-fullsim: cannot make scene '%s': %s (%s)\n", o.scene, err.msg,
                 sinew_result_string(r));

@@ -18,3 +18,14 @@ sinew_result sw_sample_make(const char *name, int32_t target_tets, int32_t nfram
 /* NULL-terminated list of sample names. */
 const char *const *sw_sample_names(void);
 #endif
+
+#ifndef SW_SAMPLES_SCENE_DECL
+#define SW_SAMPLES_SCENE_DECL
+/* A named scene: a procedural sample (resolution target_tets, a clip of nframes) or a
+ * folder of real assets under data_dir ("elephant-cd", "hand-libigl"; nframes bounds
+ * the clip, 0 keeps the asset's own). *computed_weights is set when the asset has no
+ * skin weights of its own (the bake then computes heat-diffusion weights). */
+sinew_result sw_scene_make(const char *name, int32_t target_tets, int32_t nframes,
+                           const char *data_dir, sw_character *out, int *computed_weights,
+                           sw_error *err);
+#endif

@@ -1,0 +1,290 @@
+/* The bake's orchestration and its first stage (prepare); see bake.h. */
+#include "bake.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bake_internal.h"
+#include "fem_corot.h"
+#include "weights_heat.h"
+
+sw_bake_params sw_bake_params_default(void) {
+    sw_bake_params p;
+    memset(&p, 0, sizeof p);
+    p.max_rank = 30;
+    p.pca_energy = 0.9999;
+    p.cubature_tol = 0.05;
+    p.cubature_max = 1000;
+    p.selector = SW_CUBATURE_NNHTP;
+    p.sweep_samples = 6;
+    p.max_train_frames = 40;
+    p.heldout_fraction = 0.4;
+    p.random_poses = 10;
+    p.self_contact = 1;
+    p.spring_k = 0;
+    p.threads = 0;
+    p.seed = 0x5eed5eedULL;
+    p.progress = 0;
+    return p;
+}
+
+void *sw_bake_own(sw_bake_result *out, void *p) {
+    if (p && out->nstorage < (int)(sizeof out->storage / sizeof out->storage[0]))
+        out->storage[out->nstorage++] = p;
+    return p;
+}
+
+void sw_bake_result_free(sw_bake_result *r) {
+    if (!r) return;
+    for (int i = 0; i < r->nstorage; ++i) free(r->storage[i]);
+    free(r->heldout_x);
+    free(r->heldout_T);
+    free(r->train_x);
+    free(r->train_T);
+    free(r->mass);
+    memset(r, 0, sizeof *r);
+}
+
+void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R, double *t) {
+    sw_dualquat dq[SW_MAX_BONES];
+    for (int32_t b = 0; b < s->nb; ++b) sw_dq_from_transform(T + 12 * b, &dq[b]);
+    for (int32_t v = 0; v < s->nv; ++v)
+        sw_dqs_blend(dq, s->skin_bone + 4 * v, s->skin_weight + 4 * v, 4, R + 9 * v, t + 3 * v);
+}
+
+static double seconds_now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+/* Keeps each vertex's 4 strongest influences, renormalised (the runtime blends 4). */
+static void top4(const double *w, int32_t nb, int32_t *ids, double *ws) {
+    for (int k = 0; k < 4; ++k) {
+        ids[k] = 0;
+        ws[k] = 0;
+    }
+    for (int32_t b = 0; b < nb; ++b) {
+        if (!(w[b] > 0)) continue;
+        int k = 4;
+        while (k > 0 && w[b] > ws[k - 1]) --k; /* insertion position */
+        if (k == 4) continue;
+        for (int j = 3; j > k; --j) {
+            ids[j] = ids[j - 1];
+            ws[j] = ws[j - 1];
+        }
+        ids[k] = b;
+        ws[k] = w[b];
+    }
+    double sum = ws[0] + ws[1] + ws[2] + ws[3];
+    if (sum > 0)
+        for (int k = 0; k < 4; ++k) ws[k] /= sum;
+    else
+        ws[0] = 1.0;
+}
+
+/* prepare: the bake's own copy of the weights (heat diffusion when asked), one-hot at
+ * bone-driven vertices so that skinning moves them exactly with their bone, as the
+ * full-space reference does; top-4 influences; lumped masses. */
+static sinew_result prepare(sw_bake_state *s, const sw_character *c, int heat, sw_error *err) {
+    s->ch = *c;
+    s->nv = c->mesh.nverts;
+    s->nt = c->mesh.ntets;
+    s->nb = c->skel.nbones;
+    if (s->nb > SW_MAX_BONES)
+        return sw_error_set(err, SINEW_ERROR_UNSUPPORTED, "%d bones (at most %d)", s->nb,
+                            SW_MAX_BONES);
+    size_t nw = (size_t)s->nv * s->nb;
+    s->weights = malloc(nw * sizeof(double));
+    s->skin_bone = malloc((size_t)s->nv * 4 * sizeof(int32_t));
+    s->skin_weight = malloc((size_t)s->nv * 4 * sizeof(double));
+    s->mass = calloc((size_t)s->nv, sizeof(double));
+    if (!s->weights || !s->skin_bone || !s->skin_weight || !s->mass)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for weights");
+    if (heat) {
+        sw_weights hw;
+        memset(&hw, 0, sizeof hw);
+        sinew_result r = sw_weights_heat(&c->mesh, &c->skel, 0, &hw, err);
+        if (r != SINEW_OK) return r;
+        memcpy(s->weights, hw.w, nw * sizeof(double));
+        sw_weights_free(&hw);
+    } else {
+        memcpy(s->weights, c->weights.w, nw * sizeof(double));
+    }
+    for (int32_t v = 0; v < s->nv; ++v) {
+        int32_t b = c->bone_of_vertex[v];
+        double *w = s->weights + (size_t)v * s->nb;
+        if (b >= 0)
+            for (int32_t k = 0; k < s->nb; ++k) w[k] = k == b ? 1.0 : 0.0;
+        top4(w, s->nb, s->skin_bone + 4 * v, s->skin_weight + 4 * v);
+    }
+    s->ch.weights.w = s->weights;
+    s->ch.weights.nverts = s->nv;
+    s->ch.weights.nbones = s->nb;
+    for (int32_t t = 0; t < s->nt; ++t) {
+        double Xe[12], Dm[9], vol;
+        for (int k = 0; k < 4; ++k)
+            memcpy(Xe + 3 * k, c->mesh.X + 3 * (int64_t)c->mesh.tets[4 * t + k], 24);
+        if (!sw_tet_rest(Xe, Dm, &vol))
+            return sw_error_set(err, SINEW_ERROR_DEGENERATE, "tet %d is degenerate at rest", t);
+        sw_lumped_mass_add(c->mesh.tets + 4 * t, c->density, vol, s->mass);
+    }
+    return SINEW_OK;
+}
+
+static void free_state(sw_bake_state *s) {
+    free(s->weights);
+    free(s->skin_bone);
+    free(s->skin_weight);
+    free(s->mass);
+    free(s->tet_domain);
+    free(s->domain_bone);
+    free(s->dom_vert_ptr);
+    free(s->dom_verts);
+    free(s->dom_tet_ptr);
+    free(s->dom_tets);
+    free(s->copy_mass);
+    for (int32_t i = 0; i < s->ntrain_seq; ++i) {
+        free(s->train[i].T);
+        free(s->train[i].x);
+    }
+    free(s->train);
+    free(s->heldout.T);
+    free(s->heldout.x);
+    for (int32_t d = 0; d < s->nd; ++d) {
+        if (s->basis) free(s->basis[d]);
+        if (s->cub_local) free(s->cub_local[d]);
+        if (s->cub_w) free(s->cub_w[d]);
+    }
+    free(s->basis);
+    free(s->rank);
+    free(s->cub_n);
+    free(s->cub_local);
+    free(s->cub_w);
+    sw_pool_destroy(s->pool);
+}
+
+/* Keeps the poses and full-space solutions for evaluation (sinew-bench, the report). */
+static sinew_result keep_solutions(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    size_t pt = (size_t)12 * s->nb * sizeof(double), px = (size_t)3 * s->nv * sizeof(double);
+    out->train_T = malloc((size_t)out->ntrain * pt + 1);
+    out->train_x = malloc((size_t)out->ntrain * px + 1);
+    out->heldout_T = malloc((size_t)out->nheldout * pt + 1);
+    out->heldout_x = malloc((size_t)out->nheldout * px + 1);
+    if (!out->train_T || !out->train_x || !out->heldout_T || !out->heldout_x)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for solutions");
+    int32_t k = 0;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->train[i].npose; ++j, ++k) {
+            memcpy((char *)out->train_T + k * pt, (const char *)s->train[i].T + j * pt, pt);
+            memcpy((char *)out->train_x + k * px, (const char *)s->train[i].x + j * px, px);
+        }
+    if (out->nheldout) {
+        memcpy(out->heldout_T, s->heldout.T, (size_t)out->nheldout * pt);
+        memcpy(out->heldout_x, s->heldout.x, (size_t)out->nheldout * px);
+    }
+    return SINEW_OK;
+}
+
+static void progress(const sw_bake_params *p, const char *stage, double secs, const char *what) {
+    if (p->progress) fprintf(stderr, "sinew-bake: %-9s %7.2f s  %s\n", stage, secs, what);
+}
+
+sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bake_result *out,
+                     sw_error *err) {
+    memset(out, 0, sizeof *out);
+    sw_bake_params p = params ? *params : sw_bake_params_default();
+    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
+    if (p.max_rank < 1 || p.max_rank > 1024 || !(p.pca_energy > 0 && p.pca_energy <= 1) ||
+        !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 ||
+        p.sweep_samples < 1 || p.sweep_samples > 1000 || p.max_train_frames < 1 ||
+        !(p.heldout_fraction >= 0 && p.heldout_fraction < 1) || !(p.spring_k >= 0) ||
+        !isfinite(p.spring_k))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "bake parameters out of range (rank %d, energy %g, cubature tol %g, "
+                            "max %d, sweep %d, frames %d, held-out %g, spring %g)",
+                            p.max_rank, p.pca_energy, p.cubature_tol, p.cubature_max,
+                            p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k);
+    sw_bake_state s;
+    memset(&s, 0, sizeof s);
+    s.p = &p;
+    sinew_result r;
+    double t0 = seconds_now(), t1;
+    int heat = c->weights.w == NULL;
+    if ((r = prepare(&s, c, heat, err)) != SINEW_OK) goto done;
+    if (!(s.pool = sw_pool_create(p.threads))) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
+        goto done;
+    }
+    t1 = seconds_now();
+    out->stage_seconds[0] = t1 - t0;
+    progress(&p, "prepare", t1 - t0, heat ? "heat-diffusion weights" : "asset weights");
+
+    t0 = t1;
+    if ((r = sw_bake_domains(&s, err)) != SINEW_OK) goto done;
+    t1 = seconds_now();
+    out->stage_seconds[1] = t1 - t0;
+    {
+        char msg[64];
+        snprintf(msg, sizeof msg, "%d domains", s.nd);
+        progress(&p, "domains", t1 - t0, msg);
+    }
+
+    t0 = t1;
+    if ((r = sw_bake_poses(&s, err)) != SINEW_OK || (r = sw_bake_simulate(&s, err)) != SINEW_OK)
+        goto done;
+    t1 = seconds_now();
+    out->stage_seconds[2] = t1 - t0;
+    for (int32_t i = 0; i < s.ntrain_seq; ++i) out->ntrain += s.train[i].npose;
+    out->nheldout = s.heldout.npose;
+    if ((r = keep_solutions(&s, out, err)) != SINEW_OK) goto done;
+    if (!(out->mass = malloc((size_t)s.nv * sizeof(double)))) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
+    memcpy(out->mass, s.mass, (size_t)s.nv * sizeof(double));
+    {
+        char msg[96];
+        snprintf(msg, sizeof msg, "%d training and %d held-out full-space solutions",
+                 out->ntrain, out->nheldout);
+        progress(&p, "simulate", t1 - t0, msg);
+    }
+
+    t0 = t1;
+    if ((r = sw_bake_basis(&s, out, err)) != SINEW_OK) goto done;
+    t1 = seconds_now();
+    out->stage_seconds[3] = t1 - t0;
+    {
+        char msg[128];
+        snprintf(msg, sizeof msg, "total rank %d, projection error train %.4f held-out %.4f",
+                 s.rank_total, out->train_proj_error, out->heldout_proj_error);
+        progress(&p, "basis", t1 - t0, msg);
+    }
+
+    t0 = t1;
+    if ((r = sw_bake_cubature(&s, out, err)) != SINEW_OK) goto done;
+    t1 = seconds_now();
+    out->stage_seconds[4] = t1 - t0;
+    {
+        int32_t total = 0;
+        for (int32_t d = 0; d < s.nd; ++d) total += s.cub_n[d];
+        char msg[96];
+        snprintf(msg, sizeof msg, "%d cubature tets, worst fit %.4f", total,
+                 out->cubature_error_max);
+        progress(&p, "cubature", t1 - t0, msg);
+    }
+
+    t0 = t1;
+    if ((r = sw_bake_reduce(&s, out, err)) != SINEW_OK) goto done;
+    t1 = seconds_now();
+    out->stage_seconds[5] = t1 - t0;
+    progress(&p, "reduce", t1 - t0, "springs, mass, inertia, surface");
+    r = SINEW_OK;
+done:
+    free_state(&s);
+    if (r != SINEW_OK) sw_bake_result_free(out);
+    return r;
+}

@@ -1,0 +1,73 @@
+/* The bake: a character (mesh, skeleton, weights, bone-driven vertices, clip) in, a
+ * blob view out (DESIGN.md §5). Stages:
+ *   prepare   weights (heat diffusion when the asset has none), bone-driven vertices
+ *             made rigid (one-hot weights), surface, lumped masses
+ *   domains   each tet to the strongest bone of the majority of its vertices (§2.3)
+ *   poses     training = per-joint sweeps over the range the training clip uses plus
+ *             the clip's first (1 - heldout) frames; held-out = the clip's last frames
+ *             (or random combined poses with a fixed seed when there is no clip)
+ *   simulate  full-space quasistatic solutions with self-contact, all cores
+ *   basis     un-skinned snapshots d = R^T (x - t) - rest -> per-domain uncentred PCA,
+ *             rank by an energy threshold, orthonormal columns, zero rows at
+ *             bone-driven vertices (they follow their bone exactly)
+ *   cubature  per domain on the reduced elastic forces of snapshots and perturbed
+ *             snapshots (eqs. 2.11-2.19)
+ *   reduce    interface-spring Hessian (eq. 4.20), reduced mass, inertial projections
+ */
+#ifndef SW_BAKE_H
+#define SW_BAKE_H
+
+#include "blob_view.h"
+#include "cubature_train.h"
+#include "sw_mesh.h"
+
+typedef struct sw_bake_params {
+    int32_t max_rank;       /* per domain (default 30) */
+    double pca_energy;      /* fraction of snapshot energy kept (default 0.9999) */
+    double cubature_tol;    /* default 0.05 */
+    int32_t cubature_max;   /* per domain (default 1000) */
+    sw_cubature_selector selector; /* default NN-HTP */
+    int32_t sweep_samples;  /* poses per joint sweep (default 6) */
+    int32_t max_train_frames; /* clip frames used for training at most (default 40) */
+    double heldout_fraction; /* last part of the clip held out (default 0.4) */
+    int32_t random_poses;   /* held-out poses when there is no clip (default 10) */
+    int self_contact;       /* in the training simulations (default 1) */
+    double spring_k;        /* interface springs; 0: 20 * Young's modulus */
+    int threads;            /* 0: all cores */
+    uint64_t seed;
+    int progress;           /* print stage progress to stderr */
+    int compare_selectors;  /* also train the other two selectors on the same data and
+                               report their sizes and times (the blob keeps `selector`) */
+} sw_bake_params;
+
+sw_bake_params sw_bake_params_default(void);
+
+/* What the bake made, plus the arrays the view points into (owned). */
+typedef struct sw_bake_result {
+    sw_blob_view view;
+    void *storage[32]; /* owned arrays (freed by sw_bake_result_free) */
+    int nstorage;
+    /* report */
+    double stage_seconds[8]; /* prepare, domains, poses+simulate, basis, cubature, reduce */
+    int32_t ntrain, nheldout;
+    double train_proj_error;   /* basis projection error of the training snapshots */
+    double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
+    double cubature_error_max; /* worst per-domain relative cubature training error */
+    /* per selector (greedy, importance, NN-HTP), summed over domains; filled for the
+       chosen selector, and for all three with compare_selectors */
+    int32_t selector_points[3];
+    double selector_seconds[3];
+    double selector_error[3]; /* worst domain's relative fit error */
+    double *mass;             /* nverts lumped vertex masses (for evaluation) */
+    /* full-space solutions of the held-out poses, for evaluation (3 nverts each) */
+    double *heldout_x;
+    double *heldout_T; /* 12 nbones per held-out pose */
+    double *train_x;
+    double *train_T;
+} sw_bake_result;
+
+sinew_result sw_bake(const sw_character *c, const sw_bake_params *p, sw_bake_result *out,
+                     sw_error *err);
+void sw_bake_result_free(sw_bake_result *r);
+
+#endif

@@ -1,0 +1,253 @@
+/* Material cubature per domain (thesis eqs. 2.11-2.14). Training samples are the
+ * reduced coordinates of the training snapshots, q = U^T d, and as many perturbed
+ * copies (q + 0.5 * rms(q) * gaussian): at the snapshots themselves the reduced force
+ * nearly balances, so the perturbations are what shows the force's shape. Column e of
+ * the fit matrix stacks tet e's reduced elastic force over the samples,
+ *   a_e = sum_k (R_k U_k)^T f_{e,k}(x(q)),  x_k = R_k (rest_k + U_k q) + t_k,
+ * each sample's block divided by the norm of the domain's full reduced force. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_internal.h"
+#include "fem_corot.h"
+
+typedef struct {
+    const sw_bake_state *s;
+    int32_t dom, r, nsamples;
+    const double *U;       /* domain basis, 3 n_d x r */
+    const int32_t *tet_local; /* 4 per domain tet: local copy index */
+    const double *dminv, *vol; /* per domain tet */
+    const double *q;       /* nsamples x r */
+    const sw_dualquat *dq; /* nsamples x nb (pose of each sample) */
+    const double *inv_norm; /* nsamples: 1 / |b_s| (0 drops the sample) */
+    double mu, lambda;
+} cub_ctx;
+
+/* Reduced elastic force of domain tet i for sample s into a (r), unscaled. */
+static void tet_reduced_force(const cub_ctx *c, int64_t i, int32_t smp, double *a) {
+    const sw_bake_state *s = c->s;
+    int32_t r = c->r, base = s->dom_vert_ptr[c->dom];
+    double xe[12], R[4][9], f[12];
+    for (int k = 0; k < 4; ++k) {
+        int32_t loc = c->tet_local[4 * i + k], v = s->dom_verts[base + loc];
+        double t[3], y[3];
+        sw_dqs_blend(c->dq + (size_t)smp * s->nb, s->skin_bone + 4 * v, s->skin_weight + 4 * v, 4,
+                     R[k], t);
+        const double *Uv = c->U + (size_t)3 * loc * r, *q = c->q + (size_t)smp * r;
+        for (int d = 0; d < 3; ++d) {
+            double acc = s->ch.mesh.X[3 * v + d];
+            for (int32_t j = 0; j < r; ++j) acc += Uv[d * r + j] * q[j];
+            y[d] = acc;
+        }
+        for (int d = 0; d < 3; ++d)
+            xe[3 * k + d] = R[k][3 * d] * y[0] + R[k][3 * d + 1] * y[1] + R[k][3 * d + 2] * y[2] + t[d];
+    }
+    sw_corot_eval(xe, c->dminv + 9 * i, c->vol[i], c->mu, c->lambda, f, NULL, 0);
+    for (int32_t j = 0; j < r; ++j) a[j] = 0;
+    for (int k = 0; k < 4; ++k) {
+        const double *fk = f + 3 * k;
+        double g[3]; /* R_k^T f_k */
+        for (int d = 0; d < 3; ++d) g[d] = R[k][d] * fk[0] + R[k][3 + d] * fk[1] + R[k][6 + d] * fk[2];
+        const double *Uv = c->U + (size_t)3 * c->tet_local[4 * i + k] * r;
+        for (int d = 0; d < 3; ++d)
+            for (int32_t j = 0; j < r; ++j) a[j] += Uv[d * r + j] * g[d];
+    }
+}
+
+static void column(void *vctx, int64_t cand, double *col) {
+    const cub_ctx *c = vctx;
+    for (int32_t smp = 0; smp < c->nsamples; ++smp) {
+        double *a = col + (size_t)smp * c->r;
+        tet_reduced_force(c, cand, smp, a);
+        for (int32_t j = 0; j < c->r; ++j) a[j] *= c->inv_norm[smp];
+    }
+}
+
+typedef struct {
+    const cub_ctx *c;
+    int64_t ntets;
+    double *partial; /* workers x nsamples x r */
+} sum_ctx;
+
+static void sum_worker(void *vctx, int64_t begin, int64_t end, int worker) {
+    sum_ctx *sc = vctx;
+    const cub_ctx *c = sc->c;
+    size_t block = (size_t)c->nsamples * c->r;
+    double *acc = sc->partial + (size_t)worker * block, a[1024];
+    for (int64_t i = begin; i < end; ++i)
+        for (int32_t smp = 0; smp < c->nsamples; ++smp) {
+            tet_reduced_force(c, i, smp, a);
+            for (int32_t j = 0; j < c->r; ++j) acc[(size_t)smp * c->r + j] += a[j];
+        }
+}
+
+static double gauss(uint64_t *state) {
+    uint64_t z1 = (*state += 0x9e3779b97f4a7c15ULL), z2 = (*state += 0x9e3779b97f4a7c15ULL);
+    z1 = (z1 ^ (z1 >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z1 = (z1 ^ (z1 >> 27)) * 0x94d049bb133111ebULL;
+    z2 = (z2 ^ (z2 >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z2 = (z2 ^ (z2 >> 27)) * 0x94d049bb133111ebULL;
+    double u1 = ((double)((z1 ^ (z1 >> 31)) >> 11) + 0.5) * 0x1.0p-53;
+    double u2 = (double)((z2 ^ (z2 >> 31)) >> 11) * 0x1.0p-53;
+    return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
+}
+
+/* Trains domain dom's cubature; fills s->cub_n/local/w[dom]. */
+static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *dsnap, int32_t T,
+                                 const sw_dualquat *pose_dq, sw_bake_result *out, sw_error *err) {
+    int32_t r = s->rank[dom], base = s->dom_vert_ptr[dom], nvd = s->dom_vert_ptr[dom + 1] - base;
+    int32_t t0 = s->dom_tet_ptr[dom], ntd = s->dom_tet_ptr[dom + 1] - t0, ns = 2 * T;
+    const double *U = s->basis[dom];
+    sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
+    int32_t *local_of = malloc((size_t)s->nv * sizeof(int32_t));
+    int32_t *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t));
+    double *dminv = malloc((size_t)ntd * 9 * sizeof(double)), *vol = malloc((size_t)ntd * sizeof(double));
+    double *q = calloc((size_t)ns * r, sizeof(double)), *inv_norm = malloc((size_t)ns * sizeof(double));
+    sw_dualquat *dq = malloc((size_t)ns * s->nb * sizeof(sw_dualquat));
+    double *b = NULL, *partial = NULL;
+    sw_cubature_result cr;
+    memset(&cr, 0, sizeof cr);
+    if (!local_of || !tet_local || !dminv || !vol || !q || !inv_norm || !dq) goto done;
+    for (int32_t k = 0; k < nvd; ++k) local_of[s->dom_verts[base + k]] = k;
+    for (int32_t i = 0; i < ntd; ++i) {
+        const int32_t *tet = s->ch.mesh.tets + 4 * (int64_t)s->dom_tets[t0 + i];
+        double Xe[12];
+        for (int k = 0; k < 4; ++k) {
+            tet_local[4 * i + k] = local_of[tet[k]];
+            memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)tet[k], 24);
+        }
+        sw_tet_rest(Xe, dminv + 9 * i, vol + i);
+    }
+    /* samples: snapshots projected, then perturbed copies */
+    double *rms = calloc((size_t)r, sizeof(double));
+    if (!rms) goto done;
+    for (int32_t a = 0; a < T; ++a) {
+        for (int32_t j = 0; j < r; ++j) {
+            double acc = 0;
+            for (int32_t k = 0; k < nvd; ++k)
+                for (int d = 0; d < 3; ++d)
+                    acc += U[(size_t)(3 * k + d) * r + j] * dsnap[(size_t)a * 3 * s->nv + 3 * s->dom_verts[base + k] + d];
+            q[(size_t)a * r + j] = acc;
+            rms[j] += acc * acc / T;
+        }
+        memcpy(dq + (size_t)a * s->nb, pose_dq + (size_t)a * s->nb, (size_t)s->nb * sizeof(sw_dualquat));
+        memcpy(dq + (size_t)(T + a) * s->nb, pose_dq + (size_t)a * s->nb, (size_t)s->nb * sizeof(sw_dualquat));
+    }
+    uint64_t seed = s->p->seed ^ (0x9e37ULL * (uint64_t)(dom + 1));
+    for (int32_t a = 0; a < T; ++a)
+        for (int32_t j = 0; j < r; ++j)
+            q[(size_t)(T + a) * r + j] = q[(size_t)a * r + j] + 0.5 * sqrt(rms[j]) * gauss(&seed);
+    free(rms);
+    for (int32_t smp = 0; smp < ns; ++smp) inv_norm[smp] = 1.0;
+    cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, 0, 0};
+    sw_lame(s->ch.youngs, s->ch.poisson, &c.mu, &c.lambda);
+    /* b: the domain's full reduced force per sample (Krysl projection), summed in
+     * parallel per worker and then in worker order */
+    int workers = sw_pool_size(s->pool);
+    size_t block = (size_t)ns * r;
+    partial = calloc((size_t)workers * block, sizeof(double));
+    b = calloc(block, sizeof(double));
+    if (!partial || !b) goto done;
+    sum_ctx sc = {&c, ntd, partial};
+    sw_pool_parallel_for(s->pool, ntd, sum_worker, &sc);
+    for (int w = 0; w < workers; ++w)
+        for (size_t i = 0; i < block; ++i) b[i] += partial[(size_t)w * block + i];
+    double bmax = 0;
+    for (int32_t smp = 0; smp < ns; ++smp) {
+        double n2 = 0;
+        for (int32_t j = 0; j < r; ++j) n2 += b[(size_t)smp * r + j] * b[(size_t)smp * r + j];
+        inv_norm[smp] = sqrt(n2);
+        bmax = fmax(bmax, inv_norm[smp]);
+    }
+    for (int32_t smp = 0; smp < ns; ++smp) { /* normalise; drop force-free samples */
+        double n = inv_norm[smp];
+        inv_norm[smp] = n > 1e-9 * bmax && n > 0 ? 1.0 / n : 0.0;
+        for (int32_t j = 0; j < r; ++j) b[(size_t)smp * r + j] *= inv_norm[smp];
+    }
+    sw_cubature_problem prob = {(int64_t)block, ntd, b, column, &c};
+    sw_cubature_params cp = sw_cubature_params_default();
+    cp.tol = s->p->cubature_tol;
+    cp.max_points = s->p->cubature_max < ntd ? s->p->cubature_max : ntd;
+    cp.seed = s->p->seed + (uint64_t)dom;
+    cp.threads = workers;
+    for (int sel = 0; sel < 3; ++sel) { /* the chosen selector last: its result is kept */
+        int which = sel == 2 ? (int)s->p->selector : (sel + (int)s->p->selector + 1) % 3;
+        if (sel < 2 && !s->p->compare_selectors) continue;
+        cp.selector = (sw_cubature_selector)which;
+        sw_cubature_result_free(&cr);
+        res = sw_cubature_train(&prob, &cp, &cr, err);
+        if (res == SINEW_ERROR_NOT_CONVERGED && cr.n > 0) res = SINEW_OK; /* best set, reported */
+        if (res != SINEW_OK) goto done;
+        out->selector_points[which] += cr.n;
+        out->selector_seconds[which] += cr.seconds;
+        out->selector_error[which] = fmax(out->selector_error[which], cr.rel_error);
+    }
+    s->cub_n[dom] = cr.n;
+    s->cub_local[dom] = malloc((size_t)cr.n * sizeof(int32_t));
+    s->cub_w[dom] = malloc((size_t)cr.n * sizeof(double));
+    if (!s->cub_local[dom] || !s->cub_w[dom]) {
+        res = SINEW_ERROR_OUT_OF_MEMORY;
+        goto done;
+    }
+    for (int32_t i = 0; i < cr.n; ++i) {
+        s->cub_local[dom][i] = (int32_t)cr.ids[i];
+        s->cub_w[dom][i] = cr.weights[i];
+    }
+    out->cubature_error_max = fmax(out->cubature_error_max, cr.rel_error);
+done:
+    if (res == SINEW_ERROR_OUT_OF_MEMORY)
+        sw_error_set(err, res, "out of memory training domain %d's cubature", dom);
+    sw_cubature_result_free(&cr);
+    free(local_of);
+    free(tet_local);
+    free(dminv);
+    free(vol);
+    free(q);
+    free(inv_norm);
+    free(dq);
+    free(b);
+    free(partial);
+    return res;
+}
+
+sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    int32_t T = 0;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i) T += s->train[i].npose;
+    int64_t n3 = 3 * (int64_t)s->nv;
+    s->cub_n = calloc((size_t)s->nd, sizeof(int32_t));
+    s->cub_local = calloc((size_t)s->nd, sizeof(int32_t *));
+    s->cub_w = calloc((size_t)s->nd, sizeof(double *));
+    double *dsnap = malloc((size_t)T * n3 * sizeof(double));
+    double *R = malloc((size_t)s->nv * 9 * sizeof(double)), *t = malloc((size_t)s->nv * 3 * sizeof(double));
+    sw_dualquat *pose_dq = malloc((size_t)T * s->nb * sizeof(sw_dualquat));
+    sinew_result res = SINEW_OK;
+    if (!s->cub_n || !s->cub_local || !s->cub_w || !dsnap || !R || !t || !pose_dq) {
+        res = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for cubature");
+        goto done;
+    }
+    /* the un-skinned snapshots again (cheap next to the simulations) */
+    int32_t k = 0;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->train[i].npose; ++j, ++k) {
+            const double *T12 = s->train[i].T + (size_t)j * 12 * s->nb, *x = s->train[i].x + (size_t)j * n3;
+            double *d = dsnap + (size_t)k * n3;
+            sw_bake_skin_transforms(s, T12, R, t);
+            for (int32_t v = 0; v < s->nv; ++v) {
+                const double *Rv = R + 9 * v, *tv = t + 3 * v, *X = s->ch.mesh.X + 3 * v;
+                double w[3] = {x[3 * v] - tv[0], x[3 * v + 1] - tv[1], x[3 * v + 2] - tv[2]};
+                for (int a = 0; a < 3; ++a)
+                    d[3 * v + a] = Rv[a] * w[0] + Rv[3 + a] * w[1] + Rv[6 + a] * w[2] - X[a];
+            }
+            for (int32_t b = 0; b < s->nb; ++b) sw_dq_from_transform(T12 + 12 * b, &pose_dq[(size_t)k * s->nb + b]);
+        }
+    out->cubature_error_max = 0;
+    for (int32_t d = 0; d < s->nd && res == SINEW_OK; ++d)
+        res = train_domain(s, d, dsnap, T, pose_dq, out, err);
+done:
+    free(dsnap);
+    free(R);
+    free(t);
+    free(pose_dq);
+    return res;
+}

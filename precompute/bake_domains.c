@@ -1,0 +1,130 @@
+/* Skeletal domains (thesis §2.3, §4.4.1; DESIGN.md §8): a tet goes to the strongest
+ * bone of the majority of its vertices; bones that own no tet get no domain. A domain's
+ * vertex copies are the vertices of its tets; a vertex in several domains is an
+ * interface vertex, duplicated and tied by springs (bake_reduce.c). */
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_internal.h"
+#include "fem_corot.h"
+
+static int32_t strongest_bone(const sw_bake_state *s, int32_t v) {
+    const double *w = s->weights + (size_t)v * s->nb;
+    int32_t best = 0;
+    for (int32_t b = 1; b < s->nb; ++b)
+        if (w[b] > w[best]) best = b;
+    return best;
+}
+
+/* Majority of the four vertices' strongest bones; a tie goes to the bone with the
+ * larger summed weight over the tet, then the lower id (deterministic). */
+static int32_t tet_bone(const sw_bake_state *s, const int32_t *tet) {
+    int32_t bones[4], votes[4] = {0, 0, 0, 0};
+    for (int k = 0; k < 4; ++k) bones[k] = strongest_bone(s, tet[k]);
+    for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 4; ++j) votes[k] += bones[j] == bones[k];
+    int32_t best = 0;
+    for (int k = 1; k < 4; ++k) {
+        if (votes[k] < votes[best]) continue;
+        if (votes[k] > votes[best]) {
+            best = k;
+            continue;
+        }
+        double wk = 0, wb = 0;
+        for (int j = 0; j < 4; ++j) {
+            wk += s->weights[(size_t)tet[j] * s->nb + bones[k]];
+            wb += s->weights[(size_t)tet[j] * s->nb + bones[best]];
+        }
+        if (wk > wb || (wk == wb && bones[k] < bones[best])) best = k;
+    }
+    return bones[best];
+}
+
+sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
+    const int32_t *tets = s->ch.mesh.tets;
+    int32_t *domain_of_bone = malloc((size_t)s->nb * sizeof(int32_t));
+    int32_t *mark = malloc((size_t)s->nv * sizeof(int32_t));
+    s->tet_domain = malloc((size_t)s->nt * sizeof(int32_t));
+    s->domain_bone = malloc((size_t)s->nb * sizeof(int32_t));
+    s->dom_tet_ptr = calloc((size_t)s->nb + 1, sizeof(int32_t));
+    s->dom_tets = malloc((size_t)s->nt * sizeof(int32_t));
+    s->dom_vert_ptr = calloc((size_t)s->nb + 1, sizeof(int32_t));
+    if (!domain_of_bone || !mark || !s->tet_domain || !s->domain_bone || !s->dom_tet_ptr ||
+        !s->dom_tets || !s->dom_vert_ptr) {
+        free(domain_of_bone);
+        free(mark);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
+    }
+    for (int32_t b = 0; b < s->nb; ++b) domain_of_bone[b] = -1;
+    for (int32_t t = 0; t < s->nt; ++t) s->tet_domain[t] = tet_bone(s, tets + 4 * t);
+    /* domains in bone order, only for bones that own tets */
+    for (int32_t t = 0; t < s->nt; ++t) domain_of_bone[s->tet_domain[t]] = 1;
+    s->nd = 0;
+    for (int32_t b = 0; b < s->nb; ++b)
+        if (domain_of_bone[b] > 0) {
+            s->domain_bone[s->nd] = b;
+            domain_of_bone[b] = s->nd++;
+        }
+    for (int32_t t = 0; t < s->nt; ++t) {
+        s->tet_domain[t] = domain_of_bone[s->tet_domain[t]];
+        s->dom_tet_ptr[s->tet_domain[t] + 1]++;
+    }
+    for (int32_t d = 0; d < s->nd; ++d) s->dom_tet_ptr[d + 1] += s->dom_tet_ptr[d];
+    {
+        int32_t *fill = malloc((size_t)s->nd * sizeof(int32_t));
+        if (!fill) {
+            free(domain_of_bone);
+            free(mark);
+            return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
+        }
+        memcpy(fill, s->dom_tet_ptr, (size_t)s->nd * sizeof(int32_t));
+        for (int32_t t = 0; t < s->nt; ++t) s->dom_tets[fill[s->tet_domain[t]]++] = t;
+        free(fill);
+    }
+    /* vertex copies: two passes (count, fill), vertices ascending per domain */
+    int64_t ncopies = 0;
+    for (int pass = 0; pass < 2; ++pass) {
+        ncopies = 0;
+        for (int32_t d = 0; d < s->nd; ++d) {
+            for (int32_t v = 0; v < s->nv; ++v) mark[v] = 0;
+            for (int32_t i = s->dom_tet_ptr[d]; i < s->dom_tet_ptr[d + 1]; ++i)
+                for (int k = 0; k < 4; ++k) mark[tets[4 * s->dom_tets[i] + k]] = 1;
+            if (pass == 1) s->dom_vert_ptr[d] = (int32_t)ncopies;
+            for (int32_t v = 0; v < s->nv; ++v)
+                if (mark[v]) {
+                    if (pass == 1) s->dom_verts[ncopies] = v;
+                    ncopies++;
+                }
+        }
+        if (pass == 0) {
+            if (ncopies > INT32_MAX) {
+                free(domain_of_bone);
+                free(mark);
+                return sw_error_set(err, SINEW_ERROR_UNSUPPORTED, "too many vertex copies");
+            }
+            s->dom_verts = malloc((size_t)ncopies * sizeof(int32_t));
+            s->copy_mass = calloc((size_t)ncopies, sizeof(double));
+            if (!s->dom_verts || !s->copy_mass) {
+                free(domain_of_bone);
+                free(mark);
+                return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for copies");
+            }
+        }
+    }
+    s->dom_vert_ptr[s->nd] = (int32_t)ncopies;
+    /* copy masses: lumped mass of each copy from its own domain's tets */
+    for (int32_t d = 0; d < s->nd; ++d) {
+        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base;
+        for (int32_t k = 0; k < n; ++k) mark[s->dom_verts[base + k]] = base + k;
+        for (int32_t i = s->dom_tet_ptr[d]; i < s->dom_tet_ptr[d + 1]; ++i) {
+            const int32_t *q = tets + 4 * s->dom_tets[i];
+            double Xe[12], Dm[9], vol;
+            for (int k = 0; k < 4; ++k) memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)q[k], 24);
+            sw_tet_rest(Xe, Dm, &vol);
+            for (int k = 0; k < 4; ++k) s->copy_mass[mark[q[k]]] += s->ch.density * vol / 4.0;
+        }
+    }
+    free(domain_of_bone);
+    free(mark);
+    return SINEW_OK;
+}

@@ -1,0 +1,64 @@
+/* State shared by the bake's stages (bake.c orchestrates; one file per stage). */
+#ifndef SW_BAKE_INTERNAL_H
+#define SW_BAKE_INTERNAL_H
+
+#include "bake.h"
+#include "dqs.h"
+#include "thread_pool.h"
+
+/* A sequence of poses simulated in order (each warm-starts the next). */
+typedef struct sw_pose_seq {
+    int32_t npose;
+    double *T; /* npose * 12 * nbones bone transforms */
+    double *x; /* npose * 3 * nverts full-space solutions (filled by simulate) */
+    int failed; /* poses whose solve returned NOT_FINITE */
+} sw_pose_seq;
+
+typedef struct sw_bake_state {
+    const sw_bake_params *p;
+    sw_character ch;  /* the character with the bake's weights (mesh/skeleton borrowed) */
+    double *weights;  /* owned nverts * nbones */
+    int32_t nv, nt, nb;
+    /* top-4 skin influences (runtime's DQS) */
+    int32_t *skin_bone;  /* 4 nv */
+    double *skin_weight; /* 4 nv */
+    double *mass;        /* nv lumped masses (all tets) */
+    /* domains */
+    int32_t nd;
+    int32_t *tet_domain;   /* nt */
+    int32_t *domain_bone;  /* nd */
+    int32_t *dom_vert_ptr; /* nd + 1 into dom_verts */
+    int32_t *dom_verts;    /* copies: global vertex ids, ascending per domain */
+    int32_t *dom_tet_ptr;  /* nd + 1 into dom_tets */
+    int32_t *dom_tets;     /* tets of each domain, ascending */
+    double *copy_mass;     /* per copy: mass from the domain's own tets */
+    /* poses */
+    sw_pose_seq *train;
+    int32_t ntrain_seq;
+    sw_pose_seq heldout;
+    /* basis: per domain 3 n_d x r_d, row-major */
+    int32_t *rank;
+    double **basis;
+    int32_t rank_total;
+    /* cubature: per domain local tet index into dom_tets and weights */
+    int32_t *cub_n;
+    int32_t **cub_local; /* index into the domain's dom_tets range */
+    double **cub_w;
+    sw_pool *pool;
+} sw_bake_state;
+
+/* Per-vertex DQS transforms of all vertices for bone transforms T. */
+void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R /* 9 nv */,
+                             double *t /* 3 nv */);
+
+sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err);
+sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err);
+sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err);
+sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+
+/* Records an owned allocation in the result (freed with it); returns p. */
+void *sw_bake_own(sw_bake_result *out, void *p);
+
+#endif

@@ -1,0 +1,248 @@
+/* Training and held-out poses, and their full-space solutions (DESIGN.md §5).
+ * Training: the first (1 - heldout) frames of the clip (evenly subsampled) and, per
+ * joint, a sweep from rest to the largest rotation the training frames give it.
+ * Held-out: the clip's remaining frames, never used to build the basis or cubature;
+ * without a clip, random combined poses with a fixed seed. Each sequence is solved in
+ * order (every solve warm-starts the next); sequences run in parallel, one thread
+ * each. */
+#include <math.h>
+#include <stdatomic.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_internal.h"
+#include "fullsim.h"
+
+/* Rotation part of a clip's bone transform relative to its parent: L = R_p^T R_b. */
+static void local_rotation(const sw_skeleton *sk, const double *T, int32_t b, double L[9]) {
+    const double *Rb = T + 12 * b;
+    int32_t p = sk->parent[b];
+    if (p < 0) {
+        memcpy(L, Rb, 9 * sizeof(double));
+        return;
+    }
+    const double *Rp = T + 12 * p;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
+}
+
+/* Axis-angle of a rotation matrix (angle in [0, pi]). */
+static double rotation_axis_angle(const double R[9], double axis[3]) {
+    double c = 0.5 * (R[0] + R[4] + R[8] - 1.0);
+    c = c > 1 ? 1 : c < -1 ? -1 : c;
+    double angle = acos(c);
+    double a[3] = {R[7] - R[5], R[2] - R[6], R[3] - R[1]};
+    double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    if (n < 1e-12) { /* angle 0 or pi: take the column of the largest diagonal of R + I */
+        int k = R[0] >= R[4] && R[0] >= R[8] ? 0 : R[4] >= R[8] ? 1 : 2;
+        for (int i = 0; i < 3; ++i) a[i] = R[3 * i + k] + (i == k ? 1.0 : 0.0);
+        n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        if (n < 1e-12) {
+            a[0] = 1;
+            a[1] = a[2] = 0;
+            n = 1;
+        }
+    }
+    for (int i = 0; i < 3; ++i) axis[i] = a[i] / n;
+    return angle;
+}
+
+static void rotation_from_axis_angle(const double k[3], double angle, double R[9]) {
+    double c = cos(angle), s = sin(angle), C = 1 - c;
+    R[0] = c + k[0] * k[0] * C;
+    R[1] = k[0] * k[1] * C - k[2] * s;
+    R[2] = k[0] * k[2] * C + k[1] * s;
+    R[3] = k[1] * k[0] * C + k[2] * s;
+    R[4] = c + k[1] * k[1] * C;
+    R[5] = k[1] * k[2] * C - k[0] * s;
+    R[6] = k[2] * k[0] * C - k[1] * s;
+    R[7] = k[2] * k[1] * C + k[0] * s;
+    R[8] = c + k[2] * k[2] * C;
+}
+
+static int seq_alloc(sw_pose_seq *q, int32_t npose, int32_t nb, int32_t nv) {
+    q->npose = npose;
+    q->T = malloc((size_t)npose * 12 * nb * sizeof(double));
+    q->x = malloc((size_t)npose * 3 * nv * sizeof(double));
+    return q->T && q->x;
+}
+
+static uint64_t splitmix(uint64_t *s) {
+    uint64_t z = (*s += 0x9e3779b97f4a7c15ULL);
+    z = (z ^ (z >> 30)) * 0xbf58476d1ce4e5b9ULL;
+    z = (z ^ (z >> 27)) * 0x94d049bb133111ebULL;
+    return z ^ (z >> 31);
+}
+
+sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
+    const sw_skeleton *sk = &s->ch.skel;
+    const sw_clip *clip = &s->ch.clip;
+    int32_t nb = s->nb, nf = clip->T && clip->nbones == nb ? clip->nframes : 0;
+    int32_t ntrain_frames = nf >= 2 ? (int32_t)floor(nf * (1.0 - s->p->heldout_fraction)) : 0;
+    if (nf >= 2 && ntrain_frames < 1) ntrain_frames = 1;
+    int32_t nheld_frames = nf >= 2 ? nf - ntrain_frames : 0;
+
+    /* the largest rotation each joint reaches in the training frames: its sweep */
+    double *sweep_axis = calloc((size_t)nb * 3, sizeof(double));
+    double *sweep_angle = calloc((size_t)nb, sizeof(double));
+    double *local = malloc((size_t)nb * 9 * sizeof(double));
+    if (!sweep_axis || !sweep_angle || !local) {
+        free(sweep_axis);
+        free(sweep_angle);
+        free(local);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for poses");
+    }
+    for (int32_t f = 0; f < ntrain_frames; ++f)
+        for (int32_t b = 0; b < nb; ++b) {
+            if (sk->parent[b] < 0) continue;
+            double L[9], axis[3];
+            local_rotation(sk, clip->T + (size_t)f * 12 * nb, b, L);
+            double a = rotation_axis_angle(L, axis);
+            if (a > sweep_angle[b]) {
+                sweep_angle[b] = a;
+                memcpy(sweep_axis + 3 * b, axis, sizeof axis);
+            }
+        }
+    if (nf < 2) /* no clip: sweep every joint 90 degrees about an axis across its bone */
+        for (int32_t b = 0; b < nb; ++b) {
+            if (sk->parent[b] < 0) continue;
+            const double *h = sk->joints + 3 * sk->bones[2 * b], *t = sk->joints + 3 * sk->bones[2 * b + 1];
+            double d[3] = {t[0] - h[0], t[1] - h[1], t[2] - h[2]};
+            double z[3] = {0, 0, 1};
+            if (fabs(d[2]) > 0.9 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])) z[1] = 1, z[2] = 0;
+            double a[3] = {d[1] * z[2] - d[2] * z[1], d[2] * z[0] - d[0] * z[2], d[0] * z[1] - d[1] * z[0]};
+            double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            if (n == 0) continue;
+            for (int i = 0; i < 3; ++i) sweep_axis[3 * b + i] = a[i] / n;
+            sweep_angle[b] = 1.5707963267948966; /* 90 degrees */
+        }
+    int32_t njoint = 0;
+    for (int32_t b = 0; b < nb; ++b) njoint += sweep_angle[b] > 1e-3;
+
+    s->ntrain_seq = (ntrain_frames > 0) + njoint;
+    s->train = calloc((size_t)s->ntrain_seq + 1, sizeof(sw_pose_seq));
+    if (!s->train) goto oom;
+    int32_t qi = 0;
+    if (ntrain_frames > 0) {
+        int32_t n = ntrain_frames < s->p->max_train_frames ? ntrain_frames : s->p->max_train_frames;
+        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) goto oom;
+        for (int32_t i = 0; i < n; ++i) {
+            int32_t f = n == 1 ? 0 : (int32_t)((int64_t)i * (ntrain_frames - 1) / (n - 1));
+            memcpy(s->train[qi].T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
+                   12 * nb * sizeof(double));
+        }
+        qi++;
+    }
+    for (int32_t b = 0; b < nb; ++b) {
+        if (!(sweep_angle[b] > 1e-3)) continue;
+        int32_t n = s->p->sweep_samples;
+        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) goto oom;
+        for (int32_t i = 0; i < n; ++i) {
+            for (int32_t k = 0; k < nb; ++k) {
+                double *L = local + 9 * k;
+                memset(L, 0, 9 * sizeof(double));
+                L[0] = L[4] = L[8] = 1;
+            }
+            rotation_from_axis_angle(sweep_axis + 3 * b, sweep_angle[b] * (i + 1) / n, local + 9 * b);
+            sw_forward_kinematics(sk, local, NULL, s->train[qi].T + (size_t)i * 12 * nb);
+        }
+        qi++;
+    }
+    if (nheld_frames > 0) {
+        int32_t n = nheld_frames < s->p->max_train_frames ? nheld_frames : s->p->max_train_frames;
+        if (!seq_alloc(&s->heldout, n, nb, s->nv)) goto oom;
+        for (int32_t i = 0; i < n; ++i) {
+            int32_t f = ntrain_frames + (n == 1 ? 0 : (int32_t)((int64_t)i * (nheld_frames - 1) / (n - 1)));
+            memcpy(s->heldout.T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
+                   12 * nb * sizeof(double));
+        }
+    } else if (s->p->random_poses > 0) {
+        int32_t n = s->p->random_poses;
+        uint64_t seed = s->p->seed;
+        if (!seq_alloc(&s->heldout, n, nb, s->nv)) goto oom;
+        for (int32_t i = 0; i < n; ++i) {
+            for (int32_t k = 0; k < nb; ++k) {
+                double u = (double)(splitmix(&seed) >> 11) * 0x1.0p-53;
+                rotation_from_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
+                if (!(sweep_angle[k] > 0)) {
+                    memset(local + 9 * k, 0, 9 * sizeof(double));
+                    local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;
+                }
+            }
+            sw_forward_kinematics(sk, local, NULL, s->heldout.T + (size_t)i * 12 * nb);
+        }
+    }
+    free(sweep_axis);
+    free(sweep_angle);
+    free(local);
+    if (s->ntrain_seq == 0)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "no training poses: the clip never bends a joint");
+    return SINEW_OK;
+oom:
+    free(sweep_axis);
+    free(sweep_angle);
+    free(local);
+    return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for poses");
+}
+
+typedef struct {
+    sw_bake_state *s;
+    sw_pose_seq **seqs;
+    int32_t nseq;
+    atomic_int next;
+    atomic_int failed; /* sequences whose simulator could not be created */
+} sim_ctx;
+
+static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) {
+    (void)begin;
+    (void)end;
+    (void)worker;
+    sim_ctx *ctx = vctx;
+    sw_bake_state *s = ctx->s;
+    for (;;) { /* dynamic scheduling: sequences differ a lot in cost */
+        int i = atomic_fetch_add(&ctx->next, 1);
+        if (i >= ctx->nseq) break;
+        sw_pose_seq *q = ctx->seqs[i];
+        sw_fullsim_params fp = sw_fullsim_params_default();
+        fp.threads = 1;
+        fp.self_contact = s->p->self_contact;
+        sw_fullsim *sim;
+        sw_error e;
+        if (sw_fullsim_create(&s->ch, &fp, &sim, &e) != SINEW_OK) {
+            atomic_fetch_add(&ctx->failed, 1);
+            continue;
+        }
+        for (int32_t k = 0; k < q->npose; ++k) {
+            sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, NULL);
+            if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
+            memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
+                   (size_t)s->nv * 3 * sizeof(double));
+        }
+        sw_fullsim_destroy(sim);
+    }
+}
+
+sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
+    sw_pose_seq *seqs[4096];
+    int32_t n = 0;
+    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i) seqs[n++] = &s->train[i];
+    if (s->heldout.npose > 0) seqs[n++] = &s->heldout;
+    sim_ctx ctx;
+    ctx.s = s;
+    ctx.seqs = seqs;
+    ctx.nseq = n;
+    atomic_init(&ctx.next, 0);
+    atomic_init(&ctx.failed, 0);
+    /* one task per worker; each worker pulls sequences until none is left */
+    sw_pool_parallel_for(s->pool, sw_pool_size(s->pool), simulate_worker, &ctx);
+    if (atomic_load(&ctx.failed) > 0)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "the full-space simulator rejected the character");
+    for (int32_t i = 0; i < n; ++i)
+        if (seqs[i]->failed)
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                "%d training poses of sequence %d diverged", seqs[i]->failed, i);
+    return SINEW_OK;
+}

@@ -1,0 +1,234 @@
+/* The constant reduced matrices and the blob view (bake.h "reduce").
+ *   springs (eqs. 4.17-4.20): a vertex in domains i and j has copies that skinning
+ *     moves with the same (R_v, t_v), so its spring energy k/2 |U_i q_i - U_j q_j|^2
+ *     is exactly quadratic in q with a constant Hessian, precomputed here;
+ *   mass: U^T M U per domain with each copy's mass from its own domain's tets;
+ *   inertia: the projections the runtime needs for the inertial forces of a domain
+ *     riding its bone (blob_view.h). */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_internal.h"
+#include "fem_corot.h"
+#include "mesh_io.h"
+
+#define OWN(ptr, n, type) ((ptr) = sw_bake_own(out, calloc((size_t)(n) > 0 ? (size_t)(n) : 1, sizeof(type))))
+
+sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    int32_t R = s->rank_total, nd = s->nd, ncopies = s->dom_vert_ptr[nd];
+    double kspring = s->p->spring_k > 0 ? s->p->spring_k : 20.0 * s->ch.youngs;
+    sw_surface surf;
+    memset(&surf, 0, sizeof surf);
+    sinew_result r = sw_tetmesh_surface(&s->ch.mesh, &surf, err);
+    if (r != SINEW_OK) return r;
+
+    int32_t ncub = 0;
+    int64_t nbasis = 0, ninertia = 0;
+    for (int32_t d = 0; d < nd; ++d) {
+        ncub += s->cub_n[d];
+        nbasis += (int64_t)(s->dom_vert_ptr[d + 1] - s->dom_vert_ptr[d]) * 3 * s->rank[d];
+        ninertia += 9 * (int64_t)s->rank[d] * s->rank[d];
+    }
+    double *rest, *skin_weight, *joints, *basis, *cub_weight, *cub_dminv, *cub_vol, *spring, *mass;
+    double *ins, *inx, *inu;
+    int32_t *skin_bone, *parent, *dverts, *cub_tets, *surf_tris, *copy_ptr, *copies;
+    sw_blob_domain *doms;
+    OWN(rest, 3 * s->nv, double);
+    OWN(skin_bone, 4 * s->nv, int32_t);
+    OWN(skin_weight, 4 * s->nv, double);
+    OWN(parent, s->nb, int32_t);
+    OWN(joints, 6 * s->nb, double);
+    OWN(doms, nd, sw_blob_domain);
+    OWN(dverts, ncopies, int32_t);
+    OWN(basis, nbasis, double);
+    OWN(cub_tets, 4 * ncub, int32_t);
+    OWN(cub_weight, ncub, double);
+    OWN(cub_dminv, 9 * ncub, double);
+    OWN(cub_vol, ncub, double);
+    OWN(spring, (int64_t)R * R, double);
+    OWN(mass, (int64_t)R * R, double);
+    OWN(ins, 3 * R, double);
+    OWN(inx, 9 * R, double);
+    OWN(inu, ninertia, double);
+    OWN(surf_tris, 3 * surf.ntris, int32_t);
+    OWN(copy_ptr, surf.nverts + 1, int32_t);
+    int32_t *copy_ptr_v = calloc((size_t)s->nv + 1, sizeof(int32_t)); /* copies per vertex */
+    int32_t *copy_list = malloc((size_t)ncopies * 2 * sizeof(int32_t));
+    int32_t *surf_index = malloc((size_t)s->nv * sizeof(int32_t));
+    if (!rest || !skin_bone || !skin_weight || !parent || !joints || !doms || !dverts || !basis ||
+        !cub_tets || !cub_weight || !cub_dminv || !cub_vol || !spring || !mass || !ins || !inx ||
+        !inu || !surf_tris || !copy_ptr || !copy_ptr_v || !copy_list || !surf_index ||
+        out->nstorage >= (int)(sizeof out->storage / sizeof out->storage[0])) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+        goto done;
+    }
+    memcpy(rest, s->ch.mesh.X, (size_t)s->nv * 3 * sizeof(double));
+    memcpy(skin_bone, s->skin_bone, (size_t)s->nv * 4 * sizeof(int32_t));
+    memcpy(skin_weight, s->skin_weight, (size_t)s->nv * 4 * sizeof(double));
+    for (int32_t b = 0; b < s->nb; ++b) {
+        parent[b] = s->ch.skel.parent[b];
+        memcpy(joints + 6 * b, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b], 3 * sizeof(double));
+        memcpy(joints + 6 * b + 3, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b + 1], 3 * sizeof(double));
+    }
+    memcpy(dverts, s->dom_verts, (size_t)ncopies * sizeof(int32_t));
+
+    /* domains, basis, cubature, mass and inertia per domain */
+    int32_t qoff = 0, cub = 0;
+    int64_t boff = 0, ioff = 0;
+    for (int32_t d = 0; d < nd; ++d) {
+        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base, r_d = s->rank[d];
+        sw_blob_domain *D = &doms[d];
+        memset(D, 0, sizeof *D);
+        D->bone = s->domain_bone[d];
+        D->vert_begin = base;
+        D->vert_count = n;
+        D->rank = r_d;
+        D->q_offset = qoff;
+        D->cub_begin = cub;
+        D->cub_count = s->cub_n[d];
+        D->basis_offset = boff;
+        D->inertia_offset = ioff;
+        const double *U = s->basis[d];
+        memcpy(basis + boff, U, (size_t)n * 3 * r_d * sizeof(double));
+        int32_t *local_of = surf_index; /* scratch: global -> local for this domain */
+        for (int32_t k = 0; k < n; ++k) local_of[s->dom_verts[base + k]] = k;
+        for (int32_t i = 0; i < s->cub_n[d]; ++i, ++cub) {
+            int32_t tet = s->dom_tets[s->dom_tet_ptr[d] + s->cub_local[d][i]];
+            double Xe[12];
+            for (int k = 0; k < 4; ++k) {
+                int32_t gv = s->ch.mesh.tets[4 * (int64_t)tet + k];
+                cub_tets[4 * cub + k] = local_of[gv];
+                memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)gv, 24);
+            }
+            sw_tet_rest(Xe, cub_dminv + 9 * cub, cub_vol + cub);
+            cub_weight[cub] = s->cub_w[d][i];
+        }
+        for (int32_t k = 0; k < n; ++k) {
+            double m = s->copy_mass[base + k];
+            const double *Uk = U + (size_t)3 * k * r_d, *X = s->ch.mesh.X + 3 * (int64_t)s->dom_verts[base + k];
+            for (int32_t i = 0; i < r_d; ++i) {
+                for (int a = 0; a < 3; ++a) {
+                    double u = m * Uk[a * r_d + i];
+                    if (u == 0) continue;
+                    ins[3 * (qoff + i) + a] += u;
+                    for (int bb = 0; bb < 3; ++bb) inx[9 * (qoff + i) + 3 * a + bb] += u * X[bb];
+                    for (int bb = 0; bb < 3; ++bb)
+                        for (int32_t j = 0; j < r_d; ++j)
+                            inu[ioff + (int64_t)(3 * a + bb) * r_d * r_d + (int64_t)i * r_d + j] +=
+                                u * Uk[bb * r_d + j];
+                    for (int32_t j = 0; j < r_d; ++j)
+                        mass[(int64_t)(qoff + i) * R + qoff + j] += u * Uk[a * r_d + j];
+                }
+            }
+        }
+        qoff += r_d;
+        boff += (int64_t)n * 3 * r_d;
+        ioff += 9 * (int64_t)r_d * r_d;
+    }
+    /* copies of each vertex: (domain, local) */
+    for (int32_t d = 0; d < nd; ++d)
+        for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k) copy_ptr_v[s->dom_verts[k] + 1]++;
+    for (int32_t i = 0; i < s->nv; ++i) copy_ptr_v[i + 1] += copy_ptr_v[i];
+    {
+        int32_t *fill = surf_index;
+        memcpy(fill, copy_ptr_v, (size_t)s->nv * sizeof(int32_t));
+        for (int32_t d = 0; d < nd; ++d)
+            for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k) {
+                int32_t gv = s->dom_verts[k], at = fill[gv]++;
+                copy_list[2 * at] = d;
+                copy_list[2 * at + 1] = k - s->dom_vert_ptr[d];
+            }
+    }
+    /* interface springs: every pair of copies of a vertex (eq. 4.20) */
+    for (int32_t gv = 0; gv < s->nv; ++gv)
+        for (int32_t a = copy_ptr_v[gv]; a < copy_ptr_v[gv + 1]; ++a)
+            for (int32_t b = a + 1; b < copy_ptr_v[gv + 1]; ++b) {
+                int32_t di = copy_list[2 * a], li = copy_list[2 * a + 1];
+                int32_t dj = copy_list[2 * b], lj = copy_list[2 * b + 1];
+                int32_t ri = s->rank[di], rj = s->rank[dj];
+                const double *Ui = s->basis[di] + (size_t)3 * li * ri, *Uj = s->basis[dj] + (size_t)3 * lj * rj;
+                int32_t oi = doms[di].q_offset, oj = doms[dj].q_offset;
+                for (int c = 0; c < 3; ++c) {
+                    for (int32_t x = 0; x < ri; ++x) {
+                        double ux = kspring * Ui[c * ri + x];
+                        if (ux == 0) continue;
+                        for (int32_t y = 0; y < ri; ++y) spring[(int64_t)(oi + x) * R + oi + y] += ux * Ui[c * ri + y];
+                        for (int32_t y = 0; y < rj; ++y) {
+                            spring[(int64_t)(oi + x) * R + oj + y] -= ux * Uj[c * rj + y];
+                            spring[(int64_t)(oj + y) * R + oi + x] -= ux * Uj[c * rj + y];
+                        }
+                    }
+                    for (int32_t x = 0; x < rj; ++x) {
+                        double ux = kspring * Uj[c * rj + x];
+                        if (ux == 0) continue;
+                        for (int32_t y = 0; y < rj; ++y) spring[(int64_t)(oj + x) * R + oj + y] += ux * Uj[c * rj + y];
+                    }
+                }
+            }
+    /* output surface: the tet mesh's boundary; each vertex the mean of its copies */
+    for (int32_t i = 0; i < s->nv; ++i) surf_index[i] = -1;
+    for (int32_t i = 0; i < surf.nverts; ++i) surf_index[surf.verts[i]] = i;
+    for (int32_t i = 0; i < 3 * surf.ntris; ++i) surf_tris[i] = surf_index[surf.tris[i]];
+    int32_t nsc = 0;
+    for (int32_t i = 0; i < surf.nverts; ++i) {
+        int32_t gv = surf.verts[i];
+        copy_ptr[i] = nsc;
+        nsc += copy_ptr_v[gv + 1] - copy_ptr_v[gv];
+    }
+    copy_ptr[surf.nverts] = nsc;
+    OWN(copies, 2 * nsc, int32_t);
+    if (!copies) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+        goto done;
+    }
+    for (int32_t i = 0; i < surf.nverts; ++i) {
+        int32_t gv = surf.verts[i];
+        memcpy(copies + 2 * copy_ptr[i], copy_list + 2 * copy_ptr_v[gv],
+               (size_t)(copy_ptr_v[gv + 1] - copy_ptr_v[gv]) * 2 * sizeof(int32_t));
+    }
+
+    v->nverts = s->nv;
+    v->nbones = s->nb;
+    v->ndomains = nd;
+    v->rank_total = R;
+    v->ndomain_verts = ncopies;
+    v->ncub = ncub;
+    v->nsurf_verts = surf.nverts;
+    v->nsurf_tris = surf.ntris;
+    sw_lame(s->ch.youngs, s->ch.poisson, &v->mu, &v->lambda);
+    v->rayleigh_alpha = 0.01; /* thesis §2.1.3 */
+    v->rayleigh_beta = 0.001;
+    v->contact_k = 1e5; /* DESIGN.md §8: run-time penalty */
+    v->rest = rest;
+    v->skin_bone = skin_bone;
+    v->skin_weight = skin_weight;
+    v->bone_parent = parent;
+    v->bone_joints = joints;
+    v->domains = doms;
+    v->domain_verts = dverts;
+    v->basis = basis;
+    v->nbasis = nbasis;
+    v->cub_tets = cub_tets;
+    v->cub_weight = cub_weight;
+    v->cub_dminv = cub_dminv;
+    v->cub_vol = cub_vol;
+    v->spring_hessian = spring;
+    v->mass = mass;
+    v->inertia_s = ins;
+    v->inertia_x = inx;
+    v->inertia_u = inu;
+    v->ninertia_u = ninertia;
+    v->surf_tris = surf_tris;
+    v->surf_copy_ptr = copy_ptr;
+    v->surf_copies = copies;
+    v->nsurf_copies = nsc;
+    r = SINEW_OK;
+done:
+    free(copy_ptr_v);
+    free(copy_list);
+    free(surf_index);
+    sw_surface_free(&surf);
+    return r;
+}

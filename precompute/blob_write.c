@@ -1,0 +1,209 @@
+/* Blob layout: header (64 bytes), section table (21 entries), then the 21 sections in id
+ * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
+ * everything after the header. */
+#include "blob_write.h"
+
+#include <errno.h>
+#include <fcntl.h>
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "blob_load.h"
+
+typedef struct section_src {
+    uint32_t id, elem_size;
+    const void *src;
+    uint64_t count;
+} section_src;
+
+static uint64_t round_up(uint64_t x) {
+    return (x + SINEW_BLOB_ALIGN - 1) / SINEW_BLOB_ALIGN * SINEW_BLOB_ALIGN;
+}
+
+/* The 21 sections of a validated view, in id order; `meta` must outlive the result. */
+static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
+                          section_src s[SINEW_SECTION_COUNT_V1]) {
+    const uint64_t n = (uint64_t)v->nverts, nb = (uint64_t)v->nbones, nc = (uint64_t)v->ncub,
+                   R = (uint64_t)v->rank_total;
+    const section_src list[SINEW_SECTION_COUNT_V1] = {
+        {SINEW_SECTION_META, sizeof *meta, meta, 1},
+        {SINEW_SECTION_REST, 8, v->rest, 3 * n},
+        {SINEW_SECTION_SKIN_BONE, 4, v->skin_bone, 4 * n},
+        {SINEW_SECTION_SKIN_WEIGHT, 8, v->skin_weight, 4 * n},
+        {SINEW_SECTION_BONE_PARENT, 4, v->bone_parent, nb},
+        {SINEW_SECTION_BONE_JOINTS, 8, v->bone_joints, 6 * nb},
+        {SINEW_SECTION_DOMAINS, sizeof(sw_blob_domain), v->domains, (uint64_t)v->ndomains},
+        {SINEW_SECTION_DOMAIN_VERTS, 4, v->domain_verts, (uint64_t)v->ndomain_verts},
+        {SINEW_SECTION_BASIS, 8, v->basis, (uint64_t)v->nbasis},
+        {SINEW_SECTION_CUB_TETS, 4, v->cub_tets, 4 * nc},
+        {SINEW_SECTION_CUB_WEIGHT, 8, v->cub_weight, nc},
+        {SINEW_SECTION_CUB_DMINV, 8, v->cub_dminv, 9 * nc},
+        {SINEW_SECTION_CUB_VOL, 8, v->cub_vol, nc},
+        {SINEW_SECTION_SPRING_HESSIAN, 8, v->spring_hessian, R * R},
+        {SINEW_SECTION_MASS, 8, v->mass, R * R},
+        {SINEW_SECTION_INERTIA_S, 8, v->inertia_s, 3 * R},
+        {SINEW_SECTION_INERTIA_X, 8, v->inertia_x, 9 * R},
+        {SINEW_SECTION_INERTIA_U, 8, v->inertia_u, (uint64_t)v->ninertia_u},
+        {SINEW_SECTION_SURF_TRIS, 4, v->surf_tris, 3 * (uint64_t)v->nsurf_tris},
+        {SINEW_SECTION_SURF_COPY_PTR, 4, v->surf_copy_ptr, (uint64_t)v->nsurf_verts + 1},
+        {SINEW_SECTION_SURF_COPIES, 4, v->surf_copies, 2 * (uint64_t)v->nsurf_copies}};
+    memcpy(s, list, sizeof list);
+}
+
+sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t *size,
+                                  sw_error *err) {
+    if (data) *data = NULL;
+    if (size) *size = 0;
+    if (!view || !data || !size)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "blob write: view, data and size must not be NULL");
+    char msg[512];
+    sinew_result r = sw_blob_validate_view(view, msg, sizeof msg);
+    if (r != SINEW_OK) return sw_error_set(err, r, "blob write: invalid view: %s", msg);
+
+    sinew_blob_meta meta;
+    memset(&meta, 0, sizeof meta);
+    meta.nverts = view->nverts, meta.nbones = view->nbones, meta.ndomains = view->ndomains;
+    meta.rank_total = view->rank_total, meta.ndomain_verts = view->ndomain_verts;
+    meta.ncub = view->ncub, meta.nsurf_verts = view->nsurf_verts;
+    meta.nsurf_tris = view->nsurf_tris;
+    meta.mu = view->mu, meta.lambda = view->lambda, meta.rayleigh_alpha = view->rayleigh_alpha;
+    meta.rayleigh_beta = view->rayleigh_beta, meta.contact_k = view->contact_k;
+
+    section_src src[SINEW_SECTION_COUNT_V1];
+    sinew_blob_section table[SINEW_SECTION_COUNT_V1];
+    list_sections(view, &meta, src);
+    /* Validated counts are bounded (blob_load.h limits), so no sum below overflows. */
+    uint64_t at = round_up(sizeof(sinew_blob_header) + sizeof table);
+    for (int i = 0; i < SINEW_SECTION_COUNT_V1; ++i) {
+        memset(&table[i], 0, sizeof table[i]);
+        table[i].id = src[i].id;
+        table[i].elem_size = src[i].elem_size;
+        table[i].offset = at;
+        table[i].count = src[i].count;
+        at = round_up(at + src[i].count * src[i].elem_size);
+    }
+    if (at > SIZE_MAX)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                            "blob write: %llu bytes do not fit in memory", (unsigned long long)at);
+    const size_t total = (size_t)at;
+    uint8_t *buf = aligned_alloc(SINEW_BLOB_ALIGN, total); /* total is a multiple of 64 */
+    if (!buf)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "blob write: cannot allocate %zu bytes",
+                            total);
+    memset(buf, 0, total); /* padding is zero */
+    memcpy(buf + sizeof(sinew_blob_header), table, sizeof table);
+    for (int i = 0; i < SINEW_SECTION_COUNT_V1; ++i)
+        memcpy(buf + table[i].offset, src[i].src, (size_t)(src[i].count * src[i].elem_size));
+
+    sinew_blob_header h;
+    memset(&h, 0, sizeof h);
+    memcpy(h.magic, SINEW_BLOB_MAGIC, sizeof h.magic);
+    h.version = SINEW_BLOB_VERSION;
+    h.header_size = (uint32_t)sizeof h;
+    h.file_size = total;
+    h.section_count = SINEW_SECTION_COUNT_V1;
+    h.endian_tag = SINEW_BLOB_ENDIAN_TAG;
+    h.section_table_offset = sizeof h;
+    h.checksum = sw_blob_checksum(buf + sizeof h, total - sizeof h);
+    memcpy(buf, &h, sizeof h);
+
+    /* Self-check: the bytes must load. A failure here is a writer bug, not the bake's. */
+    sw_blob_view check;
+    r = sw_blob_parse(buf, total, &check, msg, sizeof msg);
+    if (r != SINEW_OK) {
+        free(buf);
+        return sw_error_set(err, r, "blob write: internal error, the written blob fails: %s", msg);
+    }
+    *data = buf;
+    *size = total;
+    return SINEW_OK;
+}
+
+static sinew_result io_error(sw_error *err, const char *what, const char *file, int e) {
+    char why[128];
+    if (strerror_r(e, why, sizeof why) != 0) snprintf(why, sizeof why, "errno %d", e);
+    return sw_error_set(err, SINEW_ERROR_IO, "blob write: cannot %s '%s': %s", what, file, why);
+}
+
+static int write_all(int fd, const uint8_t *p, size_t n) {
+    while (n > 0) {
+        ssize_t w = write(fd, p, n > ((size_t)1 << 30) ? ((size_t)1 << 30) : n);
+        if (w < 0 && errno == EINTR) continue;
+        if (w <= 0) return -1;
+        p += w;
+        n -= (size_t)w;
+    }
+    return 0;
+}
+
+/* fsync of the folder holding `path`, so the rename itself survives a crash. Best
+ * effort: some file systems refuse to fsync a directory. */
+static void sync_parent(const char *path) {
+    const char *slash = strrchr(path, '/');
+    char dir[4096];
+    if (!slash)
+        snprintf(dir, sizeof dir, ".");
+    else if (slash == path)
+        snprintf(dir, sizeof dir, "/");
+    else if ((size_t)(slash - path) < sizeof dir)
+        snprintf(dir, sizeof dir, "%.*s", (int)(slash - path), path);
+    else
+        return;
+    int fd = open(dir, O_RDONLY | O_CLOEXEC);
+    if (fd < 0) return;
+    (void)fsync(fd);
+    close(fd);
+}
+
+static sinew_result write_file_atomic(const char *path, const uint8_t *data, size_t size,
+                                      sw_error *err) {
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (!tmp) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "blob write: out of memory");
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 5);
+    sinew_result r = SINEW_OK;
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
+    if (fd < 0) {
+        r = io_error(err, "create", tmp, errno);
+        free(tmp);
+        return r;
+    }
+    if (write_all(fd, data, size) != 0)
+        r = io_error(err, "write", tmp, errno);
+    else if (fsync(fd) != 0)
+        r = io_error(err, "fsync", tmp, errno);
+    if (close(fd) != 0 && r == SINEW_OK) r = io_error(err, "close", tmp, errno);
+    if (r == SINEW_OK && rename(tmp, path) != 0) {
+        int e = errno;
+        r = sw_error_set(err, SINEW_ERROR_IO, "blob write: cannot rename '%s' to '%s': ", tmp,
+                         path);
+        if (err) {
+            size_t used = strlen(err->msg);
+            if (strerror_r(e, err->msg + used, sizeof err->msg - used) != 0)
+                snprintf(err->msg + used, sizeof err->msg - used, "errno %d", e);
+        }
+    }
+    if (r != SINEW_OK)
+        unlink(tmp);
+    else
+        sync_parent(path);
+    free(tmp);
+    return r;
+}
+
+sinew_result sw_blob_write(const char *path, const sw_blob_view *view, sw_error *err) {
+    if (!path || !path[0])
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "blob write: no path given");
+    void *data = NULL;
+    size_t size = 0;
+    sinew_result r = sw_blob_write_memory(view, &data, &size, err);
+    if (r != SINEW_OK) return r;
+    r = write_file_atomic(path, data, size, err);
+    free(data);
+    return r;
+}

@@ -1,0 +1,24 @@
+/* Accuracy of a baked subspace against the full-space reference (DESIGN.md §7):
+ * the correction error  |x_sub - x_full|_M / |x_full - x_dqs|_M, the share of the
+ * physics correction the subspace misses (0 exact, 1 no better than skinning), summed
+ * over frames before the ratio (so frames with almost no correction do not dominate). */
+#ifndef SW_SUBSPACE_EVAL_H
+#define SW_SUBSPACE_EVAL_H
+
+#include "sinew/sinew.h"
+#include "sw_error.h"
+
+typedef struct sw_eval_result {
+    double correction_error; /* the ratio above */
+    double rel_l2;           /* |x_sub - x_full| / |x_full - rest| (thesis §4.5 style) */
+    int32_t frames;
+    int32_t failed; /* steps that did not return SINEW_OK */
+} sw_eval_result;
+
+/* Steps a fresh quasistatic instance of `blob` through npose poses (12 doubles per bone
+ * each) in order with at most max_newton iterations a step, comparing every frame with
+ * x_full (3 nverts per pose) under vertex masses `mass` (nverts). */
+sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,
+                                const double *x_full, int32_t npose, uint32_t max_newton,
+                                sw_eval_result *out, sw_error *err);
+#endif

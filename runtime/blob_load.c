@@ -1,0 +1,653 @@
+/* Blob parser and validator. Two layers, run in this order so that no check ever reads
+ * past what an earlier check proved to exist:
+ *   1. bytes: header, section table, section bounds/alignment/overlap, checksum, and the
+ *      count of every section against META (sw_blob_parse);
+ *   2. view: domain records, derived counts, every index and every value
+ *      (sw_blob_validate_view, shared with the writer).
+ * All arithmetic on file-supplied numbers is done in uint64/int64 after range checks
+ * that keep it from overflowing. */
+#include "blob_load.h"
+
+#include <math.h>
+#include <stdarg.h>
+#include <stdio.h>
+#include <string.h>
+
+_Static_assert(sizeof(sinew_blob_header) == 64, "blob header is 64 bytes");
+_Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
+_Static_assert(sizeof(sinew_blob_meta) == 72, "META is 72 bytes");
+_Static_assert(sizeof(sinew_blob_domain_record) == 48, "domain record is 48 bytes");
+_Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vertex");
+
+#define HEADER_SIZE ((uint64_t)sizeof(sinew_blob_header))
+#define ENTRY_SIZE ((uint64_t)sizeof(sinew_blob_section))
+
+static const char *const k_section_names[SINEW_SECTION_COUNT_V1 + 1] = {
+    "unknown",     "META",      "REST",           "SKIN_BONE",  "SKIN_WEIGHT", "BONE_PARENT",
+    "BONE_JOINTS", "DOMAINS",   "DOMAIN_VERTS",   "BASIS",      "CUB_TETS",    "CUB_WEIGHT",
+    "CUB_DMINV",   "CUB_VOL",   "SPRING_HESSIAN", "MASS",       "INERTIA_S",   "INERTIA_X",
+    "INERTIA_U",   "SURF_TRIS", "SURF_COPY_PTR",  "SURF_COPIES"};
+
+/* Element size of every known section (format header table). */
+static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {0, 72, 8, 4, 8, 4, 8, 48, 4, 8, 4,
+                                                                 8, 8,  8, 8, 8, 8, 8, 8,  4, 4, 4};
+
+uint64_t sw_blob_checksum(const void *data, size_t n) {
+    const uint8_t *p = data;
+    uint64_t h = 0xcbf29ce484222325ull; /* FNV-1a 64 offset basis */
+    for (size_t i = 0; i < n; ++i) {
+        h ^= p[i];
+        h *= 0x100000001b3ull; /* FNV 64 prime */
+    }
+    return h;
+}
+
+const char *sw_blob_section_name(uint32_t id) {
+    return id >= 1 && id <= SINEW_SECTION_COUNT_V1 ? k_section_names[id] : k_section_names[0];
+}
+
+static sinew_result fail(char *msg, size_t msg_size, sinew_result code, const char *fmt, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 4, 5)))
+#endif
+    ;
+
+static sinew_result fail(char *msg, size_t msg_size, sinew_result code, const char *fmt, ...) {
+    if (msg && msg_size) {
+        va_list ap;
+        va_start(ap, fmt);
+        vsnprintf(msg, msg_size, fmt, ap);
+        va_end(ap);
+    }
+    return code;
+}
+
+/* ---- layer 2: the view ----------------------------------------------------------- */
+
+static sinew_result check_count(const char *field, int64_t value, int64_t lo, int64_t hi, char *msg,
+                                size_t msg_size) {
+    if (value < lo || value > hi)
+        return fail(msg, msg_size, SINEW_ERROR_CORRUPT,
+                    "blob section META: %s = %lld outside [%lld, %lld]", field, (long long)value,
+                    (long long)lo, (long long)hi);
+    return SINEW_OK;
+}
+
+static sinew_result check_meta(const sw_blob_view *v, char *msg, size_t ms) {
+    const struct {
+        const char *name;
+        int64_t value, lo, hi;
+    } counts[] = {
+        {"nverts", v->nverts, 1, SW_BLOB_MAX_COUNT},
+        {"nbones", v->nbones, 1, SW_BLOB_MAX_BONES},
+        {"ndomains", v->ndomains, 1, v->nbones},
+        {"rank_total", v->rank_total, 1, SW_BLOB_MAX_RANK_TOTAL},
+        {"ndomain_verts", v->ndomain_verts, 1, SW_BLOB_MAX_COUNT},
+        {"ncub", v->ncub, 1, SW_BLOB_MAX_COUNT},
+        {"nsurf_verts", v->nsurf_verts, 1, SW_BLOB_MAX_COUNT},
+        {"nsurf_tris", v->nsurf_tris, 1, SW_BLOB_MAX_COUNT},
+    };
+    for (size_t i = 0; i < sizeof counts / sizeof counts[0]; ++i) {
+        sinew_result r =
+            check_count(counts[i].name, counts[i].value, counts[i].lo, counts[i].hi, msg, ms);
+        if (r != SINEW_OK) return r;
+    }
+    const struct {
+        const char *name;
+        double value;
+    } mat[] = {{"mu", v->mu},
+               {"lambda", v->lambda},
+               {"rayleigh_alpha", v->rayleigh_alpha},
+               {"rayleigh_beta", v->rayleigh_beta},
+               {"contact_k", v->contact_k}};
+    for (size_t i = 0; i < sizeof mat / sizeof mat[0]; ++i) {
+        if (!isfinite(mat[i].value))
+            return fail(msg, ms, SINEW_ERROR_NOT_FINITE, "blob section META: %s is %g", mat[i].name,
+                        mat[i].value);
+        /* Damping and contact stiffness below zero would inject energy. */
+        if (i >= 2 && mat[i].value < 0.0)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section META: %s = %g is negative",
+                        mat[i].name, mat[i].value);
+    }
+    /* A stable isotropic material: shear modulus and bulk modulus (lambda + 2/3 mu)
+     * positive. */
+    if (!(v->mu > 0.0) || !(3.0 * v->lambda + 2.0 * v->mu > 0.0))
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section META: unstable material mu = %g, lambda = %g (need mu > 0 "
+                    "and 3 lambda + 2 mu > 0)",
+                    v->mu, v->lambda);
+    return SINEW_OK;
+}
+
+static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) {
+    const struct {
+        const void *p;
+        uint32_t id;
+    } arrays[] = {{v->rest, SINEW_SECTION_REST},
+                  {v->skin_bone, SINEW_SECTION_SKIN_BONE},
+                  {v->skin_weight, SINEW_SECTION_SKIN_WEIGHT},
+                  {v->bone_parent, SINEW_SECTION_BONE_PARENT},
+                  {v->bone_joints, SINEW_SECTION_BONE_JOINTS},
+                  {v->domains, SINEW_SECTION_DOMAINS},
+                  {v->domain_verts, SINEW_SECTION_DOMAIN_VERTS},
+                  {v->basis, SINEW_SECTION_BASIS},
+                  {v->cub_tets, SINEW_SECTION_CUB_TETS},
+                  {v->cub_weight, SINEW_SECTION_CUB_WEIGHT},
+                  {v->cub_dminv, SINEW_SECTION_CUB_DMINV},
+                  {v->cub_vol, SINEW_SECTION_CUB_VOL},
+                  {v->spring_hessian, SINEW_SECTION_SPRING_HESSIAN},
+                  {v->mass, SINEW_SECTION_MASS},
+                  {v->inertia_s, SINEW_SECTION_INERTIA_S},
+                  {v->inertia_x, SINEW_SECTION_INERTIA_X},
+                  {v->inertia_u, SINEW_SECTION_INERTIA_U},
+                  {v->surf_tris, SINEW_SECTION_SURF_TRIS},
+                  {v->surf_copy_ptr, SINEW_SECTION_SURF_COPY_PTR},
+                  {v->surf_copies, SINEW_SECTION_SURF_COPIES}};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
+        if (!arrays[i].p)
+            return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
+                        "blob section %s: the view's array is NULL",
+                        sw_blob_section_name(arrays[i].id));
+    return SINEW_OK;
+}
+
+/* One domain record against the running prefix sums of the domains before it. */
+static sinew_result check_domain(const sw_blob_view *v, int32_t d, const int64_t sum[5], char *msg,
+                                 size_t ms) {
+    const sw_blob_domain *dom = &v->domains[d];
+#define DFAIL(...)                                                                                 \
+    fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section DOMAINS: domain %d: " __VA_ARGS__)
+    if (dom->bone < 0 || dom->bone >= v->nbones)
+        return DFAIL("bone %d outside [0, %d)", d, dom->bone, v->nbones);
+    if (dom->rank < 1 || dom->rank > SW_BLOB_MAX_RANK)
+        return DFAIL("rank %d outside [1, %d]", d, dom->rank, SW_BLOB_MAX_RANK);
+    if (dom->vert_begin != sum[0])
+        return DFAIL("vert_begin %d, expected %lld (after the previous domains' copies)", d,
+                     dom->vert_begin, (long long)sum[0]);
+    if (dom->vert_count < 1 || dom->vert_count > v->ndomain_verts - sum[0])
+        return DFAIL("vert_count %d outside [1, %lld] (DOMAIN_VERTS holds %d copies)", d,
+                     dom->vert_count, (long long)(v->ndomain_verts - sum[0]), v->ndomain_verts);
+    if (dom->q_offset != sum[1])
+        return DFAIL("q_offset %d, expected %lld (sum of the previous ranks)", d, dom->q_offset,
+                     (long long)sum[1]);
+    if (dom->rank > v->rank_total - sum[1])
+        return DFAIL("rank %d runs past rank_total %d", d, dom->rank, v->rank_total);
+    if (dom->cub_begin != sum[2])
+        return DFAIL("cub_begin %d, expected %lld", d, dom->cub_begin, (long long)sum[2]);
+    if (dom->cub_count < 1 || dom->cub_count > v->ncub - sum[2])
+        return DFAIL("cub_count %d outside [1, %lld] (ncub %d)", d, dom->cub_count,
+                     (long long)(v->ncub - sum[2]), v->ncub);
+    if (dom->basis_offset != sum[3])
+        return DFAIL("basis_offset %lld, expected %lld", d, (long long)dom->basis_offset,
+                     (long long)sum[3]);
+    if (dom->inertia_offset != sum[4])
+        return DFAIL("inertia_offset %lld, expected %lld", d, (long long)dom->inertia_offset,
+                     (long long)sum[4]);
+    if (dom->reserved != 0) return DFAIL("reserved field is %d, not 0", d, dom->reserved);
+#undef DFAIL
+    return SINEW_OK;
+}
+
+static sinew_result check_domains(const sw_blob_view *v, char *msg, size_t ms) {
+    /* Prefix sums: vertex copies, q, cubature, basis doubles, inertia_u doubles. The
+     * per-domain bounds checked first keep them far from overflow. */
+    int64_t sum[5] = {0, 0, 0, 0, 0};
+    for (int32_t d = 0; d < v->ndomains; ++d) {
+        sinew_result r = check_domain(v, d, sum, msg, ms);
+        if (r != SINEW_OK) return r;
+        const sw_blob_domain *dom = &v->domains[d];
+        sum[0] += dom->vert_count;
+        sum[1] += dom->rank;
+        sum[2] += dom->cub_count;
+        sum[3] += (int64_t)dom->vert_count * 3 * dom->rank;
+        sum[4] += (int64_t)9 * dom->rank * dom->rank;
+    }
+    if (sum[0] != v->ndomain_verts)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section DOMAINS: domains hold %lld vertex copies, META ndomain_verts "
+                    "is %d",
+                    (long long)sum[0], v->ndomain_verts);
+    if (sum[1] != v->rank_total)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section DOMAINS: ranks sum to %lld, META rank_total is %d",
+                    (long long)sum[1], v->rank_total);
+    if (sum[2] != v->ncub)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section DOMAINS: domains own %lld cubature tets, META ncub is %d",
+                    (long long)sum[2], v->ncub);
+    if (sum[3] != v->nbasis)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section BASIS: holds %lld doubles, the domains need %lld",
+                    (long long)v->nbasis, (long long)sum[3]);
+    if (sum[4] != v->ninertia_u)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section INERTIA_U: holds %lld doubles, the domains need %lld",
+                    (long long)v->ninertia_u, (long long)sum[4]);
+    return SINEW_OK;
+}
+
+static sinew_result check_copy_ptr(const sw_blob_view *v, char *msg, size_t ms) {
+    if (v->nsurf_copies < 1 || v->nsurf_copies > SW_BLOB_MAX_COPIES)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section SURF_COPIES: %d copies outside [1, %d]", v->nsurf_copies,
+                    SW_BLOB_MAX_COPIES);
+    if (v->surf_copy_ptr[0] != 0)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section SURF_COPY_PTR: element 0 is %d, not 0", v->surf_copy_ptr[0]);
+    /* Strictly increasing: a surface vertex is the mean of its copies, so it needs one. */
+    for (int32_t i = 0; i < v->nsurf_verts; ++i)
+        if (v->surf_copy_ptr[i + 1] <= v->surf_copy_ptr[i])
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section SURF_COPY_PTR: surface vertex %d has %lld copies (ptr %d "
+                        "-> %d); every surface vertex needs at least one",
+                        i, (long long)v->surf_copy_ptr[i + 1] - v->surf_copy_ptr[i],
+                        v->surf_copy_ptr[i], v->surf_copy_ptr[i + 1]);
+    if (v->surf_copy_ptr[v->nsurf_verts] != v->nsurf_copies)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section SURF_COPY_PTR: last element %d, but SURF_COPIES holds %d "
+                    "copies",
+                    v->surf_copy_ptr[v->nsurf_verts], v->nsurf_copies);
+    return SINEW_OK;
+}
+
+static sinew_result check_finite(uint32_t id, const double *a, int64_t n, char *msg, size_t ms) {
+    for (int64_t i = 0; i < n; ++i)
+        if (!isfinite(a[i]))
+            return fail(msg, ms, SINEW_ERROR_NOT_FINITE, "blob section %s: element %lld is %g",
+                        sw_blob_section_name(id), (long long)i, a[i]);
+    return SINEW_OK;
+}
+
+static sinew_result check_all_finite(const sw_blob_view *v, char *msg, size_t ms) {
+    const int64_t n = v->nverts, nb = v->nbones, nc = v->ncub, R = v->rank_total;
+    const struct {
+        uint32_t id;
+        const double *a;
+        int64_t n;
+    } arrays[] = {{SINEW_SECTION_REST, v->rest, 3 * n},
+                  {SINEW_SECTION_SKIN_WEIGHT, v->skin_weight, 4 * n},
+                  {SINEW_SECTION_BONE_JOINTS, v->bone_joints, 6 * nb},
+                  {SINEW_SECTION_BASIS, v->basis, v->nbasis},
+                  {SINEW_SECTION_CUB_WEIGHT, v->cub_weight, nc},
+                  {SINEW_SECTION_CUB_DMINV, v->cub_dminv, 9 * nc},
+                  {SINEW_SECTION_CUB_VOL, v->cub_vol, nc},
+                  {SINEW_SECTION_SPRING_HESSIAN, v->spring_hessian, R * R},
+                  {SINEW_SECTION_MASS, v->mass, R * R},
+                  {SINEW_SECTION_INERTIA_S, v->inertia_s, 3 * R},
+                  {SINEW_SECTION_INERTIA_X, v->inertia_x, 9 * R},
+                  {SINEW_SECTION_INERTIA_U, v->inertia_u, v->ninertia_u}};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) {
+        sinew_result r = check_finite(arrays[i].id, arrays[i].a, arrays[i].n, msg, ms);
+        if (r != SINEW_OK) return r;
+    }
+    return SINEW_OK;
+}
+
+/* Parent links must end at a root (-1) from every bone. A walk from each bone stops at a
+ * root or at a bone already proven acyclic, then marks its path: O(nbones) in all. */
+static sinew_result check_bone_tree(const sw_blob_view *v, char *msg, size_t ms) {
+    const int32_t nb = v->nbones;
+    for (int32_t b = 0; b < nb; ++b)
+        if (v->bone_parent[b] < -1 || v->bone_parent[b] >= nb)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section BONE_PARENT: bone %d: parent %d outside [-1, %d)", b,
+                        v->bone_parent[b], nb);
+    uint64_t done[SW_BLOB_MAX_BONES / 64];
+    memset(done, 0, ((size_t)nb + 63) / 64 * sizeof done[0]);
+#define DONE(c) ((done[(c) >> 6] >> ((c)&63)) & 1u)
+    for (int32_t b = 0; b < nb; ++b) {
+        int32_t steps = 0;
+        for (int32_t c = b; c >= 0 && !DONE(c); c = v->bone_parent[c])
+            if (++steps > nb)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section BONE_PARENT: bone %d: its parent chain has a cycle", b);
+        for (int32_t c = b; c >= 0 && !DONE(c); c = v->bone_parent[c])
+            done[c >> 6] |= (uint64_t)1 << (c & 63);
+    }
+#undef DONE
+    return SINEW_OK;
+}
+
+static sinew_result check_skin(const sw_blob_view *v, char *msg, size_t ms) {
+    for (int32_t i = 0; i < v->nverts; ++i) {
+        double sum = 0.0;
+        for (int k = 0; k < SW_BLOB_INFLUENCES; ++k) {
+            int32_t b = v->skin_bone[4 * (int64_t)i + k];
+            double w = v->skin_weight[4 * (int64_t)i + k];
+            if (b < 0 || b >= v->nbones)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section SKIN_BONE: vertex %d influence %d: bone %d outside "
+                            "[0, %d)",
+                            i, k, b, v->nbones);
+            if (w < 0.0)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section SKIN_WEIGHT: vertex %d influence %d: weight %g < 0", i, k,
+                            w);
+            sum += w;
+        }
+        if (fabs(sum - 1.0) > SW_BLOB_WEIGHT_SUM_TOL)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section SKIN_WEIGHT: vertex %d: weights sum to %.9g, not 1 (tol "
+                        "%g)",
+                        i, sum, SW_BLOB_WEIGHT_SUM_TOL);
+    }
+    return SINEW_OK;
+}
+
+static sinew_result check_domain_indices(const sw_blob_view *v, char *msg, size_t ms) {
+    for (int32_t d = 0; d < v->ndomains; ++d) {
+        const sw_blob_domain *dom = &v->domains[d];
+        for (int32_t k = 0; k < dom->vert_count; ++k) {
+            int32_t s = v->domain_verts[(int64_t)dom->vert_begin + k];
+            if (s < 0 || s >= v->nverts)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section DOMAIN_VERTS: domain %d local vertex %d: vertex %d "
+                            "outside [0, %d)",
+                            d, k, s, v->nverts);
+        }
+        for (int32_t c = dom->cub_begin; c < dom->cub_begin + dom->cub_count; ++c)
+            for (int k = 0; k < 4; ++k) {
+                int32_t l = v->cub_tets[4 * (int64_t)c + k];
+                if (l < 0 || l >= dom->vert_count)
+                    return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                                "blob section CUB_TETS: tet %d corner %d (domain %d): local "
+                                "vertex %d outside [0, %d)",
+                                c, k, d, l, dom->vert_count);
+            }
+    }
+    return SINEW_OK;
+}
+
+static sinew_result check_surface(const sw_blob_view *v, char *msg, size_t ms) {
+    for (int64_t i = 0; i < 3 * (int64_t)v->nsurf_tris; ++i)
+        if (v->surf_tris[i] < 0 || v->surf_tris[i] >= v->nsurf_verts)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section SURF_TRIS: triangle %lld corner %d: vertex %d outside [0, "
+                        "%d)",
+                        (long long)(i / 3), (int)(i % 3), v->surf_tris[i], v->nsurf_verts);
+    for (int32_t c = 0; c < v->nsurf_copies; ++c) {
+        int32_t d = v->surf_copies[2 * (int64_t)c], l = v->surf_copies[2 * (int64_t)c + 1];
+        if (d < 0 || d >= v->ndomains)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section SURF_COPIES: copy %d: domain %d outside [0, %d)", c, d,
+                        v->ndomains);
+        if (l < 0 || l >= v->domains[d].vert_count)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section SURF_COPIES: copy %d: local vertex %d outside [0, %d) of "
+                        "domain %d",
+                        c, l, v->domains[d].vert_count, d);
+    }
+    return SINEW_OK;
+}
+
+static sinew_result check_positive(uint32_t id, const double *a, int64_t n, int64_t stride,
+                                   char *msg, size_t ms) {
+    for (int64_t i = 0; i < n; ++i)
+        if (!(a[i * stride] > 0.0))
+            return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section %s: %s %lld is %g, must be > 0",
+                        sw_blob_section_name(id), stride > 1 ? "diagonal entry" : "element",
+                        (long long)i, a[i * stride]);
+    return SINEW_OK;
+}
+
+sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) {
+    if (msg && ms) msg[0] = '\0';
+    if (!v) return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT, "blob: view is NULL");
+    sinew_result r;
+    if ((r = check_meta(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_pointers(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_domains(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_copy_ptr(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_all_finite(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_bone_tree(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_skin(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_domain_indices(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_surface(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_positive(SINEW_SECTION_CUB_WEIGHT, v->cub_weight, v->ncub, 1, msg, ms)))
+        return r;
+    if ((r = check_positive(SINEW_SECTION_CUB_VOL, v->cub_vol, v->ncub, 1, msg, ms))) return r;
+    /* Lumped mass projected on the basis: its diagonal is sum_v m_v |U_v col i|^2 > 0. */
+    return check_positive(SINEW_SECTION_MASS, v->mass, v->rank_total, v->rank_total + 1, msg, ms);
+}
+
+/* ---- layer 1: bytes --------------------------------------------------------------- */
+
+static sinew_result check_header(const sinew_blob_header *h, size_t size, char *msg, size_t ms) {
+    if (memcmp(h->magic, SINEW_BLOB_MAGIC, sizeof h->magic) != 0)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob header: bad magic, not a sinew blob");
+    if (h->version != SINEW_BLOB_VERSION)
+        return fail(msg, ms, SINEW_ERROR_VERSION,
+                    "blob header: format version %u, this runtime reads version %u",
+                    (unsigned)h->version, SINEW_BLOB_VERSION);
+    if (h->endian_tag != SINEW_BLOB_ENDIAN_TAG)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob header: endian tag 0x%08x, expected 0x%08x (little-endian blob on a "
+                    "little-endian host)",
+                    (unsigned)h->endian_tag, SINEW_BLOB_ENDIAN_TAG);
+    if (h->header_size != HEADER_SIZE || h->section_table_offset != HEADER_SIZE)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob header: header_size %u / section_table_offset %llu, expected 64",
+                    (unsigned)h->header_size, (unsigned long long)h->section_table_offset);
+    for (size_t i = 0; i < sizeof h->reserved; ++i)
+        if (h->reserved[i] != 0)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob header: reserved byte %zu is not 0", i);
+    if (h->file_size != (uint64_t)size)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob header: file_size %llu, but %zu bytes given (truncated or padded)",
+                    (unsigned long long)h->file_size, size);
+    if (h->section_count > SW_BLOB_MAX_SECTIONS ||
+        h->section_count > (size - HEADER_SIZE) / ENTRY_SIZE)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section table: %u entries do not fit (limit %d, %zu bytes)",
+                    (unsigned)h->section_count, SW_BLOB_MAX_SECTIONS, size);
+    return SINEW_OK;
+}
+
+/* Section names in messages: known name, or the unknown id. */
+static const char *entry_name(const sinew_blob_section *s, char buf[32]) {
+    if (s->id >= 1 && s->id <= SINEW_SECTION_COUNT_V1) return sw_blob_section_name(s->id);
+    snprintf(buf, 32, "with unknown id %u", (unsigned)s->id);
+    return buf;
+}
+
+/* Bounds, alignment and size of every entry; fills end[] and found[] (index of each
+ * known id, -1 when absent). */
+static sinew_result check_entries(const sinew_blob_section *s, uint32_t n, size_t size,
+                                  uint64_t *end, int found[], char *msg, size_t ms) {
+    const uint64_t table_end = HEADER_SIZE + (uint64_t)n * ENTRY_SIZE;
+    char buf[32];
+    for (uint32_t i = 0; i < n; ++i) {
+        const char *name = entry_name(&s[i], buf);
+        const int known = s[i].id >= 1 && s[i].id <= SINEW_SECTION_COUNT_V1;
+        if (s[i].offset % SINEW_BLOB_ALIGN != 0)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s (table entry %u): offset %llu is not a multiple of %u",
+                        name, i, (unsigned long long)s[i].offset, SINEW_BLOB_ALIGN);
+        if (s[i].offset < table_end || s[i].offset > size)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s (table entry %u): offset %llu outside [%llu, %zu] "
+                        "(header and table end at %llu)",
+                        name, i, (unsigned long long)s[i].offset, (unsigned long long)table_end,
+                        size, (unsigned long long)table_end);
+        if (known) {
+            if (found[s[i].id] >= 0)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section %s: appears twice (table entries %d and %u)", name,
+                            found[s[i].id], i);
+            if (s[i].elem_size != k_elem_size[s[i].id])
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section %s (table entry %u): elem_size %u, expected %u", name, i,
+                            (unsigned)s[i].elem_size, (unsigned)k_elem_size[s[i].id]);
+            if (s[i].reserved != 0)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section %s (table entry %u): reserved field is not 0", name, i);
+            found[s[i].id] = (int)i;
+        }
+        const uint64_t room = (uint64_t)size - s[i].offset;
+        if (s[i].elem_size != 0 && s[i].count > room / s[i].elem_size)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s (table entry %u): %llu elements of %u bytes at offset "
+                        "%llu run past the end (%zu bytes)",
+                        name, i, (unsigned long long)s[i].count, (unsigned)s[i].elem_size,
+                        (unsigned long long)s[i].offset, size);
+        end[i] = s[i].offset + s[i].count * s[i].elem_size;
+    }
+    return SINEW_OK;
+}
+
+static sinew_result check_overlaps(const sinew_blob_section *s, uint32_t n, const uint64_t *end,
+                                   char *msg, size_t ms) {
+    /* n <= SW_BLOB_MAX_SECTIONS, so the quadratic scan is bounded (2016 pairs). */
+    char b1[32], b2[32];
+    for (uint32_t i = 0; i < n; ++i)
+        for (uint32_t j = i + 1; j < n; ++j)
+            if (end[i] > s[i].offset && end[j] > s[j].offset && s[i].offset < end[j] &&
+                s[j].offset < end[i])
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section %s [%llu, %llu) overlaps section %s [%llu, %llu)",
+                            entry_name(&s[i], b1), (unsigned long long)s[i].offset,
+                            (unsigned long long)end[i], entry_name(&s[j], b2),
+                            (unsigned long long)s[j].offset, (unsigned long long)end[j]);
+    return SINEW_OK;
+}
+
+/* Counts of the sections whose size follows from META alone. */
+static sinew_result check_meta_counts(const sw_blob_view *v, const sinew_blob_section *s,
+                                      const int found[], char *msg, size_t ms) {
+    const uint64_t n = (uint64_t)v->nverts, nb = (uint64_t)v->nbones, nc = (uint64_t)v->ncub,
+                   R = (uint64_t)v->rank_total;
+    const struct {
+        uint32_t id;
+        uint64_t count;
+        const char *formula;
+    } expect[] = {{SINEW_SECTION_REST, 3 * n, "3 nverts"},
+                  {SINEW_SECTION_SKIN_BONE, 4 * n, "4 nverts"},
+                  {SINEW_SECTION_SKIN_WEIGHT, 4 * n, "4 nverts"},
+                  {SINEW_SECTION_BONE_PARENT, nb, "nbones"},
+                  {SINEW_SECTION_BONE_JOINTS, 6 * nb, "6 nbones"},
+                  {SINEW_SECTION_DOMAINS, (uint64_t)v->ndomains, "ndomains"},
+                  {SINEW_SECTION_DOMAIN_VERTS, (uint64_t)v->ndomain_verts, "ndomain_verts"},
+                  {SINEW_SECTION_CUB_TETS, 4 * nc, "4 ncub"},
+                  {SINEW_SECTION_CUB_WEIGHT, nc, "ncub"},
+                  {SINEW_SECTION_CUB_DMINV, 9 * nc, "9 ncub"},
+                  {SINEW_SECTION_CUB_VOL, nc, "ncub"},
+                  {SINEW_SECTION_SPRING_HESSIAN, R * R, "rank_total^2"},
+                  {SINEW_SECTION_MASS, R * R, "rank_total^2"},
+                  {SINEW_SECTION_INERTIA_S, 3 * R, "3 rank_total"},
+                  {SINEW_SECTION_INERTIA_X, 9 * R, "9 rank_total"},
+                  {SINEW_SECTION_SURF_TRIS, 3 * (uint64_t)v->nsurf_tris, "3 nsurf_tris"},
+                  {SINEW_SECTION_SURF_COPY_PTR, (uint64_t)v->nsurf_verts + 1, "nsurf_verts + 1"}};
+    for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i) {
+        const sinew_blob_section *e = &s[found[expect[i].id]];
+        if (e->count != expect[i].count)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s: %llu elements, META needs %s = %llu",
+                        sw_blob_section_name(expect[i].id), (unsigned long long)e->count,
+                        expect[i].formula, (unsigned long long)expect[i].count);
+    }
+    return SINEW_OK;
+}
+
+/* Reads META into the view's counts; checks the counts of every section; points the
+ * view's arrays at the sections. */
+static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s, const int found[],
+                              sw_blob_view *v, char *msg, size_t ms) {
+    const sinew_blob_section *meta = &s[found[SINEW_SECTION_META]];
+    if (meta->count != 1)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section META: %llu elements, expected 1",
+                    (unsigned long long)meta->count);
+    sinew_blob_meta m;
+    memcpy(&m, bytes + meta->offset, sizeof m);
+    memset(v, 0, sizeof *v);
+    v->nverts = m.nverts, v->nbones = m.nbones, v->ndomains = m.ndomains;
+    v->rank_total = m.rank_total, v->ndomain_verts = m.ndomain_verts, v->ncub = m.ncub;
+    v->nsurf_verts = m.nsurf_verts, v->nsurf_tris = m.nsurf_tris;
+    v->mu = m.mu, v->lambda = m.lambda, v->rayleigh_alpha = m.rayleigh_alpha;
+    v->rayleigh_beta = m.rayleigh_beta, v->contact_k = m.contact_k;
+    sinew_result r = check_meta(v, msg, ms);
+    if (r != SINEW_OK) return r;
+    if ((r = check_meta_counts(v, s, found, msg, ms)) != SINEW_OK) return r;
+
+    /* Sizes that depend on the domain records: recorded here, checked against the
+     * records by the view validator. Each count is bounded by the file size. */
+    const sinew_blob_section *copies = &s[found[SINEW_SECTION_SURF_COPIES]];
+    if (copies->count % 2 != 0 || copies->count / 2 > (uint64_t)SW_BLOB_MAX_COPIES)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section SURF_COPIES: %llu elements, expected an even number <= %d",
+                    (unsigned long long)copies->count, 2 * SW_BLOB_MAX_COPIES);
+    v->nbasis = (int64_t)s[found[SINEW_SECTION_BASIS]].count;
+    v->ninertia_u = (int64_t)s[found[SINEW_SECTION_INERTIA_U]].count;
+    v->nsurf_copies = (int32_t)(copies->count / 2);
+
+#define AT(id) ((const void *)(bytes + s[found[SINEW_SECTION_##id]].offset))
+    v->rest = AT(REST);
+    v->skin_bone = AT(SKIN_BONE);
+    v->skin_weight = AT(SKIN_WEIGHT);
+    v->bone_parent = AT(BONE_PARENT);
+    v->bone_joints = AT(BONE_JOINTS);
+    v->domains = AT(DOMAINS);
+    v->domain_verts = AT(DOMAIN_VERTS);
+    v->basis = AT(BASIS);
+    v->cub_tets = AT(CUB_TETS);
+    v->cub_weight = AT(CUB_WEIGHT);
+    v->cub_dminv = AT(CUB_DMINV);
+    v->cub_vol = AT(CUB_VOL);
+    v->spring_hessian = AT(SPRING_HESSIAN);
+    v->mass = AT(MASS);
+    v->inertia_s = AT(INERTIA_S);
+    v->inertia_x = AT(INERTIA_X);
+    v->inertia_u = AT(INERTIA_U);
+    v->surf_tris = AT(SURF_TRIS);
+    v->surf_copy_ptr = AT(SURF_COPY_PTR);
+    v->surf_copies = AT(SURF_COPIES);
+#undef AT
+    return SINEW_OK;
+}
+
+sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, char *msg,
+                           size_t ms) {
+    if (msg && ms) msg[0] = '\0';
+    if (!data || !view)
+        return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT, "blob: %s is NULL",
+                    data ? "view" : "data");
+    /* Sections are used in place as double/int64 arrays. */
+    if ((uintptr_t)data % 8 != 0)
+        return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
+                    "blob: data at %p is not 8-byte aligned (64 recommended)", data);
+    const uint8_t *bytes = data;
+    if (size < HEADER_SIZE)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob header: %zu bytes given, shorter than the 64-byte header", size);
+    sinew_blob_header h;
+    memcpy(&h, bytes, sizeof h);
+    sinew_result r = check_header(&h, size, msg, ms);
+    if (r != SINEW_OK) return r;
+    /* Checksum before any payload check: a damaged file is reported as damaged, not as
+     * whatever its first damaged field happens to look like. */
+    const uint64_t sum = sw_blob_checksum(bytes + HEADER_SIZE, size - HEADER_SIZE);
+    if (sum != h.checksum)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob header: checksum mismatch (stored %016llx, computed %016llx): the "
+                    "blob is damaged",
+                    (unsigned long long)h.checksum, (unsigned long long)sum);
+
+    sinew_blob_section s[SW_BLOB_MAX_SECTIONS];
+    uint64_t end[SW_BLOB_MAX_SECTIONS];
+    const uint32_t n = h.section_count;
+    memcpy(s, bytes + HEADER_SIZE, (size_t)n * sizeof s[0]);
+    int found[SINEW_SECTION_COUNT_V1 + 1];
+    for (int i = 0; i <= SINEW_SECTION_COUNT_V1; ++i)
+        found[i] = -1;
+    if ((r = check_entries(s, n, size, end, found, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_overlaps(s, n, end, msg, ms)) != SINEW_OK) return r;
+    for (uint32_t id = 1; id <= SINEW_SECTION_COUNT_V1; ++id)
+        if (found[id] < 0)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section %s: missing",
+                        sw_blob_section_name(id));
+
+    sw_blob_view v;
+    if ((r = fill_view(bytes, s, found, &v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_validate_view(&v, msg, ms)) != SINEW_OK) return r;
+    *view = v;
+    return SINEW_OK;
+}

@@ -1,0 +1,88 @@
+/* The baked character as the runtime reads it: typed pointers into the blob (zero
+ * copy) plus counts. The bake fills one from its own arrays and hands it to the blob
+ * writer; the loader fills one from validated bytes. Every index named below has been
+ * range-checked by the loader (blob_load.c) before any runtime code sees it.
+ *
+ * Model (thesis §4.4.1, DESIGN.md §4): simulation vertex v has rest position
+ * rest[v]; its world position in domain d is
+ *     x = R_v (rest[v] + U_d[v] q_d) + t_v,
+ * with (R_v, t_v) the dual-quaternion skinning transform of v (its 4 influences) and
+ * U_d[v] the 3 x r_d rows of domain d's skinning-correction basis. Vertices shared by
+ * two domains have one copy in each, tied by springs whose reduced Hessian is the
+ * constant matrix `spring_hessian` (eqs. 4.17-4.20). */
+#ifndef SW_BLOB_VIEW_H
+#define SW_BLOB_VIEW_H
+
+#include <stdint.h>
+
+#include "sinew/sinew_blob_format.h"
+
+#define SW_BLOB_INFLUENCES 4 /* skin influences per vertex */
+
+/* One domain (the on-disk record itself, used in place):
+ *   bone            the bone this domain rides with (inertial frame)
+ *   vert_begin/count  its vertex copies are domain_verts[vert_begin .. +vert_count)
+ *   rank            r_d;  q_offset: offset of q_d in the stacked reduced vector q
+ *   cub_begin/count its cubature tets
+ *   basis_offset    into basis: vert_count * 3 * rank doubles, row-major, local
+ *                   vertex k owns rows 3k..3k+2
+ *   inertia_offset  into inertia_u: 9 * rank * rank doubles */
+typedef sinew_blob_domain_record sw_blob_domain;
+
+typedef struct sw_blob_view {
+    /* META */
+    int32_t nverts;       /* simulation vertices */
+    int32_t nbones;
+    int32_t ndomains;
+    int32_t rank_total;   /* sum of ranks = length of q */
+    int32_t ndomain_verts; /* sum of vert_count (vertex copies) */
+    int32_t ncub;         /* cubature tets over all domains */
+    int32_t nsurf_verts;  /* output (render) surface vertices */
+    int32_t nsurf_tris;
+    double mu, lambda;    /* Lamé parameters of the co-rotational material */
+    double rayleigh_alpha, rayleigh_beta;
+    double contact_k;     /* run-time penalty stiffness (reserved for self-contact) */
+
+    /* per simulation vertex */
+    const double *rest;        /* 3 * nverts */
+    const int32_t *skin_bone;  /* SW_BLOB_INFLUENCES * nverts, bone ids; unused slots 0 */
+    const double *skin_weight; /* SW_BLOB_INFLUENCES * nverts, >= 0, sum 1 */
+
+    /* skeleton (for tools and inertial frames) */
+    const int32_t *bone_parent; /* nbones, -1 for roots */
+    const double *bone_joints;  /* 6 * nbones: head xyz, tail xyz at rest */
+
+    /* domains */
+    const sw_blob_domain *domains; /* ndomains */
+    const int32_t *domain_verts;   /* ndomain_verts simulation vertex ids */
+    const double *basis;           /* sum over domains of vert_count*3*rank */
+    int64_t nbasis;                /* doubles in basis */
+
+    /* cubature, grouped by domain (domain d owns [cub_begin, cub_begin+cub_count)) */
+    const int32_t *cub_tets;  /* 4 * ncub: domain-LOCAL vertex indices (< vert_count) */
+    const double *cub_weight; /* ncub, > 0 */
+    const double *cub_dminv;  /* 9 * ncub: rest Dm^-1 */
+    const double *cub_vol;    /* ncub: rest volume */
+
+    /* constant reduced matrices, rank_total x rank_total, row-major */
+    const double *spring_hessian; /* interface springs (eq. 4.20), symmetric PSD */
+    const double *mass;           /* reduced lumped mass U^T M U, block diagonal */
+    /* Inertial projections per domain (Kim & James 2011) for the domain's bone frame,
+     * m_v the lumped masses, U_v the domain's 3 x r rows of vertex v:
+     *   inertia_s: rank_total x 3, row i of domain d: sum_v m_v U_v[:, i]^T
+     *   inertia_x: rank_total x 9, entry (i, 3a+b): sum_v m_v U_v[a, i] rest_v[b]
+     *   inertia_u: per domain 9 blocks r x r, block 3a+b entry (i, j):
+     *              sum_v m_v U_v[a, i] U_v[b, j]  (at domains[d].inertia_offset) */
+    const double *inertia_s;
+    const double *inertia_x;
+    const double *inertia_u;
+    int64_t ninertia_u;
+
+    /* output surface: vertex i is the mean of its copies (domain, local vertex) */
+    const int32_t *surf_tris;     /* 3 * nsurf_tris, indices < nsurf_verts */
+    const int32_t *surf_copy_ptr; /* nsurf_verts + 1, non-decreasing, starts at 0 */
+    const int32_t *surf_copies;   /* 2 * surf_copy_ptr[nsurf_verts]: (domain, local vertex) */
+    int32_t nsurf_copies;
+} sw_blob_view;
+
+#endif

@@ -1,0 +1,657 @@
+/* An instance of a baked character: the per-frame step (DESIGN.md §3-§4).
+ *
+ * State is the stacked reduced vector q. Every frame:
+ *   1. skin the active vertices (cubature tet corners and output-surface vertices)
+ *      with dual quaternions: (R_v, t_v);
+ *   2. reduced Newton on  Phi(q) = E_cub(q) + 1/2 q^T H_s q  [+ dynamics terms]:
+ *        E_cub = sum_c w_c E_c(x_c(q)),  x_k = R_k (rest_k + U_k q_d) + t_k   (eq. 2.11)
+ *        gradient  - sum_c w_c J_c^T f_c,  Hessian  sum_c w_c J_c^T K_c J_c (eq. 2.12)
+ *        with J_c = blockdiag(R_k) U_c; H_s the constant interface-spring Hessian;
+ *      dense Cholesky, an energy guard (halve the step while Phi grows), warm start;
+ *   3. dynamics (backward Euler in q): + 1/(2h^2) |q - q_n - h qdot_n|_M^2
+ *        + 1/(2h) |q - q_n|_D^2 - q^T f_in, D = alpha M + beta H(q_n), where f_in are
+ *      the inertial forces of each domain riding its bone (frame acceleration, angular
+ *      acceleration, centrifugal, Coriolis) from precomputed projections, O(r^2);
+ *   4. the output surface: each vertex the mean of its domain copies, and normals.
+ * Nothing in the step allocates, locks or touches a vertex that is not active: the
+ * cost depends on the cubature and surface sizes, not on the tet count. All memory is
+ * reserved at creation through the allocator hook. */
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "blob_load.h"
+#include "dense.h"
+#include "dqs.h"
+#include "fem_corot.h"
+#include "instance.h"
+
+struct sinew_instance {
+    const sinew_blob *blob;
+    const sw_blob_view *v;
+    sinew_allocator allocator;
+    sinew_step_mode mode;
+    uint32_t max_newton;
+    int32_t R, rmax, nact;
+    double size; /* rest bounding-box diagonal */
+    /* pose */
+    sw_dualquat *bone_dq;          /* nbones */
+    double *T_cur, *T_prev, *T_prev2; /* 12 nbones each */
+    int pose_set, history;         /* frames of pose history available (0..2) */
+    /* active vertices */
+    int32_t *act_vert; /* nact global ids */
+    int32_t *cub_act;  /* 4 ncub */
+    int32_t *copy_act; /* nsurf_copies */
+    double *act_R, *act_t;
+    /* reduced state and scratch */
+    double *q, *qn, *qdot, *g, *H, *Hn, *L, *dq, *qtrial, *fin, *tmp, *tmp2;
+    double *Je, *KJ; /* 12 x rmax */
+    /* output */
+    double *surf_x, *surf_n;
+    sinew_step_stats stats;
+};
+
+/* ---- memory ------------------------------------------------------------------ */
+
+static void *mem_alloc(const sinew_allocator *a, size_t size) {
+    if (size == 0) size = 1;
+    size = (size + 63) & ~(size_t)63;
+    void *p = NULL;
+    if (a->alloc)
+        p = a->alloc(size, 64, a->user);
+    else if (posix_memalign(&p, 64, size) != 0)
+        p = NULL;
+    if (p) memset(p, 0, size);
+    return p;
+}
+
+static void mem_free(const sinew_allocator *a, void *p) {
+    if (!p) return;
+    if (a->free)
+        a->free(p, a->user);
+    else
+        free(p);
+}
+
+/* The instance's arrays, listed once for allocation and release. */
+enum { NBUF = 25 };
+static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
+    const sw_blob_view *v = in->v;
+    size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
+    void **p[NBUF] = {(void **)&in->bone_dq, (void **)&in->T_cur, (void **)&in->T_prev,
+                      (void **)&in->T_prev2, (void **)&in->act_vert, (void **)&in->cub_act,
+                      (void **)&in->copy_act, (void **)&in->act_R, (void **)&in->act_t,
+                      (void **)&in->q, (void **)&in->qn, (void **)&in->qdot, (void **)&in->g,
+                      (void **)&in->H, (void **)&in->Hn, (void **)&in->L, (void **)&in->dq,
+                      (void **)&in->qtrial, (void **)&in->fin, (void **)&in->tmp, (void **)&in->tmp2,
+                      (void **)&in->Je, (void **)&in->KJ, (void **)&in->surf_x,
+                      (void **)&in->surf_n};
+    size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
+                      (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
+                      (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
+                      3 * (size_t)in->nact * d, R * d, R * d, R * d, R * d, R * R * d, R * R * d,
+                      R * R * d, R * d, R * d, R * d, R * d, R * d, 12 * (size_t)in->rmax * d,
+                      12 * (size_t)in->rmax * d, 3 * (size_t)v->nsurf_verts * d,
+                      3 * (size_t)v->nsurf_verts * d};
+    memcpy(b, p, sizeof p);
+    memcpy(sz, s, sizeof s);
+}
+
+/* ---- creation ----------------------------------------------------------------- */
+
+static void identity_pose(double *T, int32_t nb) {
+    for (int32_t b = 0; b < nb; ++b) {
+        memset(T + 12 * b, 0, 12 * sizeof(double));
+        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    }
+}
+
+SINEW_API void sinew_instance_destroy(sinew_instance *inst) {
+    if (!inst) return;
+    void **b[NBUF];
+    size_t sz[NBUF];
+    buffers(inst, b, sz);
+    sinew_allocator a = inst->allocator;
+    for (int i = 0; i < NBUF; ++i) mem_free(&a, *b[i]);
+    mem_free(&a, inst);
+}
+
+SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew_instance_def *def,
+                                             sinew_instance **out) {
+    if (!out) return SINEW_ERROR_INVALID_ARGUMENT;
+    *out = NULL;
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    if (!v) return SINEW_ERROR_INVALID_ARGUMENT;
+    sinew_instance_def d = sinew_instance_def_default();
+    if (def) {
+        if (def->struct_size < sizeof(uint32_t) + sizeof(sinew_step_mode) ||
+            def->struct_size > 4096)
+            return SINEW_ERROR_INVALID_ARGUMENT;
+        memcpy(&d, def, def->struct_size < sizeof d ? def->struct_size : sizeof d);
+        d.struct_size = sizeof d;
+    }
+    if (d.mode != SINEW_STEP_QUASISTATIC && d.mode != SINEW_STEP_DYNAMIC)
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    if (d.max_newton_iters > 100) return SINEW_ERROR_INVALID_ARGUMENT;
+    sinew_allocator a = d.allocator;
+    if (!a.alloc != !a.free) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (!a.alloc) a = blob->allocator;
+
+    sinew_instance *in = mem_alloc(&a, sizeof *in);
+    if (!in) return SINEW_ERROR_OUT_OF_MEMORY;
+    in->blob = blob;
+    in->v = v;
+    in->allocator = a;
+    in->mode = d.mode;
+    in->max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
+    in->R = v->rank_total;
+    for (int32_t k = 0; k < v->ndomains; ++k)
+        if (v->domains[k].rank > in->rmax) in->rmax = v->domains[k].rank;
+    /* active vertices: cubature corners and surface copies (a mark pass at creation) */
+    int32_t *mark = mem_alloc(&a, (size_t)v->nverts * sizeof(int32_t));
+    if (!mark) {
+        mem_free(&a, in);
+        return SINEW_ERROR_OUT_OF_MEMORY;
+    }
+    for (int32_t i = 0; i < v->nverts; ++i) mark[i] = -1;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
+            for (int j = 0; j < 4; ++j) mark[v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]]] = 0;
+    }
+    for (int32_t i = 0; i < v->nsurf_copies; ++i) {
+        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+        mark[v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]]] = 0;
+    }
+    for (int32_t i = 0; i < v->nverts; ++i)
+        if (mark[i] == 0) mark[i] = in->nact++;
+    void **b[NBUF];
+    size_t sz[NBUF];
+    buffers(in, b, sz);
+    int ok = 1;
+    for (int i = 0; i < NBUF; ++i) ok = ok && (*b[i] = mem_alloc(&a, sz[i])) != NULL;
+    if (!ok) {
+        mem_free(&a, mark);
+        sinew_instance_destroy(in);
+        return SINEW_ERROR_OUT_OF_MEMORY;
+    }
+    for (int32_t i = 0; i < v->nverts; ++i)
+        if (mark[i] >= 0) in->act_vert[mark[i]] = i;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
+            for (int j = 0; j < 4; ++j)
+                in->cub_act[4 * c + j] = mark[v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]]];
+    }
+    for (int32_t i = 0; i < v->nsurf_copies; ++i) {
+        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+        in->copy_act[i] = mark[v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]]];
+    }
+    mem_free(&a, mark);
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < v->nverts; ++i)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fmin(lo[k], v->rest[3 * i + k]);
+            hi[k] = fmax(hi[k], v->rest[3 * i + k]);
+        }
+    in->size = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                    (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    sinew_instance_reset(in);
+    *out = in;
+    return SINEW_OK;
+}
+
+SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
+    if (!inst) return SINEW_ERROR_INVALID_ARGUMENT;
+    int32_t R = inst->R, nb = inst->v->nbones;
+    memset(inst->q, 0, (size_t)R * sizeof(double));
+    memset(inst->qdot, 0, (size_t)R * sizeof(double));
+    identity_pose(inst->T_cur, nb);
+    memcpy(inst->T_prev, inst->T_cur, 12 * (size_t)nb * sizeof(double));
+    memcpy(inst->T_prev2, inst->T_cur, 12 * (size_t)nb * sizeof(double));
+    for (int32_t b = 0; b < nb; ++b) sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
+    inst->pose_set = 0;
+    inst->history = 0;
+    memset(&inst->stats, 0, sizeof inst->stats);
+    inst->stats.struct_size = sizeof inst->stats;
+    return SINEW_OK;
+}
+
+/* ---- pose ---------------------------------------------------------------------- */
+
+/* A bone transform must be finite (else NOT_FINITE) with a proper orthonormal rotation
+ * part (else INVALID_ARGUMENT). */
+static sinew_result check_transform(const double *T) {
+    for (int i = 0; i < 12; ++i)
+        if (!isfinite(T[i])) return SINEW_ERROR_NOT_FINITE;
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double d = T[i] * T[j] + T[3 + i] * T[3 + j] + T[6 + i] * T[6 + j];
+            if (fabs(d - (i == j)) > 1e-3) return SINEW_ERROR_INVALID_ARGUMENT;
+        }
+    double det = T[0] * (T[4] * T[8] - T[5] * T[7]) - T[1] * (T[3] * T[8] - T[5] * T[6]) +
+                 T[2] * (T[3] * T[7] - T[4] * T[6]);
+    return det > 0 ? SINEW_OK : SINEW_ERROR_INVALID_ARGUMENT;
+}
+
+/* Accepts the pose (all bones valid) or leaves everything as it was. */
+static sinew_result set_pose(sinew_instance *inst, const double *Td, const float *Tf) {
+    int32_t nb = inst->v->nbones;
+    for (int32_t b = 0; b < nb; ++b) {
+        double T[12];
+        for (int i = 0; i < 12; ++i) T[i] = Td ? Td[12 * b + i] : (double)Tf[12 * b + i];
+        sinew_result r = check_transform(T);
+        if (r != SINEW_OK) return r;
+    }
+    for (int32_t i = 0; i < 12 * nb; ++i) inst->T_cur[i] = Td ? Td[i] : (double)Tf[i];
+    for (int32_t b = 0; b < nb; ++b) sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
+    inst->pose_set = 1;
+    return SINEW_OK;
+}
+
+sinew_result sw_instance_set_pose_d(sinew_instance *inst, const double *T) {
+    if (!inst || !T) return SINEW_ERROR_INVALID_ARGUMENT;
+    return set_pose(inst, T, NULL);
+}
+
+SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float *transforms,
+                                               uint32_t bone_count) {
+    if (!inst || !transforms || bone_count != (uint32_t)inst->v->nbones)
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    return set_pose(inst, NULL, transforms);
+}
+
+/* ---- the reduced model ---------------------------------------------------------- */
+
+static void skin_active(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    for (int32_t a = 0; a < in->nact; ++a) {
+        int32_t gv = in->act_vert[a];
+        sw_dqs_blend(in->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4,
+                     in->act_R + 9 * a, in->act_t + 3 * a);
+    }
+}
+
+/* Position of copy (domain D, local vertex lv, active index a) for reduced q_d;
+ * also J = R U (3 x r, row-major) when J != NULL. */
+static void copy_position(const sinew_instance *in, const sw_blob_domain *D, int32_t lv, int32_t a,
+                          const double *qd, double x[3], double *J) {
+    const sw_blob_view *v = in->v;
+    int32_t r = D->rank, gv = v->domain_verts[D->vert_begin + lv];
+    const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+    const double *Rm = in->act_R + 9 * a, *t = in->act_t + 3 * a, *X = v->rest + 3 * (int64_t)gv;
+    double y[3];
+    for (int i = 0; i < 3; ++i) {
+        double acc = X[i];
+        for (int32_t j = 0; j < r; ++j) acc += U[i * r + j] * qd[j];
+        y[i] = acc;
+    }
+    for (int i = 0; i < 3; ++i) x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
+    if (J)
+        for (int i = 0; i < 3; ++i)
+            for (int32_t j = 0; j < r; ++j)
+                J[i * r + j] = Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
+}
+
+/* Cubature energy at q; with want_grad, adds -sum w J^T f to g; with want_hess, adds the
+ * domain blocks sum w J^T K J to H (both must be initialised by the caller). */
+static double cubature_eval(sinew_instance *in, const double *q, int want_grad, int want_hess) {
+    const sw_blob_view *v = in->v;
+    double E = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank, o = D->q_offset;
+        const double *qd = q + o;
+        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
+            double x[12], f[12], K[144];
+            for (int j = 0; j < 4; ++j)
+                copy_position(in, D, v->cub_tets[4 * c + j], in->cub_act[4 * c + j], qd, x + 3 * j,
+                              want_grad ? in->Je + 3 * j * r : NULL);
+            double w = v->cub_weight[c];
+            E += w * sw_corot_eval(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
+                                   want_grad ? f : NULL, want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
+            if (!want_grad) continue;
+            for (int32_t j = 0; j < r; ++j) {
+                double acc = 0;
+                for (int row = 0; row < 12; ++row) acc += in->Je[row * r + j] * f[row];
+                in->g[o + j] -= w * acc;
+            }
+            if (!want_hess) continue;
+            for (int row = 0; row < 12; ++row) /* KJ = K Je */
+                for (int32_t j = 0; j < r; ++j) {
+                    double acc = 0;
+                    for (int m = 0; m < 12; ++m) acc += K[row * 12 + m] * in->Je[m * r + j];
+                    in->KJ[row * r + j] = acc;
+                }
+            for (int32_t i = 0; i < r; ++i)
+                for (int32_t j = i; j < r; ++j) {
+                    double acc = 0;
+                    for (int row = 0; row < 12; ++row) acc += in->Je[row * r + i] * in->KJ[row * r + j];
+                    in->H[(int64_t)(o + i) * in->R + o + j] += w * acc;
+                }
+        }
+    }
+    /* the domain blocks were filled in their upper triangle: mirror */
+    if (want_hess)
+        for (int32_t k = 0; k < v->ndomains; ++k) {
+            const sw_blob_domain *D = &v->domains[k];
+            int32_t o = D->q_offset;
+            for (int32_t i = 0; i < D->rank; ++i)
+                for (int32_t j = i + 1; j < D->rank; ++j)
+                    in->H[(int64_t)(o + j) * in->R + o + i] = in->H[(int64_t)(o + i) * in->R + o + j];
+        }
+    return E;
+}
+
+/* y = A x for a dense R x R matrix. */
+static void matvec(const double *A, int32_t R, const double *x, double *y) {
+    for (int32_t i = 0; i < R; ++i) {
+        double acc = 0;
+        for (int32_t j = 0; j < R; ++j) acc += A[(int64_t)i * R + j] * x[j];
+        y[i] = acc;
+    }
+}
+
+static double dot(const double *a, const double *b, int32_t n) {
+    double s = 0;
+    for (int32_t i = 0; i < n; ++i) s += a[i] * b[i];
+    return s;
+}
+
+/* Phi(q): cubature + springs + (dynamic) inertia, damping and inertial forces. With
+ * want_grad, also g (and H with want_hess); H_n frozen at the first iteration. */
+typedef struct {
+    double h, cm, cd, alpha, beta;
+    int dynamic;
+} dyn_coef;
+
+static double potential(sinew_instance *in, const double *q, const dyn_coef *dc, int want_grad,
+                        int want_hess) {
+    int32_t R = in->R;
+    const sw_blob_view *v = in->v;
+    if (want_grad) memset(in->g, 0, (size_t)R * sizeof(double));
+    if (want_hess) memcpy(in->H, v->spring_hessian, (size_t)R * R * sizeof(double));
+    double phi = cubature_eval(in, q, want_grad, want_hess);
+    matvec(v->spring_hessian, R, q, in->tmp);
+    phi += 0.5 * dot(q, in->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i) in->g[i] += in->tmp[i];
+    if (!dc->dynamic) return phi;
+    /* inertia: cm/2 |q - qhat|_M^2 with qhat = qn + h qdot */
+    double *e = in->tmp2;
+    for (int32_t i = 0; i < R; ++i) e[i] = q[i] - in->qn[i] - dc->h * in->qdot[i];
+    matvec(v->mass, R, e, in->tmp);
+    phi += 0.5 * dc->cm * dot(e, in->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i) in->g[i] += dc->cm * in->tmp[i];
+    /* damping: cd/2 |q - qn|_D^2, D = alpha M + beta Hn */
+    for (int32_t i = 0; i < R; ++i) e[i] = q[i] - in->qn[i];
+    matvec(v->mass, R, e, in->tmp);
+    double dm = dot(e, in->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i) in->g[i] += dc->cd * dc->alpha * in->tmp[i];
+    matvec(in->Hn, R, e, in->tmp);
+    double dk = dot(e, in->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i) in->g[i] += dc->cd * dc->beta * in->tmp[i] - in->fin[i];
+    phi += 0.5 * dc->cd * (dc->alpha * dm + dc->beta * dk) - dot(q, in->fin, R);
+    if (want_hess)
+        for (int64_t i = 0; i < (int64_t)R * R; ++i)
+            in->H[i] += dc->cm * v->mass[i] + dc->cd * (dc->alpha * v->mass[i] + dc->beta * in->Hn[i]);
+    return phi;
+}
+
+/* Body-frame angular velocity of the rotation from Ra to Rb over h: log(Ra^T Rb) / h. */
+static void angular_velocity(const double *Ta, const double *Tb, double h, double w[3]) {
+    double M[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            M[3 * i + j] = Ta[i] * Tb[j] + Ta[3 + i] * Tb[3 + j] + Ta[6 + i] * Tb[6 + j];
+    double c = 0.5 * (M[0] + M[4] + M[8] - 1.0);
+    c = c > 1 ? 1 : c < -1 ? -1 : c;
+    double th = acos(c), s = sin(th);
+    double k = th < 1e-8 ? 0.5 : (s > 1e-8 ? th / (2 * s) : 0.0);
+    w[0] = k * (M[7] - M[5]) / h;
+    w[1] = k * (M[2] - M[6]) / h;
+    w[2] = k * (M[3] - M[1]) / h;
+}
+
+/* Inertial forces of every domain riding its bone (explicit, at q_n and qdot_n). */
+static void inertial_forces(sinew_instance *in, double h) {
+    const sw_blob_view *v = in->v;
+    memset(in->fin, 0, (size_t)in->R * sizeof(double));
+    if (in->history < 1) return;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t b = D->bone, r = D->rank, o = D->q_offset;
+        const double *Tc = in->T_cur + 12 * b, *Tp = in->T_prev + 12 * b, *Tq = in->T_prev2 + 12 * b;
+        double acc[3], c[3], w1[3], w0[3], al[3];
+        for (int i = 0; i < 3; ++i)
+            acc[i] = in->history >= 2 ? (Tc[9 + i] - 2 * Tp[9 + i] + Tq[9 + i]) / (h * h) : 0.0;
+        for (int i = 0; i < 3; ++i) c[i] = Tc[i] * acc[0] + Tc[3 + i] * acc[1] + Tc[6 + i] * acc[2];
+        angular_velocity(Tp, Tc, h, w1);
+        if (in->history >= 2)
+            angular_velocity(Tq, Tp, h, w0);
+        else
+            memcpy(w0, w1, sizeof w0);
+        for (int i = 0; i < 3; ++i) al[i] = (w1[i] - w0[i]) / h;
+        double W[9] = {0, -w1[2], w1[1], w1[2], 0, -w1[0], -w1[1], w1[0], 0};
+        double A[9] = {0, -al[2], al[1], al[2], 0, -al[0], -al[1], al[0], 0};
+        for (int i = 0; i < 3; ++i) /* A = [alpha]x + [w]x^2 */
+            for (int j = 0; j < 3; ++j)
+                A[3 * i + j] += W[3 * i] * W[j] + W[3 * i + 1] * W[3 + j] + W[3 * i + 2] * W[6 + j];
+        const double *P = v->inertia_u + D->inertia_offset;
+        for (int32_t i = 0; i < r; ++i) {
+            double f = 0;
+            for (int a = 0; a < 3; ++a) f += v->inertia_s[3 * (o + i) + a] * c[a];
+            for (int ab = 0; ab < 9; ++ab) {
+                if (A[ab] == 0 && W[ab] == 0) continue;
+                const double *Pab = P + (int64_t)ab * r * r + (int64_t)i * r;
+                double pq = 0, pqd = 0;
+                for (int32_t j = 0; j < r; ++j) {
+                    pq += Pab[j] * in->qn[o + j];
+                    pqd += Pab[j] * in->qdot[o + j];
+                }
+                f += A[ab] * (v->inertia_x[9 * (o + i) + ab] + pq) + 2 * W[ab] * pqd;
+            }
+            in->fin[o + i] = -f;
+        }
+    }
+}
+
+/* Solves H dq = -g by Cholesky, shifting the diagonal if H is not positive definite. */
+static int newton_direction(sinew_instance *in) {
+    int32_t R = in->R;
+    double tr = 0;
+    for (int32_t i = 0; i < R; ++i) tr += fabs(in->H[(int64_t)i * R + i]);
+    double shift = 0;
+    for (int attempt = 0; attempt < 8; ++attempt) {
+        memcpy(in->L, in->H, (size_t)R * R * sizeof(double));
+        for (int32_t i = 0; i < R; ++i) in->L[(int64_t)i * R + i] += shift;
+        if (sw_cholesky(in->L, R)) {
+            for (int32_t i = 0; i < R; ++i) in->dq[i] = -in->g[i];
+            sw_cholesky_solve(in->L, R, in->dq);
+            return 1;
+        }
+        shift = shift == 0 ? 1e-10 * tr / R + 1e-300 : shift * 100;
+    }
+    return 0;
+}
+
+static void write_surface(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        double acc[3] = {0, 0, 0};
+        int32_t b = v->surf_copy_ptr[s], e = v->surf_copy_ptr[s + 1];
+        for (int32_t i = b; i < e; ++i) {
+            const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+            double x[3];
+            copy_position(in, D, v->surf_copies[2 * i + 1], in->copy_act[i], in->q + D->q_offset, x, NULL);
+            for (int k = 0; k < 3; ++k) acc[k] += x[k];
+        }
+        for (int k = 0; k < 3; ++k) in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
+    }
+    memset(in->surf_n, 0, 3 * (size_t)v->nsurf_verts * sizeof(double));
+    for (int32_t t = 0; t < v->nsurf_tris; ++t) {
+        const int32_t *tri = v->surf_tris + 3 * t;
+        const double *a = in->surf_x + 3 * tri[0], *b = in->surf_x + 3 * tri[1], *c = in->surf_x + 3 * tri[2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        for (int k = 0; k < 3; ++k)
+            for (int j = 0; j < 3; ++j) in->surf_n[3 * tri[k] + j] += n[j]; /* area weighted */
+    }
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        double *n = in->surf_n + 3 * s, l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (l > 0)
+            for (int k = 0; k < 3; ++k) n[k] /= l;
+    }
+}
+
+/* A pose jump no animation makes in one frame (a teleport): no inertia from it. */
+static int teleported(const sinew_instance *in) {
+    for (int32_t b = 0; b < in->v->nbones; ++b) {
+        const double *Tc = in->T_cur + 12 * b, *Tp = in->T_prev + 12 * b;
+        double d2 = 0, tr = 0;
+        for (int i = 0; i < 3; ++i) d2 += (Tc[9 + i] - Tp[9 + i]) * (Tc[9 + i] - Tp[9 + i]);
+        for (int i = 0; i < 3; ++i) tr += Tc[i] * Tp[i] + Tc[3 + i] * Tp[3 + i] + Tc[6 + i] * Tp[6 + i];
+        if (d2 > 0.25 * in->size * in->size || tr < 0.0) return 1; /* > half size, > 90 deg */
+    }
+    return 0;
+}
+
+SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
+    if (!inst || !(dt > 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
+    int32_t R = inst->R;
+    const sw_blob_view *v = inst->v;
+    sinew_step_stats st;
+    memset(&st, 0, sizeof st);
+    st.struct_size = sizeof st;
+    dyn_coef dc = {dt, 0, 0, v->rayleigh_alpha, v->rayleigh_beta, inst->mode == SINEW_STEP_DYNAMIC};
+    memcpy(inst->qn, inst->q, (size_t)R * sizeof(double));
+    if (dc.dynamic) {
+        dc.cm = 1.0 / ((double)dt * dt);
+        dc.cd = 1.0 / dt;
+        if (inst->history >= 1 && teleported(inst)) {
+            memset(inst->qdot, 0, (size_t)R * sizeof(double));
+            inst->history = 0;
+            st.status |= SINEW_STEP_TELEPORT;
+        }
+        inertial_forces(inst, dt);
+    }
+    skin_active(inst);
+    double phi = 0, g0 = 0, gn = 0;
+    for (uint32_t it = 0; it <= inst->max_newton; ++it) {
+        if (dc.dynamic && it == 0) { /* Rayleigh stiffness H(q_n), frozen for the step */
+            dyn_coef statics = dc;
+            statics.dynamic = 0;
+            potential(inst, inst->q, &statics, 1, 1);
+            memcpy(inst->Hn, inst->H, (size_t)R * R * sizeof(double));
+        }
+        phi = potential(inst, inst->q, &dc, 1, 1);
+        gn = sqrt(dot(inst->g, inst->g, R));
+        if (!isfinite(phi) || !isfinite(gn)) {
+            memcpy(inst->q, inst->qn, (size_t)R * sizeof(double));
+            inst->stats = st;
+            inst->stats.status |= SINEW_STEP_FAILED;
+            return SINEW_ERROR_NOT_FINITE;
+        }
+        if (it == 0) g0 = gn;
+        if (gn <= 1e-8 * g0 || gn == 0) {
+            st.status |= SINEW_STEP_CONVERGED;
+            break;
+        }
+        if (it == inst->max_newton) break;
+        if (!newton_direction(inst)) break;
+        /* guard: halve the step while Phi grows; keep the best iterate */
+        double step = 1.0;
+        int accepted = 0;
+        for (int ls = 0; ls < 6 && !accepted; ++ls) {
+            if (ls > 0) step *= 0.5;
+            for (int32_t i = 0; i < R; ++i) inst->qtrial[i] = inst->q[i] + step * inst->dq[i];
+            double p1 = potential(inst, inst->qtrial, &dc, 0, 0);
+            if (isfinite(p1) && p1 <= phi + 1e-12 * fabs(phi)) accepted = 1;
+        }
+        if (!accepted) {
+            st.status |= SINEW_STEP_GUARD;
+            break;
+        }
+        memcpy(inst->q, inst->qtrial, (size_t)R * sizeof(double));
+        st.newton_iterations++;
+    }
+    st.residual = g0 > 0 ? gn / g0 : 0;
+    st.energy = phi;
+    if (dc.dynamic)
+        for (int32_t i = 0; i < R; ++i) inst->qdot[i] = (inst->q[i] - inst->qn[i]) / dt;
+    /* advance the pose history */
+    memcpy(inst->T_prev2, inst->T_prev, 12 * (size_t)v->nbones * sizeof(double));
+    memcpy(inst->T_prev, inst->T_cur, 12 * (size_t)v->nbones * sizeof(double));
+    if (inst->history < 2) inst->history++;
+    write_surface(inst);
+    inst->stats = st;
+    return SINEW_OK;
+}
+
+SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
+                                                   float *normals, uint32_t vertex_count) {
+    if (!inst || (!positions && !normals) || vertex_count != (uint32_t)inst->v->nsurf_verts)
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    for (uint32_t i = 0; i < 3 * vertex_count; ++i) {
+        if (positions) positions[i] = (float)inst->surf_x[i];
+        if (normals) normals[i] = (float)inst->surf_n[i];
+    }
+    return SINEW_OK;
+}
+
+SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sinew_step_stats *out) {
+    if (!inst || !out || out->struct_size < sizeof(uint32_t)) return SINEW_ERROR_INVALID_ARGUMENT;
+    uint32_t n = out->struct_size < sizeof inst->stats ? out->struct_size : (uint32_t)sizeof inst->stats;
+    memcpy(out, &inst->stats, n);
+    out->struct_size = n;
+    return SINEW_OK;
+}
+
+const double *sw_instance_surface(const sinew_instance *inst) { return inst->surf_x; }
+const double *sw_instance_q(const sinew_instance *inst) { return inst->q; }
+
+void sw_instance_full_positions(const sinew_instance *inst, double *x, double *count) {
+    const sw_blob_view *v = inst->v;
+    memset(x, 0, 3 * (size_t)v->nverts * sizeof(double));
+    memset(count, 0, (size_t)v->nverts * sizeof(double));
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank;
+        for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+            int32_t gv = v->domain_verts[D->vert_begin + lv];
+            double R[9], t[3], y[3];
+            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+            for (int i = 0; i < 3; ++i) {
+                double acc = v->rest[3 * gv + i];
+                for (int32_t j = 0; j < r; ++j) acc += U[i * r + j] * inst->q[D->q_offset + j];
+                y[i] = acc;
+            }
+            for (int i = 0; i < 3; ++i)
+                x[3 * gv + i] += R[3 * i] * y[0] + R[3 * i + 1] * y[1] + R[3 * i + 2] * y[2] + t[i];
+            count[gv] += 1;
+        }
+    }
+    for (int32_t gv = 0; gv < v->nverts; ++gv) {
+        if (count[gv] > 0) {
+            for (int i = 0; i < 3; ++i) x[3 * gv + i] /= count[gv];
+        } else {
+            double R[9], t[3];
+            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            const double *X = v->rest + 3 * gv;
+            for (int i = 0; i < 3; ++i) x[3 * gv + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+        }
+    }
+}
+
+void sw_instance_dqs_positions(const sinew_instance *inst, double *x) {
+    const sw_blob_view *v = inst->v;
+    sw_dqs_skin(v->nverts, v->rest, inst->bone_dq, v->skin_bone, v->skin_weight, 4, x);
+}
+
+void sw_instance_set_q(sinew_instance *inst, const double *q) {
+    memcpy(inst->q, q, (size_t)inst->R * sizeof(double));
+}

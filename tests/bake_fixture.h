@@ -1,0 +1,55 @@
+/* A small character baked in-process and loaded as a blob, for runtime tests. */
+#ifndef SW_BAKE_FIXTURE_H
+#define SW_BAKE_FIXTURE_H
+
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake.h"
+#include "blob_load.h"
+#include "blob_write.h"
+#include "samples.h"
+
+typedef struct {
+    sw_character ch;
+    sw_bake_result res;
+    void *data;
+    size_t size;
+    sinew_blob *blob;
+} bake_fixture;
+
+/* Bakes `sample` at about `tets` tets with a clip of `frames` frames. 1 on success. */
+static inline int bake_fixture_make(bake_fixture *f, const char *sample, int tets, int frames) {
+    sw_error err;
+    memset(f, 0, sizeof *f);
+    if (sw_sample_make(sample, tets, frames, &f->ch, &err) != SINEW_OK) return 0;
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 3;
+    p.max_train_frames = 8;
+    p.threads = 2;
+    if (sw_bake(&f->ch, &p, &f->res, &err) != SINEW_OK) {
+        fprintf(stderr, "bake failed: %s\n", err.msg);
+        return 0;
+    }
+    if (sw_blob_write_memory(&f->res.view, &f->data, &f->size, &err) != SINEW_OK) return 0;
+    sinew_blob_def d = sinew_blob_def_default();
+    d.data = f->data;
+    d.data_size = f->size;
+    return sinew_blob_load(&d, &f->blob) == SINEW_OK;
+}
+
+static inline void bake_fixture_free(bake_fixture *f) {
+    sinew_blob_destroy(f->blob);
+    free(f->data);
+    sw_bake_result_free(&f->res);
+    sw_character_free(&f->ch);
+    memset(f, 0, sizeof *f);
+}
+
+/* Pose f of the fixture's clip as float transforms (12 per bone) into out. */
+static inline void bake_fixture_pose(const bake_fixture *f, int frame, float *out) {
+    const double *T = f->ch.clip.T + (size_t)(frame % f->ch.clip.nframes) * 12 * f->ch.skel.nbones;
+    for (int i = 0; i < 12 * f->ch.skel.nbones; ++i) out[i] = (float)T[i];
+}
+#endif

@@ -1,0 +1,297 @@
+/* sinew-bench: in one run on the same mesh and motion, the full-space reference, the
+ * subspace runtime and plain dual-quaternion skinning of the same render surface.
+ *
+ *   sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
+ *               [--blob FILE] [--full-frames K] [--contract-steps S] [--threads T] --json
+ *
+ * Bakes the character (or loads --blob, then the errors are measured against fresh
+ * full-space solutions of the clip's held-out frames), then:
+ *   full_ms   median full-space quasistatic ms/frame (self-contact on) over K clip frames
+ *   sub_ms    median subspace step + surface read ms/frame over the clip
+ *   dqs_ms    median ms/frame of DQS of the render surface (positions and normals)
+ *   err_*     correction error |x_sub - x_full|_M / |x_full - x_dqs|_M on the bake's
+ *             training poses and held-out poses
+ *   allocs_in_step, locks_in_step: calls counted by the interposer over S steps after
+ *             warm-up (-1 when this build cannot observe them)
+ * Ratios: speedup_vs_full = full_ms / sub_ms, cost_vs_dqs = sub_ms / dqs_ms. The last
+ * stdout line is one JSON object. */
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <time.h>
+
+#include "bake.h"
+#include "blob_load.h"
+#include "blob_write.h"
+#include "character_io.h"
+#include "dqs.h"
+#include "fullsim.h"
+#include "instance.h"
+#include "mesh_io.h"
+#include "rt_interpose.h"
+#include "samples.h"
+#include "subspace_eval.h"
+
+#ifndef SINEW_SHARED_DATA_DIR
+#define SINEW_SHARED_DATA_DIR "../shared/data"
+#endif
+
+static double now(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
+}
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+static double median(double *v, int n) {
+    if (n <= 0) return 0;
+    qsort(v, (size_t)n, sizeof *v, cmp_double);
+    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
+}
+
+static int parse_int(const char *s, int lo, int hi, int *out) {
+    char *end;
+    errno = 0;
+    long v = strtol(s, &end, 10);
+    if (errno || *end || end == s || v < lo || v > hi) return 0;
+    *out = (int)v;
+    return 1;
+}
+
+static void usage(FILE *f) {
+    fprintf(f, "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf\n"
+               "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
+               "                   [--contract-steps S] [--threads T] [--data DIR] --json\n");
+}
+
+/* Plain DQS of the render surface (positions and area-weighted normals): the cost a
+ * host pays today, timed per frame over the clip. */
+static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames, const int32_t *surf_vert,
+                     double *x, double *n) {
+    double *ms = malloc((size_t)frames * sizeof(double));
+    sw_dualquat dq[SW_MAX_BONES];
+    for (int f = 0; f < frames && ms; ++f) {
+        const double *T = clip->T + (size_t)f * 12 * clip->nbones;
+        double t0 = now();
+        for (int32_t b = 0; b < v->nbones; ++b) sw_dq_from_transform(T + 12 * b, &dq[b]);
+        for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+            int32_t gv = surf_vert[s];
+            double R[9], t[3];
+            const double *X = v->rest + 3 * gv;
+            sw_dqs_blend(dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            for (int i = 0; i < 3; ++i) x[3 * s + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+        }
+        memset(n, 0, 3 * (size_t)v->nsurf_verts * sizeof(double));
+        for (int32_t t = 0; t < v->nsurf_tris; ++t) {
+            const int32_t *tri = v->surf_tris + 3 * t;
+            const double *a = x + 3 * tri[0], *b = x + 3 * tri[1], *c = x + 3 * tri[2];
+            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            double nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+            for (int k = 0; k < 3; ++k)
+                for (int j = 0; j < 3; ++j) n[3 * tri[k] + j] += nn[j];
+        }
+        for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+            double *q = n + 3 * s, l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
+            if (l > 0)
+                for (int k = 0; k < 3; ++k) q[k] /= l;
+        }
+        ms[f] = 1e3 * (now() - t0);
+    }
+    double m = median(ms, frames);
+    free(ms);
+    return m;
+}
+
+int main(int argc, char **argv) {
+    const char *scene = NULL, *mesh = NULL, *tgf = NULL, *weights = NULL, *clip_path = NULL;
+    const char *blob_path = NULL;
+    const char *data_dir = getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
+    int tets = 20000, frames = 0, json = 0, full_frames = 6, contract_steps = 10000, threads = 0;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        int ok = 1;
+        if (!strcmp(a, "--scene") && next) scene = argv[++i];
+        else if (!strcmp(a, "--mesh") && next) mesh = argv[++i];
+        else if (!strcmp(a, "--skeleton") && next) tgf = argv[++i];
+        else if (!strcmp(a, "--weights") && next) weights = argv[++i];
+        else if (!strcmp(a, "--clip") && next) clip_path = argv[++i];
+        else if (!strcmp(a, "--blob") && next) blob_path = argv[++i];
+        else if (!strcmp(a, "--data") && next) data_dir = argv[++i];
+        else if (!strcmp(a, "--tets") && next) ok = parse_int(argv[++i], 1000, 2000000, &tets);
+        else if (!strcmp(a, "--frames") && next) ok = parse_int(argv[++i], 2, 1000000, &frames);
+        else if (!strcmp(a, "--full-frames") && next) ok = parse_int(argv[++i], 1, 100000, &full_frames);
+        else if (!strcmp(a, "--contract-steps") && next) ok = parse_int(argv[++i], 0, 100000000, &contract_steps);
+        else if (!strcmp(a, "--threads") && next) ok = parse_int(argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--json")) json = 1;
+        else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
+            usage(stdout);
+            return 0;
+        } else ok = 0;
+        if (!ok) {
+            fprintf(stderr, "sinew-bench: bad or incomplete argument '%s'\n", a);
+            usage(stderr);
+            return 2;
+        }
+    }
+    if (!scene == !mesh || (mesh && !tgf)) {
+        usage(stderr);
+        return 2;
+    }
+    sw_error err;
+    sw_error_clear(&err);
+    sw_character ch;
+    memset(&ch, 0, sizeof ch);
+    int computed = 0;
+    sinew_result r = scene ? sw_scene_make(scene, tets, frames, data_dir, &ch, &computed, &err)
+                           : sw_character_from_files(mesh, tgf, weights, clip_path, frames, &ch, &err);
+    if (r != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: %s (%s)\n", err.msg, sinew_result_string(r));
+        return 1;
+    }
+    if (mesh && !weights) computed = 1;
+    if (computed) sw_weights_free(&ch.weights);
+    int nf = ch.clip.nframes;
+
+    /* 1. bake (or load) */
+    sw_bake_params bp = sw_bake_params_default();
+    bp.threads = threads;
+    bp.progress = 1;
+    sw_bake_result res;
+    memset(&res, 0, sizeof res);
+    sinew_blob *blob = NULL;
+    void *mem = NULL;
+    double bake_s = 0;
+    sinew_blob_def bd = sinew_blob_def_default();
+    if (blob_path) {
+        bd.path = blob_path;
+    } else {
+        double t0 = now();
+        size_t size = 0;
+        if ((r = sw_bake(&ch, &bp, &res, &err)) != SINEW_OK ||
+            (r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
+            fprintf(stderr, "sinew-bench: bake failed: %s (%s)\n", err.msg, sinew_result_string(r));
+            return 1;
+        }
+        bake_s = now() - t0;
+        bd.data = mem;
+        bd.data_size = size;
+    }
+    if ((r = sinew_blob_load(&bd, &blob)) != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: cannot load the blob: %s\n", sinew_result_string(r));
+        return 1;
+    }
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    if (v->nverts != ch.mesh.nverts || v->nbones != ch.skel.nbones) {
+        fprintf(stderr, "sinew-bench: the blob does not belong to this character (%d/%d vertices, %d/%d bones)\n",
+                v->nverts, ch.mesh.nverts, v->nbones, ch.skel.nbones);
+        return 1;
+    }
+
+    /* 2. full-space reference over the first K clip frames (same motion, all cores) */
+    sw_fullsim_params fp = sw_fullsim_params_default();
+    fp.threads = threads;
+    sw_fullsim *sim = NULL;
+    int kf = full_frames < nf ? full_frames : nf;
+    double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));
+    if ((r = sw_fullsim_create(&ch, &fp, &sim, &err)) != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: %s\n", err.msg);
+        return 1;
+    }
+    /* the full reference steps every clip frame up to the last timed one, from rest */
+    for (int f = 0; f < kf; ++f) {
+        sw_fullsim_stats st;
+        sw_fullsim_step(sim, ch.clip.T + (size_t)f * 12 * ch.skel.nbones, &st);
+        full[f] = 1e3 * st.seconds;
+        fprintf(stderr, "sinew-bench: full-space frame %d/%d: %.1f ms\n", f + 1, kf, full[f]);
+    }
+    double full_ms = median(full, kf);
+    sw_fullsim_destroy(sim);
+
+    /* 3. subspace: step + read over the clip */
+    sinew_instance *inst;
+    if ((r = sinew_instance_create(blob, NULL, &inst)) != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: cannot create an instance: %s\n", sinew_result_string(r));
+        return 1;
+    }
+    uint32_t ns = sinew_blob_surface_vertex_count(blob);
+    float *pos = malloc((size_t)ns * 3 * sizeof(float)), *nrm = malloc((size_t)ns * 3 * sizeof(float));
+    double *sub = malloc((size_t)nf * sizeof(double));
+    for (int f = 0; f < nf; ++f) {
+        double t0 = now();
+        sw_instance_set_pose_d(inst, ch.clip.T + (size_t)f * 12 * ch.skel.nbones);
+        sinew_instance_step(inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30));
+        sinew_instance_read_surface(inst, pos, nrm, ns);
+        sub[f] = 1e3 * (now() - t0);
+    }
+    double sub_ms = median(sub, nf);
+
+    /* 4. plain DQS of the same surface */
+    int32_t *surf_vert = malloc((size_t)ns * sizeof(int32_t));
+    for (uint32_t s = 0; s < ns; ++s) {
+        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * v->surf_copy_ptr[s]]];
+        surf_vert[s] = v->domain_verts[D->vert_begin + v->surf_copies[2 * v->surf_copy_ptr[s] + 1]];
+    }
+    double *xs = malloc((size_t)ns * 3 * sizeof(double)), *xn = malloc((size_t)ns * 3 * sizeof(double));
+    double d_ms = dqs_ms(v, &ch.clip, nf, surf_vert, xs, xn);
+
+    /* 5. errors against the full-space solutions */
+    sw_eval_result et, eh;
+    memset(&et, 0, sizeof et);
+    memset(&eh, 0, sizeof eh);
+    if (!blob_path) {
+        sw_eval_correction(blob, res.mass, res.train_T, res.train_x, res.ntrain, 20, &et, &err);
+        sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh, &err);
+    }
+
+    /* 6. the real-time contract: allocation and lock calls inside the step */
+    long allocs = -1, locks = -1;
+    unsigned active = sw_rt_interpose_active();
+    if (contract_steps > 0) {
+        for (int f = 0; f < 10; ++f) { /* warm-up */
+            sw_instance_set_pose_d(inst, ch.clip.T + (size_t)(f % nf) * 12 * ch.skel.nbones);
+            sinew_instance_step(inst, 1.0f / 30);
+        }
+        sw_rt_count_begin();
+        for (int s = 0; s < contract_steps; ++s) {
+            sinew_instance_set_pose(inst, NULL, 0); /* rejected: also must not allocate */
+            sw_instance_set_pose_d(inst, ch.clip.T + (size_t)(s % nf) * 12 * ch.skel.nbones);
+            sinew_instance_step(inst, 1.0f / 30);
+            sinew_instance_read_surface(inst, pos, nrm, ns);
+        }
+        sw_rt_counts c = sw_rt_count_end();
+        if (active & SW_RT_CAT_ALLOCS) allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
+        if (active & SW_RT_CAT_LOCKS) locks = (long)c.locks;
+    }
+    fprintf(stderr,
+            "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, cost %.1fx DQS;\n"
+            "             correction error train %.4f held-out %.4f; allocs %ld, locks %ld in %d steps\n",
+            full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms, et.correction_error,
+            eh.correction_error, allocs, locks, contract_steps);
+    if (json)
+        printf("{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
+               "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
+               "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
+               "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_seconds\":%.2f}\n",
+               scene ? scene : mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
+               sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub,
+               allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s);
+    free(full);
+    free(sub);
+    free(pos);
+    free(nrm);
+    free(xs);
+    free(xn);
+    free(surf_vert);
+    sinew_instance_destroy(inst);
+    sinew_blob_destroy(blob);
+    free(mem);
+    sw_bake_result_free(&res);
+    sw_character_free(&ch);
+    return 0;
+}
