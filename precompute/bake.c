@@ -161,6 +161,8 @@ static void free_state(sw_bake_state *s) {
     }
     free(s->basis);
     free(s->rank);
+    free(s->train_q);
+    free(s->train_pose);
     free(s->cub_n);
     free(s->cub_local);
     free(s->cub_w);

@@ -94,19 +94,25 @@ done:
     return U;
 }
 
+/* q_d = U_d^T d restricted to domain dm's copies (q: rank[dm] doubles). */
+static void project(const sw_bake_state *s, int32_t dm, const double *d, double *q) {
+    int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base, r = s->rank[dm];
+    const double *U = s->basis[dm];
+    for (int32_t k = 0; k < r; ++k) {
+        double acc = 0;
+        for (int32_t j = 0; j < n; ++j)
+            for (int i = 0; i < 3; ++i) acc += U[(size_t)(3 * j + i) * r + k] * d[3 * s->dom_verts[base + j] + i];
+        q[k] = acc;
+    }
+}
+
 /* Relative projection error accumulators for the snapshots d (3 nv) of one pose. */
 static void projection_error(const sw_bake_state *s, const double *d, double *num, double *den) {
     for (int32_t dm = 0; dm < s->nd; ++dm) {
         int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base, r = s->rank[dm];
         const double *U = s->basis[dm];
         double q[1024];
-        for (int32_t k = 0; k < r; ++k) {
-            double acc = 0;
-            for (int32_t j = 0; j < n; ++j)
-                for (int i = 0; i < 3; ++i)
-                    acc += U[(size_t)(3 * j + i) * r + k] * d[3 * s->dom_verts[base + j] + i];
-            q[k] = acc;
-        }
+        project(s, dm, d, q);
         for (int32_t j = 0; j < n; ++j)
             for (int i = 0; i < 3; ++i) {
                 double p = 0;
@@ -146,6 +152,23 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         free(D);
         if (!s->basis[dm]) goto oom;
         s->rank_total += s->rank[dm];
+    }
+    /* the pose-space warm start: every training pose's feature and projected solution */
+    s->ntrain = T;
+    s->train_q = malloc((size_t)T * s->rank_total * sizeof(double));
+    s->train_pose = malloc((size_t)T * 4 * s->nb * sizeof(double));
+    if (!s->train_q || !s->train_pose) goto oom;
+    k = 0;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->train[i].npose; ++j, ++k)
+            sw_pose_feature(s->train[i].T + (size_t)j * 12 * s->nb, s->ch.skel.parent, s->nb,
+                            s->train_pose + (size_t)k * 4 * s->nb);
+    for (int32_t a = 0; a < T; ++a) {
+        int32_t off = 0;
+        for (int32_t dm = 0; dm < s->nd; ++dm) {
+            project(s, dm, dall + (size_t)a * n3, s->train_q + (size_t)a * s->rank_total + off);
+            off += s->rank[dm];
+        }
     }
     double num = 0, den = 0;
     for (int32_t a = 0; a < T; ++a) projection_error(s, dall + (size_t)a * n3, &num, &den);

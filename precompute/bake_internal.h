@@ -40,6 +40,9 @@ typedef struct sw_bake_state {
     int32_t *rank;
     double **basis;
     int32_t rank_total;
+    double *train_q;    /* ntrain x rank_total: projected training solutions */
+    double *train_pose; /* ntrain x 4 nbones: pose features */
+    int32_t ntrain;
     /* cubature: per domain local tet index into dom_tets and weights */
     int32_t *cub_n;
     int32_t **cub_local; /* index into the domain's dom_tets range */

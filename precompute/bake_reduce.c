@@ -224,6 +224,18 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->surf_copy_ptr = copy_ptr;
     v->surf_copies = copies;
     v->nsurf_copies = nsc;
+    double *tq, *tp;
+    OWN(tq, (int64_t)s->ntrain * R, double);
+    OWN(tp, (int64_t)s->ntrain * 4 * s->nb, double);
+    if (!tq || !tp) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+        goto done;
+    }
+    memcpy(tq, s->train_q, (size_t)s->ntrain * R * sizeof(double));
+    memcpy(tp, s->train_pose, (size_t)s->ntrain * 4 * s->nb * sizeof(double));
+    v->ntrain = s->ntrain;
+    v->train_q = tq;
+    v->train_pose = tp;
     r = SINEW_OK;
 done:
     free(copy_ptr_v);

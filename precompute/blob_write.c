@@ -1,4 +1,4 @@
-/* Blob layout: header (64 bytes), section table (21 entries), then the 21 sections in id
+/* Blob layout: header (64 bytes), section table (23 entries), then the 23 sections in id
  * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
  * everything after the header. */
 #include "blob_write.h"
@@ -23,7 +23,7 @@ static uint64_t round_up(uint64_t x) {
     return (x + SINEW_BLOB_ALIGN - 1) / SINEW_BLOB_ALIGN * SINEW_BLOB_ALIGN;
 }
 
-/* The 21 sections of a validated view, in id order; `meta` must outlive the result. */
+/* The 23 sections of a validated view, in id order; `meta` must outlive the result. */
 static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
                           section_src s[SINEW_SECTION_COUNT_V1]) {
     const uint64_t n = (uint64_t)v->nverts, nb = (uint64_t)v->nbones, nc = (uint64_t)v->ncub,
@@ -49,7 +49,9 @@ static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
         {SINEW_SECTION_INERTIA_U, 8, v->inertia_u, (uint64_t)v->ninertia_u},
         {SINEW_SECTION_SURF_TRIS, 4, v->surf_tris, 3 * (uint64_t)v->nsurf_tris},
         {SINEW_SECTION_SURF_COPY_PTR, 4, v->surf_copy_ptr, (uint64_t)v->nsurf_verts + 1},
-        {SINEW_SECTION_SURF_COPIES, 4, v->surf_copies, 2 * (uint64_t)v->nsurf_copies}};
+        {SINEW_SECTION_SURF_COPIES, 4, v->surf_copies, 2 * (uint64_t)v->nsurf_copies},
+        {SINEW_SECTION_TRAIN_Q, 8, v->train_q, (uint64_t)v->ntrain * R},
+        {SINEW_SECTION_TRAIN_POSE, 8, v->train_pose, (uint64_t)v->ntrain * 4 * nb}};
     memcpy(s, list, sizeof list);
 }
 
@@ -72,6 +74,8 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     meta.nsurf_tris = view->nsurf_tris;
     meta.mu = view->mu, meta.lambda = view->lambda, meta.rayleigh_alpha = view->rayleigh_alpha;
     meta.rayleigh_beta = view->rayleigh_beta, meta.contact_k = view->contact_k;
+    meta.ntrain = view->ntrain;
+    meta.reserved = 0;
 
     section_src src[SINEW_SECTION_COUNT_V1];
     sinew_blob_section table[SINEW_SECTION_COUNT_V1];

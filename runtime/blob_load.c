@@ -15,7 +15,7 @@
 
 _Static_assert(sizeof(sinew_blob_header) == 64, "blob header is 64 bytes");
 _Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
-_Static_assert(sizeof(sinew_blob_meta) == 72, "META is 72 bytes");
+_Static_assert(sizeof(sinew_blob_meta) == 80, "META is 80 bytes");
 _Static_assert(sizeof(sinew_blob_domain_record) == 48, "domain record is 48 bytes");
 _Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vertex");
 
@@ -26,11 +26,11 @@ static const char *const k_section_names[SINEW_SECTION_COUNT_V1 + 1] = {
     "unknown",     "META",      "REST",           "SKIN_BONE",  "SKIN_WEIGHT", "BONE_PARENT",
     "BONE_JOINTS", "DOMAINS",   "DOMAIN_VERTS",   "BASIS",      "CUB_TETS",    "CUB_WEIGHT",
     "CUB_DMINV",   "CUB_VOL",   "SPRING_HESSIAN", "MASS",       "INERTIA_S",   "INERTIA_X",
-    "INERTIA_U",   "SURF_TRIS", "SURF_COPY_PTR",  "SURF_COPIES"};
+    "INERTIA_U",   "SURF_TRIS", "SURF_COPY_PTR",  "SURF_COPIES", "TRAIN_Q",     "TRAIN_POSE"};
 
 /* Element size of every known section (format header table). */
-static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {0, 72, 8, 4, 8, 4, 8, 48, 4, 8, 4,
-                                                                 8, 8,  8, 8, 8, 8, 8, 8,  4, 4, 4};
+static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {0, 80, 8, 4, 8, 4, 8, 48, 4, 8, 4, 8,
+                                                                 8, 8,  8, 8, 8, 8, 8, 4, 4, 4, 8, 8};
 
 uint64_t sw_blob_checksum(const void *data, size_t n) {
     const uint8_t *p = data;
@@ -86,6 +86,7 @@ static sinew_result check_meta(const sw_blob_view *v, char *msg, size_t ms) {
         {"ncub", v->ncub, 1, SW_BLOB_MAX_COUNT},
         {"nsurf_verts", v->nsurf_verts, 1, SW_BLOB_MAX_COUNT},
         {"nsurf_tris", v->nsurf_tris, 1, SW_BLOB_MAX_COUNT},
+        {"ntrain", v->ntrain, 1, 1000000},
     };
     for (size_t i = 0; i < sizeof counts / sizeof counts[0]; ++i) {
         sinew_result r =
@@ -142,7 +143,9 @@ static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) 
                   {v->inertia_u, SINEW_SECTION_INERTIA_U},
                   {v->surf_tris, SINEW_SECTION_SURF_TRIS},
                   {v->surf_copy_ptr, SINEW_SECTION_SURF_COPY_PTR},
-                  {v->surf_copies, SINEW_SECTION_SURF_COPIES}};
+                  {v->surf_copies, SINEW_SECTION_SURF_COPIES},
+                  {v->train_q, SINEW_SECTION_TRAIN_Q},
+                  {v->train_pose, SINEW_SECTION_TRAIN_POSE}};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!arrays[i].p)
             return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
@@ -275,7 +278,9 @@ static sinew_result check_all_finite(const sw_blob_view *v, char *msg, size_t ms
                   {SINEW_SECTION_MASS, v->mass, R * R},
                   {SINEW_SECTION_INERTIA_S, v->inertia_s, 3 * R},
                   {SINEW_SECTION_INERTIA_X, v->inertia_x, 9 * R},
-                  {SINEW_SECTION_INERTIA_U, v->inertia_u, v->ninertia_u}};
+                  {SINEW_SECTION_INERTIA_U, v->inertia_u, v->ninertia_u},
+                  {SINEW_SECTION_TRAIN_Q, v->train_q, (int64_t)v->ntrain * R},
+                  {SINEW_SECTION_TRAIN_POSE, v->train_pose, (int64_t)v->ntrain * 4 * nb}};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) {
         sinew_result r = check_finite(arrays[i].id, arrays[i].a, arrays[i].n, msg, ms);
         if (r != SINEW_OK) return r;
@@ -536,7 +541,9 @@ static sinew_result check_meta_counts(const sw_blob_view *v, const sinew_blob_se
                   {SINEW_SECTION_INERTIA_S, 3 * R, "3 rank_total"},
                   {SINEW_SECTION_INERTIA_X, 9 * R, "9 rank_total"},
                   {SINEW_SECTION_SURF_TRIS, 3 * (uint64_t)v->nsurf_tris, "3 nsurf_tris"},
-                  {SINEW_SECTION_SURF_COPY_PTR, (uint64_t)v->nsurf_verts + 1, "nsurf_verts + 1"}};
+                  {SINEW_SECTION_SURF_COPY_PTR, (uint64_t)v->nsurf_verts + 1, "nsurf_verts + 1"},
+                  {SINEW_SECTION_TRAIN_Q, (uint64_t)v->ntrain * R, "ntrain rank_total"},
+                  {SINEW_SECTION_TRAIN_POSE, (uint64_t)v->ntrain * 4 * nb, "4 ntrain nbones"}};
     for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i) {
         const sinew_blob_section *e = &s[found[expect[i].id]];
         if (e->count != expect[i].count)
@@ -564,6 +571,10 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     v->nsurf_verts = m.nsurf_verts, v->nsurf_tris = m.nsurf_tris;
     v->mu = m.mu, v->lambda = m.lambda, v->rayleigh_alpha = m.rayleigh_alpha;
     v->rayleigh_beta = m.rayleigh_beta, v->contact_k = m.contact_k;
+    v->ntrain = m.ntrain;
+    if (m.reserved != 0)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section META: reserved field is %d, not 0",
+                    m.reserved);
     sinew_result r = check_meta(v, msg, ms);
     if (r != SINEW_OK) return r;
     if ((r = check_meta_counts(v, s, found, msg, ms)) != SINEW_OK) return r;
@@ -600,6 +611,8 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     v->surf_tris = AT(SURF_TRIS);
     v->surf_copy_ptr = AT(SURF_COPY_PTR);
     v->surf_copies = AT(SURF_COPIES);
+    v->train_q = AT(TRAIN_Q);
+    v->train_pose = AT(TRAIN_POSE);
 #undef AT
     return SINEW_OK;
 }

@@ -83,6 +83,13 @@ typedef struct sw_blob_view {
     const int32_t *surf_copy_ptr; /* nsurf_verts + 1, non-decreasing, starts at 0 */
     const int32_t *surf_copies;   /* 2 * surf_copy_ptr[nsurf_verts]: (domain, local vertex) */
     int32_t nsurf_copies;
+
+    /* pose-space warm start: training pose t has feature train_pose[4 nbones t ..]
+     * (each bone's rotation relative to its parent as a unit quaternion w, x, y, z with
+     * w >= 0) and reduced solution train_q[R t ..] */
+    int32_t ntrain;
+    const double *train_q;
+    const double *train_pose;
 } sw_blob_view;
 
 #endif

@@ -123,3 +123,32 @@ void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int
         x[3 * (int64_t)v + 2] = y2;
     }
 }
+
+void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature) {
+    for (int32_t b = 0; b < nbones; ++b) {
+        const double *Rb = T + 12 * b;
+        double L[12] = {0};
+        if (parent[b] < 0) {
+            for (int i = 0; i < 9; ++i) L[i] = Rb[i];
+        } else { /* L = R_p^T R_b */
+            const double *Rp = T + 12 * parent[b];
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
+        }
+        sw_dualquat dq;
+        sw_dq_from_transform(L, &dq);
+        double s = dq.r[0] < 0 ? -1.0 : 1.0;
+        for (int k = 0; k < 4; ++k) feature[4 * b + k] = s * dq.r[k];
+    }
+}
+
+double sw_pose_distance(const double *fa, const double *fb, int32_t nbones) {
+    double d = 0;
+    for (int32_t b = 0; b < nbones; ++b) {
+        double c = fa[4 * b] * fb[4 * b] + fa[4 * b + 1] * fb[4 * b + 1] + fa[4 * b + 2] * fb[4 * b + 2] +
+                   fa[4 * b + 3] * fb[4 * b + 3];
+        d += 1.0 - c * c;
+    }
+    return d;
+}

@@ -28,4 +28,12 @@ void sw_dqs_blend(const sw_dualquat *bones, const int32_t *ids, const double *we
  * k per point). */
 void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int32_t *ids,
                  const double *weights, int k, double *x);
+/* Pose feature of bone transforms T (12 per bone): each bone's rotation relative to its
+ * parent's (parent[b] < 0: to the world) as a unit quaternion (w, x, y, z), w >= 0;
+ * writes 4 * nbones doubles. Invariant to the character's global placement. */
+void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature);
+
+/* Squared distance between two pose features: sum over bones of 1 - <q_a, q_b>^2
+ * (0 for the same rotations, sign of each quaternion irrelevant). */
+double sw_pose_distance(const double *fa, const double *fb, int32_t nbones);
 #endif

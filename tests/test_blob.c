@@ -29,7 +29,8 @@ enum {
     NST = 6,      /* surface triangles */
     NBASIS = 150, /* 6*3*2 + 6*3*3 + 5*3*4 */
     NIU = 261,    /* 9 * (4 + 9 + 16) */
-    MAXCOP = 16
+    MAXCOP = 16,
+    NTR = 2 /* training poses */
 };
 
 typedef struct fixture {
@@ -46,6 +47,7 @@ typedef struct fixture {
     double spring_hessian[RT * RT], mass[RT * RT], inertia_s[3 * RT], inertia_x[9 * RT];
     double inertia_u[NIU];
     int32_t surf_tris[3 * NST], surf_copy_ptr[NSV + 1], surf_copies[2 * MAXCOP];
+    double train_q[NTR * RT], train_pose[NTR * 4 * NB];
     sw_blob_view v;
 } fixture;
 
@@ -130,6 +132,10 @@ static void fixture_init(fixture *f, uint64_t seed) {
         f->inertia_x[i] = rng_sym();
     for (int i = 0; i < NIU; ++i)
         f->inertia_u[i] = rng_sym();
+    for (int i = 0; i < NTR * RT; ++i)
+        f->train_q[i] = rng_sym();
+    for (int i = 0; i < NTR * 4 * NB; ++i)
+        f->train_pose[i] = rng_sym();
     for (int t = 0; t < NST; ++t)
         rng_distinct(&f->surf_tris[3 * t], 3, NSV);
     int32_t nc = 0;
@@ -159,6 +165,7 @@ static void fixture_init(fixture *f, uint64_t seed) {
     v->inertia_u = f->inertia_u, v->ninertia_u = NIU;
     v->surf_tris = f->surf_tris, v->surf_copy_ptr = f->surf_copy_ptr;
     v->surf_copies = f->surf_copies, v->nsurf_copies = nc;
+    v->ntrain = NTR, v->train_q = f->train_q, v->train_pose = f->train_pose;
 }
 
 /* ---- helpers --------------------------------------------------------------------- */
@@ -189,6 +196,7 @@ static const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
     SAME_INT(nbasis);
     SAME_INT(ninertia_u);
     SAME_INT(nsurf_copies);
+    SAME_INT(ntrain);
     SAME_BITS(mu);
     SAME_BITS(lambda);
     SAME_BITS(rayleigh_alpha);
@@ -215,6 +223,8 @@ static const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
     SAME_ARR(surf_tris, 3 * (int64_t)a->nsurf_tris);
     SAME_ARR(surf_copy_ptr, (int64_t)a->nsurf_verts + 1);
     SAME_ARR(surf_copies, 2 * (int64_t)a->nsurf_copies);
+    SAME_ARR(train_q, (int64_t)a->ntrain * R);
+    SAME_ARR(train_pose, (int64_t)a->ntrain * 4 * nb);
 #undef SAME_INT
 #undef SAME_BITS
 #undef SAME_ARR
@@ -281,7 +291,9 @@ static int walk_view(const sw_blob_view *v, const uint8_t *base, size_t size, do
                   {v->inertia_u, 8 * v->ninertia_u},
                   {v->surf_tris, 12 * (int64_t)v->nsurf_tris},
                   {v->surf_copy_ptr, 4 * ((int64_t)v->nsurf_verts + 1)},
-                  {v->surf_copies, 8 * (int64_t)v->nsurf_copies}};
+                  {v->surf_copies, 8 * (int64_t)v->nsurf_copies},
+                  {v->train_q, 8 * (int64_t)v->ntrain * R},
+                  {v->train_pose, 32 * (int64_t)v->ntrain * nb}};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!inside(arrays[i].p, arrays[i].bytes, base, size)) return 0;
     double s = 0.0;
@@ -900,7 +912,7 @@ TEST(unknown_extra_section_still_loads) {
     size_t size = 0;
     uint8_t *blob = write_fixture(&g_fix, &size);
     ENSURE(blob != NULL);
-    /* The writer's table ends at 64 + 21*32 = 736 and the first section starts at 768:
+    /* The writer's table ends at 64 + 23*32 = 800 and the first section starts at 832:
      * room for one more entry without moving anything. New data goes at the end. */
     const uint32_t n = hdr(blob)->section_count;
     uint64_t first = UINT64_MAX;

@@ -17,7 +17,7 @@
  * for the meaning of every array):
  *
  *   id name            elem  count
- *   1  META            72    1      (sinew_blob_meta)
+ *   1  META            80    1      (sinew_blob_meta)
  *   2  REST            8     3n
  *   3  SKIN_BONE       4     4n
  *   4  SKIN_WEIGHT     8     4n
@@ -38,6 +38,8 @@
  *   19 SURF_TRIS       4     3 nsurf_tris
  *   20 SURF_COPY_PTR   4     nsurf_verts + 1
  *   21 SURF_COPIES     4     2 * surf_copy_ptr[nsurf_verts]
+ *   22 TRAIN_Q         8     ntrain * R     (reduced solutions of the training poses)
+ *   23 TRAIN_POSE      8     ntrain * 4 nbones (pose features: unit quaternions)
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -93,14 +95,18 @@ enum sinew_blob_section_id {
     SINEW_SECTION_SURF_TRIS = 19,
     SINEW_SECTION_SURF_COPY_PTR = 20,
     SINEW_SECTION_SURF_COPIES = 21,
-    SINEW_SECTION_COUNT_V1 = 21
+    SINEW_SECTION_TRAIN_Q = 22,
+    SINEW_SECTION_TRAIN_POSE = 23,
+    SINEW_SECTION_COUNT_V1 = 23
 };
 
-/** Section META: counts and material (72 bytes). */
+/** Section META: counts and material (80 bytes). */
 typedef struct sinew_blob_meta {
     int32_t nverts, nbones, ndomains, rank_total;
     int32_t ndomain_verts, ncub, nsurf_verts, nsurf_tris;
     double mu, lambda, rayleigh_alpha, rayleigh_beta, contact_k;
+    int32_t ntrain;   /**< training poses kept for the pose-space warm start (>= 1) */
+    int32_t reserved; /**< zero */
 } sinew_blob_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
