@@ -15,6 +15,7 @@
 #include "svd3.h"
 
 #include <math.h>
+#include <stddef.h>
 
 /* Twist eigenvalues divide by s_i + s_j, which is >= 0 for the rotation-variant SVD
  * (s_0 >= s_1 >= |s_2|) and vanishes only when the element is flattened with two
@@ -74,29 +75,23 @@ static void pull_to_nodes(const double Q[9], const double D[12], double g[12]) {
                 Q[3 * c] * D[3 * n] + Q[3 * c + 1] * D[3 * n + 1] + Q[3 * c + 2] * D[3 * n + 2];
 }
 
-/* Adds vol * lam * (B^T vec(U M V^T)) (B^T vec(U M V^T))^T to K. */
-static void add_mode(const double U[9], const double M[9], const double V[9], const double D[12],
-                     double w, double K[144]) {
-    if (w == 0.0) return;
-    double UM[9], Q[9], g[12];
+/* Mode k of the element Hessian: weight w (vol * eigenvalue) and direction
+ * g = B^T vec(U M V^T) (12). */
+static void mode_direction(const double U[9], const double M[9], const double V[9],
+                           const double D[12], double g[12]) {
+    double UM[9], Q[9];
     sw_m3_mul(U, M, UM);
     sw_m3_mul_nt(UM, V, Q);
     pull_to_nodes(Q, D, g);
-    /* w * (g_i g_j): the same rounding for (i, j) and (j, i), so K is exactly symmetric. */
-    for (int i = 0; i < 12; ++i)
-        for (int j = 0; j < 12; ++j)
-            K[12 * i + j] += w * (g[i] * g[j]);
 }
 
-/* K = vol B^T (dP/dF) B through the analytic eigen system of dP/dF. */
-static void corot_hessian(const double U[9], const double s[3], const double V[9],
-                          const double D[12], double vol, double mu, double lambda, uint32_t flags,
-                          double K[144]) {
+/* The element Hessian vol B^T (dP/dF) B as nine rank-one modes K = sum_k w_k g_k g_k^T,
+ * through the analytic eigen system of dP/dF (w: 9, g: 9 x 12). */
+static void corot_modes(const double U[9], const double s[3], const double V[9],
+                        const double D[12], double vol, double mu, double lambda, uint32_t flags,
+                        double w[9], double g[108]) {
     int project = (flags & SW_COROT_PROJECT_PSD) != 0;
     double e = s[0] + s[1] + s[2] - 3.0;
-    for (int i = 0; i < 144; ++i)
-        K[i] = 0.0;
-
     /* Scaling block d2Psi/ds2 = 2 mu I + lambda 1 1^T: eigenvalue 2mu + 3lambda along
      * (1,1,1)/sqrt(3), 2mu on its orthogonal complement. */
     static const double r3 = 0.57735026918962576451, r2 = 0.70710678118654752440,
@@ -106,9 +101,9 @@ static void corot_hessian(const double U[9], const double s[3], const double V[9
     for (int k = 0; k < 3; ++k) {
         double lam = project && lam_scale[k] < 0.0 ? 0.0 : lam_scale[k];
         double M[9] = {dirs[k][0], 0, 0, 0, dirs[k][1], 0, 0, 0, dirs[k][2]};
-        add_mode(U, M, V, D, vol * lam, K);
+        w[k] = vol * lam;
+        mode_direction(U, M, V, D, g + 12 * k);
     }
-
     /* Pair (i, j): flip eigenvalue (psi_i - psi_j)/(s_i - s_j) = 2mu exactly (no division,
      * so equal singular values are harmless); twist eigenvalue (psi_i + psi_j)/(s_i + s_j)
      * = 2mu + (2 lambda e - 4 mu)/(s_i + s_j), zero at any rotation of the rest state. */
@@ -125,14 +120,32 @@ static void corot_hessian(const double U[9], const double s[3], const double V[9
         double M[9] = {0};
         M[3 * i + j] = r2;
         M[3 * j + i] = -r2;
-        add_mode(U, M, V, D, vol * lam_twist, K);
+        w[3 + 2 * k] = vol * lam_twist;
+        mode_direction(U, M, V, D, g + 12 * (3 + 2 * k));
         M[3 * j + i] = r2;
-        add_mode(U, M, V, D, vol * lam_flip, K);
+        w[4 + 2 * k] = vol * lam_flip;
+        mode_direction(U, M, V, D, g + 12 * (4 + 2 * k));
     }
 }
 
-double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
-                     double lambda, double f[12], double K[144], uint32_t flags) {
+/* K = sum_k w_k g_k g_k^T; the same rounding for (i, j) and (j, i): exactly symmetric. */
+static void corot_hessian(const double U[9], const double s[3], const double V[9],
+                          const double D[12], double vol, double mu, double lambda, uint32_t flags,
+                          double K[144]) {
+    double w[9], g[108];
+    corot_modes(U, s, V, D, vol, mu, lambda, flags, w, g);
+    for (int i = 0; i < 144; ++i) K[i] = 0.0;
+    for (int k = 0; k < 9; ++k) {
+        if (w[k] == 0.0) continue;
+        const double *gk = g + 12 * k;
+        for (int i = 0; i < 12; ++i)
+            for (int j = 0; j < 12; ++j) K[12 * i + j] += w[k] * (gk[i] * gk[j]);
+    }
+}
+
+static double corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
+                         double lambda, double f[12], double K[144], double *modes_w,
+                         double *modes_g, uint32_t flags) {
     double Ds[9], F[9], U[9], s[3], V[9], D[12];
     for (int a = 0; a < 3; ++a)
         for (int k = 0; k < 3; ++k)
@@ -157,5 +170,17 @@ double sw_corot_eval(const double x[12], const double DmInv[9], double vol, doub
             f[i] = -vol * g[i];
     }
     if (K) corot_hessian(U, s, V, D, vol, mu, lambda, flags, K);
+    if (modes_w) corot_modes(U, s, V, D, vol, mu, lambda, flags, modes_w, modes_g);
     return vol * psi;
+}
+
+double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
+                     double lambda, double f[12], double K[144], uint32_t flags) {
+    return corot_eval(x, DmInv, vol, mu, lambda, f, K, NULL, NULL, flags);
+}
+
+double sw_corot_eval_modes(const double x[12], const double DmInv[9], double vol, double mu,
+                           double lambda, double f[12], double w[9], double g[108],
+                           uint32_t flags) {
+    return corot_eval(x, DmInv, vol, mu, lambda, f, NULL, w, g, flags);
 }

@@ -1,12 +1,12 @@
 #!/usr/bin/env bash
-# The main job: install what is missing, build, run the full-space reference on a
-# generated sample (the folded finger) with and without self-contact, print its frame
-# times and figures, and write pictures of the motion.
+# The main job: install what is missing, build, bake a generated sample character (the
+# folding finger), run it headless against the full-space reference and plain skinning,
+# print frame times and the benchmark summary, and write pictures.
 #   bash tools/run-main.sh [TETS] [FRAMES]
 set -euo pipefail
 cd "$(dirname "$0")/.."
 tets=${1:-20000}
-frames=${2:-12}
+frames=${2:-30}
 
 bash tools/setup-debian.sh
 cmake -S . -B build -DCMAKE_BUILD_TYPE=Release >/dev/null
@@ -15,13 +15,16 @@ cmake --build build -j"$(nproc)"
 out=out/main
 rm -rf "$out"
 mkdir -p "$out"
-echo "== full-space reference: finger, ~${tets} tets, ${frames} frames, quasistatic, self-contact on"
-build/tools/sinew-fullsim --scene finger --tets "$tets" --frames "$frames" \
-    --out "$out/finger" --json | tail -n 1 | tee "$out/finger.json"
-echo "== the same without self-contact (penetration for comparison)"
-build/tools/sinew-fullsim --scene finger --tets "$tets" --frames "$frames" \
-    --no-self-contact --out "$out/finger-nocontact" --json | tail -n 1 | tee "$out/finger-nocontact.json"
+echo "== bake: finger, ~${tets} tets, a ${frames}-frame folding clip"
+build/tools/sinew-bake --scene finger --tets "$tets" --frames "$frames" --out "$out/finger.blob" \
+    --json | tail -n 1 | tee "$out/bake.json"
+echo "== benchmark: full-space reference vs subspace runtime vs plain DQS, same mesh and motion"
+build/tools/sinew-bench --scene finger --tets "$tets" --frames "$frames" --blob "$out/finger.blob" \
+    --out "$out/subspace" --json | tail -n 1 | tee "$out/bench.json"
+echo "== full-space reference frames (for the picture)"
+build/tools/sinew-fullsim --scene finger --tets "$tets" --frames "$frames" --out "$out/full" \
+    --json | tail -n 1 | tee "$out/fullsim.json"
 echo "== pictures"
-build/tools/sinew-render --frames "$out/finger" --grid 3 --out "$out/finger.png"
-build/tools/sinew-render --frames "$out/finger-nocontact" --grid 3 --out "$out/finger-nocontact.png"
-echo "wrote $out/finger.png and $out/finger-nocontact.png (contact sheets of the motion)"
+build/tools/sinew-render --frames "$out/subspace" --grid 3 --out "$out/subspace.png" --quiet
+build/tools/sinew-render --frames "$out/full" --grid 3 --out "$out/full.png" --quiet
+echo "wrote $out/subspace.png (runtime) and $out/full.png (full-space reference): contact sheets of the clip"

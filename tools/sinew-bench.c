@@ -6,7 +6,8 @@
  *
  * Bakes the character (or loads --blob, then the errors are measured against fresh
  * full-space solutions of the clip's held-out frames), then:
- *   full_ms   median full-space quasistatic ms/frame (self-contact on) over K clip frames
+ *   full_ms   median full-space quasistatic ms/frame (self-contact on) over the clip (or
+ *             its first K frames)
  *   sub_ms    median subspace step + surface read ms/frame over the clip
  *   dqs_ms    median ms/frame of DQS of the render surface (positions and normals)
  *   err_*     correction error |x_sub - x_full|_M / |x_full - x_dqs|_M on the bake's
@@ -20,6 +21,7 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
 #include <time.h>
 
 #include "bake.h"
@@ -67,7 +69,8 @@ static int parse_int(const char *s, int lo, int hi, int *out) {
 static void usage(FILE *f) {
     fprintf(f, "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf\n"
                "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
-               "                   [--contract-steps S] [--threads T] [--data DIR] --json\n");
+               "                   [--contract-steps S] [--threads T] [--data DIR] [--out DIR] --json\n"
+               "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n");
 }
 
 /* Plain DQS of the render surface (positions and area-weighted normals): the cost a
@@ -108,11 +111,45 @@ static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames, con
     return m;
 }
 
+/* The subspace surface of every clip frame as DIR/frame_NNNN.obj (for sinew-render);
+ * replays the clip on the instance. */
+static sinew_result write_frames(const char *dir, const sinew_blob *blob, sinew_instance *inst,
+                                 const sw_character *ch, sw_error *err) {
+    uint32_t ns = sinew_blob_surface_vertex_count(blob), nt = sinew_blob_surface_triangle_count(blob);
+    float *p = malloc(sizeof(float) * 3 * ns);
+    double *x = malloc(sizeof(double) * 3 * ns);
+    uint32_t *tu = malloc(sizeof(uint32_t) * 3 * nt);
+    int32_t *ti = malloc(sizeof(int32_t) * 3 * nt);
+    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!p || !x || !tu || !ti) goto done;
+    if ((r = sinew_blob_surface_triangles(blob, tu, 3 * nt)) != SINEW_OK) goto done;
+    for (uint32_t i = 0; i < 3 * nt; ++i) ti[i] = (int32_t)tu[i];
+    mkdir(dir, 0777);
+    sinew_instance_reset(inst);
+    for (int f = 0; f < ch->clip.nframes; ++f) {
+        char path[4096];
+        sw_instance_set_pose_d(inst, ch->clip.T + (size_t)f * 12 * ch->skel.nbones);
+        sinew_instance_step(inst, 1.0f / 30);
+        sinew_instance_read_surface(inst, p, NULL, ns);
+        for (uint32_t i = 0; i < 3 * ns; ++i) x[i] = p[i];
+        snprintf(path, sizeof path, "%s/frame_%04d.obj", dir, f);
+        if ((r = sw_write_obj(path, (int32_t)ns, x, (int32_t)nt, ti, err)) != SINEW_OK) goto done;
+    }
+    r = SINEW_OK;
+done:
+    if (r == SINEW_ERROR_OUT_OF_MEMORY) sw_error_set(err, r, "out of memory writing frames");
+    free(p);
+    free(x);
+    free(tu);
+    free(ti);
+    return r;
+}
+
 int main(int argc, char **argv) {
     const char *scene = NULL, *mesh = NULL, *tgf = NULL, *weights = NULL, *clip_path = NULL;
-    const char *blob_path = NULL;
+    const char *blob_path = NULL, *out_dir = NULL;
     const char *data_dir = getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
-    int tets = 20000, frames = 0, json = 0, full_frames = 6, contract_steps = 10000, threads = 0;
+    int tets = 20000, frames = 0, json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1;
@@ -122,6 +159,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--weights") && next) weights = argv[++i];
         else if (!strcmp(a, "--clip") && next) clip_path = argv[++i];
         else if (!strcmp(a, "--blob") && next) blob_path = argv[++i];
+        else if (!strcmp(a, "--out") && next) out_dir = argv[++i];
         else if (!strcmp(a, "--data") && next) data_dir = argv[++i];
         else if (!strcmp(a, "--tets") && next) ok = parse_int(argv[++i], 1000, 2000000, &tets);
         else if (!strcmp(a, "--frames") && next) ok = parse_int(argv[++i], 2, 1000000, &frames);
@@ -197,8 +235,13 @@ int main(int argc, char **argv) {
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.threads = threads;
     sw_fullsim *sim = NULL;
-    int kf = full_frames < nf ? full_frames : nf;
+    int kf = full_frames > 0 && full_frames < nf ? full_frames : nf; /* default: the whole clip */
     double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));
+    double *full_x = malloc((size_t)(kf > 0 ? kf : 1) * 3 * ch.mesh.nverts * sizeof(double));
+    if (!full || !full_x) {
+        fprintf(stderr, "sinew-bench: out of memory\n");
+        return 1;
+    }
     if ((r = sw_fullsim_create(&ch, &fp, &sim, &err)) != SINEW_OK) {
         fprintf(stderr, "sinew-bench: %s\n", err.msg);
         return 1;
@@ -208,6 +251,8 @@ int main(int argc, char **argv) {
         sw_fullsim_stats st;
         sw_fullsim_step(sim, ch.clip.T + (size_t)f * 12 * ch.skel.nbones, &st);
         full[f] = 1e3 * st.seconds;
+        memcpy(full_x + (size_t)f * 3 * ch.mesh.nverts, sw_fullsim_positions(sim),
+               sizeof(double) * 3 * ch.mesh.nverts);
         fprintf(stderr, "sinew-bench: full-space frame %d/%d: %.1f ms\n", f + 1, kf, full[f]);
     }
     double full_ms = median(full, kf);
@@ -230,6 +275,8 @@ int main(int argc, char **argv) {
         sub[f] = 1e3 * (now() - t0);
     }
     double sub_ms = median(sub, nf);
+    if (out_dir && write_frames(out_dir, blob, inst, &ch, &err) != SINEW_OK)
+        fprintf(stderr, "sinew-bench: %s\n", err.msg);
 
     /* 4. plain DQS of the same surface */
     int32_t *surf_vert = malloc((size_t)ns * sizeof(int32_t));
@@ -244,9 +291,24 @@ int main(int argc, char **argv) {
     sw_eval_result et, eh;
     memset(&et, 0, sizeof et);
     memset(&eh, 0, sizeof eh);
-    if (!blob_path) {
+    const char *err_source;
+    if (!blob_path) { /* the bake's own training poses (clip frames and sweeps) and held-out */
+        err_source = "bake";
         sw_eval_correction(blob, res.mass, res.train_T, res.train_x, res.ntrain, 20, &et, &err);
         sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh, &err);
+    } else { /* a given blob: the clip's frames solved above, split as the bake splits them */
+        err_source = "clip";
+        double *mass = calloc((size_t)ch.mesh.nverts, sizeof(double));
+        sw_fullsim *ms = NULL;
+        if (mass && sw_fullsim_create(&ch, &fp, &ms, &err) == SINEW_OK) {
+            memcpy(mass, sw_fullsim_masses(ms), sizeof(double) * ch.mesh.nverts);
+            sw_fullsim_destroy(ms);
+        }
+        int ntr = (int)floor(kf * (1.0 - bp.heldout_fraction));
+        size_t pt = (size_t)12 * ch.skel.nbones, px = (size_t)3 * ch.mesh.nverts;
+        sw_eval_correction(blob, mass, ch.clip.T, full_x, ntr, 20, &et, &err);
+        sw_eval_correction(blob, mass, ch.clip.T + ntr * pt, full_x + ntr * px, kf - ntr, 20, &eh, &err);
+        free(mass);
     }
 
     /* 6. the real-time contract: allocation and lock calls inside the step */
@@ -277,11 +339,13 @@ int main(int argc, char **argv) {
         printf("{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
                "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
                "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
-               "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_seconds\":%.2f}\n",
+               "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_seconds\":%.2f,"
+               "\"err_source\":\"%s\"}\n",
                scene ? scene : mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
                sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub,
-               allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s);
+               allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source);
     free(full);
+    free(full_x);
     free(sub);
     free(pos);
     free(nrm);
