@@ -163,6 +163,9 @@ static void free_state(sw_bake_state *s) {
     free(s->rank);
     free(s->train_q);
     free(s->train_pose);
+    free(s->contact_ptr);
+    free(s->contact_verts);
+    free(s->contact_data);
     free(s->cub_n);
     free(s->cub_local);
     free(s->cub_w);
@@ -280,10 +283,16 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     }
 
     t0 = t1;
-    if ((r = sw_bake_reduce(&s, out, err)) != SINEW_OK) goto done;
+    if ((r = sw_bake_contacts(&s, err)) != SINEW_OK || (r = sw_bake_reduce(&s, out, err)) != SINEW_OK)
+        goto done;
     t1 = seconds_now();
     out->stage_seconds[5] = t1 - t0;
-    progress(&p, "reduce", t1 - t0, "springs, mass, inertia, surface");
+    {
+        char msg[96];
+        snprintf(msg, sizeof msg, "springs, mass, inertia, surface, %d pose-space contact pairs",
+                 s.ncontacts);
+        progress(&p, "reduce", t1 - t0, msg);
+    }
     r = SINEW_OK;
 done:
     free_state(&s);

@@ -43,6 +43,11 @@ typedef struct sw_bake_state {
     double *train_q;    /* ntrain x rank_total: projected training solutions */
     double *train_pose; /* ntrain x 4 nbones: pose features */
     int32_t ntrain;
+    /* pose-space self-contact pairs of the training solutions (bake_contacts.c) */
+    int32_t ncontacts;
+    int32_t *contact_ptr;   /* ntrain + 1 */
+    int32_t *contact_verts; /* 8 per contact */
+    double *contact_data;   /* 7 per contact */
     /* cubature: per domain local tet index into dom_tets and weights */
     int32_t *cub_n;
     int32_t **cub_local; /* index into the domain's dom_tets range */
@@ -59,6 +64,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 
 /* Records an owned allocation in the result (freed with it); returns p. */

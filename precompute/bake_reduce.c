@@ -200,7 +200,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     sw_lame(s->ch.youngs, s->ch.poisson, &v->mu, &v->lambda);
     v->rayleigh_alpha = 0.01; /* thesis §2.1.3 */
     v->rayleigh_beta = 0.001;
-    v->contact_k = 1e5; /* DESIGN.md §8: run-time penalty */
+    v->contact_k = 1e6; /* the training simulations' penalty (fullsim default) */
     v->rest = rest;
     v->skin_bone = skin_bone;
     v->skin_weight = skin_weight;
@@ -236,6 +236,22 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->ntrain = s->ntrain;
     v->train_q = tq;
     v->train_pose = tp;
+    int32_t *cp, *cv;
+    double *cd;
+    OWN(cp, s->ntrain + 1, int32_t);
+    OWN(cv, 8 * (int64_t)s->ncontacts, int32_t);
+    OWN(cd, 7 * (int64_t)s->ncontacts, double);
+    if (!cp || !cv || !cd) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+        goto done;
+    }
+    memcpy(cp, s->contact_ptr, (size_t)(s->ntrain + 1) * sizeof(int32_t));
+    memcpy(cv, s->contact_verts, (size_t)s->ncontacts * 8 * sizeof(int32_t));
+    memcpy(cd, s->contact_data, (size_t)s->ncontacts * 7 * sizeof(double));
+    v->ncontacts = s->ncontacts;
+    v->contact_ptr = cp;
+    v->contact_verts = cv;
+    v->contact_data = cd;
     r = SINEW_OK;
 done:
     free(copy_ptr_v);

@@ -1,4 +1,4 @@
-/* Blob layout: header (64 bytes), section table (23 entries), then the 23 sections in id
+/* Blob layout: header (64 bytes), section table (26 entries), then the 26 sections in id
  * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
  * everything after the header. */
 #include "blob_write.h"
@@ -23,7 +23,7 @@ static uint64_t round_up(uint64_t x) {
     return (x + SINEW_BLOB_ALIGN - 1) / SINEW_BLOB_ALIGN * SINEW_BLOB_ALIGN;
 }
 
-/* The 23 sections of a validated view, in id order; `meta` must outlive the result. */
+/* The 26 sections of a validated view, in id order; `meta` must outlive the result. */
 static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
                           section_src s[SINEW_SECTION_COUNT_V1]) {
     const uint64_t n = (uint64_t)v->nverts, nb = (uint64_t)v->nbones, nc = (uint64_t)v->ncub,
@@ -51,7 +51,10 @@ static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
         {SINEW_SECTION_SURF_COPY_PTR, 4, v->surf_copy_ptr, (uint64_t)v->nsurf_verts + 1},
         {SINEW_SECTION_SURF_COPIES, 4, v->surf_copies, 2 * (uint64_t)v->nsurf_copies},
         {SINEW_SECTION_TRAIN_Q, 8, v->train_q, (uint64_t)v->ntrain * R},
-        {SINEW_SECTION_TRAIN_POSE, 8, v->train_pose, (uint64_t)v->ntrain * 4 * nb}};
+        {SINEW_SECTION_TRAIN_POSE, 8, v->train_pose, (uint64_t)v->ntrain * 4 * nb},
+        {SINEW_SECTION_CONTACT_PTR, 4, v->contact_ptr, (uint64_t)v->ntrain + 1},
+        {SINEW_SECTION_CONTACT_VERTS, 4, v->contact_verts, 8 * (uint64_t)v->ncontacts},
+        {SINEW_SECTION_CONTACT_DATA, 8, v->contact_data, 7 * (uint64_t)v->ncontacts}};
     memcpy(s, list, sizeof list);
 }
 
@@ -75,7 +78,7 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     meta.mu = view->mu, meta.lambda = view->lambda, meta.rayleigh_alpha = view->rayleigh_alpha;
     meta.rayleigh_beta = view->rayleigh_beta, meta.contact_k = view->contact_k;
     meta.ntrain = view->ntrain;
-    meta.reserved = 0;
+    meta.ncontacts = view->ncontacts;
 
     section_src src[SINEW_SECTION_COUNT_V1];
     sinew_blob_section table[SINEW_SECTION_COUNT_V1];

@@ -26,11 +26,13 @@ static const char *const k_section_names[SINEW_SECTION_COUNT_V1 + 1] = {
     "unknown",     "META",      "REST",           "SKIN_BONE",  "SKIN_WEIGHT", "BONE_PARENT",
     "BONE_JOINTS", "DOMAINS",   "DOMAIN_VERTS",   "BASIS",      "CUB_TETS",    "CUB_WEIGHT",
     "CUB_DMINV",   "CUB_VOL",   "SPRING_HESSIAN", "MASS",       "INERTIA_S",   "INERTIA_X",
-    "INERTIA_U",   "SURF_TRIS", "SURF_COPY_PTR",  "SURF_COPIES", "TRAIN_Q",     "TRAIN_POSE"};
+    "INERTIA_U",   "SURF_TRIS", "SURF_COPY_PTR",  "SURF_COPIES", "TRAIN_Q",     "TRAIN_POSE",
+    "CONTACT_PTR", "CONTACT_VERTS", "CONTACT_DATA"};
 
 /* Element size of every known section (format header table). */
 static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {0, 80, 8, 4, 8, 4, 8, 48, 4, 8, 4, 8,
-                                                                 8, 8,  8, 8, 8, 8, 8, 4, 4, 4, 8, 8};
+                                                                 8, 8,  8, 8, 8, 8, 8, 4, 4, 4, 8, 8,
+                                                                 4, 4,  8};
 
 uint64_t sw_blob_checksum(const void *data, size_t n) {
     const uint8_t *p = data;
@@ -87,6 +89,7 @@ static sinew_result check_meta(const sw_blob_view *v, char *msg, size_t ms) {
         {"nsurf_verts", v->nsurf_verts, 1, SW_BLOB_MAX_COUNT},
         {"nsurf_tris", v->nsurf_tris, 1, SW_BLOB_MAX_COUNT},
         {"ntrain", v->ntrain, 1, 1000000},
+        {"ncontacts", v->ncontacts, 0, SW_BLOB_MAX_COUNT},
     };
     for (size_t i = 0; i < sizeof counts / sizeof counts[0]; ++i) {
         sinew_result r =
@@ -145,7 +148,10 @@ static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) 
                   {v->surf_copy_ptr, SINEW_SECTION_SURF_COPY_PTR},
                   {v->surf_copies, SINEW_SECTION_SURF_COPIES},
                   {v->train_q, SINEW_SECTION_TRAIN_Q},
-                  {v->train_pose, SINEW_SECTION_TRAIN_POSE}};
+                  {v->train_pose, SINEW_SECTION_TRAIN_POSE},
+                  {v->contact_ptr, SINEW_SECTION_CONTACT_PTR},
+                  {v->contact_verts, SINEW_SECTION_CONTACT_VERTS},
+                  {v->contact_data, SINEW_SECTION_CONTACT_DATA}};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!arrays[i].p)
             return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
@@ -280,7 +286,8 @@ static sinew_result check_all_finite(const sw_blob_view *v, char *msg, size_t ms
                   {SINEW_SECTION_INERTIA_X, v->inertia_x, 9 * R},
                   {SINEW_SECTION_INERTIA_U, v->inertia_u, v->ninertia_u},
                   {SINEW_SECTION_TRAIN_Q, v->train_q, (int64_t)v->ntrain * R},
-                  {SINEW_SECTION_TRAIN_POSE, v->train_pose, (int64_t)v->ntrain * 4 * nb}};
+                  {SINEW_SECTION_TRAIN_POSE, v->train_pose, (int64_t)v->ntrain * 4 * nb},
+                  {SINEW_SECTION_CONTACT_DATA, v->contact_data, 7 * (int64_t)v->ncontacts}};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) {
         sinew_result r = check_finite(arrays[i].id, arrays[i].a, arrays[i].n, msg, ms);
         if (r != SINEW_OK) return r;
@@ -395,6 +402,35 @@ static sinew_result check_positive(uint32_t id, const double *a, int64_t n, int6
     return SINEW_OK;
 }
 
+/* Pose-space contacts: pointers from 0 to ncontacts without decreasing, every vertex
+ * reference a valid (domain, local vertex), area weights positive. */
+static sinew_result check_contacts(const sw_blob_view *v, char *msg, size_t ms) {
+    if (v->contact_ptr[0] != 0 || v->contact_ptr[v->ntrain] != v->ncontacts)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section CONTACT_PTR: runs from %d to %d, must run from 0 to ncontacts = %d",
+                    v->contact_ptr[0], v->contact_ptr[v->ntrain], v->ncontacts);
+    for (int32_t t = 0; t < v->ntrain; ++t)
+        if (v->contact_ptr[t + 1] < v->contact_ptr[t])
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section CONTACT_PTR: entry %d (%d) below entry %d (%d)", t + 1,
+                        v->contact_ptr[t + 1], t, v->contact_ptr[t]);
+    for (int32_t c = 0; c < v->ncontacts; ++c) {
+        for (int k = 0; k < 4; ++k) {
+            int32_t d = v->contact_verts[8 * c + 2 * k], l = v->contact_verts[8 * c + 2 * k + 1];
+            if (d < 0 || d >= v->ndomains || l < 0 || l >= v->domains[d].vert_count)
+                return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                            "blob section CONTACT_VERTS: contact %d vertex %d: (domain %d, local %d) "
+                            "out of range",
+                            c, k, d, l);
+        }
+        if (!(v->contact_data[7 * c + 6] > 0))
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section CONTACT_DATA: contact %d has area weight %g (must be > 0)", c,
+                        v->contact_data[7 * c + 6]);
+    }
+    return SINEW_OK;
+}
+
 sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) {
     if (msg && ms) msg[0] = '\0';
     if (!v) return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT, "blob: view is NULL");
@@ -408,6 +444,7 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
     if ((r = check_skin(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_domain_indices(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_surface(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = check_contacts(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_positive(SINEW_SECTION_CUB_WEIGHT, v->cub_weight, v->ncub, 1, msg, ms)))
         return r;
     if ((r = check_positive(SINEW_SECTION_CUB_VOL, v->cub_vol, v->ncub, 1, msg, ms))) return r;
@@ -543,7 +580,10 @@ static sinew_result check_meta_counts(const sw_blob_view *v, const sinew_blob_se
                   {SINEW_SECTION_SURF_TRIS, 3 * (uint64_t)v->nsurf_tris, "3 nsurf_tris"},
                   {SINEW_SECTION_SURF_COPY_PTR, (uint64_t)v->nsurf_verts + 1, "nsurf_verts + 1"},
                   {SINEW_SECTION_TRAIN_Q, (uint64_t)v->ntrain * R, "ntrain rank_total"},
-                  {SINEW_SECTION_TRAIN_POSE, (uint64_t)v->ntrain * 4 * nb, "4 ntrain nbones"}};
+                  {SINEW_SECTION_TRAIN_POSE, (uint64_t)v->ntrain * 4 * nb, "4 ntrain nbones"},
+                  {SINEW_SECTION_CONTACT_PTR, (uint64_t)v->ntrain + 1, "ntrain + 1"},
+                  {SINEW_SECTION_CONTACT_VERTS, 8 * (uint64_t)v->ncontacts, "8 ncontacts"},
+                  {SINEW_SECTION_CONTACT_DATA, 7 * (uint64_t)v->ncontacts, "7 ncontacts"}};
     for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i) {
         const sinew_blob_section *e = &s[found[expect[i].id]];
         if (e->count != expect[i].count)
@@ -571,10 +611,7 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     v->nsurf_verts = m.nsurf_verts, v->nsurf_tris = m.nsurf_tris;
     v->mu = m.mu, v->lambda = m.lambda, v->rayleigh_alpha = m.rayleigh_alpha;
     v->rayleigh_beta = m.rayleigh_beta, v->contact_k = m.contact_k;
-    v->ntrain = m.ntrain;
-    if (m.reserved != 0)
-        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section META: reserved field is %d, not 0",
-                    m.reserved);
+    v->ntrain = m.ntrain, v->ncontacts = m.ncontacts;
     sinew_result r = check_meta(v, msg, ms);
     if (r != SINEW_OK) return r;
     if ((r = check_meta_counts(v, s, found, msg, ms)) != SINEW_OK) return r;
@@ -613,6 +650,9 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     v->surf_copies = AT(SURF_COPIES);
     v->train_q = AT(TRAIN_Q);
     v->train_pose = AT(TRAIN_POSE);
+    v->contact_ptr = AT(CONTACT_PTR);
+    v->contact_verts = AT(CONTACT_VERTS);
+    v->contact_data = AT(CONTACT_DATA);
 #undef AT
     return SINEW_OK;
 }

@@ -90,6 +90,17 @@ typedef struct sw_blob_view {
     int32_t ntrain;
     const double *train_q;
     const double *train_pose;
+
+    /* pose-space self-contact (thesis §3.2.3, simplified): training pose t's penetrating
+     * pairs are contacts [contact_ptr[t], contact_ptr[t+1]); contact c: vertex p and
+     * triangle (t0, t1, t2) as (domain, local vertex) pairs in contact_verts[8c..],
+     * and in contact_data[7c..] the triangle barycentrics b0..b2, the contact normal in
+     * p's un-skinned frame (R_p^T n) and the area weight ka. The penalty stiffness is
+     * contact_k. */
+    int32_t ncontacts;
+    const int32_t *contact_ptr;
+    const int32_t *contact_verts;
+    const double *contact_data;
 } sw_blob_view;
 
 #endif

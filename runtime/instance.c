@@ -52,6 +52,9 @@ struct sinew_instance {
     /* output */
     double *surf_x, *surf_n;
     double *feature; /* 4 nbones: the current pose's feature */
+    int32_t *contact_act; /* 4 per pose-space contact: active index of p, t0, t1, t2 */
+    double *Jc, *hc;      /* 4 x 3 x rmax and 4 x rmax: one contact's Jacobians */
+    int32_t nearest;      /* training pose nearest to the current pose, or -1 */
     sinew_step_stats stats;
 };
 
@@ -78,7 +81,7 @@ static void mem_free(const sinew_allocator *a, void *p) {
 }
 
 /* The instance's arrays, listed once for allocation and release. */
-enum { NBUF = 25 };
+enum { NBUF = 28 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
@@ -89,14 +92,17 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (void **)&in->H, (void **)&in->Hn, (void **)&in->L, (void **)&in->dq,
                       (void **)&in->qtrial, (void **)&in->fin, (void **)&in->tmp, (void **)&in->tmp2,
                       (void **)&in->Je, (void **)&in->surf_x,
-                      (void **)&in->surf_n, (void **)&in->feature};
+                      (void **)&in->surf_n, (void **)&in->feature, (void **)&in->contact_act,
+                      (void **)&in->Jc, (void **)&in->hc};
     size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
                       (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
                       (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
                       3 * (size_t)in->nact * d, R * d, R * d, R * d, R * d, R * R * d, R * R * d,
                       R * R * d, R * d, R * d, R * d, R * d, R * d, 12 * (size_t)in->rmax * d,
                       3 * (size_t)v->nsurf_verts * d,
-                      3 * (size_t)v->nsurf_verts * d, 4 * nb * d};
+                      3 * (size_t)v->nsurf_verts * d, 4 * nb * d,
+                      4 * (size_t)v->ncontacts * sizeof(int32_t), 12 * (size_t)in->rmax * d,
+                      4 * (size_t)in->rmax * d};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -167,6 +173,11 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
         mark[v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]]] = 0;
     }
+    for (int32_t c = 0; c < v->ncontacts; ++c)
+        for (int k = 0; k < 4; ++k) {
+            const sw_blob_domain *D = &v->domains[v->contact_verts[8 * c + 2 * k]];
+            mark[v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]]] = 0;
+        }
     for (int32_t i = 0; i < v->nverts; ++i)
         if (mark[i] == 0) mark[i] = in->nact++;
     void **b[NBUF];
@@ -191,6 +202,11 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
         in->copy_act[i] = mark[v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]]];
     }
+    for (int32_t c = 0; c < v->ncontacts; ++c)
+        for (int k = 0; k < 4; ++k) {
+            const sw_blob_domain *D = &v->domains[v->contact_verts[8 * c + 2 * k]];
+            in->contact_act[4 * c + k] = mark[v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]]];
+        }
     mem_free(&a, mark);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t i = 0; i < v->nverts; ++i)
@@ -216,6 +232,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     for (int32_t b = 0; b < nb; ++b) sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
     inst->pose_set = 0;
     inst->history = 0;
+    inst->nearest = -1;
     memset(&inst->stats, 0, sizeof inst->stats);
     inst->stats.struct_size = sizeof inst->stats;
     return SINEW_OK;
@@ -351,6 +368,74 @@ static double cubature_eval(sinew_instance *in, const double *q, int want_grad, 
     return E;
 }
 
+/* Pose-space self-contact (blob_view.h): the nearest training pose's pairs with a
+ * one-sided normal penalty E = 1/2 k ka <d, n>_+^2, d = sum b_i x_ti - x_p, n = R_p n_rest
+ * (eqs. 3.4-3.6 with the normal part only, so E is C1 where a pair separates). The
+ * Hessian k ka h h^T (h = dg/dq) may couple two domains. Added after the cubature so
+ * it lands on the full (mirrored) matrix. */
+static double contact_eval(sinew_instance *in, const double *q, int want_grad, int want_hess) {
+    const sw_blob_view *v = in->v;
+    if (in->nearest < 0) return 0;
+    double E = 0, k = v->contact_k;
+    int32_t rm = in->rmax;
+    for (int32_t c = v->contact_ptr[in->nearest]; c < v->contact_ptr[in->nearest + 1]; ++c) {
+        const int32_t *cv = v->contact_verts + 8 * (int64_t)c;
+        const double *cd = v->contact_data + 7 * (int64_t)c;
+        const sw_blob_domain *D[4];
+        double x[4][3];
+        for (int m = 0; m < 4; ++m) {
+            D[m] = &v->domains[cv[2 * m]];
+            copy_position(in, D[m], cv[2 * m + 1], in->contact_act[4 * c + m], q + D[m]->q_offset, x[m],
+                          want_grad ? in->Jc + 3 * m * rm : NULL);
+        }
+        const double *Rp = in->act_R + 9 * in->contact_act[4 * c];
+        double n[3], g = 0;
+        for (int i = 0; i < 3; ++i) n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
+        for (int i = 0; i < 3; ++i)
+            g += n[i] * (cd[0] * x[1][i] + cd[1] * x[2][i] + cd[2] * x[3][i] - x[0][i]);
+        if (!(g > 0)) continue;
+        double kk = k * cd[6];
+        E += 0.5 * kk * g * g;
+        if (!want_grad) continue;
+        const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
+        for (int m = 0; m < 4; ++m) { /* h_m = coef_m J_m^T n */
+            int32_t r = D[m]->rank;
+            const double *J = in->Jc + 3 * m * rm;
+            for (int32_t j = 0; j < r; ++j)
+                in->hc[m * rm + j] = coef[m] * (J[j] * n[0] + J[r + j] * n[1] + J[2 * r + j] * n[2]);
+            for (int32_t j = 0; j < r; ++j) in->g[D[m]->q_offset + j] += kk * g * in->hc[m * rm + j];
+        }
+        if (!want_hess) continue;
+        for (int a = 0; a < 4; ++a)
+            for (int b = 0; b < 4; ++b) {
+                int32_t ra = D[a]->rank, rb = D[b]->rank, oa = D[a]->q_offset, ob = D[b]->q_offset;
+                for (int32_t i = 0; i < ra; ++i) {
+                    double hi = kk * in->hc[a * rm + i];
+                    double *Hi = in->H + (int64_t)(oa + i) * in->R + ob;
+                    for (int32_t j = 0; j < rb; ++j) Hi[j] += hi * in->hc[b * rm + j];
+                }
+            }
+    }
+    return E;
+}
+
+/* The training pose nearest to the current pose (feature distance), or -1. */
+static int32_t nearest_training_pose(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    if (v->ntrain < 1) return -1;
+    sw_pose_feature(in->T_cur, v->bone_parent, v->nbones, in->feature);
+    int32_t best = 0;
+    double bd = INFINITY;
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        double d = sw_pose_distance(in->feature, v->train_pose + (size_t)4 * v->nbones * t, v->nbones);
+        if (d < bd) {
+            bd = d;
+            best = t;
+        }
+    }
+    return best;
+}
+
 /* y = A x for a dense R x R matrix. */
 static void matvec(const double *A, int32_t R, const double *x, double *y) {
     for (int32_t i = 0; i < R; ++i) {
@@ -380,6 +465,7 @@ static double potential(sinew_instance *in, const double *q, const dyn_coef *dc,
     if (want_grad) memset(in->g, 0, (size_t)R * sizeof(double));
     if (want_hess) memcpy(in->H, v->spring_hessian, (size_t)R * R * sizeof(double));
     double phi = cubature_eval(in, q, want_grad, want_hess);
+    phi += contact_eval(in, q, want_grad, want_hess);
     matvec(v->spring_hessian, R, q, in->tmp);
     phi += 0.5 * dot(q, in->tmp, R);
     if (want_grad)
@@ -523,18 +609,8 @@ static void write_surface(sinew_instance *in) {
  * plus two energy evaluations. Returns 1 when it switched. */
 static int pose_space_start(sinew_instance *in, const dyn_coef *dc) {
     const sw_blob_view *v = in->v;
-    if (v->ntrain < 1) return 0;
-    sw_pose_feature(in->T_cur, v->bone_parent, v->nbones, in->feature);
-    int32_t best = 0;
-    double bd = INFINITY;
-    for (int32_t t = 0; t < v->ntrain; ++t) {
-        double d = sw_pose_distance(in->feature, v->train_pose + (size_t)4 * v->nbones * t, v->nbones);
-        if (d < bd) {
-            bd = d;
-            best = t;
-        }
-    }
-    const double *qt = v->train_q + (size_t)in->R * best;
+    if (in->nearest < 0) return 0;
+    const double *qt = v->train_q + (size_t)in->R * in->nearest;
     double e_prev = potential(in, in->q, dc, 0, 0), e_train = potential(in, qt, dc, 0, 0);
     if (!(e_train < e_prev)) return 0;
     memcpy(in->q, qt, (size_t)in->R * sizeof(double));
@@ -573,6 +649,7 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
         inertial_forces(inst, dt);
     }
     skin_active(inst);
+    inst->nearest = nearest_training_pose(inst);
     if (!dc.dynamic && pose_space_start(inst, &dc)) st.status |= SINEW_STEP_POSE_SPACE;
     if (dc.dynamic) { /* Rayleigh stiffness H(q_n), frozen for the step */
         dyn_coef statics = dc;

@@ -48,6 +48,8 @@ typedef struct fixture {
     double inertia_u[NIU];
     int32_t surf_tris[3 * NST], surf_copy_ptr[NSV + 1], surf_copies[2 * MAXCOP];
     double train_q[NTR * RT], train_pose[NTR * 4 * NB];
+    int32_t contact_ptr[NTR + 1], contact_verts[8 * 2];
+    double contact_data[7 * 2];
     sw_blob_view v;
 } fixture;
 
@@ -136,6 +138,16 @@ static void fixture_init(fixture *f, uint64_t seed) {
         f->train_q[i] = rng_sym();
     for (int i = 0; i < NTR * 4 * NB; ++i)
         f->train_pose[i] = rng_sym();
+    f->contact_ptr[0] = 0, f->contact_ptr[1] = 2, f->contact_ptr[2] = 2; /* pose 0: 2 pairs */
+    for (int c = 0; c < 2; ++c) {
+        for (int k = 0; k < 4; ++k) {
+            int32_t d = (int32_t)(rng_next() % ND);
+            f->contact_verts[8 * c + 2 * k] = d;
+            f->contact_verts[8 * c + 2 * k + 1] = (int32_t)(rng_next() % (uint32_t)vc[d]);
+        }
+        for (int k = 0; k < 6; ++k) f->contact_data[7 * c + k] = rng_sym();
+        f->contact_data[7 * c + 6] = 0.5 + rng_unit();
+    }
     for (int t = 0; t < NST; ++t)
         rng_distinct(&f->surf_tris[3 * t], 3, NSV);
     int32_t nc = 0;
@@ -166,6 +178,8 @@ static void fixture_init(fixture *f, uint64_t seed) {
     v->surf_tris = f->surf_tris, v->surf_copy_ptr = f->surf_copy_ptr;
     v->surf_copies = f->surf_copies, v->nsurf_copies = nc;
     v->ntrain = NTR, v->train_q = f->train_q, v->train_pose = f->train_pose;
+    v->ncontacts = 2, v->contact_ptr = f->contact_ptr, v->contact_verts = f->contact_verts;
+    v->contact_data = f->contact_data;
 }
 
 /* ---- helpers --------------------------------------------------------------------- */
@@ -197,6 +211,7 @@ static const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
     SAME_INT(ninertia_u);
     SAME_INT(nsurf_copies);
     SAME_INT(ntrain);
+    SAME_INT(ncontacts);
     SAME_BITS(mu);
     SAME_BITS(lambda);
     SAME_BITS(rayleigh_alpha);
@@ -225,6 +240,9 @@ static const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
     SAME_ARR(surf_copies, 2 * (int64_t)a->nsurf_copies);
     SAME_ARR(train_q, (int64_t)a->ntrain * R);
     SAME_ARR(train_pose, (int64_t)a->ntrain * 4 * nb);
+    SAME_ARR(contact_ptr, (int64_t)a->ntrain + 1);
+    SAME_ARR(contact_verts, 8 * (int64_t)a->ncontacts);
+    SAME_ARR(contact_data, 7 * (int64_t)a->ncontacts);
 #undef SAME_INT
 #undef SAME_BITS
 #undef SAME_ARR
@@ -293,7 +311,10 @@ static int walk_view(const sw_blob_view *v, const uint8_t *base, size_t size, do
                   {v->surf_copy_ptr, 4 * ((int64_t)v->nsurf_verts + 1)},
                   {v->surf_copies, 8 * (int64_t)v->nsurf_copies},
                   {v->train_q, 8 * (int64_t)v->ntrain * R},
-                  {v->train_pose, 32 * (int64_t)v->ntrain * nb}};
+                  {v->train_pose, 32 * (int64_t)v->ntrain * nb},
+                  {v->contact_ptr, 4 * ((int64_t)v->ntrain + 1)},
+                  {v->contact_verts, 32 * (int64_t)v->ncontacts},
+                  {v->contact_data, 56 * (int64_t)v->ncontacts}};
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!inside(arrays[i].p, arrays[i].bytes, base, size)) return 0;
     double s = 0.0;
@@ -912,20 +933,22 @@ TEST(unknown_extra_section_still_loads) {
     size_t size = 0;
     uint8_t *blob = write_fixture(&g_fix, &size);
     ENSURE(blob != NULL);
-    /* The writer's table ends at 64 + 23*32 = 800 and the first section starts at 832:
-     * room for one more entry without moving anything. New data goes at the end. */
+    /* Insert one table entry: shift every section by 64 bytes to make room (offsets stay
+     * 64-aligned) and append the new section's data at the end. */
     const uint32_t n = hdr(blob)->section_count;
+    const size_t shift = 64, big = size + shift + 128;
+    uint8_t *b = NULL;
+    ENSURE(posix_memalign((void **)&b, 64, big) == 0);
+    memset(b, 0, big);
+    const size_t table_end = 64 + (size_t)n * 32;
     uint64_t first = UINT64_MAX;
     for (uint32_t id = 1; id <= SINEW_SECTION_COUNT_V1; ++id)
         if (entry(blob, id)->offset < first) first = entry(blob, id)->offset;
-    ENSURE(64 + (n + 1) * 32 <= first);
-    const size_t big = size + 128;
-    uint8_t *b = copy_exact(blob, size); /* resized below */
-    free(b);
-    b = NULL;
-    ENSURE(posix_memalign((void **)&b, 64, big) == 0);
-    memset(b, 0, big);
-    memcpy(b, blob, size);
+    ENSURE(first >= table_end && 64 + (size_t)(n + 1) * 32 <= first + shift);
+    memcpy(b, blob, table_end);
+    memcpy(b + first + shift, blob + first, size - first);
+    for (uint32_t i = 0; i < n; ++i) ((sinew_blob_section *)(void *)(b + 64))[i].offset += shift;
+    size += shift;
     sinew_blob_section *t = (sinew_blob_section *)(void *)(b + 64);
     t[n].id = 4242;
     t[n].elem_size = 24; /* an element size no v1 section has */

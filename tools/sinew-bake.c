@@ -30,7 +30,7 @@ static void usage(FILE *f) {
             "usage: sinew-bake (--scene NAME [--tets N] [--frames F] |\n"
             "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat] [--clip FILE])\n"
             "                  --out FILE.blob [--selector greedy|importance|nnhtp] [--tol T]\n"
-            "                  [--max-rank R] [--compare-cubature] [--no-self-contact]\n"
+            "                  [--max-rank R] [--spring-k K] [--compare-cubature] [--no-self-contact]\n"
             "                  [--threads T] [--data DIR] [--json]\n"
             "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n");
 }
@@ -81,6 +81,10 @@ int main(int argc, char **argv) {
             else if (!strcmp(s, "importance")) p.selector = SW_CUBATURE_IMPORTANCE;
             else if (!strcmp(s, "nnhtp")) p.selector = SW_CUBATURE_NNHTP;
             else ok = 0;
+        } else if (!strcmp(a, "--spring-k") && next) {
+            char *end;
+            p.spring_k = strtod(argv[++i], &end);
+            ok = !*end && p.spring_k > 0 && isfinite(p.spring_k);
         } else if (!strcmp(a, "--compare-cubature")) p.compare_selectors = 1;
         else if (!strcmp(a, "--no-self-contact")) p.self_contact = 0;
         else if (!strcmp(a, "--json")) json = 1;

@@ -40,6 +40,9 @@
  *   21 SURF_COPIES     4     2 * surf_copy_ptr[nsurf_verts]
  *   22 TRAIN_Q         8     ntrain * R     (reduced solutions of the training poses)
  *   23 TRAIN_POSE      8     ntrain * 4 nbones (pose features: unit quaternions)
+ *   24 CONTACT_PTR     4     ntrain + 1     (training pose t owns contacts [ptr[t], ptr[t+1]))
+ *   25 CONTACT_VERTS   4     8 ncontacts    ((domain, local vertex) of p, t0, t1, t2)
+ *   26 CONTACT_DATA    8     7 ncontacts    (barycentrics b0..b2, rest-frame normal, area ka)
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -97,7 +100,10 @@ enum sinew_blob_section_id {
     SINEW_SECTION_SURF_COPIES = 21,
     SINEW_SECTION_TRAIN_Q = 22,
     SINEW_SECTION_TRAIN_POSE = 23,
-    SINEW_SECTION_COUNT_V1 = 23
+    SINEW_SECTION_CONTACT_PTR = 24,
+    SINEW_SECTION_CONTACT_VERTS = 25,
+    SINEW_SECTION_CONTACT_DATA = 26,
+    SINEW_SECTION_COUNT_V1 = 26
 };
 
 /** Section META: counts and material (80 bytes). */
@@ -106,7 +112,7 @@ typedef struct sinew_blob_meta {
     int32_t ndomain_verts, ncub, nsurf_verts, nsurf_tris;
     double mu, lambda, rayleigh_alpha, rayleigh_beta, contact_k;
     int32_t ntrain;   /**< training poses kept for the pose-space warm start (>= 1) */
-    int32_t reserved; /**< zero */
+    int32_t ncontacts; /**< self-contact pairs over all training poses (>= 0) */
 } sinew_blob_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
