@@ -16,6 +16,7 @@
 
 #include <math.h>
 #include <stddef.h>
+#include <string.h>
 
 /* Twist eigenvalues divide by s_i + s_j, which is >= 0 for the rotation-variant SVD
  * (s_0 >= s_1 >= |s_2|) and vanishes only when the element is flattened with two
@@ -145,13 +146,18 @@ static void corot_hessian(const double U[9], const double s[3], const double V[9
 
 static double corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
                          double lambda, double f[12], double K[144], double *modes_w,
-                         double *modes_g, uint32_t flags) {
+                         double *modes_g, double *V_cache, uint32_t flags) {
     double Ds[9], F[9], U[9], s[3], V[9], D[12];
     for (int a = 0; a < 3; ++a)
         for (int k = 0; k < 3; ++k)
             Ds[3 * a + k] = x[3 * (k + 1) + a] - x[a];
     sw_m3_mul(Ds, DmInv, F); /* F = Ds Dm^-1 */
-    sw_svd3(F, U, s, V);
+    if (V_cache) {
+        sw_svd3_warm(F, V_cache, U, s, V);
+        memcpy(V_cache, V, sizeof V);
+    } else {
+        sw_svd3(F, U, s, V);
+    }
     double e = s[0] + s[1] + s[2] - 3.0;
     double d0 = s[0] - 1.0, d1 = s[1] - 1.0, d2 = s[2] - 1.0;
     double psi = mu * (d0 * d0 + d1 * d1 + d2 * d2) + 0.5 * lambda * e * e; /* eq. 2.3 */
@@ -176,11 +182,11 @@ static double corot_eval(const double x[12], const double DmInv[9], double vol, 
 
 double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
                      double lambda, double f[12], double K[144], uint32_t flags) {
-    return corot_eval(x, DmInv, vol, mu, lambda, f, K, NULL, NULL, flags);
+    return corot_eval(x, DmInv, vol, mu, lambda, f, K, NULL, NULL, NULL, flags);
 }
 
 double sw_corot_eval_modes(const double x[12], const double DmInv[9], double vol, double mu,
                            double lambda, double f[12], double w[9], double g[108],
-                           uint32_t flags) {
-    return corot_eval(x, DmInv, vol, mu, lambda, f, NULL, w, g, flags);
+                           double V_cache[9], uint32_t flags) {
+    return corot_eval(x, DmInv, vol, mu, lambda, f, NULL, w, g, V_cache, flags);
 }

@@ -41,10 +41,12 @@ double sw_corot_eval(const double x[12], const double DmInv[9], double vol, doub
 
 /* As sw_corot_eval, but the Hessian as its nine rank-one modes: K = sum_k w[k] g_k g_k^T
  * with g_k = g[12k .. 12k+11]. A caller projecting K onto a basis J (12 x r) gets
- * J^T K J = sum_k w[k] (J^T g_k)(J^T g_k)^T without forming K (the step's cubature). */
+ * J^T K J = sum_k w[k] (J^T g_k)(J^T g_k)^T without forming K (the step's cubature).
+ * V_cache (may be NULL) holds a proper rotation from this element's previous call: the
+ * SVD starts from it and stores its new V there (fewer Jacobi sweeps frame to frame). */
 double sw_corot_eval_modes(const double x[12], const double DmInv[9], double vol, double mu,
                            double lambda, double f[12], double w[9], double g[108],
-                           uint32_t flags);
+                           double V_cache[9], uint32_t flags);
 
 /* Lumped mass: adds density*vol/4 to each of the tet's four vertices' entry of mass. */
 void sw_lumped_mass_add(const int32_t tet[4], double density, double vol, double *mass);

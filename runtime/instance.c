@@ -55,6 +55,7 @@ struct sinew_instance {
     int32_t *contact_act; /* 4 per pose-space contact: active index of p, t0, t1, t2 */
     double *Jc, *hc;      /* 4 x 3 x rmax and 4 x rmax: one contact's Jacobians */
     int32_t nearest;      /* training pose nearest to the current pose, or -1 */
+    double *svd_V;        /* 9 per cubature tet: last SVD rotation (warm start) */
     sinew_step_stats stats;
 };
 
@@ -81,7 +82,7 @@ static void mem_free(const sinew_allocator *a, void *p) {
 }
 
 /* The instance's arrays, listed once for allocation and release. */
-enum { NBUF = 28 };
+enum { NBUF = 29 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
@@ -93,7 +94,7 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (void **)&in->qtrial, (void **)&in->fin, (void **)&in->tmp, (void **)&in->tmp2,
                       (void **)&in->Je, (void **)&in->surf_x,
                       (void **)&in->surf_n, (void **)&in->feature, (void **)&in->contact_act,
-                      (void **)&in->Jc, (void **)&in->hc};
+                      (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V};
     size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
                       (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
                       (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
@@ -102,7 +103,7 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       3 * (size_t)v->nsurf_verts * d,
                       3 * (size_t)v->nsurf_verts * d, 4 * nb * d,
                       4 * (size_t)v->ncontacts * sizeof(int32_t), 12 * (size_t)in->rmax * d,
-                      4 * (size_t)in->rmax * d};
+                      4 * (size_t)in->rmax * d, 9 * (size_t)v->ncub * d};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -233,6 +234,11 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->pose_set = 0;
     inst->history = 0;
     inst->nearest = -1;
+    for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
+        double *V = inst->svd_V + 9 * (int64_t)c;
+        memset(V, 0, 9 * sizeof(double));
+        V[0] = V[4] = V[8] = 1;
+    }
     memset(&inst->stats, 0, sizeof inst->stats);
     inst->stats.struct_size = sizeof inst->stats;
     return SINEW_OK;
@@ -331,7 +337,7 @@ static double cubature_eval(sinew_instance *in, const double *q, int want_grad, 
             double w = v->cub_weight[c];
             E += w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
                                          want_grad ? f : NULL, want_hess ? wm : NULL, gm,
-                                         SW_COROT_PROJECT_PSD);
+                                         in->svd_V + 9 * (int64_t)c, SW_COROT_PROJECT_PSD);
             if (!want_grad) continue;
             for (int32_t j = 0; j < r; ++j) {
                 double acc = 0;

@@ -12,6 +12,7 @@
 #include "mat3.h"
 
 #include <math.h>
+#include <stddef.h>
 
 enum { SVD3_MAX_SWEEPS = 40 };
 
@@ -69,7 +70,8 @@ static void any_orthogonal(const double u[3], double out[3]) {
         out[i] /= n;
 }
 
-void sw_svd3(const double A[9], double U[9], double s[3], double V[9]) {
+/* The SVD with Jacobi started from the rotation V0 (NULL: identity). */
+static void svd3(const double A[9], const double *V0, double U[9], double s[3], double V[9]) {
     /* Prescale so the largest entry is 1: no overflow in the squared norms. */
     double m = 0.0;
     int finite = 1;
@@ -84,9 +86,15 @@ void sw_svd3(const double A[9], double U[9], double s[3], double V[9]) {
         s[0] = s[1] = s[2] = finite ? 0.0 : NAN;
         return;
     }
-    double W[9];
+    double W[9], Am[9];
     for (int i = 0; i < 9; ++i)
-        W[i] = A[i] / m;
+        Am[i] = A[i] / m;
+    if (V0) { /* W = A V0: a good V0 leaves W nearly column-orthogonal already */
+        for (int i = 0; i < 9; ++i) V[i] = V0[i];
+        sw_m3_mul(Am, V0, W);
+    } else {
+        for (int i = 0; i < 9; ++i) W[i] = Am[i];
+    }
     for (int sweep = 0; sweep < SVD3_MAX_SWEEPS; ++sweep) {
         int rotated = orthogonalize_pair(W, V, 0, 1);
         rotated += orthogonalize_pair(W, V, 0, 2);
@@ -144,6 +152,12 @@ void sw_svd3(const double A[9], double U[9], double s[3], double V[9]) {
     s[0] = n[0] * m;
     s[1] = n[1] * m;
     s[2] = s2 * m;
+}
+
+void sw_svd3(const double A[9], double U[9], double s[3], double V[9]) { svd3(A, NULL, U, s, V); }
+
+void sw_svd3_warm(const double A[9], const double V0[9], double U[9], double s[3], double V[9]) {
+    svd3(A, V0, U, s, V);
 }
 
 void sw_polar3(const double A[9], double R[9], double S[9]) {

@@ -9,6 +9,11 @@
  * Handles rank-deficient, zero and nearly-degenerate A. */
 void sw_svd3(const double A[9], double U[9], double s[3], double V[9]);
 
+/* sw_svd3 with the Jacobi iteration started from V0, a proper rotation (e.g. the V of
+ * the same element's previous evaluation): the result is the same decomposition to
+ * working precision, reached in fewer sweeps when V0 is close. V may alias V0. */
+void sw_svd3_warm(const double A[9], const double V0[9], double U[9], double s[3], double V[9]);
+
 /* Polar decomposition A = R S with R a proper rotation, R = U V^T from sw_svd3
  * (so for inverted A, S is symmetric but indefinite). S may be NULL. */
 void sw_polar3(const double A[9], double R[9], double S[9]);

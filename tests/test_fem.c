@@ -711,8 +711,10 @@ TEST(hessian_modes_reproduce_K) {
         for (uint32_t flags = 0; flags <= SW_COROT_PROJECT_PSD; ++flags) {
             double K[144], f1[12], f2[12], w[9], g[108];
             double e1 = sw_corot_eval(x, Dm, vol, 1.0, 3.0, f1, K, flags);
-            double e2 = sw_corot_eval_modes(x, Dm, vol, 1.0, 3.0, f2, w, g, flags);
-            ENSURE(e1 == e2 && memcmp(f1, f2, sizeof f1) == 0);
+            double Vc[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+            double e2 = sw_corot_eval_modes(x, Dm, vol, 1.0, 3.0, f2, w, g, trial % 2 ? Vc : NULL, flags);
+            ENSURE_NEAR(e1, e2, 1e-12 * (fabs(e1) + 1e-300));
+            for (int i = 0; i < 12; ++i) ENSURE_NEAR(f1[i], f2[i], 1e-10 * (fabs(f1[i]) + 1.0));
             double scale = 0;
             for (int i = 0; i < 144; ++i) scale = fmax(scale, fabs(K[i]));
             for (int i = 0; i < 12; ++i)

@@ -271,7 +271,37 @@ TEST(polar_decomposition) {
     }
 }
 
-SW_TEST_MAIN(CASE(random_matrices), CASE(inverted_matrices_flip_only_the_smallest),
+/* Warm-started from any proper rotation (near or far from the answer) the SVD is the
+ * same decomposition as cold: same singular values, A = U S V^T, U and V rotations. */
+TEST(warm_start_gives_the_same_decomposition) {
+    uint64_t seed = 4242;
+    for (int trial = 0; trial < 3000; ++trial) {
+        double A[9], B[9], U0[9], s0[3], V0[9], U[9], s[3], V[9];
+        for (int i = 0; i < 9; ++i) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            A[i] = (double)(seed >> 11) * 0x1.0p-52 - 1.0;
+        }
+        if (trial % 4 == 0) A[0] = -A[0]; /* some inverted */
+        sw_svd3(A, U0, s0, V0);
+        /* start from the V of a perturbed matrix (near), or of an unrelated one (far) */
+        for (int i = 0; i < 9; ++i) B[i] = trial % 2 ? A[i] + 1e-3 * (double)((i * 7 + trial) % 5) : A[8 - i];
+        double Ub[9], sb[3], Vb[9];
+        sw_svd3(B, Ub, sb, Vb);
+        sw_svd3_warm(A, Vb, U, s, V);
+        double scale = fabs(s0[0]) + 1e-300;
+        for (int k = 0; k < 3; ++k) ENSURE_NEAR(s[k], s0[k], 1e-12 * scale);
+        for (int i = 0; i < 3; ++i)
+            for (int j = 0; j < 3; ++j) {
+                double r = 0;
+                for (int k = 0; k < 3; ++k) r += U[3 * i + k] * s[k] * V[3 * j + k];
+                ENSURE_NEAR(r, A[3 * i + j], 1e-13 * scale);
+            }
+        ENSURE_NEAR(det3(U), 1.0, 1e-12);
+        ENSURE_NEAR(det3(V), 1.0, 1e-12);
+    }
+}
+
+SW_TEST_MAIN(CASE(warm_start_gives_the_same_decomposition), CASE(random_matrices), CASE(inverted_matrices_flip_only_the_smallest),
              CASE(rank_deficient_matrices), CASE(repeated_singular_values),
              CASE(near_degenerate_and_extreme_scales), CASE(zero_and_non_finite),
              CASE(polar_decomposition))
