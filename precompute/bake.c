@@ -7,6 +7,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "sw_mesh.h"
+
 #include "bake_internal.h"
 #include "fem_corot.h"
 #include "weights_heat.h"
@@ -53,12 +55,6 @@ void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R,
     for (int32_t b = 0; b < s->nb; ++b) sw_dq_from_transform(T + 12 * b, &dq[b]);
     for (int32_t v = 0; v < s->nv; ++v)
         sw_dqs_blend(dq, s->skin_bone + 4 * v, s->skin_weight + 4 * v, 4, R + 9 * v, t + 3 * v);
-}
-
-static double seconds_now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* Keeps each vertex's 4 strongest influences, renormalised (the runtime blends 4). */
@@ -217,20 +213,20 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     memset(&s, 0, sizeof s);
     s.p = &p;
     sinew_result r;
-    double t0 = seconds_now(), t1;
+    double t0 = sw_now_seconds(), t1;
     int heat = c->weights.w == NULL;
     if ((r = prepare(&s, c, heat, err)) != SINEW_OK) goto done;
     if (!(s.pool = sw_pool_create(p.threads))) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
         goto done;
     }
-    t1 = seconds_now();
+    t1 = sw_now_seconds();
     out->stage_seconds[0] = t1 - t0;
     progress(&p, "prepare", t1 - t0, heat ? "heat-diffusion weights" : "asset weights");
 
     t0 = t1;
     if ((r = sw_bake_domains(&s, err)) != SINEW_OK) goto done;
-    t1 = seconds_now();
+    t1 = sw_now_seconds();
     out->stage_seconds[1] = t1 - t0;
     {
         char msg[64];
@@ -241,7 +237,7 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     t0 = t1;
     if ((r = sw_bake_poses(&s, err)) != SINEW_OK || (r = sw_bake_simulate(&s, err)) != SINEW_OK)
         goto done;
-    t1 = seconds_now();
+    t1 = sw_now_seconds();
     out->stage_seconds[2] = t1 - t0;
     for (int32_t i = 0; i < s.ntrain_seq; ++i) out->ntrain += s.train[i].npose;
     out->nheldout = s.heldout.npose;
@@ -260,7 +256,7 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
 
     t0 = t1;
     if ((r = sw_bake_basis(&s, out, err)) != SINEW_OK) goto done;
-    t1 = seconds_now();
+    t1 = sw_now_seconds();
     out->stage_seconds[3] = t1 - t0;
     {
         char msg[128];
@@ -271,7 +267,7 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
 
     t0 = t1;
     if ((r = sw_bake_cubature(&s, out, err)) != SINEW_OK) goto done;
-    t1 = seconds_now();
+    t1 = sw_now_seconds();
     out->stage_seconds[4] = t1 - t0;
     {
         int32_t total = 0;
@@ -285,7 +281,7 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     t0 = t1;
     if ((r = sw_bake_contacts(&s, err)) != SINEW_OK || (r = sw_bake_reduce(&s, out, err)) != SINEW_OK)
         goto done;
-    t1 = seconds_now();
+    t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;
     {
         char msg[96];

@@ -21,25 +21,9 @@
 #define SW_BONE_MIN_DRIVEN 4
 #define SW_BONE_REACH 2.0
 
-static double point_segment_distance(const double *p, const double *a, const double *b) {
-    double ab[3], ap[3], ab2 = 0, t = 0, d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-        ab[i] = b[i] - a[i];
-        ap[i] = p[i] - a[i];
-        ab2 += ab[i] * ab[i];
-        t += ab[i] * ap[i];
-    }
-    t = ab2 > 0 ? t / ab2 : 0;
-    t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    for (int i = 0; i < 3; ++i) {
-        double d = ap[i] - t * ab[i];
-        d2 += d * d;
-    }
-    return sqrt(d2);
-}
 
 static double bone_distance(const sw_tetmesh *m, const sw_skeleton *s, int32_t v, int32_t b) {
-    return point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
+    return sw_point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
                                   s->joints + 3 * s->bones[2 * b + 1]);
 }
 

@@ -22,6 +22,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "sw_mesh.h"
+
 #include "thread_pool.h"
 
 /* Column cache budget (sw_cubature_train); m = r T = 3000 rows keeps ~11k columns. */
@@ -56,26 +58,6 @@ static int64_t rng_below(uint64_t *s, int64_t n) {
         v = rng_next(s);
     while (v >= lim);
     return (int64_t)(v % un);
-}
-
-static double dotp(const double *a, const double *b, int64_t n) {
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    int64_t i = 0;
-    for (; i + 4 <= n; i += 4) {
-        s0 += a[i] * b[i];
-        s1 += a[i + 1] * b[i + 1];
-        s2 += a[i + 2] * b[i + 2];
-        s3 += a[i + 3] * b[i + 3];
-    }
-    for (; i < n; ++i)
-        s0 += a[i] * b[i];
-    return (s0 + s1) + (s2 + s3);
-}
-
-static double now_seconds(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- the column cache ---------------------------------------------------------- */
@@ -118,10 +100,10 @@ static void batch_range(void *ctx, int64_t begin, int64_t end, int worker) {
                 job->fresh[i] = 2;
                 continue;
             }
-            cc->norm[e] = sqrt(dotp(a, a, m));
-            cc->atb[e] = dotp(a, cc->prob->b, m);
+            cc->norm[e] = sqrt(sw_dot(a, a, m));
+            cc->atb[e] = sw_dot(a, cc->prob->b, m);
         }
-        if (job->r) job->score[i] = dotp(a, job->r, m);
+        if (job->r) job->score[i] = sw_dot(a, job->r, m);
     }
 }
 
@@ -249,7 +231,7 @@ static void gram_range(void *ctx, int64_t begin, int64_t end, int worker) {
         const double *aj = t->cc.col[ej];
         for (int64_t i = 0; i <= j; ++i) {
             int64_t ei = job->list[i], pi = t->pos[ei];
-            double g = (pi >= 0 && pj >= 0) ? t->G[pj * t->s + pi] : dotp(t->cc.col[ei], aj, t->m);
+            double g = (pi >= 0 && pj >= 0) ? t->G[pj * t->s + pi] : sw_dot(t->cc.col[ei], aj, t->m);
             job->G[j * k + i] = job->G[i * k + j] = g;
         }
     }
@@ -332,7 +314,7 @@ static sinew_result solve_on(trainer *t, const int64_t *list, int64_t k, const d
         for (int64_t q = 0; q < m; ++q)
             r[q] -= t->w[i] * a[q];
     }
-    t->rel = sqrt(dotp(r, r, m)) / t->bnorm;
+    t->rel = sqrt(sw_dot(r, r, m)) / t->bnorm;
     /* Best: once some set meets tol, the smallest such set; before, the lowest error. */
     const double tol = t->par.tol;
     int better = t->rel <= tol ? (t->best_rel > tol || s < t->best_n ||
@@ -522,7 +504,7 @@ static sinew_result nnhtp_step(trainer *t, select_buf *sb, int64_t sb_s, int *do
     double *h = sb->x0; /* h on S: support first, then the new entries */
     for (int64_t i = 0; i < s; ++i) {
         sb->list[i] = t->ids[i];
-        h[i] = dotp(t->cc.col[t->ids[i]], t->r, m);
+        h[i] = sw_dot(t->cc.col[t->ids[i]], t->r, m);
     }
     for (int64_t i = 0; i < npos; ++i) {
         sb->list[s + i] = sb->batch[sb->keys[i].i];
@@ -537,7 +519,7 @@ static sinew_result nnhtp_step(trainer *t, select_buf *sb, int64_t sb_s, int *do
         for (int64_t q = 0; q < m; ++q)
             Ah[q] += h[i] * a[q];
     }
-    double AhAh = dotp(Ah, Ah, m);
+    double AhAh = sw_dot(Ah, Ah, m);
     double mu = AhAh > 0 ? hh / AhAh : 0;
     /* eq. 2.17: H_s^+ keeps the sb_s largest positive entries of w + mu h. */
     int64_t nv = 0;
@@ -783,7 +765,7 @@ sinew_result sw_cubature_train_cache(const sw_cubature_problem *prob,
     if (out) memset(out, 0, sizeof *out);
     sinew_result res = check_input(prob, params, out, err);
     if (res != SINEW_OK) return res;
-    double t0 = now_seconds();
+    double t0 = sw_now_seconds();
     trainer t;
     select_buf sb;
     memset(&t, 0, sizeof t);
@@ -802,7 +784,7 @@ sinew_result sw_cubature_train_cache(const sw_cubature_problem *prob,
                             "cubature: out of memory (%lld candidates, %lld rows)",
                             (long long)prob->ncandidates, (long long)prob->m);
     }
-    t.bnorm = sqrt(dotp(prob->b, prob->b, prob->m));
+    t.bnorm = sqrt(sw_dot(prob->b, prob->b, prob->m));
     int stuck = 0;
     if (t.bnorm == 0) {
         t.rel = t.best_rel = 0; /* the empty cubature is exact */
@@ -818,7 +800,7 @@ sinew_result sw_cubature_train_cache(const sw_cubature_problem *prob,
                            "(max_points %d%s)",
                            t.best_rel, t.par.tol, (int)t.best_n, (int)t.par.max_points,
                            stuck ? "; no remaining candidate correlates with the residual" : "");
-    out->seconds = now_seconds() - t0;
+    out->seconds = sw_now_seconds() - t0;
     trainer_free(&t, &sb);
     return res;
 }

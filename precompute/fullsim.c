@@ -6,6 +6,8 @@
 #include <string.h>
 #include <time.h>
 
+#include "sw_mesh.h"
+
 #include "bsr_matrix.h"
 #include "fem_corot.h"
 #include "mesh_io.h"
@@ -66,12 +68,6 @@ sw_fullsim_params sw_fullsim_params_default(void) {
     p.pcg_max = 1000;
     p.threads = 0;
     return p;
-}
-
-static double now_seconds(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }
 
 /* ---- element evaluation ------------------------------------------------------ */
@@ -624,7 +620,7 @@ static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *
 sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats *stats) {
     sw_fullsim_stats st;
     memset(&st, 0, sizeof st);
-    double t0 = now_seconds();
+    double t0 = sw_now_seconds();
     const sw_character *c = sim->c;
     int32_t nv = sim->nv;
     int64_t m = 3 * (int64_t)nv;
@@ -685,7 +681,7 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
             st.energy_kinetic += 0.5 * sim->mass[v] *
                                  (sim->v[3 * v] * sim->v[3 * v] + sim->v[3 * v + 1] * sim->v[3 * v + 1] +
                                   sim->v[3 * v + 2] * sim->v[3 * v + 2]);
-    st.seconds = now_seconds() - t0;
+    st.seconds = sw_now_seconds() - t0;
     if (stats) *stats = st;
     return result;
 }

@@ -37,22 +37,6 @@ typedef struct nnls_factor {
     double *v;               /* Lawson-Hanson: m (Gram-Schmidt, residual) */
 } nnls_factor;
 
-/* Four independent partial sums in a fixed order: faster than one chain (no
- * reassociation is allowed here, -ffp-contract=off), and deterministic. */
-static double dotp(const double *a, const double *b, int64_t n) {
-    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
-    int64_t i = 0;
-    for (; i + 4 <= n; i += 4) {
-        s0 += a[i] * b[i];
-        s1 += a[i + 1] * b[i + 1];
-        s2 += a[i + 2] * b[i + 2];
-        s3 += a[i + 3] * b[i + 3];
-    }
-    for (; i < n; ++i)
-        s0 += a[i] * b[i];
-    return (s0 + s1) + (s2 + s3);
-}
-
 static inline double *rcol(const nnls_factor *f, int64_t j) {
     return f->R + j * (j + 1) / 2;
 }
@@ -106,7 +90,7 @@ static int factor_add(nnls_factor *f, int64_t j) {
     if (f->method == SW_NNLS_LAWSON_HANSON) {
         const int64_t m = f->m;
         const double *a = f->A + j * m;
-        double anorm = sqrt(dotp(a, a, m));
+        double anorm = sqrt(sw_dot(a, a, m));
         if (!(anorm > 0)) return 0;
         double *v = f->v;
         memcpy(v, a, (size_t)m * sizeof(double));
@@ -117,19 +101,19 @@ static int factor_add(nnls_factor *f, int64_t j) {
         for (int pass = 0; pass < 2; ++pass) {
             for (int64_t k = 0; k < p; ++k) {
                 const double *q = f->Q + k * m;
-                double c = dotp(q, v, m);
+                double c = sw_dot(q, v, m);
                 rc[k] += c;
                 for (int64_t i = 0; i < m; ++i)
                     v[i] -= c * q[i];
             }
         }
-        double nrm = sqrt(dotp(v, v, m));
+        double nrm = sqrt(sw_dot(v, v, m));
         if (!(nrm > LH_DEPENDENT_REL * anorm)) return 0;
         double *q = f->Q + p * m;
         for (int64_t i = 0; i < m; ++i)
             q[i] = v[i] / nrm;
         rc[p] = nrm;
-        f->qtb[p] = dotp(q, f->b, m);
+        f->qtb[p] = sw_dot(q, f->b, m);
     } else {
         const int64_t n = f->n;
         double gjj = f->G[j * n + j];
@@ -138,7 +122,7 @@ static int factor_add(nnls_factor *f, int64_t j) {
         double ll = 0;
         for (int64_t k = 0; k < p; ++k) {
             const double *ck = rcol(f, k);
-            double s = f->G[j * n + f->var[k]] - dotp(ck, rc, k);
+            double s = f->G[j * n + f->var[k]] - sw_dot(ck, rc, k);
             rc[k] = s / ck[k];
             ll += rc[k] * rc[k];
         }
@@ -202,7 +186,7 @@ static void factor_solve(const nnls_factor *f, double *z) {
     } else {
         for (int64_t j = 0; j < p; ++j) {
             const double *cj = rcol(f, j);
-            z[j] = (f->Atb[f->var[j]] - dotp(cj, z, j)) / cj[j];
+            z[j] = (f->Atb[f->var[j]] - sw_dot(cj, z, j)) / cj[j];
         }
     }
     for (int64_t j = p - 1; j >= 0; --j) {
@@ -227,7 +211,7 @@ static void dual(const nnls_factor *f, const double *x, const unsigned char *wan
                 r[i] -= xk * a[i];
         }
         for (int64_t j = 0; j < n; ++j)
-            w[j] = want[j] ? dotp(f->A + j * m, r, m) : 0;
+            w[j] = want[j] ? sw_dot(f->A + j * m, r, m) : 0;
     } else {
         for (int64_t j = 0; j < n; ++j) {
             if (!want[j]) {
@@ -413,7 +397,7 @@ static double residual_norm(const double *A, int64_t m, int64_t n, const double 
         for (int64_t i = 0; i < m; ++i)
             r[i] -= x[j] * a[i];
     }
-    return sqrt(dotp(r, r, m));
+    return sqrt(sw_dot(r, r, m));
 }
 
 static sinew_result check_common(int64_t n, double tol, int max_iter, const double *x,
@@ -458,9 +442,9 @@ sinew_result sw_nnls(sw_nnls_method method, const double *A, int64_t m, int64_t 
         if (!G || !Atb) goto oom;
         for (int64_t j = 0; j < n; ++j) {
             const double *aj = A + j * m;
-            Atb[j] = dotp(aj, b, m);
+            Atb[j] = sw_dot(aj, b, m);
             for (int64_t i = 0; i <= j; ++i)
-                G[j * n + i] = G[i * n + j] = dotp(A + i * m, aj, m);
+                G[j * n + i] = G[i * n + j] = sw_dot(A + i * m, aj, m);
         }
         f.G = G;
         f.Atb = Atb;

@@ -19,6 +19,21 @@ typedef struct sw_nnls_stats {
     int converged;   /* KKT conditions met within tolerance */
 } sw_nnls_stats;
 
+/* Dot product with four partial sums in a fixed order: faster than one chain (no
+ * reassociation is allowed, -ffp-contract=off) and deterministic. */
+static inline double sw_dot(const double *a, const double *b, int64_t n) {
+    double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+    int64_t i = 0;
+    for (; i + 4 <= n; i += 4) {
+        s0 += a[i] * b[i];
+        s1 += a[i + 1] * b[i + 1];
+        s2 += a[i + 2] * b[i + 2];
+        s3 += a[i + 3] * b[i + 3];
+    }
+    for (; i < n; ++i) s0 += a[i] * b[i];
+    return (s0 + s1) + (s2 + s3);
+}
+
 /* Solves into x (n). tol is relative to |A^T b|_inf (0: 1e-10); max_iter 0: 3n.
  * Returns INVALID_ARGUMENT for bad sizes/non-finite input, OUT_OF_MEMORY, or
  * NOT_CONVERGED (x is then the best feasible iterate). */

@@ -4,6 +4,7 @@
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <time.h>
 
 void sw_tetmesh_free(sw_tetmesh *m) {
     if (!m) return;
@@ -186,4 +187,27 @@ void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, do
         }
         for (int i = 0; i < 3; ++i) x[3 * v + i] = acc[i];
     }
+}
+
+double sw_point_segment_distance(const double *p, const double *a, const double *b) {
+    double ab[3], ap[3], ab2 = 0, t = 0, d2 = 0;
+    for (int i = 0; i < 3; ++i) {
+        ab[i] = b[i] - a[i];
+        ap[i] = p[i] - a[i];
+        ab2 += ab[i] * ab[i];
+        t += ab[i] * ap[i];
+    }
+    t = ab2 > 0 ? t / ab2 : 0;
+    t = t < 0 ? 0 : (t > 1 ? 1 : t);
+    for (int i = 0; i < 3; ++i) {
+        double d = ap[i] - t * ab[i];
+        d2 += d * d;
+    }
+    return sqrt(d2);
+}
+
+double sw_now_seconds(void) {
+    struct timespec ts;
+    clock_gettime(CLOCK_MONOTONIC, &ts);
+    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
 }

@@ -108,6 +108,12 @@ sinew_result sw_skeleton_validate(const sw_skeleton *s, sw_error *err);
  * bone transforms T (12*nbones) into x (3*n). */
 void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, double *x);
 
+/* Distance from point p to the segment a-b (a point when a == b). */
+double sw_point_segment_distance(const double *p, const double *a, const double *b);
+
+/* Monotonic wall-clock seconds (for stage and step timings). */
+double sw_now_seconds(void);
+
 /* Applies rigid transform T (12) to p (3) into out (3); out may alias p. */
 void sw_transform_point(const double *T, const double *p, double *out);
 

@@ -26,23 +26,6 @@
 /* Bones whose distances agree to this relative tolerance are tied for "nearest". */
 #define HEAT_TIE_REL 1e-12
 
-/* Distance from p to the segment a-b (a point when a == b). */
-static double point_segment_distance(const double *p, const double *a, const double *b) {
-    double ab[3], ap[3], ab2 = 0, t = 0, d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-        ab[i] = b[i] - a[i];
-        ap[i] = p[i] - a[i];
-        ab2 += ab[i] * ab[i];
-        t += ab[i] * ap[i];
-    }
-    t = ab2 > 0 ? t / ab2 : 0;
-    t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    for (int i = 0; i < 3; ++i) {
-        double d = ap[i] - t * ab[i];
-        d2 += d * d;
-    }
-    return sqrt(d2);
-}
 
 /* Everything the per-group solves share (read-only while they run). */
 typedef struct heat_system {
@@ -173,7 +156,7 @@ static sinew_result assemble(const sw_tetmesh *m, const sw_skeleton *s, double c
     for (int32_t v = 0; v < S->n; ++v) {
         double *d = S->dist + (size_t)v * S->nbones, dm = INFINITY;
         for (int32_t b = 0; b < S->nbones; ++b) {
-            d[b] = point_segment_distance(m->X + 3 * (size_t)v, s->joints + 3 * (size_t)s->bones[2 * b],
+            d[b] = sw_point_segment_distance(m->X + 3 * (size_t)v, s->joints + 3 * (size_t)s->bones[2 * b],
                                           s->joints + 3 * (size_t)s->bones[2 * b + 1]);
             dm = fmin(dm, d[b]);
         }

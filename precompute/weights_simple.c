@@ -6,23 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Distance from p to the segment a-b (a point when a == b). */
-static double point_segment_distance(const double *p, const double *a, const double *b) {
-    double ab[3], ap[3], ab2 = 0, t = 0, d2 = 0;
-    for (int i = 0; i < 3; ++i) {
-        ab[i] = b[i] - a[i];
-        ap[i] = p[i] - a[i];
-        ab2 += ab[i] * ab[i];
-        t += ab[i] * ap[i];
-    }
-    t = ab2 > 0 ? t / ab2 : 0;
-    t = t < 0 ? 0 : (t > 1 ? 1 : t);
-    for (int i = 0; i < 3; ++i) {
-        double d = ap[i] - t * ab[i];
-        d2 += d * d;
-    }
-    return sqrt(d2);
-}
 
 /* Length of the diagonal of the box around the mesh and the joints: the scale that
  * makes the distance clamp relative. */
@@ -71,7 +54,7 @@ sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton 
     for (int32_t v = 0; v < m->nverts; ++v) {
         double *row = w + (size_t)v * s->nbones, dmin = INFINITY, sum = 0;
         for (int32_t b = 0; b < s->nbones; ++b) {
-            row[b] = fmax(point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
+            row[b] = fmax(sw_point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
                                                  s->joints + 3 * s->bones[2 * b + 1]),
                           eps);
             dmin = fmin(dmin, row[b]);

@@ -15,15 +15,15 @@
 #include <string.h>
 #include <time.h>
 
+#define SW_TOOL_CHARACTER_ARGS
+#include "tool_common.h"
+#include "sw_mesh.h"
+
 #include "bake.h"
 #include "blob_write.h"
 #include "character_io.h"
 #include "samples.h"
 #include "subspace_eval.h"
-
-#ifndef SINEW_SHARED_DATA_DIR
-#define SINEW_SHARED_DATA_DIR "../shared/data"
-#endif
 
 static void usage(FILE *f) {
     fprintf(f,
@@ -35,42 +35,22 @@ static void usage(FILE *f) {
             "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n");
 }
 
-static int parse_int(const char *s, int lo, int hi, int *out) {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || end == s || v < lo || v > hi) return 0;
-    *out = (int)v;
-    return 1;
-}
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
 int main(int argc, char **argv) {
-    const char *scene = NULL, *mesh = NULL, *tgf = NULL, *weights = NULL, *clip = NULL;
+    sw_character_args ca;
+    sw_character_args_init(&ca);
     const char *out_path = NULL;
-    const char *data_dir = getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
-    int tets = 20000, frames = 0, json = 0;
+    int json = 0;
     sw_bake_params p = sw_bake_params_default();
     p.progress = 1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1;
-        if (!strcmp(a, "--scene") && next) scene = argv[++i];
-        else if (!strcmp(a, "--mesh") && next) mesh = argv[++i];
-        else if (!strcmp(a, "--skeleton") && next) tgf = argv[++i];
-        else if (!strcmp(a, "--weights") && next) weights = argv[++i];
-        else if (!strcmp(a, "--clip") && next) clip = argv[++i];
+        if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
+            /* a character option, consumed */
+        }
         else if (!strcmp(a, "--out") && next) out_path = argv[++i];
-        else if (!strcmp(a, "--data") && next) data_dir = argv[++i];
-        else if (!strcmp(a, "--tets") && next) ok = parse_int(argv[++i], 1000, 2000000, &tets);
-        else if (!strcmp(a, "--frames") && next) ok = parse_int(argv[++i], 2, 1000000, &frames);
-        else if (!strcmp(a, "--threads") && next) ok = parse_int(argv[++i], 0, 256, &p.threads);
-        else if (!strcmp(a, "--max-rank") && next) ok = parse_int(argv[++i], 1, 1024, &p.max_rank);
+        else if (!strcmp(a, "--threads") && next) ok = sw_parse_int(argv[++i], 0, 256, &p.threads);
+        else if (!strcmp(a, "--max-rank") && next) ok = sw_parse_int(argv[++i], 1, 1024, &p.max_rank);
         else if (!strcmp(a, "--tol") && next) {
             char *end;
             p.cubature_tol = strtod(argv[++i], &end);
@@ -98,7 +78,7 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
-    if (!out_path || (!scene == !mesh) || (mesh && !tgf)) {
+    if (!out_path || !sw_character_args_valid(&ca)) {
         fprintf(stderr, "sinew-bake: give --out and either --scene or --mesh with --skeleton\n");
         usage(stderr);
         return 2;
@@ -107,20 +87,14 @@ int main(int argc, char **argv) {
     sw_error_clear(&err);
     sw_character ch;
     memset(&ch, 0, sizeof ch);
-    int computed = 0;
-    double t0 = now();
-    sinew_result r = scene ? sw_scene_make(scene, tets, frames, data_dir, &ch, &computed, &err)
-                           : sw_character_from_files(mesh, tgf, weights, clip, frames, &ch, &err);
+    double t0 = sw_now_seconds();
+    sinew_result r = sw_character_args_make(&ca, &ch, &err);
     if (r != SINEW_OK) {
         fprintf(stderr, "sinew-bake: %s (%s)\n", err.msg, sinew_result_string(r));
         return 1;
     }
-    if (mesh && !weights) computed = 1;
-    if (computed) { /* no weights in the asset: the bake computes heat-diffusion weights */
-        sw_weights_free(&ch.weights);
-    }
     fprintf(stderr, "sinew-bake: %s: %d tets, %d vertices, %d bones, %d clip frames\n",
-            ch.name[0] ? ch.name : (scene ? scene : mesh), ch.mesh.ntets, ch.mesh.nverts,
+            ch.name[0] ? ch.name : (ca.scene ? ca.scene : ca.mesh), ch.mesh.ntets, ch.mesh.nverts,
             ch.skel.nbones, ch.clip.nframes);
     sw_bake_result res;
     r = sw_bake(&ch, &p, &res, &err);
@@ -135,7 +109,7 @@ int main(int argc, char **argv) {
         sw_character_free(&ch);
         return 1;
     }
-    double bake_seconds = now() - t0;
+    double bake_seconds = sw_now_seconds() - t0;
     /* evaluate the written blob against the full-space solutions */
     sinew_blob_def bd = sinew_blob_def_default();
     bd.path = out_path;
@@ -143,7 +117,7 @@ int main(int argc, char **argv) {
     sw_eval_result et, eh;
     memset(&et, 0, sizeof et);
     memset(&eh, 0, sizeof eh);
-    double t1 = now();
+    double t1 = sw_now_seconds();
     if ((r = sinew_blob_load(&bd, &blob)) != SINEW_OK ||
         (r = sw_eval_correction(blob, res.mass, res.train_T, res.train_x, res.ntrain, 20, &et, &err)) != SINEW_OK ||
         (r = sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh, &err)) != SINEW_OK) {
@@ -153,7 +127,7 @@ int main(int argc, char **argv) {
         sw_character_free(&ch);
         return 1;
     }
-    double eval_seconds = now() - t1;
+    double eval_seconds = sw_now_seconds() - t1;
     const sw_blob_view *v = &res.view;
     fprintf(stderr, "sinew-bake: wrote %s\n", out_path);
     fprintf(stderr, "  stages (s): prepare %.2f, domains %.2f, simulate %.2f, basis %.2f, cubature %.2f, reduce %.2f; total %.2f\n",

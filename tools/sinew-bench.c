@@ -24,6 +24,10 @@
 #include <sys/stat.h>
 #include <time.h>
 
+#define SW_TOOL_CHARACTER_ARGS
+#include "tool_common.h"
+#include "sw_mesh.h"
+
 #include "bake.h"
 #include "blob_load.h"
 #include "blob_write.h"
@@ -35,36 +39,6 @@
 #include "rt_interpose.h"
 #include "samples.h"
 #include "subspace_eval.h"
-
-#ifndef SINEW_SHARED_DATA_DIR
-#define SINEW_SHARED_DATA_DIR "../shared/data"
-#endif
-
-static double now(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}
-
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
-static double median(double *v, int n) {
-    if (n <= 0) return 0;
-    qsort(v, (size_t)n, sizeof *v, cmp_double);
-    return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
-}
-
-static int parse_int(const char *s, int lo, int hi, int *out) {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || end == s || v < lo || v > hi) return 0;
-    *out = (int)v;
-    return 1;
-}
 
 static void usage(FILE *f) {
     fprintf(f, "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf\n"
@@ -81,7 +55,7 @@ static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames, con
     sw_dualquat dq[SW_MAX_BONES];
     for (int f = 0; f < frames && ms; ++f) {
         const double *T = clip->T + (size_t)f * 12 * clip->nbones;
-        double t0 = now();
+        double t0 = sw_now_seconds();
         for (int32_t b = 0; b < v->nbones; ++b) sw_dq_from_transform(T + 12 * b, &dq[b]);
         for (int32_t s = 0; s < v->nsurf_verts; ++s) {
             int32_t gv = surf_vert[s];
@@ -104,9 +78,9 @@ static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames, con
             if (l > 0)
                 for (int k = 0; k < 3; ++k) q[k] /= l;
         }
-        ms[f] = 1e3 * (now() - t0);
+        ms[f] = 1e3 * (sw_now_seconds() - t0);
     }
-    double m = median(ms, frames);
+    double m = sw_median(ms, frames);
     free(ms);
     return m;
 }
@@ -146,26 +120,21 @@ done:
 }
 
 int main(int argc, char **argv) {
-    const char *scene = NULL, *mesh = NULL, *tgf = NULL, *weights = NULL, *clip_path = NULL;
+    sw_character_args ca;
+    sw_character_args_init(&ca);
     const char *blob_path = NULL, *out_dir = NULL;
-    const char *data_dir = getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
-    int tets = 20000, frames = 0, json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
+    int json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1;
-        if (!strcmp(a, "--scene") && next) scene = argv[++i];
-        else if (!strcmp(a, "--mesh") && next) mesh = argv[++i];
-        else if (!strcmp(a, "--skeleton") && next) tgf = argv[++i];
-        else if (!strcmp(a, "--weights") && next) weights = argv[++i];
-        else if (!strcmp(a, "--clip") && next) clip_path = argv[++i];
+        if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
+            /* a character option, consumed */
+        }
         else if (!strcmp(a, "--blob") && next) blob_path = argv[++i];
         else if (!strcmp(a, "--out") && next) out_dir = argv[++i];
-        else if (!strcmp(a, "--data") && next) data_dir = argv[++i];
-        else if (!strcmp(a, "--tets") && next) ok = parse_int(argv[++i], 1000, 2000000, &tets);
-        else if (!strcmp(a, "--frames") && next) ok = parse_int(argv[++i], 2, 1000000, &frames);
-        else if (!strcmp(a, "--full-frames") && next) ok = parse_int(argv[++i], 1, 100000, &full_frames);
-        else if (!strcmp(a, "--contract-steps") && next) ok = parse_int(argv[++i], 0, 100000000, &contract_steps);
-        else if (!strcmp(a, "--threads") && next) ok = parse_int(argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--full-frames") && next) ok = sw_parse_int(argv[++i], 1, 100000, &full_frames);
+        else if (!strcmp(a, "--contract-steps") && next) ok = sw_parse_int(argv[++i], 0, 100000000, &contract_steps);
+        else if (!strcmp(a, "--threads") && next) ok = sw_parse_int(argv[++i], 0, 256, &threads);
         else if (!strcmp(a, "--json")) json = 1;
         else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
@@ -177,7 +146,7 @@ int main(int argc, char **argv) {
             return 2;
         }
     }
-    if (!scene == !mesh || (mesh && !tgf)) {
+    if (!sw_character_args_valid(&ca)) {
         usage(stderr);
         return 2;
     }
@@ -185,15 +154,11 @@ int main(int argc, char **argv) {
     sw_error_clear(&err);
     sw_character ch;
     memset(&ch, 0, sizeof ch);
-    int computed = 0;
-    sinew_result r = scene ? sw_scene_make(scene, tets, frames, data_dir, &ch, &computed, &err)
-                           : sw_character_from_files(mesh, tgf, weights, clip_path, frames, &ch, &err);
+    sinew_result r = sw_character_args_make(&ca, &ch, &err);
     if (r != SINEW_OK) {
         fprintf(stderr, "sinew-bench: %s (%s)\n", err.msg, sinew_result_string(r));
         return 1;
     }
-    if (mesh && !weights) computed = 1;
-    if (computed) sw_weights_free(&ch.weights);
     int nf = ch.clip.nframes;
 
     /* 1. bake (or load) */
@@ -209,14 +174,14 @@ int main(int argc, char **argv) {
     if (blob_path) {
         bd.path = blob_path;
     } else {
-        double t0 = now();
+        double t0 = sw_now_seconds();
         size_t size = 0;
         if ((r = sw_bake(&ch, &bp, &res, &err)) != SINEW_OK ||
             (r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
             fprintf(stderr, "sinew-bench: bake failed: %s (%s)\n", err.msg, sinew_result_string(r));
             return 1;
         }
-        bake_s = now() - t0;
+        bake_s = sw_now_seconds() - t0;
         bd.data = mem;
         bd.data_size = size;
     }
@@ -255,7 +220,7 @@ int main(int argc, char **argv) {
                sizeof(double) * 3 * ch.mesh.nverts);
         fprintf(stderr, "sinew-bench: full-space frame %d/%d: %.1f ms\n", f + 1, kf, full[f]);
     }
-    double full_ms = median(full, kf);
+    double full_ms = sw_median(full, kf);
     sw_fullsim_destroy(sim);
 
     /* 3. subspace: step + read over the clip */
@@ -268,13 +233,13 @@ int main(int argc, char **argv) {
     float *pos = malloc((size_t)ns * 3 * sizeof(float)), *nrm = malloc((size_t)ns * 3 * sizeof(float));
     double *sub = malloc((size_t)nf * sizeof(double));
     for (int f = 0; f < nf; ++f) {
-        double t0 = now();
+        double t0 = sw_now_seconds();
         sw_instance_set_pose_d(inst, ch.clip.T + (size_t)f * 12 * ch.skel.nbones);
         sinew_instance_step(inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30));
         sinew_instance_read_surface(inst, pos, nrm, ns);
-        sub[f] = 1e3 * (now() - t0);
+        sub[f] = 1e3 * (sw_now_seconds() - t0);
     }
-    double sub_ms = median(sub, nf);
+    double sub_ms = sw_median(sub, nf);
     if (out_dir && write_frames(out_dir, blob, inst, &ch, &err) != SINEW_OK)
         fprintf(stderr, "sinew-bench: %s\n", err.msg);
 
@@ -341,7 +306,7 @@ int main(int argc, char **argv) {
                "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
                "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_seconds\":%.2f,"
                "\"err_source\":\"%s\"}\n",
-               scene ? scene : mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
+               ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
                sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub,
                allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source);
     free(full);

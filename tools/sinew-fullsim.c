@@ -15,6 +15,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#include "tool_common.h"
 #include "character_io.h"
 #include "fullsim.h"
 #include "mesh_io.h"
@@ -46,15 +47,6 @@ static void usage(FILE *f) {
             "  --json        print one JSON object with the figures as the last line\n");
 }
 
-static int parse_int(const char *s, int lo, int hi, int *out) {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || end == s || v < lo || v > hi) return 0;
-    *out = (int)v;
-    return 1;
-}
-
 static int parse_args(int argc, char **argv, options *o) {
     memset(o, 0, sizeof *o);
     o->params = sw_fullsim_params_default();
@@ -66,18 +58,18 @@ static int parse_args(int argc, char **argv, options *o) {
         if (!strcmp(a, "--scene") && next) {
             o->scene = argv[++i];
         } else if (!strcmp(a, "--tets") && next) {
-            if (!parse_int(argv[++i], 1000, 2000000, &o->tets)) {
+            if (!sw_parse_int(argv[++i], 1000, 2000000, &o->tets)) {
                 fprintf(stderr, "sinew-fullsim: --tets wants 1000..2000000, got '%s'\n", argv[i]);
                 return 0;
             }
         } else if (!strcmp(a, "--frames") && next) {
-            if (!parse_int(argv[++i], 1, 1000000, &o->frames)) {
+            if (!sw_parse_int(argv[++i], 1, 1000000, &o->frames)) {
                 fprintf(stderr, "sinew-fullsim: --frames wants a positive count, got '%s'\n",
                         argv[i]);
                 return 0;
             }
         } else if (!strcmp(a, "--threads") && next) {
-            if (!parse_int(argv[++i], 0, 256, &o->params.threads)) {
+            if (!sw_parse_int(argv[++i], 0, 256, &o->params.threads)) {
                 fprintf(stderr, "sinew-fullsim: --threads wants 0..256, got '%s'\n", argv[i]);
                 return 0;
             }
@@ -102,7 +94,7 @@ static int parse_args(int argc, char **argv, options *o) {
                 return 0;
             }
         } else if (!strcmp(a, "--contact-rounds") && next) {
-            if (!parse_int(argv[++i], 1, 100, &o->params.contact_rounds)) {
+            if (!sw_parse_int(argv[++i], 1, 100, &o->params.contact_rounds)) {
                 fprintf(stderr, "sinew-fullsim: --contact-rounds wants 1..100\n");
                 return 0;
             }
@@ -154,11 +146,6 @@ static int make_dirs(const char *dir) {
         }
     struct stat st;
     return stat(dir, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
 }
 
 /* Writes the simulator's surface at positions x as an OBJ of the surface vertices. */
@@ -262,8 +249,7 @@ int main(int argc, char **argv) {
     }
     double median = 0;
     if (ms && frames > 0) {
-        qsort(ms, (size_t)frames, sizeof *ms, cmp_double);
-        median = frames % 2 ? ms[frames / 2] : 0.5 * (ms[frames / 2 - 1] + ms[frames / 2]);
+        median = sw_median(ms, frames);
     }
     fprintf(stderr,
             "sinew-fullsim: median %.1f ms/frame, %.2f Newton and %.1f PCG iterations a frame, "

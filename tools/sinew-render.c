@@ -18,6 +18,7 @@
 #include <time.h>
 #include <unistd.h>
 
+#include "tool_common.h"
 #include "mesh_io.h"
 #include "png_write.h"
 #include "render.h"
@@ -47,15 +48,6 @@ static void usage(FILE *f) {
                "  --threads T     render threads (default: all cores)\n"
                "  --no-ground     no checkered ground plane\n"
                "  --quiet         no summary line on stderr\n");
-}
-
-static int parse_int(const char *s, int lo, int hi, int *out) {
-    char *end;
-    errno = 0;
-    long v = strtol(s, &end, 10);
-    if (errno || *end || end == s || v < lo || v > hi) return 0;
-    *out = (int)v;
-    return 1;
 }
 
 static int parse_args(int argc, char **argv, options *o) {
@@ -88,7 +80,7 @@ static int parse_args(int argc, char **argv, options *o) {
         for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) {
             if (strcmp(a, ints[k].flag)) continue;
             matched = 1;
-            if (!next || !parse_int(next, ints[k].lo, ints[k].hi, ints[k].dst)) {
+            if (!next || !sw_parse_int(next, ints[k].lo, ints[k].hi, ints[k].dst)) {
                 fprintf(stderr, "sinew-render: %s wants an integer in %d..%d, got '%s'\n", a,
                         ints[k].lo, ints[k].hi, next ? next : "(nothing)");
                 return 0;
