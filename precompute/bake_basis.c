@@ -45,6 +45,11 @@ static int32_t orthonormalise(double *U, int64_t m, int32_t r) {
     return kept;
 }
 
+/* OpenBLAS (linked explicitly, precompute/CMakeLists.txt). The Gram matrices are small
+ * and the bake's parallelism is across training poses, so its own worker threads only
+ * add contention (and races a thread sanitizer cannot see through). */
+void openblas_set_num_threads(int num_threads);
+
 /* Rank-r basis (row-major 3n x r) of a domain from snapshots D (T x 3n, row per pose). */
 static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_rank, double energy,
                           int32_t *rank_out) {
@@ -57,6 +62,7 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
             for (int64_t i = 0; i < m; ++i) g += D[(size_t)a * m + i] * D[(size_t)b * m + i];
             G[(size_t)a * T + b] = G[(size_t)b * T + a] = g;
         }
+    openblas_set_num_threads(1);
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', T, G, T, ev) != 0) goto done;
     double total = 0;
     for (int32_t k = 0; k < T; ++k) total += fmax(ev[k], 0.0);
