@@ -31,3 +31,126 @@ void sw_cholesky_solve(const double *L, int32_t n, double *x) {
         x[i] = s / L[(int64_t)i * n + i];
     }
 }
+
+/* Block (i, j) of a dense row-major n x n matrix, element (r, c) inside it. */
+#define BLK(M, i, j, r, c) (M)[(int64_t)(off[i] + (r)) * n + off[j] + (c)]
+
+void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off, const int32_t *size,
+                      const int32_t *order, unsigned char *nz) {
+    for (int32_t a = 0; a < nb; ++a)
+        for (int32_t b = 0; b < a; ++b) {
+            int32_t i = order[a], j = order[b], any = 0;
+            for (int32_t r = 0; r < size[i] && !any; ++r)
+                for (int32_t c = 0; c < size[j]; ++c)
+                    if (BLK(A, i, j, r, c) != 0.0) {
+                        any = 1;
+                        break;
+                    }
+            nz[a * nb + b] = (unsigned char)any;
+        }
+}
+
+int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off,
+                      const int32_t *size, const int32_t *order, unsigned char *nz, double *L) {
+    /* copy the blocks we will use: diagonal blocks and nonzero lower blocks */
+    for (int32_t a = 0; a < nb; ++a) {
+        int32_t i = order[a];
+        for (int32_t r = 0; r < size[i]; ++r)
+            for (int32_t c = 0; c <= r; ++c) BLK(L, i, i, r, c) = BLK(A, i, i, r, c);
+        for (int32_t b = 0; b < a; ++b) {
+            int32_t j = order[b];
+            if (!nz[a * nb + b]) continue;
+            for (int32_t r = 0; r < size[i]; ++r)
+                for (int32_t c = 0; c < size[j]; ++c) BLK(L, i, j, r, c) = BLK(A, i, j, r, c);
+        }
+    }
+    /* right-looking block elimination */
+    for (int32_t b = 0; b < nb; ++b) {
+        int32_t j = order[b], sj = size[j];
+        /* L_jj = chol(block) */
+        for (int32_t c = 0; c < sj; ++c) {
+            double d = BLK(L, j, j, c, c);
+            for (int32_t k = 0; k < c; ++k) d -= BLK(L, j, j, c, k) * BLK(L, j, j, c, k);
+            if (!(d > 0)) return 0;
+            d = sqrt(d);
+            BLK(L, j, j, c, c) = d;
+            for (int32_t r = c + 1; r < sj; ++r) {
+                double s = BLK(L, j, j, r, c);
+                for (int32_t k = 0; k < c; ++k) s -= BLK(L, j, j, r, k) * BLK(L, j, j, c, k);
+                BLK(L, j, j, r, c) = s / d;
+            }
+        }
+        /* L_ij = A_ij L_jj^-T for the later blocks coupled to j */
+        for (int32_t a = b + 1; a < nb; ++a) {
+            if (!nz[a * nb + b]) continue;
+            int32_t i = order[a];
+            for (int32_t r = 0; r < size[i]; ++r)
+                for (int32_t c = 0; c < sj; ++c) {
+                    double s = BLK(L, i, j, r, c);
+                    for (int32_t k = 0; k < c; ++k) s -= BLK(L, i, j, r, k) * BLK(L, j, j, c, k);
+                    BLK(L, i, j, r, c) = s / BLK(L, j, j, c, c);
+                }
+        }
+        /* Schur update of the later blocks: A_ik -= L_ij L_kj^T (fill marked in nz) */
+        for (int32_t a = b + 1; a < nb; ++a) {
+            if (!nz[a * nb + b]) continue;
+            int32_t i = order[a];
+            for (int32_t e = b + 1; e <= a; ++e) {
+                if (!nz[e * nb + b]) continue;
+                int32_t k = order[e];
+                if (e < a && !nz[a * nb + e]) { /* fill: a zero block becomes nonzero */
+                    nz[a * nb + e] = 1;
+                    for (int32_t r = 0; r < size[i]; ++r)
+                        for (int32_t c = 0; c < size[k]; ++c) BLK(L, i, k, r, c) = 0.0;
+                }
+                for (int32_t r = 0; r < size[i]; ++r)
+                    for (int32_t c = 0; c < (e == a ? r + 1 : size[k]); ++c) {
+                        double s = 0;
+                        for (int32_t m = 0; m < sj; ++m) s += BLK(L, i, j, r, m) * BLK(L, k, j, c, m);
+                        BLK(L, i, k, r, c) -= s;
+                    }
+            }
+        }
+    }
+    return 1;
+}
+
+void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32_t *off,
+                             const int32_t *size, const int32_t *order, const unsigned char *nz,
+                             double *x) {
+    for (int32_t a = 0; a < nb; ++a) { /* L y = b in elimination order */
+        int32_t i = order[a];
+        for (int32_t b = 0; b < a; ++b) {
+            if (!nz[a * nb + b]) continue;
+            int32_t j = order[b];
+            for (int32_t r = 0; r < size[i]; ++r) {
+                double s = 0;
+                for (int32_t c = 0; c < size[j]; ++c) s += BLK(L, i, j, r, c) * x[off[j] + c];
+                x[off[i] + r] -= s;
+            }
+        }
+        for (int32_t r = 0; r < size[i]; ++r) {
+            double s = x[off[i] + r];
+            for (int32_t c = 0; c < r; ++c) s -= BLK(L, i, i, r, c) * x[off[i] + c];
+            x[off[i] + r] = s / BLK(L, i, i, r, r);
+        }
+    }
+    for (int32_t a = nb - 1; a >= 0; --a) { /* L^T x = y */
+        int32_t i = order[a];
+        for (int32_t r = size[i] - 1; r >= 0; --r) {
+            double s = x[off[i] + r];
+            for (int32_t c = r + 1; c < size[i]; ++c) s -= BLK(L, i, i, c, r) * x[off[i] + c];
+            x[off[i] + r] = s / BLK(L, i, i, r, r);
+        }
+        for (int32_t b = 0; b < a; ++b) {
+            if (!nz[a * nb + b]) continue;
+            int32_t j = order[b];
+            for (int32_t c = 0; c < size[j]; ++c) {
+                double s = 0;
+                for (int32_t r = 0; r < size[i]; ++r) s += BLK(L, i, j, r, c) * x[off[i] + r];
+                x[off[j] + c] -= s;
+            }
+        }
+    }
+}
+#undef BLK

@@ -12,3 +12,27 @@ int sw_cholesky(double *A, int32_t n);
 /* Solves L L^T x = b in place (x holds b on entry) with L from sw_cholesky. */
 void sw_cholesky_solve(const double *L, int32_t n, double *x);
 #endif
+
+/* Block-sparse Cholesky of a symmetric positive definite matrix stored densely
+ * (row-major n x n) and split into nb diagonal blocks: block b covers rows/columns
+ * [off[b], off[b] + size[b]). Blocks are eliminated in the order `order` (a
+ * permutation of 0..nb-1: leaves of the coupling graph first keeps the fill small);
+ * an off-diagonal block marked zero in nz is skipped (and must be zero in A), so a
+ * chain or tree of couplings costs about sum of size^3 instead of n^3. nz (nb * nb
+ * bytes) holds on entry, at [a * nb + b] for elimination positions a > b, whether block
+ * (order[a], order[b]) may be nonzero (see sw_block_pattern); fill is added to it. A is
+ * read only in those blocks and the diagonal ones; L receives the factor in the same
+ * positions. Returns 1 on success, 0 when a pivot is not positive. */
+int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off,
+                      const int32_t *size, const int32_t *order, unsigned char *nz, double *L);
+
+/* Fills nz for sw_block_cholesky from the values of A (a block is nonzero when any
+ * entry is). O(n^2): callers that know the structure fill nz themselves. */
+void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off, const int32_t *size,
+                      const int32_t *order, unsigned char *nz);
+
+/* Solves A x = b in place (x holds b) with the factor from sw_block_cholesky (same nb,
+ * off, size, order and nz). */
+void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32_t *off,
+                             const int32_t *size, const int32_t *order, const unsigned char *nz,
+                             double *x);

@@ -56,6 +56,9 @@ struct sinew_instance {
     double *Jc, *hc;      /* 4 x 3 x rmax and 4 x rmax: one contact's Jacobians */
     int32_t nearest;      /* training pose nearest to the current pose, or -1 */
     double *svd_V;        /* 9 per cubature tet: last SVD rotation (warm start) */
+    int32_t *blk_off, *blk_size, *blk_order; /* domain blocks of H, leaves first */
+    unsigned char *blk_nz;                   /* ndomains^2 scratch of the factorisation */
+    unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
     sinew_step_stats stats;
 };
 
@@ -82,7 +85,7 @@ static void mem_free(const sinew_allocator *a, void *p) {
 }
 
 /* The instance's arrays, listed once for allocation and release. */
-enum { NBUF = 29 };
+enum { NBUF = 34 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
@@ -94,7 +97,9 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (void **)&in->qtrial, (void **)&in->fin, (void **)&in->tmp, (void **)&in->tmp2,
                       (void **)&in->Je, (void **)&in->surf_x,
                       (void **)&in->surf_n, (void **)&in->feature, (void **)&in->contact_act,
-                      (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V};
+                      (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V,
+                      (void **)&in->blk_off, (void **)&in->blk_size, (void **)&in->blk_order,
+                      (void **)&in->blk_nz, (void **)&in->blk_adj};
     size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
                       (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
                       (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
@@ -103,7 +108,11 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       3 * (size_t)v->nsurf_verts * d,
                       3 * (size_t)v->nsurf_verts * d, 4 * nb * d,
                       4 * (size_t)v->ncontacts * sizeof(int32_t), 12 * (size_t)in->rmax * d,
-                      4 * (size_t)in->rmax * d, 9 * (size_t)v->ncub * d};
+                      4 * (size_t)in->rmax * d, 9 * (size_t)v->ncub * d,
+                      (size_t)v->ndomains * sizeof(int32_t), (size_t)v->ndomains * sizeof(int32_t),
+                      (size_t)v->ndomains * sizeof(int32_t),
+                      (size_t)v->ndomains * (size_t)v->ndomains,
+                      (size_t)v->ndomains * (size_t)v->ndomains};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -114,6 +123,42 @@ static void identity_pose(double *T, int32_t nb) {
     for (int32_t b = 0; b < nb; ++b) {
         memset(T + 12 * b, 0, 12 * sizeof(double));
         T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    }
+}
+
+/* Elimination order of the domain blocks: repeatedly the block with the fewest
+ * remaining neighbours (ties: lower index), connecting its neighbours (fill). The block
+ * graph comes from the spring Hessian's nonzero blocks. adj: nd*nd scratch. */
+static void block_order_min_degree(const sw_blob_view *v, const int32_t *off, const int32_t *size,
+                                   unsigned char *springs, unsigned char *adj, int32_t *order) {
+    int32_t nd = v->ndomains, R = v->rank_total;
+    for (int32_t i = 0; i < nd; ++i)
+        for (int32_t j = 0; j < nd; ++j) {
+            int any = 0;
+            for (int32_t r = 0; r < size[i] && !any && i != j; ++r)
+                for (int32_t c = 0; c < size[j]; ++c)
+                    if (v->spring_hessian[(int64_t)(off[i] + r) * R + off[j] + c] != 0.0) {
+                        any = 1;
+                        break;
+                    }
+            adj[i * nd + j] = springs[i * nd + j] = (unsigned char)any;
+        }
+    /* 2: eliminated */
+    for (int32_t step = 0; step < nd; ++step) {
+        int32_t best = -1, bestdeg = 0;
+        for (int32_t i = 0; i < nd; ++i) {
+            if (adj[i * nd + i] == 2) continue;
+            int32_t deg = 0;
+            for (int32_t j = 0; j < nd; ++j) deg += j != i && adj[i * nd + j] == 1 && adj[j * nd + j] != 2;
+            if (best < 0 || deg < bestdeg) best = i, bestdeg = deg;
+        }
+        order[step] = best;
+        for (int32_t j = 0; j < nd; ++j) /* neighbours of best become a clique */
+            for (int32_t k = 0; k < nd; ++k)
+                if (j != k && adj[best * nd + j] == 1 && adj[best * nd + k] == 1 &&
+                    adj[j * nd + j] != 2 && adj[k * nd + k] != 2)
+                    adj[j * nd + k] = 1;
+        adj[best * nd + best] = 2;
     }
 }
 
@@ -209,6 +254,14 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
             in->contact_act[4 * c + k] = mark[v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]]];
         }
     mem_free(&a, mark);
+    /* H's domain blocks and their elimination order: greedy minimum degree on the block
+     * graph of the interface springs (with the fill it creates). Springs follow the
+     * skeleton, but vertices shared by three or more domains couple siblings too. */
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        in->blk_off[k] = v->domains[k].q_offset;
+        in->blk_size[k] = v->domains[k].rank;
+    }
+    block_order_min_degree(v, in->blk_off, in->blk_size, in->blk_adj, in->blk_nz, in->blk_order);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t i = 0; i < v->nverts; ++i)
         for (int k = 0; k < 3; ++k) {
@@ -559,21 +612,48 @@ static void inertial_forces(sinew_instance *in, double h) {
     }
 }
 
-/* Solves H dq = -g by Cholesky, shifting the diagonal if H is not positive definite. */
+/* The structural block pattern of H: spring-coupled domains and the domains the
+ * nearest training pose's contact pairs join (no scan of H's values). */
+static void block_pattern(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    int32_t nd = v->ndomains;
+    for (int32_t a = 0; a < nd; ++a)
+        for (int32_t b = 0; b < a; ++b)
+            in->blk_nz[a * nd + b] = in->blk_adj[in->blk_order[a] * nd + in->blk_order[b]];
+    if (in->nearest < 0) return;
+    for (int32_t c = v->contact_ptr[in->nearest]; c < v->contact_ptr[in->nearest + 1]; ++c)
+        for (int m = 0; m < 4; ++m)
+            for (int k = 0; k < 4; ++k) {
+                int32_t di = v->contact_verts[8 * c + 2 * m], dk = v->contact_verts[8 * c + 2 * k];
+                if (di == dk) continue;
+                int32_t a = 0, b = 0;
+                for (int32_t e = 0; e < nd; ++e) {
+                    if (in->blk_order[e] == di) a = e;
+                    if (in->blk_order[e] == dk) b = e;
+                }
+                if (a > b) in->blk_nz[a * nd + b] = 1;
+            }
+}
+
+/* Solves H dq = -g by the block-sparse Cholesky, shifting the diagonal if H is not
+ * positive definite. */
 static int newton_direction(sinew_instance *in) {
-    int32_t R = in->R;
+    int32_t R = in->R, nd = in->v->ndomains;
     double tr = 0;
     for (int32_t i = 0; i < R; ++i) tr += fabs(in->H[(int64_t)i * R + i]);
     double shift = 0;
     for (int attempt = 0; attempt < 8; ++attempt) {
-        memcpy(in->L, in->H, (size_t)R * R * sizeof(double));
-        for (int32_t i = 0; i < R; ++i) in->L[(int64_t)i * R + i] += shift;
-        if (sw_cholesky(in->L, R)) {
+        block_pattern(in);
+        if (sw_block_cholesky(in->H, R, nd, in->blk_off, in->blk_size, in->blk_order, in->blk_nz,
+                              in->L)) {
             for (int32_t i = 0; i < R; ++i) in->dq[i] = -in->g[i];
-            sw_cholesky_solve(in->L, R, in->dq);
+            sw_block_cholesky_solve(in->L, R, nd, in->blk_off, in->blk_size, in->blk_order,
+                                    in->blk_nz, in->dq);
             return 1;
         }
-        shift = shift == 0 ? 1e-10 * tr / R + 1e-300 : shift * 100;
+        double next = shift == 0 ? 1e-10 * tr / R + 1e-300 : shift * 100;
+        for (int32_t i = 0; i < R; ++i) in->H[(int64_t)i * R + i] += next - shift; /* H is rebuilt next pass */
+        shift = next;
     }
     return 0;
 }
