@@ -39,6 +39,7 @@
 #include "rt_interpose.h"
 #include "samples.h"
 #include "subspace_eval.h"
+#include "weights_heat.h"
 
 static void usage(FILE *f) {
     fprintf(f, "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf\n"
@@ -193,6 +194,13 @@ int main(int argc, char **argv) {
     if (v->nverts != ch.mesh.nverts || v->nbones != ch.skel.nbones) {
         fprintf(stderr, "sinew-bench: the blob does not belong to this character (%d/%d vertices, %d/%d bones)\n",
                 v->nverts, ch.mesh.nverts, v->nbones, ch.skel.nbones);
+        return 1;
+    }
+
+    /* An asset without weights: the bake computed heat-diffusion weights (bake.c); the
+     * reference simulator gets the same ones (it uses them for its warm start). */
+    if (!ch.weights.w && (r = sw_weights_heat(&ch.mesh, &ch.skel, 0, &ch.weights, &err)) != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: %s (%s)\n", err.msg, sinew_result_string(r));
         return 1;
     }
 
