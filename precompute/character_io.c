@@ -3,6 +3,8 @@
  * pose clip of libigl's hand (tutorial 403: slerp identity <-> pose, then FK). */
 #include "character_io.h"
 
+#include "dqs.h"
+
 #include "mesh_io.h"
 
 #include <errno.h>
@@ -20,18 +22,10 @@
 #define SW_DEFAULT_DENSITY 1.0
 #define SW_DEFAULT_FPS 30.0
 
-/* Unit quaternion (x, y, z, w) to a row-major rotation matrix. */
+/* Unit quaternion in libigl's (x, y, z, w) order to a row-major rotation matrix. */
 static void quat_to_mat(const double *q, double *R) {
-    double x = q[0], y = q[1], z = q[2], w = q[3];
-    R[0] = 1 - 2 * (y * y + z * z);
-    R[1] = 2 * (x * y - z * w);
-    R[2] = 2 * (x * z + y * w);
-    R[3] = 2 * (x * y + z * w);
-    R[4] = 1 - 2 * (x * x + z * z);
-    R[5] = 2 * (y * z - x * w);
-    R[6] = 2 * (x * z - y * w);
-    R[7] = 2 * (y * z + x * w);
-    R[8] = 1 - 2 * (x * x + y * y);
+    const double wxyz[4] = {q[3], q[0], q[1], q[2]};
+    sw_quat_to_matrix(wxyz, R);
 }
 
 /* slerp(identity, q, a) along the shorter arc (as Eigen's slerp): the rotation about

@@ -55,8 +55,7 @@ void sw_dq_from_transform(const double T[12], sw_dualquat *dq) {
     dq->d[3] = 0.5 * (r[0] * t[2] + t[0] * r[2] - t[1] * r[1]);
 }
 
-/* Unit quaternion (w, x, y, z) to a row-major rotation matrix. */
-static void matrix_from_quat(const double q[4], double R[9]) {
+void sw_quat_to_matrix(const double q[4], double R[9]) {
     double w = q[0], x = q[1], y = q[2], z = q[3];
     R[0] = 1.0 - 2.0 * (y * y + z * z);
     R[1] = 2.0 * (x * y - w * z);
@@ -100,7 +99,7 @@ void sw_dqs_blend(const sw_dualquat *bones, const int32_t *ids, const double *we
         br[j] *= inv;
         bd[j] *= inv;
     }
-    matrix_from_quat(br, R);
+    sw_quat_to_matrix(br, R);
     /* t = 2 vec(d conj(r)) = 2 (r_w d_v - d_w r_v + r_v x d_v). The part of d along r
      * (non-zero after blending) only contributes to the scalar part, which is dropped:
      * this is the projection of the blend onto the rigid transforms (Kavan §3.4). */

@@ -18,6 +18,9 @@ typedef struct sw_dualquat {
 /* Dual quaternion of a rigid transform T (12). R must be a rotation (det +1). */
 void sw_dq_from_transform(const double T[12], sw_dualquat *dq);
 
+/* Unit quaternion (w, x, y, z) to a row-major rotation matrix. */
+void sw_quat_to_matrix(const double q[4], double R[9]);
+
 /* Blends k influences (bone ids into `bones`, weights >= 0; zero weights are
  * skipped) into the skinning rotation R (9, row-major) and translation t (3). When
  * the weights sum to zero the identity is returned. */
