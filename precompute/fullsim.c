@@ -8,6 +8,7 @@
 
 #include "sw_mesh.h"
 
+#include "blob_view.h"
 #include "bsr_matrix.h"
 #include "fem_corot.h"
 #include "mesh_io.h"
@@ -55,7 +56,7 @@ sw_fullsim_params sw_fullsim_params_default(void) {
     p.rayleigh_beta = 0.001;
     p.self_contact = 1;
     p.contact_k = 1e6;
-    p.contact_alpha = 0.5;
+    p.contact_alpha = SW_CONTACT_ALPHA;
     p.neighbour_factor = 1.8;
     p.ground = 0;
     p.ground_height = 0;
@@ -524,28 +525,43 @@ static void clear_contacts(sw_fullsim *sim) {
     sim->contacts = sim->active;
 }
 
-/* One contact round: detects penetrations at the current positions; a vertex already
- * in the step's set gets its fresh contact (triangle, barycentrics, normal), a new one
- * is appended. The set only grows within a step: a contact that a solve has just
- * resolved sits at the surface and would drop out and fall back in on alternate rounds
- * (measured: the set never settled in 4 rounds on a folded finger). Returns the number
- * of vertices added (0: the set is complete and the last solve stands). */
+/* One contact round, an active-set update of the step's contact set:
+ *  - a pair whose vertex is no longer behind its surface point along the frozen normal
+ *    (<n, d> <= 0, eq. 3.12's Heaviside off) is dropped: the solve kept it there by
+ *    pulling, and a contact never pulls (adhesion would hold a fold shut as it opens);
+ *  - penetrations detected at the current positions are added, and a vertex already in
+ *    the set gets its fresh contact (triangle, barycentrics, normal).
+ * A pair the solve has just resolved sits slightly behind its surface (the penalty
+ * balances the flesh pushing it in), so it stays: the set settles instead of dropping
+ * resolved contacts and finding them again on alternate rounds. Returns the number of
+ * pairs added or dropped (0: the set is complete and the last solve stands). */
 static int32_t contact_round(sw_fullsim *sim) {
+    int32_t changed = 0, kept = 0;
+    for (int32_t i = 0; i < sim->ncontacts; ++i) {
+        sw_contact *c = &sim->active[i];
+        if (sw_contact_gap(c, sim->x) > 0) {
+            sim->active_slot[c->p] = kept;
+            sim->active[kept++] = *c;
+        } else {
+            sim->active_slot[c->p] = -1;
+            changed++;
+        }
+    }
+    sim->ncontacts = kept;
     int32_t n;
     const sw_contact *found = (sw_selfcontact_detect(sim->sc, sim->x, sim->pool),
                                sw_selfcontact_list(sim->sc, &n));
-    int32_t added = 0;
     for (int32_t i = 0; i < n; ++i) {
         int32_t slot = sim->active_slot[found[i].p];
         if (slot < 0) {
             if (sim->ncontacts > sim->surf.nverts) continue; /* cannot happen: one per vertex */
             slot = sim->active_slot[found[i].p] = sim->ncontacts++;
-            added++;
+            changed++;
         }
         sim->active[slot] = found[i];
     }
     sim->contacts = sim->active;
-    return added;
+    return changed;
 }
 
 /* Solves the Newton system at sim->x into sim->dx with the current Hessian flags;
@@ -690,6 +706,11 @@ const double *sw_fullsim_positions(const sw_fullsim *sim) { return sim->x; }
 double *sw_fullsim_velocities(sw_fullsim *sim) { return sim->v; }
 const sw_surface *sw_fullsim_surface(const sw_fullsim *sim) { return &sim->surf; }
 const double *sw_fullsim_masses(const sw_fullsim *sim) { return sim->mass; }
+
+const sw_contact *sw_fullsim_contacts(const sw_fullsim *sim, int32_t *count) {
+    *count = sim->p.self_contact ? sim->ncontacts : 0;
+    return sim->contacts;
+}
 int32_t sw_fullsim_driven_count(const sw_fullsim *sim) { return sim->ndriven; }
 
 void sw_fullsim_set_state(sw_fullsim *sim, const double *x, const double *v) {

@@ -15,9 +15,11 @@
  * block-Jacobi PCG, warm-started from the previous Newton update; assembly and the
  * matrix product run on a pthread pool. Self-contacts are detected once per contact
  * round and frozen while Newton converges (re-detecting every iteration makes Newton
- * chase a changing energy and stall); the step's contact set only grows, so a contact
- * resolved in one round keeps acting (as a spring to its surface point) until the
- * next step starts a fresh set. Results are bitwise identical for any thread
+ * chase a changing energy and stall). Between rounds the set is updated as an active
+ * set: new penetrations join, and a pair the solve held by pulling (its vertex in
+ * front of its surface point, eq. 3.12) leaves, so contacts push but never glue a
+ * fold shut; a resolved contact sits slightly behind its surface and stays. Each step
+ * starts a fresh set. Results are bitwise identical for any thread
  * count: every reduction has a fixed order. */
 #ifndef SW_FULLSIM_H
 #define SW_FULLSIM_H
@@ -99,6 +101,11 @@ void sw_fullsim_destroy(sw_fullsim *sim);
  * max_newton without reaching its tolerance (the state is kept: it is the best
  * iterate), SINEW_OK otherwise. */
 sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats *stats);
+
+/* The last step's self-contact set: every pair its contact rounds gathered, with the
+ * triangle, barycentrics and normal of the round that last saw it (the set the final
+ * solve converged with; empty without self-contact). Valid until the next step. */
+const struct sw_contact *sw_fullsim_contacts(const sw_fullsim *sim, int32_t *count);
 
 /* Current positions / velocities (3*nverts). */
 const double *sw_fullsim_positions(const sw_fullsim *sim);

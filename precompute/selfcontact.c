@@ -490,6 +490,12 @@ static void contact_d(const sw_contact *c, const double *x, double d[3]) {
             d[j] += a[s] * x[3 * (size_t)v[s] + j];
 }
 
+double sw_contact_gap(const sw_contact *c, const double *x) {
+    double d[3];
+    contact_d(c, x, d);
+    return dot3(c->n, d);
+}
+
 double sw_contact_energy(const sw_contact *c, int32_t n, const double *x, double kc, double alpha) {
     double e = 0;
     for (int32_t i = 0; i < n; ++i) {

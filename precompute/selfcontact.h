@@ -53,6 +53,10 @@ const sw_contact *sw_selfcontact_list(const sw_selfcontact *sc, int32_t *count);
 /* Largest depth among the contacts of the last detect call (0 when none). */
 double sw_selfcontact_max_depth(const sw_selfcontact *sc);
 
+/* <n, d> of one contact at positions x: positive while p is behind its surface point
+ * along the frozen normal (the pair collides, eq. 3.12). */
+double sw_contact_gap(const sw_contact *c, const double *x);
+
 /* Penalty energy of contacts c[0..n) at positions x (n, beta frozen). */
 double sw_contact_energy(const sw_contact *c, int32_t n, const double *x, double kc, double alpha);
 /* f (3*nverts) += penalty forces. */

@@ -18,6 +18,10 @@
 #include "sinew/sinew_blob_format.h"
 
 #define SW_BLOB_INFLUENCES 4 /* skin influences per vertex */
+/* Anisotropy alpha of the penalty contact (thesis eq. 3.5, N = (1-alpha) n n^T + alpha I):
+ * the reference simulator's default and the runtime's, so that the runtime's forces at a
+ * training pose are the ones the training solutions converged with. */
+#define SW_CONTACT_ALPHA 0.5
 
 /* One domain (the on-disk record itself, used in place):
  *   bone            the bone this domain rides with (inertial frame)
@@ -91,12 +95,12 @@ typedef struct sw_blob_view {
     const double *train_q;
     const double *train_pose;
 
-    /* pose-space self-contact (thesis §3.2.3, simplified): training pose t's penetrating
-     * pairs are contacts [contact_ptr[t], contact_ptr[t+1]); contact c: vertex p and
+    /* pose-space self-contact (thesis §3.2.3): the reference simulator's contact set at
+     * training pose t is contacts [contact_ptr[t], contact_ptr[t+1]); contact c: vertex p and
      * triangle (t0, t1, t2) as (domain, local vertex) pairs in contact_verts[8c..],
      * and in contact_data[7c..] the triangle barycentrics b0..b2, the contact normal in
      * p's un-skinned frame (R_p^T n) and the area weight ka. The penalty stiffness is
-     * contact_k. */
+     * contact_k, the anisotropy SW_CONTACT_ALPHA (eq. 3.5). */
     int32_t ncontacts;
     const int32_t *contact_ptr;
     const int32_t *contact_verts;

@@ -4,6 +4,7 @@
 #include <stdint.h>
 
 #include "fullsim.h"
+#include "selfcontact.h"
 #include "samples.h"
 #include "sw_test.h"
 
@@ -200,6 +201,33 @@ TEST(self_contact_removes_most_penetration_of_folded_finger) {
     ENSUREF(on <= 0.1 * off, "penetration %.4g is more than 10%% of %.4g", on, off);
 }
 
+/* The contact set is an active set (fullsim.h): when a step's rounds complete, every
+ * pair it converged with still collides (its vertex behind its surface point), also
+ * while the fold opens again, so no pair holds the flesh by pulling. */
+TEST(contacts_push_and_never_pull) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 9, &c, &err) == SINEW_OK);
+    sw_fullsim_params p = sw_fullsim_params_default();
+    sw_fullsim *sim;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_OK);
+    int with_contacts = 0;
+    for (int f = 0; f < c.clip.nframes; ++f) {
+        sw_fullsim_stats st;
+        ENSURE(sw_fullsim_step(sim, frame_T(&c, f), &st) != SINEW_ERROR_NOT_FINITE);
+        int32_t n;
+        const sw_contact *k = sw_fullsim_contacts(sim, &n);
+        with_contacts += n > 0;
+        if (st.contact_rounds >= p.contact_rounds) continue; /* the set did not settle */
+        for (int32_t i = 0; i < n; ++i)
+            ENSUREF(sw_contact_gap(&k[i], sw_fullsim_positions(sim)) > 0,
+                    "frame %d: pair %d (vertex %d) is in front of its surface point", f, i, k[i].p);
+    }
+    ENSUREF(with_contacts >= 2, "only %d frames with contacts: the test would prove little", with_contacts);
+    sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
 TEST(ground_plane_pushes_flesh_out) {
     sw_character c;
     sw_error err;
@@ -268,5 +296,6 @@ SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy), CASE(newton_con
              CASE(newmark_keeps_energy_of_undamped_oscillation),
              CASE(backward_euler_never_gains_energy),
              CASE(self_contact_removes_most_penetration_of_folded_finger),
+             CASE(contacts_push_and_never_pull),
              CASE(ground_plane_pushes_flesh_out),
              CASE(bad_input_is_rejected_and_state_kept))
