@@ -146,10 +146,14 @@ static void free_state(sw_bake_state *s) {
     for (int32_t i = 0; i < s->ntrain_seq; ++i) {
         free(s->train[i].T);
         free(s->train[i].x);
+        free(s->train[i].contact_ptr);
+        free(s->train[i].contacts);
     }
     free(s->train);
     free(s->heldout.T);
     free(s->heldout.x);
+    free(s->heldout.contact_ptr);
+    free(s->heldout.contacts);
     for (int32_t d = 0; d < s->nd; ++d) {
         if (s->basis) free(s->basis[d]);
         if (s->cub_local) free(s->cub_local[d]);

@@ -6,7 +6,10 @@
  *   poses     training = per-joint sweeps over the range the training clip uses plus
  *             the clip's first (1 - heldout) frames; held-out = the clip's last frames
  *             (or random combined poses with a fixed seed when there is no clip)
- *   simulate  full-space quasistatic solutions with self-contact, all cores
+ *   simulate  full-space quasistatic solutions with self-contact, all cores; the
+ *             clip's held-out frames continue its training frames' path (the solution
+ *             depends on the path through contact and buckling), and every training
+ *             solution's contact set is kept for the runtime (pose-space contact)
  *   basis     un-skinned snapshots d = R^T (x - t) - rest -> per-domain uncentred PCA,
  *             rank by an energy threshold, orthonormal columns, zero rows at
  *             bone-driven vertices (they follow their bone exactly)
@@ -32,7 +35,7 @@ typedef struct sw_bake_params {
     double heldout_fraction; /* last part of the clip held out (default 0.4) */
     int32_t random_poses;   /* held-out poses when there is no clip (default 10) */
     int self_contact;       /* in the training simulations (default 1) */
-    double spring_k;        /* interface springs; 0: 20 * Young's modulus */
+    double spring_k;        /* interface springs per copy pair; 0: 20 E h (h the mean rest edge) */
     int threads;            /* 0: all cores */
     uint64_t seed;
     int progress;           /* print stage progress to stderr */

@@ -4,6 +4,7 @@
 
 #include "bake.h"
 #include "dqs.h"
+#include "selfcontact.h"
 #include "thread_pool.h"
 
 /* A sequence of poses simulated in order (each warm-starts the next). */
@@ -12,6 +13,15 @@ typedef struct sw_pose_seq {
     double *T; /* npose * 12 * nbones bone transforms */
     double *x; /* npose * 3 * nverts full-space solutions (filled by simulate) */
     int failed; /* poses whose solve returned NOT_FINITE */
+    /* the reference's self-contact set of every solution (filled by simulate): pose k
+       owns contacts[contact_ptr[k], contact_ptr[k+1]) */
+    int32_t *contact_ptr; /* npose + 1 */
+    sw_contact *contacts;
+    int32_t ncontacts, contact_cap;
+    int oom; /* the contact sets did not fit in memory */
+    /* solved right after this sequence, warm-started from its last solution (the clip's
+       held-out frames continue the training frames' path) */
+    struct sw_pose_seq *then;
 } sw_pose_seq;
 
 typedef struct sw_bake_state {

@@ -65,7 +65,8 @@ static int seq_alloc(sw_pose_seq *q, int32_t npose, int32_t nb, int32_t nv) {
     q->npose = npose;
     q->T = malloc((size_t)npose * 12 * nb * sizeof(double));
     q->x = malloc((size_t)npose * 3 * nv * sizeof(double));
-    return q->T && q->x;
+    q->contact_ptr = calloc((size_t)npose + 1, sizeof(int32_t));
+    return q->T && q->x && q->contact_ptr;
 }
 
 static uint64_t splitmix(uint64_t *s) {
@@ -157,6 +158,10 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
             memcpy(s->heldout.T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
                    12 * nb * sizeof(double));
         }
+        /* the reference is path dependent (contact states, buckled folds): the held-out
+           frames are solved along the clip's path, after its training frames, as a host
+           playing the clip sees them */
+        if (ntrain_frames > 0) s->train[0].then = &s->heldout;
     } else if (s->p->random_poses > 0) {
         int32_t n = s->p->random_poses;
         uint64_t seed = s->p->seed;
@@ -187,6 +192,24 @@ oom:
     return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for poses");
 }
 
+/* Appends the simulator's contact set as pose k's (the pose-space self-contact data,
+ * bake_contacts.c). Returns 0 when out of memory. */
+static int keep_contacts(sw_pose_seq *q, int32_t k, const sw_fullsim *sim) {
+    int32_t n;
+    const sw_contact *c = sw_fullsim_contacts(sim, &n);
+    if (q->ncontacts + n > q->contact_cap) {
+        int32_t cap = 2 * (q->ncontacts + n) + 64;
+        sw_contact *m = realloc(q->contacts, (size_t)cap * sizeof *m);
+        if (!m) return 0;
+        q->contacts = m;
+        q->contact_cap = cap;
+    }
+    if (n > 0) memcpy(q->contacts + q->ncontacts, c, (size_t)n * sizeof *c);
+    q->ncontacts += n;
+    q->contact_ptr[k + 1] = q->ncontacts;
+    return 1;
+}
+
 typedef struct {
     sw_bake_state *s;
     sw_pose_seq **seqs;
@@ -214,12 +237,14 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
             atomic_fetch_add(&ctx->failed, 1);
             continue;
         }
-        for (int32_t k = 0; k < q->npose; ++k) {
-            sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, NULL);
-            if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
-            memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
-                   (size_t)s->nv * 3 * sizeof(double));
-        }
+        for (; q; q = q->then)
+            for (int32_t k = 0; k < q->npose; ++k) {
+                sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, NULL);
+                if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
+                memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
+                       (size_t)s->nv * 3 * sizeof(double));
+                if (!keep_contacts(q, k, sim)) q->oom = 1;
+            }
         sw_fullsim_destroy(sim);
     }
 }
@@ -228,7 +253,9 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     sw_pose_seq *seqs[4096];
     int32_t n = 0;
     for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i) seqs[n++] = &s->train[i];
-    if (s->heldout.npose > 0) seqs[n++] = &s->heldout;
+    int chained = 0; /* the held-out sequence continues a training one (train[0]) */
+    for (int32_t i = 0; i < s->ntrain_seq; ++i) chained |= s->train[i].then == &s->heldout;
+    if (s->heldout.npose > 0 && !chained) seqs[n++] = &s->heldout;
     sim_ctx ctx;
     ctx.s = s;
     ctx.seqs = seqs;
@@ -240,6 +267,9 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     if (atomic_load(&ctx.failed) > 0)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "the full-space simulator rejected the character");
+    if (chained) seqs[n++] = &s->heldout; /* for the checks below */
+    for (int32_t i = 0; i < n; ++i)
+        if (seqs[i]->oom) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for contact sets");
     for (int32_t i = 0; i < n; ++i)
         if (seqs[i]->failed)
             return sw_error_set(err, SINEW_ERROR_NOT_FINITE,

@@ -15,10 +15,26 @@
 
 #define OWN(ptr, n, type) ((ptr) = sw_bake_own(out, calloc((size_t)(n) > 0 ? (size_t)(n) : 1, sizeof(type))))
 
+/* Mean rest edge length over the tets' edges. */
+static double mean_edge(const sw_tetmesh *m) {
+    static const int e[6][2] = {{0, 1}, {0, 2}, {0, 3}, {1, 2}, {1, 3}, {2, 3}};
+    double sum = 0;
+    for (int32_t t = 0; t < m->ntets; ++t)
+        for (int k = 0; k < 6; ++k) {
+            const double *a = m->X + 3 * m->tets[4 * t + e[k][0]], *b = m->X + 3 * m->tets[4 * t + e[k][1]];
+            sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+        }
+    return m->ntets > 0 ? sum / (6.0 * m->ntets) : 0;
+}
+
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sw_blob_view *v = &out->view;
     int32_t R = s->rank_total, nd = s->nd, ncopies = s->dom_vert_ptr[nd];
-    double kspring = s->p->spring_k > 0 ? s->p->spring_k : 20.0 * s->ch.youngs;
+    /* per copy pair; the default scales with the stiffness of one vertex of the mesh,
+       E h: a fixed k locks the interface of a fine mesh (the domains' bases cannot
+       match there exactly) and measured best at 20 E h on the finger from 5K to 50K
+       tets (correction error 0.041 at 20K against 0.062 with k = 20 E) */
+    double kspring = s->p->spring_k > 0 ? s->p->spring_k : 20.0 * s->ch.youngs * mean_edge(&s->ch.mesh);
     sw_surface surf;
     memset(&surf, 0, sizeof surf);
     sinew_result r = sw_tetmesh_surface(&s->ch.mesh, &surf, err);
