@@ -25,6 +25,11 @@ void sw_instance_full_positions(const sinew_instance *inst, double *x, double *c
  * known state. */
 void sw_instance_set_q(sinew_instance *inst, const double *q);
 
+/* Tests: the quasistatic reduced potential (cubature, springs and the pose-space
+ * contact pairs in use) at q for the pose last set, with its gradient into g and its
+ * (PSD-projected) Hessian into H (rank_total^2, row-major) when they are not NULL. */
+double sw_instance_potential(sinew_instance *inst, const double *q, double *g, double *H);
+
 /* Evaluation only (O(N)): plain DQS of every simulation vertex at the current pose. */
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x);
 

@@ -1,0 +1,127 @@
+/* The reduced model the step minimises (runtime/instance.c): its gradient against
+ * finite differences with the pose-space contact pairs engaged, a quasistatic shape
+ * that depends on the pose alone, and its accuracy against the full-space training
+ * solutions it was baked from. */
+#include <math.h>
+
+#include "bake_fixture.h"
+#include "instance.h"
+#include "subspace_eval.h"
+#include "sw_test.h"
+
+static bake_fixture fx;
+static int fx_ok = -1;
+
+static const bake_fixture *fixture(void) {
+    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 3000, 12);
+    return fx_ok ? &fx : NULL;
+}
+
+static double urand(uint64_t *s) {
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) * 0x1.0p-53;
+}
+
+TEST(gradient_matches_finite_differences_with_contact_pairs) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    ENSUREF(v->ncontacts > 0, "the fixture's fold has no contact pairs: the test would prove less");
+    int32_t R = v->rank_total;
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    double *q = malloc(sizeof(double) * R), *g = malloc(sizeof(double) * R),
+           *H = malloc(sizeof(double) * R * R);
+    uint64_t seed = 7;
+    int checked = 0;
+    /* the most folded training poses: the ones with the most contact pairs */
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        if (v->contact_ptr[t + 1] - v->contact_ptr[t] < 3) continue;
+        ENSURE(sw_instance_set_pose_d(inst, f->res.train_T + (size_t)t * 12 * v->nbones) == SINEW_OK);
+        for (int32_t i = 0; i < R; ++i) q[i] = v->train_q[(size_t)t * R + i] * (1 + 0.02 * (urand(&seed) - 0.5));
+        double e = sw_instance_potential(inst, q, g, H);
+        ENSURE(isfinite(e));
+        double gmax = 0;
+        for (int32_t i = 0; i < R; ++i) gmax = fmax(gmax, fabs(g[i]));
+        for (int32_t i = 0; i < R; ++i) {
+            double h = 1e-6, qi = q[i];
+            q[i] = qi + h;
+            double ep = sw_instance_potential(inst, q, NULL, NULL);
+            q[i] = qi - h;
+            double em = sw_instance_potential(inst, q, NULL, NULL);
+            q[i] = qi;
+            ENSUREF(fabs((ep - em) / (2 * h) - g[i]) <= 1e-5 * gmax + 1e-8,
+                    "pose %d coordinate %d: finite difference %.9g, gradient %.9g", t, i, (ep - em) / (2 * h),
+                    g[i]);
+        }
+        /* the Newton matrix: symmetric and positive semi-definite */
+        for (int32_t i = 0; i < R; ++i)
+            for (int32_t j = 0; j < i; ++j)
+                ENSURE(fabs(H[i * R + j] - H[j * R + i]) <= 1e-9 * (fabs(H[i * R + j]) + 1));
+        for (int k = 0; k < 20; ++k) {
+            double vHv = 0, vv = 0;
+            for (int32_t i = 0; i < R; ++i) g[i] = urand(&seed) - 0.5;
+            for (int32_t i = 0; i < R; ++i)
+                for (int32_t j = 0; j < R; ++j) vHv += g[i] * H[i * R + j] * g[j];
+            for (int32_t i = 0; i < R; ++i) vv += g[i] * g[i];
+            ENSURE(vHv >= -1e-9 * vv);
+        }
+        checked++;
+    }
+    ENSURE(checked > 0);
+    free(q);
+    free(g);
+    free(H);
+    sinew_instance_destroy(inst);
+}
+
+TEST(quasistatic_shape_depends_on_the_pose_alone) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    uint32_t ns = sinew_blob_surface_vertex_count(f->blob);
+    sinew_instance *a, *b;
+    ENSURE(sinew_instance_create(f->blob, NULL, &a) == SINEW_OK);
+    ENSURE(sinew_instance_create(f->blob, NULL, &b) == SINEW_OK);
+    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones), *xa = malloc(sizeof(float) * 3 * ns),
+          *xb = malloc(sizeof(float) * 3 * ns);
+    int nf = f->ch.clip.nframes;
+    for (int k = 0; k < nf; ++k) { /* a plays the clip; b jumps to each frame after a reset */
+        bake_fixture_pose(f, k, pose);
+        ENSURE(sinew_instance_set_pose(a, pose, (uint32_t)f->ch.skel.nbones) == SINEW_OK);
+        ENSURE(sinew_instance_step(a, 1.0f / 30) == SINEW_OK);
+        ENSURE(sinew_instance_reset(b) == SINEW_OK);
+        ENSURE(sinew_instance_set_pose(b, pose, (uint32_t)f->ch.skel.nbones) == SINEW_OK);
+        ENSURE(sinew_instance_step(b, 1.0f / 30) == SINEW_OK);
+        sinew_instance_read_surface(a, xa, NULL, ns);
+        sinew_instance_read_surface(b, xb, NULL, ns);
+        double worst = 0;
+        for (uint32_t i = 0; i < 3 * ns; ++i) worst = fmax(worst, fabs((double)xa[i] - xb[i]));
+        ENSUREF(worst < 1e-4, "frame %d: played and jumped-to shapes differ by %g", k, worst);
+    }
+    free(pose);
+    free(xa);
+    free(xb);
+    sinew_instance_destroy(a);
+    sinew_instance_destroy(b);
+}
+
+TEST(training_poses_are_reproduced) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sw_eval_result e;
+    sw_error err;
+    ENSURE(sw_eval_correction(f->blob, f->res.mass, f->res.train_T, f->res.train_x, f->res.ntrain, 20, &e,
+                              &err) == SINEW_OK);
+    fprintf(stderr, "    correction error on %d training poses: %.4f (projection %.4f)\n", e.frames,
+            e.correction_error, f->res.train_proj_error);
+    ENSURE(e.failed == 0 && e.frames == f->res.ntrain);
+    ENSUREF(e.correction_error < 0.1, "correction error %.4f on the training poses", e.correction_error);
+}
+
+TEST(release_fixture) {
+    if (fx_ok > 0) bake_fixture_free(&fx);
+}
+
+SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
+             CASE(quasistatic_shape_depends_on_the_pose_alone), CASE(training_poses_are_reproduced),
+             CASE(release_fixture))
