@@ -14,6 +14,7 @@
  *             training poses and held-out poses
  *   allocs_in_step, locks_in_step: calls counted by the interposer over S steps after
  *             warm-up (-1 when this build cannot observe them)
+ *   failed_steps  steps that returned an error (a non-finite state) in all of the above
  * Ratios: speedup_vs_full = full_ms / sub_ms, cost_vs_dqs = sub_ms / dqs_ms. The last
  * stdout line is one JSON object. */
 #include <errno.h>
@@ -240,10 +241,11 @@ int main(int argc, char **argv) {
     uint32_t ns = sinew_blob_surface_vertex_count(blob);
     float *pos = malloc((size_t)ns * 3 * sizeof(float)), *nrm = malloc((size_t)ns * 3 * sizeof(float));
     double *sub = malloc((size_t)nf * sizeof(double));
+    long failed_steps = 0; /* steps that did not return SINEW_OK (a non-finite state) */
     for (int f = 0; f < nf; ++f) {
         double t0 = sw_now_seconds();
         sw_instance_set_pose_d(inst, ch.clip.T + (size_t)f * 12 * ch.skel.nbones);
-        sinew_instance_step(inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30));
+        failed_steps += sinew_instance_step(inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30)) != SINEW_OK;
         sinew_instance_read_surface(inst, pos, nrm, ns);
         sub[f] = 1e3 * (sw_now_seconds() - t0);
     }
@@ -296,13 +298,14 @@ int main(int argc, char **argv) {
         for (int s = 0; s < contract_steps; ++s) {
             sinew_instance_set_pose(inst, NULL, 0); /* rejected: also must not allocate */
             sw_instance_set_pose_d(inst, ch.clip.T + (size_t)(s % nf) * 12 * ch.skel.nbones);
-            sinew_instance_step(inst, 1.0f / 30);
+            failed_steps += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
             sinew_instance_read_surface(inst, pos, nrm, ns);
         }
         sw_rt_counts c = sw_rt_count_end();
         if (active & SW_RT_CAT_ALLOCS) allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
         if (active & SW_RT_CAT_LOCKS) locks = (long)c.locks;
     }
+    failed_steps += et.failed + eh.failed;
     fprintf(stderr,
             "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, cost %.1fx DQS;\n"
             "             correction error train %.4f held-out %.4f; allocs %ld, locks %ld in %d steps\n",
@@ -313,10 +316,10 @@ int main(int argc, char **argv) {
                "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
                "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
                "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_seconds\":%.2f,"
-               "\"err_source\":\"%s\"}\n",
+               "\"err_source\":\"%s\",\"failed_steps\":%ld}\n",
                ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
                sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub,
-               allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source);
+               allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps);
     free(full);
     free(full_x);
     free(sub);
