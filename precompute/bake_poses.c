@@ -229,7 +229,10 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
         if (i >= ctx->nseq) break;
         sw_pose_seq *q = ctx->seqs[i];
         sw_fullsim_params fp = sw_fullsim_params_default();
-        fp.threads = 1;
+        /* a chained path (the clip's training then held-out frames) is the longest serial
+           run: it gets every core (the simulator's results do not depend on its thread
+           count), the others one each */
+        fp.threads = q->then ? sw_pool_size(s->pool) : 1;
         fp.self_contact = s->p->self_contact;
         sw_fullsim *sim;
         sw_error e;
