@@ -4,6 +4,7 @@
  * invariance; a multi-element patch test; closed-form energies; rest data and mass. */
 #include "fem_corot.h"
 #include "svd3.h"
+#include "dqs.h"
 #include "sw_test.h"
 
 #include <stdint.h>
@@ -43,11 +44,8 @@ static void random_rotation(double R[9]) {
         }
     } while (n < 1e-3 || n > 1);
     n = sqrt(n);
-    double w = q[0] / n, x = q[1] / n, y = q[2] / n, z = q[3] / n;
-    double M[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                   2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                   2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
-    memcpy(R, M, sizeof M);
+    for (int i = 0; i < 4; ++i) q[i] /= n;
+    sw_quat_to_matrix(q, R);
 }
 
 static void mat_mul(const double A[9], const double B[9], double C[9]) {
