@@ -59,6 +59,7 @@ struct sinew_instance {
     double blend;         /* pose-space weight of `second` (0: `nearest` alone) */
     double *svd_V;        /* 9 per cubature tet: last SVD rotation (warm start) */
     int32_t *blk_off, *blk_size, *blk_order; /* domain blocks of H, leaves first */
+    int32_t *blk_pos;                        /* domain -> its place in blk_order */
     unsigned char *blk_nz;                   /* ndomains^2 scratch of the factorisation */
     unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
     sinew_step_stats stats;
@@ -87,7 +88,7 @@ static void mem_free(const sinew_allocator *a, void *p) {
 }
 
 /* The instance's arrays, listed once for allocation and release. */
-enum { NBUF = 34 };
+enum { NBUF = 35 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
@@ -101,7 +102,7 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (void **)&in->surf_n, (void **)&in->feature, (void **)&in->contact_act,
                       (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V,
                       (void **)&in->blk_off, (void **)&in->blk_size, (void **)&in->blk_order,
-                      (void **)&in->blk_nz, (void **)&in->blk_adj};
+                      (void **)&in->blk_nz, (void **)&in->blk_adj, (void **)&in->blk_pos};
     size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
                       (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
                       (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
@@ -114,7 +115,7 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (size_t)v->ndomains * sizeof(int32_t), (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * (size_t)v->ndomains,
-                      (size_t)v->ndomains * (size_t)v->ndomains};
+                      (size_t)v->ndomains * (size_t)v->ndomains, (size_t)v->ndomains * sizeof(int32_t)};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -264,6 +265,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         in->blk_size[k] = v->domains[k].rank;
     }
     block_order_min_degree(v, in->blk_off, in->blk_size, in->blk_adj, in->blk_nz, in->blk_order);
+    for (int32_t e = 0; e < v->ndomains; ++e) in->blk_pos[in->blk_order[e]] = e;
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t i = 0; i < v->nverts; ++i)
         for (int k = 0; k < 3; ++k) {
@@ -673,13 +675,8 @@ static void block_pattern(sinew_instance *in) {
         for (int32_t c = v->contact_ptr[pose]; c < v->contact_ptr[pose + 1]; ++c)
             for (int m = 0; m < 4; ++m)
                 for (int k = 0; k < 4; ++k) {
-                    int32_t di = v->contact_verts[8 * c + 2 * m], dk = v->contact_verts[8 * c + 2 * k];
-                    if (di == dk) continue;
-                    int32_t a = 0, b = 0;
-                    for (int32_t e = 0; e < nd; ++e) {
-                        if (in->blk_order[e] == di) a = e;
-                        if (in->blk_order[e] == dk) b = e;
-                    }
+                    int32_t a = in->blk_pos[v->contact_verts[8 * c + 2 * m]];
+                    int32_t b = in->blk_pos[v->contact_verts[8 * c + 2 * k]];
                     if (a > b) in->blk_nz[a * nd + b] = 1;
                 }
     }
@@ -693,7 +690,6 @@ static int newton_direction(sinew_instance *in) {
     for (int32_t i = 0; i < R; ++i) tr += fabs(in->H[(int64_t)i * R + i]);
     double shift = 0;
     for (int attempt = 0; attempt < 8; ++attempt) {
-        block_pattern(in);
         if (sw_block_cholesky(in->H, R, nd, in->blk_off, in->blk_size, in->blk_order, in->blk_nz,
                               in->L)) {
             for (int32_t i = 0; i < R; ++i) in->dq[i] = -in->g[i];
@@ -790,6 +786,7 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     }
     skin_active(inst);
     nearest_training_poses(inst);
+    block_pattern(inst); /* fixed for the step: the factorisations add their fill to it */
     if (!dc.dynamic && inst->nearest >= 0) {
         pose_space_start(inst);
         st.status |= SINEW_STEP_POSE_SPACE;
