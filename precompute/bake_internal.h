@@ -19,9 +19,10 @@ typedef struct sw_pose_seq {
     sw_contact *contacts;
     int32_t ncontacts, contact_cap;
     int oom; /* the contact sets did not fit in memory */
-    /* solved right after this sequence, warm-started from its last solution (the clip's
-       held-out frames continue the training frames' path) */
-    struct sw_pose_seq *then;
+    /* solved after this sequence, each warm-started from its last solution: the clip's
+       held-out frames and its return path continue the training frames' path */
+    struct sw_pose_seq *then[2];
+    int continues; /* this sequence is another's `then`: not scheduled on its own */
 } sw_pose_seq;
 
 typedef struct sw_bake_state {

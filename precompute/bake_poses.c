@@ -1,6 +1,9 @@
 /* Training and held-out poses, and their full-space solutions (DESIGN.md §5).
- * Training: the first (1 - heldout) frames of the clip (evenly subsampled) and, per
- * joint, a sweep from rest to the largest rotation the training frames give it.
+ * Training: the first (1 - heldout) frames of the clip (evenly subsampled), the same
+ * frames played back from the last one (the return path: a fold that buckled on the
+ * way in can stay buckled on the way out, and the runtime picks the branch its own
+ * state is on), and, per joint, a sweep from rest to the largest rotation the training
+ * frames give it.
  * Held-out: the clip's remaining frames, never used to build the basis or cubature;
  * without a clip, random combined poses with a fixed seed. Each sequence is solved in
  * order (every solve warm-starts the next); sequences run in parallel, one thread
@@ -121,18 +124,29 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     int32_t njoint = 0;
     for (int32_t b = 0; b < nb; ++b) njoint += sweep_angle[b] > 1e-3;
 
-    s->ntrain_seq = (ntrain_frames > 0) + njoint;
+    int32_t nclip = ntrain_frames < s->p->max_train_frames ? ntrain_frames : s->p->max_train_frames;
+    int32_t nreturn = s->p->return_path && nclip >= 2 ? nclip - 1 : 0;
+    s->ntrain_seq = (ntrain_frames > 0) + (nreturn > 0) + njoint;
     s->train = calloc((size_t)s->ntrain_seq + 1, sizeof(sw_pose_seq));
     if (!s->train) goto oom;
     int32_t qi = 0;
     if (ntrain_frames > 0) {
-        int32_t n = ntrain_frames < s->p->max_train_frames ? ntrain_frames : s->p->max_train_frames;
+        int32_t n = nclip;
         if (!seq_alloc(&s->train[qi], n, nb, s->nv)) goto oom;
         for (int32_t i = 0; i < n; ++i) {
             int32_t f = n == 1 ? 0 : (int32_t)((int64_t)i * (ntrain_frames - 1) / (n - 1));
             memcpy(s->train[qi].T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
                    12 * nb * sizeof(double));
         }
+        qi++;
+    }
+    if (nreturn > 0) { /* train[0]'s frames n-2 .. 0, continuing from its last solution */
+        if (!seq_alloc(&s->train[qi], nreturn, nb, s->nv)) goto oom;
+        for (int32_t i = 0; i < nreturn; ++i)
+            memcpy(s->train[qi].T + (size_t)i * 12 * nb, s->train[0].T + (size_t)(nreturn - 1 - i) * 12 * nb,
+                   12 * nb * sizeof(double));
+        s->train[0].then[1] = &s->train[qi];
+        s->train[qi].continues = 1;
         qi++;
     }
     for (int32_t b = 0; b < nb; ++b) {
@@ -161,7 +175,10 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
         /* the reference is path dependent (contact states, buckled folds): the held-out
            frames are solved along the clip's path, after its training frames, as a host
            playing the clip sees them */
-        if (ntrain_frames > 0) s->train[0].then = &s->heldout;
+        if (ntrain_frames > 0) {
+            s->train[0].then[0] = &s->heldout;
+            s->heldout.continues = 1;
+        }
     } else if (s->p->random_poses > 0) {
         int32_t n = s->p->random_poses;
         uint64_t seed = s->p->seed;
@@ -210,6 +227,16 @@ static int keep_contacts(sw_pose_seq *q, int32_t k, const sw_fullsim *sim) {
     return 1;
 }
 
+/* Solves q's poses in order, from the simulator's current state. */
+static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
+    for (int32_t k = 0; k < q->npose; ++k) {
+        sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, NULL);
+        if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
+        memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim), (size_t)s->nv * 3 * sizeof(double));
+        if (!keep_contacts(q, k, sim)) q->oom = 1;
+    }
+}
+
 typedef struct {
     sw_bake_state *s;
     sw_pose_seq **seqs;
@@ -232,7 +259,7 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
         /* a chained path (the clip's training then held-out frames) is the longest serial
            run: it gets every core (the simulator's results do not depend on its thread
            count), the others one each */
-        fp.threads = q->then ? sw_pool_size(s->pool) : 1;
+        fp.threads = q->then[0] || q->then[1] ? sw_pool_size(s->pool) : 1;
         fp.self_contact = s->p->self_contact;
         sw_fullsim *sim;
         sw_error e;
@@ -240,13 +267,12 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
             atomic_fetch_add(&ctx->failed, 1);
             continue;
         }
-        for (; q; q = q->then)
-            for (int32_t k = 0; k < q->npose; ++k) {
-                sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, NULL);
-                if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
-                memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
-                       (size_t)s->nv * 3 * sizeof(double));
-                if (!keep_contacts(q, k, sim)) q->oom = 1;
+        simulate_seq(s, sim, q);
+        for (int c = 0; c < 2; ++c)
+            if (q->then[c] && q->npose > 0) {
+                sw_fullsim_set_state(sim, q->T + (size_t)(q->npose - 1) * 12 * s->nb,
+                                     q->x + (size_t)(q->npose - 1) * 3 * s->nv, NULL);
+                simulate_seq(s, sim, q->then[c]);
             }
         sw_fullsim_destroy(sim);
     }
@@ -255,10 +281,9 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     sw_pose_seq *seqs[4096];
     int32_t n = 0;
-    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i) seqs[n++] = &s->train[i];
-    int chained = 0; /* the held-out sequence continues a training one (train[0]) */
-    for (int32_t i = 0; i < s->ntrain_seq; ++i) chained |= s->train[i].then == &s->heldout;
-    if (s->heldout.npose > 0 && !chained) seqs[n++] = &s->heldout;
+    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
+        if (!s->train[i].continues) seqs[n++] = &s->train[i];
+    if (s->heldout.npose > 0 && !s->heldout.continues) seqs[n++] = &s->heldout;
     sim_ctx ctx;
     ctx.s = s;
     ctx.seqs = seqs;
@@ -270,7 +295,9 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     if (atomic_load(&ctx.failed) > 0)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "the full-space simulator rejected the character");
-    if (chained) seqs[n++] = &s->heldout; /* for the checks below */
+    n = 0; /* the checks below: every sequence, continuations too */
+    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i) seqs[n++] = &s->train[i];
+    if (s->heldout.npose > 0) seqs[n++] = &s->heldout;
     for (int32_t i = 0; i < n; ++i)
         if (seqs[i]->oom) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for contact sets");
     for (int32_t i = 0; i < n; ++i)

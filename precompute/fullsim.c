@@ -713,9 +713,10 @@ const sw_contact *sw_fullsim_contacts(const sw_fullsim *sim, int32_t *count) {
 }
 int32_t sw_fullsim_driven_count(const sw_fullsim *sim) { return sim->ndriven; }
 
-void sw_fullsim_set_state(sw_fullsim *sim, const double *x, const double *v) {
+void sw_fullsim_set_state(sw_fullsim *sim, const double *T, const double *x, const double *v) {
     size_t v3 = (size_t)sim->nv * 3 * sizeof(double);
     memcpy(sim->x, x, v3);
+    if (T) sw_lbs(sim->nv, sim->c->mesh.X, &sim->c->weights, T, sim->skin_prev);
     if (v)
         memcpy(sim->v, v, v3);
     else

@@ -110,10 +110,13 @@ const struct sw_contact *sw_fullsim_contacts(const sw_fullsim *sim, int32_t *cou
 /* Current positions / velocities (3*nverts). */
 const double *sw_fullsim_positions(const sw_fullsim *sim);
 double *sw_fullsim_velocities(sw_fullsim *sim);
-/* Overwrites the state (e.g. to start an oscillation test from a perturbed shape);
- * v may be NULL (zero). Accelerations are set consistent with x: M a = f(x) + M g
- * (damping and contact forces left out). */
-void sw_fullsim_set_state(sw_fullsim *sim, const double *x, const double *v);
+/* Overwrites the state (e.g. to start an oscillation test from a perturbed shape, or
+ * a second path from a solution of an earlier step); v may be NULL (zero). T, when not
+ * NULL, is the pose x was solved at: the next step's warm start moves the flesh by the
+ * change of the skinned shape since that pose (NULL: since the last step's pose).
+ * Accelerations are set consistent with x: M a = f(x) + M g (damping and contact
+ * forces left out). */
+void sw_fullsim_set_state(sw_fullsim *sim, const double *T, const double *x, const double *v);
 
 /* The surface (boundary triangles) the simulator uses. */
 const sw_surface *sw_fullsim_surface(const sw_fullsim *sim);

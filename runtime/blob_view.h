@@ -90,7 +90,10 @@ typedef struct sw_blob_view {
 
     /* pose-space warm start: training pose t has feature train_pose[4 nbones t ..]
      * (each bone's rotation relative to its parent as a unit quaternion w, x, y, z with
-     * w >= 0) and reduced solution train_q[R t ..] */
+     * w >= 0) and reduced solution train_q[R t ..]. Stored in the order the bake solved
+     * them, each from the one before (pose t - 1 is t's predecessor on its path where t
+     * has a twin: a pose stored twice is one pose on two branches of the reference's
+     * path, and the runtime tells them apart by how each was arrived at) */
     int32_t ntrain;
     const double *train_q;
     const double *train_pose;

@@ -41,6 +41,7 @@ struct sinew_instance {
     sw_dualquat *bone_dq;          /* nbones */
     double *T_cur, *T_prev, *T_prev2; /* 12 nbones each */
     int pose_set, history;         /* frames of pose history available (0..2) */
+    int looked_up;                 /* feature_last holds a pose */
     /* active vertices */
     int32_t *act_vert; /* nact global ids */
     int32_t *cub_act;  /* 4 ncub */
@@ -57,6 +58,8 @@ struct sinew_instance {
     int32_t nearest;      /* training pose nearest to the current pose, or -1 */
     int32_t second;       /* the second nearest, or -1 */
     double blend;         /* pose-space weight of `second` (0: `nearest` alone) */
+    double *feature_last; /* 4 nbones: the pose feature of the last lookup */
+    double *motion;       /* 4 nbones: the last change of pose between two lookups */
     double *svd_V;        /* 9 per cubature tet: last SVD rotation (warm start) */
     int32_t *blk_off, *blk_size, *blk_order; /* domain blocks of H, leaves first */
     int32_t *blk_pos;                        /* domain -> its place in blk_order */
@@ -88,7 +91,7 @@ static void mem_free(const sinew_allocator *a, void *p) {
 }
 
 /* The instance's arrays, listed once for allocation and release. */
-enum { NBUF = 35 };
+enum { NBUF = 37 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
@@ -102,7 +105,8 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (void **)&in->surf_n, (void **)&in->feature, (void **)&in->contact_act,
                       (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V,
                       (void **)&in->blk_off, (void **)&in->blk_size, (void **)&in->blk_order,
-                      (void **)&in->blk_nz, (void **)&in->blk_adj, (void **)&in->blk_pos};
+                      (void **)&in->blk_nz, (void **)&in->blk_adj, (void **)&in->blk_pos,
+                      (void **)&in->feature_last, (void **)&in->motion};
     size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
                       (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
                       (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
@@ -115,7 +119,8 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (size_t)v->ndomains * sizeof(int32_t), (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * (size_t)v->ndomains,
-                      (size_t)v->ndomains * (size_t)v->ndomains, (size_t)v->ndomains * sizeof(int32_t)};
+                      (size_t)v->ndomains * (size_t)v->ndomains, (size_t)v->ndomains * sizeof(int32_t),
+                      4 * nb * d, 4 * nb * d};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -518,12 +523,50 @@ static double contact_eval(sinew_instance *in, const double *q, int want_grad, i
     return E;
 }
 
+/* Training poses t and u are the same pose (the bake stores a pose once per branch of
+ * the reference's path: on its return path, a fold that buckled on the way in may
+ * stay buckled on the way out). */
+static int same_pose(const sinew_instance *in, int32_t t, int32_t u) {
+    const sw_blob_view *v = in->v;
+    size_t f = (size_t)4 * v->nbones;
+    return u >= 0 && sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14;
+}
+
+/* Of the branches stored for training pose `rep`, the one the instance is on. The
+ * bake solved the training poses in the order it stored them, each from the one before
+ * (a path, blob_view.h), so a stored pose's arrival direction is its feature minus
+ * its predecessor's: on the way into a bend or on the way out. The branch whose
+ * arrival is most aligned with the instance's own last motion wins (the first stored
+ * on a tie, e.g. before the pose ever moved): a fold that buckled while the joint
+ * bent stays buckled while it unbends. */
+static int32_t pick_branch(const sinew_instance *in, int32_t rep) {
+    const sw_blob_view *v = in->v;
+    size_t f = (size_t)4 * v->nbones;
+    int32_t best = rep;
+    double best_s = -INFINITY;
+    for (int32_t t = 0; t < v->ntrain; ++t)
+        if (t == rep || same_pose(in, t, rep)) {
+            double s = 0, n = 0;
+            for (size_t i = 0; t > 0 && i < f; ++i) {
+                double a = v->train_pose[f * t + i] - v->train_pose[f * (t - 1) + i];
+                s += a * in->motion[i];
+                n += a * a;
+            }
+            s = n > 0 ? s / sqrt(n) : 0;
+            if (s > best_s) best_s = s, best = t;
+        }
+    return best;
+}
+
 /* The two training poses nearest to the current pose (feature distance) and the
  * pose-space blend weight of the second (DESIGN.md §8: one sample when the nearest is
  * within 1e-3 or the second is more than 4 times as far, else a blend by distance).
- * Sets in->nearest (-1 without training poses), in->second and in->blend. */
+ * A pose stored on several branches counts once; the instance's motion picks the
+ * branch (pick_branch). Sets in->nearest (-1 without training poses), in->second and
+ * in->blend. */
 static void nearest_training_poses(sinew_instance *in) {
     const sw_blob_view *v = in->v;
+    int32_t n0 = -1, n1 = -1;
     in->nearest = in->second = -1;
     in->blend = 0;
     if (v->ntrain < 1) return;
@@ -531,17 +574,28 @@ static void nearest_training_poses(sinew_instance *in) {
     double d0 = INFINITY, d1 = INFINITY;
     for (int32_t t = 0; t < v->ntrain; ++t) {
         double d = sw_pose_distance(in->feature, v->train_pose + (size_t)4 * v->nbones * t, v->nbones);
+        if ((d == d0 && same_pose(in, t, n0)) || (d == d1 && same_pose(in, t, n1))) continue;
         if (d < d0) {
-            d1 = d0, in->second = in->nearest;
-            d0 = d, in->nearest = t;
+            d1 = d0, n1 = n0;
+            d0 = d, n0 = t;
         } else if (d < d1) {
-            d1 = d, in->second = t;
+            d1 = d, n1 = t;
         }
     }
     /* the feature distance is sum (1 - cos^2(theta_b / 2)): its root is linear in the
        angles for small ones */
     double s0 = sqrt(d0), s1 = sqrt(d1);
-    if (in->second >= 0 && s0 >= 1e-3 && s1 <= 4 * s0) in->blend = s0 / (s0 + s1);
+    if (n1 >= 0 && s0 >= 1e-3 && s1 <= 4 * s0) in->blend = s0 / (s0 + s1);
+    /* the last motion: kept while the pose holds still, so a pause does not switch branch */
+    size_t f = (size_t)4 * v->nbones;
+    double moved = 0;
+    for (size_t i = 0; i < f; ++i) moved += fabs(in->feature[i] - in->feature_last[i]);
+    if (moved > 1e-9 && in->looked_up)
+        for (size_t i = 0; i < f; ++i) in->motion[i] = in->feature[i] - in->feature_last[i];
+    memcpy(in->feature_last, in->feature, f * sizeof(double));
+    in->looked_up = 1;
+    in->nearest = pick_branch(in, n0);
+    in->second = in->blend > 0 ? pick_branch(in, n1) : n1;
 }
 
 /* y = A x for a dense R x R matrix. */

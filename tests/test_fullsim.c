@@ -103,7 +103,7 @@ static sw_fullsim *oscillating(sw_character *c, sw_integrator integ, double dt, 
         x[3 * v + 1] = X[1] * (1 + s);
         x[3 * v + 2] = X[2] * (1 + s);
     }
-    sw_fullsim_set_state(sim, x, NULL);
+    sw_fullsim_set_state(sim, NULL, x, NULL);
     free(x);
     return sim;
 }

@@ -1,10 +1,12 @@
 /* The reduced model the step minimises (runtime/instance.c): its gradient against
  * finite differences with the pose-space contact pairs engaged, a quasistatic shape
- * that depends on the pose alone, and its accuracy against the full-space training
+ * that depends on the pose and the direction it was arrived at alone, the branch of
+ * the reference's path it follows, and its accuracy against the full-space training
  * solutions it was baked from. */
 #include <math.h>
 
 #include "bake_fixture.h"
+#include "dqs.h"
 #include "instance.h"
 #include "subspace_eval.h"
 #include "sw_test.h"
@@ -75,7 +77,14 @@ TEST(gradient_matches_finite_differences_with_contact_pairs) {
     sinew_instance_destroy(inst);
 }
 
-TEST(quasistatic_shape_depends_on_the_pose_alone) {
+/* Steps inst to clip frame k (float transforms, as a host sets them). */
+static void step_to_frame(const bake_fixture *f, sinew_instance *inst, int k, float *pose) {
+    bake_fixture_pose(f, k, pose);
+    ENSURE(sinew_instance_set_pose(inst, pose, (uint32_t)f->ch.skel.nbones) == SINEW_OK);
+    ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
+}
+
+TEST(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone) {
     const bake_fixture *f = fixture();
     ENSURE(f);
     uint32_t ns = sinew_blob_surface_vertex_count(f->blob);
@@ -85,24 +94,73 @@ TEST(quasistatic_shape_depends_on_the_pose_alone) {
     float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones), *xa = malloc(sizeof(float) * 3 * ns),
           *xb = malloc(sizeof(float) * 3 * ns);
     int nf = f->ch.clip.nframes;
-    for (int k = 0; k < nf; ++k) { /* a plays the clip; b jumps to each frame after a reset */
-        bake_fixture_pose(f, k, pose);
-        ENSURE(sinew_instance_set_pose(a, pose, (uint32_t)f->ch.skel.nbones) == SINEW_OK);
-        ENSURE(sinew_instance_step(a, 1.0f / 30) == SINEW_OK);
+    for (int k = 0; k < nf; ++k) { /* a plays the clip; b comes from frame k - 1 after a reset */
+        step_to_frame(f, a, k, pose);
         ENSURE(sinew_instance_reset(b) == SINEW_OK);
-        ENSURE(sinew_instance_set_pose(b, pose, (uint32_t)f->ch.skel.nbones) == SINEW_OK);
-        ENSURE(sinew_instance_step(b, 1.0f / 30) == SINEW_OK);
+        if (k > 0) step_to_frame(f, b, k - 1, pose);
+        step_to_frame(f, b, k, pose);
         sinew_instance_read_surface(a, xa, NULL, ns);
         sinew_instance_read_surface(b, xb, NULL, ns);
         double worst = 0;
         for (uint32_t i = 0; i < 3 * ns; ++i) worst = fmax(worst, fabs((double)xa[i] - xb[i]));
-        ENSUREF(worst < 1e-4, "frame %d: played and jumped-to shapes differ by %g", k, worst);
+        ENSUREF(worst < 1e-4, "frame %d: played and arrived-at shapes differ by %g", k, worst);
     }
     free(pose);
     free(xa);
     free(xb);
     sinew_instance_destroy(a);
     sinew_instance_destroy(b);
+}
+
+/* The bake stores the training clip's frames twice, on the way in and on the way back
+ * (its return path), with the reference's solution on each branch. Played in the order
+ * solved, the instance must land on the branch it arrived along: nearer that branch's
+ * reference shape than the twin's, wherever the two differ. */
+TEST(branches_follow_the_motion) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    size_t n3 = 3 * (size_t)v->nverts, fs = 4 * (size_t)v->nbones;
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    double *xs = malloc(sizeof(double) * n3), *cnt = malloc(sizeof(double) * v->nverts);
+    int twins = 0, distinct = 0;
+    double big = 0; /* the largest squared correction |x - rest|_M^2 of a training pose */
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        double c = 0;
+        for (size_t i = 0; i < n3; ++i) {
+            double d = f->res.train_x[n3 * t + i] - v->rest[i];
+            c += f->res.mass[i / 3] * d * d;
+        }
+        big = fmax(big, c);
+    }
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        ENSURE(sw_instance_set_pose_d(inst, f->res.train_T + (size_t)t * 12 * v->nbones) == SINEW_OK);
+        ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
+        int32_t u = -1;
+        for (int32_t w = 0; w < v->ntrain && u < 0; ++w)
+            if (w != t && sw_pose_distance(v->train_pose + fs * t, v->train_pose + fs * w, v->nbones) <= 1e-14) u = w;
+        if (u < 0) continue;
+        twins++;
+        const double *xt = f->res.train_x + n3 * t, *xu = f->res.train_x + n3 * u;
+        double apart = 0, own = 0, other = 0;
+        sw_instance_full_positions(inst, xs, cnt);
+        for (size_t i = 0; i < n3; ++i) {
+            double m = f->res.mass[i / 3];
+            apart += m * (xt[i] - xu[i]) * (xt[i] - xu[i]);
+            own += m * (xs[i] - xt[i]) * (xs[i] - xt[i]);
+            other += m * (xs[i] - xu[i]) * (xs[i] - xu[i]);
+        }
+        if (apart < 1e-4 * big) continue; /* the branches meet here (1% of the largest shape change) */
+        distinct++;
+        ENSUREF(own < other, "training pose %d: nearer its twin %d's shape (%g) than its own (%g)", t, u,
+                sqrt(other), sqrt(own));
+    }
+    fprintf(stderr, "    %d training poses stored on two branches, %d of them apart\n", twins, distinct);
+    ENSURE(twins > 0 && distinct > 0);
+    free(xs);
+    free(cnt);
+    sinew_instance_destroy(inst);
 }
 
 TEST(training_poses_are_reproduced) {
@@ -123,5 +181,6 @@ TEST(release_fixture) {
 }
 
 SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
-             CASE(quasistatic_shape_depends_on_the_pose_alone), CASE(training_poses_are_reproduced),
+             CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
+             CASE(branches_follow_the_motion), CASE(training_poses_are_reproduced),
              CASE(release_fixture))

@@ -39,7 +39,9 @@
  *   20 SURF_COPY_PTR   4     nsurf_verts + 1
  *   21 SURF_COPIES     4     2 * surf_copy_ptr[nsurf_verts]
  *   22 TRAIN_Q         8     ntrain * R     (reduced solutions of the training poses)
- *   23 TRAIN_POSE      8     ntrain * 4 nbones (pose features: unit quaternions)
+ *   23 TRAIN_POSE      8     ntrain * 4 nbones (pose features: unit quaternions, in the
+ *                                               order solved: a pose stored twice is two
+ *                                               branches, told apart by pose t - 1)
  *   24 CONTACT_PTR     4     ntrain + 1     (training pose t owns contacts [ptr[t], ptr[t+1]))
  *   25 CONTACT_VERTS   4     8 ncontacts    ((domain, local vertex) of p, t0, t1, t2)
  *   26 CONTACT_DATA    8     7 ncontacts    (barycentrics b0..b2, rest-frame normal, area ka)
