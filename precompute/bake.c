@@ -23,7 +23,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.selector = SW_CUBATURE_NNHTP;
     p.sweep_samples = 6;
     p.max_train_frames = 40;
-    p.return_path = 1;
+    p.return_path = 0;
     p.heldout_fraction = 0.4;
     p.random_poses = 10;
     p.self_contact = 1;

@@ -32,7 +32,9 @@ typedef struct sw_bake_params {
     sw_cubature_selector selector; /* default NN-HTP */
     int32_t sweep_samples;  /* poses per joint sweep (default 6) */
     int32_t max_train_frames; /* clip frames used for training at most (default 40) */
-    int return_path;        /* also train on those frames played back (default 1) */
+    int return_path;        /* also train on those frames played back from the last one
+                               (default 0; measured: finger held-out error 0.235 -> 0.164 at
+                               20K tets, unchanged at 50K where the rank grows 41 -> 63) */
     double heldout_fraction; /* last part of the clip held out (default 0.4) */
     int32_t random_poses;   /* held-out poses when there is no clip (default 10) */
     int self_contact;       /* in the training simulations (default 1) */

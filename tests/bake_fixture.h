@@ -19,8 +19,10 @@ typedef struct {
     sinew_blob *blob;
 } bake_fixture;
 
-/* Bakes `sample` at about `tets` tets with a clip of `frames` frames. 1 on success. */
-static inline int bake_fixture_make(bake_fixture *f, const char *sample, int tets, int frames) {
+/* Bakes `sample` at about `tets` tets with a clip of `frames` frames, with the clip's
+ * return path when return_path is set. 1 on success. */
+static inline int bake_fixture_make(bake_fixture *f, const char *sample, int tets, int frames,
+                                    int return_path) {
     sw_error err;
     memset(f, 0, sizeof *f);
     if (sw_sample_make(sample, tets, frames, &f->ch, &err) != SINEW_OK) return 0;
@@ -28,6 +30,7 @@ static inline int bake_fixture_make(bake_fixture *f, const char *sample, int tet
     p.sweep_samples = 3;
     p.max_train_frames = 8;
     p.threads = 2;
+    p.return_path = return_path;
     if (sw_bake(&f->ch, &p, &f->res, &err) != SINEW_OK) {
         fprintf(stderr, "bake failed: %s\n", err.msg);
         return 0;

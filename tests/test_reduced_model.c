@@ -15,7 +15,7 @@ static bake_fixture fx;
 static int fx_ok = -1;
 
 static const bake_fixture *fixture(void) {
-    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 3000, 12);
+    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 3000, 12, 1);
     return fx_ok ? &fx : NULL;
 }
 

@@ -40,7 +40,7 @@ static void *run(void *p) {
 
 TEST(parallel_instances_match_sequential) {
     bake_fixture f;
-    ENSURE(bake_fixture_make(&f, "finger", 1500, 10));
+    ENSURE(bake_fixture_make(&f, "finger", 1500, 10, 0));
     uint32_t ns = sinew_blob_surface_vertex_count(f.blob);
     job seq[NINST], par[NINST];
     for (int i = 0; i < NINST; ++i) {

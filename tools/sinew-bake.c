@@ -3,7 +3,7 @@
  *   sinew-bake (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf
  *              [--weights FILE.dmat] [--clip FILE]) --out FILE.blob
  *              [--selector greedy|importance|nnhtp] [--tol 0.05] [--max-rank R]
- *              [--compare-cubature] [--no-self-contact] [--no-return-path] [--threads T] [--data DIR] [--json]
+ *              [--compare-cubature] [--no-self-contact] [--return-path] [--threads T] [--data DIR] [--json]
  *
  * Shows progress per stage on stderr and ends with a summary (per-stage time, ranks,
  * cubature sizes, training and held-out errors); with --json the last stdout line is
@@ -31,7 +31,7 @@ static void usage(FILE *f) {
             "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat] [--clip FILE])\n"
             "                  --out FILE.blob [--selector greedy|importance|nnhtp] [--tol T]\n"
             "                  [--max-rank R] [--spring-k K] [--compare-cubature] [--no-self-contact]\n"
-            "                  [--no-return-path]\n"
+            "                  [--return-path]\n"
             "                  [--threads T] [--data DIR] [--json]\n"
             "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n");
 }
@@ -68,7 +68,7 @@ int main(int argc, char **argv) {
             ok = !*end && p.spring_k > 0 && isfinite(p.spring_k);
         } else if (!strcmp(a, "--compare-cubature")) p.compare_selectors = 1;
         else if (!strcmp(a, "--no-self-contact")) p.self_contact = 0;
-        else if (!strcmp(a, "--no-return-path")) p.return_path = 0;
+        else if (!strcmp(a, "--return-path")) p.return_path = 1;
         else if (!strcmp(a, "--json")) json = 1;
         else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
