@@ -297,6 +297,8 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->history = 0;
     inst->nearest = inst->second = -1;
     inst->blend = 0;
+    inst->looked_up = 0; /* no motion yet: a pose on two branches takes the first stored */
+    memset(inst->motion, 0, 4 * (size_t)nb * sizeof(double));
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->svd_V + 9 * (int64_t)c;
         memset(V, 0, 9 * sizeof(double));
