@@ -244,8 +244,12 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[2] = t1 - t0;
-    for (int32_t i = 0; i < s.ntrain_seq; ++i) out->ntrain += s.train[i].npose;
+    for (int32_t i = 0; i < s.ntrain_seq; ++i) {
+        out->ntrain += s.train[i].npose;
+        out->train_unsettled += s.train[i].unsettled;
+    }
     out->nheldout = s.heldout.npose;
+    out->heldout_unsettled = s.heldout.unsettled;
     if ((r = keep_solutions(&s, out, err)) != SINEW_OK) goto done;
     if (!(out->mass = malloc((size_t)s.nv * sizeof(double)))) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
@@ -253,9 +257,11 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     }
     memcpy(out->mass, s.mass, (size_t)s.nv * sizeof(double));
     {
-        char msg[96];
-        snprintf(msg, sizeof msg, "%d training and %d held-out full-space solutions",
-                 out->ntrain, out->nheldout);
+        char msg[160];
+        snprintf(msg, sizeof msg,
+                 "%d training and %d held-out full-space solutions (%d and %d with a contact set "
+                 "left unsettled by the round cap)",
+                 out->ntrain, out->nheldout, out->train_unsettled, out->heldout_unsettled);
         progress(&p, "simulate", t1 - t0, msg);
     }
 

@@ -56,6 +56,10 @@ typedef struct sw_bake_result {
     /* report */
     double stage_seconds[8]; /* prepare, domains, poses+simulate, basis, cubature, reduce */
     int32_t ntrain, nheldout;
+    /* reference solutions whose self-contact set the simulator's round cap stopped
+       while it still changed (sw_fullsim_stats.contacts_unsettled): their shape in the
+       fold depends on the cap, and so does the error measured against them */
+    int32_t train_unsettled, heldout_unsettled;
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     double cubature_error_max; /* worst per-domain relative cubature training error */

@@ -13,6 +13,7 @@ typedef struct sw_pose_seq {
     double *T; /* npose * 12 * nbones bone transforms */
     double *x; /* npose * 3 * nverts full-space solutions (filled by simulate) */
     int failed; /* poses whose solve returned NOT_FINITE */
+    int unsettled; /* poses whose contact set the simulator's round cap left unsettled */
     /* the reference's self-contact set of every solution (filled by simulate): pose k
        owns contacts[contact_ptr[k], contact_ptr[k+1]) */
     int32_t *contact_ptr; /* npose + 1 */

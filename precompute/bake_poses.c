@@ -230,8 +230,10 @@ static int keep_contacts(sw_pose_seq *q, int32_t k, const sw_fullsim *sim) {
 /* Solves q's poses in order, from the simulator's current state. */
 static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
     for (int32_t k = 0; k < q->npose; ++k) {
-        sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, NULL);
+        sw_fullsim_stats st;
+        sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, &st);
         if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
+        q->unsettled += st.contacts_unsettled;
         memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim), (size_t)s->nv * 3 * sizeof(double));
         if (!keep_contacts(q, k, sim)) q->oom = 1;
     }

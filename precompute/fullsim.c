@@ -564,6 +564,16 @@ static int32_t contact_round(sw_fullsim *sim) {
     return changed;
 }
 
+/* Whether a contact round at the current positions, whose penetrations are pen[0..n),
+ * would add or drop a pair (contact_round's rules, without changing the set). */
+static int set_would_change(const sw_fullsim *sim, const sw_contact *pen, int32_t n) {
+    for (int32_t i = 0; i < sim->ncontacts; ++i)
+        if (!(sw_contact_gap(&sim->active[i], sim->x) > 0)) return 1;
+    for (int32_t i = 0; i < n; ++i)
+        if (sim->active_slot[pen[i].p] < 0) return 1;
+    return 0;
+}
+
 /* Solves the Newton system at sim->x into sim->dx with the current Hessian flags;
  * returns the PCG statistics. */
 static sw_pcg_stats solve_newton_system(sw_fullsim *sim) {
@@ -664,13 +674,16 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
     sinew_result result = SINEW_ERROR_NOT_CONVERGED;
     double gref = -1;
     clear_contacts(sim);
+    int capped = 0;
     for (int round = 0;; ++round) {
         if (sim->p.self_contact && contact_round(sim) == 0 && round > 0) break; /* complete */
         st.contact_rounds += sim->p.self_contact;
         result = newton_solve(sim, &st, &gref, sim->p.newton_rtol);
-        if (result == SINEW_ERROR_NOT_FINITE || !sim->p.self_contact ||
-            round + 1 >= sim->p.contact_rounds)
+        if (result == SINEW_ERROR_NOT_FINITE || !sim->p.self_contact) break;
+        if (round + 1 >= sim->p.contact_rounds) {
+            capped = 1;
             break;
+        }
     }
     if (result == SINEW_ERROR_NOT_FINITE || !all_finite(sim->x, m)) {
         restore(sim);
@@ -684,8 +697,10 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
     int32_t found;
     sw_selfcontact_detect(sim->sc, sim->x, sim->pool);
     st.max_penetration = sw_selfcontact_max_depth(sim->sc);
-    sw_selfcontact_list(sim->sc, &found);
+    const sw_contact *pen = sw_selfcontact_list(sim->sc, &found);
     st.contacts = found;
+    if (sim->p.self_contact && capped) /* would one more round have changed the set? */
+        st.contacts_unsettled = set_would_change(sim, pen, found);
     if (sim->p.ground)
         for (int32_t v = 0; v < nv; ++v)
             if (sim->vert_area[v] > 0)

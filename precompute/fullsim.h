@@ -79,6 +79,9 @@ typedef struct sw_fullsim_stats {
     double grad_norm;     /* at exit */
     int converged;
     int32_t contacts;     /* penetrating vertices at the final positions */
+    int contacts_unsettled; /* 1: the round cap stopped the contact rounds while the set
+                               still changed (a penetrating vertex outside it, or a pair
+                               that no longer collides): the result depends on the cap */
     double max_penetration; /* deepest self-penetration at the final iterate (world units) */
     double ground_penetration; /* deepest vertex below the ground plane */
     double seconds;       /* wall time of the step */

@@ -218,13 +218,59 @@ TEST(contacts_push_and_never_pull) {
         int32_t n;
         const sw_contact *k = sw_fullsim_contacts(sim, &n);
         with_contacts += n > 0;
-        if (st.contact_rounds >= p.contact_rounds) continue; /* the set did not settle */
+        if (st.contacts_unsettled) continue; /* the round cap stopped it still changing */
         for (int32_t i = 0; i < n; ++i)
             ENSUREF(sw_contact_gap(&k[i], sw_fullsim_positions(sim)) > 0,
                     "frame %d: pair %d (vertex %d) is in front of its surface point", f, i, k[i].p);
     }
     ENSUREF(with_contacts >= 2, "only %d frames with contacts: the test would prove little", with_contacts);
     sw_fullsim_destroy(sim);
+    sw_character_free(&c);
+}
+
+/* contacts_unsettled says whether one more contact round would have changed the
+ * result: per frame of the fold, a simulator with a cap of C rounds and one with C + 1
+ * start from the same state; where the first reports a settled set they end bitwise
+ * equal, where it reports an unsettled one the second used its extra round. */
+TEST(unsettled_contact_set_is_one_another_round_changes) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 9, &c, &err) == SINEW_OK);
+    const int cap = 2;
+    sw_fullsim *sim[2];
+    for (int k = 0; k < 2; ++k) {
+        sw_fullsim_params p = sw_fullsim_params_default();
+        p.contact_rounds = cap + k;
+        p.threads = 1;
+        ENSURE(sw_fullsim_create(&c, &p, &sim[k], &err) == SINEW_OK);
+    }
+    size_t n3 = 3 * (size_t)c.mesh.nverts;
+    double *x = malloc(n3 * sizeof(double));
+    memcpy(x, c.mesh.X, n3 * sizeof(double));
+    int seen[2] = {0, 0};
+    for (int f = 1; f < c.clip.nframes; ++f) {
+        sw_fullsim_stats st[2];
+        for (int k = 0; k < 2; ++k) {
+            sw_fullsim_set_state(sim[k], frame_T(&c, f - 1), x, NULL);
+            ENSURE(sw_fullsim_step(sim[k], frame_T(&c, f), &st[k]) != SINEW_ERROR_NOT_FINITE);
+        }
+        const double *xa = sw_fullsim_positions(sim[0]), *xb = sw_fullsim_positions(sim[1]);
+        ENSURE(!st[1].contacts_unsettled || st[1].contact_rounds == cap + 1);
+        if (st[0].contact_rounds < cap) ENSURE(!st[0].contacts_unsettled); /* finished early */
+        if (st[0].contact_rounds == cap) {
+            seen[st[0].contacts_unsettled]++;
+            if (st[0].contacts_unsettled)
+                ENSUREF(st[1].contact_rounds == cap + 1, "frame %d: unsettled, yet another round changed nothing", f);
+            else
+                ENSUREF(memcmp(xa, xb, n3 * sizeof(double)) == 0,
+                        "frame %d: settled, yet another round moved the flesh", f);
+        }
+        memcpy(x, xa, n3 * sizeof(double));
+    }
+    fprintf(stderr, "    frames at the cap: %d settled, %d unsettled\n", seen[0], seen[1]);
+    ENSUREF(seen[1] > 0, "no frame reached the cap unsettled: the test would prove little");
+    free(x);
+    for (int k = 0; k < 2; ++k) sw_fullsim_destroy(sim[k]);
     sw_character_free(&c);
 }
 
@@ -297,5 +343,6 @@ SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy), CASE(newton_con
              CASE(backward_euler_never_gains_energy),
              CASE(self_contact_removes_most_penetration_of_folded_finger),
              CASE(contacts_push_and_never_pull),
+             CASE(unsettled_contact_set_is_one_another_round_changes),
              CASE(ground_plane_pushes_flesh_out),
              CASE(bad_input_is_rejected_and_state_kept))

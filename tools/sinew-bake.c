@@ -142,6 +142,10 @@ int main(int argc, char **argv) {
     fprintf(stderr, "), worst cubature fit %.4f\n", res.cubature_error_max);
     fprintf(stderr, "  poses: %d training, %d held-out; basis projection error train %.4f held-out %.4f\n",
             res.ntrain, res.nheldout, res.train_proj_error, res.heldout_proj_error);
+    if (res.train_unsettled + res.heldout_unsettled > 0)
+        fprintf(stderr, "  reference: the contact round cap left the contact set unsettled in %d training and "
+                        "%d held-out solutions (their fold depends on the cap)\n",
+                res.train_unsettled, res.heldout_unsettled);
     fprintf(stderr, "  correction error (subspace vs full, share of the correction missed): train %.4f, held-out %.4f (%d failed steps)\n",
             et.correction_error, eh.correction_error, et.failed + eh.failed);
     if (p.compare_selectors) {
@@ -154,10 +158,12 @@ int main(int argc, char **argv) {
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
                "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"heldout_poses\":%d,"
                "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
+               "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
                "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,%.2f,%.2f]",
                out_path, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones, v->ndomains, v->rank_total, v->ncub,
                res.cubature_error_max, res.ntrain, res.nheldout, res.train_proj_error,
-               res.heldout_proj_error, et.correction_error, eh.correction_error, bake_seconds,
+               res.heldout_proj_error, et.correction_error, eh.correction_error, res.train_unsettled,
+               res.heldout_unsettled, bake_seconds,
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
         if (p.compare_selectors)

@@ -221,7 +221,7 @@ int main(int argc, char **argv) {
             o.params.self_contact ? ", self-contact on" : ", self-contact off");
     double *ms = malloc((size_t)frames * sizeof(double));
     double newton_sum = 0, pcg_sum = 0, max_pen = 0, max_ground = 0, total = 0;
-    int unconverged = 0, failed = 0;
+    int unconverged = 0, failed = 0, unsettled = 0;
     for (int f = 0; f < frames && ms; ++f) {
         sw_fullsim_stats st;
         r = sw_fullsim_step(sim, ch.clip.T + (size_t)f * 12 * ch.clip.nbones, &st);
@@ -235,11 +235,13 @@ int main(int argc, char **argv) {
         pcg_sum += st.pcg_iters;
         max_pen = fmax(max_pen, st.max_penetration);
         max_ground = fmax(max_ground, st.ground_penetration);
+        unsettled += st.contacts_unsettled;
         fprintf(stderr,
                 "  frame %4d/%d  %8.1f ms  newton %2d  pcg %5d  |g| %.2e -> %.2e  contacts %5d  "
-                "penetration %.3g%s\n",
+                "penetration %.3g  rounds %d%s%s\n",
                 f + 1, frames, ms[f], st.newton_iters, st.pcg_iters, st.grad_norm0, st.grad_norm,
-                st.contacts, st.max_penetration,
+                st.contacts, st.max_penetration, st.contact_rounds,
+                st.contacts_unsettled ? "  (contact set unsettled)" : "",
                 r == SINEW_OK ? "" : r == SINEW_ERROR_NOT_CONVERGED ? "  (not converged)" : "  FAILED");
         if (o.out_dir && !write_frame(o.out_dir, f, surf, sw_fullsim_positions(sim), scratch, tris, &err)) {
             fprintf(stderr, "sinew-fullsim: %s\n", err.msg);
@@ -253,14 +255,16 @@ int main(int argc, char **argv) {
     }
     fprintf(stderr,
             "sinew-fullsim: median %.1f ms/frame, %.2f Newton and %.1f PCG iterations a frame, "
-            "max penetration %.4g, %d unconverged, %d failed frames\n",
-            median, newton_sum / frames, pcg_sum / frames, max_pen, unconverged, failed);
+            "max penetration %.4g, %d unconverged, %d failed frames, %d frames whose contact set "
+            "the round cap (%d) stopped unsettled\n",
+            median, newton_sum / frames, pcg_sum / frames, max_pen, unconverged, failed, unsettled,
+            o.params.contact_rounds);
     if (o.json)
         printf("{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"driven_verts\":%d,\"surface_tris\":%d,"
                "\"frames\":%d,\"mode\":\"%s\",\"self_contact\":%s,\"threads\":%d,"
                "\"ms_per_frame\":%.3f,\"ms_per_frame_mean\":%.3f,\"newton_iters_mean\":%.3f,"
                "\"pcg_iters_mean\":%.2f,\"max_penetration\":%.6g,\"max_ground_penetration\":%.6g,"
-               "\"unconverged_frames\":%d,\"failed_frames\":%d}\n",
+               "\"unconverged_frames\":%d,\"failed_frames\":%d,\"contact_unsettled_frames\":%d}\n",
                o.scene, ch.mesh.ntets, ch.mesh.nverts, sw_fullsim_driven_count(sim), surf->ntris,
                frames,
                o.params.integrator == SW_QUASISTATIC ? "quasistatic"
@@ -268,7 +272,7 @@ int main(int argc, char **argv) {
                                                      : "backward_euler",
                o.params.self_contact ? "true" : "false", o.params.threads, median,
                1e3 * total / frames, newton_sum / frames, pcg_sum / frames, max_pen, max_ground,
-               unconverged, failed);
+               unconverged, failed, unsettled);
     free(ms);
     free(scratch);
     free(tris);
