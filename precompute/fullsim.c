@@ -62,7 +62,7 @@ sw_fullsim_params sw_fullsim_params_default(void) {
     p.ground_height = 0;
     p.ground_k = 0; /* 0: contact_k */
     p.hessian = SW_HESSIAN_ADAPTIVE;
-    p.contact_rounds = 8;
+    p.contact_rounds = 30; /* fullsim.h: 8 left every contact frame of the finger unsettled */
     p.max_newton = 20;
     p.newton_rtol = 1e-4;
     p.pcg_rtol = 1e-3;

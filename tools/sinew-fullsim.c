@@ -42,7 +42,7 @@ static void usage(FILE *f) {
             "  --frames F    frames to simulate (default: procedural 30, assets their clip)\n"
             "  --dynamic     backward Euler dynamics (default quasistatic); --newmark: Newmark\n"
             "  --hessian M   adaptive (default) | projected | exact: element Hessians Newton uses\n"
-            "  --contact-rounds R  self-contact detection rounds a frame (default 8)\n"
+            "  --contact-rounds R  self-contact detection rounds a frame (default 30)\n"
             "  --out DIR     write each frame's surface as DIR/frame_NNNN.obj\n"
             "  --json        print one JSON object with the figures as the last line\n");
 }
