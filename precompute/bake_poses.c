@@ -2,8 +2,8 @@
  * Training: the first (1 - heldout) frames of the clip (evenly subsampled), with
  * return_path the same frames played back from the last one (the return path: a fold
  * that buckled on the way in can stay buckled on the way out, and the runtime picks
- * the branch by the direction the pose arrives from), and, per joint, a sweep from rest to the largest rotation the training
- * frames give it.
+ * the branch by the direction the pose arrives from), and, per joint, a sweep from
+ * rest to the largest rotation the training frames give it.
  * Held-out: the clip's remaining frames, never used to build the basis or cubature;
  * without a clip, random combined poses with a fixed seed. Each sequence is solved in
  * order (every solve warm-starts the next); sequences run in parallel, one thread

@@ -60,6 +60,8 @@ struct sinew_instance {
     double blend;         /* pose-space weight of `second` (0: `nearest` alone) */
     double *feature_last; /* 4 nbones: the pose feature of the last lookup */
     double *motion;       /* 4 nbones: the last change of pose between two lookups */
+    int32_t *twin_next;   /* ntrain: the next training pose storing the same pose (a
+                             cycle over its branches; itself when it has one) */
     double *svd_V;        /* 9 per cubature tet: last SVD rotation (warm start) */
     int32_t *blk_off, *blk_size, *blk_order; /* domain blocks of H, leaves first */
     int32_t *blk_pos;                        /* domain -> its place in blk_order */
@@ -91,7 +93,7 @@ static void mem_free(const sinew_allocator *a, void *p) {
 }
 
 /* The instance's arrays, listed once for allocation and release. */
-enum { NBUF = 37 };
+enum { NBUF = 38 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
@@ -106,7 +108,7 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V,
                       (void **)&in->blk_off, (void **)&in->blk_size, (void **)&in->blk_order,
                       (void **)&in->blk_nz, (void **)&in->blk_adj, (void **)&in->blk_pos,
-                      (void **)&in->feature_last, (void **)&in->motion};
+                      (void **)&in->feature_last, (void **)&in->motion, (void **)&in->twin_next};
     size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
                       (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
                       (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
@@ -120,7 +122,7 @@ static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
                       (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * (size_t)v->ndomains,
                       (size_t)v->ndomains * (size_t)v->ndomains, (size_t)v->ndomains * sizeof(int32_t),
-                      4 * nb * d, 4 * nb * d};
+                      4 * nb * d, 4 * nb * d, (size_t)v->ntrain * sizeof(int32_t)};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -131,6 +133,22 @@ static void identity_pose(double *T, int32_t nb) {
     for (int32_t b = 0; b < nb; ++b) {
         memset(T + 12 * b, 0, 12 * sizeof(double));
         T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    }
+}
+
+/* twin_next: links the training poses stored more than once (one per branch of the
+ * reference's path: on its return path a fold that buckled on the way in may stay
+ * buckled on the way out) into cycles in stored order, once at creation. */
+static void link_twins(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    size_t f = (size_t)4 * v->nbones;
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        int32_t next = t;
+        for (int32_t k = 1; k < v->ntrain && next == t; ++k) { /* t+1, ..., wrapping round */
+            int32_t u = (t + k) % v->ntrain;
+            if (sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14) next = u;
+        }
+        in->twin_next[t] = next;
     }
 }
 
@@ -271,6 +289,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     }
     block_order_min_degree(v, in->blk_off, in->blk_size, in->blk_adj, in->blk_nz, in->blk_order);
     for (int32_t e = 0; e < v->ndomains; ++e) in->blk_pos[in->blk_order[e]] = e;
+    link_twins(in);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t i = 0; i < v->nverts; ++i)
         for (int k = 0; k < 3; ++k) {
@@ -525,13 +544,16 @@ static double contact_eval(sinew_instance *in, const double *q, int want_grad, i
     return E;
 }
 
-/* Training poses t and u are the same pose (the bake stores a pose once per branch of
- * the reference's path: on its return path, a fold that buckled on the way in may
- * stay buckled on the way out). */
+/* Training pose t is stored on the branch cycle of u (the same pose: the bake stores a
+ * pose once per branch of the reference's path, twin_next). */
 static int same_pose(const sinew_instance *in, int32_t t, int32_t u) {
-    const sw_blob_view *v = in->v;
-    size_t f = (size_t)4 * v->nbones;
-    return u >= 0 && sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14;
+    if (u < 0) return 0;
+    int32_t w = u;
+    do {
+        if (w == t) return 1;
+        w = in->twin_next[w];
+    } while (w != u);
+    return 0;
 }
 
 /* Of the branches stored for training pose `rep`, the one the instance is on. The
@@ -544,19 +566,19 @@ static int same_pose(const sinew_instance *in, int32_t t, int32_t u) {
 static int32_t pick_branch(const sinew_instance *in, int32_t rep) {
     const sw_blob_view *v = in->v;
     size_t f = (size_t)4 * v->nbones;
-    int32_t best = rep;
+    int32_t best = rep, t = rep;
     double best_s = -INFINITY;
-    for (int32_t t = 0; t < v->ntrain; ++t)
-        if (t == rep || same_pose(in, t, rep)) {
-            double s = 0, n = 0;
-            for (size_t i = 0; t > 0 && i < f; ++i) {
-                double a = v->train_pose[f * t + i] - v->train_pose[f * (t - 1) + i];
-                s += a * in->motion[i];
-                n += a * a;
-            }
-            s = n > 0 ? s / sqrt(n) : 0;
-            if (s > best_s) best_s = s, best = t;
+    do { /* rep's branches, from rep round its cycle */
+        double s = 0, n = 0;
+        for (size_t i = 0; t > 0 && i < f; ++i) {
+            double a = v->train_pose[f * t + i] - v->train_pose[f * (t - 1) + i];
+            s += a * in->motion[i];
+            n += a * a;
         }
+        s = n > 0 ? s / sqrt(n) : 0;
+        if (s > best_s || (s == best_s && t < best)) best_s = s, best = t;
+        t = in->twin_next[t];
+    } while (t != rep);
     return best;
 }
 
