@@ -1,0 +1,96 @@
+/* Golden hash of the stepped surface (STYLE.md §7, the determinism tests of Box2D and
+ * Jolt): four instances of one small baked finger, quasistatic and dynamic, each from
+ * another clip offset, are stepped on 1, 2 and 4 threads; every run gives the same
+ * surfaces (positions and normals of every step), and their FNV-1a hash is the
+ * recorded golden value. The value was recorded before the runtime was laid out by
+ * subsystem (issue 9); a change that claims to keep behaviour must not move it, and a
+ * change that means to change the physics records the new value here and says why in
+ * its commit. */
+#include <pthread.h>
+#include <stdint.h>
+
+#include "bake_fixture.h"
+#include "sw_test.h"
+
+enum { NINST = 4, STEPS = 24 };
+
+/* FNV-1a 64 of the four instances' surfaces, instance after instance. */
+#define GOLDEN_SURFACE_HASH 0x56f3151acca76c54ull
+
+static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
+    const unsigned char *p = data;
+    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+    return h;
+}
+
+typedef struct {
+    const bake_fixture *f;
+    int first, stride; /* this thread steps instances first, first + stride, ... */
+    uint64_t hash[NINST];
+    int ok[NINST];
+} job;
+
+/* Steps instance i through STEPS clip frames from offset 3 i, hashing every surface. */
+static int hash_instance(const bake_fixture *f, int i, uint64_t *h) {
+    sinew_instance_def d = sinew_instance_def_default();
+    d.mode = i % 2 ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+    sinew_instance *inst;
+    *h = 0xcbf29ce484222325ull;
+    if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
+    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
+    float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 6 * ns);
+    int ok = pose && x;
+    for (int s = 0; s < STEPS && ok; ++s) {
+        bake_fixture_pose(f, s + 3 * i, pose);
+        ok = sinew_instance_set_pose(inst, pose, nb) == SINEW_OK &&
+             sinew_instance_step(inst, 1.0f / 30) == SINEW_OK &&
+             sinew_instance_read_surface(inst, x, x + 3 * ns, ns) == SINEW_OK;
+        if (ok) *h = fnv1a(*h, x, sizeof(float) * 6 * ns);
+    }
+    free(pose);
+    free(x);
+    sinew_instance_destroy(inst);
+    return ok;
+}
+
+static void *run(void *p) {
+    job *j = p;
+    for (int i = j->first; i < NINST; i += j->stride) j->ok[i] = hash_instance(j->f, i, &j->hash[i]);
+    return NULL;
+}
+
+/* The combined hash of all instances stepped on `nthreads` threads (0 on failure). */
+static uint64_t hash_on_threads(const bake_fixture *f, int nthreads) {
+    job jobs[4];
+    pthread_t th[4];
+    for (int t = 0; t < nthreads; ++t) {
+        jobs[t] = (job){.f = f, .first = t, .stride = nthreads};
+        if (pthread_create(&th[t], NULL, run, &jobs[t]) != 0) return 0;
+    }
+    for (int t = 0; t < nthreads; ++t) pthread_join(th[t], NULL);
+    uint64_t h = 0xcbf29ce484222325ull;
+    for (int i = 0; i < NINST; ++i) {
+        const job *j = &jobs[i % nthreads];
+        if (!j->ok[i]) return 0;
+        h = fnv1a(h, &j->hash[i], sizeof j->hash[i]);
+    }
+    return h;
+}
+
+TEST(surface_hash_is_golden_on_1_2_4_threads) {
+    bake_fixture f;
+    ENSURE(bake_fixture_make(&f, "finger", 1500, 10, 0));
+    static const int threads[] = {1, 2, 4};
+    uint64_t h[3];
+    for (int t = 0; t < 3; ++t) {
+        h[t] = hash_on_threads(&f, threads[t]);
+        fprintf(stderr, "  %d threads: surface hash 0x%016llx\n", threads[t], (unsigned long long)h[t]);
+    }
+    bake_fixture_free(&f);
+    ENSURE(h[0] != 0);
+    ENSUREF(h[1] == h[0] && h[2] == h[0], "the hash depends on the thread count");
+    ENSUREF(h[0] == GOLDEN_SURFACE_HASH, "surface hash 0x%016llx, golden 0x%016llx",
+            (unsigned long long)h[0], (unsigned long long)GOLDEN_SURFACE_HASH);
+}
+
+SW_TEST_MAIN(CASE(surface_hash_is_golden_on_1_2_4_threads))
