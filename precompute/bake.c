@@ -42,7 +42,8 @@ void *sw_bake_own(sw_bake_result *out, void *p) {
 
 void sw_bake_result_free(sw_bake_result *r) {
     if (!r) return;
-    for (int i = 0; i < r->nstorage; ++i) free(r->storage[i]);
+    for (int i = 0; i < r->nstorage; ++i)
+        free(r->storage[i]);
     free(r->heldout_x);
     free(r->heldout_T);
     free(r->train_x);
@@ -53,7 +54,8 @@ void sw_bake_result_free(sw_bake_result *r) {
 
 void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R, double *t) {
     sw_dualquat dq[SW_MAX_BONES];
-    for (int32_t b = 0; b < s->nb; ++b) sw_dq_from_transform(T + 12 * b, &dq[b]);
+    for (int32_t b = 0; b < s->nb; ++b)
+        sw_dq_from_transform(T + 12 * b, &dq[b]);
     for (int32_t v = 0; v < s->nv; ++v)
         sw_dqs_blend(dq, s->skin_bone + 4 * v, s->skin_weight + 4 * v, 4, R + 9 * v, t + 3 * v);
 }
@@ -67,7 +69,8 @@ static void top4(const double *w, int32_t nb, int32_t *ids, double *ws) {
     for (int32_t b = 0; b < nb; ++b) {
         if (!(w[b] > 0)) continue;
         int k = 4;
-        while (k > 0 && w[b] > ws[k - 1]) --k; /* insertion position */
+        while (k > 0 && w[b] > ws[k - 1])
+            --k; /* insertion position */
         if (k == 4) continue;
         for (int j = 3; j > k; --j) {
             ids[j] = ids[j - 1];
@@ -78,7 +81,8 @@ static void top4(const double *w, int32_t nb, int32_t *ids, double *ws) {
     }
     double sum = ws[0] + ws[1] + ws[2] + ws[3];
     if (sum > 0)
-        for (int k = 0; k < 4; ++k) ws[k] /= sum;
+        for (int k = 0; k < 4; ++k)
+            ws[k] /= sum;
     else
         ws[0] = 1.0;
 }
@@ -115,7 +119,8 @@ static sinew_result prepare(sw_bake_state *s, const sw_character *c, int heat, s
         int32_t b = c->bone_of_vertex[v];
         double *w = s->weights + (size_t)v * s->nb;
         if (b >= 0)
-            for (int32_t k = 0; k < s->nb; ++k) w[k] = k == b ? 1.0 : 0.0;
+            for (int32_t k = 0; k < s->nb; ++k)
+                w[k] = k == b ? 1.0 : 0.0;
         top4(w, s->nb, s->skin_bone + 4 * v, s->skin_weight + 4 * v);
     }
     s->ch.weights.w = s->weights;
@@ -205,8 +210,8 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     sw_bake_params p = params ? *params : sw_bake_params_default();
     if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
     if (p.max_rank < 1 || p.max_rank > 1024 || !(p.pca_energy > 0 && p.pca_energy <= 1) ||
-        !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 ||
-        p.sweep_samples < 1 || p.sweep_samples > 1000 || p.max_train_frames < 1 ||
+        !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 || p.sweep_samples < 1 ||
+        p.sweep_samples > 1000 || p.max_train_frames < 1 ||
         !(p.heldout_fraction >= 0 && p.heldout_fraction < 1) || !(p.spring_k >= 0) ||
         !isfinite(p.spring_k))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
@@ -282,7 +287,8 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     out->stage_seconds[4] = t1 - t0;
     {
         int32_t total = 0;
-        for (int32_t d = 0; d < s.nd; ++d) total += s.cub_n[d];
+        for (int32_t d = 0; d < s.nd; ++d)
+            total += s.cub_n[d];
         char msg[96];
         snprintf(msg, sizeof msg, "%d cubature tets, worst fit %.4f", total,
                  out->cubature_error_max);
@@ -290,7 +296,8 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     }
 
     t0 = t1;
-    if ((r = sw_bake_contacts(&s, err)) != SINEW_OK || (r = sw_bake_reduce(&s, out, err)) != SINEW_OK)
+    if ((r = sw_bake_contacts(&s, err)) != SINEW_OK ||
+        (r = sw_bake_reduce(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;

@@ -25,25 +25,25 @@
 #include "sw_mesh.h"
 
 typedef struct sw_bake_params {
-    int32_t max_rank;       /* per domain (default 30) */
-    double pca_energy;      /* fraction of snapshot energy kept (default 0.9999) */
-    double cubature_tol;    /* default 0.05 */
-    int32_t cubature_max;   /* per domain (default 1000) */
+    int32_t max_rank;              /* per domain (default 30) */
+    double pca_energy;             /* fraction of snapshot energy kept (default 0.9999) */
+    double cubature_tol;           /* default 0.05 */
+    int32_t cubature_max;          /* per domain (default 1000) */
     sw_cubature_selector selector; /* default NN-HTP */
-    int32_t sweep_samples;  /* poses per joint sweep (default 6) */
-    int32_t max_train_frames; /* clip frames used for training at most (default 40) */
-    int return_path;        /* also train on those frames played back from the last one
-                               (default 0; measured: finger held-out error 0.235 -> 0.164 at
-                               20K tets, unchanged at 50K where the rank grows 41 -> 63) */
-    double heldout_fraction; /* last part of the clip held out (default 0.4) */
-    int32_t random_poses;   /* held-out poses when there is no clip (default 10) */
-    int self_contact;       /* in the training simulations (default 1) */
-    double spring_k;        /* interface springs per copy pair; 0: 20 E h (h the mean rest edge) */
-    int threads;            /* 0: all cores */
+    int32_t sweep_samples;         /* poses per joint sweep (default 6) */
+    int32_t max_train_frames;      /* clip frames used for training at most (default 40) */
+    int return_path;               /* also train on those frames played back from the last one
+                                      (default 0; measured: finger held-out error 0.235 -> 0.164 at
+                                      20K tets, unchanged at 50K where the rank grows 41 -> 63) */
+    double heldout_fraction;       /* last part of the clip held out (default 0.4) */
+    int32_t random_poses;          /* held-out poses when there is no clip (default 10) */
+    int self_contact;              /* in the training simulations (default 1) */
+    double spring_k; /* interface springs per copy pair; 0: 20 E h (h the mean rest edge) */
+    int threads;     /* 0: all cores */
     uint64_t seed;
-    int progress;           /* print stage progress to stderr */
-    int compare_selectors;  /* also train the other two selectors on the same data and
-                               report their sizes and times (the blob keeps `selector`) */
+    int progress;          /* print stage progress to stderr */
+    int compare_selectors; /* also train the other two selectors on the same data and
+                              report their sizes and times (the blob keeps `selector`) */
 } sw_bake_params;
 
 sw_bake_params sw_bake_params_default(void);

@@ -32,14 +32,18 @@ static int32_t orthonormalise(double *U, int64_t m, int32_t r) {
         for (int pass = 0; pass < 2; ++pass) /* twice is enough (Kahan) */
             for (int32_t k = 0; k < kept; ++k) {
                 double dot = 0;
-                for (int64_t i = 0; i < m; ++i) dot += U[i * r + k] * U[i * r + j];
-                for (int64_t i = 0; i < m; ++i) U[i * r + j] -= dot * U[i * r + k];
+                for (int64_t i = 0; i < m; ++i)
+                    dot += U[i * r + k] * U[i * r + j];
+                for (int64_t i = 0; i < m; ++i)
+                    U[i * r + j] -= dot * U[i * r + k];
             }
         double n = 0;
-        for (int64_t i = 0; i < m; ++i) n += U[i * r + j] * U[i * r + j];
+        for (int64_t i = 0; i < m; ++i)
+            n += U[i * r + j] * U[i * r + j];
         n = sqrt(n);
         if (n < 1e-10) continue;
-        for (int64_t i = 0; i < m; ++i) U[i * r + kept] = U[i * r + j] / n;
+        for (int64_t i = 0; i < m; ++i)
+            U[i * r + kept] = U[i * r + j] / n;
         kept++;
     }
     return kept;
@@ -59,17 +63,20 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
     for (int32_t a = 0; a < T; ++a)
         for (int32_t b = a; b < T; ++b) {
             double g = 0;
-            for (int64_t i = 0; i < m; ++i) g += D[(size_t)a * m + i] * D[(size_t)b * m + i];
+            for (int64_t i = 0; i < m; ++i)
+                g += D[(size_t)a * m + i] * D[(size_t)b * m + i];
             G[(size_t)a * T + b] = G[(size_t)b * T + a] = g;
         }
     openblas_set_num_threads(1);
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', T, G, T, ev) != 0) goto done;
     double total = 0;
-    for (int32_t k = 0; k < T; ++k) total += fmax(ev[k], 0.0);
+    for (int32_t k = 0; k < T; ++k)
+        total += fmax(ev[k], 0.0);
     int32_t r = 0;
     double acc = 0;
     /* eigenvalues ascend: take from the top */
-    while (r < T && r < max_rank && (r == 0 || acc < energy * total) && ev[T - 1 - r] > 1e-14 * total) {
+    while (r < T && r < max_rank && (r == 0 || acc < energy * total) &&
+           ev[T - 1 - r] > 1e-14 * total) {
         acc += ev[T - 1 - r];
         r++;
     }
@@ -83,7 +90,8 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
             for (int32_t a = 0; a < T; ++a) {
                 double c = G[(size_t)a * T + col] / sig;
                 if (c == 0) continue;
-                for (int64_t i = 0; i < m; ++i) U[i * r + k] += c * D[(size_t)a * m + i];
+                for (int64_t i = 0; i < m; ++i)
+                    U[i * r + k] += c * D[(size_t)a * m + i];
             }
         }
         r = orthonormalise(U, m, r);
@@ -107,7 +115,8 @@ static void project(const sw_bake_state *s, int32_t dm, const double *d, double 
     for (int32_t k = 0; k < r; ++k) {
         double acc = 0;
         for (int32_t j = 0; j < n; ++j)
-            for (int i = 0; i < 3; ++i) acc += U[(size_t)(3 * j + i) * r + k] * d[3 * s->dom_verts[base + j] + i];
+            for (int i = 0; i < 3; ++i)
+                acc += U[(size_t)(3 * j + i) * r + k] * d[3 * s->dom_verts[base + j] + i];
         q[k] = acc;
     }
 }
@@ -122,7 +131,8 @@ static void projection_error(const sw_bake_state *s, const double *d, double *nu
         for (int32_t j = 0; j < n; ++j)
             for (int i = 0; i < 3; ++i) {
                 double p = 0;
-                for (int32_t k = 0; k < r; ++k) p += U[(size_t)(3 * j + i) * r + k] * q[k];
+                for (int32_t k = 0; k < r; ++k)
+                    p += U[(size_t)(3 * j + i) * r + k] * q[k];
                 double dv = d[3 * s->dom_verts[base + j] + i];
                 *num += (dv - p) * (dv - p);
                 *den += dv * dv;
@@ -132,10 +142,12 @@ static void projection_error(const sw_bake_state *s, const double *d, double *nu
 
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     int32_t T = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i) T += s->train[i].npose;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        T += s->train[i].npose;
     int64_t n3 = 3 * (int64_t)s->nv;
     double *dall = malloc((size_t)T * n3 * sizeof(double));
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)), *t = malloc((size_t)s->nv * 3 * sizeof(double));
+    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->nv * 3 * sizeof(double));
     double *dtmp = malloc((size_t)n3 * sizeof(double));
     s->rank = calloc((size_t)s->nd, sizeof(int32_t));
     s->basis = calloc((size_t)s->nd, sizeof(double *));
@@ -152,9 +164,10 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         if (!D) goto oom;
         for (int32_t a = 0; a < T; ++a)
             for (int32_t j = 0; j < n; ++j)
-                memcpy(D + (size_t)a * 3 * n + 3 * j, dall + (size_t)a * n3 + 3 * s->dom_verts[base + j],
-                       3 * sizeof(double));
-        s->basis[dm] = domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy, &s->rank[dm]);
+                memcpy(D + (size_t)a * 3 * n + 3 * j,
+                       dall + (size_t)a * n3 + 3 * s->dom_verts[base + j], 3 * sizeof(double));
+        s->basis[dm] =
+            domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy, &s->rank[dm]);
         free(D);
         if (!s->basis[dm]) goto oom;
         s->rank_total += s->rank[dm];
@@ -177,7 +190,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         }
     }
     double num = 0, den = 0;
-    for (int32_t a = 0; a < T; ++a) projection_error(s, dall + (size_t)a * n3, &num, &den);
+    for (int32_t a = 0; a < T; ++a)
+        projection_error(s, dall + (size_t)a * n3, &num, &den);
     out->train_proj_error = den > 0 ? sqrt(num / den) : 0;
     num = den = 0;
     for (int32_t j = 0; j < s->heldout.npose; ++j) {

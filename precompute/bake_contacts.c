@@ -12,10 +12,12 @@
 
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err) {
     int32_t *first = malloc((size_t)s->nv * 2 * sizeof(int32_t));
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)), *t = malloc((size_t)s->nv * 3 * sizeof(double));
+    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->nv * 3 * sizeof(double));
     s->contact_ptr = calloc((size_t)s->ntrain + 1, sizeof(int32_t));
     int32_t total = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i) total += s->train[i].ncontacts;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        total += s->train[i].ncontacts;
     s->ncontacts = 0;
     s->contact_verts = malloc(((size_t)total + 1) * 8 * sizeof(int32_t));
     s->contact_data = malloc(((size_t)total + 1) * 7 * sizeof(double));
@@ -24,7 +26,8 @@ sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for contacts");
         goto done;
     }
-    for (int32_t v = 0; v < s->nv; ++v) first[2 * v] = -1;
+    for (int32_t v = 0; v < s->nv; ++v)
+        first[2 * v] = -1;
     for (int32_t d = s->nd - 1; d >= 0; --d) /* the lowest domain holding the vertex wins */
         for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k) {
             first[2 * s->dom_verts[k]] = d;
@@ -40,7 +43,8 @@ sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err) {
             if (n > 0) sw_bake_skin_transforms(s, T, R, t);
             for (int32_t m = 0; m < n; ++m) {
                 int32_t ids[4] = {c[m].p, c[m].tri[0], c[m].tri[1], c[m].tri[2]}, ok = 1;
-                for (int a = 0; a < 4; ++a) ok = ok && first[2 * ids[a]] >= 0;
+                for (int a = 0; a < 4; ++a)
+                    ok = ok && first[2 * ids[a]] >= 0;
                 if (!ok) continue; /* a vertex in no domain cannot carry a force */
                 int32_t *cv = s->contact_verts + 8 * (size_t)s->ncontacts;
                 double *cd = s->contact_data + 7 * (size_t)s->ncontacts;
@@ -49,7 +53,8 @@ sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err) {
                     cv[2 * a + 1] = first[2 * ids[a] + 1];
                 }
                 const double *Rp = R + 9 * (size_t)c[m].p;
-                for (int a = 0; a < 3; ++a) cd[a] = c[m].beta[a];
+                for (int a = 0; a < 3; ++a)
+                    cd[a] = c[m].beta[a];
                 for (int a = 0; a < 3; ++a)
                     cd[3 + a] = Rp[a] * c[m].n[0] + Rp[3 + a] * c[m].n[1] + Rp[6 + a] * c[m].n[2];
                 cd[6] = c[m].ka;

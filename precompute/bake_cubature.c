@@ -15,12 +15,12 @@
 typedef struct {
     const sw_bake_state *s;
     int32_t dom, r, nsamples;
-    const double *U;       /* domain basis, 3 n_d x r */
-    const int32_t *tet_local; /* 4 per domain tet: local copy index */
+    const double *U;           /* domain basis, 3 n_d x r */
+    const int32_t *tet_local;  /* 4 per domain tet: local copy index */
     const double *dminv, *vol; /* per domain tet */
-    const double *q;       /* nsamples x r */
-    const sw_dualquat *dq; /* nsamples x nb (pose of each sample) */
-    const double *inv_norm; /* nsamples: 1 / |b_s| (0 drops the sample) */
+    const double *q;           /* nsamples x r */
+    const sw_dualquat *dq;     /* nsamples x nb (pose of each sample) */
+    const double *inv_norm;    /* nsamples: 1 / |b_s| (0 drops the sample) */
     double mu, lambda;
 } cub_ctx;
 
@@ -37,21 +37,26 @@ static void tet_reduced_force(const cub_ctx *c, int64_t i, int32_t smp, double *
         const double *Uv = c->U + (size_t)3 * loc * r, *q = c->q + (size_t)smp * r;
         for (int d = 0; d < 3; ++d) {
             double acc = s->ch.mesh.X[3 * v + d];
-            for (int32_t j = 0; j < r; ++j) acc += Uv[d * r + j] * q[j];
+            for (int32_t j = 0; j < r; ++j)
+                acc += Uv[d * r + j] * q[j];
             y[d] = acc;
         }
         for (int d = 0; d < 3; ++d)
-            xe[3 * k + d] = R[k][3 * d] * y[0] + R[k][3 * d + 1] * y[1] + R[k][3 * d + 2] * y[2] + t[d];
+            xe[3 * k + d] =
+                R[k][3 * d] * y[0] + R[k][3 * d + 1] * y[1] + R[k][3 * d + 2] * y[2] + t[d];
     }
     sw_corot_eval(xe, c->dminv + 9 * i, c->vol[i], c->mu, c->lambda, f, NULL, 0);
-    for (int32_t j = 0; j < r; ++j) a[j] = 0;
+    for (int32_t j = 0; j < r; ++j)
+        a[j] = 0;
     for (int k = 0; k < 4; ++k) {
         const double *fk = f + 3 * k;
         double g[3]; /* R_k^T f_k */
-        for (int d = 0; d < 3; ++d) g[d] = R[k][d] * fk[0] + R[k][3 + d] * fk[1] + R[k][6 + d] * fk[2];
+        for (int d = 0; d < 3; ++d)
+            g[d] = R[k][d] * fk[0] + R[k][3 + d] * fk[1] + R[k][6 + d] * fk[2];
         const double *Uv = c->U + (size_t)3 * c->tet_local[4 * i + k] * r;
         for (int d = 0; d < 3; ++d)
-            for (int32_t j = 0; j < r; ++j) a[j] += Uv[d * r + j] * g[d];
+            for (int32_t j = 0; j < r; ++j)
+                a[j] += Uv[d * r + j] * g[d];
     }
 }
 
@@ -60,7 +65,8 @@ static void column(void *vctx, int64_t cand, double *col) {
     for (int32_t smp = 0; smp < c->nsamples; ++smp) {
         double *a = col + (size_t)smp * c->r;
         tet_reduced_force(c, cand, smp, a);
-        for (int32_t j = 0; j < c->r; ++j) a[j] *= c->inv_norm[smp];
+        for (int32_t j = 0; j < c->r; ++j)
+            a[j] *= c->inv_norm[smp];
     }
 }
 
@@ -78,7 +84,8 @@ static void sum_worker(void *vctx, int64_t begin, int64_t end, int worker) {
     for (int64_t i = begin; i < end; ++i)
         for (int32_t smp = 0; smp < c->nsamples; ++smp) {
             tet_reduced_force(c, i, smp, a);
-            for (int32_t j = 0; j < c->r; ++j) acc[(size_t)smp * c->r + j] += a[j];
+            for (int32_t j = 0; j < c->r; ++j)
+                acc[(size_t)smp * c->r + j] += a[j];
         }
 }
 
@@ -102,14 +109,17 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
     int32_t *local_of = malloc((size_t)s->nv * sizeof(int32_t));
     int32_t *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t));
-    double *dminv = malloc((size_t)ntd * 9 * sizeof(double)), *vol = malloc((size_t)ntd * sizeof(double));
-    double *q = calloc((size_t)ns * r, sizeof(double)), *inv_norm = malloc((size_t)ns * sizeof(double));
+    double *dminv = malloc((size_t)ntd * 9 * sizeof(double)),
+           *vol = malloc((size_t)ntd * sizeof(double));
+    double *q = calloc((size_t)ns * r, sizeof(double)),
+           *inv_norm = malloc((size_t)ns * sizeof(double));
     sw_dualquat *dq = malloc((size_t)ns * s->nb * sizeof(sw_dualquat));
     double *b = NULL, *partial = NULL;
     sw_cubature_result cr;
     memset(&cr, 0, sizeof cr);
     if (!local_of || !tet_local || !dminv || !vol || !q || !inv_norm || !dq) goto done;
-    for (int32_t k = 0; k < nvd; ++k) local_of[s->dom_verts[base + k]] = k;
+    for (int32_t k = 0; k < nvd; ++k)
+        local_of[s->dom_verts[base + k]] = k;
     for (int32_t i = 0; i < ntd; ++i) {
         const int32_t *tet = s->ch.mesh.tets + 4 * (int64_t)s->dom_tets[t0 + i];
         double Xe[12];
@@ -127,19 +137,23 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
             double acc = 0;
             for (int32_t k = 0; k < nvd; ++k)
                 for (int d = 0; d < 3; ++d)
-                    acc += U[(size_t)(3 * k + d) * r + j] * dsnap[(size_t)a * 3 * s->nv + 3 * s->dom_verts[base + k] + d];
+                    acc += U[(size_t)(3 * k + d) * r + j] *
+                           dsnap[(size_t)a * 3 * s->nv + 3 * s->dom_verts[base + k] + d];
             q[(size_t)a * r + j] = acc;
             rms[j] += acc * acc / T;
         }
-        memcpy(dq + (size_t)a * s->nb, pose_dq + (size_t)a * s->nb, (size_t)s->nb * sizeof(sw_dualquat));
-        memcpy(dq + (size_t)(T + a) * s->nb, pose_dq + (size_t)a * s->nb, (size_t)s->nb * sizeof(sw_dualquat));
+        memcpy(dq + (size_t)a * s->nb, pose_dq + (size_t)a * s->nb,
+               (size_t)s->nb * sizeof(sw_dualquat));
+        memcpy(dq + (size_t)(T + a) * s->nb, pose_dq + (size_t)a * s->nb,
+               (size_t)s->nb * sizeof(sw_dualquat));
     }
     uint64_t seed = s->p->seed ^ (0x9e37ULL * (uint64_t)(dom + 1));
     for (int32_t a = 0; a < T; ++a)
         for (int32_t j = 0; j < r; ++j)
             q[(size_t)(T + a) * r + j] = q[(size_t)a * r + j] + 0.5 * sqrt(rms[j]) * gauss(&seed);
     free(rms);
-    for (int32_t smp = 0; smp < ns; ++smp) inv_norm[smp] = 1.0;
+    for (int32_t smp = 0; smp < ns; ++smp)
+        inv_norm[smp] = 1.0;
     cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, 0, 0};
     sw_lame(s->ch.youngs, s->ch.poisson, &c.mu, &c.lambda);
     /* b: the domain's full reduced force per sample (Krysl projection), summed in
@@ -152,18 +166,21 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     sum_ctx sc = {&c, ntd, partial};
     sw_pool_parallel_for(s->pool, ntd, sum_worker, &sc);
     for (int w = 0; w < workers; ++w)
-        for (size_t i = 0; i < block; ++i) b[i] += partial[(size_t)w * block + i];
+        for (size_t i = 0; i < block; ++i)
+            b[i] += partial[(size_t)w * block + i];
     double bmax = 0;
     for (int32_t smp = 0; smp < ns; ++smp) {
         double n2 = 0;
-        for (int32_t j = 0; j < r; ++j) n2 += b[(size_t)smp * r + j] * b[(size_t)smp * r + j];
+        for (int32_t j = 0; j < r; ++j)
+            n2 += b[(size_t)smp * r + j] * b[(size_t)smp * r + j];
         inv_norm[smp] = sqrt(n2);
         bmax = fmax(bmax, inv_norm[smp]);
     }
     for (int32_t smp = 0; smp < ns; ++smp) { /* normalise; drop force-free samples */
         double n = inv_norm[smp];
         inv_norm[smp] = n > 1e-9 * bmax && n > 0 ? 1.0 / n : 0.0;
-        for (int32_t j = 0; j < r; ++j) b[(size_t)smp * r + j] *= inv_norm[smp];
+        for (int32_t j = 0; j < r; ++j)
+            b[(size_t)smp * r + j] *= inv_norm[smp];
     }
     sw_cubature_problem prob = {(int64_t)block, ntd, b, column, &c};
     sw_cubature_params cp = sw_cubature_params_default();
@@ -213,13 +230,15 @@ done:
 
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     int32_t T = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i) T += s->train[i].npose;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        T += s->train[i].npose;
     int64_t n3 = 3 * (int64_t)s->nv;
     s->cub_n = calloc((size_t)s->nd, sizeof(int32_t));
     s->cub_local = calloc((size_t)s->nd, sizeof(int32_t *));
     s->cub_w = calloc((size_t)s->nd, sizeof(double *));
     double *dsnap = malloc((size_t)T * n3 * sizeof(double));
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)), *t = malloc((size_t)s->nv * 3 * sizeof(double));
+    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->nv * 3 * sizeof(double));
     sw_dualquat *pose_dq = malloc((size_t)T * s->nb * sizeof(sw_dualquat));
     sinew_result res = SINEW_OK;
     if (!s->cub_n || !s->cub_local || !s->cub_w || !dsnap || !R || !t || !pose_dq) {
@@ -230,7 +249,8 @@ sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *e
     int32_t k = 0;
     for (int32_t i = 0; i < s->ntrain_seq; ++i)
         for (int32_t j = 0; j < s->train[i].npose; ++j, ++k) {
-            const double *T12 = s->train[i].T + (size_t)j * 12 * s->nb, *x = s->train[i].x + (size_t)j * n3;
+            const double *T12 = s->train[i].T + (size_t)j * 12 * s->nb,
+                         *x = s->train[i].x + (size_t)j * n3;
             double *d = dsnap + (size_t)k * n3;
             sw_bake_skin_transforms(s, T12, R, t);
             for (int32_t v = 0; v < s->nv; ++v) {
@@ -239,7 +259,8 @@ sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *e
                 for (int a = 0; a < 3; ++a)
                     d[3 * v + a] = Rv[a] * w[0] + Rv[3 + a] * w[1] + Rv[6 + a] * w[2] - X[a];
             }
-            for (int32_t b = 0; b < s->nb; ++b) sw_dq_from_transform(T12 + 12 * b, &pose_dq[(size_t)k * s->nb + b]);
+            for (int32_t b = 0; b < s->nb; ++b)
+                sw_dq_from_transform(T12 + 12 * b, &pose_dq[(size_t)k * s->nb + b]);
         }
     out->cubature_error_max = 0;
     for (int32_t d = 0; d < s->nd && res == SINEW_OK; ++d)

@@ -20,9 +20,11 @@ static int32_t strongest_bone(const sw_bake_state *s, int32_t v) {
  * larger summed weight over the tet, then the lower id (deterministic). */
 static int32_t tet_bone(const sw_bake_state *s, const int32_t *tet) {
     int32_t bones[4], votes[4] = {0, 0, 0, 0};
-    for (int k = 0; k < 4; ++k) bones[k] = strongest_bone(s, tet[k]);
     for (int k = 0; k < 4; ++k)
-        for (int j = 0; j < 4; ++j) votes[k] += bones[j] == bones[k];
+        bones[k] = strongest_bone(s, tet[k]);
+    for (int k = 0; k < 4; ++k)
+        for (int j = 0; j < 4; ++j)
+            votes[k] += bones[j] == bones[k];
     int32_t best = 0;
     for (int k = 1; k < 4; ++k) {
         if (votes[k] < votes[best]) continue;
@@ -55,10 +57,13 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
         free(mark);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
     }
-    for (int32_t b = 0; b < s->nb; ++b) domain_of_bone[b] = -1;
-    for (int32_t t = 0; t < s->nt; ++t) s->tet_domain[t] = tet_bone(s, tets + 4 * t);
+    for (int32_t b = 0; b < s->nb; ++b)
+        domain_of_bone[b] = -1;
+    for (int32_t t = 0; t < s->nt; ++t)
+        s->tet_domain[t] = tet_bone(s, tets + 4 * t);
     /* domains in bone order, only for bones that own tets */
-    for (int32_t t = 0; t < s->nt; ++t) domain_of_bone[s->tet_domain[t]] = 1;
+    for (int32_t t = 0; t < s->nt; ++t)
+        domain_of_bone[s->tet_domain[t]] = 1;
     s->nd = 0;
     for (int32_t b = 0; b < s->nb; ++b)
         if (domain_of_bone[b] > 0) {
@@ -69,7 +74,8 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
         s->tet_domain[t] = domain_of_bone[s->tet_domain[t]];
         s->dom_tet_ptr[s->tet_domain[t] + 1]++;
     }
-    for (int32_t d = 0; d < s->nd; ++d) s->dom_tet_ptr[d + 1] += s->dom_tet_ptr[d];
+    for (int32_t d = 0; d < s->nd; ++d)
+        s->dom_tet_ptr[d + 1] += s->dom_tet_ptr[d];
     {
         int32_t *fill = malloc((size_t)s->nd * sizeof(int32_t));
         if (!fill) {
@@ -78,7 +84,8 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
             return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
         }
         memcpy(fill, s->dom_tet_ptr, (size_t)s->nd * sizeof(int32_t));
-        for (int32_t t = 0; t < s->nt; ++t) s->dom_tets[fill[s->tet_domain[t]]++] = t;
+        for (int32_t t = 0; t < s->nt; ++t)
+            s->dom_tets[fill[s->tet_domain[t]]++] = t;
         free(fill);
     }
     /* vertex copies: two passes (count, fill), vertices ascending per domain */
@@ -86,9 +93,11 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
     for (int pass = 0; pass < 2; ++pass) {
         ncopies = 0;
         for (int32_t d = 0; d < s->nd; ++d) {
-            for (int32_t v = 0; v < s->nv; ++v) mark[v] = 0;
+            for (int32_t v = 0; v < s->nv; ++v)
+                mark[v] = 0;
             for (int32_t i = s->dom_tet_ptr[d]; i < s->dom_tet_ptr[d + 1]; ++i)
-                for (int k = 0; k < 4; ++k) mark[tets[4 * s->dom_tets[i] + k]] = 1;
+                for (int k = 0; k < 4; ++k)
+                    mark[tets[4 * s->dom_tets[i] + k]] = 1;
             if (pass == 1) s->dom_vert_ptr[d] = (int32_t)ncopies;
             for (int32_t v = 0; v < s->nv; ++v)
                 if (mark[v]) {
@@ -115,13 +124,16 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
     /* copy masses: lumped mass of each copy from its own domain's tets */
     for (int32_t d = 0; d < s->nd; ++d) {
         int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base;
-        for (int32_t k = 0; k < n; ++k) mark[s->dom_verts[base + k]] = base + k;
+        for (int32_t k = 0; k < n; ++k)
+            mark[s->dom_verts[base + k]] = base + k;
         for (int32_t i = s->dom_tet_ptr[d]; i < s->dom_tet_ptr[d + 1]; ++i) {
             const int32_t *q = tets + 4 * s->dom_tets[i];
             double Xe[12], Dm[9], vol;
-            for (int k = 0; k < 4; ++k) memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)q[k], 24);
+            for (int k = 0; k < 4; ++k)
+                memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)q[k], 24);
             sw_tet_rest(Xe, Dm, &vol);
-            for (int k = 0; k < 4; ++k) s->copy_mass[mark[q[k]]] += s->ch.density * vol / 4.0;
+            for (int k = 0; k < 4; ++k)
+                s->copy_mass[mark[q[k]]] += s->ch.density * vol / 4.0;
         }
     }
     free(domain_of_bone);

@@ -10,9 +10,9 @@
 /* A sequence of poses simulated in order (each warm-starts the next). */
 typedef struct sw_pose_seq {
     int32_t npose;
-    double *T; /* npose * 12 * nbones bone transforms */
-    double *x; /* npose * 3 * nverts full-space solutions (filled by simulate) */
-    int failed; /* poses whose solve returned NOT_FINITE */
+    double *T;     /* npose * 12 * nbones bone transforms */
+    double *x;     /* npose * 3 * nverts full-space solutions (filled by simulate) */
+    int failed;    /* poses whose solve returned NOT_FINITE */
     int unsettled; /* poses whose contact set the simulator's round cap left unsettled */
     /* the reference's self-contact set of every solution (filled by simulate): pose k
        owns contacts[contact_ptr[k], contact_ptr[k+1]) */
@@ -28,8 +28,8 @@ typedef struct sw_pose_seq {
 
 typedef struct sw_bake_state {
     const sw_bake_params *p;
-    sw_character ch;  /* the character with the bake's weights (mesh/skeleton borrowed) */
-    double *weights;  /* owned nverts * nbones */
+    sw_character ch; /* the character with the bake's weights (mesh/skeleton borrowed) */
+    double *weights; /* owned nverts * nbones */
     int32_t nv, nt, nb;
     /* top-4 skin influences (runtime's DQS) */
     int32_t *skin_bone;  /* 4 nv */

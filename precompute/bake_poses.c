@@ -39,7 +39,8 @@ static double rotation_axis_angle(const double R[9], double axis[3]) {
     double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
     if (n < 1e-12) { /* angle 0 or pi: take the column of the largest diagonal of R + I */
         int k = R[0] >= R[4] && R[0] >= R[8] ? 0 : R[4] >= R[8] ? 1 : 2;
-        for (int i = 0; i < 3; ++i) a[i] = R[3 * i + k] + (i == k ? 1.0 : 0.0);
+        for (int i = 0; i < 3; ++i)
+            a[i] = R[3 * i + k] + (i == k ? 1.0 : 0.0);
         n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
         if (n < 1e-12) {
             a[0] = 1;
@@ -47,7 +48,8 @@ static double rotation_axis_angle(const double R[9], double axis[3]) {
             n = 1;
         }
     }
-    for (int i = 0; i < 3; ++i) axis[i] = a[i] / n;
+    for (int i = 0; i < 3; ++i)
+        axis[i] = a[i] / n;
     return angle;
 }
 
@@ -111,18 +113,23 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     if (nf < 2) /* no clip: sweep every joint 90 degrees about an axis across its bone */
         for (int32_t b = 0; b < nb; ++b) {
             if (sk->parent[b] < 0) continue;
-            const double *h = sk->joints + 3 * sk->bones[2 * b], *t = sk->joints + 3 * sk->bones[2 * b + 1];
+            const double *h = sk->joints + 3 * sk->bones[2 * b],
+                         *t = sk->joints + 3 * sk->bones[2 * b + 1];
             double d[3] = {t[0] - h[0], t[1] - h[1], t[2] - h[2]};
             double z[3] = {0, 0, 1};
-            if (fabs(d[2]) > 0.9 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])) z[1] = 1, z[2] = 0;
-            double a[3] = {d[1] * z[2] - d[2] * z[1], d[2] * z[0] - d[0] * z[2], d[0] * z[1] - d[1] * z[0]};
+            if (fabs(d[2]) > 0.9 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
+                z[1] = 1, z[2] = 0;
+            double a[3] = {d[1] * z[2] - d[2] * z[1], d[2] * z[0] - d[0] * z[2],
+                           d[0] * z[1] - d[1] * z[0]};
             double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
             if (n == 0) continue;
-            for (int i = 0; i < 3; ++i) sweep_axis[3 * b + i] = a[i] / n;
+            for (int i = 0; i < 3; ++i)
+                sweep_axis[3 * b + i] = a[i] / n;
             sweep_angle[b] = 1.5707963267948966; /* 90 degrees */
         }
     int32_t njoint = 0;
-    for (int32_t b = 0; b < nb; ++b) njoint += sweep_angle[b] > 1e-3;
+    for (int32_t b = 0; b < nb; ++b)
+        njoint += sweep_angle[b] > 1e-3;
 
     int32_t nclip = ntrain_frames < s->p->max_train_frames ? ntrain_frames : s->p->max_train_frames;
     int32_t nreturn = s->p->return_path && nclip >= 2 ? nclip - 1 : 0;
@@ -143,8 +150,8 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     if (nreturn > 0) { /* train[0]'s frames n-2 .. 0, continuing from its last solution */
         if (!seq_alloc(&s->train[qi], nreturn, nb, s->nv)) goto oom;
         for (int32_t i = 0; i < nreturn; ++i)
-            memcpy(s->train[qi].T + (size_t)i * 12 * nb, s->train[0].T + (size_t)(nreturn - 1 - i) * 12 * nb,
-                   12 * nb * sizeof(double));
+            memcpy(s->train[qi].T + (size_t)i * 12 * nb,
+                   s->train[0].T + (size_t)(nreturn - 1 - i) * 12 * nb, 12 * nb * sizeof(double));
         s->train[0].then[1] = &s->train[qi];
         s->train[qi].continues = 1;
         qi++;
@@ -159,7 +166,8 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
                 memset(L, 0, 9 * sizeof(double));
                 L[0] = L[4] = L[8] = 1;
             }
-            rotation_from_axis_angle(sweep_axis + 3 * b, sweep_angle[b] * (i + 1) / n, local + 9 * b);
+            rotation_from_axis_angle(sweep_axis + 3 * b, sweep_angle[b] * (i + 1) / n,
+                                     local + 9 * b);
             sw_forward_kinematics(sk, local, NULL, s->train[qi].T + (size_t)i * 12 * nb);
         }
         qi++;
@@ -168,7 +176,8 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
         int32_t n = nheld_frames < s->p->max_train_frames ? nheld_frames : s->p->max_train_frames;
         if (!seq_alloc(&s->heldout, n, nb, s->nv)) goto oom;
         for (int32_t i = 0; i < n; ++i) {
-            int32_t f = ntrain_frames + (n == 1 ? 0 : (int32_t)((int64_t)i * (nheld_frames - 1) / (n - 1)));
+            int32_t f =
+                ntrain_frames + (n == 1 ? 0 : (int32_t)((int64_t)i * (nheld_frames - 1) / (n - 1)));
             memcpy(s->heldout.T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
                    12 * nb * sizeof(double));
         }
@@ -234,7 +243,8 @@ static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
         sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, &st);
         if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
         q->unsettled += st.contacts_unsettled;
-        memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim), (size_t)s->nv * 3 * sizeof(double));
+        memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
+               (size_t)s->nv * 3 * sizeof(double));
         if (!keep_contacts(q, k, sim)) q->oom = 1;
     }
 }
@@ -298,10 +308,12 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "the full-space simulator rejected the character");
     n = 0; /* the checks below: every sequence, continuations too */
-    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i) seqs[n++] = &s->train[i];
+    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
+        seqs[n++] = &s->train[i];
     if (s->heldout.npose > 0) seqs[n++] = &s->heldout;
     for (int32_t i = 0; i < n; ++i)
-        if (seqs[i]->oom) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for contact sets");
+        if (seqs[i]->oom)
+            return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for contact sets");
     for (int32_t i = 0; i < n; ++i)
         if (seqs[i]->failed)
             return sw_error_set(err, SINEW_ERROR_NOT_FINITE,

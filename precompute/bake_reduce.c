@@ -13,7 +13,8 @@
 #include "fem_corot.h"
 #include "mesh_io.h"
 
-#define OWN(ptr, n, type) ((ptr) = sw_bake_own(out, calloc((size_t)(n) > 0 ? (size_t)(n) : 1, sizeof(type))))
+#define OWN(ptr, n, type)                                                                          \
+    ((ptr) = sw_bake_own(out, calloc((size_t)(n) > 0 ? (size_t)(n) : 1, sizeof(type))))
 
 /* Mean rest edge length over the tets' edges. */
 static double mean_edge(const sw_tetmesh *m) {
@@ -21,8 +22,10 @@ static double mean_edge(const sw_tetmesh *m) {
     double sum = 0;
     for (int32_t t = 0; t < m->ntets; ++t)
         for (int k = 0; k < 6; ++k) {
-            const double *a = m->X + 3 * m->tets[4 * t + e[k][0]], *b = m->X + 3 * m->tets[4 * t + e[k][1]];
-            sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) + (a[2] - b[2]) * (a[2] - b[2]));
+            const double *a = m->X + 3 * m->tets[4 * t + e[k][0]],
+                         *b = m->X + 3 * m->tets[4 * t + e[k][1]];
+            sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
+                        (a[2] - b[2]) * (a[2] - b[2]));
         }
     return m->ntets > 0 ? sum / (6.0 * m->ntets) : 0;
 }
@@ -34,7 +37,8 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
        E h: a fixed k locks the interface of a fine mesh (the domains' bases cannot
        match there exactly) and measured best at 20 E h on the finger from 5K to 50K
        tets (correction error 0.041 at 20K against 0.062 with k = 20 E) */
-    double kspring = s->p->spring_k > 0 ? s->p->spring_k : 20.0 * s->ch.youngs * mean_edge(&s->ch.mesh);
+    double kspring =
+        s->p->spring_k > 0 ? s->p->spring_k : 20.0 * s->ch.youngs * mean_edge(&s->ch.mesh);
     sw_surface surf;
     memset(&surf, 0, sizeof surf);
     sinew_result r = sw_tetmesh_surface(&s->ch.mesh, &surf, err);
@@ -86,7 +90,8 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     for (int32_t b = 0; b < s->nb; ++b) {
         parent[b] = s->ch.skel.parent[b];
         memcpy(joints + 6 * b, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b], 3 * sizeof(double));
-        memcpy(joints + 6 * b + 3, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b + 1], 3 * sizeof(double));
+        memcpy(joints + 6 * b + 3, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b + 1],
+               3 * sizeof(double));
     }
     memcpy(dverts, s->dom_verts, (size_t)ncopies * sizeof(int32_t));
 
@@ -109,7 +114,8 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
         const double *U = s->basis[d];
         memcpy(basis + boff, U, (size_t)n * 3 * r_d * sizeof(double));
         int32_t *local_of = surf_index; /* scratch: global -> local for this domain */
-        for (int32_t k = 0; k < n; ++k) local_of[s->dom_verts[base + k]] = k;
+        for (int32_t k = 0; k < n; ++k)
+            local_of[s->dom_verts[base + k]] = k;
         for (int32_t i = 0; i < s->cub_n[d]; ++i, ++cub) {
             int32_t tet = s->dom_tets[s->dom_tet_ptr[d] + s->cub_local[d][i]];
             double Xe[12];
@@ -123,13 +129,15 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
         }
         for (int32_t k = 0; k < n; ++k) {
             double m = s->copy_mass[base + k];
-            const double *Uk = U + (size_t)3 * k * r_d, *X = s->ch.mesh.X + 3 * (int64_t)s->dom_verts[base + k];
+            const double *Uk = U + (size_t)3 * k * r_d,
+                         *X = s->ch.mesh.X + 3 * (int64_t)s->dom_verts[base + k];
             for (int32_t i = 0; i < r_d; ++i) {
                 for (int a = 0; a < 3; ++a) {
                     double u = m * Uk[a * r_d + i];
                     if (u == 0) continue;
                     ins[3 * (qoff + i) + a] += u;
-                    for (int bb = 0; bb < 3; ++bb) inx[9 * (qoff + i) + 3 * a + bb] += u * X[bb];
+                    for (int bb = 0; bb < 3; ++bb)
+                        inx[9 * (qoff + i) + 3 * a + bb] += u * X[bb];
                     for (int bb = 0; bb < 3; ++bb)
                         for (int32_t j = 0; j < r_d; ++j)
                             inu[ioff + (int64_t)(3 * a + bb) * r_d * r_d + (int64_t)i * r_d + j] +=
@@ -145,8 +153,10 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     }
     /* copies of each vertex: (domain, local) */
     for (int32_t d = 0; d < nd; ++d)
-        for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k) copy_ptr_v[s->dom_verts[k] + 1]++;
-    for (int32_t i = 0; i < s->nv; ++i) copy_ptr_v[i + 1] += copy_ptr_v[i];
+        for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k)
+            copy_ptr_v[s->dom_verts[k] + 1]++;
+    for (int32_t i = 0; i < s->nv; ++i)
+        copy_ptr_v[i + 1] += copy_ptr_v[i];
     {
         int32_t *fill = surf_index;
         memcpy(fill, copy_ptr_v, (size_t)s->nv * sizeof(int32_t));
@@ -164,13 +174,15 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
                 int32_t di = copy_list[2 * a], li = copy_list[2 * a + 1];
                 int32_t dj = copy_list[2 * b], lj = copy_list[2 * b + 1];
                 int32_t ri = s->rank[di], rj = s->rank[dj];
-                const double *Ui = s->basis[di] + (size_t)3 * li * ri, *Uj = s->basis[dj] + (size_t)3 * lj * rj;
+                const double *Ui = s->basis[di] + (size_t)3 * li * ri,
+                             *Uj = s->basis[dj] + (size_t)3 * lj * rj;
                 int32_t oi = doms[di].q_offset, oj = doms[dj].q_offset;
                 for (int c = 0; c < 3; ++c) {
                     for (int32_t x = 0; x < ri; ++x) {
                         double ux = kspring * Ui[c * ri + x];
                         if (ux == 0) continue;
-                        for (int32_t y = 0; y < ri; ++y) spring[(int64_t)(oi + x) * R + oi + y] += ux * Ui[c * ri + y];
+                        for (int32_t y = 0; y < ri; ++y)
+                            spring[(int64_t)(oi + x) * R + oi + y] += ux * Ui[c * ri + y];
                         for (int32_t y = 0; y < rj; ++y) {
                             spring[(int64_t)(oi + x) * R + oj + y] -= ux * Uj[c * rj + y];
                             spring[(int64_t)(oj + y) * R + oi + x] -= ux * Uj[c * rj + y];
@@ -179,14 +191,18 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
                     for (int32_t x = 0; x < rj; ++x) {
                         double ux = kspring * Uj[c * rj + x];
                         if (ux == 0) continue;
-                        for (int32_t y = 0; y < rj; ++y) spring[(int64_t)(oj + x) * R + oj + y] += ux * Uj[c * rj + y];
+                        for (int32_t y = 0; y < rj; ++y)
+                            spring[(int64_t)(oj + x) * R + oj + y] += ux * Uj[c * rj + y];
                     }
                 }
             }
     /* output surface: the tet mesh's boundary; each vertex the mean of its copies */
-    for (int32_t i = 0; i < s->nv; ++i) surf_index[i] = -1;
-    for (int32_t i = 0; i < surf.nverts; ++i) surf_index[surf.verts[i]] = i;
-    for (int32_t i = 0; i < 3 * surf.ntris; ++i) surf_tris[i] = surf_index[surf.tris[i]];
+    for (int32_t i = 0; i < s->nv; ++i)
+        surf_index[i] = -1;
+    for (int32_t i = 0; i < surf.nverts; ++i)
+        surf_index[surf.verts[i]] = i;
+    for (int32_t i = 0; i < 3 * surf.ntris; ++i)
+        surf_tris[i] = surf_index[surf.tris[i]];
     int32_t nsc = 0;
     for (int32_t i = 0; i < surf.nverts; ++i) {
         int32_t gv = surf.verts[i];

@@ -21,10 +21,9 @@
 #define SW_BONE_MIN_DRIVEN 4
 #define SW_BONE_REACH 2.0
 
-
 static double bone_distance(const sw_tetmesh *m, const sw_skeleton *s, int32_t v, int32_t b) {
     return sw_point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
-                                  s->joints + 3 * s->bones[2 * b + 1]);
+                                     s->joints + 3 * s->bones[2 * b + 1]);
 }
 
 static void sub3(const double *a, const double *b, double *c) {

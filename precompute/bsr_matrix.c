@@ -28,8 +28,8 @@ void sw_bsr_free(sw_bsr *m) {
     memset(m, 0, sizeof *m);
 }
 
-sinew_result sw_bsr_create_from_tets(int32_t nverts, int32_t ntets, const int32_t *tets, sw_bsr *out,
-                                     sw_error *err) {
+sinew_result sw_bsr_create_from_tets(int32_t nverts, int32_t ntets, const int32_t *tets,
+                                     sw_bsr *out, sw_error *err) {
     memset(out, 0, sizeof *out);
     int64_t nent = (int64_t)ntets * 16;
     /* Sorting every element entry by (block, source) yields the block pattern in row
@@ -57,7 +57,8 @@ sinew_result sw_bsr_create_from_tets(int32_t nverts, int32_t ntets, const int32_
     out->src_ptr = malloc(((size_t)nb + 1) * sizeof *out->src_ptr);
     out->src = malloc((size_t)nent * sizeof *out->src);
     if (!out->col || !out->val || !out->src_ptr || !out->src) goto oom;
-    for (int32_t r = 0; r < nverts; ++r) out->diag[r] = -1; /* isolated vertices keep -1 */
+    for (int32_t r = 0; r < nverts; ++r)
+        out->diag[r] = -1; /* isolated vertices keep -1 */
     int64_t b = -1;
     for (int64_t i = 0; i < nent; ++i) {
         if (i == 0 || p[i].rc != p[i - 1].rc) {
@@ -71,7 +72,8 @@ sinew_result sw_bsr_create_from_tets(int32_t nverts, int32_t ntets, const int32_
         out->src[i] = p[i].e;
     }
     out->src_ptr[nb] = nent;
-    for (int32_t r = 0; r < nverts; ++r) out->row_ptr[r + 1] += out->row_ptr[r];
+    for (int32_t r = 0; r < nverts; ++r)
+        out->row_ptr[r + 1] += out->row_ptr[r];
     free(p);
     return SINEW_OK;
 oom:
@@ -98,7 +100,8 @@ static void assemble_rows(void *vctx, int64_t begin, int64_t end, int worker) {
                 int a = (int)(loc / 4), c = (int)(loc % 4);
                 const double *K = ctx->Ke + e * 144;
                 for (int i = 0; i < 3; ++i)
-                    for (int j = 0; j < 3; ++j) acc[3 * i + j] += K[(3 * a + i) * 12 + 3 * c + j];
+                    for (int j = 0; j < 3; ++j)
+                        acc[3 * i + j] += K[(3 * a + i) * 12 + 3 * c + j];
             }
             memcpy(m->val + 9 * b, acc, sizeof acc);
         }

@@ -26,8 +26,8 @@ typedef struct sw_bsr {
 } sw_bsr;
 
 /* Pattern of all vertex pairs sharing a tet (tets: 4*ntets vertex ids < nverts). */
-sinew_result sw_bsr_create_from_tets(int32_t nverts, int32_t ntets, const int32_t *tets, sw_bsr *out,
-                                     sw_error *err);
+sinew_result sw_bsr_create_from_tets(int32_t nverts, int32_t ntets, const int32_t *tets,
+                                     sw_bsr *out, sw_error *err);
 void sw_bsr_free(sw_bsr *m);
 
 /* val = sum of the element matrices Ke (ntets * 144, each 12x12 row-major in the

@@ -18,8 +18,8 @@ sinew_result sw_clip_from_pose_quats(const sw_skeleton *s, const double *quats, 
 
 /* Simple skin weights when an asset has none: inverse distance to bone segments
  * (w ~ 1/d^4), normalised. (The bake owns heat-diffusion weights.) */
-sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton *s,
-                                         sw_weights *out, sw_error *err);
+sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton *s, sw_weights *out,
+                                         sw_error *err);
 
 /* Chooses the vertices driven kinematically by each bone ("inside the bone"): those
  * close to the bone's segment relative to the flesh thickness around it, at least a

@@ -231,7 +231,8 @@ static void gram_range(void *ctx, int64_t begin, int64_t end, int worker) {
         const double *aj = t->cc.col[ej];
         for (int64_t i = 0; i <= j; ++i) {
             int64_t ei = job->list[i], pi = t->pos[ei];
-            double g = (pi >= 0 && pj >= 0) ? t->G[pj * t->s + pi] : sw_dot(t->cc.col[ei], aj, t->m);
+            double g =
+                (pi >= 0 && pj >= 0) ? t->G[pj * t->s + pi] : sw_dot(t->cc.col[ei], aj, t->m);
             job->G[j * k + i] = job->G[i * k + j] = g;
         }
     }

@@ -30,13 +30,13 @@ typedef enum sw_cubature_selector {
 
 typedef struct sw_cubature_params {
     sw_cubature_selector selector;
-    double tol;          /* target relative residual |A w - b| / |b| (default 0.05) */
-    int32_t max_points;  /* upper bound on the set size (default 1000) */
-    int32_t candidates;  /* random candidates examined per iteration (0: automatic) */
+    double tol;            /* target relative residual |A w - b| / |b| (default 0.05) */
+    int32_t max_points;    /* upper bound on the set size (default 1000) */
+    int32_t candidates;    /* random candidates examined per iteration (0: automatic) */
     int32_t per_iteration; /* points added per iteration (importance; 0: automatic) */
-    uint64_t seed;       /* fixed seed: the result is deterministic */
+    uint64_t seed;         /* fixed seed: the result is deterministic */
     sw_nnls_method nnls;
-    int threads;         /* column evaluation threads (0/1: serial) */
+    int threads; /* column evaluation threads (0/1: serial) */
 } sw_cubature_params;
 
 sw_cubature_params sw_cubature_params_default(void);

@@ -26,11 +26,11 @@ struct sw_fullsim {
     sw_surface surf;
     double *vert_area; /* nv: rest surface area around each surface vertex (0 inside) */
     sw_selfcontact *sc;
-    sw_bsr K;    /* pattern; val holds the Newton system matrix during an iteration */
-    double *Kn;  /* 9*nblocks: K(x_n), the Rayleigh stiffness term (dynamics only) */
-    double *Ke;  /* 144*nt element Hessians */
-    double *fe;  /* 12*nt element forces */
-    double *ee;  /* nt element energies */
+    sw_bsr K;               /* pattern; val holds the Newton system matrix during an iteration */
+    double *Kn;             /* 9*nblocks: K(x_n), the Rayleigh stiffness term (dynamics only) */
+    double *Ke;             /* 144*nt element Hessians */
+    double *fe;             /* 12*nt element forces */
+    double *ee;             /* nt element energies */
     int64_t *inc_ptr, *inc; /* vertex -> element entries (4*t + local), for force gathers */
     double *x, *v, *a, *xn, *vn, *an, *xhat, *Dvn;
     double *skin_prev, *skin_now;
@@ -41,8 +41,8 @@ struct sw_fullsim {
     double c_m, c_d, s; /* integrator coefficients of this step */
     const sw_contact *contacts;
     int32_t ncontacts;
-    double gfloor; /* absolute gradient norm treated as converged */
-    uint32_t hess_flags; /* sw_corot_eval flags of the current evaluation */
+    double gfloor;        /* absolute gradient norm treated as converged */
+    uint32_t hess_flags;  /* sw_corot_eval flags of the current evaluation */
     sw_contact *active;   /* the step's contact set: surf.nverts slots, one per vertex */
     int32_t *active_slot; /* nv: slot of a vertex in `active`, or -1 */
 };
@@ -88,11 +88,12 @@ static void eval_elements(void *vctx, int64_t begin, int64_t end, int worker) {
     const int32_t *tets = sim->c->mesh.tets;
     for (int64_t t = begin; t < end; ++t) {
         double xe[12];
-        for (int k = 0; k < 4; ++k) memcpy(xe + 3 * k, ctx->x + 3 * (int64_t)tets[4 * t + k], 24);
-        sim->ee[t] = sw_corot_eval(xe, sim->DmInv + 9 * t, sim->vol[t], sim->mu, sim->lambda,
-                                   ctx->want >= EVAL_FORCE ? sim->fe + 12 * t : NULL,
-                                   ctx->want >= EVAL_HESSIAN ? sim->Ke + 144 * t : NULL,
-                                   sim->hess_flags);
+        for (int k = 0; k < 4; ++k)
+            memcpy(xe + 3 * k, ctx->x + 3 * (int64_t)tets[4 * t + k], 24);
+        sim->ee[t] =
+            sw_corot_eval(xe, sim->DmInv + 9 * t, sim->vol[t], sim->mu, sim->lambda,
+                          ctx->want >= EVAL_FORCE ? sim->fe + 12 * t : NULL,
+                          ctx->want >= EVAL_HESSIAN ? sim->Ke + 144 * t : NULL, sim->hess_flags);
     }
 }
 
@@ -118,13 +119,16 @@ static double evaluate(sw_fullsim *sim, const double *x, int want) {
     if (want >= EVAL_FORCE) sw_pool_parallel_for(sim->pool, sim->nv, gather_forces, sim);
     if (want >= EVAL_HESSIAN) sw_bsr_assemble(&sim->K, sim->Ke, sim->pool);
     double e = 0;
-    for (int32_t t = 0; t < sim->nt; ++t) e += sim->ee[t];
+    for (int32_t t = 0; t < sim->nt; ++t)
+        e += sim->ee[t];
     return e;
 }
 
 /* ---- potential, gradient, operator ------------------------------------------ */
 
-static int dynamic(const sw_fullsim *sim) { return sim->p.integrator != SW_QUASISTATIC; }
+static int dynamic(const sw_fullsim *sim) {
+    return sim->p.integrator != SW_QUASISTATIC;
+}
 
 static double ground_k(const sw_fullsim *sim) {
     return sim->p.ground_k > 0 ? sim->p.ground_k : sim->p.contact_k;
@@ -148,7 +152,8 @@ static double potential(sw_fullsim *sim, const double *x, double elastic) {
     }
     if (!dynamic(sim)) return phi;
     int64_t m = 3 * (int64_t)sim->nv;
-    for (int64_t i = 0; i < m; ++i) sim->tmp[i] = x[i] - sim->xn[i];
+    for (int64_t i = 0; i < m; ++i)
+        sim->tmp[i] = x[i] - sim->xn[i];
     sw_bsr Kn = sim->K;
     Kn.val = sim->Kn;
     sw_bsr_multiply(&Kn, sim->tmp, sim->kdx, sim->pool);
@@ -161,7 +166,8 @@ static double potential(sw_fullsim *sim, const double *x, double elastic) {
             damp_m += sim->mass[v] * dn * dn;
             lin += dn * sim->Dvn[k];
         }
-    for (int64_t k = 0; k < m; ++k) damp_k += sim->tmp[k] * sim->kdx[k];
+    for (int64_t k = 0; k < m; ++k)
+        damp_k += sim->tmp[k] * sim->kdx[k];
     phi += 0.5 * sim->c_m * inertia +
            0.5 * sim->c_d * (sim->p.rayleigh_alpha * damp_m + sim->p.rayleigh_beta * damp_k) -
            sim->s * lin;
@@ -173,21 +179,26 @@ static double gradient(sw_fullsim *sim, const double *x) {
     int32_t nv = sim->nv;
     int64_t m = 3 * (int64_t)nv;
     double *g = sim->g;
-    for (int64_t k = 0; k < m; ++k) g[k] = -sim->fint[k];
+    for (int64_t k = 0; k < m; ++k)
+        g[k] = -sim->fint[k];
     if (sim->p.self_contact && sim->ncontacts) {
         /* contact forces into tmp, then subtract */
         memset(sim->tmp, 0, (size_t)m * sizeof(double));
         sw_contact_add_forces(sim->contacts, sim->ncontacts, x, sim->p.contact_k,
                               sim->p.contact_alpha, sim->tmp);
-        for (int64_t k = 0; k < m; ++k) g[k] -= sim->tmp[k];
+        for (int64_t k = 0; k < m; ++k)
+            g[k] -= sim->tmp[k];
     }
     for (int32_t v = 0; v < nv; ++v) {
         if (sim->p.ground && sim->vert_area[v] > 0 && x[3 * v + 1] < sim->p.ground_height)
-            g[3 * v + 1] -= ground_k(sim) * sim->vert_area[v] * (sim->p.ground_height - x[3 * v + 1]);
-        for (int i = 0; i < 3; ++i) g[3 * v + i] -= sim->mass[v] * sim->p.gravity[i];
+            g[3 * v + 1] -=
+                ground_k(sim) * sim->vert_area[v] * (sim->p.ground_height - x[3 * v + 1]);
+        for (int i = 0; i < 3; ++i)
+            g[3 * v + i] -= sim->mass[v] * sim->p.gravity[i];
     }
     if (dynamic(sim)) {
-        for (int64_t k = 0; k < m; ++k) sim->tmp[k] = x[k] - sim->xn[k];
+        for (int64_t k = 0; k < m; ++k)
+            sim->tmp[k] = x[k] - sim->xn[k];
         sw_bsr Kn = sim->K;
         Kn.val = sim->Kn;
         sw_bsr_multiply(&Kn, sim->tmp, sim->kdx, sim->pool);
@@ -217,13 +228,15 @@ static void finish_system(sw_fullsim *sim, const double *x) {
     sw_bsr *K = &sim->K;
     if (dynamic(sim)) {
         double cb = sim->c_d * sim->p.rayleigh_beta;
-        for (int64_t i = 0; i < 9 * K->nblocks; ++i) K->val[i] += cb * sim->Kn[i];
+        for (int64_t i = 0; i < 9 * K->nblocks; ++i)
+            K->val[i] += cb * sim->Kn[i];
     }
     double cm = dynamic(sim) ? sim->c_m + sim->c_d * sim->p.rayleigh_alpha : 0.0;
     for (int32_t v = 0; v < sim->nv; ++v) {
         if (K->diag[v] < 0) continue;
         double *B = K->val + 9 * K->diag[v];
-        for (int i = 0; i < 3; ++i) B[4 * i] += cm * sim->mass[v];
+        for (int i = 0; i < 3; ++i)
+            B[4 * i] += cm * sim->mass[v];
         if (sim->p.ground && sim->vert_area[v] > 0 && x[3 * v + 1] < sim->p.ground_height)
             B[4] += ground_k(sim) * sim->vert_area[v];
         memcpy(sim->diag + 9 * v, B, 9 * sizeof(double));
@@ -264,13 +277,14 @@ static sinew_result check_params(const sw_fullsim_params *p, sw_error *err) {
                             p->rayleigh_beta);
     if (!(p->contact_k >= 0) || !isfinite(p->contact_k) || !(p->contact_alpha >= 0) ||
         !(p->contact_alpha <= 1) || !(p->ground_k >= 0) || !isfinite(p->ground_k))
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "contact stiffness %g / anisotropy %g / ground stiffness %g out of range",
-                            p->contact_k, p->contact_alpha, p->ground_k);
+        return sw_error_set(
+            err, SINEW_ERROR_INVALID_ARGUMENT,
+            "contact stiffness %g / anisotropy %g / ground stiffness %g out of range", p->contact_k,
+            p->contact_alpha, p->ground_k);
     if (!all_finite(p->gravity, 3) || !isfinite(p->ground_height))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "gravity or ground not finite");
-    if (p->hessian < SW_HESSIAN_ADAPTIVE || p->hessian > SW_HESSIAN_EXACT || p->contact_rounds < 1 ||
-        p->contact_rounds > 100)
+    if (p->hessian < SW_HESSIAN_ADAPTIVE || p->hessian > SW_HESSIAN_EXACT ||
+        p->contact_rounds < 1 || p->contact_rounds > 100)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "hessian mode %d / contact rounds %d out of range", (int)p->hessian,
                             p->contact_rounds);
@@ -316,10 +330,10 @@ static sinew_result check_character(const sw_character *c, sw_error *err) {
 /* The per-vertex 3-vectors the simulator owns, listed once for allocation and release. */
 enum { SW_NVECS = 18 };
 static void state_vectors(sw_fullsim *sim, double **v[SW_NVECS]) {
-    double **all[SW_NVECS] = {&sim->x,   &sim->v,         &sim->a,        &sim->xn,   &sim->vn,
-                              &sim->an,  &sim->xhat,      &sim->Dvn,      &sim->skin_prev,
-                              &sim->skin_now, &sim->g,    &sim->dx,       &sim->dx_prev,
-                              &sim->tmp, &sim->xtrial,    &sim->fint,     &sim->rhs,  &sim->kdx};
+    double **all[SW_NVECS] = {
+        &sim->x,       &sim->v,   &sim->a,         &sim->xn,       &sim->vn,  &sim->an,
+        &sim->xhat,    &sim->Dvn, &sim->skin_prev, &sim->skin_now, &sim->g,   &sim->dx,
+        &sim->dx_prev, &sim->tmp, &sim->xtrial,    &sim->fint,     &sim->rhs, &sim->kdx};
     memcpy(v, all, sizeof all);
 }
 
@@ -345,7 +359,8 @@ void sw_fullsim_destroy(sw_fullsim *sim) {
     free(sim->active_slot);
     double **vecs[SW_NVECS];
     state_vectors(sim, vecs);
-    for (int i = 0; i < SW_NVECS; ++i) free(*vecs[i]);
+    for (int i = 0; i < SW_NVECS; ++i)
+        free(*vecs[i]);
     sw_pcg_workspace_free(&sim->ws);
     sw_pool_destroy(sim->pool);
     free(sim);
@@ -381,9 +396,10 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
     state_vectors(sim, vecs);
     sim->diag = calloc((size_t)nv, 9 * sizeof(double));
     sim->Pinv = calloc((size_t)nv, 9 * sizeof(double));
-    int ok = sim->diag && sim->Pinv && sim->DmInv && sim->vol && sim->mass && sim->free_mask && sim->vert_area && sim->Ke &&
-             sim->fe && sim->ee && sim->inc_ptr && sim->inc;
-    for (int i = 0; i < SW_NVECS; ++i) ok = ok && (*vecs[i] = calloc(1, v3));
+    int ok = sim->diag && sim->Pinv && sim->DmInv && sim->vol && sim->mass && sim->free_mask &&
+             sim->vert_area && sim->Ke && sim->fe && sim->ee && sim->inc_ptr && sim->inc;
+    for (int i = 0; i < SW_NVECS; ++i)
+        ok = ok && (*vecs[i] = calloc(1, v3));
     ok = ok && sw_pcg_workspace_init(&sim->ws, nv);
     if (!ok) {
         sw_fullsim_destroy(sim);
@@ -393,15 +409,18 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
     const int32_t *tets = c->mesh.tets;
     for (int32_t t = 0; t < nt; ++t) {
         double Xe[12];
-        for (int k = 0; k < 4; ++k) memcpy(Xe + 3 * k, X + 3 * (int64_t)tets[4 * t + k], 24);
+        for (int k = 0; k < 4; ++k)
+            memcpy(Xe + 3 * k, X + 3 * (int64_t)tets[4 * t + k], 24);
         if (!sw_tet_rest(Xe, sim->DmInv + 9 * t, sim->vol + t)) {
             sw_fullsim_destroy(sim);
             return sw_error_set(err, SINEW_ERROR_DEGENERATE, "tet %d is degenerate at rest", t);
         }
         sw_lumped_mass_add(tets + 4 * t, c->density, sim->vol[t], sim->mass);
-        for (int k = 0; k < 4; ++k) sim->inc_ptr[tets[4 * t + k] + 1]++;
+        for (int k = 0; k < 4; ++k)
+            sim->inc_ptr[tets[4 * t + k] + 1]++;
     }
-    for (int32_t v = 0; v < nv; ++v) sim->inc_ptr[v + 1] += sim->inc_ptr[v];
+    for (int32_t v = 0; v < nv; ++v)
+        sim->inc_ptr[v + 1] += sim->inc_ptr[v];
     int64_t *fill = malloc((size_t)nv * sizeof(int64_t));
     if (!fill) {
         sw_fullsim_destroy(sim);
@@ -409,7 +428,8 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
     }
     memcpy(fill, sim->inc_ptr, (size_t)nv * sizeof(int64_t));
     for (int32_t t = 0; t < nt; ++t) /* element order within each vertex: deterministic */
-        for (int k = 0; k < 4; ++k) sim->inc[fill[tets[4 * t + k]]++] = 4 * (int64_t)t + k;
+        for (int k = 0; k < 4; ++k)
+            sim->inc[fill[tets[4 * t + k]]++] = 4 * (int64_t)t + k;
     free(fill);
     for (int32_t v = 0; v < nv; ++v) {
         sim->free_mask[v] = c->bone_of_vertex[v] < 0;
@@ -422,7 +442,8 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
             hi[i] = fmax(hi[i], X[3 * v + i]);
         }
     double diag2 = 0;
-    for (int i = 0; i < 3; ++i) diag2 += (hi[i] - lo[i]) * (hi[i] - lo[i]);
+    for (int i = 0; i < 3; ++i)
+        diag2 += (hi[i] - lo[i]) * (hi[i] - lo[i]);
     sim->gfloor = 1e-12 * c->youngs * diag2 * sqrt((double)nv);
 
     if ((r = sw_tetmesh_surface(&c->mesh, &sim->surf, err)) != SINEW_OK ||
@@ -443,7 +464,8 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
         double cx = e1[1] * e2[2] - e1[2] * e2[1], cy = e1[2] * e2[0] - e1[0] * e2[2],
                cz = e1[0] * e2[1] - e1[1] * e2[0];
         double area = 0.5 * sqrt(cx * cx + cy * cy + cz * cz);
-        for (int k = 0; k < 3; ++k) sim->vert_area[tri[k]] += area / 3.0;
+        for (int k = 0; k < 3; ++k)
+            sim->vert_area[tri[k]] += area / 3.0;
     }
     sim->active = malloc(((size_t)sim->surf.nverts + 1) * sizeof(sw_contact));
     sim->active_slot = malloc((size_t)nv * sizeof(int32_t));
@@ -459,7 +481,8 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
         sw_fullsim_destroy(sim);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start %d threads", p.threads);
     }
-    for (int32_t v = 0; v < nv; ++v) sim->active_slot[v] = -1;
+    for (int32_t v = 0; v < nv; ++v)
+        sim->active_slot[v] = -1;
     memcpy(sim->x, X, v3);
     memcpy(sim->skin_prev, X, v3);
     *out = sim;
@@ -520,7 +543,8 @@ static void restore(sw_fullsim *sim) {
 
 /* Empties the step's contact set. */
 static void clear_contacts(sw_fullsim *sim) {
-    for (int32_t i = 0; i < sim->ncontacts; ++i) sim->active_slot[sim->active[i].p] = -1;
+    for (int32_t i = 0; i < sim->ncontacts; ++i)
+        sim->active_slot[sim->active[i].p] = -1;
     sim->ncontacts = 0;
     sim->contacts = sim->active;
 }
@@ -549,8 +573,8 @@ static int32_t contact_round(sw_fullsim *sim) {
     }
     sim->ncontacts = kept;
     int32_t n;
-    const sw_contact *found = (sw_selfcontact_detect(sim->sc, sim->x, sim->pool),
-                               sw_selfcontact_list(sim->sc, &n));
+    const sw_contact *found =
+        (sw_selfcontact_detect(sim->sc, sim->x, sim->pool), sw_selfcontact_list(sim->sc, &n));
     for (int32_t i = 0; i < n; ++i) {
         int32_t slot = sim->active_slot[found[i].p];
         if (slot < 0) {
@@ -587,8 +611,7 @@ static sw_pcg_stats solve_newton_system(sw_fullsim *sim) {
 /* Newton with a backtracking (Armijo) line search on Phi, contacts frozen, from
  * sim->x, until |grad| <= rtol * *gref. *gref is the gradient norm of the step's
  * first evaluation (set by it when negative). */
-static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *gref,
-                                 double rtol) {
+static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *gref, double rtol) {
     int32_t nv = sim->nv;
     int64_t m = 3 * (int64_t)nv;
     size_t v3 = (size_t)m * sizeof(double);
@@ -602,7 +625,8 @@ static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *
         st->grad_norm = gn;
         if (gn <= rtol * *gref || gn <= sim->gfloor) return SINEW_OK;
         if (it == sim->p.max_newton) return SINEW_ERROR_NOT_CONVERGED;
-        for (int64_t k = 0; k < m; ++k) sim->rhs[k] = -sim->g[k];
+        for (int64_t k = 0; k < m; ++k)
+            sim->rhs[k] = -sim->g[k];
         sw_pcg_stats ps = solve_newton_system(sim);
         st->pcg_iters += ps.iters;
         if (ps.negative_curvature && sim->p.hessian == SW_HESSIAN_ADAPTIVE) {
@@ -613,7 +637,8 @@ static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *
             st->projected_iters++;
         }
         double slope = 0;
-        for (int64_t k = 0; k < m; ++k) slope += sim->g[k] * sim->dx[k];
+        for (int64_t k = 0; k < m; ++k)
+            slope += sim->g[k] * sim->dx[k];
         if (!(slope < 0)) { /* not a descent direction: preconditioned gradient instead */
             for (int32_t v = 0; v < nv; ++v) {
                 const double *P = sim->Pinv + 9 * v, *gv = sim->g + 3 * v;
@@ -622,13 +647,15 @@ static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *
                         -(P[3 * i] * gv[0] + P[3 * i + 1] * gv[1] + P[3 * i + 2] * gv[2]);
             }
             slope = 0;
-            for (int64_t k = 0; k < m; ++k) slope += sim->g[k] * sim->dx[k];
+            for (int64_t k = 0; k < m; ++k)
+                slope += sim->g[k] * sim->dx[k];
             if (!(slope < 0)) return SINEW_ERROR_NOT_CONVERGED;
         }
         double phi0 = potential(sim, sim->x, elastic), step = 1.0;
         int accepted = 0;
         for (int ls = 0; ls < 16 && !accepted; ++ls, step *= 0.5) {
-            for (int64_t k = 0; k < m; ++k) sim->xtrial[k] = sim->x[k] + step * sim->dx[k];
+            for (int64_t k = 0; k < m; ++k)
+                sim->xtrial[k] = sim->x[k] + step * sim->dx[k];
             double phi1 = potential(sim, sim->xtrial, evaluate(sim, sim->xtrial, EVAL_ENERGY));
             /* Near convergence the decrease falls below Phi's round-off: a full Newton
              * step whose change is at that level is accepted. */
@@ -638,7 +665,8 @@ static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *
         }
         if (!accepted) return SINEW_ERROR_NOT_CONVERGED; /* stagnation: keep the best iterate */
         memcpy(sim->x, sim->xtrial, v3);
-        for (int64_t k = 0; k < m; ++k) sim->dx_prev[k] = step * sim->dx[k];
+        for (int64_t k = 0; k < m; ++k)
+            sim->dx_prev[k] = step * sim->dx[k];
         st->newton_iters++;
     }
 }
@@ -709,24 +737,35 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
     st.energy_elastic = evaluate(sim, sim->x, EVAL_ENERGY);
     if (dynamic(sim))
         for (int32_t v = 0; v < nv; ++v)
-            st.energy_kinetic += 0.5 * sim->mass[v] *
-                                 (sim->v[3 * v] * sim->v[3 * v] + sim->v[3 * v + 1] * sim->v[3 * v + 1] +
-                                  sim->v[3 * v + 2] * sim->v[3 * v + 2]);
+            st.energy_kinetic +=
+                0.5 * sim->mass[v] *
+                (sim->v[3 * v] * sim->v[3 * v] + sim->v[3 * v + 1] * sim->v[3 * v + 1] +
+                 sim->v[3 * v + 2] * sim->v[3 * v + 2]);
     st.seconds = sw_now_seconds() - t0;
     if (stats) *stats = st;
     return result;
 }
 
-const double *sw_fullsim_positions(const sw_fullsim *sim) { return sim->x; }
-double *sw_fullsim_velocities(sw_fullsim *sim) { return sim->v; }
-const sw_surface *sw_fullsim_surface(const sw_fullsim *sim) { return &sim->surf; }
-const double *sw_fullsim_masses(const sw_fullsim *sim) { return sim->mass; }
+const double *sw_fullsim_positions(const sw_fullsim *sim) {
+    return sim->x;
+}
+double *sw_fullsim_velocities(sw_fullsim *sim) {
+    return sim->v;
+}
+const sw_surface *sw_fullsim_surface(const sw_fullsim *sim) {
+    return &sim->surf;
+}
+const double *sw_fullsim_masses(const sw_fullsim *sim) {
+    return sim->mass;
+}
 
 const sw_contact *sw_fullsim_contacts(const sw_fullsim *sim, int32_t *count) {
     *count = sim->p.self_contact ? sim->ncontacts : 0;
     return sim->contacts;
 }
-int32_t sw_fullsim_driven_count(const sw_fullsim *sim) { return sim->ndriven; }
+int32_t sw_fullsim_driven_count(const sw_fullsim *sim) {
+    return sim->ndriven;
+}
 
 void sw_fullsim_set_state(sw_fullsim *sim, const double *T, const double *x, const double *v) {
     size_t v3 = (size_t)sim->nv * 3 * sizeof(double);
@@ -746,4 +785,6 @@ void sw_fullsim_set_state(sw_fullsim *sim, const double *T, const double *x, con
                                     : 0.0;
 }
 
-double sw_fullsim_elastic_energy(sw_fullsim *sim) { return evaluate(sim, sim->x, EVAL_ENERGY); }
+double sw_fullsim_elastic_energy(sw_fullsim *sim) {
+    return evaluate(sim, sim->x, EVAL_ENERGY);
+}

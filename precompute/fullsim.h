@@ -46,52 +46,52 @@ typedef enum sw_hessian_mode {
 
 typedef struct sw_fullsim_params {
     sw_integrator integrator;
-    double dt;             /* seconds per step (default 1/30) */
-    double rayleigh_alpha; /* mass damping (default 0.01, thesis §2.1.3) */
-    double rayleigh_beta;  /* stiffness damping (default 0.001) */
-    double gravity[3];     /* default 0: the reference isolates the skin's own physics */
-    int self_contact;      /* penalty self-contact forces on (default 1) */
-    double contact_k;      /* kc of eq. 3.4 (default 1e6, DESIGN.md §8) */
-    double contact_alpha;  /* anisotropy alpha of eq. 3.5 (default 0.5) */
+    double dt;               /* seconds per step (default 1/30) */
+    double rayleigh_alpha;   /* mass damping (default 0.01, thesis §2.1.3) */
+    double rayleigh_beta;    /* stiffness damping (default 0.001) */
+    double gravity[3];       /* default 0: the reference isolates the skin's own physics */
+    int self_contact;        /* penalty self-contact forces on (default 1) */
+    double contact_k;        /* kc of eq. 3.4 (default 1e6, DESIGN.md §8) */
+    double contact_alpha;    /* anisotropy alpha of eq. 3.5 (default 0.5) */
     double neighbour_factor; /* DESIGN.md §8 (default 1.8) */
-    int ground;            /* ground plane y = ground_height on (default 0) */
+    int ground;              /* ground plane y = ground_height on (default 0) */
     double ground_height;
-    double ground_k; /* penalty per unit rest area (default contact_k) */
+    double ground_k;         /* penalty per unit rest area (default contact_k) */
     sw_hessian_mode hessian; /* default SW_HESSIAN_ADAPTIVE */
-    int contact_rounds; /* self-contact: detect, freeze the contacts, converge Newton on
-                           that smooth energy, re-detect and add new penetrations; stop
-                           when none is new or after this many rounds (default 30:
-                           with 8, every contact frame of the 20K and 50K finger
-                           stopped unsettled and its fold moved by up to 0.45 of the
-                           skinning correction when the cap was raised to 30) */
-    int max_newton;  /* per step (default 20) */
-    double newton_rtol; /* stop when |grad| <= rtol * |grad at first iterate| (1e-4) */
-    double pcg_rtol;    /* PCG relative residual (default 1e-3) */
-    int pcg_max;        /* default 1000 */
-    int threads;        /* 0: all cores */
+    int contact_rounds;      /* self-contact: detect, freeze the contacts, converge Newton on
+                                that smooth energy, re-detect and add new penetrations; stop
+                                when none is new or after this many rounds (default 30:
+                                with 8, every contact frame of the 20K and 50K finger
+                                stopped unsettled and its fold moved by up to 0.45 of the
+                                skinning correction when the cap was raised to 30) */
+    int max_newton;          /* per step (default 20) */
+    double newton_rtol;      /* stop when |grad| <= rtol * |grad at first iterate| (1e-4) */
+    double pcg_rtol;         /* PCG relative residual (default 1e-3) */
+    int pcg_max;             /* default 1000 */
+    int threads;             /* 0: all cores */
 } sw_fullsim_params;
 
 sw_fullsim_params sw_fullsim_params_default(void);
 
 typedef struct sw_fullsim_stats {
     int newton_iters;
-    int pcg_iters;        /* summed over the step's Newton iterations */
-    int projected_iters;  /* Newton iterations that fell back to the projected Hessian */
-    int contact_rounds;   /* contact rounds used (0 without self-contact) */
-    double grad_norm0;    /* |grad Phi| at the first iterate */
-    double grad_norm;     /* at exit */
+    int pcg_iters;       /* summed over the step's Newton iterations */
+    int projected_iters; /* Newton iterations that fell back to the projected Hessian */
+    int contact_rounds;  /* contact rounds used (0 without self-contact) */
+    double grad_norm0;   /* |grad Phi| at the first iterate */
+    double grad_norm;    /* at exit */
     int converged;
-    int32_t contacts;     /* penetrating vertices at the final positions */
-    int contacts_unsettled; /* 1: the round cap stopped the contact rounds while the set
-                               still changed (a penetrating vertex outside it, or a pair
-                               that no longer collides): the result depends on the cap */
-    double max_penetration; /* deepest self-penetration at the final iterate (world units) */
+    int32_t contacts;          /* penetrating vertices at the final positions */
+    int contacts_unsettled;    /* 1: the round cap stopped the contact rounds while the set
+                                  still changed (a penetrating vertex outside it, or a pair
+                                  that no longer collides): the result depends on the cap */
+    double max_penetration;    /* deepest self-penetration at the final iterate (world units) */
     double ground_penetration; /* deepest vertex below the ground plane */
-    double seconds;       /* wall time of the step */
-    double energy_elastic; /* E(x) at exit */
-    double energy_kinetic; /* 1/2 v^T M v at exit (0 in quasistatic) */
-    double grad_history[32]; /* |grad Phi| after k Newton updates (k < 32; a contact round
-                                re-detection overwrites its entry) */
+    double seconds;            /* wall time of the step */
+    double energy_elastic;     /* E(x) at exit */
+    double energy_kinetic;     /* 1/2 v^T M v at exit (0 in quasistatic) */
+    double grad_history[32];   /* |grad Phi| after k Newton updates (k < 32; a contact round
+                                  re-detection overwrites its entry) */
 } sw_fullsim_stats;
 
 typedef struct sw_fullsim sw_fullsim;

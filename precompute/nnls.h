@@ -30,7 +30,8 @@ static inline double sw_dot(const double *a, const double *b, int64_t n) {
         s2 += a[i + 2] * b[i + 2];
         s3 += a[i + 3] * b[i + 3];
     }
-    for (; i < n; ++i) s0 += a[i] * b[i];
+    for (; i < n; ++i)
+        s0 += a[i] * b[i];
     return (s0 + s1) + (s2 + s3);
 }
 
@@ -43,7 +44,7 @@ sinew_result sw_nnls(sw_nnls_method method, const double *A, int64_t m, int64_t 
  * A^T b, btb = b.b (only for stats->residual). x0 (optional, n, >= 0) warm-starts the
  * passive set with supp(x0) (cubature training re-solves after small support
  * changes). Same tol/max_iter/result conventions as sw_nnls. */
-sinew_result sw_nnls_normal(const double *AtA, const double *Atb, double btb, int64_t n,
-                            double tol, int max_iter, const double *x0, double *x,
-                            sw_nnls_stats *stats, sw_error *err);
+sinew_result sw_nnls_normal(const double *AtA, const double *Atb, double btb, int64_t n, double tol,
+                            int max_iter, const double *x0, double *x, sw_nnls_stats *stats,
+                            sw_error *err);
 #endif

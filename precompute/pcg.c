@@ -50,7 +50,8 @@ void sw_block_jacobi_invert(int32_t n, const double *diag, const unsigned char *
             o[7] = (a[1] * a[6] - a[0] * a[7]) * inv;
             o[8] = (a[0] * a[4] - a[1] * a[3]) * inv;
         } else {
-            for (int i = 0; i < 3; ++i) o[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 1.0;
+            for (int i = 0; i < 3; ++i)
+                o[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 1.0;
         }
     }
 }
@@ -66,7 +67,8 @@ static void apply_prec(int32_t n, const double *Pinv, const double *r, double *z
 
 static double dot(int64_t n, const double *a, const double *b) {
     double s = 0;
-    for (int64_t i = 0; i < n; ++i) s += a[i] * b[i];
+    for (int64_t i = 0; i < n; ++i)
+        s += a[i] * b[i];
     return s;
 }
 
@@ -80,7 +82,8 @@ static void residual(sw_linop_fn A, void *ctx, const double *b, const unsigned c
                      sw_pcg_workspace *ws, const double *x) {
     int64_t m = 3 * (int64_t)ws->n;
     A(ctx, x, ws->Ap);
-    for (int64_t i = 0; i < m; ++i) ws->r[i] = b[i] - ws->Ap[i];
+    for (int64_t i = 0; i < m; ++i)
+        ws->r[i] = b[i] - ws->Ap[i];
     mask(ws->n, free_mask, ws->r);
 }
 
@@ -122,17 +125,20 @@ sw_pcg_stats sw_pcg_solve(sw_linop_fn A, void *ctx, const double *b, const doubl
             break;
         }
         double alpha = rz / pAp;
-        for (int64_t i = 0; i < m; ++i) x[i] += alpha * p[i];
+        for (int64_t i = 0; i < m; ++i)
+            x[i] += alpha * p[i];
         st.iters++;
         if (st.iters % 50 == 0)
             residual(A, ctx, b, free_mask, ws, x);
         else
-            for (int64_t i = 0; i < m; ++i) r[i] -= alpha * Ap[i];
+            for (int64_t i = 0; i < m; ++i)
+                r[i] -= alpha * Ap[i];
         apply_prec(n, Pinv, r, z);
         double rz_new = dot(m, r, z);
         double beta = rz_new / rz;
         rz = rz_new;
-        for (int64_t i = 0; i < m; ++i) p[i] = z[i] + beta * p[i];
+        for (int64_t i = 0; i < m; ++i)
+            p[i] = z[i] + beta * p[i];
     }
     st.rel_residual = sqrt(fmax(rz, 0) / bnorm);
     st.converged = rz <= tol2;

@@ -19,7 +19,8 @@ sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, cons
     def.max_newton_iters = max_newton;
     sinew_instance *inst;
     sinew_result r = sinew_instance_create(blob, &def, &inst);
-    if (r != SINEW_OK) return sw_error_set(err, r, "cannot create an instance: %s", sinew_result_string(r));
+    if (r != SINEW_OK)
+        return sw_error_set(err, r, "cannot create an instance: %s", sinew_result_string(r));
     int32_t n = v->nverts;
     double *xs = malloc((size_t)n * 3 * sizeof(double)), *cnt = malloc((size_t)n * sizeof(double));
     double *xd = malloc((size_t)n * 3 * sizeof(double));
@@ -30,7 +31,8 @@ sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, cons
     double num = 0, den = 0, l2n = 0, l2d = 0;
     for (int32_t f = 0; f < npose; ++f) {
         const double *Tf = T + (size_t)f * 12 * v->nbones, *xf = x_full + (size_t)f * 3 * n;
-        if (sw_instance_set_pose_d(inst, Tf) != SINEW_OK || sinew_instance_step(inst, 1.0f / 30) != SINEW_OK) {
+        if (sw_instance_set_pose_d(inst, Tf) != SINEW_OK ||
+            sinew_instance_step(inst, 1.0f / 30) != SINEW_OK) {
             out->failed++;
             continue;
         }

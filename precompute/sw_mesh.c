@@ -75,8 +75,8 @@ sinew_result sw_tetmesh_validate(const sw_tetmesh *m, double min_volume, sw_erro
                             m ? m->nverts : 0, m ? m->ntets : 0);
     for (int32_t v = 0; v < 3 * m->nverts; ++v)
         if (!isfinite(m->X[v]))
-            return sw_error_set(err, SINEW_ERROR_NOT_FINITE, "vertex %d has a non-finite coordinate",
-                                v / 3);
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                "vertex %d has a non-finite coordinate", v / 3);
     for (int32_t t = 0; t < m->ntets; ++t) {
         const int32_t *q = m->tets + 4 * t;
         for (int k = 0; k < 4; ++k) {
@@ -86,8 +86,8 @@ sinew_result sw_tetmesh_validate(const sw_tetmesh *m, double min_volume, sw_erro
                                     m->nverts);
             for (int j = 0; j < k; ++j)
                 if (q[j] == q[k])
-                    return sw_error_set(err, SINEW_ERROR_DEGENERATE,
-                                        "tet %d repeats vertex %d", t, q[k]);
+                    return sw_error_set(err, SINEW_ERROR_DEGENERATE, "tet %d repeats vertex %d", t,
+                                        q[k]);
         }
         double vol = sw_tet_signed_volume(m->X + 3 * q[0], m->X + 3 * q[1], m->X + 3 * q[2],
                                           m->X + 3 * q[3]);
@@ -151,7 +151,8 @@ static void fk_bone(const sw_skeleton *s, const double *local, const double *roo
                     unsigned char *done, int32_t b) {
     while (!done[b]) {
         int32_t c = b; /* walk up to the highest unfinished ancestor */
-        while (s->parent[c] >= 0 && !done[s->parent[c]]) c = s->parent[c];
+        while (s->parent[c] >= 0 && !done[s->parent[c]])
+            c = s->parent[c];
         const double *h = s->joints + 3 * s->bones[2 * c];
         const double *L = local + 9 * c;
         double Lc[12]; /* x -> h + L (x - h) */
@@ -163,14 +164,15 @@ static void fk_bone(const sw_skeleton *s, const double *local, const double *roo
         } else {
             memcpy(T + 12 * c, Lc, sizeof Lc);
             if (root_t)
-                for (int i = 0; i < 3; ++i) T[12 * c + 9 + i] += root_t[i];
+                for (int i = 0; i < 3; ++i)
+                    T[12 * c + 9 + i] += root_t[i];
         }
         done[c] = 1;
     }
 }
 
-void sw_forward_kinematics(const sw_skeleton *s, const double *local, const double *root_translation,
-                           double *T) {
+void sw_forward_kinematics(const sw_skeleton *s, const double *local,
+                           const double *root_translation, double *T) {
     unsigned char done[SW_MAX_BONES] = {0};
     for (int32_t b = 0; b < s->nbones && b < SW_MAX_BONES; ++b)
         fk_bone(s, local, root_translation, T, done, b);
@@ -183,9 +185,11 @@ void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, do
         for (int32_t b = 0; b < W->nbones; ++b) {
             if (w[b] == 0.0) continue;
             sw_transform_point(T + 12 * b, X + 3 * v, p);
-            for (int i = 0; i < 3; ++i) acc[i] += w[b] * p[i];
+            for (int i = 0; i < 3; ++i)
+                acc[i] += w[b] * p[i];
         }
-        for (int i = 0; i < 3; ++i) x[3 * v + i] = acc[i];
+        for (int i = 0; i < 3; ++i)
+            x[3 * v + i] = acc[i];
     }
 }
 

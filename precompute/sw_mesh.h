@@ -95,8 +95,8 @@ sinew_result sw_tetmesh_validate(const sw_tetmesh *m, double min_volume, sw_erro
  * transform: T_b(x) = T_parent(h_b + L_b (x - h_b)); every root bone also gets
  * `root_translation` (3, may be NULL). The skeleton must pass sw_skeleton_validate
  * (at most SW_MAX_BONES bones). Writes 12*nbones to T. */
-void sw_forward_kinematics(const sw_skeleton *s, const double *local, const double *root_translation,
-                           double *T);
+void sw_forward_kinematics(const sw_skeleton *s, const double *local,
+                           const double *root_translation, double *T);
 
 #define SW_MAX_BONES 1024
 

@@ -26,19 +26,18 @@
 /* Bones whose distances agree to this relative tolerance are tied for "nearest". */
 #define HEAT_TIE_REL 1e-12
 
-
 /* Everything the per-group solves share (read-only while they run). */
 typedef struct heat_system {
     int32_t n, nbones;
     const int64_t *row_ptr;
     const int32_t *col;
-    double *a;              /* scalar A = L + H per pattern entry */
-    double *h;              /* n: H_vv */
-    double *dist;           /* n * nbones: distance of v to bone b */
-    double *dmin;           /* n: distance to the nearest bone (unclamped) */
-    double *Pinv;           /* 9n: Jacobi preconditioner, 1/A_vv on the block diagonal */
+    double *a;                /* scalar A = L + H per pattern entry */
+    double *h;                /* n: H_vv */
+    double *dist;             /* n * nbones: distance of v to bone b */
+    double *dmin;             /* n: distance to the nearest bone (unclamped) */
+    double *Pinv;             /* 9n: Jacobi preconditioner, 1/A_vv on the block diagonal */
     unsigned char *free_mask; /* n: 0 for a vertex in no tet (left out of the solve) */
-    double *W;              /* n * nbones: the raw solutions */
+    double *W;                /* n * nbones: the raw solutions */
 } heat_system;
 
 /* y = A x on each of the three components (the linear operator of sw_pcg_solve). */
@@ -111,7 +110,8 @@ static void solve_groups(void *vctx, int64_t begin, int64_t end, int worker) {
 
 static sinew_result validate(const sw_tetmesh *m, const sw_skeleton *s, double c, sw_error *err) {
     if (!m || !s)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "heat weights: NULL mesh or skeleton");
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "heat weights: NULL mesh or skeleton");
     if (!isfinite(c))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "heat weights: bone-term strength c = %g is not finite", c);
@@ -138,7 +138,8 @@ static sinew_result validate(const sw_tetmesh *m, const sw_skeleton *s, double c
 static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t v = 0; v < m->nverts + s->njoints; ++v) {
-        const double *p = v < m->nverts ? m->X + 3 * (size_t)v : s->joints + 3 * (size_t)(v - m->nverts);
+        const double *p =
+            v < m->nverts ? m->X + 3 * (size_t)v : s->joints + 3 * (size_t)(v - m->nverts);
         for (int i = 0; i < 3; ++i) {
             lo[i] = fmin(lo[i], p[i]);
             hi[i] = fmax(hi[i], p[i]);
@@ -156,8 +157,9 @@ static sinew_result assemble(const sw_tetmesh *m, const sw_skeleton *s, double c
     for (int32_t v = 0; v < S->n; ++v) {
         double *d = S->dist + (size_t)v * S->nbones, dm = INFINITY;
         for (int32_t b = 0; b < S->nbones; ++b) {
-            d[b] = sw_point_segment_distance(m->X + 3 * (size_t)v, s->joints + 3 * (size_t)s->bones[2 * b],
-                                          s->joints + 3 * (size_t)s->bones[2 * b + 1]);
+            d[b] = sw_point_segment_distance(m->X + 3 * (size_t)v,
+                                             s->joints + 3 * (size_t)s->bones[2 * b],
+                                             s->joints + 3 * (size_t)s->bones[2 * b + 1]);
             dm = fmin(dm, d[b]);
         }
         S->dmin[v] = dm;
@@ -273,8 +275,9 @@ sinew_result sw_weights_heat(const sw_tetmesh *m, const sw_skeleton *s, double c
     rc = sw_bsr_create_from_tets(m->nverts, m->ntets, m->tets, &pattern, err);
     if (rc) return rc;
     size_t n = (size_t)m->nverts, nb = (size_t)s->nbones;
-    heat_system S = {m->nverts, s->nbones, pattern.row_ptr, pattern.col, NULL, NULL, NULL,
-                     NULL, NULL, NULL, NULL};
+    heat_system S = {
+        m->nverts, s->nbones, pattern.row_ptr, pattern.col, NULL, NULL, NULL, NULL, NULL,
+        NULL,      NULL};
     S.a = malloc((size_t)pattern.nblocks * sizeof *S.a);
     S.h = malloc(n * sizeof *S.h);
     S.dist = malloc(n * nb * sizeof *S.dist);

@@ -6,7 +6,6 @@
 #include <stdlib.h>
 #include <string.h>
 
-
 /* Length of the diagonal of the box around the mesh and the joints: the scale that
  * makes the distance clamp relative. */
 static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
@@ -55,7 +54,7 @@ sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton 
         double *row = w + (size_t)v * s->nbones, dmin = INFINITY, sum = 0;
         for (int32_t b = 0; b < s->nbones; ++b) {
             row[b] = fmax(sw_point_segment_distance(m->X + 3 * v, s->joints + 3 * s->bones[2 * b],
-                                                 s->joints + 3 * s->bones[2 * b + 1]),
+                                                    s->joints + 3 * s->bones[2 * b + 1]),
                           eps);
             dmin = fmin(dmin, row[b]);
         }

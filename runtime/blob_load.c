@@ -23,16 +23,15 @@ _Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vert
 #define ENTRY_SIZE ((uint64_t)sizeof(sinew_blob_section))
 
 static const char *const k_section_names[SINEW_SECTION_COUNT_V1 + 1] = {
-    "unknown",     "META",      "REST",           "SKIN_BONE",  "SKIN_WEIGHT", "BONE_PARENT",
-    "BONE_JOINTS", "DOMAINS",   "DOMAIN_VERTS",   "BASIS",      "CUB_TETS",    "CUB_WEIGHT",
-    "CUB_DMINV",   "CUB_VOL",   "SPRING_HESSIAN", "MASS",       "INERTIA_S",   "INERTIA_X",
-    "INERTIA_U",   "SURF_TRIS", "SURF_COPY_PTR",  "SURF_COPIES", "TRAIN_Q",     "TRAIN_POSE",
+    "unknown",     "META",          "REST",           "SKIN_BONE",   "SKIN_WEIGHT", "BONE_PARENT",
+    "BONE_JOINTS", "DOMAINS",       "DOMAIN_VERTS",   "BASIS",       "CUB_TETS",    "CUB_WEIGHT",
+    "CUB_DMINV",   "CUB_VOL",       "SPRING_HESSIAN", "MASS",        "INERTIA_S",   "INERTIA_X",
+    "INERTIA_U",   "SURF_TRIS",     "SURF_COPY_PTR",  "SURF_COPIES", "TRAIN_Q",     "TRAIN_POSE",
     "CONTACT_PTR", "CONTACT_VERTS", "CONTACT_DATA"};
 
 /* Element size of every known section (format header table). */
-static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {0, 80, 8, 4, 8, 4, 8, 48, 4, 8, 4, 8,
-                                                                 8, 8,  8, 8, 8, 8, 8, 4, 4, 4, 8, 8,
-                                                                 4, 4,  8};
+static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {
+    0, 80, 8, 4, 8, 4, 8, 48, 4, 8, 4, 8, 8, 8, 8, 8, 8, 8, 8, 4, 4, 4, 8, 8, 4, 4, 8};
 
 uint64_t sw_blob_checksum(const void *data, size_t n) {
     const uint8_t *p = data;
@@ -406,9 +405,10 @@ static sinew_result check_positive(uint32_t id, const double *a, int64_t n, int6
  * reference a valid (domain, local vertex), area weights positive. */
 static sinew_result check_contacts(const sw_blob_view *v, char *msg, size_t ms) {
     if (v->contact_ptr[0] != 0 || v->contact_ptr[v->ntrain] != v->ncontacts)
-        return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                    "blob section CONTACT_PTR: runs from %d to %d, must run from 0 to ncontacts = %d",
-                    v->contact_ptr[0], v->contact_ptr[v->ntrain], v->ncontacts);
+        return fail(
+            msg, ms, SINEW_ERROR_CORRUPT,
+            "blob section CONTACT_PTR: runs from %d to %d, must run from 0 to ncontacts = %d",
+            v->contact_ptr[0], v->contact_ptr[v->ntrain], v->ncontacts);
     for (int32_t t = 0; t < v->ntrain; ++t)
         if (v->contact_ptr[t + 1] < v->contact_ptr[t])
             return fail(msg, ms, SINEW_ERROR_CORRUPT,
@@ -418,10 +418,11 @@ static sinew_result check_contacts(const sw_blob_view *v, char *msg, size_t ms) 
         for (int k = 0; k < 4; ++k) {
             int32_t d = v->contact_verts[8 * c + 2 * k], l = v->contact_verts[8 * c + 2 * k + 1];
             if (d < 0 || d >= v->ndomains || l < 0 || l >= v->domains[d].vert_count)
-                return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                            "blob section CONTACT_VERTS: contact %d vertex %d: (domain %d, local %d) "
-                            "out of range",
-                            c, k, d, l);
+                return fail(
+                    msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section CONTACT_VERTS: contact %d vertex %d: (domain %d, local %d) "
+                    "out of range",
+                    c, k, d, l);
         }
         if (!(v->contact_data[7 * c + 6] > 0))
             return fail(msg, ms, SINEW_ERROR_CORRUPT,

@@ -35,17 +35,17 @@ typedef sinew_blob_domain_record sw_blob_domain;
 
 typedef struct sw_blob_view {
     /* META */
-    int32_t nverts;       /* simulation vertices */
+    int32_t nverts; /* simulation vertices */
     int32_t nbones;
     int32_t ndomains;
-    int32_t rank_total;   /* sum of ranks = length of q */
+    int32_t rank_total;    /* sum of ranks = length of q */
     int32_t ndomain_verts; /* sum of vert_count (vertex copies) */
-    int32_t ncub;         /* cubature tets over all domains */
-    int32_t nsurf_verts;  /* output (render) surface vertices */
+    int32_t ncub;          /* cubature tets over all domains */
+    int32_t nsurf_verts;   /* output (render) surface vertices */
     int32_t nsurf_tris;
-    double mu, lambda;    /* Lamé parameters of the co-rotational material */
+    double mu, lambda; /* Lamé parameters of the co-rotational material */
     double rayleigh_alpha, rayleigh_beta;
-    double contact_k;     /* run-time penalty stiffness (reserved for self-contact) */
+    double contact_k; /* run-time penalty stiffness (reserved for self-contact) */
 
     /* per simulation vertex */
     const double *rest;        /* 3 * nverts */

@@ -6,13 +6,15 @@
 int sw_cholesky(double *A, int32_t n) {
     for (int32_t j = 0; j < n; ++j) {
         double d = A[(int64_t)j * n + j];
-        for (int32_t k = 0; k < j; ++k) d -= A[(int64_t)j * n + k] * A[(int64_t)j * n + k];
+        for (int32_t k = 0; k < j; ++k)
+            d -= A[(int64_t)j * n + k] * A[(int64_t)j * n + k];
         if (!(d > 0)) return 0;
         d = sqrt(d);
         A[(int64_t)j * n + j] = d;
         for (int32_t i = j + 1; i < n; ++i) {
             double s = A[(int64_t)i * n + j];
-            for (int32_t k = 0; k < j; ++k) s -= A[(int64_t)i * n + k] * A[(int64_t)j * n + k];
+            for (int32_t k = 0; k < j; ++k)
+                s -= A[(int64_t)i * n + k] * A[(int64_t)j * n + k];
             A[(int64_t)i * n + j] = s / d;
         }
     }
@@ -22,12 +24,14 @@ int sw_cholesky(double *A, int32_t n) {
 void sw_cholesky_solve(const double *L, int32_t n, double *x) {
     for (int32_t i = 0; i < n; ++i) { /* L y = b */
         double s = x[i];
-        for (int32_t k = 0; k < i; ++k) s -= L[(int64_t)i * n + k] * x[k];
+        for (int32_t k = 0; k < i; ++k)
+            s -= L[(int64_t)i * n + k] * x[k];
         x[i] = s / L[(int64_t)i * n + i];
     }
     for (int32_t i = n - 1; i >= 0; --i) { /* L^T x = y */
         double s = x[i];
-        for (int32_t k = i + 1; k < n; ++k) s -= L[(int64_t)k * n + i] * x[k];
+        for (int32_t k = i + 1; k < n; ++k)
+            s -= L[(int64_t)k * n + i] * x[k];
         x[i] = s / L[(int64_t)i * n + i];
     }
 }
@@ -35,8 +39,8 @@ void sw_cholesky_solve(const double *L, int32_t n, double *x) {
 /* Block (i, j) of a dense row-major n x n matrix, element (r, c) inside it. */
 #define BLK(M, i, j, r, c) (M)[(int64_t)(off[i] + (r)) * n + off[j] + (c)]
 
-void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off, const int32_t *size,
-                      const int32_t *order, unsigned char *nz) {
+void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off,
+                      const int32_t *size, const int32_t *order, unsigned char *nz) {
     for (int32_t a = 0; a < nb; ++a)
         for (int32_t b = 0; b < a; ++b) {
             int32_t i = order[a], j = order[b], any = 0;
@@ -56,12 +60,14 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
     for (int32_t a = 0; a < nb; ++a) {
         int32_t i = order[a];
         for (int32_t r = 0; r < size[i]; ++r)
-            for (int32_t c = 0; c <= r; ++c) BLK(L, i, i, r, c) = BLK(A, i, i, r, c);
+            for (int32_t c = 0; c <= r; ++c)
+                BLK(L, i, i, r, c) = BLK(A, i, i, r, c);
         for (int32_t b = 0; b < a; ++b) {
             int32_t j = order[b];
             if (!nz[a * nb + b]) continue;
             for (int32_t r = 0; r < size[i]; ++r)
-                for (int32_t c = 0; c < size[j]; ++c) BLK(L, i, j, r, c) = BLK(A, i, j, r, c);
+                for (int32_t c = 0; c < size[j]; ++c)
+                    BLK(L, i, j, r, c) = BLK(A, i, j, r, c);
         }
     }
     /* right-looking block elimination */
@@ -70,13 +76,15 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
         /* L_jj = chol(block) */
         for (int32_t c = 0; c < sj; ++c) {
             double d = BLK(L, j, j, c, c);
-            for (int32_t k = 0; k < c; ++k) d -= BLK(L, j, j, c, k) * BLK(L, j, j, c, k);
+            for (int32_t k = 0; k < c; ++k)
+                d -= BLK(L, j, j, c, k) * BLK(L, j, j, c, k);
             if (!(d > 0)) return 0;
             d = sqrt(d);
             BLK(L, j, j, c, c) = d;
             for (int32_t r = c + 1; r < sj; ++r) {
                 double s = BLK(L, j, j, r, c);
-                for (int32_t k = 0; k < c; ++k) s -= BLK(L, j, j, r, k) * BLK(L, j, j, c, k);
+                for (int32_t k = 0; k < c; ++k)
+                    s -= BLK(L, j, j, r, k) * BLK(L, j, j, c, k);
                 BLK(L, j, j, r, c) = s / d;
             }
         }
@@ -87,7 +95,8 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
             for (int32_t r = 0; r < size[i]; ++r)
                 for (int32_t c = 0; c < sj; ++c) {
                     double s = BLK(L, i, j, r, c);
-                    for (int32_t k = 0; k < c; ++k) s -= BLK(L, i, j, r, k) * BLK(L, j, j, c, k);
+                    for (int32_t k = 0; k < c; ++k)
+                        s -= BLK(L, i, j, r, k) * BLK(L, j, j, c, k);
                     BLK(L, i, j, r, c) = s / BLK(L, j, j, c, c);
                 }
         }
@@ -101,12 +110,14 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
                 if (e < a && !nz[a * nb + e]) { /* fill: a zero block becomes nonzero */
                     nz[a * nb + e] = 1;
                     for (int32_t r = 0; r < size[i]; ++r)
-                        for (int32_t c = 0; c < size[k]; ++c) BLK(L, i, k, r, c) = 0.0;
+                        for (int32_t c = 0; c < size[k]; ++c)
+                            BLK(L, i, k, r, c) = 0.0;
                 }
                 for (int32_t r = 0; r < size[i]; ++r)
                     for (int32_t c = 0; c < (e == a ? r + 1 : size[k]); ++c) {
                         double s = 0;
-                        for (int32_t m = 0; m < sj; ++m) s += BLK(L, i, j, r, m) * BLK(L, k, j, c, m);
+                        for (int32_t m = 0; m < sj; ++m)
+                            s += BLK(L, i, j, r, m) * BLK(L, k, j, c, m);
                         BLK(L, i, k, r, c) -= s;
                     }
             }
@@ -125,13 +136,15 @@ void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32
             int32_t j = order[b];
             for (int32_t r = 0; r < size[i]; ++r) {
                 double s = 0;
-                for (int32_t c = 0; c < size[j]; ++c) s += BLK(L, i, j, r, c) * x[off[j] + c];
+                for (int32_t c = 0; c < size[j]; ++c)
+                    s += BLK(L, i, j, r, c) * x[off[j] + c];
                 x[off[i] + r] -= s;
             }
         }
         for (int32_t r = 0; r < size[i]; ++r) {
             double s = x[off[i] + r];
-            for (int32_t c = 0; c < r; ++c) s -= BLK(L, i, i, r, c) * x[off[i] + c];
+            for (int32_t c = 0; c < r; ++c)
+                s -= BLK(L, i, i, r, c) * x[off[i] + c];
             x[off[i] + r] = s / BLK(L, i, i, r, r);
         }
     }
@@ -139,7 +152,8 @@ void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32
         int32_t i = order[a];
         for (int32_t r = size[i] - 1; r >= 0; --r) {
             double s = x[off[i] + r];
-            for (int32_t c = r + 1; c < size[i]; ++c) s -= BLK(L, i, i, c, r) * x[off[i] + c];
+            for (int32_t c = r + 1; c < size[i]; ++c)
+                s -= BLK(L, i, i, c, r) * x[off[i] + c];
             x[off[i] + r] = s / BLK(L, i, i, r, r);
         }
         for (int32_t b = 0; b < a; ++b) {
@@ -147,7 +161,8 @@ void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32
             int32_t j = order[b];
             for (int32_t c = 0; c < size[j]; ++c) {
                 double s = 0;
-                for (int32_t r = 0; r < size[i]; ++r) s += BLK(L, i, j, r, c) * x[off[i] + r];
+                for (int32_t r = 0; r < size[i]; ++r)
+                    s += BLK(L, i, j, r, c) * x[off[i] + r];
                 x[off[j] + c] -= s;
             }
         }

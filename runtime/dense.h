@@ -28,8 +28,8 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
 
 /* Fills nz for sw_block_cholesky from the values of A (a block is nonzero when any
  * entry is). O(n^2): callers that know the structure fill nz themselves. */
-void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off, const int32_t *size,
-                      const int32_t *order, unsigned char *nz);
+void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off,
+                      const int32_t *size, const int32_t *order, unsigned char *nz);
 
 /* Solves A x = b in place (x holds b) with the factor from sw_block_cholesky (same nb,
  * off, size, order and nz). */

@@ -79,8 +79,8 @@ void sw_dqs_blend(const sw_dualquat *bones, const int32_t *ids, const double *we
         if (!pivot) pivot = q->r;
         /* Antipodality: q and -q are the same transform; summing them would cancel, so
          * every influence joins the hemisphere of the first one (Kavan et al. 2008 §4). */
-        double dot = q->r[0] * pivot[0] + q->r[1] * pivot[1] + q->r[2] * pivot[2] +
-                     q->r[3] * pivot[3];
+        double dot =
+            q->r[0] * pivot[0] + q->r[1] * pivot[1] + q->r[2] * pivot[2] + q->r[3] * pivot[3];
         if (dot < 0) w = -w;
         for (int j = 0; j < 4; ++j) {
             br[j] += w * q->r[j];
@@ -128,7 +128,8 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
         const double *Rb = T + 12 * b;
         double L[12] = {0};
         if (parent[b] < 0) {
-            for (int i = 0; i < 9; ++i) L[i] = Rb[i];
+            for (int i = 0; i < 9; ++i)
+                L[i] = Rb[i];
         } else { /* L = R_p^T R_b */
             const double *Rp = T + 12 * parent[b];
             for (int i = 0; i < 3; ++i)
@@ -138,15 +139,16 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
         sw_dualquat dq;
         sw_dq_from_transform(L, &dq);
         double s = dq.r[0] < 0 ? -1.0 : 1.0;
-        for (int k = 0; k < 4; ++k) feature[4 * b + k] = s * dq.r[k];
+        for (int k = 0; k < 4; ++k)
+            feature[4 * b + k] = s * dq.r[k];
     }
 }
 
 double sw_pose_distance(const double *fa, const double *fb, int32_t nbones) {
     double d = 0;
     for (int32_t b = 0; b < nbones; ++b) {
-        double c = fa[4 * b] * fb[4 * b] + fa[4 * b + 1] * fb[4 * b + 1] + fa[4 * b + 2] * fb[4 * b + 2] +
-                   fa[4 * b + 3] * fb[4 * b + 3];
+        double c = fa[4 * b] * fb[4 * b] + fa[4 * b + 1] * fb[4 * b + 1] +
+                   fa[4 * b + 2] * fb[4 * b + 2] + fa[4 * b + 3] * fb[4 * b + 3];
         d += 1.0 - c * c;
     }
     return d;

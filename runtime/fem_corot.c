@@ -88,9 +88,9 @@ static void mode_direction(const double U[9], const double M[9], const double V[
 
 /* The element Hessian vol B^T (dP/dF) B as nine rank-one modes K = sum_k w_k g_k g_k^T,
  * through the analytic eigen system of dP/dF (w: 9, g: 9 x 12). */
-static void corot_modes(const double U[9], const double s[3], const double V[9],
-                        const double D[12], double vol, double mu, double lambda, uint32_t flags,
-                        double w[9], double g[108]) {
+static void corot_modes(const double U[9], const double s[3], const double V[9], const double D[12],
+                        double vol, double mu, double lambda, uint32_t flags, double w[9],
+                        double g[108]) {
     int project = (flags & SW_COROT_PROJECT_PSD) != 0;
     double e = s[0] + s[1] + s[2] - 3.0;
     /* Scaling block d2Psi/ds2 = 2 mu I + lambda 1 1^T: eigenvalue 2mu + 3lambda along
@@ -135,12 +135,14 @@ static void corot_hessian(const double U[9], const double s[3], const double V[9
                           double K[144]) {
     double w[9], g[108];
     corot_modes(U, s, V, D, vol, mu, lambda, flags, w, g);
-    for (int i = 0; i < 144; ++i) K[i] = 0.0;
+    for (int i = 0; i < 144; ++i)
+        K[i] = 0.0;
     for (int k = 0; k < 9; ++k) {
         if (w[k] == 0.0) continue;
         const double *gk = g + 12 * k;
         for (int i = 0; i < 12; ++i)
-            for (int j = 0; j < 12; ++j) K[12 * i + j] += w[k] * (gk[i] * gk[j]);
+            for (int j = 0; j < 12; ++j)
+                K[12 * i + j] += w[k] * (gk[i] * gk[j]);
     }
 }
 

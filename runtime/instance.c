@@ -38,10 +38,10 @@ struct sinew_instance {
     int32_t R, rmax, nact;
     double size; /* rest bounding-box diagonal */
     /* pose */
-    sw_dualquat *bone_dq;          /* nbones */
+    sw_dualquat *bone_dq;             /* nbones */
     double *T_cur, *T_prev, *T_prev2; /* 12 nbones each */
-    int pose_set, history;         /* frames of pose history available (0..2) */
-    int looked_up;                 /* feature_last holds a pose */
+    int pose_set, history;            /* frames of pose history available (0..2) */
+    int looked_up;                    /* feature_last holds a pose */
     /* active vertices */
     int32_t *act_vert; /* nact global ids */
     int32_t *cub_act;  /* 4 ncub */
@@ -52,7 +52,7 @@ struct sinew_instance {
     double *Je; /* 12 x rmax: the Jacobian of one cubature tet */
     /* output */
     double *surf_x, *surf_n;
-    double *feature; /* 4 nbones: the current pose's feature */
+    double *feature;      /* 4 nbones: the current pose's feature */
     int32_t *contact_act; /* 4 per pose-space contact: active index of p, t0, t1, t2 */
     double *Jc, *hc;      /* 4 x 3 x rmax each: one contact's Jacobians, and N G */
     int32_t nearest;      /* training pose nearest to the current pose, or -1 */
@@ -97,32 +97,57 @@ enum { NBUF = 38 };
 static void buffers(sinew_instance *in, void **b[NBUF], size_t sz[NBUF]) {
     const sw_blob_view *v = in->v;
     size_t R = (size_t)in->R, nb = (size_t)v->nbones, d = sizeof(double);
-    void **p[NBUF] = {(void **)&in->bone_dq, (void **)&in->T_cur, (void **)&in->T_prev,
-                      (void **)&in->T_prev2, (void **)&in->act_vert, (void **)&in->cub_act,
-                      (void **)&in->copy_act, (void **)&in->act_R, (void **)&in->act_t,
-                      (void **)&in->q, (void **)&in->qn, (void **)&in->qdot, (void **)&in->g,
-                      (void **)&in->H, (void **)&in->Hn, (void **)&in->L, (void **)&in->dq,
-                      (void **)&in->qtrial, (void **)&in->fin, (void **)&in->tmp, (void **)&in->tmp2,
-                      (void **)&in->Je, (void **)&in->surf_x,
-                      (void **)&in->surf_n, (void **)&in->feature, (void **)&in->contact_act,
-                      (void **)&in->Jc, (void **)&in->hc, (void **)&in->svd_V,
-                      (void **)&in->blk_off, (void **)&in->blk_size, (void **)&in->blk_order,
-                      (void **)&in->blk_nz, (void **)&in->blk_adj, (void **)&in->blk_pos,
-                      (void **)&in->feature_last, (void **)&in->motion, (void **)&in->twin_next};
-    size_t s[NBUF] = {nb * sizeof(sw_dualquat), 12 * nb * d, 12 * nb * d, 12 * nb * d,
-                      (size_t)in->nact * sizeof(int32_t), 4 * (size_t)v->ncub * sizeof(int32_t),
-                      (size_t)v->nsurf_copies * sizeof(int32_t), 9 * (size_t)in->nact * d,
-                      3 * (size_t)in->nact * d, R * d, R * d, R * d, R * d, R * R * d, R * R * d,
-                      R * R * d, R * d, R * d, R * d, R * d, R * d, 12 * (size_t)in->rmax * d,
+    void **p[NBUF] = {(void **)&in->bone_dq,  (void **)&in->T_cur,       (void **)&in->T_prev,
+                      (void **)&in->T_prev2,  (void **)&in->act_vert,    (void **)&in->cub_act,
+                      (void **)&in->copy_act, (void **)&in->act_R,       (void **)&in->act_t,
+                      (void **)&in->q,        (void **)&in->qn,          (void **)&in->qdot,
+                      (void **)&in->g,        (void **)&in->H,           (void **)&in->Hn,
+                      (void **)&in->L,        (void **)&in->dq,          (void **)&in->qtrial,
+                      (void **)&in->fin,      (void **)&in->tmp,         (void **)&in->tmp2,
+                      (void **)&in->Je,       (void **)&in->surf_x,      (void **)&in->surf_n,
+                      (void **)&in->feature,  (void **)&in->contact_act, (void **)&in->Jc,
+                      (void **)&in->hc,       (void **)&in->svd_V,       (void **)&in->blk_off,
+                      (void **)&in->blk_size, (void **)&in->blk_order,   (void **)&in->blk_nz,
+                      (void **)&in->blk_adj,  (void **)&in->blk_pos,     (void **)&in->feature_last,
+                      (void **)&in->motion,   (void **)&in->twin_next};
+    size_t s[NBUF] = {nb * sizeof(sw_dualquat),
+                      12 * nb * d,
+                      12 * nb * d,
+                      12 * nb * d,
+                      (size_t)in->nact * sizeof(int32_t),
+                      4 * (size_t)v->ncub * sizeof(int32_t),
+                      (size_t)v->nsurf_copies * sizeof(int32_t),
+                      9 * (size_t)in->nact * d,
+                      3 * (size_t)in->nact * d,
+                      R * d,
+                      R * d,
+                      R * d,
+                      R * d,
+                      R * R * d,
+                      R * R * d,
+                      R * R * d,
+                      R * d,
+                      R * d,
+                      R * d,
+                      R * d,
+                      R * d,
+                      12 * (size_t)in->rmax * d,
                       3 * (size_t)v->nsurf_verts * d,
-                      3 * (size_t)v->nsurf_verts * d, 4 * nb * d,
-                      4 * (size_t)v->ncontacts * sizeof(int32_t), 12 * (size_t)in->rmax * d,
-                      12 * (size_t)in->rmax * d, 9 * (size_t)v->ncub * d,
-                      (size_t)v->ndomains * sizeof(int32_t), (size_t)v->ndomains * sizeof(int32_t),
+                      3 * (size_t)v->nsurf_verts * d,
+                      4 * nb * d,
+                      4 * (size_t)v->ncontacts * sizeof(int32_t),
+                      12 * (size_t)in->rmax * d,
+                      12 * (size_t)in->rmax * d,
+                      9 * (size_t)v->ncub * d,
+                      (size_t)v->ndomains * sizeof(int32_t),
+                      (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * sizeof(int32_t),
                       (size_t)v->ndomains * (size_t)v->ndomains,
-                      (size_t)v->ndomains * (size_t)v->ndomains, (size_t)v->ndomains * sizeof(int32_t),
-                      4 * nb * d, 4 * nb * d, (size_t)v->ntrain * sizeof(int32_t)};
+                      (size_t)v->ndomains * (size_t)v->ndomains,
+                      (size_t)v->ndomains * sizeof(int32_t),
+                      4 * nb * d,
+                      4 * nb * d,
+                      (size_t)v->ntrain * sizeof(int32_t)};
     memcpy(b, p, sizeof p);
     memcpy(sz, s, sizeof s);
 }
@@ -146,7 +171,8 @@ static void link_twins(sinew_instance *in) {
         int32_t next = t;
         for (int32_t k = 1; k < v->ntrain && next == t; ++k) { /* t+1, ..., wrapping round */
             int32_t u = (t + k) % v->ntrain;
-            if (sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14) next = u;
+            if (sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14)
+                next = u;
         }
         in->twin_next[t] = next;
     }
@@ -175,7 +201,8 @@ static void block_order_min_degree(const sw_blob_view *v, const int32_t *off, co
         for (int32_t i = 0; i < nd; ++i) {
             if (adj[i * nd + i] == 2) continue;
             int32_t deg = 0;
-            for (int32_t j = 0; j < nd; ++j) deg += j != i && adj[i * nd + j] == 1 && adj[j * nd + j] != 2;
+            for (int32_t j = 0; j < nd; ++j)
+                deg += j != i && adj[i * nd + j] == 1 && adj[j * nd + j] != 2;
             if (best < 0 || deg < bestdeg) best = i, bestdeg = deg;
         }
         order[step] = best;
@@ -194,7 +221,8 @@ SINEW_API void sinew_instance_destroy(sinew_instance *inst) {
     size_t sz[NBUF];
     buffers(inst, b, sz);
     sinew_allocator a = inst->allocator;
-    for (int i = 0; i < NBUF; ++i) mem_free(&a, *b[i]);
+    for (int i = 0; i < NBUF; ++i)
+        mem_free(&a, *b[i]);
     mem_free(&a, inst);
 }
 
@@ -235,11 +263,13 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         mem_free(&a, in);
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
-    for (int32_t i = 0; i < v->nverts; ++i) mark[i] = -1;
+    for (int32_t i = 0; i < v->nverts; ++i)
+        mark[i] = -1;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
-            for (int j = 0; j < 4; ++j) mark[v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]]] = 0;
+            for (int j = 0; j < 4; ++j)
+                mark[v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]]] = 0;
     }
     for (int32_t i = 0; i < v->nsurf_copies; ++i) {
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
@@ -256,7 +286,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     size_t sz[NBUF];
     buffers(in, b, sz);
     int ok = 1;
-    for (int i = 0; i < NBUF; ++i) ok = ok && (*b[i] = mem_alloc(&a, sz[i])) != NULL;
+    for (int i = 0; i < NBUF; ++i)
+        ok = ok && (*b[i] = mem_alloc(&a, sz[i])) != NULL;
     if (!ok) {
         mem_free(&a, mark);
         sinew_instance_destroy(in);
@@ -268,7 +299,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         const sw_blob_domain *D = &v->domains[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
             for (int j = 0; j < 4; ++j)
-                in->cub_act[4 * c + j] = mark[v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]]];
+                in->cub_act[4 * c + j] =
+                    mark[v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]]];
     }
     for (int32_t i = 0; i < v->nsurf_copies; ++i) {
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
@@ -277,7 +309,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     for (int32_t c = 0; c < v->ncontacts; ++c)
         for (int k = 0; k < 4; ++k) {
             const sw_blob_domain *D = &v->domains[v->contact_verts[8 * c + 2 * k]];
-            in->contact_act[4 * c + k] = mark[v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]]];
+            in->contact_act[4 * c + k] =
+                mark[v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]]];
         }
     mem_free(&a, mark);
     /* H's domain blocks and their elimination order: greedy minimum degree on the block
@@ -288,7 +321,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         in->blk_size[k] = v->domains[k].rank;
     }
     block_order_min_degree(v, in->blk_off, in->blk_size, in->blk_adj, in->blk_nz, in->blk_order);
-    for (int32_t e = 0; e < v->ndomains; ++e) in->blk_pos[in->blk_order[e]] = e;
+    for (int32_t e = 0; e < v->ndomains; ++e)
+        in->blk_pos[in->blk_order[e]] = e;
     link_twins(in);
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t i = 0; i < v->nverts; ++i)
@@ -311,7 +345,8 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     identity_pose(inst->T_cur, nb);
     memcpy(inst->T_prev, inst->T_cur, 12 * (size_t)nb * sizeof(double));
     memcpy(inst->T_prev2, inst->T_cur, 12 * (size_t)nb * sizeof(double));
-    for (int32_t b = 0; b < nb; ++b) sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
+    for (int32_t b = 0; b < nb; ++b)
+        sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
     inst->pose_set = 0;
     inst->history = 0;
     inst->nearest = inst->second = -1;
@@ -350,12 +385,15 @@ static sinew_result set_pose(sinew_instance *inst, const double *Td, const float
     int32_t nb = inst->v->nbones;
     for (int32_t b = 0; b < nb; ++b) {
         double T[12];
-        for (int i = 0; i < 12; ++i) T[i] = Td ? Td[12 * b + i] : (double)Tf[12 * b + i];
+        for (int i = 0; i < 12; ++i)
+            T[i] = Td ? Td[12 * b + i] : (double)Tf[12 * b + i];
         sinew_result r = check_transform(T);
         if (r != SINEW_OK) return r;
     }
-    for (int32_t i = 0; i < 12 * nb; ++i) inst->T_cur[i] = Td ? Td[i] : (double)Tf[i];
-    for (int32_t b = 0; b < nb; ++b) sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
+    for (int32_t i = 0; i < 12 * nb; ++i)
+        inst->T_cur[i] = Td ? Td[i] : (double)Tf[i];
+    for (int32_t b = 0; b < nb; ++b)
+        sw_dq_from_transform(inst->T_cur + 12 * b, &inst->bone_dq[b]);
     inst->pose_set = 1;
     return SINEW_OK;
 }
@@ -394,14 +432,17 @@ static void copy_position(const sinew_instance *in, const sw_blob_domain *D, int
     double y[3];
     for (int i = 0; i < 3; ++i) {
         double acc = X[i];
-        for (int32_t j = 0; j < r; ++j) acc += U[i * r + j] * qd[j];
+        for (int32_t j = 0; j < r; ++j)
+            acc += U[i * r + j] * qd[j];
         y[i] = acc;
     }
-    for (int i = 0; i < 3; ++i) x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
+    for (int i = 0; i < 3; ++i)
+        x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
     if (J)
         for (int i = 0; i < 3; ++i)
             for (int32_t j = 0; j < r; ++j)
-                J[i * r + j] = Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
+                J[i * r + j] =
+                    Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
 }
 
 /* Cubature energy at q; with want_grad, adds -sum w J^T f to g; with want_hess, adds the
@@ -425,7 +466,8 @@ static double cubature_eval(sinew_instance *in, const double *q, int want_grad, 
             if (!want_grad) continue;
             for (int32_t j = 0; j < r; ++j) {
                 double acc = 0;
-                for (int row = 0; row < 12; ++row) acc += in->Je[row * r + j] * f[row];
+                for (int row = 0; row < 12; ++row)
+                    acc += in->Je[row * r + j] * f[row];
                 in->g[o + j] -= w * acc;
             }
             if (!want_hess) continue;
@@ -435,13 +477,15 @@ static double cubature_eval(sinew_instance *in, const double *q, int want_grad, 
                 const double *gk = gm + 12 * k;
                 for (int32_t j = 0; j < r; ++j) {
                     double acc = 0;
-                    for (int row = 0; row < 12; ++row) acc += in->Je[row * r + j] * gk[row];
+                    for (int row = 0; row < 12; ++row)
+                        acc += in->Je[row * r + j] * gk[row];
                     h[j] = acc;
                 }
                 double wk = w * wm[k];
                 for (int32_t i = 0; i < r; ++i) {
                     double *Hi = in->H + (int64_t)(o + i) * in->R + o, hi = wk * h[i];
-                    for (int32_t j = i; j < r; ++j) Hi[j] += hi * h[j];
+                    for (int32_t j = i; j < r; ++j)
+                        Hi[j] += hi * h[j];
                 }
             }
         }
@@ -453,7 +497,8 @@ static double cubature_eval(sinew_instance *in, const double *q, int want_grad, 
             int32_t o = D->q_offset;
             for (int32_t i = 0; i < D->rank; ++i)
                 for (int32_t j = i + 1; j < D->rank; ++j)
-                    in->H[(int64_t)(o + j) * in->R + o + i] = in->H[(int64_t)(o + i) * in->R + o + j];
+                    in->H[(int64_t)(o + j) * in->R + o + i] =
+                        in->H[(int64_t)(o + i) * in->R + o + j];
         }
     return E;
 }
@@ -479,17 +524,21 @@ static double contact_pairs(sinew_instance *in, int32_t pose, double weight, con
         double x[4][3], d[3] = {0, 0, 0};
         for (int m = 0; m < 4; ++m) {
             D[m] = &v->domains[cv[2 * m]];
-            copy_position(in, D[m], cv[2 * m + 1], in->contact_act[4 * c + m], q + D[m]->q_offset, x[m],
-                          want_grad ? in->Jc + 3 * m * rm : NULL);
-            for (int i = 0; i < 3; ++i) d[i] += coef[m] * x[m][i];
+            copy_position(in, D[m], cv[2 * m + 1], in->contact_act[4 * c + m], q + D[m]->q_offset,
+                          x[m], want_grad ? in->Jc + 3 * m * rm : NULL);
+            for (int i = 0; i < 3; ++i)
+                d[i] += coef[m] * x[m][i];
         }
         const double *Rp = in->act_R + 9 * in->contact_act[4 * c];
         double n[3], g = 0;
-        for (int i = 0; i < 3; ++i) n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
-        for (int i = 0; i < 3; ++i) g += n[i] * d[i];
+        for (int i = 0; i < 3; ++i)
+            n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
+        for (int i = 0; i < 3; ++i)
+            g += n[i] * d[i];
         if (!(g > 0)) continue;
         double kk = k * cd[6], Nd[3];
-        for (int i = 0; i < 3; ++i) Nd[i] = al * d[i] + (1 - al) * g * n[i];
+        for (int i = 0; i < 3; ++i)
+            Nd[i] = al * d[i] + (1 - al) * g * n[i];
         E += 0.5 * kk * (d[0] * Nd[0] + d[1] * Nd[1] + d[2] * Nd[2]);
         if (!want_grad) continue;
         /* G per distinct domain (slot `lead[m]` holds the sum of its domain's slots) */
@@ -502,10 +551,12 @@ static double contact_pairs(sinew_instance *in, int32_t pose, double weight, con
                 if (D[leads[l]] == D[m]) lead[m] = leads[l];
             if (lead[m] == m) {
                 leads[nlead++] = m;
-                for (int32_t j = 0; j < 3 * r; ++j) Jm[j] *= coef[m];
+                for (int32_t j = 0; j < 3 * r; ++j)
+                    Jm[j] *= coef[m];
             } else {
                 double *Jl = in->Jc + 3 * lead[m] * rm;
-                for (int32_t j = 0; j < 3 * r; ++j) Jl[j] += coef[m] * Jm[j];
+                for (int32_t j = 0; j < 3 * r; ++j)
+                    Jl[j] += coef[m] * Jm[j];
             }
         }
         for (int l = 0; l < nlead; ++l) {
@@ -515,8 +566,10 @@ static double contact_pairs(sinew_instance *in, int32_t pose, double weight, con
             double *P = in->hc + 3 * l * rm; /* N G */
             for (int32_t j = 0; j < r; ++j) {
                 double gn = n[0] * G[j] + n[1] * G[r + j] + n[2] * G[2 * r + j];
-                for (int i = 0; i < 3; ++i) P[i * r + j] = al * G[i * r + j] + (1 - al) * n[i] * gn;
-                in->g[Dl->q_offset + j] += kk * (G[j] * Nd[0] + G[r + j] * Nd[1] + G[2 * r + j] * Nd[2]);
+                for (int i = 0; i < 3; ++i)
+                    P[i * r + j] = al * G[i * r + j] + (1 - al) * n[i] * gn;
+                in->g[Dl->q_offset + j] +=
+                    kk * (G[j] * Nd[0] + G[r + j] * Nd[1] + G[2 * r + j] * Nd[2]);
             }
         }
         if (!want_hess) continue;
@@ -528,7 +581,8 @@ static double contact_pairs(sinew_instance *in, int32_t pose, double weight, con
                 for (int32_t i = 0; i < ra; ++i) {
                     double *Hi = in->H + (int64_t)(Da->q_offset + i) * in->R + Db->q_offset;
                     double g0 = kk * Ga[i], g1 = kk * Ga[ra + i], g2 = kk * Ga[2 * ra + i];
-                    for (int32_t j = 0; j < rb; ++j) Hi[j] += g0 * Pb[j] + g1 * Pb[rb + j] + g2 * Pb[2 * rb + j];
+                    for (int32_t j = 0; j < rb; ++j)
+                        Hi[j] += g0 * Pb[j] + g1 * Pb[rb + j] + g2 * Pb[2 * rb + j];
                 }
             }
     }
@@ -597,7 +651,8 @@ static void nearest_training_poses(sinew_instance *in) {
     sw_pose_feature(in->T_cur, v->bone_parent, v->nbones, in->feature);
     double d0 = INFINITY, d1 = INFINITY;
     for (int32_t t = 0; t < v->ntrain; ++t) {
-        double d = sw_pose_distance(in->feature, v->train_pose + (size_t)4 * v->nbones * t, v->nbones);
+        double d =
+            sw_pose_distance(in->feature, v->train_pose + (size_t)4 * v->nbones * t, v->nbones);
         if ((d == d0 && same_pose(in, t, n0)) || (d == d1 && same_pose(in, t, n1))) continue;
         if (d < d0) {
             d1 = d0, n1 = n0;
@@ -613,9 +668,11 @@ static void nearest_training_poses(sinew_instance *in) {
     /* the last motion: kept while the pose holds still, so a pause does not switch branch */
     size_t f = (size_t)4 * v->nbones;
     double moved = 0;
-    for (size_t i = 0; i < f; ++i) moved += fabs(in->feature[i] - in->feature_last[i]);
+    for (size_t i = 0; i < f; ++i)
+        moved += fabs(in->feature[i] - in->feature_last[i]);
     if (moved > 1e-9 && in->looked_up)
-        for (size_t i = 0; i < f; ++i) in->motion[i] = in->feature[i] - in->feature_last[i];
+        for (size_t i = 0; i < f; ++i)
+            in->motion[i] = in->feature[i] - in->feature_last[i];
     memcpy(in->feature_last, in->feature, f * sizeof(double));
     in->looked_up = 1;
     in->nearest = pick_branch(in, n0);
@@ -626,14 +683,16 @@ static void nearest_training_poses(sinew_instance *in) {
 static void matvec(const double *A, int32_t R, const double *x, double *y) {
     for (int32_t i = 0; i < R; ++i) {
         double acc = 0;
-        for (int32_t j = 0; j < R; ++j) acc += A[(int64_t)i * R + j] * x[j];
+        for (int32_t j = 0; j < R; ++j)
+            acc += A[(int64_t)i * R + j] * x[j];
         y[i] = acc;
     }
 }
 
 static double dot(const double *a, const double *b, int32_t n) {
     double s = 0;
-    for (int32_t i = 0; i < n; ++i) s += a[i] * b[i];
+    for (int32_t i = 0; i < n; ++i)
+        s += a[i] * b[i];
     return s;
 }
 
@@ -655,29 +714,36 @@ static double potential(sinew_instance *in, const double *q, const dyn_coef *dc,
     matvec(v->spring_hessian, R, q, in->tmp);
     phi += 0.5 * dot(q, in->tmp, R);
     if (want_grad)
-        for (int32_t i = 0; i < R; ++i) in->g[i] += in->tmp[i];
+        for (int32_t i = 0; i < R; ++i)
+            in->g[i] += in->tmp[i];
     if (!dc->dynamic) return phi;
     /* inertia: cm/2 |q - qhat|_M^2 with qhat = qn + h qdot */
     double *e = in->tmp2;
-    for (int32_t i = 0; i < R; ++i) e[i] = q[i] - in->qn[i] - dc->h * in->qdot[i];
+    for (int32_t i = 0; i < R; ++i)
+        e[i] = q[i] - in->qn[i] - dc->h * in->qdot[i];
     matvec(v->mass, R, e, in->tmp);
     phi += 0.5 * dc->cm * dot(e, in->tmp, R);
     if (want_grad)
-        for (int32_t i = 0; i < R; ++i) in->g[i] += dc->cm * in->tmp[i];
+        for (int32_t i = 0; i < R; ++i)
+            in->g[i] += dc->cm * in->tmp[i];
     /* damping: cd/2 |q - qn|_D^2, D = alpha M + beta Hn */
-    for (int32_t i = 0; i < R; ++i) e[i] = q[i] - in->qn[i];
+    for (int32_t i = 0; i < R; ++i)
+        e[i] = q[i] - in->qn[i];
     matvec(v->mass, R, e, in->tmp);
     double dm = dot(e, in->tmp, R);
     if (want_grad)
-        for (int32_t i = 0; i < R; ++i) in->g[i] += dc->cd * dc->alpha * in->tmp[i];
+        for (int32_t i = 0; i < R; ++i)
+            in->g[i] += dc->cd * dc->alpha * in->tmp[i];
     matvec(in->Hn, R, e, in->tmp);
     double dk = dot(e, in->tmp, R);
     if (want_grad)
-        for (int32_t i = 0; i < R; ++i) in->g[i] += dc->cd * dc->beta * in->tmp[i] - in->fin[i];
+        for (int32_t i = 0; i < R; ++i)
+            in->g[i] += dc->cd * dc->beta * in->tmp[i] - in->fin[i];
     phi += 0.5 * dc->cd * (dc->alpha * dm + dc->beta * dk) - dot(q, in->fin, R);
     if (want_hess)
         for (int64_t i = 0; i < (int64_t)R * R; ++i)
-            in->H[i] += dc->cm * v->mass[i] + dc->cd * (dc->alpha * v->mass[i] + dc->beta * in->Hn[i]);
+            in->H[i] +=
+                dc->cm * v->mass[i] + dc->cd * (dc->alpha * v->mass[i] + dc->beta * in->Hn[i]);
     return phi;
 }
 
@@ -704,17 +770,20 @@ static void inertial_forces(sinew_instance *in, double h) {
     for (int32_t k = 0; k < v->ndomains; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         int32_t b = D->bone, r = D->rank, o = D->q_offset;
-        const double *Tc = in->T_cur + 12 * b, *Tp = in->T_prev + 12 * b, *Tq = in->T_prev2 + 12 * b;
+        const double *Tc = in->T_cur + 12 * b, *Tp = in->T_prev + 12 * b,
+                     *Tq = in->T_prev2 + 12 * b;
         double acc[3], c[3], w1[3], w0[3], al[3];
         for (int i = 0; i < 3; ++i)
             acc[i] = in->history >= 2 ? (Tc[9 + i] - 2 * Tp[9 + i] + Tq[9 + i]) / (h * h) : 0.0;
-        for (int i = 0; i < 3; ++i) c[i] = Tc[i] * acc[0] + Tc[3 + i] * acc[1] + Tc[6 + i] * acc[2];
+        for (int i = 0; i < 3; ++i)
+            c[i] = Tc[i] * acc[0] + Tc[3 + i] * acc[1] + Tc[6 + i] * acc[2];
         angular_velocity(Tp, Tc, h, w1);
         if (in->history >= 2)
             angular_velocity(Tq, Tp, h, w0);
         else
             memcpy(w0, w1, sizeof w0);
-        for (int i = 0; i < 3; ++i) al[i] = (w1[i] - w0[i]) / h;
+        for (int i = 0; i < 3; ++i)
+            al[i] = (w1[i] - w0[i]) / h;
         double W[9] = {0, -w1[2], w1[1], w1[2], 0, -w1[0], -w1[1], w1[0], 0};
         double A[9] = {0, -al[2], al[1], al[2], 0, -al[0], -al[1], al[0], 0};
         for (int i = 0; i < 3; ++i) /* A = [alpha]x + [w]x^2 */
@@ -723,7 +792,8 @@ static void inertial_forces(sinew_instance *in, double h) {
         const double *P = v->inertia_u + D->inertia_offset;
         for (int32_t i = 0; i < r; ++i) {
             double f = 0;
-            for (int a = 0; a < 3; ++a) f += v->inertia_s[3 * (o + i) + a] * c[a];
+            for (int a = 0; a < 3; ++a)
+                f += v->inertia_s[3 * (o + i) + a] * c[a];
             for (int ab = 0; ab < 9; ++ab) {
                 if (A[ab] == 0 && W[ab] == 0) continue;
                 const double *Pab = P + (int64_t)ab * r * r + (int64_t)i * r;
@@ -765,18 +835,21 @@ static void block_pattern(sinew_instance *in) {
 static int newton_direction(sinew_instance *in) {
     int32_t R = in->R, nd = in->v->ndomains;
     double tr = 0;
-    for (int32_t i = 0; i < R; ++i) tr += fabs(in->H[(int64_t)i * R + i]);
+    for (int32_t i = 0; i < R; ++i)
+        tr += fabs(in->H[(int64_t)i * R + i]);
     double shift = 0;
     for (int attempt = 0; attempt < 8; ++attempt) {
         if (sw_block_cholesky(in->H, R, nd, in->blk_off, in->blk_size, in->blk_order, in->blk_nz,
                               in->L)) {
-            for (int32_t i = 0; i < R; ++i) in->dq[i] = -in->g[i];
+            for (int32_t i = 0; i < R; ++i)
+                in->dq[i] = -in->g[i];
             sw_block_cholesky_solve(in->L, R, nd, in->blk_off, in->blk_size, in->blk_order,
                                     in->blk_nz, in->dq);
             return 1;
         }
         double next = shift == 0 ? 1e-10 * tr / R + 1e-300 : shift * 100;
-        for (int32_t i = 0; i < R; ++i) in->H[(int64_t)i * R + i] += next - shift; /* H is rebuilt next pass */
+        for (int32_t i = 0; i < R; ++i)
+            in->H[(int64_t)i * R + i] += next - shift; /* H is rebuilt next pass */
         shift = next;
     }
     return 0;
@@ -790,24 +863,32 @@ static void write_surface(sinew_instance *in) {
         for (int32_t i = b; i < e; ++i) {
             const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
             double x[3];
-            copy_position(in, D, v->surf_copies[2 * i + 1], in->copy_act[i], in->q + D->q_offset, x, NULL);
-            for (int k = 0; k < 3; ++k) acc[k] += x[k];
+            copy_position(in, D, v->surf_copies[2 * i + 1], in->copy_act[i], in->q + D->q_offset, x,
+                          NULL);
+            for (int k = 0; k < 3; ++k)
+                acc[k] += x[k];
         }
-        for (int k = 0; k < 3; ++k) in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
+        for (int k = 0; k < 3; ++k)
+            in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
     }
     memset(in->surf_n, 0, 3 * (size_t)v->nsurf_verts * sizeof(double));
     for (int32_t t = 0; t < v->nsurf_tris; ++t) {
         const int32_t *tri = v->surf_tris + 3 * t;
-        const double *a = in->surf_x + 3 * tri[0], *b = in->surf_x + 3 * tri[1], *c = in->surf_x + 3 * tri[2];
-        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+        const double *a = in->surf_x + 3 * tri[0], *b = in->surf_x + 3 * tri[1],
+                     *c = in->surf_x + 3 * tri[2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+               e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
         for (int k = 0; k < 3; ++k)
-            for (int j = 0; j < 3; ++j) in->surf_n[3 * tri[k] + j] += n[j]; /* area weighted */
+            for (int j = 0; j < 3; ++j)
+                in->surf_n[3 * tri[k] + j] += n[j]; /* area weighted */
     }
     for (int32_t s = 0; s < v->nsurf_verts; ++s) {
         double *n = in->surf_n + 3 * s, l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (l > 0)
-            for (int k = 0; k < 3; ++k) n[k] /= l;
+            for (int k = 0; k < 3; ++k)
+                n[k] /= l;
     }
 }
 
@@ -828,7 +909,8 @@ static void pose_space_start(sinew_instance *in) {
         return;
     }
     const double *q1 = v->train_q + (size_t)in->R * in->second;
-    for (int32_t i = 0; i < in->R; ++i) in->q[i] = (1 - in->blend) * q0[i] + in->blend * q1[i];
+    for (int32_t i = 0; i < in->R; ++i)
+        in->q[i] = (1 - in->blend) * q0[i] + in->blend * q1[i];
 }
 
 /* A pose jump no animation makes in one frame (a teleport): no inertia from it. */
@@ -836,8 +918,10 @@ static int teleported(const sinew_instance *in) {
     for (int32_t b = 0; b < in->v->nbones; ++b) {
         const double *Tc = in->T_cur + 12 * b, *Tp = in->T_prev + 12 * b;
         double d2 = 0, tr = 0;
-        for (int i = 0; i < 3; ++i) d2 += (Tc[9 + i] - Tp[9 + i]) * (Tc[9 + i] - Tp[9 + i]);
-        for (int i = 0; i < 3; ++i) tr += Tc[i] * Tp[i] + Tc[3 + i] * Tp[3 + i] + Tc[6 + i] * Tp[6 + i];
+        for (int i = 0; i < 3; ++i)
+            d2 += (Tc[9 + i] - Tp[9 + i]) * (Tc[9 + i] - Tp[9 + i]);
+        for (int i = 0; i < 3; ++i)
+            tr += Tc[i] * Tp[i] + Tc[3 + i] * Tp[3 + i] + Tc[6 + i] * Tp[6 + i];
         if (d2 > 0.25 * in->size * in->size || tr < 0.0) return 1; /* > half size, > 90 deg */
     }
     return 0;
@@ -901,7 +985,8 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
          * alone (0.0279 / 0.1679 train / held-out at 5K) while the step took 0.7 ms
          * instead of 1.6 ms at 20K. */
         if (sqrt(dot(inst->dq, inst->dq, R)) <= 3e-3 * sqrt(dot(inst->q, inst->q, R))) {
-            for (int32_t i = 0; i < R; ++i) inst->q[i] += inst->dq[i];
+            for (int32_t i = 0; i < R; ++i)
+                inst->q[i] += inst->dq[i];
             st.newton_iterations++;
             st.status |= SINEW_STEP_CONVERGED;
             break;
@@ -910,7 +995,8 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
         double phi0 = phi, gn0 = gn, step = 1.0;
         int accepted = 0;
         for (int ls = 0; ls < 5; ++ls, step *= 0.5) {
-            for (int32_t i = 0; i < R; ++i) inst->q[i] = inst->qtrial[i] + step * inst->dq[i];
+            for (int32_t i = 0; i < R; ++i)
+                inst->q[i] = inst->qtrial[i] + step * inst->dq[i];
             phi = potential(inst, inst->q, &dc, 1, 1);
             if (isfinite(phi) && phi <= phi0 + 1e-12 * fabs(phi0)) {
                 accepted = 1;
@@ -930,7 +1016,8 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     st.residual = g0 > 0 ? gn / g0 : 0;
     st.energy = phi;
     if (dc.dynamic)
-        for (int32_t i = 0; i < R; ++i) inst->qdot[i] = (inst->q[i] - inst->qn[i]) / dt;
+        for (int32_t i = 0; i < R; ++i)
+            inst->qdot[i] = (inst->q[i] - inst->qn[i]) / dt;
     /* advance the pose history */
     memcpy(inst->T_prev2, inst->T_prev, 12 * (size_t)v->nbones * sizeof(double));
     memcpy(inst->T_prev, inst->T_cur, 12 * (size_t)v->nbones * sizeof(double));
@@ -953,14 +1040,19 @@ SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, f
 
 SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sinew_step_stats *out) {
     if (!inst || !out || out->struct_size < sizeof(uint32_t)) return SINEW_ERROR_INVALID_ARGUMENT;
-    uint32_t n = out->struct_size < sizeof inst->stats ? out->struct_size : (uint32_t)sizeof inst->stats;
+    uint32_t n =
+        out->struct_size < sizeof inst->stats ? out->struct_size : (uint32_t)sizeof inst->stats;
     memcpy(out, &inst->stats, n);
     out->struct_size = n;
     return SINEW_OK;
 }
 
-const double *sw_instance_surface(const sinew_instance *inst) { return inst->surf_x; }
-const double *sw_instance_q(const sinew_instance *inst) { return inst->q; }
+const double *sw_instance_surface(const sinew_instance *inst) {
+    return inst->surf_x;
+}
+const double *sw_instance_q(const sinew_instance *inst) {
+    return inst->q;
+}
 
 void sw_instance_full_positions(const sinew_instance *inst, double *x, double *count) {
     const sw_blob_view *v = inst->v;
@@ -976,7 +1068,8 @@ void sw_instance_full_positions(const sinew_instance *inst, double *x, double *c
             const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
             for (int i = 0; i < 3; ++i) {
                 double acc = v->rest[3 * gv + i];
-                for (int32_t j = 0; j < r; ++j) acc += U[i * r + j] * inst->q[D->q_offset + j];
+                for (int32_t j = 0; j < r; ++j)
+                    acc += U[i * r + j] * inst->q[D->q_offset + j];
                 y[i] = acc;
             }
             for (int i = 0; i < 3; ++i)
@@ -986,12 +1079,14 @@ void sw_instance_full_positions(const sinew_instance *inst, double *x, double *c
     }
     for (int32_t gv = 0; gv < v->nverts; ++gv) {
         if (count[gv] > 0) {
-            for (int i = 0; i < 3; ++i) x[3 * gv + i] /= count[gv];
+            for (int i = 0; i < 3; ++i)
+                x[3 * gv + i] /= count[gv];
         } else {
             double R[9], t[3];
             sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
             const double *X = v->rest + 3 * gv;
-            for (int i = 0; i < 3; ++i) x[3 * gv + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+            for (int i = 0; i < 3; ++i)
+                x[3 * gv + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
         }
     }
 }

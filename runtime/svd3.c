@@ -90,10 +90,12 @@ static void svd3(const double A[9], const double *V0, double U[9], double s[3], 
     for (int i = 0; i < 9; ++i)
         Am[i] = A[i] / m;
     if (V0) { /* W = A V0: a good V0 leaves W nearly column-orthogonal already */
-        for (int i = 0; i < 9; ++i) V[i] = V0[i];
+        for (int i = 0; i < 9; ++i)
+            V[i] = V0[i];
         sw_m3_mul(Am, V0, W);
     } else {
-        for (int i = 0; i < 9; ++i) W[i] = Am[i];
+        for (int i = 0; i < 9; ++i)
+            W[i] = Am[i];
     }
     for (int sweep = 0; sweep < SVD3_MAX_SWEEPS; ++sweep) {
         int rotated = orthogonalize_pair(W, V, 0, 1);
@@ -154,7 +156,9 @@ static void svd3(const double A[9], const double *V0, double U[9], double s[3], 
     s[2] = s2 * m;
 }
 
-void sw_svd3(const double A[9], double U[9], double s[3], double V[9]) { svd3(A, NULL, U, s, V); }
+void sw_svd3(const double A[9], double U[9], double s[3], double V[9]) {
+    svd3(A, NULL, U, s, V);
+}
 
 void sw_svd3_warm(const double A[9], const double V0[9], double U[9], double s[3], double V[9]) {
     svd3(A, V0, U, s, V);

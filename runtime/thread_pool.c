@@ -38,7 +38,8 @@ static void *worker_main(void *p) {
     uint64_t seen = 0;
     pthread_mutex_lock(&pool->mu);
     for (;;) {
-        while (!pool->quit && pool->generation == seen) pthread_cond_wait(&pool->wake, &pool->mu);
+        while (!pool->quit && pool->generation == seen)
+            pthread_cond_wait(&pool->wake, &pool->mu);
         if (pool->quit) break;
         seen = pool->generation;
         sw_range_fn fn = pool->fn;
@@ -94,7 +95,8 @@ void sw_pool_destroy(sw_pool *pool) {
         pool->quit = 1;
         pthread_cond_broadcast(&pool->wake);
         pthread_mutex_unlock(&pool->mu);
-        for (int i = 1; i < pool->nworkers; ++i) pthread_join(pool->threads[i - 1], NULL);
+        for (int i = 1; i < pool->nworkers; ++i)
+            pthread_join(pool->threads[i - 1], NULL);
         pthread_mutex_destroy(&pool->mu);
         pthread_cond_destroy(&pool->wake);
         pthread_cond_destroy(&pool->done);
@@ -103,7 +105,9 @@ void sw_pool_destroy(sw_pool *pool) {
     free(pool);
 }
 
-int sw_pool_size(const sw_pool *pool) { return pool ? pool->nworkers : 1; }
+int sw_pool_size(const sw_pool *pool) {
+    return pool ? pool->nworkers : 1;
+}
 
 void sw_pool_parallel_for(sw_pool *pool, int64_t n, sw_range_fn fn, void *ctx) {
     if (n <= 0) return;
@@ -123,6 +127,7 @@ void sw_pool_parallel_for(sw_pool *pool, int64_t n, sw_range_fn fn, void *ctx) {
     sw_pool_chunk(n, pool->nworkers, 0, &b, &e);
     if (e > b) fn(ctx, b, e, 0);
     pthread_mutex_lock(&pool->mu);
-    while (pool->pending > 0) pthread_cond_wait(&pool->done, &pool->mu);
+    while (pool->pending > 0)
+        pthread_cond_wait(&pool->done, &pool->mu);
     pthread_mutex_unlock(&pool->mu);
 }

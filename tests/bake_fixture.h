@@ -59,6 +59,7 @@ static inline void bake_fixture_free(bake_fixture *f) {
 /* Pose f of the fixture's clip as float transforms (12 per bone) into out. */
 static inline void bake_fixture_pose(const bake_fixture *f, int frame, float *out) {
     const double *T = f->ch.clip.T + (size_t)(frame % f->ch.clip.nframes) * 12 * f->ch.skel.nbones;
-    for (int i = 0; i < 12 * f->ch.skel.nbones; ++i) out[i] = (float)T[i];
+    for (int i = 0; i < 12 * f->ch.skel.nbones; ++i)
+        out[i] = (float)T[i];
 }
 #endif

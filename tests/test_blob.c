@@ -145,7 +145,8 @@ static void fixture_init(fixture *f, uint64_t seed) {
             f->contact_verts[8 * c + 2 * k] = d;
             f->contact_verts[8 * c + 2 * k + 1] = (int32_t)(rng_next() % (uint32_t)vc[d]);
         }
-        for (int k = 0; k < 6; ++k) f->contact_data[7 * c + k] = rng_sym();
+        for (int k = 0; k < 6; ++k)
+            f->contact_data[7 * c + k] = rng_sym();
         f->contact_data[7 * c + 6] = 0.5 + rng_unit();
     }
     for (int t = 0; t < NST; ++t)
@@ -947,7 +948,8 @@ TEST(unknown_extra_section_still_loads) {
     ENSURE(first >= table_end && 64 + (size_t)(n + 1) * 32 <= first + shift);
     memcpy(b, blob, table_end);
     memcpy(b + first + shift, blob + first, size - first);
-    for (uint32_t i = 0; i < n; ++i) ((sinew_blob_section *)(void *)(b + 64))[i].offset += shift;
+    for (uint32_t i = 0; i < n; ++i)
+        ((sinew_blob_section *)(void *)(b + 64))[i].offset += shift;
     size += shift;
     sinew_blob_section *t = (sinew_blob_section *)(void *)(b + 64);
     t[n].id = 4242;

@@ -18,15 +18,18 @@ static void make_spd(int32_t n, int32_t nb, const int32_t *off, const int32_t *s
         for (int32_t j = 0; j <= i; ++j) {
             if (i != j && !couple[i * nb + j]) continue;
             for (int32_t r = 0; r < size[i]; ++r)
-                for (int32_t c = 0; c < size[j]; ++c) B[(off[i] + r) * n + off[j] + c] = urand();
+                for (int32_t c = 0; c < size[j]; ++c)
+                    B[(off[i] + r) * n + off[j] + c] = urand();
         }
     /* A = B B^T restricted to the coupling pattern would fill; instead a diagonally
      * dominant symmetric matrix with the pattern */
     for (int32_t r = 0; r < n; ++r)
-        for (int32_t c = 0; c <= r; ++c) A[r * n + c] = A[c * n + r] = B[r * n + c];
+        for (int32_t c = 0; c <= r; ++c)
+            A[r * n + c] = A[c * n + r] = B[r * n + c];
     for (int32_t r = 0; r < n; ++r) {
         double s = 0;
-        for (int32_t c = 0; c < n; ++c) s += fabs(A[r * n + c]);
+        for (int32_t c = 0; c < n; ++c)
+            s += fabs(A[r * n + c]);
         A[r * n + r] = s + 1.0;
     }
     free(B);
@@ -40,17 +43,20 @@ static void check_solve(int32_t nb, const int32_t *size, const unsigned char *co
         n += size[b];
     }
     double *A = calloc((size_t)n * n, sizeof(double)), *L = calloc((size_t)n * n, sizeof(double));
-    double *Ld = malloc(sizeof(double) * n * n), *x = malloc(sizeof(double) * n), *y = malloc(sizeof(double) * n);
+    double *Ld = malloc(sizeof(double) * n * n), *x = malloc(sizeof(double) * n),
+           *y = malloc(sizeof(double) * n);
     unsigned char nz[256];
     make_spd(n, nb, off, size, couple, A);
-    for (int32_t i = 0; i < n; ++i) x[i] = y[i] = urand();
+    for (int32_t i = 0; i < n; ++i)
+        x[i] = y[i] = urand();
     memcpy(Ld, A, sizeof(double) * n * n);
     sw_block_pattern(A, n, nb, off, size, order, nz);
     int ok1 = sw_cholesky(Ld, n), ok2 = sw_block_cholesky(A, n, nb, off, size, order, nz, L);
     if (ok1 && ok2) {
         sw_cholesky_solve(Ld, n, x);
         sw_block_cholesky_solve(L, n, nb, off, size, order, nz, y);
-        for (int32_t i = 0; i < n; ++i) *maxerr = fmax(*maxerr, fabs(x[i] - y[i]) / (fabs(x[i]) + 1e-3));
+        for (int32_t i = 0; i < n; ++i)
+            *maxerr = fmax(*maxerr, fabs(x[i] - y[i]) / (fabs(x[i]) + 1e-3));
     } else {
         *maxerr = INFINITY;
     }
@@ -64,12 +70,15 @@ static void check_solve(int32_t nb, const int32_t *size, const unsigned char *co
 TEST(block_cholesky_matches_dense_on_chains_trees_and_fill) {
     const int32_t size[6] = {3, 5, 1, 4, 6, 2};
     unsigned char chain[36] = {0}, tree[36] = {0}, loop[36] = {0};
-    for (int i = 1; i < 6; ++i) chain[i * 6 + i - 1] = chain[(i - 1) * 6 + i] = 1;
+    for (int i = 1; i < 6; ++i)
+        chain[i * 6 + i - 1] = chain[(i - 1) * 6 + i] = 1;
     const int parent[6] = {-1, 0, 0, 1, 1, 2};
-    for (int i = 1; i < 6; ++i) tree[i * 6 + parent[i]] = tree[parent[i] * 6 + i] = 1;
+    for (int i = 1; i < 6; ++i)
+        tree[i * 6 + parent[i]] = tree[parent[i] * 6 + i] = 1;
     memcpy(loop, tree, sizeof loop);
     loop[5 * 6 + 4] = loop[4 * 6 + 5] = 1; /* a contact between two leaves: fill */
-    const int32_t orders[4][6] = {{0, 1, 2, 3, 4, 5}, {5, 4, 3, 2, 1, 0}, {3, 4, 5, 1, 2, 0}, {2, 0, 5, 3, 1, 4}};
+    const int32_t orders[4][6] = {
+        {0, 1, 2, 3, 4, 5}, {5, 4, 3, 2, 1, 0}, {3, 4, 5, 1, 2, 0}, {2, 0, 5, 3, 1, 4}};
     double worst = 0;
     for (int t = 0; t < 20; ++t)
         for (int o = 0; o < 4; ++o) {

@@ -95,8 +95,8 @@ TEST(single_influence_reproduces_transform) {
                 T[i] = (i % 4 == 0) ? 1.0 : 0.0;
         sw_dualquat dq;
         sw_dq_from_transform(T, &dq);
-        double n = sqrt(dq.r[0] * dq.r[0] + dq.r[1] * dq.r[1] + dq.r[2] * dq.r[2] +
-                        dq.r[3] * dq.r[3]);
+        double n =
+            sqrt(dq.r[0] * dq.r[0] + dq.r[1] * dq.r[1] + dq.r[2] * dq.r[2] + dq.r[3] * dq.r[3]);
         ENSURE_NEAR(n, 1.0, 1e-14);
         /* A unit dual quaternion has r . d = 0. */
         ENSURE_NEAR(dq.r[0] * dq.d[0] + dq.r[1] * dq.d[1] + dq.r[2] * dq.d[2] + dq.r[3] * dq.d[3],
@@ -324,7 +324,9 @@ TEST(skin_matches_per_point_blend) {
     ENSURE(max_diff(Y, x, 3 * N) == 0.0);
 }
 
-SW_TEST_MAIN(CASE(single_influence_reproduces_transform), CASE(antipodal_input_matches_identical_input),
-             CASE(same_axis_blend_is_intermediate_rotation), CASE(random_blends_are_proper_rotations),
-             CASE(translations_only_equal_lbs), CASE(candy_wrapper_twist_keeps_volume),
-             CASE(zero_weights_give_identity), CASE(skin_matches_per_point_blend))
+SW_TEST_MAIN(CASE(single_influence_reproduces_transform),
+             CASE(antipodal_input_matches_identical_input),
+             CASE(same_axis_blend_is_intermediate_rotation),
+             CASE(random_blends_are_proper_rotations), CASE(translations_only_equal_lbs),
+             CASE(candy_wrapper_twist_keeps_volume), CASE(zero_weights_give_identity),
+             CASE(skin_matches_per_point_blend))

@@ -44,7 +44,8 @@ static void random_rotation(double R[9]) {
         }
     } while (n < 1e-3 || n > 1);
     n = sqrt(n);
-    for (int i = 0; i < 4; ++i) q[i] /= n;
+    for (int i = 0; i < 4; ++i)
+        q[i] /= n;
     sw_quat_to_matrix(q, R);
 }
 
@@ -702,34 +703,43 @@ TEST(hessian_modes_reproduce_K) {
     uint64_t seed = 77;
     for (int trial = 0; trial < 200; ++trial) {
         double X[12], x[12], Dm[9], vol;
-        for (int i = 0; i < 12; ++i) X[i] = (double)((seed = seed * 6364136223846793005ull + 1) >> 11) * 0x1.0p-53;
+        for (int i = 0; i < 12; ++i)
+            X[i] = (double)((seed = seed * 6364136223846793005ull + 1) >> 11) * 0x1.0p-53;
         if (!sw_tet_rest(X, Dm, &vol)) continue;
         for (int i = 0; i < 12; ++i)
-            x[i] = X[i] * (trial % 3 ? 1.0 : -0.5) + 0.3 * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) * 0x1.0p-53 - 0.5);
+            x[i] = X[i] * (trial % 3 ? 1.0 : -0.5) +
+                   0.3 * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) * 0x1.0p-53 -
+                          0.5);
         for (uint32_t flags = 0; flags <= SW_COROT_PROJECT_PSD; ++flags) {
             double K[144], f1[12], f2[12], w[9], g[108];
             double e1 = sw_corot_eval(x, Dm, vol, 1.0, 3.0, f1, K, flags);
             double Vc[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-            double e2 = sw_corot_eval_modes(x, Dm, vol, 1.0, 3.0, f2, w, g, trial % 2 ? Vc : NULL, flags);
+            double e2 =
+                sw_corot_eval_modes(x, Dm, vol, 1.0, 3.0, f2, w, g, trial % 2 ? Vc : NULL, flags);
             ENSURE_NEAR(e1, e2, 1e-12 * (fabs(e1) + 1e-300));
-            for (int i = 0; i < 12; ++i) ENSURE_NEAR(f1[i], f2[i], 1e-10 * (fabs(f1[i]) + 1.0));
+            for (int i = 0; i < 12; ++i)
+                ENSURE_NEAR(f1[i], f2[i], 1e-10 * (fabs(f1[i]) + 1.0));
             double scale = 0;
-            for (int i = 0; i < 144; ++i) scale = fmax(scale, fabs(K[i]));
+            for (int i = 0; i < 144; ++i)
+                scale = fmax(scale, fabs(K[i]));
             for (int i = 0; i < 12; ++i)
                 for (int j = 0; j < 12; ++j) {
                     double k = 0;
-                    for (int m = 0; m < 9; ++m) k += w[m] * g[12 * m + i] * g[12 * m + j];
+                    for (int m = 0; m < 9; ++m)
+                        k += w[m] * g[12 * m + i] * g[12 * m + j];
                     ENSURE_NEAR(k, K[12 * i + j], 1e-12 * (scale + 1e-300));
                 }
             if (flags)
-                for (int m = 0; m < 9; ++m) ENSURE(w[m] >= 0);
+                for (int m = 0; m < 9; ++m)
+                    ENSURE(w[m] >= 0);
         }
     }
 }
 
-SW_TEST_MAIN(CASE(hessian_modes_reproduce_K), CASE(eigen_helper_is_correct), CASE(fd_well_shaped_elements),
-             CASE(fd_strongly_deformed_elements), CASE(fd_inverted_elements),
-             CASE(projected_hessian_is_symmetric_psd), CASE(projection_is_identity_on_psd_hessians),
+SW_TEST_MAIN(CASE(hessian_modes_reproduce_K), CASE(eigen_helper_is_correct),
+             CASE(fd_well_shaped_elements), CASE(fd_strongly_deformed_elements),
+             CASE(fd_inverted_elements), CASE(projected_hessian_is_symmetric_psd),
+             CASE(projection_is_identity_on_psd_hessians),
              CASE(rigid_motion_gives_zero_force_and_six_zero_modes),
              CASE(forces_are_free_of_net_force_and_torque),
              CASE(energy_matches_closed_form_for_uniaxial_stretch), CASE(patch_test_uniform_stress),

@@ -27,7 +27,8 @@ TEST(rigid_pose_gives_rigid_shape_and_zero_energy) {
     ENSURE(sw_fullsim_create(&c, NULL, &sim, &err) == SINEW_OK);
     double th = 0.6, T[12] = {cos(th), -sin(th), 0, sin(th), cos(th), 0, 0, 0, 1, 0.3, -2.0, 5.0};
     double *Tb = malloc(sizeof(double) * 12 * c.skel.nbones);
-    for (int b = 0; b < c.skel.nbones; ++b) memcpy(Tb + 12 * b, T, sizeof T);
+    for (int b = 0; b < c.skel.nbones; ++b)
+        memcpy(Tb + 12 * b, T, sizeof T);
     sw_fullsim_stats st;
     ENSURE(sw_fullsim_step(sim, Tb, &st) == SINEW_OK);
     const double *x = sw_fullsim_positions(sim);
@@ -35,7 +36,8 @@ TEST(rigid_pose_gives_rigid_shape_and_zero_energy) {
     for (int v = 0; v < c.mesh.nverts; ++v) {
         double p[3];
         sw_transform_point(T, c.mesh.X + 3 * v, p);
-        for (int i = 0; i < 3; ++i) err_max = fmax(err_max, fabs(p[i] - x[3 * v + i]));
+        for (int i = 0; i < 3; ++i)
+            err_max = fmax(err_max, fabs(p[i] - x[3 * v + i]));
     }
     ENSUREF(err_max < 1e-9, "max deviation from the rigid motion %g", err_max);
     ENSURE(st.energy_elastic < 1e-12 * c.youngs);
@@ -68,11 +70,12 @@ TEST(newton_converges_quadratically) {
     /* Relative gradients e_k; quadratic: log e_{k+1} ~ 2 log e_k once e_k is small. */
     int checked = 0;
     for (int k = 0; k + 1 <= st.newton_iters && k + 1 < 32; ++k) {
-        double ek = st.grad_history[k] / st.grad_norm0, ek1 = st.grad_history[k + 1] / st.grad_norm0;
+        double ek = st.grad_history[k] / st.grad_norm0,
+               ek1 = st.grad_history[k + 1] / st.grad_norm0;
         fprintf(stderr, "    newton %d: |g|/|g0| = %.3e\n", k + 1, ek1);
         if (ek < 1e-2 && ek1 > 1e-12) {
-            ENSUREF(log10(ek1) <= 1.6 * log10(ek), "e_k = %.3e -> e_k+1 = %.3e is not quadratic", ek,
-                    ek1);
+            ENSUREF(log10(ek1) <= 1.6 * log10(ek), "e_k = %.3e -> e_k+1 = %.3e is not quadratic",
+                    ek, ek1);
             checked++;
         }
     }
@@ -114,7 +117,8 @@ TEST(newmark_keeps_energy_of_undamped_oscillation) {
     sw_fullsim *sim = oscillating(&c, SW_NEWMARK, 2e-3, &err);
     ENSUREF(sim, "%s", err.msg);
     double *I = calloc((size_t)12 * c.skel.nbones, sizeof(double));
-    for (int b = 0; b < c.skel.nbones; ++b) I[12 * b] = I[12 * b + 4] = I[12 * b + 8] = 1;
+    for (int b = 0; b < c.skel.nbones; ++b)
+        I[12 * b] = I[12 * b + 4] = I[12 * b + 8] = 1;
     double e0 = sw_fullsim_elastic_energy(sim), worst = 0, kin_max = 0;
     ENSURE(e0 > 0);
     for (int s = 0; s < 150; ++s) {
@@ -126,7 +130,8 @@ TEST(newmark_keeps_energy_of_undamped_oscillation) {
         worst = fmax(worst, fabs(e - e0) / e0);
         kin_max = fmax(kin_max, st.energy_kinetic / e0);
     }
-    fprintf(stderr, "    Newmark: max |E - E0|/E0 = %.4f, peak kinetic share %.2f\n", worst, kin_max);
+    fprintf(stderr, "    Newmark: max |E - E0|/E0 = %.4f, peak kinetic share %.2f\n", worst,
+            kin_max);
     ENSUREF(kin_max > 0.3, "the flesh barely moved (kinetic share %.3f)", kin_max);
     ENSUREF(worst < 0.03, "energy drifted by %.2f%%", 100 * worst);
     free(I);
@@ -140,7 +145,8 @@ TEST(backward_euler_never_gains_energy) {
     sw_fullsim *sim = oscillating(&c, SW_BACKWARD_EULER, 2e-3, &err);
     ENSUREF(sim, "%s", err.msg);
     double *I = calloc((size_t)12 * c.skel.nbones, sizeof(double));
-    for (int b = 0; b < c.skel.nbones; ++b) I[12 * b] = I[12 * b + 4] = I[12 * b + 8] = 1;
+    for (int b = 0; b < c.skel.nbones; ++b)
+        I[12 * b] = I[12 * b + 4] = I[12 * b + 8] = 1;
     double prev = sw_fullsim_elastic_energy(sim), e0 = prev;
     for (int s = 0; s < 60; ++s) {
         sw_fullsim_stats st;
@@ -197,7 +203,8 @@ TEST(self_contact_removes_most_penetration_of_folded_finger) {
     fprintf(stderr, "    max penetration: without self-contact %.4g, with %.4g (ratio %.3f)\n", off,
             on, on / off);
     ENSURE(ok_off && ok_on);
-    ENSUREF(off > 0.02, "the fold does not self-intersect (%.4g): the test would prove nothing", off);
+    ENSUREF(off > 0.02, "the fold does not self-intersect (%.4g): the test would prove nothing",
+            off);
     ENSUREF(on <= 0.1 * off, "penetration %.4g is more than 10%% of %.4g", on, off);
 }
 
@@ -223,7 +230,8 @@ TEST(contacts_push_and_never_pull) {
             ENSUREF(sw_contact_gap(&k[i], sw_fullsim_positions(sim)) > 0,
                     "frame %d: pair %d (vertex %d) is in front of its surface point", f, i, k[i].p);
     }
-    ENSUREF(with_contacts >= 2, "only %d frames with contacts: the test would prove little", with_contacts);
+    ENSUREF(with_contacts >= 2, "only %d frames with contacts: the test would prove little",
+            with_contacts);
     sw_fullsim_destroy(sim);
     sw_character_free(&c);
 }
@@ -260,7 +268,8 @@ TEST(unsettled_contact_set_is_one_another_round_changes) {
         if (st[0].contact_rounds == cap) {
             seen[st[0].contacts_unsettled]++;
             if (st[0].contacts_unsettled)
-                ENSUREF(st[1].contact_rounds == cap + 1, "frame %d: unsettled, yet another round changed nothing", f);
+                ENSUREF(st[1].contact_rounds == cap + 1,
+                        "frame %d: unsettled, yet another round changed nothing", f);
             else
                 ENSUREF(memcmp(xa, xb, n3 * sizeof(double)) == 0,
                         "frame %d: settled, yet another round moved the flesh", f);
@@ -270,7 +279,8 @@ TEST(unsettled_contact_set_is_one_another_round_changes) {
     fprintf(stderr, "    frames at the cap: %d settled, %d unsettled\n", seen[0], seen[1]);
     ENSUREF(seen[1] > 0, "no frame reached the cap unsettled: the test would prove little");
     free(x);
-    for (int k = 0; k < 2; ++k) sw_fullsim_destroy(sim[k]);
+    for (int k = 0; k < 2; ++k)
+        sw_fullsim_destroy(sim[k]);
     sw_character_free(&c);
 }
 
@@ -312,7 +322,8 @@ TEST(bad_input_is_rejected_and_state_kept) {
     /* no bone-driven vertex: singular */
     int32_t *keep = c.bone_of_vertex;
     c.bone_of_vertex = calloc((size_t)c.mesh.nverts, sizeof(int32_t));
-    for (int v = 0; v < c.mesh.nverts; ++v) c.bone_of_vertex[v] = -1;
+    for (int v = 0; v < c.mesh.nverts; ++v)
+        c.bone_of_vertex[v] = -1;
     ENSURE(sw_fullsim_create(&c, NULL, &sim, &err) == SINEW_ERROR_INVALID_ARGUMENT);
     ENSURE(strstr(err.msg, "singular"));
     free(c.bone_of_vertex);
@@ -338,11 +349,11 @@ TEST(bad_input_is_rejected_and_state_kept) {
     sw_character_free(&c);
 }
 
-SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy), CASE(newton_converges_quadratically),
+SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy),
+             CASE(newton_converges_quadratically),
              CASE(newmark_keeps_energy_of_undamped_oscillation),
              CASE(backward_euler_never_gains_energy),
              CASE(self_contact_removes_most_penetration_of_folded_finger),
              CASE(contacts_push_and_never_pull),
              CASE(unsettled_contact_set_is_one_another_round_changes),
-             CASE(ground_plane_pushes_flesh_out),
-             CASE(bad_input_is_rejected_and_state_kept))
+             CASE(ground_plane_pushes_flesh_out), CASE(bad_input_is_rejected_and_state_kept))

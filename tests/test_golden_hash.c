@@ -19,7 +19,8 @@ enum { NINST = 4, STEPS = 24 };
 
 static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
     const unsigned char *p = data;
-    for (size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 0x100000001b3ull;
+    for (size_t i = 0; i < n; ++i)
+        h = (h ^ p[i]) * 0x100000001b3ull;
     return h;
 }
 
@@ -55,7 +56,8 @@ static int hash_instance(const bake_fixture *f, int i, uint64_t *h) {
 
 static void *run(void *p) {
     job *j = p;
-    for (int i = j->first; i < NINST; i += j->stride) j->ok[i] = hash_instance(j->f, i, &j->hash[i]);
+    for (int i = j->first; i < NINST; i += j->stride)
+        j->ok[i] = hash_instance(j->f, i, &j->hash[i]);
     return NULL;
 }
 
@@ -67,7 +69,8 @@ static uint64_t hash_on_threads(const bake_fixture *f, int nthreads) {
         jobs[t] = (job){.f = f, .first = t, .stride = nthreads};
         if (pthread_create(&th[t], NULL, run, &jobs[t]) != 0) return 0;
     }
-    for (int t = 0; t < nthreads; ++t) pthread_join(th[t], NULL);
+    for (int t = 0; t < nthreads; ++t)
+        pthread_join(th[t], NULL);
     uint64_t h = 0xcbf29ce484222325ull;
     for (int i = 0; i < NINST; ++i) {
         const job *j = &jobs[i % nthreads];
@@ -84,7 +87,8 @@ TEST(surface_hash_is_golden_on_1_2_4_threads) {
     uint64_t h[3];
     for (int t = 0; t < 3; ++t) {
         h[t] = hash_on_threads(&f, threads[t]);
-        fprintf(stderr, "  %d threads: surface hash 0x%016llx\n", threads[t], (unsigned long long)h[t]);
+        fprintf(stderr, "  %d threads: surface hash 0x%016llx\n", threads[t],
+                (unsigned long long)h[t]);
     }
     bake_fixture_free(&f);
     ENSURE(h[0] != 0);

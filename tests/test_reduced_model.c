@@ -39,12 +39,15 @@ TEST(gradient_matches_finite_differences_with_contact_pairs) {
     /* the most folded training poses: the ones with the most contact pairs */
     for (int32_t t = 0; t < v->ntrain; ++t) {
         if (v->contact_ptr[t + 1] - v->contact_ptr[t] < 3) continue;
-        ENSURE(sw_instance_set_pose_d(inst, f->res.train_T + (size_t)t * 12 * v->nbones) == SINEW_OK);
-        for (int32_t i = 0; i < R; ++i) q[i] = v->train_q[(size_t)t * R + i] * (1 + 0.02 * (urand(&seed) - 0.5));
+        ENSURE(sw_instance_set_pose_d(inst, f->res.train_T + (size_t)t * 12 * v->nbones) ==
+               SINEW_OK);
+        for (int32_t i = 0; i < R; ++i)
+            q[i] = v->train_q[(size_t)t * R + i] * (1 + 0.02 * (urand(&seed) - 0.5));
         double e = sw_instance_potential(inst, q, g, H);
         ENSURE(isfinite(e));
         double gmax = 0;
-        for (int32_t i = 0; i < R; ++i) gmax = fmax(gmax, fabs(g[i]));
+        for (int32_t i = 0; i < R; ++i)
+            gmax = fmax(gmax, fabs(g[i]));
         for (int32_t i = 0; i < R; ++i) {
             double h = 1e-6, qi = q[i];
             q[i] = qi + h;
@@ -53,8 +56,8 @@ TEST(gradient_matches_finite_differences_with_contact_pairs) {
             double em = sw_instance_potential(inst, q, NULL, NULL);
             q[i] = qi;
             ENSUREF(fabs((ep - em) / (2 * h) - g[i]) <= 1e-5 * gmax + 1e-8,
-                    "pose %d coordinate %d: finite difference %.9g, gradient %.9g", t, i, (ep - em) / (2 * h),
-                    g[i]);
+                    "pose %d coordinate %d: finite difference %.9g, gradient %.9g", t, i,
+                    (ep - em) / (2 * h), g[i]);
         }
         /* the Newton matrix: symmetric and positive semi-definite */
         for (int32_t i = 0; i < R; ++i)
@@ -62,10 +65,13 @@ TEST(gradient_matches_finite_differences_with_contact_pairs) {
                 ENSURE(fabs(H[i * R + j] - H[j * R + i]) <= 1e-9 * (fabs(H[i * R + j]) + 1));
         for (int k = 0; k < 20; ++k) {
             double vHv = 0, vv = 0;
-            for (int32_t i = 0; i < R; ++i) g[i] = urand(&seed) - 0.5;
             for (int32_t i = 0; i < R; ++i)
-                for (int32_t j = 0; j < R; ++j) vHv += g[i] * H[i * R + j] * g[j];
-            for (int32_t i = 0; i < R; ++i) vv += g[i] * g[i];
+                g[i] = urand(&seed) - 0.5;
+            for (int32_t i = 0; i < R; ++i)
+                for (int32_t j = 0; j < R; ++j)
+                    vHv += g[i] * H[i * R + j] * g[j];
+            for (int32_t i = 0; i < R; ++i)
+                vv += g[i] * g[i];
             ENSURE(vHv >= -1e-9 * vv);
         }
         checked++;
@@ -91,8 +97,8 @@ TEST(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone) {
     sinew_instance *a, *b;
     ENSURE(sinew_instance_create(f->blob, NULL, &a) == SINEW_OK);
     ENSURE(sinew_instance_create(f->blob, NULL, &b) == SINEW_OK);
-    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones), *xa = malloc(sizeof(float) * 3 * ns),
-          *xb = malloc(sizeof(float) * 3 * ns);
+    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones),
+          *xa = malloc(sizeof(float) * 3 * ns), *xb = malloc(sizeof(float) * 3 * ns);
     int nf = f->ch.clip.nframes;
     for (int k = 0; k < nf; ++k) { /* a plays the clip; b comes from frame k - 1 after a reset */
         step_to_frame(f, a, k, pose);
@@ -102,7 +108,8 @@ TEST(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone) {
         sinew_instance_read_surface(a, xa, NULL, ns);
         sinew_instance_read_surface(b, xb, NULL, ns);
         double worst = 0;
-        for (uint32_t i = 0; i < 3 * ns; ++i) worst = fmax(worst, fabs((double)xa[i] - xb[i]));
+        for (uint32_t i = 0; i < 3 * ns; ++i)
+            worst = fmax(worst, fabs((double)xa[i] - xb[i]));
         ENSUREF(worst < 1e-4, "frame %d: played and arrived-at shapes differ by %g", k, worst);
     }
     /* a reset forgets the motion: jumping to the last frame then matches a new instance */
@@ -146,11 +153,14 @@ TEST(branches_follow_the_motion) {
         big = fmax(big, c);
     }
     for (int32_t t = 0; t < v->ntrain; ++t) {
-        ENSURE(sw_instance_set_pose_d(inst, f->res.train_T + (size_t)t * 12 * v->nbones) == SINEW_OK);
+        ENSURE(sw_instance_set_pose_d(inst, f->res.train_T + (size_t)t * 12 * v->nbones) ==
+               SINEW_OK);
         ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
         int32_t u = -1;
         for (int32_t w = 0; w < v->ntrain && u < 0; ++w)
-            if (w != t && sw_pose_distance(v->train_pose + fs * t, v->train_pose + fs * w, v->nbones) <= 1e-14) u = w;
+            if (w != t && sw_pose_distance(v->train_pose + fs * t, v->train_pose + fs * w,
+                                           v->nbones) <= 1e-14)
+                u = w;
         if (u < 0) continue;
         twins++;
         const double *xt = f->res.train_x + n3 * t, *xu = f->res.train_x + n3 * u;
@@ -162,12 +172,14 @@ TEST(branches_follow_the_motion) {
             own += m * (xs[i] - xt[i]) * (xs[i] - xt[i]);
             other += m * (xs[i] - xu[i]) * (xs[i] - xu[i]);
         }
-        if (apart < 1e-4 * big) continue; /* the branches meet here (1% of the largest shape change) */
+        if (apart < 1e-4 * big)
+            continue; /* the branches meet here (1% of the largest shape change) */
         distinct++;
-        ENSUREF(own < other, "training pose %d: nearer its twin %d's shape (%g) than its own (%g)", t, u,
-                sqrt(other), sqrt(own));
+        ENSUREF(own < other, "training pose %d: nearer its twin %d's shape (%g) than its own (%g)",
+                t, u, sqrt(other), sqrt(own));
     }
-    fprintf(stderr, "    %d training poses stored on two branches, %d of them apart\n", twins, distinct);
+    fprintf(stderr, "    %d training poses stored on two branches, %d of them apart\n", twins,
+            distinct);
     ENSURE(twins > 0 && distinct > 0);
     free(xs);
     free(cnt);
@@ -179,12 +191,13 @@ TEST(training_poses_are_reproduced) {
     ENSURE(f);
     sw_eval_result e;
     sw_error err;
-    ENSURE(sw_eval_correction(f->blob, f->res.mass, f->res.train_T, f->res.train_x, f->res.ntrain, 20, &e,
-                              &err) == SINEW_OK);
+    ENSURE(sw_eval_correction(f->blob, f->res.mass, f->res.train_T, f->res.train_x, f->res.ntrain,
+                              20, &e, &err) == SINEW_OK);
     fprintf(stderr, "    correction error on %d training poses: %.4f (projection %.4f)\n", e.frames,
             e.correction_error, f->res.train_proj_error);
     ENSURE(e.failed == 0 && e.frames == f->res.ntrain);
-    ENSUREF(e.correction_error < 0.1, "correction error %.4f on the training poses", e.correction_error);
+    ENSUREF(e.correction_error < 0.1, "correction error %.4f on the training poses",
+            e.correction_error);
 }
 
 TEST(release_fixture) {

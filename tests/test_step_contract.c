@@ -19,7 +19,8 @@ static const bake_fixture *fixture(void) {
 /* FNV-1a over float outputs: a bitwise fingerprint of a run. */
 static uint64_t hash_floats(uint64_t h, const float *x, size_t n) {
     const unsigned char *p = (const unsigned char *)x;
-    for (size_t i = 0; i < n * sizeof(float); ++i) h = (h ^ p[i]) * 0x100000001b3ULL;
+    for (size_t i = 0; i < n * sizeof(float); ++i)
+        h = (h ^ p[i]) * 0x100000001b3ULL;
     return h;
 }
 
@@ -30,7 +31,8 @@ static uint64_t run_hash(sinew_step_mode mode, int steps) {
     sinew_instance *inst;
     if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
     uint32_t ns = sinew_blob_surface_vertex_count(f->blob);
-    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones), *x = malloc(sizeof(float) * 3 * ns);
+    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones),
+          *x = malloc(sizeof(float) * 3 * ns);
     uint64_t h = 0xcbf29ce484222325ULL;
     for (int s = 0; s < steps; ++s) {
         bake_fixture_pose(f, s, pose);
@@ -57,7 +59,8 @@ static void count_steps(sinew_step_mode mode) {
     int frames = f->ch.clip.nframes;
     float *poses = malloc(sizeof(float) * 12 * nb * frames), *x = malloc(sizeof(float) * 3 * ns),
           *n = malloc(sizeof(float) * 3 * ns);
-    for (int k = 0; k < frames; ++k) bake_fixture_pose(f, k, poses + (size_t)12 * nb * k);
+    for (int k = 0; k < frames; ++k)
+        bake_fixture_pose(f, k, poses + (size_t)12 * nb * k);
     for (int s = 0; s < 20; ++s) { /* warm-up */
         sinew_instance_set_pose(inst, poses + (size_t)12 * nb * (s % frames), nb);
         sinew_instance_step(inst, 1.0f / 30);
@@ -85,8 +88,12 @@ static void count_steps(sinew_step_mode mode) {
     sinew_instance_destroy(inst);
 }
 
-TEST(quasistatic_step_allocates_and_locks_nothing) { count_steps(SINEW_STEP_QUASISTATIC); }
-TEST(dynamic_step_allocates_and_locks_nothing) { count_steps(SINEW_STEP_DYNAMIC); }
+TEST(quasistatic_step_allocates_and_locks_nothing) {
+    count_steps(SINEW_STEP_QUASISTATIC);
+}
+TEST(dynamic_step_allocates_and_locks_nothing) {
+    count_steps(SINEW_STEP_DYNAMIC);
+}
 
 TEST(identical_runs_give_identical_output) {
     ENSURE(fixture());
@@ -135,7 +142,8 @@ TEST(bad_input_is_rejected_and_state_kept) {
     ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
     ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
     ENSURE(sinew_instance_read_surface(inst, x1, NULL, ns) == SINEW_OK);
-    for (uint32_t i = 0; i < 3 * ns; ++i) ENSURE(isfinite(x1[i]) && fabsf(x1[i] - x0[i]) < 1e-3f);
+    for (uint32_t i = 0; i < 3 * ns; ++i)
+        ENSURE(isfinite(x1[i]) && fabsf(x1[i] - x0[i]) < 1e-3f);
     free(pose);
     free(x0);
     free(x1);
@@ -156,7 +164,8 @@ TEST(teleport_gives_a_status_and_a_finite_state) {
         sinew_instance_set_pose(inst, pose, nb);
         ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
     }
-    for (uint32_t b = 0; b < nb; ++b) pose[12 * b + 9] += 1000.0f; /* jump far away */
+    for (uint32_t b = 0; b < nb; ++b)
+        pose[12 * b + 9] += 1000.0f; /* jump far away */
     ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
     ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
     sinew_step_stats st;
@@ -164,7 +173,8 @@ TEST(teleport_gives_a_status_and_a_finite_state) {
     ENSURE(sinew_instance_get_stats(inst, &st) == SINEW_OK);
     ENSURE(st.status & SINEW_STEP_TELEPORT);
     ENSURE(sinew_instance_read_surface(inst, x, NULL, ns) == SINEW_OK);
-    for (uint32_t i = 0; i < 3 * ns; ++i) ENSURE(isfinite(x[i]));
+    for (uint32_t i = 0; i < 3 * ns; ++i)
+        ENSURE(isfinite(x[i]));
     free(pose);
     free(x);
     sinew_instance_destroy(inst);
@@ -189,11 +199,13 @@ TEST(dynamic_flesh_overshoots_and_settles_when_the_clip_stops) {
         memcpy(a, b, sizeof(float) * 3 * ns);
         sinew_instance_read_surface(dyn, b, NULL, ns);
         double move = 0; /* surface motion during this frame while the bones stand still */
-        for (uint32_t i = 0; i < 3 * ns; ++i) move = fmax(move, fabs((double)a[i] - b[i]));
+        for (uint32_t i = 0; i < 3 * ns; ++i)
+            move = fmax(move, fabs((double)a[i] - b[i]));
         if (s >= peak + 1 && s <= peak + 3) after = fmax(after, move);
         if (s == peak + 149) settled = move;
     }
-    fprintf(stderr, "    surface motion per frame after the clip stops: %.3g, 5 s later %.3g\n", after, settled);
+    fprintf(stderr, "    surface motion per frame after the clip stops: %.3g, 5 s later %.3g\n",
+            after, settled);
     ENSUREF(after > 1e-4, "the flesh stops dead with the bones (%.3g): no inertia", after);
     ENSUREF(settled < 0.05 * after, "the flesh did not settle (%.3g -> %.3g)", after, settled);
     free(pose);
@@ -202,11 +214,16 @@ TEST(dynamic_flesh_overshoots_and_settles_when_the_clip_stops) {
     sinew_instance_destroy(dyn);
 }
 
-static void cleanup(void) { if (fx_ok > 0) bake_fixture_free(&fx); }
+static void cleanup(void) {
+    if (fx_ok > 0) bake_fixture_free(&fx);
+}
 
-TEST(release_fixture) { cleanup(); }
+TEST(release_fixture) {
+    cleanup();
+}
 
 SW_TEST_MAIN(CASE(quasistatic_step_allocates_and_locks_nothing),
-             CASE(dynamic_step_allocates_and_locks_nothing), CASE(identical_runs_give_identical_output),
-             CASE(bad_input_is_rejected_and_state_kept), CASE(teleport_gives_a_status_and_a_finite_state),
+             CASE(dynamic_step_allocates_and_locks_nothing),
+             CASE(identical_runs_give_identical_output), CASE(bad_input_is_rejected_and_state_kept),
+             CASE(teleport_gives_a_status_and_a_finite_state),
              CASE(dynamic_flesh_overshoots_and_settles_when_the_clip_stops), CASE(release_fixture))

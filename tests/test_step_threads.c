@@ -11,7 +11,7 @@ enum { NINST = 4, STEPS = 30 };
 
 typedef struct {
     const bake_fixture *f;
-    int index; /* instances differ: each starts at another clip offset and mode */
+    int index;  /* instances differ: each starts at another clip offset and mode */
     float *out; /* final surface */
     int ok;
 } job;
@@ -49,13 +49,17 @@ TEST(parallel_instances_match_sequential) {
         run(&seq[i]);
     }
     pthread_t th[NINST];
-    for (int i = 0; i < NINST; ++i) ENSURE(pthread_create(&th[i], NULL, run, &par[i]) == 0);
-    for (int i = 0; i < NINST; ++i) pthread_join(th[i], NULL);
+    for (int i = 0; i < NINST; ++i)
+        ENSURE(pthread_create(&th[i], NULL, run, &par[i]) == 0);
+    for (int i = 0; i < NINST; ++i)
+        pthread_join(th[i], NULL);
     for (int i = 0; i < NINST; ++i) {
         ENSURE(seq[i].ok && par[i].ok);
-        ENSUREF(memcmp(seq[i].out, par[i].out, sizeof(float) * 3 * ns) == 0, "instance %d differs", i);
+        ENSUREF(memcmp(seq[i].out, par[i].out, sizeof(float) * 3 * ns) == 0, "instance %d differs",
+                i);
     }
-    ENSURE(memcmp(seq[0].out, seq[2].out, sizeof(float) * 3 * ns) != 0); /* they are different runs */
+    ENSURE(memcmp(seq[0].out, seq[2].out, sizeof(float) * 3 * ns) !=
+           0); /* they are different runs */
     for (int i = 0; i < NINST; ++i) {
         free(seq[i].out);
         free(par[i].out);

@@ -47,7 +47,8 @@ static void random_rotation(double R[9]) {
         }
     } while (n < 1e-3 || n > 1);
     n = sqrt(n);
-    for (int i = 0; i < 4; ++i) q[i] /= n;
+    for (int i = 0; i < 4; ++i)
+        q[i] /= n;
     sw_quat_to_matrix(q, R);
 }
 
@@ -282,16 +283,19 @@ TEST(warm_start_gives_the_same_decomposition) {
         if (trial % 4 == 0) A[0] = -A[0]; /* some inverted */
         sw_svd3(A, U0, s0, V0);
         /* start from the V of a perturbed matrix (near), or of an unrelated one (far) */
-        for (int i = 0; i < 9; ++i) B[i] = trial % 2 ? A[i] + 1e-3 * (double)((i * 7 + trial) % 5) : A[8 - i];
+        for (int i = 0; i < 9; ++i)
+            B[i] = trial % 2 ? A[i] + 1e-3 * (double)((i * 7 + trial) % 5) : A[8 - i];
         double Ub[9], sb[3], Vb[9];
         sw_svd3(B, Ub, sb, Vb);
         sw_svd3_warm(A, Vb, U, s, V);
         double scale = fabs(s0[0]) + 1e-300;
-        for (int k = 0; k < 3; ++k) ENSURE_NEAR(s[k], s0[k], 1e-12 * scale);
+        for (int k = 0; k < 3; ++k)
+            ENSURE_NEAR(s[k], s0[k], 1e-12 * scale);
         for (int i = 0; i < 3; ++i)
             for (int j = 0; j < 3; ++j) {
                 double r = 0;
-                for (int k = 0; k < 3; ++k) r += U[3 * i + k] * s[k] * V[3 * j + k];
+                for (int k = 0; k < 3; ++k)
+                    r += U[3 * i + k] * s[k] * V[3 * j + k];
                 ENSURE_NEAR(r, A[3 * i + j], 1e-13 * scale);
             }
         ENSURE_NEAR(det3(U), 1.0, 1e-12);
@@ -299,7 +303,7 @@ TEST(warm_start_gives_the_same_decomposition) {
     }
 }
 
-SW_TEST_MAIN(CASE(warm_start_gives_the_same_decomposition), CASE(random_matrices), CASE(inverted_matrices_flip_only_the_smallest),
-             CASE(rank_deficient_matrices), CASE(repeated_singular_values),
-             CASE(near_degenerate_and_extreme_scales), CASE(zero_and_non_finite),
-             CASE(polar_decomposition))
+SW_TEST_MAIN(CASE(warm_start_gives_the_same_decomposition), CASE(random_matrices),
+             CASE(inverted_matrices_flip_only_the_smallest), CASE(rank_deficient_matrices),
+             CASE(repeated_singular_values), CASE(near_degenerate_and_extreme_scales),
+             CASE(zero_and_non_finite), CASE(polar_decomposition))

@@ -69,7 +69,8 @@ static const char *sw_record_check(const sw_record *r, pthread_t caller) {
         sw_pool_chunk(r->n, r->nworkers, w, &b, &e);
         if (r->calls[w] != (e > b ? 1 : 0)) return "a worker was called other than once";
         if (e <= b) continue;
-        if (r->begin[w] != b || r->end[w] != e) return "a worker ran a chunk other than sw_pool_chunk's";
+        if (r->begin[w] != b || r->end[w] != e)
+            return "a worker ran a chunk other than sw_pool_chunk's";
         for (int64_t i = b; i < e; ++i)
             if (r->owner[i] != w) return "an index was visited by the wrong worker";
         /* The caller is worker 0; the others are the pool's own threads. */
@@ -113,8 +114,8 @@ TEST(chunks_partition_exactly) {
                 prev_end = e;
                 prev_size = e - b;
             }
-            ENSUREF(prev_end == n, "n=%lld workers=%d: chunks end at %lld", (long long)n,
-                    workers, (long long)prev_end);
+            ENSUREF(prev_end == n, "n=%lld workers=%d: chunks end at %lld", (long long)n, workers,
+                    (long long)prev_end);
         }
     }
     /* Ranges beyond 32 bits do not overflow. */
@@ -143,7 +144,8 @@ TEST(chunking_is_deterministic) {
             for (int w = 0; same && w < workers; ++w)
                 same = ra.begin[w] == rb.begin[w] && ra.end[w] == rb.end[w] &&
                        ra.calls[w] == rb.calls[w];
-            for (int64_t i = 0; same && i < n; ++i) same = ra.owner[i] == rb.owner[i];
+            for (int64_t i = 0; same && i < n; ++i)
+                same = ra.owner[i] == rb.owner[i];
             sw_record_free(&ra);
             sw_record_free(&rb);
         }
@@ -169,7 +171,8 @@ static void sw_block_sums(void *ctx, int64_t begin, int64_t end, int worker) {
     for (int64_t blk = begin; blk < end; ++blk) {
         int64_t lo = blk * SW_BLOCK, hi = lo + SW_BLOCK < c->n ? lo + SW_BLOCK : c->n;
         double s = 0.0;
-        for (int64_t i = lo; i < hi; ++i) s += c->x[i];
+        for (int64_t i = lo; i < hi; ++i)
+            s += c->x[i];
         c->block_sum[blk] = s;
     }
 }
@@ -179,7 +182,8 @@ static double sw_pool_sum(sw_pool *pool, const double *x, int64_t n, double *blo
     int64_t nblocks = (n + SW_BLOCK - 1) / SW_BLOCK;
     sw_pool_parallel_for(pool, nblocks, sw_block_sums, &c);
     double total = 0.0;
-    for (int64_t blk = 0; blk < nblocks; ++blk) total += block_sum[blk];
+    for (int64_t blk = 0; blk < nblocks; ++blk)
+        total += block_sum[blk];
     return total;
 }
 
@@ -199,7 +203,8 @@ TEST(reduction_identical_across_worker_counts) {
         x[i] = ldexp((double)(s >> 11) / 9007199254740992.0 - 0.5, (int)(s % 61) - 30);
     }
     double serial = sw_pool_sum(NULL, x, N, blocks), naive = 0.0;
-    for (int i = 0; i < N; ++i) naive += x[i];
+    for (int i = 0; i < N; ++i)
+        naive += x[i];
     double got[5];
     int fail_at = 0;
     for (int workers = 1; workers <= 4 && !fail_at; ++workers) {
@@ -217,8 +222,8 @@ TEST(reduction_identical_across_worker_counts) {
     free(x);
     free(blocks);
     ENSUREF(fail_at >= 0, "sw_pool_create(%d) failed", -fail_at);
-    ENSUREF(fail_at == 0, "sum with %d workers = %.17g, serial = %.17g", fail_at,
-            got[fail_at], serial);
+    ENSUREF(fail_at == 0, "sum with %d workers = %.17g, serial = %.17g", fail_at, got[fail_at],
+            serial);
     /* Sanity: the blocked order really differs from naive left-to-right summation on
      * this data, so the test above is sensitive to the order it fixes. */
     ENSURE(isfinite(serial) && memcmp(&naive, &serial, sizeof serial) != 0);
@@ -231,7 +236,8 @@ typedef struct {
 static void sw_count_fn(void *ctx, int64_t begin, int64_t end, int worker) {
     sw_count_ctx *c = ctx;
     int64_t s = 0;
-    for (int64_t i = begin; i < end; ++i) s += i;
+    for (int64_t i = begin; i < end; ++i)
+        s += i;
     c->per_worker[worker] += s;
 }
 
@@ -247,7 +253,8 @@ TEST(pool_reused_many_times) {
         int64_t n = 1 + round % 97;
         sw_pool_parallel_for(pool, n, sw_count_fn, &c);
         int64_t total = 0;
-        for (int w = 0; w < SW_MAX_WORKERS; ++w) total += c.per_worker[w];
+        for (int w = 0; w < SW_MAX_WORKERS; ++w)
+            total += c.per_worker[w];
         if (total != n * (n - 1) / 2) bad_round = round;
     }
     sw_pool_destroy(pool);
@@ -263,7 +270,8 @@ TEST(pool_of_one_and_null_pool_run_on_the_caller) {
     for (int p = 0; p < 2 && !err; ++p) {
         for (int64_t n = 0; n <= 9 && !err; ++n) {
             sw_record r;
-            if (!sw_record_run(&r, pools[p], n)) err = "out of memory";
+            if (!sw_record_run(&r, pools[p], n))
+                err = "out of memory";
             else {
                 err = sw_record_check(&r, pthread_self());
                 /* One call for the whole range, none for an empty one. */

@@ -17,7 +17,8 @@ TEST(every_result_has_a_distinct_string) {
     for (int r = 0; r < SINEW_RESULT_COUNT_; ++r) {
         const char *s = sinew_result_string((sinew_result)r);
         ENSURE(s && *s && strcmp(s, "unknown result code") != 0);
-        for (int q = 0; q < r; ++q) ENSURE(strcmp(s, sinew_result_string((sinew_result)q)) != 0);
+        for (int q = 0; q < r; ++q)
+            ENSURE(strcmp(s, sinew_result_string((sinew_result)q)) != 0);
     }
     ENSURE(strcmp(sinew_result_string((sinew_result)9999), "unknown result code") == 0);
 }

@@ -62,7 +62,8 @@ static int32_t mirror_of(const sw_tetmesh *m, int32_t v) {
     const double *p = m->X + 3 * v;
     for (int32_t u = 0; u < m->nverts; ++u) {
         const double *q = m->X + 3 * u;
-        if (fabs(q[0] - (4.0 - p[0])) < 1e-9 && fabs(q[1] - p[1]) < 1e-9 && fabs(q[2] - p[2]) < 1e-9)
+        if (fabs(q[0] - (4.0 - p[0])) < 1e-9 && fabs(q[1] - p[1]) < 1e-9 &&
+            fabs(q[2] - p[2]) < 1e-9)
             return u;
     }
     return -1;
@@ -99,7 +100,8 @@ static int mirrored_cylinder(sw_tetmesh *out) {
     for (int32_t t = 0; t < m->ntets; ++t) {
         const int32_t *T = m->tets + 4 * t;
         if (map[T[0]] < 0 || map[T[1]] < 0 || map[T[2]] < 0 || map[T[3]] < 0) continue;
-        int32_t *a = out->tets + 4 * (size_t)out->ntets++, *b = out->tets + 4 * (size_t)out->ntets++;
+        int32_t *a = out->tets + 4 * (size_t)out->ntets++,
+                *b = out->tets + 4 * (size_t)out->ntets++;
         for (int i = 0; i < 4; ++i) {
             a[i] = map[T[i]];
             b[i] = map[m->nverts + T[i ^ (i < 2)]]; /* vertices 0 and 1 swapped */
@@ -190,7 +192,8 @@ TEST(neighbouring_vertices_have_close_weights) {
      * local extremum (with two bones the rows already sum to 1 before normalising, so
      * this holds for the final weights up to the solver tolerance). */
     const sw_tetmesh *m = &cyl.mesh;
-    double *lo = malloc(sizeof(double) * (size_t)m->nverts), *hi = malloc(sizeof(double) * (size_t)m->nverts);
+    double *lo = malloc(sizeof(double) * (size_t)m->nverts),
+           *hi = malloc(sizeof(double) * (size_t)m->nverts);
     ENSURE(lo && hi);
     for (int32_t v = 0; v < m->nverts; ++v) { /* p_v of bone 0: 1, 1/2 on the plane, 0 */
         double x = m->X[3 * v];
@@ -389,10 +392,12 @@ static void cleanup(void) {
     sw_character_free(&cyl);
 }
 
-TEST(zz_cleanup) { cleanup(); }
+TEST(zz_cleanup) {
+    cleanup();
+}
 
 SW_TEST_MAIN(CASE(rows_are_partitions_of_unity), CASE(far_ends_belong_to_their_bone),
              CASE(falloff_is_symmetric_about_the_joint), CASE(falloff_is_monotone_along_the_axis),
              CASE(neighbouring_vertices_have_close_weights), CASE(default_c_and_larger_c_sharpen),
-             CASE(vertex_in_no_tet_goes_to_its_nearest_bone), CASE(bad_input_is_rejected), CASE(real_hand_every_bone_dominates_somewhere),
-             CASE(zz_cleanup))
+             CASE(vertex_in_no_tet_goes_to_its_nearest_bone), CASE(bad_input_is_rejected),
+             CASE(real_hand_every_bone_dominates_somewhere), CASE(zz_cleanup))

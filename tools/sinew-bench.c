@@ -46,42 +46,51 @@
 #include "weights_heat.h"
 
 static void usage(FILE *f) {
-    fprintf(f, "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf\n"
-               "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
-               "                   [--contract-steps S] [--threads T] [--data DIR] [--out DIR] --json\n"
-               "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n");
+    fprintf(
+        f,
+        "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton "
+        "FILE.tgf\n"
+        "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
+        "                   [--contract-steps S] [--threads T] [--data DIR] [--out DIR] --json\n"
+        "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n");
 }
 
 /* Plain DQS of the render surface (positions and area-weighted normals): the cost a
  * host pays today, timed per frame over the clip. */
-static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames, const int32_t *surf_vert,
-                     double *x, double *n) {
+static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames,
+                     const int32_t *surf_vert, double *x, double *n) {
     double *ms = malloc((size_t)frames * sizeof(double));
     sw_dualquat dq[SW_MAX_BONES];
     for (int f = 0; f < frames && ms; ++f) {
         const double *T = clip->T + (size_t)f * 12 * clip->nbones;
         double t0 = sw_now_seconds();
-        for (int32_t b = 0; b < v->nbones; ++b) sw_dq_from_transform(T + 12 * b, &dq[b]);
+        for (int32_t b = 0; b < v->nbones; ++b)
+            sw_dq_from_transform(T + 12 * b, &dq[b]);
         for (int32_t s = 0; s < v->nsurf_verts; ++s) {
             int32_t gv = surf_vert[s];
             double R[9], t[3];
             const double *X = v->rest + 3 * gv;
             sw_dqs_blend(dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
-            for (int i = 0; i < 3; ++i) x[3 * s + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+            for (int i = 0; i < 3; ++i)
+                x[3 * s + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
         }
         memset(n, 0, 3 * (size_t)v->nsurf_verts * sizeof(double));
         for (int32_t t = 0; t < v->nsurf_tris; ++t) {
             const int32_t *tri = v->surf_tris + 3 * t;
             const double *a = x + 3 * tri[0], *b = x + 3 * tri[1], *c = x + 3 * tri[2];
-            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]}, e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-            double nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2], e1[0] * e2[1] - e1[1] * e2[0]};
+            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+                   e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+            double nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                            e1[0] * e2[1] - e1[1] * e2[0]};
             for (int k = 0; k < 3; ++k)
-                for (int j = 0; j < 3; ++j) n[3 * tri[k] + j] += nn[j];
+                for (int j = 0; j < 3; ++j)
+                    n[3 * tri[k] + j] += nn[j];
         }
         for (int32_t s = 0; s < v->nsurf_verts; ++s) {
             double *q = n + 3 * s, l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
             if (l > 0)
-                for (int k = 0; k < 3; ++k) q[k] /= l;
+                for (int k = 0; k < 3; ++k)
+                    q[k] /= l;
         }
         ms[f] = 1e3 * (sw_now_seconds() - t0);
     }
@@ -94,7 +103,8 @@ static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames, con
  * replays the clip on the instance. */
 static sinew_result write_frames(const char *dir, const sinew_blob *blob, sinew_instance *inst,
                                  const sw_character *ch, sw_error *err) {
-    uint32_t ns = sinew_blob_surface_vertex_count(blob), nt = sinew_blob_surface_triangle_count(blob);
+    uint32_t ns = sinew_blob_surface_vertex_count(blob),
+             nt = sinew_blob_surface_triangle_count(blob);
     float *p = malloc(sizeof(float) * 3 * ns);
     double *x = malloc(sizeof(double) * 3 * ns);
     uint32_t *tu = malloc(sizeof(uint32_t) * 3 * nt);
@@ -102,7 +112,8 @@ static sinew_result write_frames(const char *dir, const sinew_blob *blob, sinew_
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
     if (!p || !x || !tu || !ti) goto done;
     if ((r = sinew_blob_surface_triangles(blob, tu, 3 * nt)) != SINEW_OK) goto done;
-    for (uint32_t i = 0; i < 3 * nt; ++i) ti[i] = (int32_t)tu[i];
+    for (uint32_t i = 0; i < 3 * nt; ++i)
+        ti[i] = (int32_t)tu[i];
     mkdir(dir, 0777);
     sinew_instance_reset(inst);
     for (int f = 0; f < ch->clip.nframes; ++f) {
@@ -110,7 +121,8 @@ static sinew_result write_frames(const char *dir, const sinew_blob *blob, sinew_
         sw_instance_set_pose_d(inst, ch->clip.T + (size_t)f * 12 * ch->skel.nbones);
         sinew_instance_step(inst, 1.0f / 30);
         sinew_instance_read_surface(inst, p, NULL, ns);
-        for (uint32_t i = 0; i < 3 * ns; ++i) x[i] = p[i];
+        for (uint32_t i = 0; i < 3 * ns; ++i)
+            x[i] = p[i];
         snprintf(path, sizeof path, "%s/frame_%04d.obj", dir, f);
         if ((r = sw_write_obj(path, (int32_t)ns, x, (int32_t)nt, ti, err)) != SINEW_OK) goto done;
     }
@@ -134,17 +146,23 @@ int main(int argc, char **argv) {
         int ok = 1;
         if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
             /* a character option, consumed */
-        }
-        else if (!strcmp(a, "--blob") && next) blob_path = argv[++i];
-        else if (!strcmp(a, "--out") && next) out_dir = argv[++i];
-        else if (!strcmp(a, "--full-frames") && next) ok = sw_parse_int(argv[++i], 1, 100000, &full_frames);
-        else if (!strcmp(a, "--contract-steps") && next) ok = sw_parse_int(argv[++i], 0, 100000000, &contract_steps);
-        else if (!strcmp(a, "--threads") && next) ok = sw_parse_int(argv[++i], 0, 256, &threads);
-        else if (!strcmp(a, "--json")) json = 1;
+        } else if (!strcmp(a, "--blob") && next)
+            blob_path = argv[++i];
+        else if (!strcmp(a, "--out") && next)
+            out_dir = argv[++i];
+        else if (!strcmp(a, "--full-frames") && next)
+            ok = sw_parse_int(argv[++i], 1, 100000, &full_frames);
+        else if (!strcmp(a, "--contract-steps") && next)
+            ok = sw_parse_int(argv[++i], 0, 100000000, &contract_steps);
+        else if (!strcmp(a, "--threads") && next)
+            ok = sw_parse_int(argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--json"))
+            json = 1;
         else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
             usage(stdout);
             return 0;
-        } else ok = 0;
+        } else
+            ok = 0;
         if (!ok) {
             fprintf(stderr, "sinew-bench: bad or incomplete argument '%s'\n", a);
             usage(stderr);
@@ -196,14 +214,17 @@ int main(int argc, char **argv) {
     }
     const sw_blob_view *v = sw_blob_get_view(blob);
     if (v->nverts != ch.mesh.nverts || v->nbones != ch.skel.nbones) {
-        fprintf(stderr, "sinew-bench: the blob does not belong to this character (%d/%d vertices, %d/%d bones)\n",
+        fprintf(stderr,
+                "sinew-bench: the blob does not belong to this character (%d/%d vertices, %d/%d "
+                "bones)\n",
                 v->nverts, ch.mesh.nverts, v->nbones, ch.skel.nbones);
         return 1;
     }
 
     /* An asset without weights: the bake computed heat-diffusion weights (bake.c); the
      * reference simulator gets the same ones (it uses them for its warm start). */
-    if (!ch.weights.w && (r = sw_weights_heat(&ch.mesh, &ch.skel, 0, &ch.weights, &err)) != SINEW_OK) {
+    if (!ch.weights.w &&
+        (r = sw_weights_heat(&ch.mesh, &ch.skel, 0, &ch.weights, &err)) != SINEW_OK) {
         fprintf(stderr, "sinew-bench: %s (%s)\n", err.msg, sinew_result_string(r));
         return 1;
     }
@@ -244,13 +265,15 @@ int main(int argc, char **argv) {
         return 1;
     }
     uint32_t ns = sinew_blob_surface_vertex_count(blob);
-    float *pos = malloc((size_t)ns * 3 * sizeof(float)), *nrm = malloc((size_t)ns * 3 * sizeof(float));
+    float *pos = malloc((size_t)ns * 3 * sizeof(float)),
+          *nrm = malloc((size_t)ns * 3 * sizeof(float));
     double *sub = malloc((size_t)nf * sizeof(double));
     long failed_steps = 0; /* steps that did not return SINEW_OK (a non-finite state) */
     for (int f = 0; f < nf; ++f) {
         double t0 = sw_now_seconds();
         sw_instance_set_pose_d(inst, ch.clip.T + (size_t)f * 12 * ch.skel.nbones);
-        failed_steps += sinew_instance_step(inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30)) != SINEW_OK;
+        failed_steps += sinew_instance_step(
+                            inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30)) != SINEW_OK;
         sinew_instance_read_surface(inst, pos, nrm, ns);
         sub[f] = 1e3 * (sw_now_seconds() - t0);
     }
@@ -264,7 +287,8 @@ int main(int argc, char **argv) {
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * v->surf_copy_ptr[s]]];
         surf_vert[s] = v->domain_verts[D->vert_begin + v->surf_copies[2 * v->surf_copy_ptr[s] + 1]];
     }
-    double *xs = malloc((size_t)ns * 3 * sizeof(double)), *xn = malloc((size_t)ns * 3 * sizeof(double));
+    double *xs = malloc((size_t)ns * 3 * sizeof(double)),
+           *xn = malloc((size_t)ns * 3 * sizeof(double));
     double d_ms = dqs_ms(v, &ch.clip, nf, surf_vert, xs, xn);
 
     /* 5. errors against the full-space solutions */
@@ -275,7 +299,8 @@ int main(int argc, char **argv) {
     if (!blob_path) { /* the bake's own training poses (clip frames and sweeps) and held-out */
         err_source = "bake";
         sw_eval_correction(blob, res.mass, res.train_T, res.train_x, res.ntrain, 20, &et, &err);
-        sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh, &err);
+        sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh,
+                           &err);
     } else { /* a given blob: the clip's frames solved above, split as the bake splits them */
         err_source = "clip";
         double *mass = calloc((size_t)ch.mesh.nverts, sizeof(double));
@@ -287,7 +312,8 @@ int main(int argc, char **argv) {
         int ntr = (int)floor(kf * (1.0 - bp.heldout_fraction));
         size_t pt = (size_t)12 * ch.skel.nbones, px = (size_t)3 * ch.mesh.nverts;
         sw_eval_correction(blob, mass, ch.clip.T, full_x, ntr, 20, &et, &err);
-        sw_eval_correction(blob, mass, ch.clip.T + ntr * pt, full_x + ntr * px, kf - ntr, 20, &eh, &err);
+        sw_eval_correction(blob, mass, ch.clip.T + ntr * pt, full_x + ntr * px, kf - ntr, 20, &eh,
+                           &err);
         free(mass);
     }
 
@@ -307,25 +333,30 @@ int main(int argc, char **argv) {
             sinew_instance_read_surface(inst, pos, nrm, ns);
         }
         sw_rt_counts c = sw_rt_count_end();
-        if (active & SW_RT_CAT_ALLOCS) allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
+        if (active & SW_RT_CAT_ALLOCS)
+            allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
         if (active & SW_RT_CAT_LOCKS) locks = (long)c.locks;
     }
     failed_steps += et.failed + eh.failed;
     fprintf(stderr,
-            "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, cost %.1fx DQS;\n"
-            "             correction error train %.4f held-out %.4f; allocs %ld, locks %ld in %d steps\n",
+            "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, "
+            "cost %.1fx DQS;\n"
+            "             correction error train %.4f held-out %.4f; allocs %ld, locks %ld in %d "
+            "steps\n",
             full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms, et.correction_error,
             eh.correction_error, allocs, locks, contract_steps);
     if (json)
-        printf("{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
-               "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
-               "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
-               "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_seconds\":%.2f,"
-               "\"err_source\":\"%s\",\"failed_steps\":%ld,\"ref_unsettled\":%d}\n",
-               ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
-               sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub,
-               allocs, locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
-               blob_path ? full_unsettled : res.train_unsettled + res.heldout_unsettled);
+        printf(
+            "{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
+            "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
+            "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
+            "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_"
+            "seconds\":%.2f,"
+            "\"err_source\":\"%s\",\"failed_steps\":%ld,\"ref_unsettled\":%d}\n",
+            ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
+            sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub, allocs,
+            locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
+            blob_path ? full_unsettled : res.train_unsettled + res.heldout_unsettled);
     free(full);
     free(full_x);
     free(sub);

@@ -153,7 +153,8 @@ static int write_frame(const char *dir, int frame, const sw_surface *s, const do
                        double *scratch, int32_t *tris, sw_error *err) {
     char path[4096];
     snprintf(path, sizeof path, "%s/frame_%04d.obj", dir, frame);
-    for (int32_t i = 0; i < s->nverts; ++i) memcpy(scratch + 3 * i, x + 3 * s->verts[i], 24);
+    for (int32_t i = 0; i < s->nverts; ++i)
+        memcpy(scratch + 3 * i, x + 3 * s->verts[i], 24);
     /* s->verts is ascending: map tet-mesh ids to surface ids by binary search */
     for (int32_t t = 0; t < 3 * s->ntris; ++t) {
         int32_t lo = 0, hi = s->nverts - 1, id = s->tris[t];
@@ -242,8 +243,11 @@ int main(int argc, char **argv) {
                 f + 1, frames, ms[f], st.newton_iters, st.pcg_iters, st.grad_norm0, st.grad_norm,
                 st.contacts, st.max_penetration, st.contact_rounds,
                 st.contacts_unsettled ? "  (contact set unsettled)" : "",
-                r == SINEW_OK ? "" : r == SINEW_ERROR_NOT_CONVERGED ? "  (not converged)" : "  FAILED");
-        if (o.out_dir && !write_frame(o.out_dir, f, surf, sw_fullsim_positions(sim), scratch, tris, &err)) {
+                r == SINEW_OK                    ? ""
+                : r == SINEW_ERROR_NOT_CONVERGED ? "  (not converged)"
+                                                 : "  FAILED");
+        if (o.out_dir &&
+            !write_frame(o.out_dir, f, surf, sw_fullsim_positions(sim), scratch, tris, &err)) {
             fprintf(stderr, "sinew-fullsim: %s\n", err.msg);
             failed++;
             break;

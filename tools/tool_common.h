@@ -85,8 +85,9 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
     int computed = 0;
     memset(ch, 0, sizeof *ch);
     sinew_result r =
-        c->scene ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
-                 : sw_character_from_files(c->mesh, c->tgf, c->weights, c->clip, c->frames, ch, err);
+        c->scene
+            ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
+            : sw_character_from_files(c->mesh, c->tgf, c->weights, c->clip, c->frames, ch, err);
     if (r == SINEW_OK && (computed || (c->mesh && !c->weights))) sw_weights_free(&ch->weights);
     return r;
 }

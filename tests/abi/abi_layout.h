@@ -8,30 +8,30 @@
 
 #include <sinew/sinew.h>
 
-#define SW_ABI_LAYOUT(X)                                  \
-    X(sizeof(sinew_result))                               \
-    X(sizeof(sinew_log_level))                            \
-    X(sizeof(sinew_step_mode))                            \
-    X(sizeof(sinew_allocator))                            \
-    X(offsetof(sinew_allocator, alloc))                   \
-    X(offsetof(sinew_allocator, free))                    \
-    X(offsetof(sinew_allocator, user))                    \
-    X(sizeof(sinew_logger))                               \
-    X(offsetof(sinew_logger, log))                        \
-    X(offsetof(sinew_logger, user))                       \
-    X(offsetof(sinew_logger, max_level))                  \
-    X(sizeof(sinew_blob_def))                             \
-    X(offsetof(sinew_blob_def, struct_size))              \
-    X(offsetof(sinew_blob_def, path))                     \
-    X(offsetof(sinew_blob_def, data))                     \
-    X(offsetof(sinew_blob_def, data_size))                \
-    X(offsetof(sinew_blob_def, allocator))                \
-    X(offsetof(sinew_blob_def, logger))                   \
-    X(sizeof(sinew_instance_def))                         \
-    X(offsetof(sinew_instance_def, struct_size))          \
-    X(offsetof(sinew_instance_def, mode))                 \
-    X(offsetof(sinew_instance_def, max_newton_iters))     \
-    X(offsetof(sinew_instance_def, allocator))            \
+#define SW_ABI_LAYOUT(X)                                                                           \
+    X(sizeof(sinew_result))                                                                        \
+    X(sizeof(sinew_log_level))                                                                     \
+    X(sizeof(sinew_step_mode))                                                                     \
+    X(sizeof(sinew_allocator))                                                                     \
+    X(offsetof(sinew_allocator, alloc))                                                            \
+    X(offsetof(sinew_allocator, free))                                                             \
+    X(offsetof(sinew_allocator, user))                                                             \
+    X(sizeof(sinew_logger))                                                                        \
+    X(offsetof(sinew_logger, log))                                                                 \
+    X(offsetof(sinew_logger, user))                                                                \
+    X(offsetof(sinew_logger, max_level))                                                           \
+    X(sizeof(sinew_blob_def))                                                                      \
+    X(offsetof(sinew_blob_def, struct_size))                                                       \
+    X(offsetof(sinew_blob_def, path))                                                              \
+    X(offsetof(sinew_blob_def, data))                                                              \
+    X(offsetof(sinew_blob_def, data_size))                                                         \
+    X(offsetof(sinew_blob_def, allocator))                                                         \
+    X(offsetof(sinew_blob_def, logger))                                                            \
+    X(sizeof(sinew_instance_def))                                                                  \
+    X(offsetof(sinew_instance_def, struct_size))                                                   \
+    X(offsetof(sinew_instance_def, mode))                                                          \
+    X(offsetof(sinew_instance_def, max_newton_iters))                                              \
+    X(offsetof(sinew_instance_def, allocator))                                                     \
     X(offsetof(sinew_instance_def, logger))
 
 #ifdef __cplusplus

@@ -7,7 +7,7 @@
 
 /* The target's C_STANDARD must beat the project's global C17 (abi.cmake passes the
  * expected value), and extensions must be off, or this test would prove nothing. */
-#if !defined(__STDC_VERSION__) || !defined(SW_ABI_EXPECT_STDC) || \
+#if !defined(__STDC_VERSION__) || !defined(SW_ABI_EXPECT_STDC) ||                                  \
     __STDC_VERSION__ != SW_ABI_EXPECT_STDC
 #error "compiled with a different C standard than the target asked for"
 #endif
@@ -49,8 +49,8 @@ SW_ABI_ASSERT(SINEW_LOG_INFO == 2 && SINEW_LOG_DEBUG == 3, log_levels_high);
 SW_ABI_ASSERT(SINEW_STEP_QUASISTATIC == 0 && SINEW_STEP_DYNAMIC == 1, step_modes);
 
 /* The packed version is usable in #if and in constant expressions. */
-SW_ABI_ASSERT(SINEW_VERSION == ((SINEW_VERSION_MAJOR << 16) | (SINEW_VERSION_MINOR << 8) |
-                                SINEW_VERSION_PATCH),
+SW_ABI_ASSERT(SINEW_VERSION ==
+                  ((SINEW_VERSION_MAJOR << 16) | (SINEW_VERSION_MINOR << 8) | SINEW_VERSION_PATCH),
               packed_version);
 SW_ABI_ASSERT(sizeof(SINEW_VERSION) == sizeof(uint32_t), version_is_u32);
 

@@ -30,16 +30,12 @@ static_assert(std::is_same<decltype(SINEW_VERSION), uint32_t>::value, "version i
 // The exact signatures a C++ host binds to.
 static_assert(std::is_same<decltype(&sinew_version), uint32_t (*)()>::value, "sig");
 static_assert(std::is_same<decltype(&sinew_version_string), const char *(*)()>::value, "sig");
-static_assert(std::is_same<decltype(&sinew_version_compatible), int (*)(uint32_t)>::value,
+static_assert(std::is_same<decltype(&sinew_version_compatible), int (*)(uint32_t)>::value, "sig");
+static_assert(std::is_same<decltype(&sinew_result_string), const char *(*)(sinew_result)>::value,
               "sig");
-static_assert(std::is_same<decltype(&sinew_result_string),
-                           const char *(*)(sinew_result)>::value,
+static_assert(std::is_same<decltype(&sinew_blob_def_default), sinew_blob_def (*)()>::value, "sig");
+static_assert(std::is_same<decltype(&sinew_instance_def_default), sinew_instance_def (*)()>::value,
               "sig");
-static_assert(std::is_same<decltype(&sinew_blob_def_default), sinew_blob_def (*)()>::value,
-              "sig");
-static_assert(
-    std::is_same<decltype(&sinew_instance_def_default), sinew_instance_def (*)()>::value,
-    "sig");
 
 namespace {
 

@@ -123,7 +123,8 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
 #define SINEW_STEP_GUARD 2u     /**< the energy guard stopped Newton early (best iterate kept) */
 #define SINEW_STEP_TELEPORT 4u  /**< the pose jumped: no inertia taken from that jump */
 #define SINEW_STEP_FAILED 8u    /**< non-finite state: the step was undone */
-#define SINEW_STEP_POSE_SPACE 16u /**< quasistatic: started from the pose-space blend of training solutions */
+#define SINEW_STEP_POSE_SPACE                                                                      \
+    16u /**< quasistatic: started from the pose-space blend of training solutions */
 
 /** Figures of an instance's last step. */
 typedef struct sinew_step_stats {

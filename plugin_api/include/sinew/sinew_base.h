@@ -32,7 +32,7 @@ extern "C" {
 #define SINEW_VERSION_MINOR 1
 #define SINEW_VERSION_PATCH 0
 /** Packed version: major << 16 | minor << 8 | patch. */
-#define SINEW_VERSION \
+#define SINEW_VERSION                                                                              \
     ((uint32_t)((SINEW_VERSION_MAJOR << 16) | (SINEW_VERSION_MINOR << 8) | SINEW_VERSION_PATCH))
 
 /** Packed version (major << 16 | minor << 8 | patch) of the library loaded at run time. */

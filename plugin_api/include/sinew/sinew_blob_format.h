@@ -113,7 +113,7 @@ typedef struct sinew_blob_meta {
     int32_t nverts, nbones, ndomains, rank_total;
     int32_t ndomain_verts, ncub, nsurf_verts, nsurf_tris;
     double mu, lambda, rayleigh_alpha, rayleigh_beta, contact_k;
-    int32_t ntrain;   /**< training poses kept for the pose-space warm start (>= 1) */
+    int32_t ntrain;    /**< training poses kept for the pose-space warm start (>= 1) */
     int32_t ncontacts; /**< self-contact pairs over all training poses (>= 0) */
 } sinew_blob_meta;
 
