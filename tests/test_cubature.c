@@ -1,4 +1,4 @@
-/* Cubature training (precompute/cubature_train.c) on synthetic problems: exact
+/* Cubature training (precompute/train/cubature_train.c) on synthetic problems: exact
  * recovery of a sparse non-negative combination, a smooth FEM-like quadrature
  * problem, determinism over seeds, thread counts and cache evictions, the
  * max_points limit, and error paths. Prints a table of the three selectors. */

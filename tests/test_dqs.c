@@ -1,4 +1,4 @@
-/* Dual-quaternion skinning (runtime/dqs.c): exact single-bone reproduction, the
+/* Dual-quaternion skinning (runtime/math/dqs.c): exact single-bone reproduction, the
  * antipodality fix, intermediate rotations, orthonormality under random blends, the
  * translation-only and candy-wrapper cases, and sw_dqs_skin against sw_dqs_blend. */
 #include "sw_test.h"

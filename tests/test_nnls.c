@@ -1,4 +1,4 @@
-/* NNLS (precompute/nnls.c): KKT conditions on random problems of every shape, both
+/* NNLS (precompute/train/nnls.c): KKT conditions on random problems of every shape, both
  * methods agreeing, exact recovery of sparse solutions, brute force over all active
  * sets on tiny problems, warm starts, error paths, and a timing of LH vs FNNLS. */
 #include "nnls.h"

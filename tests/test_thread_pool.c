@@ -1,4 +1,4 @@
-/* The default pthread pool (runtime/thread_pool.h): exact partitioning, deterministic
+/* The default pthread pool (runtime/core/thread_pool.h): exact partitioning, deterministic
  * chunking, reductions that do not depend on the worker count, and the serial paths
  * (pool of 1, NULL pool). Labelled "threads" so the TSan build runs it: the per-index and
  * per-worker writes below are unsynchronised on purpose, so overlapping chunks or a

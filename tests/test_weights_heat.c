@@ -1,4 +1,4 @@
-/* Heat-diffusion skin weights (precompute/weights_heat.c) on the procedural cylinder
+/* Heat-diffusion skin weights (precompute/rig/weights_heat.c) on the procedural cylinder
  * (two bones on the x axis, joint at x = 2) and on the real libigl hand. */
 #include "sw_test.h"
 

@@ -210,8 +210,3 @@ double sw_point_segment_distance(const double *p, const double *a, const double 
     return sqrt(d2);
 }
 
-double sw_now_seconds(void) {
-    struct timespec ts;
-    clock_gettime(CLOCK_MONOTONIC, &ts);
-    return (double)ts.tv_sec + 1e-9 * (double)ts.tv_nsec;
-}

@@ -2,7 +2,7 @@
  * sinew/sinew_blob_format.h into a zero-copy sw_blob_view, after checking every offset,
  * count, index and value, so that no runtime code ever has to range-check the blob.
  *
- * The same view validator runs in the writer (precompute/blob_write.c) before a byte is
+ * The same view validator runs in the writer (precompute/bake/blob_write.c) before a byte is
  * written, so a bake bug is reported at bake time, with the same message a loader would
  * give, instead of producing a file that no runtime accepts.
  *

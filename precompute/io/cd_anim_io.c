@@ -21,7 +21,7 @@
  * scale with s and the centre cancels in the translation difference), so applying the
  * raw translation difference to the raw TGF joints gives exactly the conjugated
  * transforms for the raw .mesh coordinates. We therefore do not normalise. */
-#include "character_io.h"
+#include "clip_io.h"
 
 #include <errno.h>
 #include <math.h>

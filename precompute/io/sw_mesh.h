@@ -16,6 +16,7 @@
 
 #include <stdint.h>
 
+#include "clock.h"
 #include "sw_error.h"
 
 typedef struct sw_tetmesh {
@@ -111,8 +112,6 @@ void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, do
 /* Distance from point p to the segment a-b (a point when a == b). */
 double sw_point_segment_distance(const double *p, const double *a, const double *b);
 
-/* Monotonic wall-clock seconds (for stage and step timings). */
-double sw_now_seconds(void);
 
 /* Applies rigid transform T (12) to p (3) into out (3); out may alias p. */
 void sw_transform_point(const double *T, const double *p, double *out);

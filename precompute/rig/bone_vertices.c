@@ -9,7 +9,7 @@
  * down and no domain is left floating. Surface vertices are never driven: they carry the
  * secondary motion we are simulating. Everything is ordered by (distance, index), so the
  * result is deterministic. */
-#include "character_io.h"
+#include "rig.h"
 
 #include "mesh_io.h"
 

@@ -1,6 +1,6 @@
 /* Inverse-distance skin weights, for assets that ship none (the bake computes the
  * heat-diffusion weights of DESIGN.md §8; these only need to be plausible and smooth). */
-#include "character_io.h"
+#include "rig.h"
 
 #include <math.h>
 #include <stdlib.h>

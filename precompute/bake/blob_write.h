@@ -1,6 +1,6 @@
 /* The blob writer (DESIGN.md §6): lays a baked character (an sw_blob_view filled from the
  * bake's arrays) out in the format of sinew/sinew_blob_format.h. The view is validated
- * first with the loader's own validator (runtime/blob_load.h), so a bake bug is reported
+ * first with the loader's own validator (runtime/blob/blob_load.h), so a bake bug is reported
  * here, with the message a runtime would give, instead of producing a file no runtime
  * accepts. Sections are written in id order, each at a multiple of 64 bytes with zero
  * padding, and the file is padded to a multiple of 64. Thread-safe (no shared state). */
