@@ -3,7 +3,6 @@
  * into the mapping or the host's buffer. */
 #include <errno.h>
 #include <fcntl.h>
-#include <stdarg.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -11,42 +10,10 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include "alloc.h"
 #include "blob_load.h"
-
-/* True when the caller's def (of struct_size bytes) holds all of `field`. */
-#define DEF_COVERS(def, field)                                                                     \
-    ((size_t)(def)->struct_size >= offsetof(sinew_blob_def, field) + sizeof((def)->field))
-
-static void blob_log(const sinew_logger *lg, sinew_log_level level, uint32_t id, const char *fmt,
-                     ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-
-static void blob_log(const sinew_logger *lg, sinew_log_level level, uint32_t id, const char *fmt,
-                     ...) {
-    if (!lg->log || level > lg->max_level) return;
-    char text[768];
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(text, sizeof text, fmt, ap);
-    va_end(ap);
-    lg->log(level, id, text, lg->user);
-}
-
-static void *blob_alloc(const sinew_allocator *a, size_t size, size_t align) {
-    if (a->alloc) return a->alloc(size, align, a->user);
-    /* aligned_alloc wants a size that is a multiple of the alignment. */
-    return aligned_alloc(align, (size + align - 1) / align * align);
-}
-
-static void blob_free(const sinew_allocator *a, void *p) {
-    if (a->free)
-        a->free(p, a->user);
-    else
-        free(p);
-}
+#include "def_read.h"
+#include "log.h"
 
 /* Maps `path` read-only; on success (map, size) describe the mapping. */
 static sinew_result map_file(const char *path, const sinew_logger *lg, void **map, size_t *size) {
@@ -57,19 +24,19 @@ static sinew_result map_file(const char *path, const sinew_logger *lg, void **ma
         int e = errno;
         if (strerror_r(e, why, sizeof why) != 0) snprintf(why, sizeof why, "errno %d", e);
         if (fd >= 0) close(fd);
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot open '%s': %s",
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot open '%s': %s",
                  path, why);
         return SINEW_ERROR_IO;
     }
     if (!S_ISREG(st.st_mode) || st.st_size < 0 || (uint64_t)st.st_size > SIZE_MAX) {
         close(fd);
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO,
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO,
                  "sinew_blob_load: '%s' is not a regular file of a mappable size", path);
         return SINEW_ERROR_IO;
     }
     if ((uint64_t)st.st_size < sizeof(sinew_blob_header)) {
         close(fd);
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID,
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID,
                  "sinew_blob_load: '%s': blob header: the file has %lld bytes, shorter than "
                  "the 64-byte header",
                  path, (long long)st.st_size);
@@ -80,7 +47,7 @@ static sinew_result map_file(const char *path, const sinew_logger *lg, void **ma
     close(fd); /* the mapping stays valid */
     if (p == MAP_FAILED) {
         if (strerror_r(e, why, sizeof why) != 0) snprintf(why, sizeof why, "errno %d", e);
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot map '%s': %s",
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot map '%s': %s",
                  path, why);
         return SINEW_ERROR_IO;
     }
@@ -89,31 +56,22 @@ static sinew_result map_file(const char *path, const sinew_logger *lg, void **ma
     return SINEW_OK;
 }
 
-/* The caller's def with every field its struct_size does not cover at its default. */
-static sinew_result read_def(const sinew_blob_def *def, sinew_blob_def *d) {
-    *d = sinew_blob_def_default();
-    if (!DEF_COVERS(def, data_size)) return SINEW_ERROR_INVALID_ARGUMENT;
-    d->path = def->path;
-    d->data = def->data;
-    d->data_size = def->data_size;
-    if (DEF_COVERS(def, allocator)) d->allocator = def->allocator;
-    if (DEF_COVERS(def, logger)) d->logger = def->logger;
-    return SINEW_OK;
-}
-
 SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **out) {
     if (!def || !out) return SINEW_ERROR_INVALID_ARGUMENT;
-    sinew_blob_def d;
-    if (read_def(def, &d) != SINEW_OK) return SINEW_ERROR_INVALID_ARGUMENT;
+    /* the fields every caller has: path, data and data_size */
+    sinew_blob_def d = sinew_blob_def_default();
+    if (sw_def_read(&d, sizeof d, def, offsetof(sinew_blob_def, data_size) + sizeof(size_t)) !=
+        SINEW_OK)
+        return SINEW_ERROR_INVALID_ARGUMENT;
     const sinew_logger *lg = &d.logger;
-    if ((d.allocator.alloc == NULL) != (d.allocator.free == NULL)) {
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID_ARGUMENT,
+    if (sw_allocator_check(&d.allocator) != SINEW_OK) {
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID_ARGUMENT,
                  "sinew_blob_load: allocator.alloc and allocator.free must both be set or "
                  "both be NULL");
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
     if ((d.path == NULL) == (d.data == NULL)) {
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID_ARGUMENT,
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID_ARGUMENT,
                  "sinew_blob_load: give exactly one of def->path and def->data");
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
@@ -132,17 +90,17 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     sinew_result r = sw_blob_parse(data, size, &view, msg, sizeof msg);
     if (r != SINEW_OK) {
         if (map) munmap(map, size);
-        blob_log(lg, SINEW_LOG_ERROR,
+        sw_log(lg, SINEW_LOG_ERROR,
                  r == SINEW_ERROR_INVALID_ARGUMENT ? SINEW_MSG_BLOB_INVALID_ARGUMENT
                                                    : SINEW_MSG_BLOB_INVALID,
                  "sinew_blob_load: '%s': %s", d.path ? d.path : "<host buffer>", msg);
         return r;
     }
 
-    sinew_blob *blob = blob_alloc(&d.allocator, sizeof *blob, _Alignof(sinew_blob));
+    sinew_blob *blob = sw_alloc(&d.allocator, sizeof *blob, SW_ALLOC_ALIGN);
     if (!blob) {
         if (map) munmap(map, size);
-        blob_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_OUT_OF_MEMORY,
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_OUT_OF_MEMORY,
                  "sinew_blob_load: out of memory (%zu bytes)", sizeof *blob);
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
@@ -153,7 +111,7 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     blob->map_size = map ? size : 0;
     blob->allocator = d.allocator;
     blob->logger = d.logger;
-    blob_log(lg, SINEW_LOG_INFO, SINEW_MSG_BLOB_LOADED,
+    sw_log(lg, SINEW_LOG_INFO, SINEW_MSG_BLOB_LOADED,
              "sinew_blob_load: '%s': %zu bytes %s; %d vertices, %d bones, %d domains, rank %d, "
              "%d cubature tets, %d surface vertices, %d triangles",
              d.path ? d.path : "<host buffer>", size, map ? "mapped" : "in place", view.nverts,
@@ -167,7 +125,7 @@ SINEW_API void sinew_blob_destroy(sinew_blob *blob) {
     if (!blob) return;
     if (blob->map) munmap(blob->map, blob->map_size);
     sinew_allocator a = blob->allocator;
-    blob_free(&a, blob);
+    sw_free(&a, blob);
 }
 
 const sw_blob_view *sw_blob_get_view(const sinew_blob *blob) {
