@@ -13,6 +13,7 @@
 #include "fem_corot.h"
 #include "mesh_io.h"
 #include "pcg.h"
+#include "penalty.h"
 
 struct sw_fullsim {
     sw_fullsim_params p;

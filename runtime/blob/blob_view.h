@@ -18,10 +18,6 @@
 #include "sinew/sinew_blob_format.h"
 
 #define SW_BLOB_INFLUENCES 4 /* skin influences per vertex */
-/* Anisotropy alpha of the penalty contact (thesis eq. 3.5, N = (1-alpha) n n^T + alpha I):
- * the reference simulator's default and the runtime's, so that the runtime's forces at a
- * training pose are the ones the training solutions converged with. */
-#define SW_CONTACT_ALPHA 0.5
 
 /* One domain (the on-disk record itself, used in place):
  *   bone            the bone this domain rides with (inertial frame)
@@ -103,7 +99,7 @@ typedef struct sw_blob_view {
      * triangle (t0, t1, t2) as (domain, local vertex) pairs in contact_verts[8c..],
      * and in contact_data[7c..] the triangle barycentrics b0..b2, the contact normal in
      * p's un-skinned frame (R_p^T n) and the area weight ka. The penalty stiffness is
-     * contact_k, the anisotropy SW_CONTACT_ALPHA (eq. 3.5). */
+     * contact_k, the anisotropy SW_CONTACT_ALPHA (contact/penalty.h, eq. 3.5). */
     int32_t ncontacts;
     const int32_t *contact_ptr;
     const int32_t *contact_verts;

@@ -25,6 +25,7 @@
 #include "dqs.h"
 #include "fem_corot.h"
 #include "instance.h"
+#include "penalty.h"
 
 /* ranks per domain are validated <= SW_BLOB_MAX_RANK by the loader */
 #define SW_BLOB_MAX_RANK_STEP SW_BLOB_MAX_RANK
