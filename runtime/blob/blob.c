@@ -25,21 +25,21 @@ static sinew_result map_file(const char *path, const sinew_logger *lg, void **ma
         if (strerror_r(e, why, sizeof why) != 0) snprintf(why, sizeof why, "errno %d", e);
         if (fd >= 0) close(fd);
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot open '%s': %s",
-                 path, why);
+               path, why);
         return SINEW_ERROR_IO;
     }
     if (!S_ISREG(st.st_mode) || st.st_size < 0 || (uint64_t)st.st_size > SIZE_MAX) {
         close(fd);
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO,
-                 "sinew_blob_load: '%s' is not a regular file of a mappable size", path);
+               "sinew_blob_load: '%s' is not a regular file of a mappable size", path);
         return SINEW_ERROR_IO;
     }
     if ((uint64_t)st.st_size < sizeof(sinew_blob_header)) {
         close(fd);
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID,
-                 "sinew_blob_load: '%s': blob header: the file has %lld bytes, shorter than "
-                 "the 64-byte header",
-                 path, (long long)st.st_size);
+               "sinew_blob_load: '%s': blob header: the file has %lld bytes, shorter than "
+               "the 64-byte header",
+               path, (long long)st.st_size);
         return SINEW_ERROR_CORRUPT;
     }
     void *p = mmap(NULL, (size_t)st.st_size, PROT_READ, MAP_PRIVATE, fd, 0);
@@ -47,8 +47,8 @@ static sinew_result map_file(const char *path, const sinew_logger *lg, void **ma
     close(fd); /* the mapping stays valid */
     if (p == MAP_FAILED) {
         if (strerror_r(e, why, sizeof why) != 0) snprintf(why, sizeof why, "errno %d", e);
-        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot map '%s': %s",
-                 path, why);
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_IO, "sinew_blob_load: cannot map '%s': %s", path,
+               why);
         return SINEW_ERROR_IO;
     }
     *map = p;
@@ -66,13 +66,13 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     const sinew_logger *lg = &d.logger;
     if (sw_allocator_check(&d.allocator) != SINEW_OK) {
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID_ARGUMENT,
-                 "sinew_blob_load: allocator.alloc and allocator.free must both be set or "
-                 "both be NULL");
+               "sinew_blob_load: allocator.alloc and allocator.free must both be set or "
+               "both be NULL");
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
     if ((d.path == NULL) == (d.data == NULL)) {
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_INVALID_ARGUMENT,
-                 "sinew_blob_load: give exactly one of def->path and def->data");
+               "sinew_blob_load: give exactly one of def->path and def->data");
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
 
@@ -91,9 +91,9 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     if (r != SINEW_OK) {
         if (map) munmap(map, size);
         sw_log(lg, SINEW_LOG_ERROR,
-                 r == SINEW_ERROR_INVALID_ARGUMENT ? SINEW_MSG_BLOB_INVALID_ARGUMENT
-                                                   : SINEW_MSG_BLOB_INVALID,
-                 "sinew_blob_load: '%s': %s", d.path ? d.path : "<host buffer>", msg);
+               r == SINEW_ERROR_INVALID_ARGUMENT ? SINEW_MSG_BLOB_INVALID_ARGUMENT
+                                                 : SINEW_MSG_BLOB_INVALID,
+               "sinew_blob_load: '%s': %s", d.path ? d.path : "<host buffer>", msg);
         return r;
     }
 
@@ -101,7 +101,7 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     if (!blob) {
         if (map) munmap(map, size);
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_OUT_OF_MEMORY,
-                 "sinew_blob_load: out of memory (%zu bytes)", sizeof *blob);
+               "sinew_blob_load: out of memory (%zu bytes)", sizeof *blob);
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
     blob->view = view;
@@ -112,11 +112,11 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     blob->allocator = d.allocator;
     blob->logger = d.logger;
     sw_log(lg, SINEW_LOG_INFO, SINEW_MSG_BLOB_LOADED,
-             "sinew_blob_load: '%s': %zu bytes %s; %d vertices, %d bones, %d domains, rank %d, "
-             "%d cubature tets, %d surface vertices, %d triangles",
-             d.path ? d.path : "<host buffer>", size, map ? "mapped" : "in place", view.nverts,
-             view.nbones, view.ndomains, view.rank_total, view.ncub, view.nsurf_verts,
-             view.nsurf_tris);
+           "sinew_blob_load: '%s': %zu bytes %s; %d vertices, %d bones, %d domains, rank %d, "
+           "%d cubature tets, %d surface vertices, %d triangles",
+           d.path ? d.path : "<host buffer>", size, map ? "mapped" : "in place", view.nverts,
+           view.nbones, view.ndomains, view.rank_total, view.ncub, view.nsurf_verts,
+           view.nsurf_tris);
     *out = blob;
     return SINEW_OK;
 }

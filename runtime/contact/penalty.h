@@ -19,7 +19,8 @@
 static inline void sw_penalty_apply_N(const double n[3], double alpha, const double u[3],
                                       double o[3]) {
     double s = (1 - alpha) * (n[0] * u[0] + n[1] * u[1] + n[2] * u[2]);
-    for (int j = 0; j < 3; ++j) o[j] = s * n[j] + alpha * u[j];
+    for (int j = 0; j < 3; ++j)
+        o[j] = s * n[j] + alpha * u[j];
 }
 
 /* E = 1/2 k d^T Nd for the pair's stiffness k (= k_contact ka) and Nd = N d. */

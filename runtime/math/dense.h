@@ -11,7 +11,6 @@ int sw_cholesky(double *A, int32_t n);
 
 /* Solves L L^T x = b in place (x holds b on entry) with L from sw_cholesky. */
 void sw_cholesky_solve(const double *L, int32_t n, double *x);
-#endif
 
 /* Block-sparse Cholesky of a symmetric positive definite matrix stored densely
  * (row-major n x n) and split into nb diagonal blocks: block b covers rows/columns
@@ -36,3 +35,32 @@ void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off
 void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32_t *off,
                              const int32_t *size, const int32_t *order, const unsigned char *nz,
                              double *x);
+
+/* Elimination order of the nb diagonal blocks of the symmetric matrix A (row-major
+ * n x n, blocks as in sw_block_cholesky) for the block Cholesky: repeatedly the block
+ * with the fewest remaining neighbours (ties: the lower index), connecting its
+ * neighbours (the fill it creates). coupled (nb * nb) receives whether two blocks have
+ * a nonzero entry; adj (nb * nb) is scratch. */
+void sw_block_order_min_degree(const double *A, int32_t n, int32_t nb, const int32_t *off,
+                               const int32_t *size, unsigned char *coupled, unsigned char *adj,
+                               int32_t *order);
+
+/* a . b over n entries, summed in index order. */
+static inline double sw_dot(const double *a, const double *b, int32_t n) {
+    double s = 0;
+    for (int32_t i = 0; i < n; ++i)
+        s += a[i] * b[i];
+    return s;
+}
+
+/* y = A x for a dense row-major n x n matrix (y may not alias x). */
+static inline void sw_matvec(const double *A, int32_t n, const double *x, double *y) {
+    for (int32_t i = 0; i < n; ++i) {
+        double acc = 0;
+        for (int32_t j = 0; j < n; ++j)
+            acc += A[(int64_t)i * n + j] * x[j];
+        y[i] = acc;
+    }
+}
+
+#endif

@@ -1,0 +1,174 @@
+/* sinew — the types of the public ABI: opaque handles, the def structs with their
+ * defaults, the task callbacks, the step's status flags and statistics. The functions
+ * are in sinew.h, the collision world's in sinew_world.h.
+ *
+ * Conventions (STYLE.md §1-§5):
+ *  - Functions are sinew_<object>_<verb>; types are sinew_<snake_name>; macros SINEW_*.
+ *  - Objects are opaque handles. A blob (baked character) is immutable once loaded and
+ *    may be shared by any number of instances on any number of threads. An instance is
+ *    owned by one thread at a time.
+ *  - Every def struct starts with `struct_size` and is initialised by the inline
+ *    sinew_*_def_default(). Zero in a field means "the default". The library reads
+ *    only the bytes that the caller's struct_size covers, so adding fields at the end
+ *    never breaks an old binary.
+ *  - Every fallible call returns a sinew_result; output handles are written only on
+ *    SINEW_OK.
+ *  - Units: lengths in the character's own units, time in seconds, angles in radians.
+ */
+#ifndef SINEW_TYPES_H
+#define SINEW_TYPES_H
+
+#include "sinew_base.h"
+
+#ifdef __cplusplus
+extern "C" {
+#endif
+
+/** A loaded, validated, immutable baked character (opaque). */
+typedef struct sinew_blob sinew_blob;
+
+/** One simulated character: pose, state and all its scratch memory (opaque). */
+typedef struct sinew_instance sinew_instance;
+
+/** The static and moving colliders instances collide with (opaque; sinew_world.h). */
+typedef struct sinew_world sinew_world;
+
+/** How to load a blob: from a file path (mapped) or from a host-owned buffer. */
+typedef struct sinew_blob_def {
+    uint32_t struct_size;      /**< sizeof(sinew_blob_def), set by the default */
+    const char *path;          /**< file to map, or NULL when `data` is given */
+    const void *data;          /**< host buffer, 64-byte aligned, outliving the blob */
+    size_t data_size;          /**< bytes in `data` */
+    sinew_allocator allocator; /**< memory hooks; zero means the C library */
+    sinew_logger logger;       /**< log hook; zero means silent */
+} sinew_blob_def;
+
+/** A sinew_blob_def with every field at its default. */
+static inline sinew_blob_def sinew_blob_def_default(void) {
+    sinew_blob_def d;
+    d.struct_size = (uint32_t)sizeof(sinew_blob_def);
+    d.path = NULL;
+    d.data = NULL;
+    d.data_size = 0;
+    d.allocator.alloc = NULL;
+    d.allocator.free = NULL;
+    d.allocator.user = NULL;
+    d.logger.log = NULL;
+    d.logger.user = NULL;
+    d.logger.max_level = SINEW_LOG_WARNING;
+    return d;
+}
+
+/** Stable log message ids of blob loading (sinew_logger). */
+#define SINEW_MSG_BLOB_INVALID_ARGUMENT 0x0100u /**< error: bad def or arguments */
+#define SINEW_MSG_BLOB_IO 0x0101u               /**< error: the file could not be mapped */
+#define SINEW_MSG_BLOB_INVALID 0x0102u          /**< error: validation failed (names section) */
+#define SINEW_MSG_BLOB_OUT_OF_MEMORY 0x0103u    /**< error: the allocator returned NULL */
+#define SINEW_MSG_BLOB_LOADED 0x0104u           /**< info: loaded, with its counts */
+
+/** Stable log message ids of instance creation (sinew_logger). */
+#define SINEW_MSG_INSTANCE_INVALID_ARGUMENT 0x0200u /**< error: bad def or arguments */
+#define SINEW_MSG_INSTANCE_OUT_OF_MEMORY 0x0201u    /**< error: the allocator returned NULL */
+#define SINEW_MSG_INSTANCE_UNSUPPORTED 0x0202u      /**< error: a def field this version lacks */
+#define SINEW_MSG_INSTANCE_CREATED 0x0203u          /**< info: created, with its memory */
+
+/** A range task of the library: items [begin, end) on the host's worker `worker`. */
+typedef void sinew_task_fn(uint32_t begin, uint32_t end, uint32_t worker, void *task_context);
+
+/** The host's job system, in the manner of Box2D v3's enqueueTask / finishTask: enqueue
+ * runs `task` over [0, item_count) split into ranges of at least min_range items on
+ * the host's workers and returns a handle (or NULL after running it inline); finish
+ * waits for that handle. Called only from inside the step of the instance that owns
+ * them. */
+typedef struct sinew_task_callbacks {
+    void *(*enqueue)(sinew_task_fn *task, uint32_t item_count, uint32_t min_range,
+                     void *task_context, void *user);
+    void (*finish)(void *user_task, void *user);
+    uint32_t worker_count; /**< workers the host runs tasks on (worker < worker_count) */
+    void *user;
+} sinew_task_callbacks;
+
+/** Integration mode of an instance. */
+typedef enum sinew_step_mode {
+    SINEW_STEP_QUASISTATIC = 0, /**< equilibrium every frame: no inertia */
+    SINEW_STEP_DYNAMIC = 1      /**< implicit dynamics: flesh lags, jiggles and settles */
+} sinew_step_mode;
+
+/** How to create an instance of a blob. All memory is reserved at creation. */
+typedef struct sinew_instance_def {
+    uint32_t struct_size;      /**< sizeof(sinew_instance_def), set by the default */
+    sinew_step_mode mode;      /**< default quasistatic */
+    uint32_t max_newton_iters; /**< per step; 0 means 5 */
+    sinew_allocator allocator; /**< memory hooks; zero means the blob's */
+    sinew_logger logger;       /**< log hook; zero means the blob's */
+    /** Budget: the pose-space self-contact pairs one step may evaluate (the pairs of the
+     * two nearest training poses). 0 means the pairs of the blob's two fullest training
+     * poses, which never runs out. A step that needs more evaluates the nearest pose's
+     * pairs first, drops the rest and flags SINEW_STEP_BUDGET. */
+    uint32_t max_contact_pairs;
+    /** The host's job system for one instance's parallel work. Reserved: this version
+     * steps serially and rejects a def whose enqueue or finish is set
+     * (SINEW_ERROR_UNSUPPORTED); keep it zero. */
+    sinew_task_callbacks tasks;
+} sinew_instance_def;
+
+/** A sinew_instance_def with every field at its default. */
+static inline sinew_instance_def sinew_instance_def_default(void) {
+    sinew_instance_def d;
+    d.struct_size = (uint32_t)sizeof(sinew_instance_def);
+    d.mode = SINEW_STEP_QUASISTATIC;
+    d.max_newton_iters = 0;
+    d.allocator.alloc = NULL;
+    d.allocator.free = NULL;
+    d.allocator.user = NULL;
+    d.logger.log = NULL;
+    d.logger.user = NULL;
+    d.logger.max_level = SINEW_LOG_WARNING;
+    d.max_contact_pairs = 0;
+    d.tasks.enqueue = NULL;
+    d.tasks.finish = NULL;
+    d.tasks.worker_count = 0;
+    d.tasks.user = NULL;
+    return d;
+}
+
+/** Status flags of a step (sinew_step_stats.status). */
+#define SINEW_STEP_CONVERGED 1u /**< Newton reached its tolerance */
+#define SINEW_STEP_GUARD 2u     /**< the energy guard stopped Newton early (best iterate kept) */
+#define SINEW_STEP_TELEPORT 4u  /**< the pose jumped: no inertia taken from that jump */
+#define SINEW_STEP_FAILED 8u    /**< non-finite state: the step was undone */
+/** quasistatic: started from the pose-space blend of training solutions */
+#define SINEW_STEP_POSE_SPACE 16u
+/** a budget of the instance def ran out (budget_exceeded says which): the step did what
+ * fit */
+#define SINEW_STEP_BUDGET 32u
+
+/** Budgets of an instance (sinew_step_stats.budget_exceeded bits). */
+#define SINEW_BUDGET_CONTACT_PAIRS 1u /**< sinew_instance_def.max_contact_pairs */
+
+/** Figures of an instance's last step. */
+typedef struct sinew_step_stats {
+    uint32_t struct_size;       /**< set by the caller to sizeof(sinew_step_stats) */
+    uint32_t newton_iterations; /**< Newton updates taken */
+    uint32_t status;            /**< SINEW_STEP_* flags */
+    uint32_t reserved;          /**< zero */
+    double residual;            /**< |gradient| at exit relative to its value at entry */
+    double energy;              /**< the step's potential at exit */
+    /* The step's phases (DESIGN.md §4), wall-clock milliseconds each: */
+    double ms_skin;           /**< skinning the active vertices */
+    double ms_contact;        /**< pose-space lookup and the contact pairs in use */
+    double ms_dynamics;       /**< inertial forces, the start state, the frozen damping Hessian */
+    double ms_solve;          /**< the potential and Newton */
+    double ms_output;         /**< the output surface and its normals */
+    uint32_t active_vertices; /**< vertices skinned each step */
+    uint32_t cubature_tets;   /**< tets of one potential evaluation */
+    uint32_t potential_evals; /**< evaluations of the potential (cubature passes) */
+    uint32_t contact_pairs;   /**< pose-space contact pairs in use */
+    uint32_t contact_pairs_dropped; /**< pairs the max_contact_pairs budget left out */
+    uint32_t budget_exceeded;       /**< SINEW_BUDGET_* bits of the budgets that ran out */
+} sinew_step_stats;
+
+#ifdef __cplusplus
+}
+#endif
+#endif /* SINEW_TYPES_H */

@@ -1,0 +1,105 @@
+#include "pose_contact.h"
+
+#include <stddef.h>
+
+#include "penalty.h"
+
+/* Pose-space self-contact (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
+ * training pose's pairs, each the reference's penalty E = 1/2 k ka d^T N d with
+ * d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and n = R_p n_rest, applied
+ * while the pair collides (the Heaviside of eq. 3.12: p behind the triangle along n).
+ * Per pair the slots of one domain are summed into G_d = sum coef_m J_m (3 x r_d), so
+ * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
+ * couple two domains. Added after the cubature so it lands on the full (mirrored)
+ * matrix. */
+static double contact_pairs(sw_reduced *red, const int32_t *pairs, int32_t npairs, double weight,
+                            const double *q, int want_grad, int want_hess) {
+    const sw_blob_view *v = red->v;
+    double E = 0, k = weight * v->contact_k, al = SW_CONTACT_ALPHA;
+    int32_t rm = red->rmax;
+    for (int32_t p = 0; p < npairs; ++p) {
+        const int32_t c = pairs[p];
+        const int32_t *cv = v->contact_verts + 8 * (int64_t)c;
+        const double *cd = v->contact_data + 7 * (int64_t)c;
+        const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
+        const sw_blob_domain *D[4];
+        double x[4][3], d[3] = {0, 0, 0};
+        for (int m = 0; m < 4; ++m) {
+            D[m] = &v->domains[cv[2 * m]];
+            sw_reduced_position(red, D[m], cv[2 * m + 1], red->contact_act[4 * c + m],
+                                q + D[m]->q_offset, x[m], want_grad ? red->Jc + 3 * m * rm : NULL);
+            for (int i = 0; i < 3; ++i)
+                d[i] += coef[m] * x[m][i];
+        }
+        const double *Rp = red->act_R + 9 * red->contact_act[4 * c];
+        double n[3], g = 0;
+        for (int i = 0; i < 3; ++i)
+            n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
+        for (int i = 0; i < 3; ++i)
+            g += n[i] * d[i];
+        if (!(g > 0)) continue;
+        double kk = k * cd[6], Nd[3];
+        sw_penalty_apply_N(n, al, d, Nd);
+        E += sw_penalty_energy(kk, d, Nd);
+        if (!want_grad) continue;
+        /* G per distinct domain (slot `lead[m]` holds the sum of its domain's slots) */
+        int lead[4], nlead = 0, leads[4];
+        for (int m = 0; m < 4; ++m) {
+            int32_t r = D[m]->rank;
+            double *Jm = red->Jc + 3 * m * rm;
+            lead[m] = m;
+            for (int l = 0; l < nlead; ++l)
+                if (D[leads[l]] == D[m]) lead[m] = leads[l];
+            if (lead[m] == m) {
+                leads[nlead++] = m;
+                for (int32_t j = 0; j < 3 * r; ++j)
+                    Jm[j] *= coef[m];
+            } else {
+                double *Jl = red->Jc + 3 * lead[m] * rm;
+                for (int32_t j = 0; j < 3 * r; ++j)
+                    Jl[j] += coef[m] * Jm[j];
+            }
+        }
+        for (int l = 0; l < nlead; ++l) {
+            const sw_blob_domain *Dl = D[leads[l]];
+            int32_t r = Dl->rank;
+            const double *G = red->Jc + 3 * leads[l] * rm;
+            double *P = red->hc + 3 * l * rm; /* N G */
+            for (int32_t j = 0; j < r; ++j) {
+                double col[3] = {G[j], G[r + j], G[2 * r + j]}, Ncol[3];
+                sw_penalty_apply_N(n, al, col, Ncol);
+                for (int i = 0; i < 3; ++i)
+                    P[i * r + j] = Ncol[i];
+                red->g[Dl->q_offset + j] +=
+                    kk * (G[j] * Nd[0] + G[r + j] * Nd[1] + G[2 * r + j] * Nd[2]);
+            }
+        }
+        if (!want_hess) continue;
+        for (int a = 0; a < nlead; ++a)
+            for (int b = 0; b < nlead; ++b) {
+                const sw_blob_domain *Da = D[leads[a]], *Db = D[leads[b]];
+                int32_t ra = Da->rank, rb = Db->rank;
+                const double *Ga = red->Jc + 3 * leads[a] * rm, *Pb = red->hc + 3 * b * rm;
+                for (int32_t i = 0; i < ra; ++i) {
+                    double *Hi = red->H + (int64_t)(Da->q_offset + i) * red->R + Db->q_offset;
+                    double g0 = kk * Ga[i], g1 = kk * Ga[ra + i], g2 = kk * Ga[2 * ra + i];
+                    for (int32_t j = 0; j < rb; ++j)
+                        Hi[j] += g0 * Pb[j] + g1 * Pb[rb + j] + g2 * Pb[2 * rb + j];
+                }
+            }
+    }
+    return E;
+}
+
+/* The two nearest training poses' pairs with their pose-space blend weights (DESIGN.md
+ * §8, thesis §3.2.3: the two schemes' forces interpolated). */
+double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,
+                            int want_grad, int want_hess) {
+    if (ps->nearest < 0) return 0;
+    double E =
+        contact_pairs(red, ps->pairs, ps->npairs_nearest, 1 - ps->blend, q, want_grad, want_hess);
+    if (ps->blend > 0)
+        E += contact_pairs(red, ps->pairs + ps->npairs_nearest, ps->npairs - ps->npairs_nearest,
+                           ps->blend, q, want_grad, want_hess);
+    return E;
+}

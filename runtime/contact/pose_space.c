@@ -1,0 +1,140 @@
+#include "pose_space.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "dqs.h"
+
+/* twin_next: links the training poses stored more than once (one per branch of the
+ * reference's path: on its return path a fold that buckled on the way in may stay
+ * buckled on the way out) into cycles in stored order, once at creation. */
+void sw_pose_space_link_twins(const sw_blob_view *v, int32_t *twin_next) {
+    size_t f = (size_t)4 * v->nbones;
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        int32_t next = t;
+        for (int32_t k = 1; k < v->ntrain && next == t; ++k) { /* t+1, ..., wrapping round */
+            int32_t u = (t + k) % v->ntrain;
+            if (sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14)
+                next = u;
+        }
+        twin_next[t] = next;
+    }
+}
+
+void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones) {
+    ps->nearest = ps->second = -1;
+    ps->blend = 0;
+    ps->looked_up = 0; /* no motion yet: a pose on two branches takes the first stored */
+    memset(ps->motion, 0, 4 * (size_t)nbones * sizeof(double));
+    ps->npairs_nearest = ps->npairs = ps->dropped = 0;
+}
+
+/* Training pose t is stored on the branch cycle of u (the same pose: the bake stores a
+ * pose once per branch of the reference's path, twin_next). */
+static int same_pose(const sw_pose_space *ps, int32_t t, int32_t u) {
+    if (u < 0) return 0;
+    int32_t w = u;
+    do {
+        if (w == t) return 1;
+        w = ps->twin_next[w];
+    } while (w != u);
+    return 0;
+}
+
+/* Of the branches stored for training pose `rep`, the one the instance is on. The
+ * bake solved the training poses in the order it stored them, each from the one before
+ * (a path, blob_view.h), so a stored pose's arrival direction is its feature minus
+ * its predecessor's: on the way into a bend or on the way out. The branch whose
+ * arrival is most aligned with the instance's own last motion wins (the first stored
+ * on a tie, e.g. before the pose ever moved): a fold that buckled while the joint
+ * bent stays buckled while it unbends. */
+static int32_t pick_branch(const sw_pose_space *ps, const sw_blob_view *v, int32_t rep) {
+    size_t f = (size_t)4 * v->nbones;
+    int32_t best = rep, t = rep;
+    double best_s = -INFINITY;
+    do { /* rep's branches, from rep round its cycle */
+        double s = 0, n = 0;
+        for (size_t i = 0; t > 0 && i < f; ++i) {
+            double a = v->train_pose[f * t + i] - v->train_pose[f * (t - 1) + i];
+            s += a * ps->motion[i];
+            n += a * a;
+        }
+        s = n > 0 ? s / sqrt(n) : 0;
+        if (s > best_s || (s == best_s && t < best)) best_s = s, best = t;
+        t = ps->twin_next[t];
+    } while (t != rep);
+    return best;
+}
+
+/* The two training poses nearest to the current pose (feature distance) and the
+ * pose-space blend weight of the second (DESIGN.md §8: one sample when the nearest is
+ * within 1e-3 or the second is more than 4 times as far, else a blend by distance).
+ * A pose stored on several branches counts once; the instance's motion picks the
+ * branch (pick_branch). Sets ps->nearest (-1 without training poses), ps->second and
+ * ps->blend. */
+void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T) {
+    int32_t n0 = -1, n1 = -1;
+    ps->nearest = ps->second = -1;
+    ps->blend = 0;
+    if (v->ntrain < 1) return;
+    sw_pose_feature(T, v->bone_parent, v->nbones, ps->feature);
+    double d0 = INFINITY, d1 = INFINITY;
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        double d =
+            sw_pose_distance(ps->feature, v->train_pose + (size_t)4 * v->nbones * t, v->nbones);
+        if ((d == d0 && same_pose(ps, t, n0)) || (d == d1 && same_pose(ps, t, n1))) continue;
+        if (d < d0) {
+            d1 = d0, n1 = n0;
+            d0 = d, n0 = t;
+        } else if (d < d1) {
+            d1 = d, n1 = t;
+        }
+    }
+    /* the feature distance is sum (1 - cos^2(theta_b / 2)): its root is linear in the
+       angles for small ones */
+    double s0 = sqrt(d0), s1 = sqrt(d1);
+    if (n1 >= 0 && s0 >= 1e-3 && s1 <= 4 * s0) ps->blend = s0 / (s0 + s1);
+    /* the last motion: kept while the pose holds still, so a pause does not switch branch */
+    size_t f = (size_t)4 * v->nbones;
+    double moved = 0;
+    for (size_t i = 0; i < f; ++i)
+        moved += fabs(ps->feature[i] - ps->feature_last[i]);
+    if (moved > 1e-9 && ps->looked_up)
+        for (size_t i = 0; i < f; ++i)
+            ps->motion[i] = ps->feature[i] - ps->feature_last[i];
+    memcpy(ps->feature_last, ps->feature, f * sizeof(double));
+    ps->looked_up = 1;
+    ps->nearest = pick_branch(ps, v, n0);
+    ps->second = ps->blend > 0 ? pick_branch(ps, v, n1) : n1;
+}
+
+/* Appends the pairs of training pose `pose` while the budget lasts. */
+static void gather_pose(sw_pose_space *ps, const sw_blob_view *v, int32_t pose) {
+    for (int32_t c = v->contact_ptr[pose]; c < v->contact_ptr[pose + 1]; ++c) {
+        if (ps->npairs == ps->max_pairs) {
+            ps->dropped += v->contact_ptr[pose + 1] - c;
+            return;
+        }
+        ps->pairs[ps->npairs++] = c;
+    }
+}
+
+void sw_pose_space_gather_pairs(sw_pose_space *ps, const sw_blob_view *v) {
+    ps->npairs_nearest = ps->npairs = ps->dropped = 0;
+    if (ps->nearest < 0) return;
+    gather_pose(ps, v, ps->nearest);
+    ps->npairs_nearest = ps->npairs;
+    if (ps->blend > 0) gather_pose(ps, v, ps->second);
+}
+
+int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v) {
+    int32_t a = 0, b = 0; /* the largest and second largest counts */
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        int32_t n = v->contact_ptr[t + 1] - v->contact_ptr[t];
+        if (n > a)
+            b = a, a = n;
+        else if (n > b)
+            b = n;
+    }
+    return a + b;
+}

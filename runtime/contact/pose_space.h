@@ -1,0 +1,48 @@
+/* The pose space of the step (thesis §3.2.3, DESIGN.md §8): the training poses nearest
+ * to the current pose by their pose feature, the blend weight between the two nearest,
+ * the branch a pose stored twice is on, and the pose-space contact pairs those poses
+ * bring into this step (under the instance's budget). */
+#ifndef SW_POSE_SPACE_H
+#define SW_POSE_SPACE_H
+
+#include <stdint.h>
+
+#include "blob_view.h"
+
+typedef struct sw_pose_space {
+    double *feature;      /* 4 nbones: the current pose's feature */
+    double *feature_last; /* 4 nbones: the pose feature of the last lookup */
+    double *motion;       /* 4 nbones: the last change of pose between two lookups */
+    int32_t *twin_next;   /* ntrain: the next training pose storing the same pose (a
+                             cycle over its branches; itself when it has one) */
+    int looked_up;        /* feature_last holds a pose */
+    int32_t nearest;      /* training pose nearest to the current pose, or -1 */
+    int32_t second;       /* the second nearest, or -1 */
+    double blend;         /* pose-space weight of `second` (0: `nearest` alone) */
+    /* the contact pairs in use: pairs[0, npairs_nearest) are the nearest pose's,
+       pairs[npairs_nearest, npairs) the second's (when blended) */
+    int32_t *pairs;    /* max_pairs contact ids */
+    int32_t max_pairs; /* the budget: at most this many pairs a step */
+    int32_t npairs_nearest, npairs;
+    int32_t dropped; /* pairs the budget left out this step */
+} sw_pose_space;
+
+/* Links the training poses stored more than once into cycles (twin_next, ntrain). */
+void sw_pose_space_link_twins(const sw_blob_view *v, int32_t *twin_next);
+
+/* Forgets the pose history: no motion, no nearest pose. */
+void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);
+
+/* Finds the two nearest training poses of the pose T (12 per bone) and the blend
+ * weight, and updates the pose motion. Sets nearest (-1 without training poses), second
+ * and blend. O(ntrain nbones). */
+void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T);
+
+/* Collects the contact pairs of the poses the lookup found into ps->pairs, the nearest
+ * pose's first, at most max_pairs; sets npairs_nearest, npairs and dropped. */
+void sw_pose_space_gather_pairs(sw_pose_space *ps, const sw_blob_view *v);
+
+/* The default pair budget: the pairs of the two training poses that hold the most. */
+int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v);
+
+#endif

@@ -1,0 +1,32 @@
+#include "reduced_map.h"
+
+void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq) {
+    const sw_blob_view *v = m->v;
+    for (int32_t a = 0; a < m->nact; ++a) {
+        int32_t gv = m->act_vert[a];
+        sw_dqs_blend(bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, m->act_R + 9 * a,
+                     m->act_t + 3 * a);
+    }
+}
+
+void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
+                         const double *qd, double x[3], double *J) {
+    const sw_blob_view *v = m->v;
+    int32_t r = D->rank, gv = v->domain_verts[D->vert_begin + lv];
+    const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+    const double *Rm = m->act_R + 9 * a, *t = m->act_t + 3 * a, *X = v->rest + 3 * (int64_t)gv;
+    double y[3];
+    for (int i = 0; i < 3; ++i) {
+        double acc = X[i];
+        for (int32_t j = 0; j < r; ++j)
+            acc += U[i * r + j] * qd[j];
+        y[i] = acc;
+    }
+    for (int i = 0; i < 3; ++i)
+        x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
+    if (J)
+        for (int i = 0; i < 3; ++i)
+            for (int32_t j = 0; j < r; ++j)
+                J[i * r + j] =
+                    Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
+}

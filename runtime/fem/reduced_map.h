@@ -1,0 +1,43 @@
+/* The subspace map of the step (thesis §4.4.1, eq. 4.13): a vertex copy k of domain d
+ * sits at  x_k = R_k (rest_k + U_k q_d) + t_k,  with (R_k, t_k) the dual-quaternion
+ * skinning transform of its vertex and U_k its rows of the domain's basis. Only the
+ * "active" vertices are skinned each step: cubature tet corners, output surface copies
+ * and pose-space contact vertices, so the cost follows those counts, not the mesh.
+ *
+ * sw_reduced is what every reduced evaluation (cubature, contact, potential) reads and
+ * accumulates into; the instance owns its arrays (one memory plan, instance.c). */
+#ifndef SW_REDUCED_MAP_H
+#define SW_REDUCED_MAP_H
+
+#include <stdint.h>
+
+#include "blob_view.h"
+#include "dqs.h"
+
+typedef struct sw_reduced {
+    const sw_blob_view *v;
+    int32_t R;             /* rank_total: the length of q */
+    int32_t rmax;          /* the largest domain rank */
+    int32_t nact;          /* active vertices */
+    int32_t *act_vert;     /* nact: the global vertex of each, ascending */
+    int32_t *cub_act;      /* 4 ncub: active index of each cubature tet corner */
+    int32_t *copy_act;     /* nsurf_copies: active index of each surface copy */
+    int32_t *contact_act;  /* 4 ncontacts: active index of p, t0, t1, t2 */
+    double *act_R, *act_t; /* 9 and 3 per active vertex: its skinning transform */
+    double *g;             /* R: gradient accumulator */
+    double *H;             /* R x R: Hessian accumulator */
+    double *Je;            /* 12 x rmax: one cubature tet's Jacobian */
+    double *Jc, *hc;       /* 4 x 3 x rmax each: one contact's Jacobians and N G */
+    double *svd_V;         /* 9 per cubature tet: its last SVD rotation (warm start) */
+} sw_reduced;
+
+/* Skins every active vertex with the bones' dual quaternions (act_R, act_t). */
+void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
+
+/* Position x of copy (domain D, local vertex lv, active index a) for the domain's
+ * reduced coordinates qd, and its Jacobian J = R U (3 x r_d, row-major) when J is not
+ * NULL. */
+void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
+                         const double *qd, double x[3], double *J);
+
+#endif

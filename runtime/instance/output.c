@@ -1,0 +1,130 @@
+/* What a step leaves for the host: the output surface (each vertex the mean of its
+ * domain copies, area-weighted normals), its float copy, the step's figures; and the
+ * O(N) evaluation helpers of tools and tests, which are never part of a step. */
+#include <math.h>
+#include <string.h>
+
+#include "instance.h"
+#include "instance_internal.h"
+
+void sw_instance_write_surface(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        double acc[3] = {0, 0, 0};
+        int32_t b = v->surf_copy_ptr[s], e = v->surf_copy_ptr[s + 1];
+        for (int32_t i = b; i < e; ++i) {
+            const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+            double x[3];
+            sw_reduced_position(&in->red, D, v->surf_copies[2 * i + 1], in->red.copy_act[i],
+                                in->solver.q + D->q_offset, x, NULL);
+            for (int k = 0; k < 3; ++k)
+                acc[k] += x[k];
+        }
+        for (int k = 0; k < 3; ++k)
+            in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
+    }
+    memset(in->surf_n, 0, 3 * (size_t)v->nsurf_verts * sizeof(double));
+    for (int32_t t = 0; t < v->nsurf_tris; ++t) {
+        const int32_t *tri = v->surf_tris + 3 * t;
+        const double *a = in->surf_x + 3 * tri[0], *b = in->surf_x + 3 * tri[1],
+                     *c = in->surf_x + 3 * tri[2];
+        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
+               e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
+        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                       e1[0] * e2[1] - e1[1] * e2[0]};
+        for (int k = 0; k < 3; ++k)
+            for (int j = 0; j < 3; ++j)
+                in->surf_n[3 * tri[k] + j] += n[j]; /* area weighted */
+    }
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        double *n = in->surf_n + 3 * s, l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
+        if (l > 0)
+            for (int k = 0; k < 3; ++k)
+                n[k] /= l;
+    }
+}
+
+SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
+                                                   float *normals, uint32_t vertex_count) {
+    if (!inst || (!positions && !normals) || vertex_count != (uint32_t)inst->v->nsurf_verts)
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    for (uint32_t i = 0; i < 3 * vertex_count; ++i) {
+        if (positions) positions[i] = (float)inst->surf_x[i];
+        if (normals) normals[i] = (float)inst->surf_n[i];
+    }
+    return SINEW_OK;
+}
+
+SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sinew_step_stats *out) {
+    if (!inst || !out || out->struct_size < sizeof(uint32_t)) return SINEW_ERROR_INVALID_ARGUMENT;
+    uint32_t n =
+        out->struct_size < sizeof inst->stats ? out->struct_size : (uint32_t)sizeof inst->stats;
+    memcpy(out, &inst->stats, n);
+    out->struct_size = n;
+    return SINEW_OK;
+}
+
+const double *sw_instance_surface(const sinew_instance *inst) {
+    return inst->surf_x;
+}
+const double *sw_instance_q(const sinew_instance *inst) {
+    return inst->solver.q;
+}
+
+void sw_instance_full_positions(const sinew_instance *inst, double *x, double *count) {
+    const sw_blob_view *v = inst->v;
+    memset(x, 0, 3 * (size_t)v->nverts * sizeof(double));
+    memset(count, 0, (size_t)v->nverts * sizeof(double));
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank;
+        for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+            int32_t gv = v->domain_verts[D->vert_begin + lv];
+            double R[9], t[3], y[3];
+            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+            for (int i = 0; i < 3; ++i) {
+                double acc = v->rest[3 * gv + i];
+                for (int32_t j = 0; j < r; ++j)
+                    acc += U[i * r + j] * inst->solver.q[D->q_offset + j];
+                y[i] = acc;
+            }
+            for (int i = 0; i < 3; ++i)
+                x[3 * gv + i] += R[3 * i] * y[0] + R[3 * i + 1] * y[1] + R[3 * i + 2] * y[2] + t[i];
+            count[gv] += 1;
+        }
+    }
+    for (int32_t gv = 0; gv < v->nverts; ++gv) {
+        if (count[gv] > 0) {
+            for (int i = 0; i < 3; ++i)
+                x[3 * gv + i] /= count[gv];
+        } else {
+            double R[9], t[3];
+            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            const double *X = v->rest + 3 * gv;
+            for (int i = 0; i < 3; ++i)
+                x[3 * gv + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
+        }
+    }
+}
+
+void sw_instance_dqs_positions(const sinew_instance *inst, double *x) {
+    const sw_blob_view *v = inst->v;
+    sw_dqs_skin(v->nverts, v->rest, inst->bone_dq, v->skin_bone, v->skin_weight, 4, x);
+}
+
+double sw_instance_potential(sinew_instance *inst, const double *q, double *g, double *H) {
+    sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
+    size_t R = (size_t)inst->red.R;
+    sw_reduced_skin(&inst->red, inst->bone_dq);
+    sw_pose_space_lookup(&inst->ps, inst->v, inst->pose.T_cur);
+    sw_pose_space_gather_pairs(&inst->ps, inst->v);
+    double phi = sw_potential(&inst->red, &inst->ps, &inst->solver, q, &dc, g || H, H != NULL);
+    if (g) memcpy(g, inst->red.g, R * sizeof(double));
+    if (H) memcpy(H, inst->red.H, R * R * sizeof(double));
+    return phi;
+}
+
+void sw_instance_set_q(sinew_instance *inst, const double *q) {
+    memcpy(inst->solver.q, q, (size_t)inst->red.R * sizeof(double));
+}

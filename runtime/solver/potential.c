@@ -1,0 +1,55 @@
+/* The potential of one step (thesis eqs. 2.11, 4.20 and the backward-Euler terms):
+ *   Phi(q) = E_cub(q) + E_contact(q) + 1/2 q^T H_s q
+ *          [ + cm/2 |q - q_n - h qdot_n|_M^2 + cd/2 |q - q_n|_D^2 - q^T f_in ],
+ * D = alpha M + beta H(q_n), H_s the constant interface-spring Hessian, M the constant
+ * reduced mass, f_in the inertial forces of the domains riding their bones. */
+#include <string.h>
+
+#include "cubature.h"
+#include "dense.h"
+#include "pose_contact.h"
+#include "solver.h"
+
+double sw_potential(sw_reduced *red, const sw_pose_space *ps, const sw_solver *s, const double *q,
+                    const sw_dyn_coef *dc, int want_grad, int want_hess) {
+    int32_t R = red->R;
+    const sw_blob_view *v = red->v;
+    if (want_grad) memset(red->g, 0, (size_t)R * sizeof(double));
+    if (want_hess) memcpy(red->H, v->spring_hessian, (size_t)R * R * sizeof(double));
+    double phi = sw_cubature_eval(red, q, want_grad, want_hess);
+    phi += sw_pose_contact_eval(red, ps, q, want_grad, want_hess);
+    sw_matvec(v->spring_hessian, R, q, s->tmp);
+    phi += 0.5 * sw_dot(q, s->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i)
+            red->g[i] += s->tmp[i];
+    if (!dc->dynamic) return phi;
+    /* inertia: cm/2 |q - qhat|_M^2 with qhat = qn + h qdot */
+    double *e = s->tmp2;
+    for (int32_t i = 0; i < R; ++i)
+        e[i] = q[i] - s->qn[i] - dc->h * s->qdot[i];
+    sw_matvec(v->mass, R, e, s->tmp);
+    phi += 0.5 * dc->cm * sw_dot(e, s->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i)
+            red->g[i] += dc->cm * s->tmp[i];
+    /* damping: cd/2 |q - qn|_D^2, D = alpha M + beta Hn */
+    for (int32_t i = 0; i < R; ++i)
+        e[i] = q[i] - s->qn[i];
+    sw_matvec(v->mass, R, e, s->tmp);
+    double dm = sw_dot(e, s->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i)
+            red->g[i] += dc->cd * dc->alpha * s->tmp[i];
+    sw_matvec(s->Hn, R, e, s->tmp);
+    double dk = sw_dot(e, s->tmp, R);
+    if (want_grad)
+        for (int32_t i = 0; i < R; ++i)
+            red->g[i] += dc->cd * dc->beta * s->tmp[i] - s->fin[i];
+    phi += 0.5 * dc->cd * (dc->alpha * dm + dc->beta * dk) - sw_dot(q, s->fin, R);
+    if (want_hess)
+        for (int64_t i = 0; i < (int64_t)R * R; ++i)
+            red->H[i] +=
+                dc->cm * v->mass[i] + dc->cd * (dc->alpha * v->mass[i] + dc->beta * s->Hn[i]);
+    return phi;
+}

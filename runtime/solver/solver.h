@@ -1,0 +1,53 @@
+/* The reduced solve of one step (thesis §4.4, DESIGN.md §4): the state q and its history,
+ * the potential Phi(q) of a quasistatic or backward-Euler step, and Newton with an energy
+ * guard on a block-sparse Cholesky of its Hessian. The instance owns the arrays. */
+#ifndef SW_SOLVER_H
+#define SW_SOLVER_H
+
+#include <stdint.h>
+
+#include "pose_space.h"
+#include "reduced_map.h"
+#include "sinew/sinew.h"
+
+typedef struct sw_solver {
+    double *q, *qn, *qdot; /* R each: the state, its value at step start, its velocity */
+    double *fin;           /* R: inertial forces of the step (inertia.h) */
+    double *Hn;            /* R x R: the Hessian at q_n (Rayleigh stiffness damping) */
+    double *L;             /* R x R: the block Cholesky factor */
+    double *dq, *qtrial;   /* R each: Newton update, the iterate before it */
+    double *tmp, *tmp2;    /* R each: scratch */
+    /* H's domain blocks and their elimination order (leaves of the coupling graph first) */
+    int32_t *blk_off, *blk_size, *blk_order; /* ndomains each */
+    int32_t *blk_pos;                        /* domain -> its place in blk_order */
+    unsigned char *blk_nz;                   /* ndomains^2: the factor's block pattern */
+    unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
+    uint32_t max_newton;                     /* Newton updates a step at most */
+} sw_solver;
+
+/* The time discretisation of a step: quasistatic (dynamic = 0) or backward Euler with
+ * cm = 1/h^2, cd = 1/h and Rayleigh damping alpha M + beta H(q_n). */
+typedef struct sw_dyn_coef {
+    double h, cm, cd, alpha, beta;
+    int dynamic;
+} sw_dyn_coef;
+
+/* The block layout of H and its minimum-degree elimination order, once at creation. */
+void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v);
+
+/* Phi(q): cubature + contact + springs [+ inertia, damping and inertial forces]. With
+ * want_grad also red->g (and red->H with want_hess); H_n is frozen for the step. */
+double sw_potential(sw_reduced *red, const sw_pose_space *ps, const sw_solver *s, const double *q,
+                    const sw_dyn_coef *dc, int want_grad, int want_hess);
+
+/* The structural block pattern of H for this step: spring-coupled domains and the
+ * domains the contact pairs in use join (no scan of H's values). */
+void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_pose_space *ps);
+
+/* Newton from s->q with the energy guard, into s->q; fills st's iterations, status
+ * (CONVERGED, GUARD), residual, energy and potential_evals. A non-finite potential
+ * restores q_n, sets FAILED and returns SINEW_ERROR_NOT_FINITE. */
+sinew_result sw_newton_solve(sw_reduced *red, const sw_pose_space *ps, sw_solver *s,
+                             const sw_dyn_coef *dc, sinew_step_stats *st);
+
+#endif
