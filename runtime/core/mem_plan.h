@@ -29,4 +29,10 @@ static inline void *sw_plan_take(sw_mem_plan *p, uint64_t count, size_t elem) {
     return p->base && count ? p->base + at : NULL;
 }
 
+/* The block's size: everything laid out, rounded up to the alignment (what sw_alloc
+ * reserves). */
+static inline size_t sw_plan_size(const sw_mem_plan *p) {
+    return (p->size + SW_ALLOC_ALIGN - 1) & ~(size_t)(SW_ALLOC_ALIGN - 1);
+}
+
 #endif

@@ -208,7 +208,7 @@ SINEW_API sinew_result sinew_instance_memory_size(const sinew_blob *blob,
     sw_mem_plan plan = {NULL, 0, 0};
     layout(&plan, &scratch, sw_blob_get_view(blob), &z);
     if (plan.overflow) return SINEW_ERROR_OUT_OF_MEMORY;
-    *bytes = plan.size;
+    *bytes = sw_plan_size(&plan);
     return SINEW_OK;
 }
 
@@ -237,10 +237,11 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sinew_instance sized;
     sw_mem_plan plan = {NULL, 0, 0};
     layout(&plan, &sized, v, &z);
-    unsigned char *block = plan.overflow ? NULL : sw_alloc(&d.allocator, plan.size, SW_ALLOC_ALIGN);
+    unsigned char *block =
+        plan.overflow ? NULL : sw_alloc(&d.allocator, sw_plan_size(&plan), SW_ALLOC_ALIGN);
     if (!block) {
         sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_OUT_OF_MEMORY,
-               "sinew_instance_create: out of memory (%zu bytes)", plan.size);
+               "sinew_instance_create: out of memory (%zu bytes)", sw_plan_size(&plan));
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
     sinew_instance *in = (sinew_instance *)(void *)block;
@@ -251,7 +252,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->allocator = d.allocator;
     in->logger = d.logger;
     in->mode = d.mode;
-    in->memory_size = plan.size;
+    in->memory_size = sw_plan_size(&plan);
     in->size = rest_size(v);
     in->red.v = v;
     in->red.R = v->rank_total;
@@ -266,7 +267,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sw_log(&d.logger, SINEW_LOG_INFO, SINEW_MSG_INSTANCE_CREATED,
            "sinew_instance_create: %zu bytes in one block; %d active vertices, rank %d, %d "
            "contact pairs a step at most",
-           plan.size, in->red.nact, in->red.R, z.max_pairs);
+           in->memory_size, in->red.nact, in->red.R, z.max_pairs);
     *out = in;
     return SINEW_OK;
 }

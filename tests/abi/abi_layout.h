@@ -32,7 +32,21 @@
     X(offsetof(sinew_instance_def, mode))                                                          \
     X(offsetof(sinew_instance_def, max_newton_iters))                                              \
     X(offsetof(sinew_instance_def, allocator))                                                     \
-    X(offsetof(sinew_instance_def, logger))
+    X(offsetof(sinew_instance_def, logger))                                                        \
+    X(offsetof(sinew_instance_def, max_contact_pairs))                                             \
+    X(offsetof(sinew_instance_def, tasks))                                                         \
+    X(sizeof(sinew_task_callbacks))                                                                \
+    X(offsetof(sinew_task_callbacks, enqueue))                                                     \
+    X(offsetof(sinew_task_callbacks, finish))                                                      \
+    X(offsetof(sinew_task_callbacks, worker_count))                                                \
+    X(offsetof(sinew_task_callbacks, user))                                                        \
+    X(sizeof(sinew_step_stats))                                                                    \
+    X(offsetof(sinew_step_stats, residual))                                                        \
+    X(offsetof(sinew_step_stats, energy))                                                          \
+    X(offsetof(sinew_step_stats, ms_skin))                                                         \
+    X(offsetof(sinew_step_stats, ms_output))                                                       \
+    X(offsetof(sinew_step_stats, active_vertices))                                                 \
+    X(offsetof(sinew_step_stats, budget_exceeded))
 
 #ifdef __cplusplus
 extern "C" {

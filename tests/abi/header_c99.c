@@ -21,6 +21,8 @@
 #include <sinew/sinew_base.h>
 #include <sinew/sinew.h>
 #include <sinew/sinew.h> /* include guards: a second inclusion must be harmless */
+#include <sinew/sinew_types.h>
+#include <sinew/sinew_world.h>
 
 #include "sw_test.h"
 

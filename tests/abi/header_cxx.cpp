@@ -4,6 +4,7 @@
 // byte for byte what the C compiler produced (compared with abi_layout_c.c).
 #include <sinew/sinew.h>
 #include <sinew/sinew.h> // include guards
+#include <sinew/sinew_world.h>
 
 #include <cstdio>
 #include <cstring>
