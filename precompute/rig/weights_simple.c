@@ -2,6 +2,8 @@
  * heat-diffusion weights of DESIGN.md §8; these only need to be plausible and smooth). */
 #include "rig.h"
 
+#include "bbox.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -9,19 +11,11 @@
 /* Length of the diagonal of the box around the mesh and the joints: the scale that
  * makes the distance clamp relative. */
 static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t v = 0; v < m->nverts; ++v)
-        for (int i = 0; i < 3; ++i) {
-            lo[i] = fmin(lo[i], m->X[3 * v + i]);
-            hi[i] = fmax(hi[i], m->X[3 * v + i]);
-        }
-    for (int32_t j = 0; j < s->njoints; ++j)
-        for (int i = 0; i < 3; ++i) {
-            lo[i] = fmin(lo[i], s->joints[3 * j + i]);
-            hi[i] = fmax(hi[i], s->joints[3 * j + i]);
-        }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double lo[3], hi[3];
+    sw_bbox_empty(lo, hi);
+    sw_bbox_add(lo, hi, m->nverts, m->X);
+    sw_bbox_add(lo, hi, s->njoints, s->joints);
+    return sw_bbox_diagonal(lo, hi);
 }
 
 sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton *s, sw_weights *out,

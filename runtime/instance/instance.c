@@ -5,6 +5,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "bbox.h"
 #include "def_read.h"
 #include "instance.h"
 #include "instance_internal.h"
@@ -214,14 +215,10 @@ SINEW_API sinew_result sinew_instance_memory_size(const sinew_blob *blob,
 
 /* The rest bounding-box diagonal: the size a teleport is measured against. */
 static double rest_size(const sw_blob_view *v) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t i = 0; i < v->nverts; ++i)
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = fmin(lo[k], v->rest[3 * i + k]);
-            hi[k] = fmax(hi[k], v->rest[3 * i + k]);
-        }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double lo[3], hi[3];
+    sw_bbox_empty(lo, hi);
+    sw_bbox_add(lo, hi, v->nverts, v->rest);
+    return sw_bbox_diagonal(lo, hi);
 }
 
 SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew_instance_def *def,

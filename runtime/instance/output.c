@@ -6,6 +6,7 @@
 
 #include "instance.h"
 #include "instance_internal.h"
+#include "surface_normals.h"
 
 void sw_instance_write_surface(sinew_instance *in) {
     const sw_blob_view *v = in->v;
@@ -23,25 +24,7 @@ void sw_instance_write_surface(sinew_instance *in) {
         for (int k = 0; k < 3; ++k)
             in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
     }
-    memset(in->surf_n, 0, 3 * (size_t)v->nsurf_verts * sizeof(double));
-    for (int32_t t = 0; t < v->nsurf_tris; ++t) {
-        const int32_t *tri = v->surf_tris + 3 * t;
-        const double *a = in->surf_x + 3 * tri[0], *b = in->surf_x + 3 * tri[1],
-                     *c = in->surf_x + 3 * tri[2];
-        double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-               e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-        double n[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                       e1[0] * e2[1] - e1[1] * e2[0]};
-        for (int k = 0; k < 3; ++k)
-            for (int j = 0; j < 3; ++j)
-                in->surf_n[3 * tri[k] + j] += n[j]; /* area weighted */
-    }
-    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
-        double *n = in->surf_n + 3 * s, l = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
-        if (l > 0)
-            for (int k = 0; k < 3; ++k)
-                n[k] /= l;
-    }
+    sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
 }
 
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,

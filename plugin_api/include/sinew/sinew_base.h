@@ -91,6 +91,24 @@ typedef struct sinew_logger {
     sinew_log_level max_level; /**< messages above this level are not formatted at all */
 } sinew_logger;
 
+/** The C library's allocation (all hooks NULL). */
+static inline sinew_allocator sinew_allocator_default(void) {
+    sinew_allocator a;
+    a.alloc = NULL;
+    a.free = NULL;
+    a.user = NULL;
+    return a;
+}
+
+/** A silent logger (no hook) that would pass errors and warnings. */
+static inline sinew_logger sinew_logger_default(void) {
+    sinew_logger l;
+    l.log = NULL;
+    l.user = NULL;
+    l.max_level = SINEW_LOG_WARNING;
+    return l;
+}
+
 #ifdef __cplusplus
 }
 #endif

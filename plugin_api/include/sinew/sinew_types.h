@@ -50,12 +50,8 @@ static inline sinew_blob_def sinew_blob_def_default(void) {
     d.path = NULL;
     d.data = NULL;
     d.data_size = 0;
-    d.allocator.alloc = NULL;
-    d.allocator.free = NULL;
-    d.allocator.user = NULL;
-    d.logger.log = NULL;
-    d.logger.user = NULL;
-    d.logger.max_level = SINEW_LOG_WARNING;
+    d.allocator = sinew_allocator_default();
+    d.logger = sinew_logger_default();
     return d;
 }
 
@@ -118,12 +114,8 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.struct_size = (uint32_t)sizeof(sinew_instance_def);
     d.mode = SINEW_STEP_QUASISTATIC;
     d.max_newton_iters = 0;
-    d.allocator.alloc = NULL;
-    d.allocator.free = NULL;
-    d.allocator.user = NULL;
-    d.logger.log = NULL;
-    d.logger.user = NULL;
-    d.logger.max_level = SINEW_LOG_WARNING;
+    d.allocator = sinew_allocator_default();
+    d.logger = sinew_logger_default();
     d.max_contact_pairs = 0;
     d.tasks.enqueue = NULL;
     d.tasks.finish = NULL;
