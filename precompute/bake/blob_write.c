@@ -48,14 +48,9 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
 
     sinew_blob_meta meta;
     memset(&meta, 0, sizeof meta);
-    meta.nverts = view->nverts, meta.nbones = view->nbones, meta.ndomains = view->ndomains;
-    meta.rank_total = view->rank_total, meta.ndomain_verts = view->ndomain_verts;
-    meta.ncub = view->ncub, meta.nsurf_verts = view->nsurf_verts;
-    meta.nsurf_tris = view->nsurf_tris;
-    meta.mu = view->mu, meta.lambda = view->lambda, meta.rayleigh_alpha = view->rayleigh_alpha;
-    meta.rayleigh_beta = view->rayleigh_beta, meta.contact_k = view->contact_k;
-    meta.ntrain = view->ntrain;
-    meta.ncontacts = view->ncontacts;
+#define TO_META(field) meta.field = view->field;
+    SW_BLOB_META_FIELDS(TO_META)
+#undef TO_META
 
     section_src src[SINEW_SECTION_COUNT_V1];
     sinew_blob_section table[SINEW_SECTION_COUNT_V1];

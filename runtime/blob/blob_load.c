@@ -20,6 +20,11 @@ _Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
     _Static_assert(sizeof(type) == elem_size, #NAME " elements are " #elem_size " bytes");
 SINEW_BLOB_SECTIONS(SIZE_MATCHES)
 #undef SIZE_MATCHES
+/* SW_BLOB_META_FIELDS covers every byte of META: no field is left uncopied. */
+#define META_FIELD_SIZE(field) +sizeof(((sinew_blob_meta *)0)->field)
+_Static_assert(0 SW_BLOB_META_FIELDS(META_FIELD_SIZE) == sizeof(sinew_blob_meta),
+               "SW_BLOB_META_FIELDS lists every META field");
+#undef META_FIELD_SIZE
 _Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vertex");
 
 #define HEADER_SIZE ((uint64_t)sizeof(sinew_blob_header))
@@ -568,12 +573,9 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     sinew_blob_meta m;
     memcpy(&m, bytes + meta->offset, sizeof m);
     memset(v, 0, sizeof *v);
-    v->nverts = m.nverts, v->nbones = m.nbones, v->ndomains = m.ndomains;
-    v->rank_total = m.rank_total, v->ndomain_verts = m.ndomain_verts, v->ncub = m.ncub;
-    v->nsurf_verts = m.nsurf_verts, v->nsurf_tris = m.nsurf_tris;
-    v->mu = m.mu, v->lambda = m.lambda, v->rayleigh_alpha = m.rayleigh_alpha;
-    v->rayleigh_beta = m.rayleigh_beta, v->contact_k = m.contact_k;
-    v->ntrain = m.ntrain, v->ncontacts = m.ncontacts;
+#define FROM_META(field) v->field = m.field;
+    SW_BLOB_META_FIELDS(FROM_META)
+#undef FROM_META
     sinew_result r = check_meta(v, msg, ms);
     if (r != SINEW_OK) return r;
     if ((r = check_meta_counts(v, s, found, msg, ms)) != SINEW_OK) return r;
