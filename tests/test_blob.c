@@ -167,20 +167,12 @@ static void fixture_init(fixture *f, uint64_t seed) {
     v->ndomain_verts = NDV, v->ncub = NCUB, v->nsurf_verts = NSV, v->nsurf_tris = NST;
     v->mu = 1e5, v->lambda = 4e5, v->rayleigh_alpha = 0.1, v->rayleigh_beta = 0.01;
     v->contact_k = 1e3;
-    v->rest = f->rest, v->skin_bone = f->skin_bone, v->skin_weight = f->skin_weight;
-    v->bone_parent = f->bone_parent, v->bone_joints = f->bone_joints;
-    v->domains = f->domains, v->domain_verts = f->domain_verts;
-    v->basis = f->basis, v->nbasis = NBASIS;
-    v->cub_tets = f->cub_tets, v->cub_weight = f->cub_weight;
-    v->cub_dminv = f->cub_dminv, v->cub_vol = f->cub_vol;
-    v->spring_hessian = f->spring_hessian, v->mass = f->mass;
-    v->inertia_s = f->inertia_s, v->inertia_x = f->inertia_x;
-    v->inertia_u = f->inertia_u, v->ninertia_u = NIU;
-    v->surf_tris = f->surf_tris, v->surf_copy_ptr = f->surf_copy_ptr;
-    v->surf_copies = f->surf_copies, v->nsurf_copies = nc;
-    v->ntrain = NTR, v->train_q = f->train_q, v->train_pose = f->train_pose;
-    v->ncontacts = 2, v->contact_ptr = f->contact_ptr, v->contact_verts = f->contact_verts;
-    v->contact_data = f->contact_data;
+    v->nbasis = NBASIS, v->ninertia_u = NIU, v->nsurf_copies = nc;
+    v->ntrain = NTR, v->ncontacts = 2;
+    /* The fixture's arrays carry the view's field names. */
+#define POINT(id, NAME, elem_size, type, field, ...) v->field = f->field;
+    SINEW_BLOB_ARRAY_SECTIONS(POINT)
+#undef POINT
 }
 
 /* ---- helpers --------------------------------------------------------------------- */
@@ -188,65 +180,18 @@ static void fixture_init(fixture *f, uint64_t seed) {
 /* First field in which two views differ (counts, scalars bitwise, arrays bitwise), or
  * NULL when they are identical. */
 static const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
-#define SAME_INT(f)                                                                                \
-    do {                                                                                           \
-        if (a->f != b->f) return #f;                                                               \
-    } while (0)
 #define SAME_BITS(f)                                                                               \
-    do {                                                                                           \
-        if (memcmp(&a->f, &b->f, sizeof a->f) != 0) return #f;                                     \
-    } while (0)
-#define SAME_ARR(f, n)                                                                             \
-    do {                                                                                           \
-        if (memcmp(a->f, b->f, (size_t)(n) * sizeof a->f[0]) != 0) return #f;                      \
-    } while (0)
-    SAME_INT(nverts);
-    SAME_INT(nbones);
-    SAME_INT(ndomains);
-    SAME_INT(rank_total);
-    SAME_INT(ndomain_verts);
-    SAME_INT(ncub);
-    SAME_INT(nsurf_verts);
-    SAME_INT(nsurf_tris);
-    SAME_INT(nbasis);
-    SAME_INT(ninertia_u);
-    SAME_INT(nsurf_copies);
-    SAME_INT(ntrain);
-    SAME_INT(ncontacts);
-    SAME_BITS(mu);
-    SAME_BITS(lambda);
-    SAME_BITS(rayleigh_alpha);
-    SAME_BITS(rayleigh_beta);
-    SAME_BITS(contact_k);
-    const int64_t n = a->nverts, nb = a->nbones, nc = a->ncub, R = a->rank_total;
-    SAME_ARR(rest, 3 * n);
-    SAME_ARR(skin_bone, 4 * n);
-    SAME_ARR(skin_weight, 4 * n);
-    SAME_ARR(bone_parent, nb);
-    SAME_ARR(bone_joints, 6 * nb);
-    SAME_ARR(domains, a->ndomains);
-    SAME_ARR(domain_verts, a->ndomain_verts);
-    SAME_ARR(basis, a->nbasis);
-    SAME_ARR(cub_tets, 4 * nc);
-    SAME_ARR(cub_weight, nc);
-    SAME_ARR(cub_dminv, 9 * nc);
-    SAME_ARR(cub_vol, nc);
-    SAME_ARR(spring_hessian, R * R);
-    SAME_ARR(mass, R * R);
-    SAME_ARR(inertia_s, 3 * R);
-    SAME_ARR(inertia_x, 9 * R);
-    SAME_ARR(inertia_u, a->ninertia_u);
-    SAME_ARR(surf_tris, 3 * (int64_t)a->nsurf_tris);
-    SAME_ARR(surf_copy_ptr, (int64_t)a->nsurf_verts + 1);
-    SAME_ARR(surf_copies, 2 * (int64_t)a->nsurf_copies);
-    SAME_ARR(train_q, (int64_t)a->ntrain * R);
-    SAME_ARR(train_pose, (int64_t)a->ntrain * 4 * nb);
-    SAME_ARR(contact_ptr, (int64_t)a->ntrain + 1);
-    SAME_ARR(contact_verts, 8 * (int64_t)a->ncontacts);
-    SAME_ARR(contact_data, 7 * (int64_t)a->ncontacts);
-#undef SAME_INT
+    if (memcmp(&a->f, &b->f, sizeof a->f) != 0) return #f;
+    SW_BLOB_META_FIELDS(SAME_BITS)
+    SAME_BITS(nbasis)
+    SAME_BITS(ninertia_u)
+    SAME_BITS(nsurf_copies)
 #undef SAME_BITS
-#undef SAME_ARR
+    SW_BLOB_COUNT_LOCALS(a);
+#define SAME_ARRAY(id, NAME, elem_size, type, field, by_meta, count, formula)                      \
+    if (memcmp(a->field, b->field, (size_t)(count) * sizeof a->field[0]) != 0) return #field;
+    SINEW_BLOB_ARRAY_SECTIONS(SAME_ARRAY)
+#undef SAME_ARRAY
     return NULL;
 }
 
@@ -287,35 +232,17 @@ static int inside(const void *p, int64_t bytes, const uint8_t *base, size_t size
 /* Everything a runtime would dereference, from an accepted view: every array inside the
  * buffer, and every index chain followed. Under ASan an out-of-range index aborts. */
 static int walk_view(const sw_blob_view *v, const uint8_t *base, size_t size, double *acc) {
-    const int64_t n = v->nverts, nb = v->nbones, nc = v->ncub, R = v->rank_total;
+    const int64_t R = v->rank_total;
+    SW_BLOB_COUNT_LOCALS(v);
     const struct {
         const void *p;
         int64_t bytes;
-    } arrays[] = {{v->rest, 24 * n},
-                  {v->skin_bone, 16 * n},
-                  {v->skin_weight, 32 * n},
-                  {v->bone_parent, 4 * nb},
-                  {v->bone_joints, 48 * nb},
-                  {v->domains, 48 * (int64_t)v->ndomains},
-                  {v->domain_verts, 4 * (int64_t)v->ndomain_verts},
-                  {v->basis, 8 * v->nbasis},
-                  {v->cub_tets, 16 * nc},
-                  {v->cub_weight, 8 * nc},
-                  {v->cub_dminv, 72 * nc},
-                  {v->cub_vol, 8 * nc},
-                  {v->spring_hessian, 8 * R * R},
-                  {v->mass, 8 * R * R},
-                  {v->inertia_s, 24 * R},
-                  {v->inertia_x, 72 * R},
-                  {v->inertia_u, 8 * v->ninertia_u},
-                  {v->surf_tris, 12 * (int64_t)v->nsurf_tris},
-                  {v->surf_copy_ptr, 4 * ((int64_t)v->nsurf_verts + 1)},
-                  {v->surf_copies, 8 * (int64_t)v->nsurf_copies},
-                  {v->train_q, 8 * (int64_t)v->ntrain * R},
-                  {v->train_pose, 32 * (int64_t)v->ntrain * nb},
-                  {v->contact_ptr, 4 * ((int64_t)v->ntrain + 1)},
-                  {v->contact_verts, 32 * (int64_t)v->ncontacts},
-                  {v->contact_data, 56 * (int64_t)v->ncontacts}};
+    } arrays[] = {
+#define EXTENT(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
+    {v->field, (int64_t)(elem_size * (count))},
+        SINEW_BLOB_ARRAY_SECTIONS(EXTENT)
+#undef EXTENT
+    };
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!inside(arrays[i].p, arrays[i].bytes, base, size)) return 0;
     double s = 0.0;
@@ -402,6 +329,16 @@ TEST(memory_round_trip_is_bit_exact) {
         for (uint64_t b = e->offset + e->count * e->elem_size; b % 64 != 0; ++b)
             ENSUREF(blob[b] == 0, "padding byte %llu after section %u", (unsigned long long)b, id);
     }
+    /* Each section holds the fixture's array (SURF_COPIES: the copies used), sized by the
+     * fixture's own declarations, not by the table's count expressions: a wrong count in
+     * the table would otherwise pass the writer, the loader and view_diff alike. */
+#define HOLDS_FIXTURE(id, NAME, elem_size, type, field, ...)                                       \
+    ENSUREF(entry(blob, id)->count *elem_size == (id == SINEW_SECTION_SURF_COPIES                  \
+                                                      ? 2 * sizeof(int32_t) * g_fix.v.nsurf_copies \
+                                                      : sizeof g_fix.field),                       \
+            "section " #NAME ": %llu elements", (unsigned long long)entry(blob, id)->count);
+    SINEW_BLOB_ARRAY_SECTIONS(HOLDS_FIXTURE)
+#undef HOLDS_FIXTURE
     sw_blob_view v;
     char msg[512];
     ENSUREF(sw_blob_parse(blob, size, &v, msg, sizeof msg) == SINEW_OK, "%s", msg);

@@ -26,35 +26,12 @@ static uint64_t round_up(uint64_t x) {
 /* The 26 sections of a validated view, in id order; `meta` must outlive the result. */
 static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
                           section_src s[SINEW_SECTION_COUNT_V1]) {
-    const uint64_t n = (uint64_t)v->nverts, nb = (uint64_t)v->nbones, nc = (uint64_t)v->ncub,
-                   R = (uint64_t)v->rank_total;
-    const section_src list[SINEW_SECTION_COUNT_V1] = {
-        {SINEW_SECTION_META, sizeof *meta, meta, 1},
-        {SINEW_SECTION_REST, 8, v->rest, 3 * n},
-        {SINEW_SECTION_SKIN_BONE, 4, v->skin_bone, 4 * n},
-        {SINEW_SECTION_SKIN_WEIGHT, 8, v->skin_weight, 4 * n},
-        {SINEW_SECTION_BONE_PARENT, 4, v->bone_parent, nb},
-        {SINEW_SECTION_BONE_JOINTS, 8, v->bone_joints, 6 * nb},
-        {SINEW_SECTION_DOMAINS, sizeof(sw_blob_domain), v->domains, (uint64_t)v->ndomains},
-        {SINEW_SECTION_DOMAIN_VERTS, 4, v->domain_verts, (uint64_t)v->ndomain_verts},
-        {SINEW_SECTION_BASIS, 8, v->basis, (uint64_t)v->nbasis},
-        {SINEW_SECTION_CUB_TETS, 4, v->cub_tets, 4 * nc},
-        {SINEW_SECTION_CUB_WEIGHT, 8, v->cub_weight, nc},
-        {SINEW_SECTION_CUB_DMINV, 8, v->cub_dminv, 9 * nc},
-        {SINEW_SECTION_CUB_VOL, 8, v->cub_vol, nc},
-        {SINEW_SECTION_SPRING_HESSIAN, 8, v->spring_hessian, R * R},
-        {SINEW_SECTION_MASS, 8, v->mass, R * R},
-        {SINEW_SECTION_INERTIA_S, 8, v->inertia_s, 3 * R},
-        {SINEW_SECTION_INERTIA_X, 8, v->inertia_x, 9 * R},
-        {SINEW_SECTION_INERTIA_U, 8, v->inertia_u, (uint64_t)v->ninertia_u},
-        {SINEW_SECTION_SURF_TRIS, 4, v->surf_tris, 3 * (uint64_t)v->nsurf_tris},
-        {SINEW_SECTION_SURF_COPY_PTR, 4, v->surf_copy_ptr, (uint64_t)v->nsurf_verts + 1},
-        {SINEW_SECTION_SURF_COPIES, 4, v->surf_copies, 2 * (uint64_t)v->nsurf_copies},
-        {SINEW_SECTION_TRAIN_Q, 8, v->train_q, (uint64_t)v->ntrain * R},
-        {SINEW_SECTION_TRAIN_POSE, 8, v->train_pose, (uint64_t)v->ntrain * 4 * nb},
-        {SINEW_SECTION_CONTACT_PTR, 4, v->contact_ptr, (uint64_t)v->ntrain + 1},
-        {SINEW_SECTION_CONTACT_VERTS, 4, v->contact_verts, 8 * (uint64_t)v->ncontacts},
-        {SINEW_SECTION_CONTACT_DATA, 8, v->contact_data, 7 * (uint64_t)v->ncontacts}};
+    SW_BLOB_COUNT_LOCALS(v);
+#define SOURCE(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
+    {id, elem_size, v->field, count},
+    const section_src list[SINEW_SECTION_COUNT_V1] = {{SINEW_SECTION_META, sizeof *meta, meta, 1},
+                                                      SINEW_BLOB_ARRAY_SECTIONS(SOURCE)};
+#undef SOURCE
     memcpy(s, list, sizeof list);
 }
 
@@ -71,14 +48,9 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
 
     sinew_blob_meta meta;
     memset(&meta, 0, sizeof meta);
-    meta.nverts = view->nverts, meta.nbones = view->nbones, meta.ndomains = view->ndomains;
-    meta.rank_total = view->rank_total, meta.ndomain_verts = view->ndomain_verts;
-    meta.ncub = view->ncub, meta.nsurf_verts = view->nsurf_verts;
-    meta.nsurf_tris = view->nsurf_tris;
-    meta.mu = view->mu, meta.lambda = view->lambda, meta.rayleigh_alpha = view->rayleigh_alpha;
-    meta.rayleigh_beta = view->rayleigh_beta, meta.contact_k = view->contact_k;
-    meta.ntrain = view->ntrain;
-    meta.ncontacts = view->ncontacts;
+#define TO_META(field) meta.field = view->field;
+    SW_BLOB_META_FIELDS(TO_META)
+#undef TO_META
 
     section_src src[SINEW_SECTION_COUNT_V1];
     sinew_blob_section table[SINEW_SECTION_COUNT_V1];

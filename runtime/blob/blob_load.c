@@ -15,23 +15,30 @@
 
 _Static_assert(sizeof(sinew_blob_header) == 64, "blob header is 64 bytes");
 _Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
-_Static_assert(sizeof(sinew_blob_meta) == 80, "META is 80 bytes");
-_Static_assert(sizeof(sinew_blob_domain_record) == 48, "domain record is 48 bytes");
+/* Each section's C type has the element size of the format. */
+#define SIZE_MATCHES(id, NAME, elem_size, type, ...)                                               \
+    _Static_assert(sizeof(type) == elem_size, #NAME " elements are " #elem_size " bytes");
+SINEW_BLOB_SECTIONS(SIZE_MATCHES)
+#undef SIZE_MATCHES
+/* SW_BLOB_META_FIELDS covers every byte of META: no field is left uncopied. */
+#define META_FIELD_SIZE(field) +sizeof(((sinew_blob_meta *)0)->field)
+_Static_assert(0 SW_BLOB_META_FIELDS(META_FIELD_SIZE) == sizeof(sinew_blob_meta),
+               "SW_BLOB_META_FIELDS lists every META field");
+#undef META_FIELD_SIZE
 _Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vertex");
 
 #define HEADER_SIZE ((uint64_t)sizeof(sinew_blob_header))
 #define ENTRY_SIZE ((uint64_t)sizeof(sinew_blob_section))
 
-static const char *const k_section_names[SINEW_SECTION_COUNT_V1 + 1] = {
-    "unknown",     "META",          "REST",           "SKIN_BONE",   "SKIN_WEIGHT", "BONE_PARENT",
-    "BONE_JOINTS", "DOMAINS",       "DOMAIN_VERTS",   "BASIS",       "CUB_TETS",    "CUB_WEIGHT",
-    "CUB_DMINV",   "CUB_VOL",       "SPRING_HESSIAN", "MASS",        "INERTIA_S",   "INERTIA_X",
-    "INERTIA_U",   "SURF_TRIS",     "SURF_COPY_PTR",  "SURF_COPIES", "TRAIN_Q",     "TRAIN_POSE",
-    "CONTACT_PTR", "CONTACT_VERTS", "CONTACT_DATA"};
-
-/* Element size of every known section (format header table). */
-static const uint32_t k_elem_size[SINEW_SECTION_COUNT_V1 + 1] = {
-    0, 80, 8, 4, 8, 4, 8, 48, 4, 8, 4, 8, 8, 8, 8, 8, 8, 8, 8, 4, 4, 4, 8, 8, 4, 4, 8};
+/* Name and element size of every known section, by id; entry 0 names the unknown ones.
+ * The designated initializers make a repeated id a compile error (-Werror). */
+#define SECTION_INFO(id, NAME, elem_size, ...) [id] = {#NAME, elem_size},
+static const struct {
+    const char *name;
+    uint32_t elem_size;
+} k_sections[SINEW_SECTION_COUNT_V1 + 1] = {[0] = {"unknown", 0},
+                                            SINEW_BLOB_SECTIONS(SECTION_INFO)};
+#undef SECTION_INFO
 
 uint64_t sw_blob_checksum(const void *data, size_t n) {
     const uint8_t *p = data;
@@ -44,7 +51,7 @@ uint64_t sw_blob_checksum(const void *data, size_t n) {
 }
 
 const char *sw_blob_section_name(uint32_t id) {
-    return id >= 1 && id <= SINEW_SECTION_COUNT_V1 ? k_section_names[id] : k_section_names[0];
+    return k_sections[id >= 1 && id <= SINEW_SECTION_COUNT_V1 ? id : 0].name;
 }
 
 static sinew_result fail(char *msg, size_t msg_size, sinew_result code, const char *fmt, ...)
@@ -126,31 +133,11 @@ static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) 
     const struct {
         const void *p;
         uint32_t id;
-    } arrays[] = {{v->rest, SINEW_SECTION_REST},
-                  {v->skin_bone, SINEW_SECTION_SKIN_BONE},
-                  {v->skin_weight, SINEW_SECTION_SKIN_WEIGHT},
-                  {v->bone_parent, SINEW_SECTION_BONE_PARENT},
-                  {v->bone_joints, SINEW_SECTION_BONE_JOINTS},
-                  {v->domains, SINEW_SECTION_DOMAINS},
-                  {v->domain_verts, SINEW_SECTION_DOMAIN_VERTS},
-                  {v->basis, SINEW_SECTION_BASIS},
-                  {v->cub_tets, SINEW_SECTION_CUB_TETS},
-                  {v->cub_weight, SINEW_SECTION_CUB_WEIGHT},
-                  {v->cub_dminv, SINEW_SECTION_CUB_DMINV},
-                  {v->cub_vol, SINEW_SECTION_CUB_VOL},
-                  {v->spring_hessian, SINEW_SECTION_SPRING_HESSIAN},
-                  {v->mass, SINEW_SECTION_MASS},
-                  {v->inertia_s, SINEW_SECTION_INERTIA_S},
-                  {v->inertia_x, SINEW_SECTION_INERTIA_X},
-                  {v->inertia_u, SINEW_SECTION_INERTIA_U},
-                  {v->surf_tris, SINEW_SECTION_SURF_TRIS},
-                  {v->surf_copy_ptr, SINEW_SECTION_SURF_COPY_PTR},
-                  {v->surf_copies, SINEW_SECTION_SURF_COPIES},
-                  {v->train_q, SINEW_SECTION_TRAIN_Q},
-                  {v->train_pose, SINEW_SECTION_TRAIN_POSE},
-                  {v->contact_ptr, SINEW_SECTION_CONTACT_PTR},
-                  {v->contact_verts, SINEW_SECTION_CONTACT_VERTS},
-                  {v->contact_data, SINEW_SECTION_CONTACT_DATA}};
+    } arrays[] = {
+#define ARRAY(id, NAME, elem_size, type, field, ...) {v->field, id},
+        SINEW_BLOB_ARRAY_SECTIONS(ARRAY)
+#undef ARRAY
+    };
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!arrays[i].p)
             return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
@@ -266,29 +253,23 @@ static sinew_result check_finite(uint32_t id, const double *a, int64_t n, char *
     return SINEW_OK;
 }
 
+/* Every double of the view: the sections of element type double. (_Generic picks, per
+ * row, the array and its count for doubles and NULL otherwise.) */
 static sinew_result check_all_finite(const sw_blob_view *v, char *msg, size_t ms) {
-    const int64_t n = v->nverts, nb = v->nbones, nc = v->ncub, R = v->rank_total;
+    SW_BLOB_COUNT_LOCALS(v);
     const struct {
         uint32_t id;
         const double *a;
-        int64_t n;
-    } arrays[] = {{SINEW_SECTION_REST, v->rest, 3 * n},
-                  {SINEW_SECTION_SKIN_WEIGHT, v->skin_weight, 4 * n},
-                  {SINEW_SECTION_BONE_JOINTS, v->bone_joints, 6 * nb},
-                  {SINEW_SECTION_BASIS, v->basis, v->nbasis},
-                  {SINEW_SECTION_CUB_WEIGHT, v->cub_weight, nc},
-                  {SINEW_SECTION_CUB_DMINV, v->cub_dminv, 9 * nc},
-                  {SINEW_SECTION_CUB_VOL, v->cub_vol, nc},
-                  {SINEW_SECTION_SPRING_HESSIAN, v->spring_hessian, R * R},
-                  {SINEW_SECTION_MASS, v->mass, R * R},
-                  {SINEW_SECTION_INERTIA_S, v->inertia_s, 3 * R},
-                  {SINEW_SECTION_INERTIA_X, v->inertia_x, 9 * R},
-                  {SINEW_SECTION_INERTIA_U, v->inertia_u, v->ninertia_u},
-                  {SINEW_SECTION_TRAIN_Q, v->train_q, (int64_t)v->ntrain * R},
-                  {SINEW_SECTION_TRAIN_POSE, v->train_pose, (int64_t)v->ntrain * 4 * nb},
-                  {SINEW_SECTION_CONTACT_DATA, v->contact_data, 7 * (int64_t)v->ncontacts}};
+        uint64_t n;
+    } arrays[] = {
+#define DOUBLES(id, NAME, elem_size, type, field, by_meta, count, formula)                         \
+    {id, _Generic((type *)0, double * : v->field, default : NULL), count},
+        SINEW_BLOB_ARRAY_SECTIONS(DOUBLES)
+#undef DOUBLES
+    };
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) {
-        sinew_result r = check_finite(arrays[i].id, arrays[i].a, arrays[i].n, msg, ms);
+        if (!arrays[i].a) continue;
+        sinew_result r = check_finite(arrays[i].id, arrays[i].a, (int64_t)arrays[i].n, msg, ms);
         if (r != SINEW_OK) return r;
     }
     return SINEW_OK;
@@ -517,10 +498,10 @@ static sinew_result check_entries(const sinew_blob_section *s, uint32_t n, size_
                 return fail(msg, ms, SINEW_ERROR_CORRUPT,
                             "blob section %s: appears twice (table entries %d and %u)", name,
                             found[s[i].id], i);
-            if (s[i].elem_size != k_elem_size[s[i].id])
+            if (s[i].elem_size != k_sections[s[i].id].elem_size)
                 return fail(msg, ms, SINEW_ERROR_CORRUPT,
                             "blob section %s (table entry %u): elem_size %u, expected %u", name, i,
-                            (unsigned)s[i].elem_size, (unsigned)k_elem_size[s[i].id]);
+                            (unsigned)s[i].elem_size, (unsigned)k_sections[s[i].id].elem_size);
             if (s[i].reserved != 0)
                 return fail(msg, ms, SINEW_ERROR_CORRUPT,
                             "blob section %s (table entry %u): reserved field is not 0", name, i);
@@ -554,40 +535,25 @@ static sinew_result check_overlaps(const sinew_blob_section *s, uint32_t n, cons
     return SINEW_OK;
 }
 
-/* Counts of the sections whose size follows from META alone. */
+/* Counts of the sections whose size follows from META alone (by_meta). The other rows'
+ * counts read nbasis, ninertia_u and nsurf_copies, still 0 here, and go unused. */
 static sinew_result check_meta_counts(const sw_blob_view *v, const sinew_blob_section *s,
                                       const int found[], char *msg, size_t ms) {
-    const uint64_t n = (uint64_t)v->nverts, nb = (uint64_t)v->nbones, nc = (uint64_t)v->ncub,
-                   R = (uint64_t)v->rank_total;
+    SW_BLOB_COUNT_LOCALS(v);
     const struct {
         uint32_t id;
+        int by_meta;
         uint64_t count;
         const char *formula;
-    } expect[] = {{SINEW_SECTION_REST, 3 * n, "3 nverts"},
-                  {SINEW_SECTION_SKIN_BONE, 4 * n, "4 nverts"},
-                  {SINEW_SECTION_SKIN_WEIGHT, 4 * n, "4 nverts"},
-                  {SINEW_SECTION_BONE_PARENT, nb, "nbones"},
-                  {SINEW_SECTION_BONE_JOINTS, 6 * nb, "6 nbones"},
-                  {SINEW_SECTION_DOMAINS, (uint64_t)v->ndomains, "ndomains"},
-                  {SINEW_SECTION_DOMAIN_VERTS, (uint64_t)v->ndomain_verts, "ndomain_verts"},
-                  {SINEW_SECTION_CUB_TETS, 4 * nc, "4 ncub"},
-                  {SINEW_SECTION_CUB_WEIGHT, nc, "ncub"},
-                  {SINEW_SECTION_CUB_DMINV, 9 * nc, "9 ncub"},
-                  {SINEW_SECTION_CUB_VOL, nc, "ncub"},
-                  {SINEW_SECTION_SPRING_HESSIAN, R * R, "rank_total^2"},
-                  {SINEW_SECTION_MASS, R * R, "rank_total^2"},
-                  {SINEW_SECTION_INERTIA_S, 3 * R, "3 rank_total"},
-                  {SINEW_SECTION_INERTIA_X, 9 * R, "9 rank_total"},
-                  {SINEW_SECTION_SURF_TRIS, 3 * (uint64_t)v->nsurf_tris, "3 nsurf_tris"},
-                  {SINEW_SECTION_SURF_COPY_PTR, (uint64_t)v->nsurf_verts + 1, "nsurf_verts + 1"},
-                  {SINEW_SECTION_TRAIN_Q, (uint64_t)v->ntrain * R, "ntrain rank_total"},
-                  {SINEW_SECTION_TRAIN_POSE, (uint64_t)v->ntrain * 4 * nb, "4 ntrain nbones"},
-                  {SINEW_SECTION_CONTACT_PTR, (uint64_t)v->ntrain + 1, "ntrain + 1"},
-                  {SINEW_SECTION_CONTACT_VERTS, 8 * (uint64_t)v->ncontacts, "8 ncontacts"},
-                  {SINEW_SECTION_CONTACT_DATA, 7 * (uint64_t)v->ncontacts, "7 ncontacts"}};
+    } expect[] = {
+#define EXPECT(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
+    {id, by_meta, count, formula},
+        SINEW_BLOB_ARRAY_SECTIONS(EXPECT)
+#undef EXPECT
+    };
     for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i) {
         const sinew_blob_section *e = &s[found[expect[i].id]];
-        if (e->count != expect[i].count)
+        if (expect[i].by_meta && e->count != expect[i].count)
             return fail(msg, ms, SINEW_ERROR_CORRUPT,
                         "blob section %s: %llu elements, META needs %s = %llu",
                         sw_blob_section_name(expect[i].id), (unsigned long long)e->count,
@@ -607,12 +573,9 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     sinew_blob_meta m;
     memcpy(&m, bytes + meta->offset, sizeof m);
     memset(v, 0, sizeof *v);
-    v->nverts = m.nverts, v->nbones = m.nbones, v->ndomains = m.ndomains;
-    v->rank_total = m.rank_total, v->ndomain_verts = m.ndomain_verts, v->ncub = m.ncub;
-    v->nsurf_verts = m.nsurf_verts, v->nsurf_tris = m.nsurf_tris;
-    v->mu = m.mu, v->lambda = m.lambda, v->rayleigh_alpha = m.rayleigh_alpha;
-    v->rayleigh_beta = m.rayleigh_beta, v->contact_k = m.contact_k;
-    v->ntrain = m.ntrain, v->ncontacts = m.ncontacts;
+#define FROM_META(field) v->field = m.field;
+    SW_BLOB_META_FIELDS(FROM_META)
+#undef FROM_META
     sinew_result r = check_meta(v, msg, ms);
     if (r != SINEW_OK) return r;
     if ((r = check_meta_counts(v, s, found, msg, ms)) != SINEW_OK) return r;
@@ -628,32 +591,9 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     v->ninertia_u = (int64_t)s[found[SINEW_SECTION_INERTIA_U]].count;
     v->nsurf_copies = (int32_t)(copies->count / 2);
 
-#define AT(id) ((const void *)(bytes + s[found[SINEW_SECTION_##id]].offset))
-    v->rest = AT(REST);
-    v->skin_bone = AT(SKIN_BONE);
-    v->skin_weight = AT(SKIN_WEIGHT);
-    v->bone_parent = AT(BONE_PARENT);
-    v->bone_joints = AT(BONE_JOINTS);
-    v->domains = AT(DOMAINS);
-    v->domain_verts = AT(DOMAIN_VERTS);
-    v->basis = AT(BASIS);
-    v->cub_tets = AT(CUB_TETS);
-    v->cub_weight = AT(CUB_WEIGHT);
-    v->cub_dminv = AT(CUB_DMINV);
-    v->cub_vol = AT(CUB_VOL);
-    v->spring_hessian = AT(SPRING_HESSIAN);
-    v->mass = AT(MASS);
-    v->inertia_s = AT(INERTIA_S);
-    v->inertia_x = AT(INERTIA_X);
-    v->inertia_u = AT(INERTIA_U);
-    v->surf_tris = AT(SURF_TRIS);
-    v->surf_copy_ptr = AT(SURF_COPY_PTR);
-    v->surf_copies = AT(SURF_COPIES);
-    v->train_q = AT(TRAIN_Q);
-    v->train_pose = AT(TRAIN_POSE);
-    v->contact_ptr = AT(CONTACT_PTR);
-    v->contact_verts = AT(CONTACT_VERTS);
-    v->contact_data = AT(CONTACT_DATA);
+#define AT(id, NAME, elem_size, type, field, ...)                                                  \
+    v->field = (const type *)(const void *)(bytes + s[found[id]].offset);
+    SINEW_BLOB_ARRAY_SECTIONS(AT)
 #undef AT
     return SINEW_OK;
 }

@@ -19,6 +19,20 @@
 
 #define SW_BLOB_INFLUENCES 4 /* skin influences per vertex */
 
+/* The fields of META (sinew_blob_meta), which the view copies under the same names. */
+#define SW_BLOB_META_FIELDS(X)                                                                     \
+    SINEW_BLOB_META_COUNTS(X) X(mu) X(lambda) X(rayleigh_alpha) X(rayleigh_beta) X(contact_k)
+
+/* Declares a `const uint64_t` local for every name of SINEW_BLOB_COUNTS, holding that count
+ * of the view `view`, so that the sections' count expressions (SINEW_BLOB_SECTIONS) can be
+ * evaluated in the scope that follows. */
+#define SW_BLOB_COUNT_LOCALS(view)                                                                 \
+    const sw_blob_view *const sw_blob_counts_of_ = (view);                                         \
+    SINEW_BLOB_COUNTS(SW_BLOB_COUNT_LOCAL_)
+#define SW_BLOB_COUNT_LOCAL_(name)                                                                 \
+    const uint64_t name = (uint64_t)sw_blob_counts_of_->name;                                      \
+    (void)name;
+
 /* One domain (the on-disk record itself, used in place):
  *   bone            the bone this domain rides with (inertial frame)
  *   vert_begin/count  its vertex copies are domain_verts[vert_begin .. +vert_count)

@@ -23,6 +23,7 @@
 #include <sinew/sinew.h> /* include guards: a second inclusion must be harmless */
 #include <sinew/sinew_types.h>
 #include <sinew/sinew_world.h>
+#include <sinew/sinew_blob_format.h>
 
 #include "sw_test.h"
 
@@ -60,6 +61,14 @@ SW_ABI_ASSERT(sizeof(SINEW_VERSION) == sizeof(uint32_t), version_is_u32);
  * which version of the struct it was handed. */
 SW_ABI_ASSERT(offsetof(sinew_blob_def, struct_size) == 0, blob_def_size_first);
 SW_ABI_ASSERT(offsetof(sinew_instance_def, struct_size) == 0, instance_def_size_first);
+
+/* The blob format's section table expands in strict C: stable ids, and element types of
+ * the format's element sizes. */
+SW_ABI_ASSERT(SINEW_SECTION_META == 1 && SINEW_SECTION_CONTACT_DATA == 26, section_ids);
+SW_ABI_ASSERT(SINEW_SECTION_COUNT_V1 == 26, section_count_v1);
+#define SW_ABI_ELEM_SIZE(id, NAME, elem_size, type, ...)                                           \
+    SW_ABI_ASSERT(sizeof(type) == elem_size, elem_size_##NAME);
+SINEW_BLOB_SECTIONS(SW_ABI_ELEM_SIZE)
 
 /* Every public function, with the exact signature a host binary was built against. */
 typedef uint32_t (*sw_abi_version_fn)(void);

@@ -5,6 +5,7 @@
 #include <sinew/sinew.h>
 #include <sinew/sinew.h> // include guards
 #include <sinew/sinew_world.h>
+#include <sinew/sinew_blob_format.h>
 
 #include <cstdio>
 #include <cstring>
@@ -26,6 +27,10 @@ static_assert(std::is_trivial<sinew_logger>::value, "logger trivial");
 static_assert(offsetof(sinew_blob_def, struct_size) == 0, "struct_size first");
 static_assert(offsetof(sinew_instance_def, struct_size) == 0, "struct_size first");
 static_assert(SINEW_OK == 0 && SINEW_ERROR_UNSUPPORTED == 11, "stable result codes");
+static_assert(SINEW_SECTION_META == 1 && SINEW_SECTION_COUNT_V1 == 26, "stable section ids");
+#define SW_ABI_CXX_ELEM_SIZE(id, NAME, elem_size, type, ...)                                       \
+    static_assert(sizeof(type) == elem_size, #NAME " element size");
+SINEW_BLOB_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 static_assert(std::is_same<decltype(SINEW_VERSION), uint32_t>::value, "version is u32");
 
 // The exact signatures a C++ host binds to.

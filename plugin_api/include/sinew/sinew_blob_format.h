@@ -13,38 +13,20 @@
  * section ids are skipped (a later minor version may add some); a known id appears at
  * most once.
  *
- * Sections of version 1 (R = rank_total, n = nverts, see sw_blob_view in the runtime
- * for the meaning of every array):
- *
- *   id name            elem  count
- *   1  META            80    1      (sinew_blob_meta)
- *   2  REST            8     3n
- *   3  SKIN_BONE       4     4n
- *   4  SKIN_WEIGHT     8     4n
- *   5  BONE_PARENT     4     nbones
- *   6  BONE_JOINTS     8     6 nbones
- *   7  DOMAINS         48    ndomains (sinew_blob_domain_record)
- *   8  DOMAIN_VERTS    4     ndomain_verts
- *   9  BASIS           8     sum_d vert_count_d * 3 * rank_d
- *   10 CUB_TETS        4     4 ncub
- *   11 CUB_WEIGHT      8     ncub
- *   12 CUB_DMINV       8     9 ncub
- *   13 CUB_VOL         8     ncub
- *   14 SPRING_HESSIAN  8     R*R
- *   15 MASS            8     R*R
- *   16 INERTIA_S       8     3R
- *   17 INERTIA_X       8     9R
- *   18 INERTIA_U       8     sum_d 9 rank_d^2
- *   19 SURF_TRIS       4     3 nsurf_tris
- *   20 SURF_COPY_PTR   4     nsurf_verts + 1
- *   21 SURF_COPIES     4     2 * surf_copy_ptr[nsurf_verts]
- *   22 TRAIN_Q         8     ntrain * R     (reduced solutions of the training poses)
- *   23 TRAIN_POSE      8     ntrain * 4 nbones (pose features: unit quaternions, in the
- *                                               order solved: a pose stored twice is two
- *                                               branches, told apart by pose t - 1)
- *   24 CONTACT_PTR     4     ntrain + 1     (training pose t owns contacts [ptr[t], ptr[t+1]))
- *   25 CONTACT_VERTS   4     8 ncontacts    ((domain, local vertex) of p, t0, t1, t2)
- *   26 CONTACT_DATA    8     7 ncontacts    (barycentrics b0..b2, rest-frame normal, area ka)
+ * Sections of version 1: the table SINEW_BLOB_SECTIONS below, one row a section; the
+ * section ids, the loader's section names, element sizes, count checks and view, and the
+ * writer's section list are all generated from it. Notes on its rows (see sw_blob_view
+ * in the runtime for the meaning of every array):
+ *   META          one sinew_blob_meta, the counts and material (the view copies them:
+ *                 `meta` names no view field); every other section is an array, a row
+ *                 of SINEW_BLOB_ARRAY_SECTIONS
+ *   DOMAINS       one sinew_blob_domain_record a domain
+ *   TRAIN_Q       reduced solutions of the training poses
+ *   TRAIN_POSE    pose features (unit quaternions), in the order solved: a pose stored
+ *                 twice is two branches, told apart by pose t - 1
+ *   CONTACT_PTR   training pose t owns contacts [ptr[t], ptr[t+1])
+ *   CONTACT_VERTS (domain, local vertex) of p, t0, t1, t2
+ *   CONTACT_DATA  barycentrics b0..b2, rest-frame normal, area ka
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -78,35 +60,70 @@ typedef struct sinew_blob_section {
     uint64_t reserved;  /**< zero */
 } sinew_blob_section;
 
+/* The names a section's count is written in: META's counts (sinew_blob_meta), and three
+ * counts that the sections' own sizes give and the domain records and the copy pointers
+ * must match:
+ *   nbasis       = sum_d vert_count_d * 3 * rank_d  (doubles in BASIS)
+ *   ninertia_u   = sum_d 9 rank_d^2                  (doubles in INERTIA_U)
+ *   nsurf_copies = surf_copy_ptr[nsurf_verts]        ((domain, vertex) pairs in SURF_COPIES) */
+/* clang-format off */
+#define SINEW_BLOB_META_COUNTS(X)                                                                  \
+    X(nverts) X(nbones) X(ndomains) X(rank_total) X(ndomain_verts) X(ncub) X(nsurf_verts)          \
+    X(nsurf_tris) X(ntrain) X(ncontacts)
+#define SINEW_BLOB_COUNTS(X) SINEW_BLOB_META_COUNTS(X) X(nbasis) X(ninertia_u) X(nsurf_copies)
+
+/* The sections, one row each: X(id, NAME, elem_size, type, field, by_meta, count, formula)
+ *   id         section id (SINEW_SECTION_<NAME>); rows in id order, ids 1, 2, ... no gaps
+ *   NAME       the section's name, as messages spell it
+ *   elem_size  bytes per element in the file; type: the C type of one element (that size)
+ *   field      the array's name (the sw_blob_view field the runtime points at it)
+ *   by_meta    1 when META's counts alone fix the count: the loader checks it against them;
+ *              0 when the section's count gives nbasis, ninertia_u or nsurf_copies
+ *   count      elements: a C expression in the names of SINEW_BLOB_COUNTS
+ *   formula    the count as messages write it */
+#define SINEW_BLOB_SECTIONS(X)                                                                     \
+    X( 1, META,           80, sinew_blob_meta, meta, 1, 1, "1")                                    \
+    SINEW_BLOB_ARRAY_SECTIONS(X)
+
+#define SINEW_BLOB_ARRAY_SECTIONS(X)                                                               \
+    X( 2, REST,            8, double,  rest,           1, 3 * nverts,          "3 nverts")         \
+    X( 3, SKIN_BONE,       4, int32_t, skin_bone,      1, 4 * nverts,          "4 nverts")         \
+    X( 4, SKIN_WEIGHT,     8, double,  skin_weight,    1, 4 * nverts,          "4 nverts")         \
+    X( 5, BONE_PARENT,     4, int32_t, bone_parent,    1, nbones,              "nbones")           \
+    X( 6, BONE_JOINTS,     8, double,  bone_joints,    1, 6 * nbones,          "6 nbones")         \
+    X( 7, DOMAINS,        48, sinew_blob_domain_record, domains, 1, ndomains, "ndomains")          \
+    X( 8, DOMAIN_VERTS,    4, int32_t, domain_verts,   1, ndomain_verts,       "ndomain_verts")    \
+    X( 9, BASIS,           8, double,  basis,          0, nbasis,              "nbasis")           \
+    X(10, CUB_TETS,        4, int32_t, cub_tets,       1, 4 * ncub,            "4 ncub")           \
+    X(11, CUB_WEIGHT,      8, double,  cub_weight,     1, ncub,                "ncub")             \
+    X(12, CUB_DMINV,       8, double,  cub_dminv,      1, 9 * ncub,            "9 ncub")           \
+    X(13, CUB_VOL,         8, double,  cub_vol,        1, ncub,                "ncub")             \
+    X(14, SPRING_HESSIAN,  8, double,  spring_hessian, 1, rank_total * rank_total, "rank_total^2") \
+    X(15, MASS,            8, double,  mass,           1, rank_total * rank_total, "rank_total^2") \
+    X(16, INERTIA_S,       8, double,  inertia_s,      1, 3 * rank_total,      "3 rank_total")     \
+    X(17, INERTIA_X,       8, double,  inertia_x,      1, 9 * rank_total,      "9 rank_total")     \
+    X(18, INERTIA_U,       8, double,  inertia_u,      0, ninertia_u,          "ninertia_u")       \
+    X(19, SURF_TRIS,       4, int32_t, surf_tris,      1, 3 * nsurf_tris,      "3 nsurf_tris")     \
+    X(20, SURF_COPY_PTR,   4, int32_t, surf_copy_ptr,  1, nsurf_verts + 1,     "nsurf_verts + 1")  \
+    X(21, SURF_COPIES,     4, int32_t, surf_copies,    0, 2 * nsurf_copies,    "2 nsurf_copies")   \
+    X(22, TRAIN_Q,         8, double,  train_q, 1, ntrain * rank_total, "ntrain rank_total")       \
+    X(23, TRAIN_POSE,      8, double,  train_pose,     1, 4 * ntrain * nbones, "4 ntrain nbones")  \
+    X(24, CONTACT_PTR,     4, int32_t, contact_ptr,    1, ntrain + 1,          "ntrain + 1")       \
+    X(25, CONTACT_VERTS,   4, int32_t, contact_verts,  1, 8 * ncontacts,       "8 ncontacts")      \
+    X(26, CONTACT_DATA,    8, double,  contact_data,   1, 7 * ncontacts,       "7 ncontacts")
+
+/* Not variadic: C++98 hosts compile this header without warnings. */
+#define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
+    SINEW_SECTION_##NAME = id,
+#define SINEW_BLOB_PLUS_ONE_(id, NAME, elem_size, type, field, by_meta, count, formula) +1
+/** Section ids; SINEW_SECTION_COUNT_V1 (26) is the number of sections of version 1. */
 enum sinew_blob_section_id {
-    SINEW_SECTION_META = 1,
-    SINEW_SECTION_REST = 2,
-    SINEW_SECTION_SKIN_BONE = 3,
-    SINEW_SECTION_SKIN_WEIGHT = 4,
-    SINEW_SECTION_BONE_PARENT = 5,
-    SINEW_SECTION_BONE_JOINTS = 6,
-    SINEW_SECTION_DOMAINS = 7,
-    SINEW_SECTION_DOMAIN_VERTS = 8,
-    SINEW_SECTION_BASIS = 9,
-    SINEW_SECTION_CUB_TETS = 10,
-    SINEW_SECTION_CUB_WEIGHT = 11,
-    SINEW_SECTION_CUB_DMINV = 12,
-    SINEW_SECTION_CUB_VOL = 13,
-    SINEW_SECTION_SPRING_HESSIAN = 14,
-    SINEW_SECTION_MASS = 15,
-    SINEW_SECTION_INERTIA_S = 16,
-    SINEW_SECTION_INERTIA_X = 17,
-    SINEW_SECTION_INERTIA_U = 18,
-    SINEW_SECTION_SURF_TRIS = 19,
-    SINEW_SECTION_SURF_COPY_PTR = 20,
-    SINEW_SECTION_SURF_COPIES = 21,
-    SINEW_SECTION_TRAIN_Q = 22,
-    SINEW_SECTION_TRAIN_POSE = 23,
-    SINEW_SECTION_CONTACT_PTR = 24,
-    SINEW_SECTION_CONTACT_VERTS = 25,
-    SINEW_SECTION_CONTACT_DATA = 26,
-    SINEW_SECTION_COUNT_V1 = 26
+    SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_COUNT_V1 = 0 SINEW_BLOB_SECTIONS(SINEW_BLOB_PLUS_ONE_)
 };
+#undef SINEW_BLOB_ENUM_ROW_
+#undef SINEW_BLOB_PLUS_ONE_
+/* clang-format on */
 
 /** Section META: counts and material (80 bytes). */
 typedef struct sinew_blob_meta {
