@@ -19,7 +19,20 @@
 static inline void sw_penalty_apply_N(const double n[3], double alpha, const double u[3],
                                       double o[3]) {
     double s = (1 - alpha) * (n[0] * u[0] + n[1] * u[1] + n[2] * u[2]);
-    for (int j = 0; j < 3; ++j) o[j] = s * n[j] + alpha * u[j];
+    for (int j = 0; j < 3; ++j)
+        o[j] = s * n[j] + alpha * u[j];
+}
+
+/* N = (1 - alpha) n n^T + alpha I (eq. 3.5) as a row-major 3x3 matrix. */
+static inline void sw_penalty_N(const double n[3], double alpha, double N[9]) {
+    for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q)
+            N[3 * r + q] = (1 - alpha) * n[r] * n[q] + (r == q ? alpha : 0);
+}
+
+/* n . d: positive while the pair collides (p behind the surface, eq. 3.12's Heaviside). */
+static inline double sw_penalty_gap(const double n[3], const double d[3]) {
+    return n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
 }
 
 /* E = 1/2 k d^T Nd for the pair's stiffness k (= k_contact ka) and Nd = N d. */
