@@ -1,5 +1,6 @@
 /* Full-space self-contact: detection (thesis §3.3.1 "Collision Resolution",
- * DESIGN.md §8) and the penalty of eqs. 3.4-3.6. */
+ * DESIGN.md §8) and the assembly of the penalty of eqs. 3.4-3.6 (the law itself is the
+ * runtime's contact/penalty.h). */
 #include "selfcontact.h"
 
 #include <math.h>
@@ -7,6 +8,7 @@
 #include <string.h>
 
 #include "bvh.h"
+#include "penalty.h"
 
 /* A vertex counts as inside a tet when all its barycentrics are >= -this. */
 #define SC_BARY_TOL 1e-12
@@ -463,7 +465,8 @@ double sw_selfcontact_max_depth(const sw_selfcontact *sc) {
 }
 
 /* ---- penalty (eqs. 3.4-3.6) ------------------------------------------------------
- * With n and beta frozen, d = J x where J = [-I, beta_0 I, beta_1 I, beta_2 I] acts on
+ * The law (N, N d, the energy) is penalty.h's, shared with the runtime's step. With n
+ * and beta frozen, d = J x where J = [-I, beta_0 I, beta_1 I, beta_2 I] acts on
  * (x_p, x_t0, x_t1, x_t2); each contact is a quadratic 1/2 k J^T N J. Written over four
  * slots (vertex, coefficient) so a vertex appearing twice is still exact. */
 
@@ -471,13 +474,6 @@ static void slots(const sw_contact *c, int32_t v[4], double a[4]) {
     v[0] = c->p, a[0] = -1;
     for (int k = 0; k < 3; ++k)
         v[k + 1] = c->tri[k], a[k + 1] = c->beta[k];
-}
-
-/* N u, N = (1 - alpha) n n^T + alpha I (eq. 3.5). */
-static void apply_N(const double *n, double alpha, const double *u, double *o) {
-    double s = (1 - alpha) * dot3(n, u);
-    for (int j = 0; j < 3; ++j)
-        o[j] = s * n[j] + alpha * u[j];
 }
 
 static void contact_d(const sw_contact *c, const double *x, double d[3]) {
@@ -493,7 +489,7 @@ static void contact_d(const sw_contact *c, const double *x, double d[3]) {
 double sw_contact_gap(const sw_contact *c, const double *x) {
     double d[3];
     contact_d(c, x, d);
-    return dot3(c->n, d);
+    return sw_penalty_gap(c->n, d);
 }
 
 double sw_contact_energy(const sw_contact *c, int32_t n, const double *x, double kc, double alpha) {
@@ -501,8 +497,9 @@ double sw_contact_energy(const sw_contact *c, int32_t n, const double *x, double
     for (int32_t i = 0; i < n; ++i) {
         double d[3], Nd[3];
         contact_d(&c[i], x, d);
-        apply_N(c[i].n, alpha, d, Nd);
-        e += 0.5 * kc * c[i].ka * dot3(d, Nd);
+        sw_penalty_apply_N(c[i].n, alpha, d, Nd);
+        /* 0.5 (kc ka) rather than (0.5 kc) ka: the same, scaling by 0.5 is exact */
+        e += sw_penalty_energy(kc * c[i].ka, d, Nd);
     }
     return e;
 }
@@ -514,7 +511,7 @@ void sw_contact_add_forces(const sw_contact *c, int32_t n, const double *x, doub
         double a[4], d[3], Nd[3];
         slots(&c[i], v, a);
         contact_d(&c[i], x, d);
-        apply_N(c[i].n, alpha, d, Nd);
+        sw_penalty_apply_N(c[i].n, alpha, d, Nd);
         double k = kc * c[i].ka;
         /* eq. 3.4 (a = -1 gives f_p = k N d) and eq. 3.6 (f_i = -beta_i k N d). */
         for (int s = 0; s < 4; ++s)
@@ -530,9 +527,7 @@ void sw_contact_add_diag(const sw_contact *c, int32_t n, double kc, double alpha
         slots(&c[i], v, a);
         double k = kc * c[i].ka;
         double N[9];
-        for (int r = 0; r < 3; ++r)
-            for (int q = 0; q < 3; ++q)
-                N[3 * r + q] = (1 - alpha) * c[i].n[r] * c[i].n[q] + (r == q ? alpha : 0);
+        sw_penalty_N(c[i].n, alpha, N);
         for (int s = 0; s < 4; ++s) {
             int seen = 0;
             for (int u = 0; u < s; ++u)
@@ -553,7 +548,7 @@ void sw_contact_apply_hessian(const sw_contact *c, int32_t n, double kc, double 
     for (int32_t i = 0; i < n; ++i) {
         double Jv[3], NJv[3];
         contact_d(&c[i], v, Jv);
-        apply_N(c[i].n, alpha, Jv, NJv);
+        sw_penalty_apply_N(c[i].n, alpha, Jv, NJv);
         int32_t vs[4];
         double a[4];
         slots(&c[i], vs, a);

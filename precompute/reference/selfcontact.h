@@ -10,7 +10,8 @@
  * below `neighbour_factor` times the triangle's longest rest edge are neighbours,
  * not contacts, and are skipped.
  *
- * Penalty (eqs. 3.4-3.6), with n and beta frozen at detection:
+ * Penalty (eqs. 3.4-3.6; the law is the runtime's contact/penalty.h), with n and beta
+ * frozen at detection:
  *   E = 1/2 kc ka d^T N d,  d = v_s - v_p,  N = (1-alpha) n n^T + alpha I,
  *   f_p = kc ka N d,  f_{t_i} = -beta_i kc ka N d,
  *   Hessian kc ka J^T N J with J = [-I, beta_0 I, beta_1 I, beta_2 I] (PSD).

@@ -23,6 +23,18 @@ static inline void sw_penalty_apply_N(const double n[3], double alpha, const dou
         o[j] = s * n[j] + alpha * u[j];
 }
 
+/* N = (1 - alpha) n n^T + alpha I (eq. 3.5) as a row-major 3x3 matrix. */
+static inline void sw_penalty_N(const double n[3], double alpha, double N[9]) {
+    for (int r = 0; r < 3; ++r)
+        for (int q = 0; q < 3; ++q)
+            N[3 * r + q] = (1 - alpha) * n[r] * n[q] + (r == q ? alpha : 0);
+}
+
+/* n . d: positive while the pair collides (p behind the surface, eq. 3.12's Heaviside). */
+static inline double sw_penalty_gap(const double n[3], const double d[3]) {
+    return n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+}
+
 /* E = 1/2 k d^T Nd for the pair's stiffness k (= k_contact ka) and Nd = N d. */
 static inline double sw_penalty_energy(double k, const double d[3], const double Nd[3]) {
     return 0.5 * k * (d[0] * Nd[0] + d[1] * Nd[1] + d[2] * Nd[2]);

@@ -32,12 +32,10 @@ static double contact_pairs(sw_reduced *red, const int32_t *pairs, int32_t npair
                 d[i] += coef[m] * x[m][i];
         }
         const double *Rp = red->act_R + 9 * red->contact_act[4 * c];
-        double n[3], g = 0;
+        double n[3];
         for (int i = 0; i < 3; ++i)
             n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
-        for (int i = 0; i < 3; ++i)
-            g += n[i] * d[i];
-        if (!(g > 0)) continue;
+        if (!(sw_penalty_gap(n, d) > 0)) continue;
         double kk = k * cd[6], Nd[3];
         sw_penalty_apply_N(n, al, d, Nd);
         E += sw_penalty_energy(kk, d, Nd);
