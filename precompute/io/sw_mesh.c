@@ -209,4 +209,3 @@ double sw_point_segment_distance(const double *p, const double *a, const double 
     }
     return sqrt(d2);
 }
-
