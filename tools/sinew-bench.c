@@ -43,6 +43,7 @@
 #include "rt_interpose.h"
 #include "samples.h"
 #include "subspace_eval.h"
+#include "vec3.h"
 #include "weights_heat.h"
 
 static void usage(FILE *f) {
@@ -78,20 +79,16 @@ static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames,
         for (int32_t t = 0; t < v->nsurf_tris; ++t) {
             const int32_t *tri = v->surf_tris + 3 * t;
             const double *a = x + 3 * tri[0], *b = x + 3 * tri[1], *c = x + 3 * tri[2];
-            double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]},
-                   e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
-            double nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
-                            e1[0] * e2[1] - e1[1] * e2[0]};
+            double e1[3], e2[3], nn[3];
+            sw_v3_sub(b, a, e1);
+            sw_v3_sub(c, a, e2);
+            sw_v3_cross(e1, e2, nn);
             for (int k = 0; k < 3; ++k)
                 for (int j = 0; j < 3; ++j)
                     n[3 * tri[k] + j] += nn[j];
         }
-        for (int32_t s = 0; s < v->nsurf_verts; ++s) {
-            double *q = n + 3 * s, l = sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2]);
-            if (l > 0)
-                for (int k = 0; k < 3; ++k)
-                    q[k] /= l;
-        }
+        for (int32_t s = 0; s < v->nsurf_verts; ++s)
+            sw_v3_normalize(n + 3 * s);
         ms[f] = 1e3 * (sw_now_seconds() - t0);
     }
     double m = sw_median(ms, frames);

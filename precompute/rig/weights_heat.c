@@ -6,6 +6,7 @@
  * run in parallel on a thread pool; each group's solve is serial, so the result does
  * not depend on the thread count. */
 #include "weights_heat.h"
+#include "vec3.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -145,8 +146,7 @@ static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
             hi[i] = fmax(hi[i], p[i]);
         }
     }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    return sw_v3_dist(hi, lo);
 }
 
 /* Distances, H, and the matrix values A = L + H on the pattern. */

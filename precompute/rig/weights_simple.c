@@ -1,6 +1,7 @@
 /* Inverse-distance skin weights, for assets that ship none (the bake computes the
  * heat-diffusion weights of DESIGN.md §8; these only need to be plausible and smooth). */
 #include "rig.h"
+#include "vec3.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -20,8 +21,7 @@ static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
             lo[i] = fmin(lo[i], s->joints[3 * j + i]);
             hi[i] = fmax(hi[i], s->joints[3 * j + i]);
         }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    return sw_v3_dist(hi, lo);
 }
 
 sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton *s, sw_weights *out,
