@@ -75,10 +75,9 @@ TEST(active_categories_match_build) {
     ENSURE(sw_rt_interpose_active() == m); /* stable */
     int unseen = 0;
     for (int f = 0; f < SW_RT_FN_COUNT; ++f) {
-        int cat = f <= SW_RT_PVALLOC  ? SW_RT_CAT_ALLOCS
-                  : f == SW_RT_FREE   ? SW_RT_CAT_FREES
-                  : f <= SW_RT_MUNMAP ? SW_RT_CAT_MAPS
-                                      : SW_RT_CAT_LOCKS;
+        int cat = sw_rt_fn_category((sw_rt_fn)f);
+        ENSURE(cat == SW_RT_CAT_ALLOCS || cat == SW_RT_CAT_FREES || cat == SW_RT_CAT_MAPS ||
+               cat == SW_RT_CAT_LOCKS);
         if (sw_rt_fn_observable((sw_rt_fn)f))
             ENSURE(m & cat); /* never beyond its category */
         else if (m & SW_RT_DETAIL)
@@ -89,7 +88,7 @@ TEST(active_categories_match_build) {
     }
     if (unseen) fprintf(stderr, "\n");
     ENSURE(sw_rt_fn_observable(SW_RT_MALLOC) && sw_rt_fn_observable(SW_RT_FREE));
-    ENSURE(!sw_rt_fn_observable(SW_RT_FN_COUNT));
+    ENSURE(!sw_rt_fn_observable(SW_RT_FN_COUNT) && sw_rt_fn_category(SW_RT_FN_COUNT) == 0);
 }
 
 TEST(counts_malloc_and_free) {
@@ -279,6 +278,14 @@ TEST(counts_each_lock_kind) {
         total += want[i].n;
     }
     ENSUREF(c.locks == total && c.allocs == 0 && c.frees == 0 && c.maps == 0, "%s", describe(&c));
+    /* Every lock function of the table is exercised above. */
+    for (int f = 0; f < SW_RT_FN_COUNT; ++f) {
+        size_t i = 0;
+        while (i < sizeof want / sizeof want[0] && want[i].fn != (sw_rt_fn)f)
+            ++i;
+        if (sw_rt_fn_category((sw_rt_fn)f) == SW_RT_CAT_LOCKS)
+            ENSUREF(i < sizeof want / sizeof want[0], "%s not exercised", sw_rt_fn_name(f));
+    }
 }
 
 /* A real blocking condvar wait, woken by another thread: the forwarded

@@ -8,7 +8,11 @@
  *
  * Sanitizer builds: the sanitizer runtime already defines these names and must keep
  * seeing the calls, so nothing is defined here; allocations are counted through the
- * sanitizer's malloc/free hooks and the other categories are reported unobservable. */
+ * sanitizer's malloc/free hooks and the other categories are reported unobservable.
+ *
+ * The functions are listed once, in the table of rt_interpose_fns.h: the names, the
+ * categories, the wrappers and the self-check's list of our own definitions are made
+ * from it here. */
 #define _GNU_SOURCE /* dlvsym, RTLD_NEXT, mremap, memalign/pvalloc, SYS_futex */
 
 #include "rt_interpose.h"
@@ -56,33 +60,27 @@
 static _Thread_local int tl_on SW_RT_TLS;
 static _Thread_local sw_rt_counts tl_counts SW_RT_TLS;
 
-/* clang-format off */
-static const char *const fn_names[SW_RT_FN_COUNT] = {
-    "malloc", "calloc", "realloc", "aligned_alloc", "posix_memalign", "memalign", "valloc",
-    "pvalloc", "free", "mmap", "mremap", "munmap", "pthread_mutex_lock",
-    "pthread_mutex_trylock", "pthread_mutex_timedlock", "pthread_mutex_unlock",
-    "pthread_rwlock_rdlock", "pthread_rwlock_wrlock", "pthread_rwlock_tryrdlock",
-    "pthread_rwlock_trywrlock", "pthread_rwlock_timedrdlock", "pthread_rwlock_timedwrlock",
-    "pthread_rwlock_unlock", "pthread_cond_wait", "pthread_cond_timedwait",
-    "pthread_cond_signal", "pthread_cond_broadcast", "pthread_spin_lock",
-    "pthread_spin_trylock", "pthread_spin_unlock", "pthread_barrier_wait", "sem_wait",
-    "sem_trywait", "sem_timedwait", "sem_post", "mtx_lock", "mtx_trylock", "mtx_timedlock",
-    "mtx_unlock", "cnd_wait", "cnd_timedwait", "cnd_signal", "cnd_broadcast",
-    "syscall(SYS_futex)"};
-/* clang-format on */
+/* The symbol each counter stands for, and its category, from the table. */
+#define SYMBOL_(ID, CAT, HOW, ret, name, ...) #name,
+static const char *const fn_symbols[SW_RT_FN_COUNT] = {SW_RT_FNS(SYMBOL_)};
+#undef SYMBOL_
+#define CATEGORY_(ID, CAT, ...) SW_RT_CAT_##CAT,
+static const unsigned char fn_categories[SW_RT_FN_COUNT] = {SW_RT_FNS(CATEGORY_)};
+#undef CATEGORY_
 
 _Static_assert(SW_RT_FN_COUNT <= 64, "observable_fns is a 64-bit mask");
-_Static_assert(sizeof fn_names / sizeof fn_names[0] == SW_RT_FN_COUNT, "one name per function");
 
 static int fn_category(int f) {
-    if (f <= SW_RT_PVALLOC) return SW_RT_CAT_ALLOCS;
-    if (f == SW_RT_FREE) return SW_RT_CAT_FREES;
-    if (f <= SW_RT_MUNMAP) return SW_RT_CAT_MAPS;
-    return SW_RT_CAT_LOCKS;
+    return fn_categories[f];
+}
+
+int sw_rt_fn_category(sw_rt_fn fn) {
+    return (fn >= 0 && fn < SW_RT_FN_COUNT) ? fn_category(fn) : 0;
 }
 
 const char *sw_rt_fn_name(sw_rt_fn fn) {
-    return (fn >= 0 && fn < SW_RT_FN_COUNT) ? fn_names[fn] : "?";
+    if (fn == SW_RT_SYSCALL_FUTEX) return "syscall(SYS_futex)"; /* counted for futex only */
+    return (fn >= 0 && fn < SW_RT_FN_COUNT) ? fn_symbols[fn] : "?";
 }
 
 /* Set once by sw_rt_interpose_active (computing it calls dlsym, which may allocate). */
@@ -118,20 +116,10 @@ static inline void count(sw_rt_fn f) {
 
 /* The real functions, indexed by sw_rt_fn, plus mmap64 (which shares mmap's counter). */
 enum { R_MMAP64 = SW_RT_FN_COUNT, R_COUNT };
-/* clang-format off */
-static const char *const real_names[R_COUNT] = {
-    "malloc", "calloc", "realloc", "aligned_alloc", "posix_memalign", "memalign", "valloc",
-    "pvalloc", "free", "mmap", "mremap", "munmap", "pthread_mutex_lock",
-    "pthread_mutex_trylock", "pthread_mutex_timedlock", "pthread_mutex_unlock",
-    "pthread_rwlock_rdlock", "pthread_rwlock_wrlock", "pthread_rwlock_tryrdlock",
-    "pthread_rwlock_trywrlock", "pthread_rwlock_timedrdlock", "pthread_rwlock_timedwrlock",
-    "pthread_rwlock_unlock", "pthread_cond_wait", "pthread_cond_timedwait",
-    "pthread_cond_signal", "pthread_cond_broadcast", "pthread_spin_lock",
-    "pthread_spin_trylock", "pthread_spin_unlock", "pthread_barrier_wait", "sem_wait",
-    "sem_trywait", "sem_timedwait", "sem_post", "mtx_lock", "mtx_trylock", "mtx_timedlock",
-    "mtx_unlock", "cnd_wait", "cnd_timedwait", "cnd_signal", "cnd_broadcast", "syscall",
-    "mmap64"};
-/* clang-format on */
+
+static const char *real_name(int i) {
+    return i == R_MMAP64 ? "mmap64" : fn_symbols[i];
+}
 
 static void *_Atomic real_fns[R_COUNT];
 static _Thread_local int tl_resolving SW_RT_TLS;
@@ -149,8 +137,8 @@ static void *resolve(int i) {
     if (tl_resolving) return NULL;
     tl_resolving = 1;
     void *p = NULL;
-    if (is_cond_fn(i)) p = dlvsym(RTLD_NEXT, real_names[i], "GLIBC_2.3.2");
-    if (!p) p = dlsym(RTLD_NEXT, real_names[i]);
+    if (is_cond_fn(i)) p = dlvsym(RTLD_NEXT, real_name(i), "GLIBC_2.3.2");
+    if (!p) p = dlsym(RTLD_NEXT, real_name(i));
     tl_resolving = 0;
     if (p) atomic_store_explicit(&real_fns[i], p, memory_order_release);
     return p;
@@ -218,26 +206,7 @@ static size_t boot_size(const void *p) {
     return n;
 }
 
-/* ---- allocator ---- */
-typedef void *(*malloc_fn)(size_t);
-typedef void *(*calloc_fn)(size_t, size_t);
-typedef void *(*realloc_fn)(void *, size_t);
-typedef void *(*memalign_fn)(size_t, size_t);
-typedef int (*posix_memalign_fn)(void **, size_t, size_t);
-typedef void (*free_fn)(void *);
-
-void *malloc(size_t n) {
-    count(SW_RT_MALLOC);
-    malloc_fn f;
-    REAL(f, SW_RT_MALLOC);
-    return f ? f(n) : boot_alloc(n, 16);
-}
-
-void *calloc(size_t k, size_t n) {
-    count(SW_RT_CALLOC);
-    calloc_fn f;
-    REAL(f, SW_RT_CALLOC);
-    if (f) return f(k, n);
+static void *boot_calloc(size_t k, size_t n) {
     if (n && k > SIZE_MAX / n) {
         errno = ENOMEM;
         return NULL;
@@ -245,12 +214,42 @@ void *calloc(size_t k, size_t n) {
     return boot_alloc(k * n, 16);
 }
 
+static int boot_posix_memalign(void **out, size_t a, size_t n) {
+    *out = boot_alloc(n, a);
+    return *out ? 0 : ENOMEM;
+}
+
+/* ---- the wrappers ---- */
+typedef const struct timespec *ts_p; /* for the table's prototypes */
+
+/* Counts the call as `counted`, forwards it to real function `real` or, while that is
+ * unresolved, returns `fallback`. */
+#define WRAP(ret, name, params, args, counted, real, fallback)                                     \
+    ret name params {                                                                              \
+        count(counted);                                                                            \
+        ret(*f_) params;                                                                           \
+        REAL(f_, real);                                                                            \
+        return f_ ? f_ args : (fallback);                                                          \
+    }
+#define WRAP_FWD(ID, ret, name, params, args, fallback)                                            \
+    WRAP(ret, name, params, args, SW_RT_##ID, SW_RT_##ID, fallback)
+#define WRAP_HAND(...) /* written out below */
+#define WRAPPER_(ID, CAT, HOW, ...) WRAP_##HOW(ID, __VA_ARGS__)
+SW_RT_FNS(WRAPPER_)
+#undef WRAPPER_
+
+#if defined(__LP64__)
+/* Same function as mmap on 64-bit glibc, but a separate symbol a caller may use. */
+WRAP(void *, mmap64, (void *addr, size_t len, int prot, int flags, int fd, off64_t off),
+     (addr, len, prot, flags, fd, off), SW_RT_MMAP, R_MMAP64, (errno = ENOMEM, MAP_FAILED))
+#endif
+
 void *realloc(void *p, size_t n) {
     count(SW_RT_REALLOC);
-    realloc_fn f;
+    void *(*f)(void *, size_t);
     REAL(f, SW_RT_REALLOC);
     if (p && is_boot(p)) { /* move out of the arena into real memory */
-        malloc_fn m;
+        void *(*m)(size_t);
         REAL(m, SW_RT_MALLOC);
         void *q = m ? m(n) : boot_alloc(n, 16);
         if (q) memcpy(q, p, boot_size(p) < n ? boot_size(p) : n);
@@ -262,77 +261,10 @@ void *realloc(void *p, size_t n) {
 void free(void *p) {
     count(SW_RT_FREE);
     if (!p || is_boot(p)) return;
-    free_fn f;
+    void (*f)(void *);
     REAL(f, SW_RT_FREE);
     if (f) f(p); /* unreachable without f: p came from a resolved allocator */
 }
-
-void *aligned_alloc(size_t a, size_t n) {
-    count(SW_RT_ALIGNED_ALLOC);
-    memalign_fn f;
-    REAL(f, SW_RT_ALIGNED_ALLOC);
-    return f ? f(a, n) : boot_alloc(n, a);
-}
-
-int posix_memalign(void **out, size_t a, size_t n) {
-    count(SW_RT_POSIX_MEMALIGN);
-    posix_memalign_fn f;
-    REAL(f, SW_RT_POSIX_MEMALIGN);
-    if (f) return f(out, a, n);
-    *out = boot_alloc(n, a);
-    return *out ? 0 : ENOMEM;
-}
-
-void *memalign(size_t a, size_t n) {
-    count(SW_RT_MEMALIGN);
-    memalign_fn f;
-    REAL(f, SW_RT_MEMALIGN);
-    return f ? f(a, n) : boot_alloc(n, a);
-}
-
-void *valloc(size_t n) {
-    count(SW_RT_VALLOC);
-    malloc_fn f;
-    REAL(f, SW_RT_VALLOC);
-    return f ? f(n) : boot_alloc(n, 4096);
-}
-
-void *pvalloc(size_t n) {
-    count(SW_RT_PVALLOC);
-    malloc_fn f;
-    REAL(f, SW_RT_PVALLOC);
-    return f ? f(n) : boot_alloc(n, 4096);
-}
-
-/* ---- mappings ---- */
-typedef void *(*mmap_fn)(void *, size_t, int, int, int, off_t);
-typedef void *(*mremap_fn)(void *, size_t, size_t, int, ...);
-typedef int (*munmap_fn)(void *, size_t);
-
-void *mmap(void *addr, size_t len, int prot, int flags, int fd, off_t off) {
-    count(SW_RT_MMAP);
-    mmap_fn f;
-    REAL(f, SW_RT_MMAP);
-    if (!f) {
-        errno = ENOMEM;
-        return MAP_FAILED;
-    }
-    return f(addr, len, prot, flags, fd, off);
-}
-
-#if defined(__LP64__)
-/* Same function as mmap on 64-bit glibc, but a separate symbol a caller may use. */
-void *mmap64(void *addr, size_t len, int prot, int flags, int fd, off64_t off) {
-    count(SW_RT_MMAP);
-    mmap_fn f;
-    REAL(f, R_MMAP64);
-    if (!f) {
-        errno = ENOMEM;
-        return MAP_FAILED;
-    }
-    return f(addr, len, prot, flags, fd, (off_t)off);
-}
-#endif
 
 void *mremap(void *old, size_t old_len, size_t new_len, int flags, ...) {
     count(SW_RT_MREMAP);
@@ -343,155 +275,13 @@ void *mremap(void *old, size_t old_len, size_t new_len, int flags, ...) {
         new_addr = va_arg(ap, void *);
         va_end(ap);
     }
-    mremap_fn f;
+    void *(*f)(void *, size_t, size_t, int, ...);
     REAL(f, SW_RT_MREMAP);
     if (!f) {
         errno = ENOMEM;
         return MAP_FAILED;
     }
     return f(old, old_len, new_len, flags, new_addr);
-}
-
-int munmap(void *addr, size_t len) {
-    count(SW_RT_MUNMAP);
-    munmap_fn f;
-    REAL(f, SW_RT_MUNMAP);
-    if (!f) {
-        errno = ENOSYS;
-        return -1;
-    }
-    return f(addr, len);
-}
-
-/* ---- locks ----
- * A lock function can only be unresolved while dlsym is resolving on this thread,
- * and dlsym takes the dynamic linker's internal locks, not these: fail loudly. */
-#define FWD1(idx, T, fail, a)                                                                      \
-    do {                                                                                           \
-        count(idx);                                                                                \
-        int (*f_)(T);                                                                              \
-        REAL(f_, idx);                                                                             \
-        return f_ ? f_(a) : (fail);                                                                \
-    } while (0)
-#define FWD2(idx, T1, T2, fail, a, b)                                                              \
-    do {                                                                                           \
-        count(idx);                                                                                \
-        int (*f_)(T1, T2);                                                                         \
-        REAL(f_, idx);                                                                             \
-        return f_ ? f_(a, b) : (fail);                                                             \
-    } while (0)
-#define FWD3(idx, T1, T2, T3, fail, a, b, c)                                                       \
-    do {                                                                                           \
-        count(idx);                                                                                \
-        int (*f_)(T1, T2, T3);                                                                     \
-        REAL(f_, idx);                                                                             \
-        return f_ ? f_(a, b, c) : (fail);                                                          \
-    } while (0)
-
-typedef const struct timespec *ts_p;
-
-int pthread_mutex_lock(pthread_mutex_t *m) {
-    FWD1(SW_RT_MUTEX_LOCK, pthread_mutex_t *, ENOSYS, m);
-}
-int pthread_mutex_trylock(pthread_mutex_t *m) {
-    FWD1(SW_RT_MUTEX_TRYLOCK, pthread_mutex_t *, ENOSYS, m);
-}
-int pthread_mutex_timedlock(pthread_mutex_t *restrict m, const struct timespec *restrict t) {
-    FWD2(SW_RT_MUTEX_TIMEDLOCK, pthread_mutex_t *, ts_p, ENOSYS, m, t);
-}
-int pthread_mutex_unlock(pthread_mutex_t *m) {
-    FWD1(SW_RT_MUTEX_UNLOCK, pthread_mutex_t *, ENOSYS, m);
-}
-
-int pthread_rwlock_rdlock(pthread_rwlock_t *l) {
-    FWD1(SW_RT_RWLOCK_RDLOCK, pthread_rwlock_t *, ENOSYS, l);
-}
-int pthread_rwlock_wrlock(pthread_rwlock_t *l) {
-    FWD1(SW_RT_RWLOCK_WRLOCK, pthread_rwlock_t *, ENOSYS, l);
-}
-int pthread_rwlock_tryrdlock(pthread_rwlock_t *l) {
-    FWD1(SW_RT_RWLOCK_TRYRDLOCK, pthread_rwlock_t *, ENOSYS, l);
-}
-int pthread_rwlock_trywrlock(pthread_rwlock_t *l) {
-    FWD1(SW_RT_RWLOCK_TRYWRLOCK, pthread_rwlock_t *, ENOSYS, l);
-}
-int pthread_rwlock_timedrdlock(pthread_rwlock_t *restrict l, const struct timespec *restrict t) {
-    FWD2(SW_RT_RWLOCK_TIMEDRDLOCK, pthread_rwlock_t *, ts_p, ENOSYS, l, t);
-}
-int pthread_rwlock_timedwrlock(pthread_rwlock_t *restrict l, const struct timespec *restrict t) {
-    FWD2(SW_RT_RWLOCK_TIMEDWRLOCK, pthread_rwlock_t *, ts_p, ENOSYS, l, t);
-}
-int pthread_rwlock_unlock(pthread_rwlock_t *l) {
-    FWD1(SW_RT_RWLOCK_UNLOCK, pthread_rwlock_t *, ENOSYS, l);
-}
-
-int pthread_cond_wait(pthread_cond_t *restrict c, pthread_mutex_t *restrict m) {
-    FWD2(SW_RT_COND_WAIT, pthread_cond_t *, pthread_mutex_t *, ENOSYS, c, m);
-}
-int pthread_cond_timedwait(pthread_cond_t *restrict c, pthread_mutex_t *restrict m,
-                           const struct timespec *restrict t) {
-    FWD3(SW_RT_COND_TIMEDWAIT, pthread_cond_t *, pthread_mutex_t *, ts_p, ENOSYS, c, m, t);
-}
-int pthread_cond_signal(pthread_cond_t *c) {
-    FWD1(SW_RT_COND_SIGNAL, pthread_cond_t *, ENOSYS, c);
-}
-int pthread_cond_broadcast(pthread_cond_t *c) {
-    FWD1(SW_RT_COND_BROADCAST, pthread_cond_t *, ENOSYS, c);
-}
-
-int pthread_spin_lock(pthread_spinlock_t *s) {
-    FWD1(SW_RT_SPIN_LOCK, pthread_spinlock_t *, ENOSYS, s);
-}
-int pthread_spin_trylock(pthread_spinlock_t *s) {
-    FWD1(SW_RT_SPIN_TRYLOCK, pthread_spinlock_t *, ENOSYS, s);
-}
-int pthread_spin_unlock(pthread_spinlock_t *s) {
-    FWD1(SW_RT_SPIN_UNLOCK, pthread_spinlock_t *, ENOSYS, s);
-}
-int pthread_barrier_wait(pthread_barrier_t *b) {
-    FWD1(SW_RT_BARRIER_WAIT, pthread_barrier_t *, ENOSYS, b);
-}
-
-/* Semaphores report failure through errno. */
-#define SEM_FAIL (errno = ENOSYS, -1)
-int sem_wait(sem_t *s) {
-    FWD1(SW_RT_SEM_WAIT, sem_t *, SEM_FAIL, s);
-}
-int sem_trywait(sem_t *s) {
-    FWD1(SW_RT_SEM_TRYWAIT, sem_t *, SEM_FAIL, s);
-}
-int sem_timedwait(sem_t *restrict s, const struct timespec *restrict t) {
-    FWD2(SW_RT_SEM_TIMEDWAIT, sem_t *, ts_p, SEM_FAIL, s, t);
-}
-int sem_post(sem_t *s) {
-    FWD1(SW_RT_SEM_POST, sem_t *, SEM_FAIL, s);
-}
-
-/* C11 <threads.h>: in glibc these call the pthread internals directly, so they need
- * their own wrappers. */
-int mtx_lock(mtx_t *m) {
-    FWD1(SW_RT_MTX_LOCK, mtx_t *, thrd_error, m);
-}
-int mtx_trylock(mtx_t *m) {
-    FWD1(SW_RT_MTX_TRYLOCK, mtx_t *, thrd_error, m);
-}
-int mtx_timedlock(mtx_t *restrict m, const struct timespec *restrict t) {
-    FWD2(SW_RT_MTX_TIMEDLOCK, mtx_t *, ts_p, thrd_error, m, t);
-}
-int mtx_unlock(mtx_t *m) {
-    FWD1(SW_RT_MTX_UNLOCK, mtx_t *, thrd_error, m);
-}
-int cnd_wait(cnd_t *c, mtx_t *m) {
-    FWD2(SW_RT_CND_WAIT, cnd_t *, mtx_t *, thrd_error, c, m);
-}
-int cnd_timedwait(cnd_t *restrict c, mtx_t *restrict m, const struct timespec *restrict t) {
-    FWD3(SW_RT_CND_TIMEDWAIT, cnd_t *, mtx_t *, ts_p, thrd_error, c, m, t);
-}
-int cnd_signal(cnd_t *c) {
-    FWD1(SW_RT_CND_SIGNAL, cnd_t *, thrd_error, c);
-}
-int cnd_broadcast(cnd_t *c) {
-    FWD1(SW_RT_CND_BROADCAST, cnd_t *, thrd_error, c);
 }
 
 /* syscall(SYS_futex, ...): a hand-rolled lock. The kernel takes at most six register
@@ -514,66 +304,18 @@ long syscall(long number, ...) {
 }
 
 /* Our own definition of each name, to compare with what the dynamic linker resolves. */
-static void *own_fn(int i) {
-    void (*fp)(void) = NULL;
-#define OWN(idx, name)                                                                             \
-    case idx:                                                                                      \
-        fp = (void (*)(void))name;                                                                 \
-        break
-    switch (i) {
-        OWN(SW_RT_MALLOC, malloc);
-        OWN(SW_RT_CALLOC, calloc);
-        OWN(SW_RT_REALLOC, realloc);
-        OWN(SW_RT_ALIGNED_ALLOC, aligned_alloc);
-        OWN(SW_RT_POSIX_MEMALIGN, posix_memalign);
-        OWN(SW_RT_MEMALIGN, memalign);
-        OWN(SW_RT_VALLOC, valloc);
-        OWN(SW_RT_PVALLOC, pvalloc);
-        OWN(SW_RT_FREE, free);
-        OWN(SW_RT_MMAP, mmap);
-        OWN(SW_RT_MREMAP, mremap);
-        OWN(SW_RT_MUNMAP, munmap);
-        OWN(SW_RT_MUTEX_LOCK, pthread_mutex_lock);
-        OWN(SW_RT_MUTEX_TRYLOCK, pthread_mutex_trylock);
-        OWN(SW_RT_MUTEX_TIMEDLOCK, pthread_mutex_timedlock);
-        OWN(SW_RT_MUTEX_UNLOCK, pthread_mutex_unlock);
-        OWN(SW_RT_RWLOCK_RDLOCK, pthread_rwlock_rdlock);
-        OWN(SW_RT_RWLOCK_WRLOCK, pthread_rwlock_wrlock);
-        OWN(SW_RT_RWLOCK_TRYRDLOCK, pthread_rwlock_tryrdlock);
-        OWN(SW_RT_RWLOCK_TRYWRLOCK, pthread_rwlock_trywrlock);
-        OWN(SW_RT_RWLOCK_TIMEDRDLOCK, pthread_rwlock_timedrdlock);
-        OWN(SW_RT_RWLOCK_TIMEDWRLOCK, pthread_rwlock_timedwrlock);
-        OWN(SW_RT_RWLOCK_UNLOCK, pthread_rwlock_unlock);
-        OWN(SW_RT_COND_WAIT, pthread_cond_wait);
-        OWN(SW_RT_COND_TIMEDWAIT, pthread_cond_timedwait);
-        OWN(SW_RT_COND_SIGNAL, pthread_cond_signal);
-        OWN(SW_RT_COND_BROADCAST, pthread_cond_broadcast);
-        OWN(SW_RT_SPIN_LOCK, pthread_spin_lock);
-        OWN(SW_RT_SPIN_TRYLOCK, pthread_spin_trylock);
-        OWN(SW_RT_SPIN_UNLOCK, pthread_spin_unlock);
-        OWN(SW_RT_BARRIER_WAIT, pthread_barrier_wait);
-        OWN(SW_RT_SEM_WAIT, sem_wait);
-        OWN(SW_RT_SEM_TRYWAIT, sem_trywait);
-        OWN(SW_RT_SEM_TIMEDWAIT, sem_timedwait);
-        OWN(SW_RT_SEM_POST, sem_post);
-        OWN(SW_RT_MTX_LOCK, mtx_lock);
-        OWN(SW_RT_MTX_TRYLOCK, mtx_trylock);
-        OWN(SW_RT_MTX_TIMEDLOCK, mtx_timedlock);
-        OWN(SW_RT_MTX_UNLOCK, mtx_unlock);
-        OWN(SW_RT_CND_WAIT, cnd_wait);
-        OWN(SW_RT_CND_TIMEDWAIT, cnd_timedwait);
-        OWN(SW_RT_CND_SIGNAL, cnd_signal);
-        OWN(SW_RT_CND_BROADCAST, cnd_broadcast);
-        OWN(SW_RT_SYSCALL_FUTEX, syscall);
+#define OWN_(ID, CAT, HOW, ret, name, ...) (void (*)(void)) name,
 #if defined(__LP64__)
-        OWN(R_MMAP64, mmap64);
+#define OWN_MMAP64 (void (*)(void)) mmap64
+#else
+#define OWN_MMAP64 NULL
 #endif
-    default:
-        break;
-    }
-#undef OWN
+static void (*const own_fns[R_COUNT])(void) = {SW_RT_FNS(OWN_) OWN_MMAP64};
+#undef OWN_
+
+static void *own_fn(int i) {
     void *p = NULL;
-    if (fp) memcpy(&p, &fp, sizeof p);
+    if (own_fns[i]) memcpy(&p, &own_fns[i], sizeof p);
     return p;
 }
 
@@ -592,7 +334,7 @@ static int compute_active(void) {
 #endif
             continue;
         }
-        if (!real_get(i) || dlsym(RTLD_DEFAULT, real_names[i]) != mine) mask &= ~cat;
+        if (!real_get(i) || dlsym(RTLD_DEFAULT, real_name(i)) != mine) mask &= ~cat;
     }
     if (mask & SW_RT_CAT_ALLOCS) {
         /* volatile: GCC may otherwise delete an unused strdup/free pair. */
@@ -674,7 +416,8 @@ static int compute_active(void) {
     void *(*volatile v_pvalloc)(size_t) = pvalloc;
 #endif
     uint64_t seen = 0;
-    for (int f = SW_RT_MALLOC; f <= SW_RT_FREE; ++f) {
+    for (int f = 0; f < SW_RT_FN_COUNT; ++f) {
+        if (!(fn_category(f) & (SW_RT_CAT_ALLOCS | SW_RT_CAT_FREES))) continue;
         void *p = NULL, *q = NULL;
         sw_rt_count_begin();
         switch (f) {
@@ -803,7 +546,7 @@ const char *sw_rt_counts_describe(const sw_rt_counts *c, char *buf, size_t n) {
         int any = 0;
         for (int f = 0; f < SW_RT_FN_COUNT; ++f) {
             if (fn_category(f) != cats[k].cat || !c->by_fn[f]) continue;
-            PUT("%s%s %" PRIu64, any ? ", " : " (", fn_names[f], c->by_fn[f]);
+            PUT("%s%s %" PRIu64, any ? ", " : " (", sw_rt_fn_name((sw_rt_fn)f), c->by_fn[f]);
             any = 1;
         }
         if (any) PUT(")");

@@ -21,58 +21,13 @@
 #include <stddef.h>
 #include <stdint.h>
 
-/* One counter per interposed function (the per-function detail of sw_rt_counts). */
-typedef enum sw_rt_fn {
-    /* allocations */
-    SW_RT_MALLOC,
-    SW_RT_CALLOC,
-    SW_RT_REALLOC,
-    SW_RT_ALIGNED_ALLOC,
-    SW_RT_POSIX_MEMALIGN,
-    SW_RT_MEMALIGN,
-    SW_RT_VALLOC,
-    SW_RT_PVALLOC,
-    /* frees */
-    SW_RT_FREE,
-    /* mappings */
-    SW_RT_MMAP,
-    SW_RT_MREMAP,
-    SW_RT_MUNMAP,
-    /* locks: every call that takes, tries, releases, waits on or wakes a lock */
-    SW_RT_MUTEX_LOCK,
-    SW_RT_MUTEX_TRYLOCK,
-    SW_RT_MUTEX_TIMEDLOCK,
-    SW_RT_MUTEX_UNLOCK,
-    SW_RT_RWLOCK_RDLOCK,
-    SW_RT_RWLOCK_WRLOCK,
-    SW_RT_RWLOCK_TRYRDLOCK,
-    SW_RT_RWLOCK_TRYWRLOCK,
-    SW_RT_RWLOCK_TIMEDRDLOCK,
-    SW_RT_RWLOCK_TIMEDWRLOCK,
-    SW_RT_RWLOCK_UNLOCK,
-    SW_RT_COND_WAIT,
-    SW_RT_COND_TIMEDWAIT,
-    SW_RT_COND_SIGNAL,
-    SW_RT_COND_BROADCAST,
-    SW_RT_SPIN_LOCK,
-    SW_RT_SPIN_TRYLOCK,
-    SW_RT_SPIN_UNLOCK,
-    SW_RT_BARRIER_WAIT,
-    SW_RT_SEM_WAIT,
-    SW_RT_SEM_TRYWAIT,
-    SW_RT_SEM_TIMEDWAIT,
-    SW_RT_SEM_POST,
-    SW_RT_MTX_LOCK, /* C11 <threads.h> */
-    SW_RT_MTX_TRYLOCK,
-    SW_RT_MTX_TIMEDLOCK,
-    SW_RT_MTX_UNLOCK,
-    SW_RT_CND_WAIT,
-    SW_RT_CND_TIMEDWAIT,
-    SW_RT_CND_SIGNAL,
-    SW_RT_CND_BROADCAST,
-    SW_RT_SYSCALL_FUTEX, /* syscall(SYS_futex, ...) made by code directly */
-    SW_RT_FN_COUNT
-} sw_rt_fn;
+#include "rt_interpose_fns.h"
+
+/* One counter per interposed function (the per-function detail of sw_rt_counts), in the
+ * order of the table in rt_interpose_fns.h: SW_RT_MALLOC, ..., SW_RT_SYSCALL_FUTEX. */
+#define SW_RT_FN_ENUM_(ID, ...) SW_RT_##ID,
+typedef enum sw_rt_fn { SW_RT_FNS(SW_RT_FN_ENUM_) SW_RT_FN_COUNT } sw_rt_fn;
+#undef SW_RT_FN_ENUM_
 
 /* Category bits of sw_rt_interpose_active(). */
 enum {
@@ -121,6 +76,9 @@ int sw_rt_fn_observable(sw_rt_fn fn);
 
 /* Name of an interposed function ("malloc", "pthread_mutex_lock", ...). */
 const char *sw_rt_fn_name(sw_rt_fn fn);
+
+/* The SW_RT_CAT_* category of an interposed function (0 for one out of range). */
+int sw_rt_fn_category(sw_rt_fn fn);
 
 /* Writes e.g. "allocs 2 (malloc 1, calloc 1), frees 2 (free 2), maps 0, locks 0" into
  * buf (truncated to n bytes, always terminated when n > 0) and returns buf. */

@@ -1,13 +1,16 @@
 #!/usr/bin/env bash
 # The whole test suite, as CI runs it:
 #   setup    tools/setup-debian.sh (installs missing Debian packages)
+#   format   clang-format --dry-run -Werror (the repo's .clang-format, Debian 12's
+#            clang-format 14) over every git-tracked *.c, *.h and *.cpp file; fails naming
+#            the files that are not formatted (fix: clang-format -i FILE)
 #   release  Release build in build/, warnings as errors, every CTest test
 #   asan     Debug build in build-asan/ with ASan+UBSan (leaks too), every CTest test
 #   tsan     Debug build in build-tsan/ with TSan, only the tests labelled "threads"
 # Every stage runs even when an earlier one failed; the script prints each stage's wall
 # time and status and exits non-zero if any stage failed.
 #
-# usage: bash tools/run-tests.sh [stage...]     (default: all four, in that order)
+# usage: bash tools/run-tests.sh [stage...]     (default: all five, in that order)
 # env:   SINEW_JOBS (build parallelism, default: cores), SINEW_CTEST_JOBS (default 2)
 set -uo pipefail
 
@@ -42,6 +45,42 @@ stage_setup() {
     bash "$root/tools/setup-debian.sh"
 }
 
+# Checks, changes nothing. One batched run first; when it fails, each file on its own, so
+# that the failures are named file by file.
+stage_format() {
+    if ! command -v clang-format >/dev/null 2>&1; then
+        echo "run-tests: clang-format not found (tools/setup-debian.sh installs it)" >&2
+        return 1
+    fi
+    local files=() bad=() f out
+    mapfile -d '' files < <(git -C "$root" ls-files -z -- '*.c' '*.h' '*.cpp')
+    if [ "${#files[@]}" -eq 0 ]; then
+        echo "run-tests: no git-tracked C/C++ files found (not a git checkout?)" >&2
+        return 1
+    fi
+    clang-format --version
+    local present=()
+    for f in "${files[@]}"; do
+        [ -f "$root/$f" ] && present+=("$f") # not those deleted in the working tree
+    done
+    if (cd "$root" && clang-format --style=file --dry-run -Werror "${present[@]}" 2>/dev/null); then
+        echo "run-tests: format: ${#present[@]} files checked, all formatted"
+        return 0
+    fi
+    for f in "${present[@]}"; do
+        if ! out=$(clang-format --style=file --dry-run -Werror "$root/$f" 2>&1); then
+            bad+=("$f")
+            # Not a formatting difference (a bad .clang-format, a crash): show it.
+            grep -q 'clang-format-violations' <<<"$out" || printf '%s\n' "$out" >&2
+        fi
+    done
+    echo "run-tests: format: ${#present[@]} files checked, ${#bad[@]} not formatted"
+    [ "${#bad[@]}" -eq 0 ] && return 0
+    echo "run-tests: not formatted as .clang-format says (fix with clang-format -i FILE):" >&2
+    printf '  %s\n' "${bad[@]}" >&2
+    return 1
+}
+
 stage_release() {
     build_and_test build "" \
         -DCMAKE_BUILD_TYPE=Release -DSINEW_WERROR=ON -DSINEW_SANITIZE=
@@ -63,11 +102,11 @@ stage_tsan() {
 }
 
 stages=("$@")
-[ "${#stages[@]}" -gt 0 ] || stages=(setup release asan tsan)
+[ "${#stages[@]}" -gt 0 ] || stages=(setup format release asan tsan)
 for s in "${stages[@]}"; do
     case $s in
-    setup | release | asan | tsan) ;;
-    *) echo "run-tests: unknown stage '$s' (setup release asan tsan)" >&2; exit 2 ;;
+    setup | format | release | asan | tsan) ;;
+    *) echo "run-tests: unknown stage '$s' (setup format release asan tsan)" >&2; exit 2 ;;
     esac
 done
 

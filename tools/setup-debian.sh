@@ -13,6 +13,7 @@ packages=(
     libopenblas-dev  # bake-time dense linear algebra
     liblapacke-dev
     libassimp-dev    # glTF/FBX import in the bake (DESIGN.md §5)
+    clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
 )
 
 installed() {

@@ -82,16 +82,9 @@ int main(int argc, char **argv) {
             p.return_path = 1;
         else if (!strcmp(a, "--json"))
             json = 1;
-        else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            return 0;
-        } else
+        else if (!sw_tool_help(a, usage))
             ok = 0;
-        if (!ok) {
-            fprintf(stderr, "sinew-bake: bad or incomplete argument '%s'\n", a);
-            usage(stderr);
-            return 2;
-        }
+        if (!ok) return sw_tool_bad_arg("sinew-bake", a, usage);
     }
     if (!out_path || !sw_character_args_valid(&ca)) {
         fprintf(stderr, "sinew-bake: give --out and either --scene or --mesh with --skeleton\n");
@@ -99,15 +92,10 @@ int main(int argc, char **argv) {
         return 2;
     }
     sw_error err;
-    sw_error_clear(&err);
     sw_character ch;
-    memset(&ch, 0, sizeof ch);
     double t0 = sw_now_seconds();
     sinew_result r = sw_character_args_make(&ca, &ch, &err);
-    if (r != SINEW_OK) {
-        fprintf(stderr, "sinew-bake: %s (%s)\n", err.msg, sinew_result_string(r));
-        return 1;
-    }
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bake: ");
     fprintf(stderr, "sinew-bake: %s: %d tets, %d vertices, %d bones, %d clip frames\n",
             ch.name[0] ? ch.name : (ca.scene ? ca.scene : ca.mesh), ch.mesh.ntets, ch.mesh.nverts,
             ch.skel.nbones, ch.clip.nframes);

@@ -44,6 +44,7 @@
 #include "samples.h"
 #include "subspace_eval.h"
 #include "surface_normals.h"
+#include "vec3.h"
 #include "weights_heat.h"
 
 static void usage(FILE *f) {
@@ -142,30 +143,18 @@ int main(int argc, char **argv) {
             ok = sw_parse_int(argv[++i], 0, 256, &threads);
         else if (!strcmp(a, "--json"))
             json = 1;
-        else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            return 0;
-        } else
+        else if (!sw_tool_help(a, usage))
             ok = 0;
-        if (!ok) {
-            fprintf(stderr, "sinew-bench: bad or incomplete argument '%s'\n", a);
-            usage(stderr);
-            return 2;
-        }
+        if (!ok) return sw_tool_bad_arg("sinew-bench", a, usage);
     }
     if (!sw_character_args_valid(&ca)) {
         usage(stderr);
         return 2;
     }
     sw_error err;
-    sw_error_clear(&err);
     sw_character ch;
-    memset(&ch, 0, sizeof ch);
     sinew_result r = sw_character_args_make(&ca, &ch, &err);
-    if (r != SINEW_OK) {
-        fprintf(stderr, "sinew-bench: %s (%s)\n", err.msg, sinew_result_string(r));
-        return 1;
-    }
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bench: ");
     int nf = ch.clip.nframes;
 
     /* 1. bake (or load) */
@@ -184,10 +173,8 @@ int main(int argc, char **argv) {
         double t0 = sw_now_seconds();
         size_t size = 0;
         if ((r = sw_bake(&ch, &bp, &res, &err)) != SINEW_OK ||
-            (r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
-            fprintf(stderr, "sinew-bench: bake failed: %s (%s)\n", err.msg, sinew_result_string(r));
-            return 1;
-        }
+            (r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "sinew-bench: bake failed: ");
         bake_s = sw_now_seconds() - t0;
         bd.data = mem;
         bd.data_size = size;
@@ -208,10 +195,8 @@ int main(int argc, char **argv) {
     /* An asset without weights: the bake computed heat-diffusion weights (bake.c); the
      * reference simulator gets the same ones (it uses them for its warm start). */
     if (!ch.weights.w &&
-        (r = sw_weights_heat(&ch.mesh, &ch.skel, 0, &ch.weights, &err)) != SINEW_OK) {
-        fprintf(stderr, "sinew-bench: %s (%s)\n", err.msg, sinew_result_string(r));
-        return 1;
-    }
+        (r = sw_weights_heat(&ch.mesh, &ch.skel, 0, &ch.weights, &err)) != SINEW_OK)
+        return sw_tool_failed(r, &err, "sinew-bench: ");
 
     /* 2. full-space reference over the first K clip frames (same motion, all cores) */
     sw_fullsim_params fp = sw_fullsim_params_default();

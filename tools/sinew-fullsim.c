@@ -21,10 +21,6 @@
 #include "mesh_io.h"
 #include "samples.h"
 
-#ifndef SINEW_SHARED_DATA_DIR
-#define SINEW_SHARED_DATA_DIR "../shared/data"
-#endif
-
 typedef struct {
     const char *scene, *out_dir, *data_dir;
     int tets, frames, json, threads;
@@ -52,11 +48,16 @@ static int parse_args(int argc, char **argv, options *o) {
     o->params = sw_fullsim_params_default();
     o->tets = 20000;
     o->frames = -1;
-    o->data_dir = getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
+    o->data_dir = sw_tool_data_dir();
+    const sw_tool_opt opts[] = {{"--scene", &o->scene, NULL, 0},
+                                {"--out", &o->out_dir, NULL, 0},
+                                {"--data", &o->data_dir, NULL, 0},
+                                {"--no-self-contact", NULL, &o->params.self_contact, 0},
+                                {"--json", NULL, &o->json, 1}};
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--scene") && next) {
-            o->scene = argv[++i];
+        if (sw_tool_take(opts, sizeof opts / sizeof opts[0], argc, argv, &i)) {
+            /* taken */
         } else if (!strcmp(a, "--tets") && next) {
             if (!sw_parse_int(argv[++i], 1000, 2000000, &o->tets)) {
                 fprintf(stderr, "sinew-fullsim: --tets wants 1000..2000000, got '%s'\n", argv[i]);
@@ -102,20 +103,8 @@ static int parse_args(int argc, char **argv, options *o) {
             o->params.integrator = SW_BACKWARD_EULER;
         } else if (!strcmp(a, "--newmark")) {
             o->params.integrator = SW_NEWMARK;
-        } else if (!strcmp(a, "--no-self-contact")) {
-            o->params.self_contact = 0;
-        } else if (!strcmp(a, "--out") && next) {
-            o->out_dir = argv[++i];
-        } else if (!strcmp(a, "--data") && next) {
-            o->data_dir = argv[++i];
-        } else if (!strcmp(a, "--json")) {
-            o->json = 1;
-        } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            exit(0);
-        } else {
-            fprintf(stderr, "sinew-fullsim: unknown or incomplete argument '%s'\n", a);
-            return 0;
+        } else if (!sw_tool_help(a, usage)) {
+            return sw_tool_unknown_arg("sinew-fullsim", a);
         }
     }
     if (!o->scene) {
@@ -183,11 +172,8 @@ int main(int argc, char **argv) {
     sinew_result r;
     r = sw_scene_make(o.scene, o.tets, o.frames > 0 ? o.frames : (is_sample(o.scene) ? 30 : 60),
                       o.data_dir, &ch, NULL, &err);
-    if (r != SINEW_OK) {
-        fprintf(stderr, "sinew-fullsim: cannot make scene '%s': %s (%s)\n", o.scene, err.msg,
-                sinew_result_string(r));
-        return 1;
-    }
+    if (r != SINEW_OK)
+        return sw_tool_failed(r, &err, "sinew-fullsim: cannot make scene '%s': ", o.scene);
     int frames = ch.clip.nframes;
     if (o.frames > 0 && o.frames < frames) frames = o.frames;
     sw_fullsim *sim = NULL;

@@ -74,6 +74,10 @@ static int parse_args(int argc, char **argv, options *o) {
                 {"--threads", 1, 64, &o->threads},
                 {"--azimuth", -360, 360, &o->azimuth},
                 {"--elevation", -89, 89, &o->elevation}};
+    const sw_tool_opt opts[] = {{"--frames", &o->frames_dir, NULL, 0},
+                                {"--out", &o->out, NULL, 0},
+                                {"--no-ground", NULL, &o->ground, 0},
+                                {"--quiet", NULL, &o->quiet, 1}};
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int matched = 0;
@@ -90,21 +94,10 @@ static int parse_args(int argc, char **argv, options *o) {
         if (matched) continue;
         if (!strcmp(a, "--obj") && next) {
             o->objs[o->nobjs++] = argv[++i];
-        } else if (!strcmp(a, "--frames") && next) {
-            o->frames_dir = argv[++i];
-        } else if (!strcmp(a, "--out") && next) {
-            o->out = argv[++i];
-        } else if (!strcmp(a, "--no-ground")) {
-            o->ground = 0;
-        } else if (!strcmp(a, "--quiet")) {
-            o->quiet = 1;
-        } else if (!strcmp(a, "--help") || !strcmp(a, "-h")) {
-            usage(stdout);
-            free(o->objs);
-            exit(0);
-        } else {
-            fprintf(stderr, "sinew-render: unknown or incomplete argument '%s'\n", a);
-            return 0;
+        } else if (sw_tool_take(opts, sizeof opts / sizeof opts[0], argc, argv, &i)) {
+            /* taken */
+        } else if (!sw_tool_help(a, usage)) {
+            return sw_tool_unknown_arg("sinew-render", a);
         }
     }
     if (!o->out || (o->nobjs == 0) == (o->frames_dir == NULL)) {

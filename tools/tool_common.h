@@ -1,9 +1,24 @@
-/* Small helpers shared by the command-line tools: strict integer arguments and medians. */
+/* Small helpers shared by the command-line tools: strict integer arguments, medians, and
+ * what every tool does with --help, with an argument it cannot take and with a failure. */
 #ifndef SW_TOOL_COMMON_H
 #define SW_TOOL_COMMON_H
 
 #include <errno.h>
+#include <stdarg.h>
+#include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
+
+#include "sw_error.h"
+
+#ifndef SINEW_SHARED_DATA_DIR
+#define SINEW_SHARED_DATA_DIR "../shared/data"
+#endif
+
+/* The folder of the real assets: $SINEW_DATA_DIR, else the build's shared data folder. */
+static inline const char *sw_tool_data_dir(void) {
+    return getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
+}
 
 /* Parses all of s as a base-10 integer in [lo, hi] into *out; 0 when it is not one. */
 static inline int sw_parse_int(const char *s, int lo, int hi, int *out) {
@@ -26,18 +41,71 @@ static inline double sw_median(double *v, int n) {
     qsort(v, (size_t)n, sizeof *v, sw_cmp_double);
     return n % 2 ? v[n / 2] : 0.5 * (v[n / 2 - 1] + v[n / 2]);
 }
+
+/* Options that take a string value or set an int flag, as a tool's table. */
+typedef struct sw_tool_opt {
+    const char *name; /* "--out" */
+    const char **str; /* a string option: receives the argument after the name */
+    int *flag, value; /* or a flag: *flag = value */
+} sw_tool_opt;
+
+/* When argv[*i] names one of the n options (a string option only when its value
+ * follows), takes it and its value (advancing *i) and returns 1; 0 otherwise. */
+static inline int sw_tool_take(const sw_tool_opt *opts, size_t n, int argc, char **argv, int *i) {
+    for (size_t k = 0; k < n; ++k) {
+        if (strcmp(argv[*i], opts[k].name)) continue;
+        if (!opts[k].str) return (*opts[k].flag = opts[k].value), 1;
+        if (*i + 1 >= argc) return 0;
+        *opts[k].str = argv[++*i];
+        return 1;
+    }
+    return 0;
+}
+
+/* --help or -h prints the usage on stdout and exits with status 0. Returns 0 for any
+ * other argument, so that it ends a tool's chain of options. */
+static inline int sw_tool_help(const char *a, void (*usage)(FILE *)) {
+    if (strcmp(a, "--help") && strcmp(a, "-h")) return 0;
+    usage(stdout);
+    exit(0);
+}
+
+/* sinew-bake and sinew-bench, for an argument they cannot take (unknown, incomplete or
+ * a bad value): names it and prints the usage on stderr; returns the exit status 2. */
+static inline int sw_tool_bad_arg(const char *tool, const char *a, void (*usage)(FILE *)) {
+    fprintf(stderr, "%s: bad or incomplete argument '%s'\n", tool, a);
+    usage(stderr);
+    return 2;
+}
+
+/* sinew-fullsim and sinew-render, for an argument none of their options takes: names it
+ * on stderr and returns 0 (their parse_args fails; main prints the usage). */
+static inline int sw_tool_unknown_arg(const char *tool, const char *a) {
+    fprintf(stderr, "%s: unknown or incomplete argument '%s'\n", tool, a);
+    return 0;
+}
+
+/* A failed call: prints the printf-formatted prefix (the tool's name and what failed),
+ * then "MESSAGE (RESULT)" of err and r, on stderr; returns the exit status 1. */
+static inline int sw_tool_failed(sinew_result r, const sw_error *err, const char *prefix, ...)
+#if defined(__GNUC__)
+    __attribute__((format(printf, 3, 4)))
+#endif
+    ;
+static inline int sw_tool_failed(sinew_result r, const sw_error *err, const char *prefix, ...) {
+    va_list ap;
+    va_start(ap, prefix);
+    vfprintf(stderr, prefix, ap);
+    va_end(ap);
+    fprintf(stderr, "%s (%s)\n", err->msg, sinew_result_string(r));
+    return 1;
+}
 #endif
 
 #ifdef SW_TOOL_CHARACTER_ARGS
 /* The character inputs sinew-bake and sinew-bench share: a named scene, or files. */
-#include <string.h>
-
 #include "character_io.h"
 #include "samples.h"
-
-#ifndef SINEW_SHARED_DATA_DIR
-#define SINEW_SHARED_DATA_DIR "../shared/data"
-#endif
 
 typedef struct sw_character_args {
     const char *scene, *mesh, *tgf, *weights, *clip, *data_dir;
@@ -46,7 +114,7 @@ typedef struct sw_character_args {
 
 static inline void sw_character_args_init(sw_character_args *c) {
     memset(c, 0, sizeof *c);
-    c->data_dir = getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;
+    c->data_dir = sw_tool_data_dir();
     c->tets = 20000;
 }
 
@@ -77,12 +145,13 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
     return !c->scene != !c->mesh && (!c->mesh || c->tgf);
 }
 
-/* Builds the character. When the asset has no skin weights of its own (files without
- * --weights, or an asset folder that ships none) they are dropped, so that the bake
- * computes heat-diffusion weights. */
+/* Builds the character into *ch (zeroed first; err cleared first). When the asset has no
+ * skin weights of its own (files without --weights, or an asset folder that ships none)
+ * they are dropped, so that the bake computes heat-diffusion weights. */
 static inline sinew_result sw_character_args_make(const sw_character_args *c, sw_character *ch,
                                                   sw_error *err) {
     int computed = 0;
+    sw_error_clear(err);
     memset(ch, 0, sizeof *ch);
     sinew_result r =
         c->scene

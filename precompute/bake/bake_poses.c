@@ -15,6 +15,7 @@
 
 #include "bake_internal.h"
 #include "fullsim.h"
+#include "vec3.h"
 
 /* Rotation part of a clip's bone transform relative to its parent: L = R_p^T R_b. */
 static void local_rotation(const sw_skeleton *sk, const double *T, int32_t b, double L[9]) {
@@ -36,12 +37,12 @@ static double rotation_axis_angle(const double R[9], double axis[3]) {
     c = c > 1 ? 1 : c < -1 ? -1 : c;
     double angle = acos(c);
     double a[3] = {R[7] - R[5], R[2] - R[6], R[3] - R[1]};
-    double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+    double n = sw_v3_norm(a);
     if (n < 1e-12) { /* angle 0 or pi: take the column of the largest diagonal of R + I */
         int k = R[0] >= R[4] && R[0] >= R[8] ? 0 : R[4] >= R[8] ? 1 : 2;
         for (int i = 0; i < 3; ++i)
             a[i] = R[3 * i + k] + (i == k ? 1.0 : 0.0);
-        n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+        n = sw_v3_norm(a);
         if (n < 1e-12) {
             a[0] = 1;
             a[1] = a[2] = 0;
@@ -115,13 +116,11 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
             if (sk->parent[b] < 0) continue;
             const double *h = sk->joints + 3 * sk->bones[2 * b],
                          *t = sk->joints + 3 * sk->bones[2 * b + 1];
-            double d[3] = {t[0] - h[0], t[1] - h[1], t[2] - h[2]};
-            double z[3] = {0, 0, 1};
-            if (fabs(d[2]) > 0.9 * sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]))
-                z[1] = 1, z[2] = 0;
-            double a[3] = {d[1] * z[2] - d[2] * z[1], d[2] * z[0] - d[0] * z[2],
-                           d[0] * z[1] - d[1] * z[0]};
-            double n = sqrt(a[0] * a[0] + a[1] * a[1] + a[2] * a[2]);
+            double d[3], z[3] = {0, 0, 1}, a[3];
+            sw_v3_sub(t, h, d);
+            if (fabs(d[2]) > 0.9 * sw_v3_norm(d)) z[1] = 1, z[2] = 0;
+            sw_v3_cross(d, z, a);
+            double n = sw_v3_norm(a);
             if (n == 0) continue;
             for (int i = 0; i < 3; ++i)
                 sweep_axis[3 * b + i] = a[i] / n;

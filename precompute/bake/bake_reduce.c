@@ -12,6 +12,7 @@
 #include "bake_internal.h"
 #include "fem_corot.h"
 #include "mesh_io.h"
+#include "vec3.h"
 
 #define OWN(ptr, n, type)                                                                          \
     ((ptr) = sw_bake_own(out, calloc((size_t)(n) > 0 ? (size_t)(n) : 1, sizeof(type))))
@@ -24,8 +25,7 @@ static double mean_edge(const sw_tetmesh *m) {
         for (int k = 0; k < 6; ++k) {
             const double *a = m->X + 3 * m->tets[4 * t + e[k][0]],
                          *b = m->X + 3 * m->tets[4 * t + e[k][1]];
-            sum += sqrt((a[0] - b[0]) * (a[0] - b[0]) + (a[1] - b[1]) * (a[1] - b[1]) +
-                        (a[2] - b[2]) * (a[2] - b[2]));
+            sum += sw_v3_dist(a, b);
         }
     return m->ntets > 0 ? sum / (6.0 * m->ntets) : 0;
 }

@@ -6,6 +6,7 @@
 #include "dqs.h"
 
 #include "mesh_io.h"
+#include "vec3.h"
 
 #include <errno.h>
 #include <math.h>
@@ -33,7 +34,7 @@ static void quat_to_mat(const double *q, double *R) {
 static void slerp_from_identity(const double *q, double a, double *out) {
     double sgn = q[3] < 0 ? -1.0 : 1.0; /* q and -q are the same rotation */
     double v[3] = {sgn * q[0], sgn * q[1], sgn * q[2]}, w = sgn * q[3];
-    double s = sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2]);
+    double s = sw_v3_norm(v);
     double half = atan2(s, w); /* half angle in [0, pi/2] */
     double k = s > 0 ? sin(a * half) / s : a;
     for (int i = 0; i < 3; ++i)

@@ -4,12 +4,7 @@
 #include <string.h>
 
 #include "mesh_io.h"
-
-static void cross(const double *a, const double *b, double *c) {
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
+#include "vec3.h"
 
 /* Smallest and largest of the six dihedral angles (radians). The dihedral angle at the
  * edge shared by faces k and l is pi minus the angle between their outward normals;
@@ -20,12 +15,10 @@ static void dihedrals(const double *p[4], double *lo, double *hi) {
     double n[4][3], len[4];
     for (int k = 0; k < 4; ++k) {
         double e1[3], e2[3];
-        for (int i = 0; i < 3; ++i) {
-            e1[i] = p[face[k][1]][i] - p[face[k][0]][i];
-            e2[i] = p[face[k][2]][i] - p[face[k][0]][i];
-        }
-        cross(e1, e2, n[k]);
-        len[k] = sqrt(n[k][0] * n[k][0] + n[k][1] * n[k][1] + n[k][2] * n[k][2]);
+        sw_v3_sub(p[face[k][1]], p[face[k][0]], e1);
+        sw_v3_sub(p[face[k][2]], p[face[k][0]], e2);
+        sw_v3_cross(e1, e2, n[k]);
+        len[k] = sw_v3_norm(n[k]);
     }
     *lo = INFINITY;
     *hi = -INFINITY;
@@ -33,8 +26,7 @@ static void dihedrals(const double *p[4], double *lo, double *hi) {
         for (int l = k + 1; l < 4; ++l) {
             double a = 0.0;
             if (len[k] > 0.0 && len[l] > 0.0) {
-                double c = -(n[k][0] * n[l][0] + n[k][1] * n[l][1] + n[k][2] * n[l][2]) /
-                           (len[k] * len[l]);
+                double c = -sw_v3_dot(n[k], n[l]) / (len[k] * len[l]);
                 a = acos(c < -1.0 ? -1.0 : (c > 1.0 ? 1.0 : c));
             }
             if (a < *lo) *lo = a;

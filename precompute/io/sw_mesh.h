@@ -112,7 +112,6 @@ void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, do
 /* Distance from point p to the segment a-b (a point when a == b). */
 double sw_point_segment_distance(const double *p, const double *a, const double *b);
 
-
 /* Applies rigid transform T (12) to p (3) into out (3); out may alias p. */
 void sw_transform_point(const double *T, const double *p, double *out);
 

@@ -9,6 +9,7 @@
 
 #include "bvh.h"
 #include "penalty.h"
+#include "vec3.h"
 
 /* A vertex counts as inside a tet when all its barycentrics are >= -this. */
 #define SC_BARY_TOL 1e-12
@@ -36,21 +37,9 @@ struct sw_selfcontact {
     double max_depth;
 };
 
-static void sub3(const double *a, const double *b, double *o) {
-    o[0] = a[0] - b[0], o[1] = a[1] - b[1], o[2] = a[2] - b[2];
-}
-static void cross3(const double *a, const double *b, double *o) {
-    o[0] = a[1] * b[2] - a[2] * b[1];
-    o[1] = a[2] * b[0] - a[0] * b[2];
-    o[2] = a[0] * b[1] - a[1] * b[0];
-}
-static double dot3(const double *a, const double *b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-static double det3(const double *a, const double *b, const double *c) {
-    double t[3];
-    cross3(b, c, t);
-    return dot3(a, t);
+/* The penalty section below still calls dot3 by that name. */
+static inline double dot3(const double *a, const double *b) {
+    return sw_v3_dot(a, b);
 }
 
 void sw_selfcontact_destroy(sw_selfcontact *sc) {
@@ -135,10 +124,10 @@ static sinew_result validate(const sw_tetmesh *m, const sw_surface *s, double fa
                     "surface vertex list",
                     (int)t, (int)v[k]);
         double e1[3], e2[3], nrm[3];
-        sub3(m->X + 3 * (size_t)v[1], m->X + 3 * (size_t)v[0], e1);
-        sub3(m->X + 3 * (size_t)v[2], m->X + 3 * (size_t)v[0], e2);
-        cross3(e1, e2, nrm);
-        if (!(dot3(nrm, nrm) > 0))
+        sw_v3_sub(m->X + 3 * (size_t)v[1], m->X + 3 * (size_t)v[0], e1);
+        sw_v3_sub(m->X + 3 * (size_t)v[2], m->X + 3 * (size_t)v[0], e2);
+        sw_v3_cross(e1, e2, nrm);
+        if (!(sw_v3_dot(nrm, nrm) > 0))
             return sw_error_set(
                 err, SINEW_ERROR_DEGENERATE,
                 "sw_selfcontact_create: surface triangle %d (%d %d %d) has zero rest area", (int)t,
@@ -155,13 +144,13 @@ static void rest_measures(sw_selfcontact *sc) {
         const double *a = sc->X + 3 * (size_t)v[0], *b = sc->X + 3 * (size_t)v[1],
                      *c = sc->X + 3 * (size_t)v[2];
         double e[3][3], nrm[3];
-        sub3(b, a, e[0]);
-        sub3(c, b, e[1]);
-        sub3(a, c, e[2]);
-        cross3(e[0], e[2], nrm);
-        double area = 0.5 * sqrt(dot3(nrm, nrm)), longest = 0;
+        sw_v3_sub(b, a, e[0]);
+        sw_v3_sub(c, b, e[1]);
+        sw_v3_sub(a, c, e[2]);
+        sw_v3_cross(e[0], e[2], nrm);
+        double area = 0.5 * sw_v3_norm(nrm), longest = 0;
         for (int k = 0; k < 3; ++k) {
-            double l = sqrt(dot3(e[k], e[k]));
+            double l = sw_v3_norm(e[k]);
             if (l > longest) longest = l;
         }
         sc->tri_area[t] = area;
@@ -221,10 +210,9 @@ sinew_result sw_selfcontact_create(const sw_tetmesh *mesh, const sw_surface *sur
             if (sc->X[3 * i + k] < lo[k]) lo[k] = sc->X[3 * i + k];
             if (sc->X[3 * i + k] > hi[k]) hi[k] = sc->X[3 * i + k];
         }
-    double diag[3] = {hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]};
     /* Every rest point lies in the bounding box, so this radius always finds the
      * closest surface triangle, yet it is finite (STYLE.md §6). */
-    sc->rest_diag = 1.01 * sqrt(dot3(diag, diag)) + 1e-300;
+    sc->rest_diag = 1.01 * sw_v3_dist(hi, lo) + 1e-300;
 
     sw_bvh_element_boxes(sc->tris, 3, sc->X, 0, sc->ntris, box);
     r = sw_bvh_build(sc->ntris, box, &sc->tri_bvh, err);
@@ -259,20 +247,20 @@ static int tet_barycentrics(const double *x, const int32_t *v, const double *p, 
     const double *x0 = x + 3 * (size_t)v[0], *x1 = x + 3 * (size_t)v[1], *x2 = x + 3 * (size_t)v[2],
                  *x3 = x + 3 * (size_t)v[3];
     double e1[3], e2[3], e3[3], q0[3], q1[3], q2[3], q3[3];
-    sub3(x1, x0, e1);
-    sub3(x2, x0, e2);
-    sub3(x3, x0, e3);
-    double vol = det3(e1, e2, e3);
+    sw_v3_sub(x1, x0, e1);
+    sw_v3_sub(x2, x0, e2);
+    sw_v3_sub(x3, x0, e3);
+    double vol = sw_v3_triple(e1, e2, e3);
     if (!(vol != 0) || !isfinite(vol)) return 0;
-    sub3(x0, p, q0);
-    sub3(x1, p, q1);
-    sub3(x2, p, q2);
-    sub3(x3, p, q3);
+    sw_v3_sub(x0, p, q0);
+    sw_v3_sub(x1, p, q1);
+    sw_v3_sub(x2, p, q2);
+    sw_v3_sub(x3, p, q3);
     /* Each weight is the signed volume of the tet with its vertex replaced by p. */
-    b[0] = det3(q1, q2, q3) / vol;
-    b[1] = -det3(q0, q2, q3) / vol;
-    b[2] = det3(q0, q1, q3) / vol;
-    b[3] = -det3(q0, q1, q2) / vol;
+    b[0] = sw_v3_triple(q1, q2, q3) / vol;
+    b[1] = -sw_v3_triple(q0, q2, q3) / vol;
+    b[2] = sw_v3_triple(q0, q1, q3) / vol;
+    b[3] = -sw_v3_triple(q0, q1, q2) / vol;
     return 1;
 }
 
@@ -305,8 +293,8 @@ static int visit_tet(void *ctx, int32_t t) {
     sw_closest_point_triangle(Xp, sc->X + 3 * (size_t)tv[0], sc->X + 3 * (size_t)tv[1],
                               sc->X + 3 * (size_t)tv[2], beta, Q);
     double dQ[3];
-    sub3(Q, Xp, dQ);
-    if (sqrt(dot3(dQ, dQ)) < sc->neighbour_factor * edge) return 0;
+    sw_v3_sub(Q, Xp, dQ);
+    if (sw_v3_norm(dQ) < sc->neighbour_factor * edge) return 0;
     if (q->tet < 0 || hit.dist > q->rest_depth || (hit.dist == q->rest_depth && t < q->tet)) {
         q->tet = t;
         q->rest_depth = hit.dist;
@@ -330,8 +318,8 @@ static void make_contact(const sw_selfcontact *sc, const double *x, int32_t si,
     }
     c->ka = 0.25 * (sc->ring[si] + sc->tri_area[q->hit.tri]);
     double d[3];
-    sub3(vs, q->xp, d);
-    double len = sqrt(dot3(d, d));
+    sw_v3_sub(vs, q->xp, d);
+    double len = sw_v3_norm(d);
     c->depth = len;
     if (len > 0 && isfinite(len)) {
         for (int j = 0; j < 3; ++j)
@@ -343,10 +331,10 @@ static void make_contact(const sw_selfcontact *sc, const double *x, int32_t si,
     double e1[3], e2[3], nrm[3];
     for (int pass = 0; pass < 2; ++pass) {
         const double *P = pass == 0 ? x : sc->X;
-        sub3(P + 3 * (size_t)tv[1], P + 3 * (size_t)tv[0], e1);
-        sub3(P + 3 * (size_t)tv[2], P + 3 * (size_t)tv[0], e2);
-        cross3(e1, e2, nrm);
-        double l = sqrt(dot3(nrm, nrm));
+        sw_v3_sub(P + 3 * (size_t)tv[1], P + 3 * (size_t)tv[0], e1);
+        sw_v3_sub(P + 3 * (size_t)tv[2], P + 3 * (size_t)tv[0], e2);
+        sw_v3_cross(e1, e2, nrm);
+        double l = sw_v3_norm(nrm);
         if (l > 0 && isfinite(l)) {
             for (int j = 0; j < 3; ++j)
                 c->n[j] = nrm[j] / l;

@@ -12,6 +12,7 @@
 #include "rig.h"
 
 #include "mesh_io.h"
+#include "vec3.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -26,21 +27,6 @@ static double bone_distance(const sw_tetmesh *m, const sw_skeleton *s, int32_t v
                                      s->joints + 3 * s->bones[2 * b + 1]);
 }
 
-static void sub3(const double *a, const double *b, double *c) {
-    for (int i = 0; i < 3; ++i)
-        c[i] = a[i] - b[i];
-}
-
-static double dot3(const double *a, const double *b) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static void cross3(const double *a, const double *b, double *c) {
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
-}
-
 /* Affine rank of the listed vertices (-1 none, 0 point, 1 line, 2 plane, 3 space), found
  * greedily: the point farthest from the first, then the largest triangle, then the
  * largest tet, each compared with the set's extent (1e-3 relative). */
@@ -50,27 +36,27 @@ static int affine_rank(const sw_tetmesh *m, const int32_t *ids, int32_t n) {
     double e1[3] = {0, 0, 0}, L2 = 0, A2 = 0, nrm[3] = {0, 0, 0}, vol = 0;
     for (int32_t i = 1; i < n; ++i) {
         double d[3];
-        sub3(m->X + 3 * ids[i], a, d);
-        if (dot3(d, d) > L2) {
-            L2 = dot3(d, d);
+        sw_v3_sub(m->X + 3 * ids[i], a, d);
+        if (sw_v3_dot(d, d) > L2) {
+            L2 = sw_v3_dot(d, d);
             memcpy(e1, d, sizeof d);
         }
     }
     if (!(L2 > 0)) return 0;
     for (int32_t i = 1; i < n; ++i) {
         double d[3], c[3];
-        sub3(m->X + 3 * ids[i], a, d);
-        cross3(e1, d, c);
-        if (dot3(c, c) > A2) {
-            A2 = dot3(c, c);
+        sw_v3_sub(m->X + 3 * ids[i], a, d);
+        sw_v3_cross(e1, d, c);
+        if (sw_v3_dot(c, c) > A2) {
+            A2 = sw_v3_dot(c, c);
             memcpy(nrm, c, sizeof c);
         }
     }
     if (!(A2 > 1e-6 * L2 * L2)) return 1; /* all within 1e-3 L of a line */
     for (int32_t i = 1; i < n; ++i) {
         double d[3];
-        sub3(m->X + 3 * ids[i], a, d);
-        vol = fmax(vol, fabs(dot3(nrm, d)));
+        sw_v3_sub(m->X + 3 * ids[i], a, d);
+        vol = fmax(vol, fabs(sw_v3_dot(nrm, d)));
     }
     return vol > 1e-3 * sqrt(L2) * sqrt(A2) ? 3 : 2; /* a point 1e-3 L off the plane */
 }
@@ -193,16 +179,16 @@ static void flesh_radii(const sw_tetmesh *m, const sw_skeleton *s, const unsigne
     for (int32_t b = 0; b < s->nbones; ++b) {
         const double *h = s->joints + 3 * s->bones[2 * b], *t = s->joints + 3 * s->bones[2 * b + 1];
         double ax[3], L2, beside = INFINITY, own = INFINITY, any = INFINITY;
-        sub3(t, h, ax);
-        L2 = dot3(ax, ax);
+        sw_v3_sub(t, h, ax);
+        L2 = sw_v3_dot(ax, ax);
         for (int32_t v = 0; v < m->nverts; ++v) {
             if (!surf[v]) continue;
             double d = bone_distance(m, s, v, b), hv[3];
             any = fmin(any, d);
             if (dom[v] != b) continue;
             own = fmin(own, d);
-            sub3(m->X + 3 * v, h, hv);
-            double u = dot3(hv, ax);
+            sw_v3_sub(m->X + 3 * v, h, hv);
+            double u = sw_v3_dot(hv, ax);
             if (u > 0 && u < L2) beside = fmin(beside, d);
         }
         radius[b] = isfinite(beside) ? beside : (isfinite(own) ? own : any);

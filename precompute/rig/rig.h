@@ -16,4 +16,8 @@ sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton 
 sinew_result sw_select_bone_vertices(const sw_tetmesh *m, const sw_skeleton *s, const sw_weights *w,
                                      int32_t *bone_of_vertex, sw_error *err);
 
+/* The bounding-box diagonal of a mesh and its skeleton's joints: the scale the weights'
+ * distance clamps are relative to. */
+double sw_rig_diagonal(const sw_tetmesh *m, const sw_skeleton *s);
+
 #endif

@@ -7,6 +7,9 @@
  * not depend on the thread count. */
 #include "weights_heat.h"
 
+#include "rig.h"
+#include "vec3.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -134,25 +137,10 @@ static sinew_result validate(const sw_tetmesh *m, const sw_skeleton *s, double c
     return SINEW_OK;
 }
 
-/* Bounding-box diagonal of mesh and joints: the scale of the distance clamp. */
-static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t v = 0; v < m->nverts + s->njoints; ++v) {
-        const double *p =
-            v < m->nverts ? m->X + 3 * (size_t)v : s->joints + 3 * (size_t)(v - m->nverts);
-        for (int i = 0; i < 3; ++i) {
-            lo[i] = fmin(lo[i], p[i]);
-            hi[i] = fmax(hi[i], p[i]);
-        }
-    }
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
-}
-
 /* Distances, H, and the matrix values A = L + H on the pattern. */
 static sinew_result assemble(const sw_tetmesh *m, const sw_skeleton *s, double c, heat_system *S,
                              sw_error *err) {
-    double dclamp = HEAT_MIN_DIST_FRACTION * scene_diagonal(m, s);
+    double dclamp = HEAT_MIN_DIST_FRACTION * sw_rig_diagonal(m, s);
     if (!(dclamp > 0)) dclamp = 1e-300;
     for (int32_t v = 0; v < S->n; ++v) {
         double *d = S->dist + (size_t)v * S->nbones, dm = INFINITY;

@@ -1,6 +1,7 @@
 /* Inverse-distance skin weights, for assets that ship none (the bake computes the
  * heat-diffusion weights of DESIGN.md §8; these only need to be plausible and smooth). */
 #include "rig.h"
+#include "vec3.h"
 
 #include "bbox.h"
 
@@ -8,9 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-/* Length of the diagonal of the box around the mesh and the joints: the scale that
- * makes the distance clamp relative. */
-static double scene_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
+double sw_rig_diagonal(const sw_tetmesh *m, const sw_skeleton *s) {
     double lo[3], hi[3];
     sw_bbox_empty(lo, hi);
     sw_bbox_add(lo, hi, m->nverts, m->X);
@@ -42,7 +41,7 @@ sinew_result sw_weights_inverse_distance(const sw_tetmesh *m, const sw_skeleton 
                             "inverse-distance weights: out of memory");
     /* A vertex on a segment would divide by zero: distances are clamped to a tiny
      * fraction of the model size, which makes that bone's weight ~1. */
-    double eps = 1e-9 * scene_diagonal(m, s);
+    double eps = 1e-9 * sw_rig_diagonal(m, s);
     if (!(eps > 0)) eps = 1e-300;
     for (int32_t v = 0; v < m->nverts; ++v) {
         double *row = w + (size_t)v * s->nbones, dmin = INFINITY, sum = 0;

@@ -1,5 +1,6 @@
 /* AABB tree: median-split build, backward-sweep refit, fixed-stack queries. */
 #include "bvh.h"
+#include "vec3.h"
 
 #include <math.h>
 #include <stdlib.h>
@@ -262,18 +263,14 @@ static double box_dist2(const double *b, const double *p) {
 void sw_closest_point_triangle(const double p[3], const double a[3], const double b[3],
                                const double c[3], double beta[3], double q[3]) {
     double ab[3], ac[3], ap[3], bp[3], cp[3];
-    for (int k = 0; k < 3; ++k) {
-        ab[k] = b[k] - a[k];
-        ac[k] = c[k] - a[k];
-        ap[k] = p[k] - a[k];
-        bp[k] = p[k] - b[k];
-        cp[k] = p[k] - c[k];
-    }
-#define DOT(u, v) ((u)[0] * (v)[0] + (u)[1] * (v)[1] + (u)[2] * (v)[2])
-    double d1 = DOT(ab, ap), d2 = DOT(ac, ap);
-    double d3 = DOT(ab, bp), d4 = DOT(ac, bp);
-    double d5 = DOT(ab, cp), d6 = DOT(ac, cp);
-#undef DOT
+    sw_v3_sub(b, a, ab);
+    sw_v3_sub(c, a, ac);
+    sw_v3_sub(p, a, ap);
+    sw_v3_sub(p, b, bp);
+    sw_v3_sub(p, c, cp);
+    double d1 = sw_v3_dot(ab, ap), d2 = sw_v3_dot(ac, ap);
+    double d3 = sw_v3_dot(ab, bp), d4 = sw_v3_dot(ac, bp);
+    double d5 = sw_v3_dot(ab, cp), d6 = sw_v3_dot(ac, cp);
     double u, v, w; /* weights of a, b, c */
     double vc = d1 * d4 - d3 * d2, vb = d5 * d2 - d1 * d6, va = d3 * d6 - d5 * d4;
     if (d1 <= 0 && d2 <= 0) { /* vertex region a */

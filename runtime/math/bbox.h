@@ -6,6 +6,8 @@
 #include <math.h>
 #include <stdint.h>
 
+#include "vec3.h"
+
 /* lo, hi = the empty box (every point added grows it). */
 static inline void sw_bbox_empty(double lo[3], double hi[3]) {
     for (int i = 0; i < 3; ++i) {
@@ -25,8 +27,7 @@ static inline void sw_bbox_add(double lo[3], double hi[3], int32_t n, const doub
 
 /* The box's diagonal |hi - lo|. */
 static inline double sw_bbox_diagonal(const double lo[3], const double hi[3]) {
-    return sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    return sw_v3_dist(hi, lo);
 }
 
 #endif

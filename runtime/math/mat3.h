@@ -1,7 +1,10 @@
 /* Small static-inline 3x3 helpers for the material kernels (svd3.c, fem_corot.c).
- * Row-major 3x3 matrices, 3-vectors as double[3]. Private to the runtime. */
+ * Row-major 3x3 matrices; the 3-vector helpers (sw_v3_dot, sw_v3_cross, ...) are vec3.h's.
+ * Private to the runtime. */
 #ifndef SW_MAT3_H
 #define SW_MAT3_H
+
+#include "vec3.h"
 
 /* C = A B (C may not alias A or B). */
 static inline void sw_m3_mul(const double A[9], const double B[9], double C[9]) {
@@ -33,16 +36,6 @@ static inline double sw_m3_det(const double A[9]) {
 static inline void sw_m3_identity(double A[9]) {
     for (int i = 0; i < 9; ++i)
         A[i] = (i % 4 == 0) ? 1.0 : 0.0;
-}
-
-static inline double sw_v3_dot(const double a[3], const double b[3]) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-
-static inline void sw_v3_cross(const double a[3], const double b[3], double c[3]) {
-    c[0] = a[1] * b[2] - a[2] * b[1];
-    c[1] = a[2] * b[0] - a[0] * b[2];
-    c[2] = a[0] * b[1] - a[1] * b[0];
 }
 
 #endif

@@ -2,8 +2,8 @@
  * Not part of the default build. Build and run (clang with libFuzzer):
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
- *     -Iplugin_api/include -Iruntime/blob -Iruntime/math tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c -lm \
- *     -o build-fuzz-blob
+ *     -Iplugin_api/include -Iruntime/blob -Iruntime/math \
+ *     tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c -lm -o build-fuzz-blob
  *   mkdir -p /tmp/blob-corpus && ./build-fuzz-blob -max_len=65536 /tmp/blob-corpus
  *
  * Seed the corpus with real blobs (e.g. the bake's output, or the bytes test_blob writes)

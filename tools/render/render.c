@@ -1,6 +1,7 @@
 /* Ray-cast renderer over Embree 3 (see render.h). Geometry goes to Embree as float
  * triangles; shading is done here in double, per pixel, independent of thread count. */
 #include "render.h"
+#include "vec3.h"
 
 #include <embree3/rtcore.h>
 #include <float.h>
@@ -14,31 +15,6 @@
 /* Coordinates beyond this would lose everything when converted to float for Embree. */
 #define COORD_MAX 1e30
 
-/* ---- small vector helpers ------------------------------------------------------- */
-
-static double dot3(const double a[3], const double b[3]) {
-    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2];
-}
-static void cross3(const double a[3], const double b[3], double o[3]) {
-    double r[3] = {a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0]};
-    memcpy(o, r, sizeof r);
-}
-static double norm3(const double a[3]) {
-    return sqrt(dot3(a, a));
-}
-/* Normalises in place; returns the old length (0 leaves `a` unchanged). */
-static double normalize3(double a[3]) {
-    double n = norm3(a);
-    if (n > 0) {
-        a[0] /= n;
-        a[1] /= n;
-        a[2] /= n;
-    }
-    return n;
-}
-static int finite3(const double a[3]) {
-    return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
-}
 static double clamp01(double x) {
     return x < 0 ? 0 : (x > 1 ? 1 : x);
 }
@@ -93,12 +69,12 @@ sinew_result sw_render_bbox(int32_t nverts, const double *X, double bmin[3], dou
 static int camera_basis(const sw_render_params *p, double fwd[3], double right[3], double cup[3]) {
     for (int k = 0; k < 3; ++k)
         fwd[k] = p->target[k] - p->eye[k];
-    if (!(normalize3(fwd) > 0)) return 0;
-    cross3(fwd, p->up, right);
-    double n = norm3(right), nu = norm3(p->up);
+    if (!(sw_v3_normalize(fwd) > 0)) return 0;
+    sw_v3_cross(fwd, p->up, right);
+    double n = sw_v3_norm(right), nu = sw_v3_norm(p->up);
     if (!(n > 1e-9 * nu)) return 0;
-    normalize3(right);
-    cross3(right, fwd, cup);
+    sw_v3_normalize(right);
+    sw_v3_cross(right, fwd, cup);
     return 1;
 }
 
@@ -106,7 +82,7 @@ sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], c
                                     sw_error *err) {
     if (!p || !bmin || !bmax)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "render: NULL argument");
-    if (!finite3(bmin) || !finite3(bmax))
+    if (!sw_v3_isfinite(bmin) || !sw_v3_isfinite(bmax))
         return sw_error_set(err, SINEW_ERROR_NOT_FINITE, "render: bounding box is not finite");
     for (int k = 0; k < 3; ++k)
         if (bmin[k] > bmax[k])
@@ -124,24 +100,24 @@ sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], c
                             "render: view azimuth %g / elevation %g (elevation within (-90, 90))",
                             p->view_azimuth_deg, p->view_elevation_deg);
     double u[3] = {p->up[0], p->up[1], p->up[2]};
-    if (!finite3(u) || !(normalize3(u) > 0))
+    if (!sw_v3_isfinite(u) || !(sw_v3_normalize(u) > 0))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "render: up vector is zero");
     /* "Front" is +Z unless up is close to Z (then +X), made perpendicular to up. */
     double f[3] = {0, 0, 1};
     if (fabs(u[2]) > 0.9) f[0] = 1, f[2] = 0;
-    double fu = dot3(f, u);
+    double fu = sw_v3_dot(f, u);
     for (int k = 0; k < 3; ++k)
         f[k] -= fu * u[k];
-    normalize3(f);
+    sw_v3_normalize(f);
     double s[3];
-    cross3(u, f, s);
+    sw_v3_cross(u, f, s);
     double c[3], d[3];
     for (int k = 0; k < 3; ++k) {
         c[k] = 0.5 * (bmin[k] + bmax[k]);
         d[k] = bmax[k] - bmin[k];
     }
-    double r = 0.5 * norm3(d);
-    if (!(r > 0)) r = 1e-3 * (1.0 + norm3(c)); /* a single point: any small frame */
+    double r = 0.5 * sw_v3_norm(d);
+    if (!(r > 0)) r = 1e-3 * (1.0 + sw_v3_norm(c)); /* a single point: any small frame */
     /* The bounding sphere fits when its angular radius is below the tighter half fov. */
     double ty = tan(0.5 * p->fov_y_deg * PI / 180.0);
     double tx = ty * (double)p->width / (double)p->height;
@@ -157,7 +133,7 @@ sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], c
     for (int i = 0; i < 8; ++i) {
         double corner[3] = {(i & 1) ? bmax[0] : bmin[0], (i & 2) ? bmax[1] : bmin[1],
                             (i & 4) ? bmax[2] : bmin[2]};
-        double h = dot3(corner, u);
+        double h = sw_v3_dot(corner, u);
         if (h < lo) lo = h;
     }
     p->ground_level = lo;
@@ -181,7 +157,8 @@ static sinew_result validate_params(const sw_render_params *p, sw_error *err) {
     if (p->threads < 0 || p->threads > 64)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "render: thread count %d outside 0..64", p->threads);
-    if (!finite3(p->eye) || !finite3(p->target) || !finite3(p->up) || !finite3(p->key_dir))
+    if (!sw_v3_isfinite(p->eye) || !sw_v3_isfinite(p->target) || !sw_v3_isfinite(p->up) ||
+        !sw_v3_isfinite(p->key_dir))
         return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
                             "render: camera or light vector is not finite");
     double a[3], b[3], c[3];
@@ -291,13 +268,13 @@ static float *vertex_normals(int32_t nverts, const double *X, int32_t ntris, con
         double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
         double e2[3] = {c[0] - a[0], c[1] - a[1], c[2] - a[2]};
         double fn[3];
-        cross3(e1, e2, fn);
+        sw_v3_cross(e1, e2, fn);
         for (int i = 0; i < 3; ++i)
             for (int k = 0; k < 3; ++k)
                 acc[3 * (int64_t)v[i] + k] += fn[k];
     }
     for (int32_t v = 0; v < nverts; ++v) {
-        normalize3(acc + 3 * (int64_t)v);
+        sw_v3_normalize(acc + 3 * (int64_t)v);
         for (int k = 0; k < 3; ++k)
             n[3 * (int64_t)v + k] = (float)acc[3 * (int64_t)v + k];
     }
@@ -369,7 +346,7 @@ static int occluded(const render_ctx *c, const double o[3], const double d[3]) {
  * viewer. Returns linear radiance for `albedo`. */
 static void lambert(const render_ctx *c, const double pos[3], const double n[3],
                     const double albedo[3], double out[3]) {
-    double kd = dot3(n, c->key_dir), fd = dot3(n, c->fill_dir);
+    double kd = sw_v3_dot(n, c->key_dir), fd = sw_v3_dot(n, c->fill_dir);
     double light = c->p->ambient + c->p->fill * (fd > 0 ? fd : 0);
     if (kd > 0) {
         double o[3];
@@ -394,11 +371,11 @@ static void shade_surface(const render_ctx *c, const struct RTCRayHit *rh, const
     double e1[3] = {b[0] - a[0], b[1] - a[1], b[2] - a[2]};
     double e2[3] = {q[0] - a[0], q[1] - a[1], q[2] - a[2]};
     double ng[3];
-    cross3(e1, e2, ng); /* CCW geometric normal, same convention as vertex_normals */
-    normalize3(ng);
+    sw_v3_cross(e1, e2, ng); /* CCW geometric normal, same convention as vertex_normals */
+    sw_v3_normalize(ng);
     /* Face the viewer: an inverted or self-intersecting patch seen from its back still
      * gets light instead of a black hole. The smooth normal flips with it. */
-    double sgn = dot3(ng, dir) > 0 ? -1.0 : 1.0;
+    double sgn = sw_v3_dot(ng, dir) > 0 ? -1.0 : 1.0;
     double n[3] = {sgn * ng[0], sgn * ng[1], sgn * ng[2]};
     if (c->vnormals) {
         double u = rh->hit.u, w = rh->hit.v, s[3];
@@ -407,7 +384,7 @@ static void shade_surface(const render_ctx *c, const struct RTCRayHit *rh, const
                           u * c->vnormals[3 * (int64_t)v[1] + k] +
                           w * c->vnormals[3 * (int64_t)v[2] + k]);
         /* Keep the smooth normal only where it agrees with the face. */
-        if (normalize3(s) > 1e-6 && dot3(s, n) > 0) memcpy(n, s, sizeof n);
+        if (sw_v3_normalize(s) > 1e-6 && sw_v3_dot(s, n) > 0) memcpy(n, s, sizeof n);
     }
     double albedo[3] = {0.80, 0.45, 0.36}; /* linear skin tone */
     if (c->colors)
@@ -428,18 +405,18 @@ static void shade_ground(const render_ctx *c, double t, const double dir[3], dou
     double pos[3], n[3], rel[3];
     for (int k = 0; k < 3; ++k)
         pos[k] = p->eye[k] + t * dir[k];
-    double sgn = dot3(c->up, dir) > 0 ? -1.0 : 1.0;
+    double sgn = sw_v3_dot(c->up, dir) > 0 ? -1.0 : 1.0;
     for (int k = 0; k < 3; ++k)
         n[k] = sgn * c->up[k];
     /* Checker coordinates along the camera's right and its projection on the plane. */
     double a[3], b[3];
-    cross3(c->up, c->right, b);
-    if (!(normalize3(b) > 0)) b[0] = 1, b[1] = b[2] = 0;
-    cross3(b, c->up, a);
+    sw_v3_cross(c->up, c->right, b);
+    if (!(sw_v3_normalize(b) > 0)) b[0] = 1, b[1] = b[2] = 0;
+    sw_v3_cross(b, c->up, a);
     for (int k = 0; k < 3; ++k)
         rel[k] = pos[k] - p->target[k];
-    double x = dot3(rel, a) / p->ground_tile, y = dot3(rel, b) / p->ground_tile;
-    double r = (dot3(rel, rel) - dot3(rel, c->up) * dot3(rel, c->up));
+    double x = sw_v3_dot(rel, a) / p->ground_tile, y = sw_v3_dot(rel, b) / p->ground_tile;
+    double r = (sw_v3_dot(rel, rel) - sw_v3_dot(rel, c->up) * sw_v3_dot(rel, c->up));
     r = sqrt(r > 0 ? r : 0) / p->ground_radius;
     if (r >= 1) {
         for (int k = 0; k < 3; ++k)
@@ -479,9 +456,9 @@ static void trace(const render_ctx *c, const double dir[3], double out[3]) {
     }
     double t_ground = INFINITY;
     if (p->ground) {
-        double dn = dot3(dir, c->up);
+        double dn = sw_v3_dot(dir, c->up);
         if (dn != 0) {
-            double t = (p->ground_level - dot3(p->eye, c->up)) / dn;
+            double t = (p->ground_level - sw_v3_dot(p->eye, c->up)) / dn;
             if (t > 0) t_ground = t;
         }
     }
@@ -509,7 +486,7 @@ static void render_row(const render_ctx *c, int32_t y) {
                 double dir[3], col[3];
                 for (int k = 0; k < 3; ++k)
                     dir[k] = c->fwd[k] + u * c->right[k] + v * c->cup[k];
-                normalize3(dir);
+                sw_v3_normalize(dir);
                 trace(c, dir, col);
                 for (int k = 0; k < 3; ++k)
                     acc[k] += col[k];
@@ -557,15 +534,15 @@ static void render_rows(const render_ctx *c) {
 static void setup_lights(render_ctx *c) {
     const sw_render_params *p = c->p;
     memcpy(c->up, p->up, sizeof c->up);
-    normalize3(c->up);
+    sw_v3_normalize(c->up);
     memcpy(c->key_dir, p->key_dir, sizeof c->key_dir);
-    if (!(normalize3(c->key_dir) > 0))
+    if (!(sw_v3_normalize(c->key_dir) > 0))
         for (int k = 0; k < 3; ++k) /* upper left, a little in front of the subject */
             c->key_dir[k] = -0.6 * c->right[k] + 0.7 * c->cup[k] - 0.45 * c->fwd[k];
-    normalize3(c->key_dir);
+    sw_v3_normalize(c->key_dir);
     for (int k = 0; k < 3; ++k)
         c->fill_dir[k] = 0.7 * c->right[k] - 0.2 * c->cup[k] - 0.6 * c->fwd[k];
-    normalize3(c->fill_dir);
+    sw_v3_normalize(c->fill_dir);
 }
 
 sinew_result sw_render_surface(const sw_render_params *p, int32_t nverts, const double *X,
@@ -591,13 +568,13 @@ sinew_result sw_render_surface(const sw_render_params *p, int32_t nverts, const 
     c.aspect = (double)p->width / (double)p->height;
     /* Shadow-ray offset: relative to the scene size so float round-off of the hit
      * point cannot make a surface shadow itself. */
-    double scale = norm3(p->eye) + norm3(p->target);
+    double scale = sw_v3_norm(p->eye) + sw_v3_norm(p->target);
     if (nverts > 0) {
         double bmin[3], bmax[3], d[3];
         sw_render_bbox(nverts, X, bmin, bmax, NULL);
         for (int k = 0; k < 3; ++k)
             d[k] = bmax[k] - bmin[k];
-        scale += norm3(d) + norm3(bmin) + norm3(bmax);
+        scale += sw_v3_norm(d) + sw_v3_norm(bmin) + sw_v3_norm(bmax);
     }
     c.eps = 2e-5 * (scale > 0 ? scale : 1.0);
 
