@@ -18,6 +18,9 @@
  *   ref_unsettled reference solutions behind err_* whose self-contact set the
  *             simulator's round cap stopped while it still changed (their fold, and the
  *             error measured against it, depend on the cap)
+ *   phase_ms  median ms/frame of each phase of the step (the step's own stats: skin,
+ *             contact, dynamics, solve, output), and potential_evals, the mean number of
+ *             potential evaluations (cubature passes) a step
  * Ratios: speedup_vs_full = full_ms / sub_ms, cost_vs_dqs = sub_ms / dqs_ms. The last
  * stdout line is one JSON object. */
 #include <errno.h>
@@ -46,6 +49,9 @@
 #include "surface_normals.h"
 #include "vec3.h"
 #include "weights_heat.h"
+
+/* The step's phases as sinew_step_stats reports them. */
+enum { NPHASES = 5 };
 
 static void usage(FILE *f) {
     fprintf(
@@ -237,6 +243,7 @@ int main(int argc, char **argv) {
     float *pos = malloc((size_t)ns * 3 * sizeof(float)),
           *nrm = malloc((size_t)ns * 3 * sizeof(float));
     double *sub = malloc((size_t)nf * sizeof(double));
+    double *phase = malloc((size_t)nf * NPHASES * sizeof(double)), evals = 0;
     long failed_steps = 0; /* steps that did not return SINEW_OK (a non-finite state) */
     for (int f = 0; f < nf; ++f) {
         double t0 = sw_now_seconds();
@@ -245,8 +252,18 @@ int main(int argc, char **argv) {
                             inst, 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30)) != SINEW_OK;
         sinew_instance_read_surface(inst, pos, nrm, ns);
         sub[f] = 1e3 * (sw_now_seconds() - t0);
+        sinew_step_stats st = {.struct_size = sizeof st};
+        sinew_instance_get_stats(inst, &st);
+        const double ms[NPHASES] = {st.ms_skin, st.ms_contact, st.ms_dynamics, st.ms_solve,
+                                    st.ms_output};
+        for (int k = 0; k < NPHASES; ++k)
+            phase[(size_t)k * nf + f] = ms[k];
+        evals += st.potential_evals / (double)nf;
     }
-    double sub_ms = sw_median(sub, nf);
+    double sub_ms = sw_median(sub, nf), phase_ms[NPHASES];
+    for (int k = 0; k < NPHASES; ++k)
+        phase_ms[k] = sw_median(phase + (size_t)k * nf, nf);
+    free(phase);
     if (out_dir && write_frames(out_dir, blob, inst, &ch, &err) != SINEW_OK)
         fprintf(stderr, "sinew-bench: %s\n", err.msg);
 
@@ -314,6 +331,10 @@ int main(int argc, char **argv) {
             "steps\n",
             full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms, et.correction_error,
             eh.correction_error, allocs, locks, contract_steps);
+    fprintf(stderr,
+            "             step phases (median ms): skin %.4f, contact %.4f, dynamics %.4f, solve "
+            "%.4f, output %.4f; %.1f potential evaluations a step\n",
+            phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals);
     if (json)
         printf(
             "{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
@@ -321,11 +342,14 @@ int main(int argc, char **argv) {
             "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
             "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_"
             "seconds\":%.2f,"
-            "\"err_source\":\"%s\",\"failed_steps\":%ld,\"ref_unsettled\":%d}\n",
+            "\"err_source\":\"%s\",\"failed_steps\":%ld,\"ref_unsettled\":%d,"
+            "\"phase_ms\":{\"skin\":%.4f,\"contact\":%.4f,\"dynamics\":%.4f,\"solve\":%.4f,"
+            "\"output\":%.4f},\"potential_evals\":%.2f}\n",
             ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
             sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
-            blob_path ? full_unsettled : res.train_unsettled + res.heldout_unsettled);
+            blob_path ? full_unsettled : res.train_unsettled + res.heldout_unsettled, phase_ms[0],
+            phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals);
     free(full);
     free(full_x);
     free(sub);
