@@ -1,4 +1,4 @@
-/* The reduced model the step minimises (runtime/instance.c): its gradient against
+/* The reduced model the step minimises (runtime/solver/potential.c): its gradient against
  * finite differences with the pose-space contact pairs engaged, a quasistatic shape
  * that depends on the pose and the direction it was arrived at alone, the branch of
  * the reference's path it follows, and its accuracy against the full-space training
