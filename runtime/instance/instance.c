@@ -244,17 +244,15 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sinew_instance *in = (sinew_instance *)(void *)block;
     plan = (sw_mem_plan){block, 0, 0};
     layout(&plan, in, v, &z);
-    in->blob = blob;
     in->v = v;
     in->allocator = d.allocator;
-    in->logger = d.logger;
     in->mode = d.mode;
-    in->memory_size = sw_plan_size(&plan);
     in->size = rest_size(v);
     in->red.v = v;
     in->red.R = v->rank_total;
     in->red.rmax = z.rmax;
-    in->red.nact = active_vertices(v, in->red.act_vert);
+    in->red.nact = z.nact; /* counted for the layout; now listed */
+    (void)active_vertices(v, in->red.act_vert);
     visit_active(v, &in->red, assign_active, &in->red);
     in->ps.max_pairs = z.max_pairs;
     sw_pose_space_link_twins(v, in->ps.twin_next);
@@ -264,7 +262,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sw_log(&d.logger, SINEW_LOG_INFO, SINEW_MSG_INSTANCE_CREATED,
            "sinew_instance_create: %zu bytes in one block; %d active vertices, rank %d, %d "
            "contact pairs a step at most",
-           in->memory_size, in->red.nact, in->red.R, z.max_pairs);
+           sw_plan_size(&plan), in->red.nact, in->red.R, z.max_pairs);
     *out = in;
     return SINEW_OK;
 }
@@ -289,7 +287,6 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     memcpy(ph->T_prev2, ph->T_cur, 12 * (size_t)nb * sizeof(double));
     for (int32_t b = 0; b < nb; ++b)
         sw_dq_from_transform(ph->T_cur + 12 * b, &inst->bone_dq[b]);
-    inst->pose_set = 0;
     ph->history = 0;
     sw_pose_space_reset(&inst->ps, nb);
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */

@@ -10,16 +10,12 @@
 #include "solver.h"
 
 struct sinew_instance {
-    const sinew_blob *blob;
     const sw_blob_view *v;
     sinew_allocator allocator; /* frees the block */
-    sinew_logger logger;
     sinew_step_mode mode;
-    size_t memory_size;   /* bytes of the one block (the struct comes first) */
-    double size;          /* rest bounding-box diagonal */
-    sw_dualquat *bone_dq; /* nbones: the current pose */
-    sw_pose_history pose; /* the current pose and the two before */
-    int pose_set;
+    double size;             /* rest bounding-box diagonal */
+    sw_dualquat *bone_dq;    /* nbones: the current pose */
+    sw_pose_history pose;    /* the current pose and the two before */
     sw_reduced red;          /* the subspace map and the evaluation accumulators */
     sw_pose_space ps;        /* training poses near the current one, contact pairs */
     sw_solver solver;        /* state and Newton */

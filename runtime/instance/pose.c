@@ -34,7 +34,6 @@ static sinew_result set_pose(sinew_instance *inst, const double *Td, const float
         inst->pose.T_cur[i] = Td ? Td[i] : (double)Tf[i];
     for (int32_t b = 0; b < nb; ++b)
         sw_dq_from_transform(inst->pose.T_cur + 12 * b, &inst->bone_dq[b]);
-    inst->pose_set = 1;
     return SINEW_OK;
 }
 
