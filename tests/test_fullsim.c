@@ -349,6 +349,45 @@ TEST(bad_input_is_rejected_and_state_kept) {
     sw_character_free(&c);
 }
 
+/* The direct solve (CHOLMOD) and PCG reach the same solution: the finger folded into
+ * self-contact, each frame's positions within the Newton tolerance of each other, and
+ * the direct path really factors (and never iterates PCG). */
+TEST(direct_and_pcg_solves_agree) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 5, &c, &err) == SINEW_OK);
+    sw_fullsim *sim[2];
+    for (int k = 0; k < 2; ++k) {
+        sw_fullsim_params p = sw_fullsim_params_default();
+        p.solver = k ? SW_SOLVER_CHOLMOD : SW_SOLVER_PCG;
+        p.newton_rtol = 1e-8; /* both converge far below the difference tested */
+        p.max_newton = 60;
+        ENSURE(sw_fullsim_create(&c, &p, &sim[k], &err) == SINEW_OK);
+    }
+    double scale = 0, worst = 0;
+    for (int32_t i = 0; i < 3 * c.mesh.nverts; ++i)
+        scale = fmax(scale, fabs(c.mesh.X[i]));
+    int contacts = 0;
+    for (int f = 0; f <= c.clip.nframes / 2; ++f) {
+        sw_fullsim_stats st[2];
+        for (int k = 0; k < 2; ++k)
+            ENSURE(sw_fullsim_step(sim[k], frame_T(&c, f), &st[k]) != SINEW_ERROR_NOT_FINITE);
+        ENSURE(st[0].solver == SW_SOLVER_PCG && st[1].solver == SW_SOLVER_CHOLMOD);
+        ENSURE(st[1].pcg_iters == 0 && (f == 0 || st[1].factorizations > 0));
+        contacts += st[0].contacts;
+        const double *a = sw_fullsim_positions(sim[0]), *b = sw_fullsim_positions(sim[1]);
+        for (int32_t i = 0; i < 3 * c.mesh.nverts; ++i)
+            worst = fmax(worst, fabs(a[i] - b[i]));
+        fprintf(stderr, "    frame %d: newton pcg %d / direct %d (%d factorisations), |dx| %.3g\n",
+                f, st[0].newton_iters, st[1].newton_iters, st[1].factorizations, worst);
+    }
+    ENSUREF(contacts > 0, "the fold never reached self-contact: the test would prove less");
+    ENSUREF(worst < 1e-4 * scale, "solutions differ by %.3g (scale %.3g)", worst, scale);
+    for (int k = 0; k < 2; ++k)
+        sw_fullsim_destroy(sim[k]);
+    sw_character_free(&c);
+}
+
 SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy),
              CASE(newton_converges_quadratically),
              CASE(newmark_keeps_energy_of_undamped_oscillation),
@@ -356,4 +395,5 @@ SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy),
              CASE(self_contact_removes_most_penetration_of_folded_finger),
              CASE(contacts_push_and_never_pull),
              CASE(unsettled_contact_set_is_one_another_round_changes),
-             CASE(ground_plane_pushes_flesh_out), CASE(bad_input_is_rejected_and_state_kept))
+             CASE(ground_plane_pushes_flesh_out), CASE(bad_input_is_rejected_and_state_kept),
+             CASE(direct_and_pcg_solves_agree))

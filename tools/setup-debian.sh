@@ -12,6 +12,7 @@ packages=(
     libccd-dev       # convex contact (MPR)
     libopenblas-dev  # bake-time dense linear algebra
     liblapacke-dev
+    libsuitesparse-dev # CHOLMOD: the reference's sparse direct solve (bake and tools only)
     libassimp-dev    # glTF/FBX import in the bake (DESIGN.md §5)
     clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
 )

@@ -32,6 +32,7 @@
 #include <time.h>
 
 #define SW_TOOL_CHARACTER_ARGS
+#define SW_TOOL_REFERENCE_ARGS
 #include "tool_common.h"
 #include "sw_mesh.h"
 
@@ -59,8 +60,11 @@ static void usage(FILE *f) {
         "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton "
         "FILE.tgf\n"
         "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
-        "                   [--contract-steps S] [--threads T] [--data DIR] [--out DIR] --json\n"
-        "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n");
+        "                   [--contract-steps S] [--threads T] [reference options] [--data DIR]\n"
+        "                   [--out DIR] --json\n"
+        "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n"
+        "reference options (the full-space run the bench times; a bake it runs uses the\n"
+        "defaults):\n" SW_REFERENCE_USAGE);
 }
 
 /* Plain DQS of the render surface (positions and area-weighted normals): the cost a
@@ -132,10 +136,13 @@ int main(int argc, char **argv) {
     sw_character_args_init(&ca);
     const char *blob_path = NULL, *out_dir = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
+    sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1;
-        if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
+        if (sw_reference_args_take(&ref_solver, argc, argv, &i, &ok)) {
+            if (!ok) return 2;
+        } else if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
             /* a character option, consumed */
         } else if (!strcmp(a, "--blob") && next)
             blob_path = argv[++i];
@@ -207,6 +214,9 @@ int main(int argc, char **argv) {
     /* 2. full-space reference over the first K clip frames (same motion, all cores) */
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.threads = threads;
+    fp.solver = ref_solver.solver;
+    fp.contact_rounds = ref_solver.contact_rounds;
+    fp.hessian = ref_solver.hessian;
     sw_fullsim *sim = NULL;
     int kf = full_frames > 0 && full_frames < nf ? full_frames : nf; /* default: the whole clip */
     double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));
@@ -220,12 +230,19 @@ int main(int argc, char **argv) {
         return 1;
     }
     /* the full reference steps every clip frame up to the last timed one, from rest */
-    int full_unsettled = 0; /* frames whose contact set the round cap left unsettled */
+    int full_unsettled = 0; /* frames whose contact set did not settle */
+    int full_newton_max = 0;
+    double full_mean = 0, full_max = 0;
+    sw_linear_solver full_solver = SW_SOLVER_AUTO;
     for (int f = 0; f < kf; ++f) {
         sw_fullsim_stats st;
         sw_fullsim_step(sim, ch.clip.T + (size_t)f * 12 * ch.skel.nbones, &st);
         full_unsettled += st.contacts_unsettled;
         full[f] = 1e3 * st.seconds;
+        full_mean += full[f] / kf;
+        full_max = fmax(full_max, full[f]);
+        full_newton_max = st.newton_iters > full_newton_max ? st.newton_iters : full_newton_max;
+        full_solver = st.solver;
         memcpy(full_x + (size_t)f * 3 * ch.mesh.nverts, sw_fullsim_positions(sim),
                sizeof(double) * 3 * ch.mesh.nverts);
         fprintf(stderr, "sinew-bench: full-space frame %d/%d: %.1f ms\n", f + 1, kf, full[f]);
@@ -344,12 +361,15 @@ int main(int argc, char **argv) {
             "seconds\":%.2f,"
             "\"err_source\":\"%s\",\"failed_steps\":%ld,\"ref_unsettled\":%d,"
             "\"phase_ms\":{\"skin\":%.4f,\"contact\":%.4f,\"dynamics\":%.4f,\"solve\":%.4f,"
-            "\"output\":%.4f},\"potential_evals\":%.2f}\n",
+            "\"output\":%.4f},\"potential_evals\":%.2f,\"solver\":\"%s\",\"unsettled_frames\":%d,"
+            "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f}\n",
             ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
             sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
             blob_path ? full_unsettled : res.train_unsettled + res.heldout_unsettled, phase_ms[0],
-            phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals);
+            phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
+            sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
+            full_max);
     free(full);
     free(full_x);
     free(sub);

@@ -15,6 +15,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
+#define SW_TOOL_REFERENCE_ARGS
 #include "tool_common.h"
 #include "character_io.h"
 #include "fullsim.h"
@@ -28,19 +29,16 @@ typedef struct {
 } options;
 
 static void usage(FILE *f) {
-    fprintf(f,
-            "usage: sinew-fullsim --scene NAME [--tets N] [--frames F] [--dynamic] [--newmark]\n"
-            "                     [--no-self-contact] [--ground HEIGHT] [--threads T]\n"
-            "                     [--hessian adaptive|projected|exact] [--contact-rounds R]\n"
-            "                     [--data DIR] [--out DIR] [--json]\n"
-            "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n"
-            "  --tets N      procedural resolution (default 20000)\n"
-            "  --frames F    frames to simulate (default: procedural 30, assets their clip)\n"
-            "  --dynamic     backward Euler dynamics (default quasistatic); --newmark: Newmark\n"
-            "  --hessian M   adaptive (default) | projected | exact: element Hessians Newton uses\n"
-            "  --contact-rounds R  self-contact detection rounds a frame (default 30)\n"
-            "  --out DIR     write each frame's surface as DIR/frame_NNNN.obj\n"
-            "  --json        print one JSON object with the figures as the last line\n");
+    fprintf(f, "usage: sinew-fullsim --scene NAME [--tets N] [--frames F] [--dynamic] [--newmark]\n"
+               "                     [--no-self-contact] [--ground HEIGHT] [--threads T]\n"
+               "                     [reference options] [--data DIR] [--out DIR] [--json]\n"
+               "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n"
+               "  --tets N      procedural resolution (default 20000)\n"
+               "  --frames F    frames to simulate (default: procedural 30, assets their clip)\n"
+               "  --dynamic     backward Euler dynamics (default quasistatic); --newmark: "
+               "Newmark\n" SW_REFERENCE_USAGE
+               "  --out DIR     write each frame's surface as DIR/frame_NNNN.obj\n"
+               "  --json        print one JSON object with the figures as the last line\n");
 }
 
 static int parse_args(int argc, char **argv, options *o) {
@@ -54,6 +52,7 @@ static int parse_args(int argc, char **argv, options *o) {
                                 {"--data", &o->data_dir, NULL, 0},
                                 {"--no-self-contact", NULL, &o->params.self_contact, 0},
                                 {"--json", NULL, &o->json, 1}};
+    int ok = 1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         if (sw_tool_take(opts, sizeof opts / sizeof opts[0], argc, argv, &i)) {
@@ -82,23 +81,8 @@ static int parse_args(int argc, char **argv, options *o) {
                 fprintf(stderr, "sinew-fullsim: --ground wants a height, got '%s'\n", argv[i]);
                 return 0;
             }
-        } else if (!strcmp(a, "--hessian") && next) {
-            const char *h = argv[++i];
-            if (!strcmp(h, "adaptive"))
-                o->params.hessian = SW_HESSIAN_ADAPTIVE;
-            else if (!strcmp(h, "projected"))
-                o->params.hessian = SW_HESSIAN_PROJECTED;
-            else if (!strcmp(h, "exact"))
-                o->params.hessian = SW_HESSIAN_EXACT;
-            else {
-                fprintf(stderr, "sinew-fullsim: --hessian wants adaptive|projected|exact\n");
-                return 0;
-            }
-        } else if (!strcmp(a, "--contact-rounds") && next) {
-            if (!sw_parse_int(argv[++i], 1, 100, &o->params.contact_rounds)) {
-                fprintf(stderr, "sinew-fullsim: --contact-rounds wants 1..100\n");
-                return 0;
-            }
+        } else if (sw_reference_args_take(&o->params, argc, argv, &i, &ok)) {
+            if (!ok) return 0;
         } else if (!strcmp(a, "--dynamic")) {
             o->params.integrator = SW_BACKWARD_EULER;
         } else if (!strcmp(a, "--newmark")) {
@@ -208,7 +192,9 @@ int main(int argc, char **argv) {
             o.params.self_contact ? ", self-contact on" : ", self-contact off");
     double *ms = malloc((size_t)frames * sizeof(double));
     double newton_sum = 0, pcg_sum = 0, max_pen = 0, max_ground = 0, total = 0;
-    int unconverged = 0, failed = 0, unsettled = 0;
+    int unconverged = 0, failed = 0, unsettled = 0, newton_max = 0, factors = 0;
+    double ms_max = 0;
+    sw_linear_solver solver = SW_SOLVER_AUTO;
     for (int f = 0; f < frames && ms; ++f) {
         sw_fullsim_stats st;
         r = sw_fullsim_step(sim, ch.clip.T + (size_t)f * 12 * ch.clip.nbones, &st);
@@ -223,11 +209,16 @@ int main(int argc, char **argv) {
         max_pen = fmax(max_pen, st.max_penetration);
         max_ground = fmax(max_ground, st.ground_penetration);
         unsettled += st.contacts_unsettled;
+        newton_max = st.newton_iters > newton_max ? st.newton_iters : newton_max;
+        ms_max = fmax(ms_max, ms[f]);
+        factors += st.factorizations;
+        solver = st.solver;
         fprintf(stderr,
-                "  frame %4d/%d  %8.1f ms  newton %2d  pcg %5d  |g| %.2e -> %.2e  contacts %5d  "
+                "  frame %4d/%d  %8.1f ms  newton %2d  pcg %5d  factor %3d  |g| %.2e -> %.2e  "
+                "contacts %5d  "
                 "penetration %.3g  rounds %d%s%s\n",
-                f + 1, frames, ms[f], st.newton_iters, st.pcg_iters, st.grad_norm0, st.grad_norm,
-                st.contacts, st.max_penetration, st.contact_rounds,
+                f + 1, frames, ms[f], st.newton_iters, st.pcg_iters, st.factorizations,
+                st.grad_norm0, st.grad_norm, st.contacts, st.max_penetration, st.contact_rounds,
                 st.contacts_unsettled ? "  (contact set unsettled)" : "",
                 r == SINEW_OK                    ? ""
                 : r == SINEW_ERROR_NOT_CONVERGED ? "  (not converged)"
@@ -243,26 +234,32 @@ int main(int argc, char **argv) {
     if (ms && frames > 0) {
         median = sw_median(ms, frames);
     }
+    double mean = frames > 0 ? 1e3 * total / frames : 0;
     fprintf(stderr,
-            "sinew-fullsim: median %.1f ms/frame, %.2f Newton and %.1f PCG iterations a frame, "
-            "max penetration %.4g, %d unconverged, %d failed frames, %d frames whose contact set "
-            "the round cap (%d) stopped unsettled\n",
-            median, newton_sum / frames, pcg_sum / frames, max_pen, unconverged, failed, unsettled,
+            "sinew-fullsim: %s solver, ms/frame median %.1f mean %.1f max %.1f, %.2f Newton "
+            "(max %d), %.1f PCG iterations and %.2f factorisations a frame, max penetration "
+            "%.4g, %d unconverged, %d failed frames, %d unsettled frames (round cap %d)\n",
+            sw_linear_solver_name(solver), median, mean, ms_max, newton_sum / frames, newton_max,
+            pcg_sum / frames, (double)factors / frames, max_pen, unconverged, failed, unsettled,
             o.params.contact_rounds);
     if (o.json)
         printf("{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"driven_verts\":%d,\"surface_tris\":%d,"
                "\"frames\":%d,\"mode\":\"%s\",\"self_contact\":%s,\"threads\":%d,"
-               "\"ms_per_frame\":%.3f,\"ms_per_frame_mean\":%.3f,\"newton_iters_mean\":%.3f,"
-               "\"pcg_iters_mean\":%.2f,\"max_penetration\":%.6g,\"max_ground_penetration\":%.6g,"
-               "\"unconverged_frames\":%d,\"failed_frames\":%d,\"contact_unsettled_frames\":%d}\n",
+               "\"solver\":\"%s\","
+               "\"ms_per_frame\":%.3f,\"ms_per_frame_mean\":%.3f,\"ms_per_frame_max\":%.3f,"
+               "\"newton_iters_mean\":%.3f,\"newton_iters_max\":%d,\"pcg_iters_mean\":%.2f,"
+               "\"factorizations_mean\":%.3f,\"max_penetration\":%.6g,"
+               "\"max_ground_penetration\":%.6g,\"unconverged_frames\":%d,\"failed_frames\":%d,"
+               "\"unsettled_frames\":%d}\n",
                o.scene, ch.mesh.ntets, ch.mesh.nverts, sw_fullsim_driven_count(sim), surf->ntris,
                frames,
                o.params.integrator == SW_QUASISTATIC ? "quasistatic"
                : o.params.integrator == SW_NEWMARK   ? "newmark"
                                                      : "backward_euler",
-               o.params.self_contact ? "true" : "false", o.params.threads, median,
-               1e3 * total / frames, newton_sum / frames, pcg_sum / frames, max_pen, max_ground,
-               unconverged, failed, unsettled);
+               o.params.self_contact ? "true" : "false", o.params.threads,
+               sw_linear_solver_name(solver), median, mean, ms_max, newton_sum / frames, newton_max,
+               pcg_sum / frames, (double)factors / frames, max_pen, max_ground, unconverged, failed,
+               unsettled);
     free(ms);
     free(scratch);
     free(tris);

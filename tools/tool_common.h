@@ -161,3 +161,54 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
     return r;
 }
 #endif
+
+#ifdef SW_TOOL_REFERENCE_ARGS
+/* The full-space reference's solver options, shared by sinew-fullsim, sinew-bench and
+ * sinew-bake. */
+#include "fullsim.h"
+
+#define SW_REFERENCE_USAGE                                                                         \
+    "  --solver S          the reference's linear solver: auto (default) | cholmod | pcg\n"        \
+    "  --contact-rounds R  the round cap (default 30)\n"                                           \
+    "  --hessian M         adaptive (default) | projected | exact element Hessians\n"
+
+/* When argv[*i] is a reference option, consumes it and its value and returns 1, with
+ * *ok = 0 (and a message) for a bad value; returns 0 for any other argument. */
+static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **argv, int *i,
+                                         int *ok) {
+    const char *a = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
+    if (!v) return 0;
+    if (!strcmp(a, "--solver")) {
+        ++*i;
+        *ok = 1;
+        if (!strcmp(v, "auto"))
+            p->solver = SW_SOLVER_AUTO;
+        else if (!strcmp(v, "cholmod"))
+            p->solver = SW_SOLVER_CHOLMOD;
+        else if (!strcmp(v, "pcg"))
+            p->solver = SW_SOLVER_PCG;
+        else
+            *ok = 0, fprintf(stderr, "--solver wants auto|cholmod|pcg, got '%s'\n", v);
+        return 1;
+    }
+    if (!strcmp(a, "--contact-rounds")) {
+        *ok = sw_parse_int(argv[++*i], 1, 100, &p->contact_rounds);
+        if (!*ok) fprintf(stderr, "--contact-rounds wants 1..100, got '%s'\n", v);
+        return 1;
+    }
+    if (!strcmp(a, "--hessian")) {
+        ++*i;
+        *ok = 1;
+        if (!strcmp(v, "adaptive"))
+            p->hessian = SW_HESSIAN_ADAPTIVE;
+        else if (!strcmp(v, "projected"))
+            p->hessian = SW_HESSIAN_PROJECTED;
+        else if (!strcmp(v, "exact"))
+            p->hessian = SW_HESSIAN_EXACT;
+        else
+            *ok = 0, fprintf(stderr, "--hessian wants adaptive|projected|exact, got '%s'\n", v);
+        return 1;
+    }
+    return 0;
+}
+#endif

@@ -12,8 +12,9 @@
  *   backward Euler: c_m = 1/h^2, xhat = x_n + h v_n, c_d = 1/h, s = 0;
  *   Newmark (1/4, 1/2): c_m = 4/h^2, xhat = x_n + h v_n + h^2/4 a_n, c_d = 2/h, s = 1.
  * The Newton system (K + Kc + Kg + c_m M + c_d D) dx = -grad Phi is solved by
- * block-Jacobi PCG, warm-started from the previous Newton update; assembly and the
- * matrix product run on a pthread pool. Self-contacts are detected once per contact
+ * block-Jacobi PCG, warm-started from the previous Newton update, or by a sparse direct
+ * Cholesky (CHOLMOD, sparse_chol.h; --solver cholmod); assembly and the matrix product
+ * run on a pthread pool. Self-contacts are detected once per contact
  * round and frozen while Newton converges (re-detecting every iteration makes Newton
  * chase a changing energy and stall). Between rounds the set is updated as an active
  * set: new penetrations join, and a pair the solve held by pulling (its vertex in
@@ -44,6 +45,17 @@ typedef enum sw_hessian_mode {
     SW_HESSIAN_EXACT = 2      /* always exact, truncated PCG (Newton-CG) */
 } sw_hessian_mode;
 
+/* Which linear solver takes the Newton systems. */
+typedef enum sw_linear_solver {
+    SW_SOLVER_AUTO = 0,    /* by problem size (sw_fullsim_solver_for) */
+    SW_SOLVER_CHOLMOD = 1, /* sparse direct, supernodal Cholesky (sparse_chol.h) */
+    SW_SOLVER_PCG = 2      /* block-Jacobi PCG */
+} sw_linear_solver;
+
+/* The solver AUTO picks for a mesh of nverts vertices. */
+sw_linear_solver sw_fullsim_solver_for(int32_t nverts);
+const char *sw_linear_solver_name(sw_linear_solver s);
+
 typedef struct sw_fullsim_params {
     sw_integrator integrator;
     double dt;               /* seconds per step (default 1/30) */
@@ -58,6 +70,7 @@ typedef struct sw_fullsim_params {
     double ground_height;
     double ground_k;         /* penalty per unit rest area (default contact_k) */
     sw_hessian_mode hessian; /* default SW_HESSIAN_ADAPTIVE */
+    sw_linear_solver solver; /* default SW_SOLVER_AUTO */
     int contact_rounds;      /* self-contact: detect, freeze the contacts, converge Newton on
                                 that smooth energy, re-detect and add new penetrations; stop
                                 when none is new or after this many rounds (default 30:
@@ -85,6 +98,8 @@ typedef struct sw_fullsim_stats {
     int contacts_unsettled;    /* 1: the round cap stopped the contact rounds while the set
                                   still changed (a penetrating vertex outside it, or a pair
                                   that no longer collides): the result depends on the cap */
+    sw_linear_solver solver;   /* the solver that ran (CHOLMOD or PCG) */
+    int factorizations;        /* numeric factorisations (direct solver) */
     double max_penetration;    /* deepest self-penetration at the final iterate (world units) */
     double ground_penetration; /* deepest vertex below the ground plane */
     double seconds;            /* wall time of the step */

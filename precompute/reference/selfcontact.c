@@ -458,7 +458,7 @@ double sw_selfcontact_max_depth(const sw_selfcontact *sc) {
  * (x_p, x_t0, x_t1, x_t2); each contact is a quadratic 1/2 k J^T N J. Written over four
  * slots (vertex, coefficient) so a vertex appearing twice is still exact. */
 
-static void slots(const sw_contact *c, int32_t v[4], double a[4]) {
+void sw_contact_slots(const sw_contact *c, int32_t v[4], double a[4]) {
     v[0] = c->p, a[0] = -1;
     for (int k = 0; k < 3; ++k)
         v[k + 1] = c->tri[k], a[k + 1] = c->beta[k];
@@ -467,7 +467,7 @@ static void slots(const sw_contact *c, int32_t v[4], double a[4]) {
 static void contact_d(const sw_contact *c, const double *x, double d[3]) {
     int32_t v[4];
     double a[4];
-    slots(c, v, a);
+    sw_contact_slots(c, v, a);
     d[0] = d[1] = d[2] = 0;
     for (int s = 0; s < 4; ++s)
         for (int j = 0; j < 3; ++j)
@@ -497,7 +497,7 @@ void sw_contact_add_forces(const sw_contact *c, int32_t n, const double *x, doub
     for (int32_t i = 0; i < n; ++i) {
         int32_t v[4];
         double a[4], d[3], Nd[3];
-        slots(&c[i], v, a);
+        sw_contact_slots(&c[i], v, a);
         contact_d(&c[i], x, d);
         sw_penalty_apply_N(c[i].n, alpha, d, Nd);
         double k = kc * c[i].ka;
@@ -512,7 +512,7 @@ void sw_contact_add_diag(const sw_contact *c, int32_t n, double kc, double alpha
     for (int32_t i = 0; i < n; ++i) {
         int32_t v[4];
         double a[4];
-        slots(&c[i], v, a);
+        sw_contact_slots(&c[i], v, a);
         double k = kc * c[i].ka;
         double N[9];
         sw_penalty_N(c[i].n, alpha, N);
@@ -539,7 +539,7 @@ void sw_contact_apply_hessian(const sw_contact *c, int32_t n, double kc, double 
         sw_penalty_apply_N(c[i].n, alpha, Jv, NJv);
         int32_t vs[4];
         double a[4];
-        slots(&c[i], vs, a);
+        sw_contact_slots(&c[i], vs, a);
         double k = kc * c[i].ka;
         for (int s = 0; s < 4; ++s)
             for (int j = 0; j < 3; ++j)

@@ -58,6 +58,9 @@ double sw_selfcontact_max_depth(const sw_selfcontact *sc);
  * along the frozen normal (the pair collides, eq. 3.12). */
 double sw_contact_gap(const sw_contact *c, const double *x);
 
+/* The four (vertex, coefficient) slots of d = J x: (p, -1), (tri_k, beta_k). */
+void sw_contact_slots(const sw_contact *c, int32_t v[4], double a[4]);
+
 /* Penalty energy of contacts c[0..n) at positions x (n, beta frozen). */
 double sw_contact_energy(const sw_contact *c, int32_t n, const double *x, double kc, double alpha);
 /* f (3*nverts) += penalty forces. */

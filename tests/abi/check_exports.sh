@@ -95,6 +95,11 @@ if [ "$soname" != "libsinew.so.$major" ]; then
     violation "SONAME is '${soname:-<none>}', expected 'libsinew.so.$major'"
 fi
 
+# --- licence: CHOLMOD's Supernodal module is GPL; only the bake and tools may link it ---
+if grep -qiE '\(NEEDED\).*\[lib(cholmod|suitesparse|metis)' "$tmp/dyn.txt"; then
+    violation "libsinew links CHOLMOD/SuiteSparse/METIS (GPL parts): only the bake may"
+fi
+
 if [ "$violations" -gt 0 ]; then
     echo "check_exports: $violations ABI violation(s) in $lib" >&2
     exit 1

@@ -1,0 +1,242 @@
+/* The reference's incremental potential Phi (fullsim.h), its gradient and the Newton
+ * system. */
+#include "fullsim_internal.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "fem_corot.h"
+#include "penalty.h"
+
+/* ---- element evaluation ------------------------------------------------------ */
+
+typedef struct {
+    sw_fullsim *sim;
+    const double *x;
+    int want;
+} elem_ctx;
+
+static void eval_elements(void *vctx, int64_t begin, int64_t end, int worker) {
+    (void)worker;
+    elem_ctx *ctx = vctx;
+    sw_fullsim *sim = ctx->sim;
+    const int32_t *tets = sim->c->mesh.tets;
+    for (int64_t t = begin; t < end; ++t) {
+        double xe[12];
+        for (int k = 0; k < 4; ++k)
+            memcpy(xe + 3 * k, ctx->x + 3 * (int64_t)tets[4 * t + k], 24);
+        sim->ee[t] =
+            sw_corot_eval(xe, sim->DmInv + 9 * t, sim->vol[t], sim->mu, sim->lambda,
+                          ctx->want >= EVAL_FORCE ? sim->fe + 12 * t : NULL,
+                          ctx->want >= EVAL_HESSIAN ? sim->Ke + 144 * t : NULL, sim->hess_flags);
+    }
+}
+
+static void gather_forces(void *vctx, int64_t begin, int64_t end, int worker) {
+    (void)worker;
+    sw_fullsim *sim = vctx;
+    for (int64_t v = begin; v < end; ++v) {
+        double f[3] = {0, 0, 0};
+        for (int64_t i = sim->inc_ptr[v]; i < sim->inc_ptr[v + 1]; ++i) {
+            const double *fe = sim->fe + 3 * sim->inc[i]; /* inc = 4*t + local */
+            f[0] += fe[0];
+            f[1] += fe[1];
+            f[2] += fe[2];
+        }
+        memcpy(sim->fint + 3 * v, f, sizeof f);
+    }
+}
+
+/* Evaluates all elements at x; returns the elastic energy (summed in element order). */
+double sw_fullsim_evaluate(sw_fullsim *sim, const double *x, int want) {
+    elem_ctx ctx = {sim, x, want};
+    sw_pool_parallel_for(sim->pool, sim->nt, eval_elements, &ctx);
+    if (want >= EVAL_FORCE) sw_pool_parallel_for(sim->pool, sim->nv, gather_forces, sim);
+    if (want >= EVAL_HESSIAN) sw_bsr_assemble(&sim->K, sim->Ke, sim->pool);
+    double e = 0;
+    for (int32_t t = 0; t < sim->nt; ++t)
+        e += sim->ee[t];
+    return e;
+}
+
+/* ---- potential, gradient, operator ------------------------------------------ */
+
+int sw_fullsim_dynamic(const sw_fullsim *sim) {
+    return sim->p.integrator != SW_QUASISTATIC;
+}
+
+static double ground_k(const sw_fullsim *sim) {
+    return sim->p.ground_k > 0 ? sim->p.ground_k : sim->p.contact_k;
+}
+
+/* The incremental potential Phi(x) of fullsim.h, with the elastic part `elastic`
+ * already evaluated at x and the contacts frozen. Uses tmp and kdx as scratch. */
+double sw_fullsim_potential(sw_fullsim *sim, const double *x, double elastic) {
+    double phi = elastic;
+    if (sim->p.self_contact && sim->ncontacts)
+        phi += sw_contact_energy(sim->contacts, sim->ncontacts, x, sim->p.contact_k,
+                                 sim->p.contact_alpha);
+    for (int32_t v = 0; v < sim->nv; ++v) {
+        const double *xv = x + 3 * v;
+        if (sim->p.ground && sim->vert_area[v] > 0 && xv[1] < sim->p.ground_height) {
+            double d = sim->p.ground_height - xv[1];
+            phi += 0.5 * ground_k(sim) * sim->vert_area[v] * d * d;
+        }
+        const double *gr = sim->p.gravity;
+        phi -= sim->mass[v] * (gr[0] * xv[0] + gr[1] * xv[1] + gr[2] * xv[2]);
+    }
+    if (!sw_fullsim_dynamic(sim)) return phi;
+    int64_t m = 3 * (int64_t)sim->nv;
+    for (int64_t i = 0; i < m; ++i)
+        sim->tmp[i] = x[i] - sim->xn[i];
+    sw_bsr Kn = sim->K;
+    Kn.val = sim->Kn;
+    sw_bsr_multiply(&Kn, sim->tmp, sim->kdx, sim->pool);
+    double inertia = 0, damp_m = 0, damp_k = 0, lin = 0;
+    for (int32_t v = 0; v < sim->nv; ++v)
+        for (int i = 0; i < 3; ++i) {
+            int64_t k = 3 * (int64_t)v + i;
+            double dh = x[k] - sim->xhat[k], dn = sim->tmp[k];
+            inertia += sim->mass[v] * dh * dh;
+            damp_m += sim->mass[v] * dn * dn;
+            lin += dn * sim->Dvn[k];
+        }
+    for (int64_t k = 0; k < m; ++k)
+        damp_k += sim->tmp[k] * sim->kdx[k];
+    phi += 0.5 * sim->c_m * inertia +
+           0.5 * sim->c_d * (sim->p.rayleigh_alpha * damp_m + sim->p.rayleigh_beta * damp_k) -
+           sim->s * lin;
+    return phi;
+}
+
+/* g = grad Phi at x (forces fint and contacts of x already evaluated), masked. */
+double sw_fullsim_gradient(sw_fullsim *sim, const double *x) {
+    int32_t nv = sim->nv;
+    int64_t m = 3 * (int64_t)nv;
+    double *g = sim->g;
+    for (int64_t k = 0; k < m; ++k)
+        g[k] = -sim->fint[k];
+    if (sim->p.self_contact && sim->ncontacts) {
+        /* contact forces into tmp, then subtract */
+        memset(sim->tmp, 0, (size_t)m * sizeof(double));
+        sw_contact_add_forces(sim->contacts, sim->ncontacts, x, sim->p.contact_k,
+                              sim->p.contact_alpha, sim->tmp);
+        for (int64_t k = 0; k < m; ++k)
+            g[k] -= sim->tmp[k];
+    }
+    for (int32_t v = 0; v < nv; ++v) {
+        if (sim->p.ground && sim->vert_area[v] > 0 && x[3 * v + 1] < sim->p.ground_height)
+            g[3 * v + 1] -=
+                ground_k(sim) * sim->vert_area[v] * (sim->p.ground_height - x[3 * v + 1]);
+        for (int i = 0; i < 3; ++i)
+            g[3 * v + i] -= sim->mass[v] * sim->p.gravity[i];
+    }
+    if (sw_fullsim_dynamic(sim)) {
+        for (int64_t k = 0; k < m; ++k)
+            sim->tmp[k] = x[k] - sim->xn[k];
+        sw_bsr Kn = sim->K;
+        Kn.val = sim->Kn;
+        sw_bsr_multiply(&Kn, sim->tmp, sim->kdx, sim->pool);
+        for (int32_t v = 0; v < nv; ++v)
+            for (int i = 0; i < 3; ++i) {
+                int64_t k = 3 * (int64_t)v + i;
+                g[k] += sim->c_m * sim->mass[v] * (x[k] - sim->xhat[k]) +
+                        sim->c_d * (sim->p.rayleigh_alpha * sim->mass[v] * sim->tmp[k] +
+                                    sim->p.rayleigh_beta * sim->kdx[k]) -
+                        sim->s * sim->Dvn[k];
+            }
+    }
+    double n2 = 0;
+    for (int32_t v = 0; v < nv; ++v) {
+        if (!sim->free_mask[v]) {
+            g[3 * v] = g[3 * v + 1] = g[3 * v + 2] = 0;
+            continue;
+        }
+        n2 += g[3 * v] * g[3 * v] + g[3 * v + 1] * g[3 * v + 1] + g[3 * v + 2] * g[3 * v + 2];
+    }
+    return sqrt(n2);
+}
+
+/* K.val (elastic Hessian) += c_d beta Kn + (c_m + c_d alpha) M + ground terms; the
+ * diagonal blocks (plus contact diagonals) go to sim->diag for the preconditioner. */
+static void finish_system(sw_fullsim *sim, const double *x) {
+    sw_bsr *K = &sim->K;
+    if (sw_fullsim_dynamic(sim)) {
+        double cb = sim->c_d * sim->p.rayleigh_beta;
+        for (int64_t i = 0; i < 9 * K->nblocks; ++i)
+            K->val[i] += cb * sim->Kn[i];
+    }
+    double cm = sw_fullsim_dynamic(sim) ? sim->c_m + sim->c_d * sim->p.rayleigh_alpha : 0.0;
+    for (int32_t v = 0; v < sim->nv; ++v) {
+        if (K->diag[v] < 0) continue;
+        double *B = K->val + 9 * K->diag[v];
+        for (int i = 0; i < 3; ++i)
+            B[4 * i] += cm * sim->mass[v];
+        if (sim->p.ground && sim->vert_area[v] > 0 && x[3 * v + 1] < sim->p.ground_height)
+            B[4] += ground_k(sim) * sim->vert_area[v];
+        memcpy(sim->diag + 9 * v, B, 9 * sizeof(double));
+    }
+    if (sim->p.self_contact && sim->ncontacts)
+        sw_contact_add_diag(sim->contacts, sim->ncontacts, sim->p.contact_k, sim->p.contact_alpha,
+                            sim->diag);
+    sw_block_jacobi_invert(sim->nv, sim->diag, sim->free_mask, sim->Pinv);
+}
+
+static void system_apply(void *vctx, const double *xin, double *y) {
+    sw_fullsim *sim = vctx;
+    sw_bsr_multiply(&sim->K, xin, y, sim->pool);
+    if (sim->p.self_contact && sim->ncontacts)
+        sw_contact_apply_hessian(sim->contacts, sim->ncontacts, sim->p.contact_k,
+                                 sim->p.contact_alpha, xin, y);
+}
+
+static sw_pcg_stats solve_pcg(sw_fullsim *sim) {
+    size_t v3 = (size_t)sim->nv * 3 * sizeof(double);
+    memcpy(sim->dx, sim->dx_prev, v3); /* warm start from the last update */
+    return sw_pcg_solve(system_apply, sim, sim->rhs, sim->Pinv, sim->free_mask, sim->p.pcg_rtol,
+                        sim->p.pcg_max, &sim->ws, sim->dx);
+}
+
+/* The direct path: factor and solve; SINEW_ERROR_DEGENERATE when indefinite. */
+static sinew_result solve_direct(sw_fullsim *sim) {
+    sw_error e;
+    int32_t n = sim->p.self_contact ? sim->ncontacts : 0;
+    sinew_result r = sw_sparse_chol_factor(sim->chol, &sim->K, sim->contacts, n, sim->p.contact_k,
+                                           sim->p.contact_alpha, &e);
+    if (r == SINEW_OK) r = sw_sparse_chol_solve(sim->chol, sim->rhs, sim->dx, &e);
+    return r;
+}
+
+sinew_result sw_fullsim_solve_system(sw_fullsim *sim, sw_fullsim_stats *st) {
+    finish_system(sim, sim->x);
+    int indefinite;
+    sinew_result r = SINEW_OK;
+    if (sim->chol) {
+        r = solve_direct(sim);
+        indefinite = r == SINEW_ERROR_DEGENERATE;
+    } else {
+        sw_pcg_stats ps = solve_pcg(sim);
+        st->pcg_iters += ps.iters;
+        indefinite = ps.negative_curvature;
+    }
+    /* Indefinite: the projected element Hessians, this once (always for the direct
+     * solve, which has no truncated answer; PCG in adaptive mode). A diagonal shift
+     * (Levenberg-Marquardt) instead was measured worse: the finger's exact Hessian in
+     * a fold needed a shift of the whole diagonal's size, which is gradient descent. */
+    if (indefinite && (sim->chol ? sim->p.hessian != SW_HESSIAN_PROJECTED
+                                 : sim->p.hessian == SW_HESSIAN_ADAPTIVE)) {
+        sim->hess_flags = SW_COROT_PROJECT_PSD;
+        sw_fullsim_evaluate(sim, sim->x, EVAL_HESSIAN);
+        finish_system(sim, sim->x);
+        st->projected_iters++;
+        if (sim->chol)
+            r = solve_direct(sim);
+        else
+            st->pcg_iters += solve_pcg(sim).iters;
+    }
+    if (sim->chol && r != SINEW_OK) {
+        if (r == SINEW_ERROR_NOT_FINITE) return r;
+        st->pcg_iters += solve_pcg(sim).iters; /* no factor: the iterative solve */
+    }
+    return SINEW_OK;
+}
