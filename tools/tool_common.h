@@ -188,12 +188,12 @@ static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **
         else if (!strcmp(v, "pcg"))
             p->solver = SW_SOLVER_PCG;
         else
-            *ok = 0, fprintf(stderr, "--solver wants auto|cholmod|pcg, got '%s'\n", v);
+            *ok = 0, fprintf(stderr, "%s: --solver wants auto|cholmod|pcg, got '%s'\n", argv[0], v);
         return 1;
     }
     if (!strcmp(a, "--contact-rounds")) {
         *ok = sw_parse_int(argv[++*i], 1, 100, &p->contact_rounds);
-        if (!*ok) fprintf(stderr, "--contact-rounds wants 1..100, got '%s'\n", v);
+        if (!*ok) fprintf(stderr, "%s: --contact-rounds wants 1..100, got '%s'\n", argv[0], v);
         return 1;
     }
     if (!strcmp(a, "--hessian")) {
@@ -206,7 +206,8 @@ static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **
         else if (!strcmp(v, "exact"))
             p->hessian = SW_HESSIAN_EXACT;
         else
-            *ok = 0, fprintf(stderr, "--hessian wants adaptive|projected|exact, got '%s'\n", v);
+            *ok = 0,
+            fprintf(stderr, "%s: --hessian wants adaptive|projected|exact, got '%s'\n", argv[0], v);
         return 1;
     }
     return 0;

@@ -50,6 +50,8 @@ int sw_fullsim_dynamic(const sw_fullsim *sim);
 double sw_fullsim_evaluate(sw_fullsim *sim, const double *x, int want);
 /* Phi(x) with the elastic part already evaluated at x and the contacts sim->contacts. */
 double sw_fullsim_potential(sw_fullsim *sim, const double *x, double elastic);
+/* y = K(x_n) u, the Rayleigh stiffness frozen at the start of the step (dynamics). */
+void sw_fullsim_apply_Kn(sw_fullsim *sim, const double *u, double *y);
 /* sim->g = grad Phi at x (masked); returns its norm. */
 double sw_fullsim_gradient(sw_fullsim *sim, const double *x);
 /* sim->dx = the Newton step for sim->rhs at sim->x (element Hessians in K by the

@@ -26,9 +26,7 @@ static void set_integrator(sw_fullsim *sim) {
     sim->hess_flags = SW_COROT_PROJECT_PSD;
     sw_fullsim_evaluate(sim, sim->xn, EVAL_HESSIAN);
     memcpy(sim->Kn, sim->K.val, (size_t)sim->K.nblocks * 9 * sizeof(double));
-    sw_bsr Kn = sim->K;
-    Kn.val = sim->Kn;
-    sw_bsr_multiply(&Kn, sim->vn, sim->Dvn, sim->pool);
+    sw_fullsim_apply_Kn(sim, sim->vn, sim->Dvn);
     for (int32_t v = 0; v < nv; ++v)
         for (int i = 0; i < 3; ++i) {
             int64_t k = 3 * (int64_t)v + i;

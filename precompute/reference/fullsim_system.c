@@ -69,6 +69,12 @@ static double ground_k(const sw_fullsim *sim) {
     return sim->p.ground_k > 0 ? sim->p.ground_k : sim->p.contact_k;
 }
 
+void sw_fullsim_apply_Kn(sw_fullsim *sim, const double *u, double *y) {
+    sw_bsr Kn = sim->K; /* K's pattern, the frozen values */
+    Kn.val = sim->Kn;
+    sw_bsr_multiply(&Kn, u, y, sim->pool);
+}
+
 /* The incremental potential Phi(x) of fullsim.h, with the elastic part `elastic`
  * already evaluated at x and the contacts frozen. Uses tmp and kdx as scratch. */
 double sw_fullsim_potential(sw_fullsim *sim, const double *x, double elastic) {
@@ -89,9 +95,7 @@ double sw_fullsim_potential(sw_fullsim *sim, const double *x, double elastic) {
     int64_t m = 3 * (int64_t)sim->nv;
     for (int64_t i = 0; i < m; ++i)
         sim->tmp[i] = x[i] - sim->xn[i];
-    sw_bsr Kn = sim->K;
-    Kn.val = sim->Kn;
-    sw_bsr_multiply(&Kn, sim->tmp, sim->kdx, sim->pool);
+    sw_fullsim_apply_Kn(sim, sim->tmp, sim->kdx);
     double inertia = 0, damp_m = 0, damp_k = 0, lin = 0;
     for (int32_t v = 0; v < sim->nv; ++v)
         for (int i = 0; i < 3; ++i) {
@@ -134,9 +138,7 @@ double sw_fullsim_gradient(sw_fullsim *sim, const double *x) {
     if (sw_fullsim_dynamic(sim)) {
         for (int64_t k = 0; k < m; ++k)
             sim->tmp[k] = x[k] - sim->xn[k];
-        sw_bsr Kn = sim->K;
-        Kn.val = sim->Kn;
-        sw_bsr_multiply(&Kn, sim->tmp, sim->kdx, sim->pool);
+        sw_fullsim_apply_Kn(sim, sim->tmp, sim->kdx);
         for (int32_t v = 0; v < nv; ++v)
             for (int i = 0; i < 3; ++i) {
                 int64_t k = 3 * (int64_t)v + i;

@@ -111,7 +111,7 @@ static int64_t contact_keys(sw_sparse_chol *s, const sw_bsr *K, const sw_contact
                 s->scratch[m++] = (int64_t)hi * s->nverts + lo;
             }
     }
-    qsort(s->scratch, (size_t)m, sizeof(int64_t), cmp_i64);
+    if (m > 1) qsort(s->scratch, (size_t)m, sizeof(int64_t), cmp_i64); /* NULL when m = 0 */
     int64_t u = 0;
     for (int64_t i = 0; i < m; ++i)
         if (u == 0 || s->scratch[i] != s->scratch[u - 1]) s->scratch[u++] = s->scratch[i];
