@@ -209,8 +209,9 @@ TEST(self_contact_removes_most_penetration_of_folded_finger) {
 }
 
 /* The contact set is an active set (fullsim.h): when a step's rounds complete, every
- * pair it converged with still collides (its vertex behind its surface point), also
- * while the fold opens again, so no pair holds the flesh by pulling. */
+ * pair it converged with still collides or sits within the hysteresis band in front of
+ * its surface point (half its detection depth), also while the fold opens again, so no
+ * pair holds the flesh open-fold by pulling. */
 TEST(contacts_push_and_never_pull) {
     sw_character c;
     sw_error err;
@@ -226,9 +227,11 @@ TEST(contacts_push_and_never_pull) {
         const sw_contact *k = sw_fullsim_contacts(sim, &n);
         with_contacts += n > 0;
         if (st.contacts_unsettled) continue; /* the round cap stopped it still changing */
-        for (int32_t i = 0; i < n; ++i)
-            ENSUREF(sw_contact_gap(&k[i], sw_fullsim_positions(sim)) > 0,
-                    "frame %d: pair %d (vertex %d) is in front of its surface point", f, i, k[i].p);
+        for (int32_t i = 0; i < n; ++i)      /* in front by at most the hysteresis band */
+            ENSUREF(sw_contact_gap(&k[i], sw_fullsim_positions(sim)) > -0.5 * k[i].depth,
+                    "frame %d: pair %d (vertex %d) is %.3g in front of its surface point (depth "
+                    "%.3g)",
+                    f, i, k[i].p, -sw_contact_gap(&k[i], sw_fullsim_positions(sim)), k[i].depth);
     }
     ENSUREF(with_contacts >= 2, "only %d frames with contacts: the test would prove little",
             with_contacts);

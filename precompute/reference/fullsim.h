@@ -18,8 +18,9 @@
  * round and frozen while Newton converges (re-detecting every iteration makes Newton
  * chase a changing energy and stall). Between rounds the set is updated as an active
  * set: new penetrations join, and a pair the solve held by pulling (its vertex in
- * front of its surface point, eq. 3.12) leaves, so contacts push but never glue a
- * fold shut; a resolved contact sits slightly behind its surface and stays. Each step
+ * front of its surface point, eq. 3.12, by more than half its detection depth: a
+ * hysteresis band, fullsim_step.c) leaves, so contacts push but never glue a fold shut;
+ * a resolved contact sits near its surface and stays. Each step
  * starts a fresh set. Results are bitwise identical for any thread
  * count: every reduction has a fixed order. */
 #ifndef SW_FULLSIM_H
