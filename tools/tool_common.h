@@ -174,42 +174,33 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
 
 /* When argv[*i] is a reference option, consumes it and its value and returns 1, with
  * *ok = 0 (and a message) for a bad value; returns 0 for any other argument. */
+/* The index of v in the NULL-terminated names, or -1. */
+static inline int sw_tool_choice(const char *v, const char *const *names) {
+    for (int k = 0; names[k]; ++k)
+        if (!strcmp(v, names[k])) return k;
+    return -1;
+}
+
 static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **argv, int *i,
                                          int *ok) {
     const char *a = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
     if (!v) return 0;
+    /* names in enum order: sw_linear_solver, sw_hessian_mode */
+    static const char *const solvers[] = {"auto", "cholmod", "pcg", NULL};
+    static const char *const hessians[] = {"adaptive", "projected", "exact", NULL};
+    int k;
+    ++*i;
     if (!strcmp(a, "--solver")) {
-        ++*i;
-        *ok = 1;
-        if (!strcmp(v, "auto"))
-            p->solver = SW_SOLVER_AUTO;
-        else if (!strcmp(v, "cholmod"))
-            p->solver = SW_SOLVER_CHOLMOD;
-        else if (!strcmp(v, "pcg"))
-            p->solver = SW_SOLVER_PCG;
-        else
-            *ok = 0, fprintf(stderr, "%s: --solver wants auto|cholmod|pcg, got '%s'\n", argv[0], v);
-        return 1;
+        if ((*ok = (k = sw_tool_choice(v, solvers)) >= 0)) p->solver = (sw_linear_solver)k;
+    } else if (!strcmp(a, "--hessian")) {
+        if ((*ok = (k = sw_tool_choice(v, hessians)) >= 0)) p->hessian = (sw_hessian_mode)k;
+    } else if (!strcmp(a, "--contact-rounds")) {
+        *ok = sw_parse_int(v, 1, 100, &p->contact_rounds);
+    } else {
+        --*i;
+        return 0;
     }
-    if (!strcmp(a, "--contact-rounds")) {
-        *ok = sw_parse_int(argv[++*i], 1, 100, &p->contact_rounds);
-        if (!*ok) fprintf(stderr, "%s: --contact-rounds wants 1..100, got '%s'\n", argv[0], v);
-        return 1;
-    }
-    if (!strcmp(a, "--hessian")) {
-        ++*i;
-        *ok = 1;
-        if (!strcmp(v, "adaptive"))
-            p->hessian = SW_HESSIAN_ADAPTIVE;
-        else if (!strcmp(v, "projected"))
-            p->hessian = SW_HESSIAN_PROJECTED;
-        else if (!strcmp(v, "exact"))
-            p->hessian = SW_HESSIAN_EXACT;
-        else
-            *ok = 0,
-            fprintf(stderr, "%s: --hessian wants adaptive|projected|exact, got '%s'\n", argv[0], v);
-        return 1;
-    }
-    return 0;
+    if (!*ok) fprintf(stderr, "%s: %s: bad value '%s' (see --help)\n", argv[0], a, v);
+    return 1;
 }
 #endif

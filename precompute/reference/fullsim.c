@@ -12,16 +12,6 @@
 #include "mesh_io.h"
 #include "penalty.h"
 
-/* Measured on the finger's 40-frame fold at 20K tets (3,984 vertices, 2 cores): a
- * CHOLMOD factorisation costs 140-270 ms (nnz(L) 2.6-3.2M, 0.9-1.4 GFlop), more than a
- * whole PCG solve of the same Newton system, and the exact co-rotational Hessian of the
- * fold is indefinite in most iterations, so adaptive Newton factors twice; PCG wins at
- * every size measured so far (README). */
-sw_linear_solver sw_fullsim_solver_for(int32_t nverts) {
-    (void)nverts;
-    return SW_SOLVER_PCG;
-}
-
 const char *sw_linear_solver_name(sw_linear_solver s) {
     return s == SW_SOLVER_CHOLMOD ? "cholmod" : s == SW_SOLVER_PCG ? "pcg" : "auto";
 }
@@ -282,8 +272,7 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
         sw_fullsim_destroy(sim);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start %d threads", p.threads);
     }
-    sw_linear_solver solver = p.solver == SW_SOLVER_AUTO ? sw_fullsim_solver_for(nv) : p.solver;
-    if (solver == SW_SOLVER_CHOLMOD &&
+    if (p.solver == SW_SOLVER_CHOLMOD &&
         (r = sw_sparse_chol_create(nv, sim->free_mask, &sim->chol, err)) != SINEW_OK) {
         sw_fullsim_destroy(sim);
         return r;

@@ -48,13 +48,15 @@ typedef enum sw_hessian_mode {
 
 /* Which linear solver takes the Newton systems. */
 typedef enum sw_linear_solver {
-    SW_SOLVER_AUTO = 0,    /* by problem size (sw_fullsim_solver_for) */
+    /* PCG: measured on the finger's 40-frame fold at 20K tets (3,984 vertices, 2 cores),
+     * a CHOLMOD factorisation costs 140-270 ms, more than a whole PCG solve of the same
+     * Newton system, and the exact co-rotational Hessian of the fold is indefinite in
+     * most iterations, so adaptive Newton factors twice (README, Status) */
+    SW_SOLVER_AUTO = 0,
     SW_SOLVER_CHOLMOD = 1, /* sparse direct, supernodal Cholesky (sparse_chol.h) */
     SW_SOLVER_PCG = 2      /* block-Jacobi PCG */
 } sw_linear_solver;
 
-/* The solver AUTO picks for a mesh of nverts vertices. */
-sw_linear_solver sw_fullsim_solver_for(int32_t nverts);
 const char *sw_linear_solver_name(sw_linear_solver s);
 
 typedef struct sw_fullsim_params {

@@ -83,12 +83,6 @@ static int cmp_i64(const void *a, const void *b) {
     return (x > y) - (x < y);
 }
 
-/* Whether the free vertices i <= j (free indices) are coupled by K's pattern. */
-static int in_K(const sw_bsr *K, const sw_sparse_chol *s, int32_t vi, int32_t vj) {
-    (void)s;
-    return sw_bsr_block(K, vi, vj) != NULL;
-}
-
 /* The contacts' couplings of free vertex pairs outside K, as sorted unique keys in
  * s->scratch; returns their count or -1 when out of memory. */
 static int64_t contact_keys(sw_sparse_chol *s, const sw_bsr *K, const sw_contact *c, int32_t n) {
@@ -107,7 +101,7 @@ static int64_t contact_keys(sw_sparse_chol *s, const sw_bsr *K, const sw_contact
             for (int q = p + 1; q < 4; ++q) {
                 int32_t lo = v[p] < v[q] ? v[p] : v[q], hi = v[p] < v[q] ? v[q] : v[p];
                 if (lo == hi || s->free_index[lo] < 0 || s->free_index[hi] < 0) continue;
-                if (in_K(K, s, lo, hi)) continue;
+                if (sw_bsr_block(K, lo, hi)) continue; /* the tets couple them already */
                 s->scratch[m++] = (int64_t)hi * s->nverts + lo;
             }
     }
@@ -198,9 +192,9 @@ static sinew_result analyse(sw_sparse_chol *s, const sw_bsr *K, sw_error *err) {
     return SINEW_OK;
 }
 
-/* Position in A->x of the entry (3i + r, 3j + c), i <= j free block indices, r <= c
- * when i == j. */
-static int64_t entry(const sw_sparse_chol *s, int32_t i, int32_t j, int r, int c) {
+/* Position in A->x of the entry (3i, 3j + c), i <= j free block indices: column 3j + c
+ * holds block row i's three rows from there (on the diagonal block, rows 0..c). */
+static int64_t entry(const sw_sparse_chol *s, int32_t i, int32_t j, int c) {
     int64_t lo = s->col_ptr[j], hi = s->col_ptr[j + 1] - 1; /* the last is the diagonal */
     while (lo < hi) {
         int64_t mid = lo + (hi - lo) / 2;
@@ -210,29 +204,32 @@ static int64_t entry(const sw_sparse_chol *s, int32_t i, int32_t j, int r, int c
             hi = mid;
     }
     const SuiteSparse_long *Ap = s->A->p;
-    return Ap[3 * j + c] + 3 * (lo - s->col_ptr[j]) + r;
+    return Ap[3 * j + c] + 3 * (lo - s->col_ptr[j]);
+}
+
+/* A's block (i, j), i <= j, += f * B^T for a row-major 3x3 B (upper triangle only on the
+ * diagonal block). */
+static void add_block(sw_sparse_chol *s, int32_t i, int32_t j, double f, const double B[9]) {
+    double *Ax = s->A->x;
+    for (int c = 0; c < 3; ++c) {
+        int64_t pos = entry(s, i, j, c);
+        int top = i == j ? c : 2;
+        for (int r = 0; r <= top; ++r)
+            Ax[pos + r] += f * B[3 * c + r];
+    }
 }
 
 /* A->x = K (free part, upper triangle) + contact Hessians. */
 static void assemble(sw_sparse_chol *s, const sw_bsr *K, const sw_contact *ct, int32_t n, double kc,
                      double alpha) {
-    double *Ax = s->A->x;
-    memset(Ax, 0, s->A->nzmax * sizeof(double));
+    memset(s->A->x, 0, s->A->nzmax * sizeof(double));
     for (int32_t vj = 0; vj < s->nverts; ++vj) {
         int32_t j = s->free_index[vj];
         if (j < 0) continue;
         for (int64_t b = K->row_ptr[vj]; b < K->row_ptr[vj + 1]; ++b) {
             int32_t vi = K->col[b], i = s->free_index[vi];
-            if (vi > vj || i < 0) continue;
-            /* block (vj, vi) of K's row vj is the transpose of (vi, vj): entry (r, c) of
-               (vi, vj) = entry (c, r) of the stored row-major block */
-            const double *B = K->val + 9 * b;
-            for (int c = 0; c < 3; ++c) {
-                int64_t pos = entry(s, i, j, 0, c);
-                int top = i == j ? c : 2;
-                for (int r = 0; r <= top; ++r)
-                    Ax[pos + r] += B[3 * c + r];
-            }
+            /* K's block (vj, vi) is the transpose of (vi, vj) */
+            if (vi <= vj && i >= 0) add_block(s, i, j, 1.0, K->val + 9 * b);
         }
     }
     for (int32_t k = 0; k < n; ++k) {
@@ -241,19 +238,13 @@ static void assemble(sw_sparse_chol *s, const sw_bsr *K, const sw_contact *ct, i
         sw_contact_slots(&ct[k], v, a);
         sw_penalty_N(ct[k].n, alpha, N);
         double kk = kc * ct[k].ka;
-        /* block (v_p, v_q) of k J^T N J is kk a_p a_q N; each unordered vertex pair once
-           in the upper triangle, the diagonal blocks from every ordered slot pair */
+        /* block (v_p, v_q) of k J^T N J is kk a_p a_q N (N symmetric); each unordered
+           vertex pair once in the upper triangle, the diagonal blocks from every ordered
+           slot pair */
         for (int p = 0; p < 4; ++p)
             for (int q = 0; q < 4; ++q) {
                 int32_t i = s->free_index[v[p]], j = s->free_index[v[q]];
-                if (i < 0 || j < 0 || i > j) continue;
-                double f = kk * a[p] * a[q];
-                for (int c = 0; c < 3; ++c) {
-                    int64_t pos = entry(s, i, j, 0, c);
-                    int top = i == j ? c : 2;
-                    for (int r = 0; r <= top; ++r)
-                        Ax[pos + r] += f * N[3 * r + c];
-                }
+                if (i >= 0 && j >= 0 && i <= j) add_block(s, i, j, kk * a[p] * a[q], N);
             }
     }
 }
