@@ -1,0 +1,57 @@
+/* The collision world inside the runtime (sinew_world.h): colliders in their own
+ * frames, and the one query the step and the reference make of them.
+ *
+ * A query takes a world-space point, maps it into the collider's frame (no rebuild when
+ * the host moves a collider), and returns the closest point of the collider's surface,
+ * the outward unit normal there and the signed distance (negative inside):
+ *   plane, sphere, capsule, box   closed form
+ *   hull                          libccd MPR (ccdMPRPenetration; never GJK/EPA, which
+ *                                 reallocs on every overlapping call, STYLE.md §6)
+ *   mesh                          Embree rtcPointQuery with a finite radius on the
+ *                                 scene committed when the mesh was added; inside or
+ *                                 outside from the angle-weighted pseudonormal of the
+ *                                 closest feature (face, edge or vertex)
+ * Queries never allocate, lock or commit, and any number of threads may query one world
+ * at once while no one changes it. */
+#ifndef SW_COLLISION_H
+#define SW_COLLISION_H
+
+#include <stdint.h>
+
+#include "sinew/sinew_world.h"
+
+/* The answer of one query, in world space. */
+typedef struct sw_collider_hit {
+    double phi;       /* signed distance of the point to the surface, < 0 inside */
+    double point[3];  /* the closest surface point */
+    double normal[3]; /* outward unit normal of the surface at `point` */
+} sw_collider_hit;
+
+/* One live collider as the step reads it (the world owns it; opaque beyond these). */
+typedef struct sw_collider sw_collider;
+
+/* The world's collider slots: [0, sw_world_slot_count) with NULL for empty slots. */
+uint32_t sw_world_slot_count(const sinew_world *w);
+const sw_collider *sw_world_slot(const sinew_world *w, uint32_t slot);
+
+/* The id of the collider in `slot` (as sinew_world_add_collider returned it), and the
+ * slot of a valid id (or -1). */
+sinew_collider_id sw_collider_id_of(const sinew_world *w, uint32_t slot);
+int32_t sw_world_slot_of(const sinew_world *w, sinew_collider_id id);
+
+/* Its penalty stiffness (0: the blob's) and Coulomb friction coefficient. */
+double sw_collider_stiffness(const sw_collider *c);
+double sw_collider_friction(const sw_collider *c);
+
+/* Its world-space rigid transform: x_world = R y + t (R row-major). */
+void sw_collider_transform(const sw_collider *c, double R[9], double t[3]);
+
+/* A world-space axis-aligned box holding every point within `margin` of the solid
+ * (for a plane, the half-space's box: infinite along the plane, +-HUGE_VAL). */
+void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]);
+
+/* The query: returns 1 and fills `hit` when x is inside the collider or within
+ * `radius` (> 0, finite) of its surface, else 0 (hit untouched). */
+int sw_collider_query(const sw_collider *c, const double x[3], double radius, sw_collider_hit *hit);
+
+#endif
