@@ -14,6 +14,7 @@ packages=(
     liblapacke-dev
     libsuitesparse-dev # CHOLMOD: the reference's sparse direct solve (bake and tools only)
     libassimp-dev    # glTF/FBX import in the bake (DESIGN.md §5)
+    libcjson-dev     # world files (precompute/io/world_io.c)
     clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
 )
 
