@@ -1,0 +1,101 @@
+/* One collider as the step reads it (collision.h): its properties, its world-space box,
+ * and the query, which maps the point into the collider's frame, asks the shape there,
+ * and maps the answer back: moving a collider never rebuilds anything. */
+#include <math.h>
+
+#include "collision_internal.h"
+
+double sw_collider_stiffness(const sw_collider *c) {
+    return c->stiffness;
+}
+
+double sw_collider_friction(const sw_collider *c) {
+    return c->friction;
+}
+
+void sw_collider_transform(const sw_collider *c, double R[9], double t[3]) {
+    for (int i = 0; i < 9; ++i)
+        R[i] = c->R[i];
+    for (int i = 0; i < 3; ++i)
+        t[i] = c->t[i];
+}
+
+/* The plane's world box: unbounded, except on the axis its world normal lies along
+ * (within 1e-12 in each other component), where the solid ends at the plane. */
+static void plane_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]) {
+    const double *nl = c->u.plane.n, *R = c->R;
+    double n[3];
+    for (int i = 0; i < 3; ++i) {
+        n[i] = R[3 * i] * nl[0] + R[3 * i + 1] * nl[1] + R[3 * i + 2] * nl[2];
+        lo[i] = -HUGE_VAL;
+        hi[i] = HUGE_VAL;
+    }
+    double off = c->u.plane.offset + sw_v3_dot(n, c->t);
+    for (int k = 0; k < 3; ++k) {
+        if (!(fabs(n[(k + 1) % 3]) <= 1e-12 && fabs(n[(k + 2) % 3]) <= 1e-12)) continue;
+        if (n[k] > 0)
+            hi[k] = off / n[k] + margin;
+        else
+            lo[k] = off / n[k] - margin;
+    }
+}
+
+void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]) {
+    if (c->shape == SINEW_SHAPE_PLANE) {
+        plane_bounds(c, margin, lo, hi);
+        return;
+    }
+    /* The local box's centre moves with R, its half extents grow to |R| e. */
+    double m[3], e[3];
+    for (int i = 0; i < 3; ++i) {
+        m[i] = 0.5 * (c->lo[i] + c->hi[i]);
+        e[i] = 0.5 * (c->hi[i] - c->lo[i]);
+    }
+    for (int i = 0; i < 3; ++i) {
+        const double *r = c->R + 3 * i;
+        double cw = r[0] * m[0] + r[1] * m[1] + r[2] * m[2] + c->t[i];
+        double ew = fabs(r[0]) * e[0] + fabs(r[1]) * e[1] + fabs(r[2]) * e[2] + margin;
+        lo[i] = cw - ew;
+        hi[i] = cw + ew;
+    }
+}
+
+int sw_shape_query_local(const sw_collider *c, const double y[3], double radius,
+                         sw_collider_hit *hit) {
+    switch (c->shape) {
+    case SINEW_SHAPE_PLANE:
+        return sw_plane_query(c, y, radius, hit);
+    case SINEW_SHAPE_SPHERE:
+        return sw_sphere_query(c, y, radius, hit);
+    case SINEW_SHAPE_CAPSULE:
+        return sw_capsule_query(c, y, radius, hit);
+    case SINEW_SHAPE_BOX:
+        return sw_box_query(c, y, radius, hit);
+    case SINEW_SHAPE_HULL:
+        return sw_hull_query(c, y, radius, hit);
+    case SINEW_SHAPE_MESH:
+        return sw_mesh_query(c, y, radius, hit);
+    }
+    return 0;
+}
+
+/* y = R^T (x - t); the hit's point back as R p + t and its normal as R n. A radius that
+ * is not positive and finite, or a point that is not finite, finds nothing. */
+int sw_collider_query(const sw_collider *c, const double x[3], double radius,
+                      sw_collider_hit *hit) {
+    if (!(radius > 0) || !isfinite(radius) || !sw_v3_isfinite(x)) return 0;
+    const double *R = c->R;
+    double d[3], y[3];
+    sw_v3_sub(x, c->t, d);
+    for (int i = 0; i < 3; ++i)
+        y[i] = R[i] * d[0] + R[3 + i] * d[1] + R[6 + i] * d[2];
+    sw_collider_hit h;
+    if (!sw_shape_query_local(c, y, radius, &h)) return 0;
+    hit->phi = h.phi;
+    for (int i = 0; i < 3; ++i) {
+        const double *r = R + 3 * i;
+        hit->point[i] = r[0] * h.point[0] + r[1] * h.point[1] + r[2] * h.point[2] + c->t[i];
+        hit->normal[i] = r[0] * h.normal[0] + r[1] * h.normal[1] + r[2] * h.normal[2];
+    }
+    return 1;
+}
