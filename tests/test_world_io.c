@@ -95,7 +95,7 @@ TEST(optional_fields_defaults_and_normalisation) {
         "[1, 0, 0, 0]}]}]}",
         NULL, &w, &e);
     ENSUREF(rc == SINEW_OK, "%s", e.msg);
-    ENSURE(w.frames == 40 && w.ncolliders == 2);
+    ENSURE(w.frames == 40 && w.ncolliders == 2 && !w.rest_pose); /* "pose" defaults to clip */
     ENSURE(!strcmp(w.colliders[0].name, "collider0") && !strcmp(w.colliders[1].name, "collider1"));
     ENSURE(w.colliders[0].def.normal[2] == -1.0f && w.colliders[0].def.offset == 2.0f);
     ENSURE(w.colliders[0].def.stiffness == 1e4f && w.colliders[0].def.friction == 0.5f);
@@ -112,7 +112,7 @@ TEST(optional_fields_defaults_and_normalisation) {
 
 TEST(sample_worlds_parse) {
     static const char *names[] = {"finger_table.json", "capsule_pipe.json", "hand_handle.json"};
-    static const int ncoll[] = {2, 1, 1}, frames[] = {30, 30, 60};
+    static const int ncoll[] = {2, 1, 1}, frames[] = {30, 30, 60}, rest[] = {1, 0, 0};
     for (int i = 0; i < 3; ++i) {
         char path[1024];
         snprintf(path, sizeof path, "%s/samples/worlds/%s", SINEW_SOURCE_DIR, names[i]);
@@ -121,7 +121,7 @@ TEST(sample_worlds_parse) {
         sw_error_clear(&e);
         sinew_result rc = sw_world_file_read(path, &w, &e);
         ENSUREF(rc == SINEW_OK, "%s: %s", names[i], e.msg);
-        ENSURE(w.ncolliders == ncoll[i] && w.frames == frames[i]);
+        ENSURE(w.ncolliders == ncoll[i] && w.frames == frames[i] && w.rest_pose == rest[i]);
         ENSURE(sw_world_file_last_key_frame(&w) < w.frames);
         ENSURE(!strcmp(w.path, path));
         sw_world_file_free(&w);
@@ -261,6 +261,12 @@ static const bad_case bad_cases[] = {
     {"{\"sinew_world\": 1, \"colliders\": [], \"frames\": 2.5}",
      SINEW_ERROR_INVALID_ARGUMENT,
      {"\"frames\""}},
+    {"{\"sinew_world\": 1, \"colliders\": [], \"pose\": \"still\"}",
+     SINEW_ERROR_INVALID_ARGUMENT,
+     {"\"pose\"", "\"rest\""}},
+    {"{\"sinew_world\": 1, \"colliders\": [], \"pose\": 1}",
+     SINEW_ERROR_INVALID_ARGUMENT,
+     {"\"pose\""}},
     {"{\"sinew_world\": 1, \"colliders\": [], \"colliders\": []}",
      SINEW_ERROR_INVALID_ARGUMENT,
      {"\"colliders\"", "repeated"}},

@@ -21,8 +21,17 @@
  *   phase_ms  median ms/frame of each phase of the step (the step's own stats: skin,
  *             contact, dynamics, solve, output), and potential_evals, the mean number of
  *             potential evaluations (cubature passes) a step
- * Ratios: speedup_vs_full = full_ms / sub_ms, cost_vs_dqs = sub_ms / dqs_ms. The last
- * stdout line is one JSON object. */
+ * Ratios: speedup_vs_full = full_ms / sub_ms, cost_vs_dqs = sub_ms / dqs_ms.
+ * With --world FILE (a world file, samples/worlds) it then runs the reference and the
+ * runtime with that world on the same mesh and motion (world_bench.h) and adds
+ *   world_contact_frames  frames in which the reference touches a collider
+ *   err_world_sub         correction error over those frames, subspace vs reference
+ *   pen_world_full, pen_world_sub  deepest penetration into any collider (world units)
+ *   world_query_ms        median ms of a step's world detection; world_queries, the
+ *                         mean collider queries a step; world_contacts, the mean copies
+ *                         in contact
+ *   world_allocs_in_step, world_locks_in_step  the contract counts with world contact
+ * The last stdout line is one JSON object. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -50,6 +59,7 @@
 #include "surface_normals.h"
 #include "vec3.h"
 #include "weights_heat.h"
+#include "world_bench.h"
 
 /* The step's phases as sinew_step_stats reports them. */
 enum { NPHASES = 5 };
@@ -61,8 +71,10 @@ static void usage(FILE *f) {
         "FILE.tgf\n"
         "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
         "                   [--contract-steps S] [--threads T] [reference options] [--data DIR]\n"
-        "                   [--out DIR] --json\n"
+        "                   [--out DIR] [--world FILE.json] --json\n"
         "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n"
+        "  --world F  also run reference and runtime against world file F (JSON schema 1,\n"
+        "             samples/worlds/README.md) and report the world figures\n"
         "reference options (the full-space run the bench times; a bake it runs uses the\n"
         "defaults):\n" SW_REFERENCE_USAGE);
 }
@@ -134,7 +146,7 @@ done:
 int main(int argc, char **argv) {
     sw_character_args ca;
     sw_character_args_init(&ca);
-    const char *blob_path = NULL, *out_dir = NULL;
+    const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
@@ -148,6 +160,8 @@ int main(int argc, char **argv) {
             blob_path = argv[++i];
         else if (!strcmp(a, "--out") && next)
             out_dir = argv[++i];
+        else if (!strcmp(a, "--world") && next)
+            world_path = argv[++i];
         else if (!strcmp(a, "--full-frames") && next)
             ok = sw_parse_int(argv[++i], 1, 100000, &full_frames);
         else if (!strcmp(a, "--contract-steps") && next)
@@ -341,6 +355,26 @@ int main(int argc, char **argv) {
         if (active & SW_RT_CAT_LOCKS) locks = (long)c.locks;
     }
     failed_steps += et.failed + eh.failed;
+
+    /* 7. the collision world, when given */
+    sw_world_bench wb;
+    memset(&wb, 0, sizeof wb);
+    if (world_path) {
+        sw_world_scene ws;
+        if ((r = sw_world_scene_load(world_path, &ws, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "sinew-bench: ");
+        r = sw_world_bench_run(&ch, blob, &ws, &fp, ca.frames, contract_steps, &wb, &err);
+        sw_world_scene_free(&ws);
+        if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bench: world run failed: ");
+        failed_steps += wb.sub_failed + wb.ref_failed;
+        fprintf(stderr,
+                "sinew-bench: world %s: %d frames, %d with contact; err_world_sub %.4f; "
+                "penetration full %.5f sub %.5f; world query %.4f ms, %.0f queries, %.1f "
+                "contacts a step; allocs %ld, locks %ld\n",
+                world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
+                wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.allocs,
+                wb.locks);
+    }
     fprintf(stderr,
             "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, "
             "cost %.1fx DQS;\n"
@@ -362,7 +396,7 @@ int main(int argc, char **argv) {
             "\"err_source\":\"%s\",\"failed_steps\":%ld,\"ref_unsettled\":%d,"
             "\"phase_ms\":{\"skin\":%.4f,\"contact\":%.4f,\"dynamics\":%.4f,\"solve\":%.4f,"
             "\"output\":%.4f},\"potential_evals\":%.2f,\"solver\":\"%s\",\"unsettled_frames\":%d,"
-            "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f}\n",
+            "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f",
             ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
             sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
@@ -370,6 +404,16 @@ int main(int argc, char **argv) {
             phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
             sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
             full_max);
+    if (json && world_path)
+        printf(",\"world\":\"%s\",\"world_frames\":%d,\"world_contact_frames\":%d,"
+               "\"err_world_sub\":%.5f,\"pen_world_full\":%.6g,\"pen_world_sub\":%.6g,"
+               "\"world_query_ms\":%.5f,\"world_queries\":%.1f,\"world_contacts\":%.1f,"
+               "\"world_full_ms\":%.3f,\"world_sub_ms\":%.4f,\"world_ref_unsettled\":%d,"
+               "\"world_allocs_in_step\":%ld,\"world_locks_in_step\":%ld",
+               world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
+               wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.full_ms,
+               wb.sub_ms, wb.ref_unsettled, wb.allocs, wb.locks);
+    if (json) printf("}\n");
     free(full);
     free(full_x);
     free(sub);

@@ -2,12 +2,15 @@
  * asset, frame by frame along the character's clip.
  *
  *   sinew-fullsim --scene NAME [--tets N] [--frames F] [--dynamic] [--newmark]
- *                 [--no-self-contact] [--ground H] [--threads T] [--data DIR]
- *                 [--out DIR] [--json]
+ *                 [--no-self-contact] [--ground H] [--world FILE.json] [--threads T]
+ *                 [--data DIR] [--out DIR] [--json]
  *
  * NAME is a procedural sample (cylinder, finger, capsule) or a folder of the real
- * assets (elephant-cd, hand-libigl). Progress goes to stderr; with --json the last
- * line of stdout is one JSON object with the run's figures. */
+ * assets (elephant-cd, hand-libigl). With --world the character collides with the
+ * world file's colliders, moved to their keyframes every frame (samples/worlds); the
+ * file says whether the character plays its clip or holds its rest pose. Progress goes
+ * to stderr; with --json the last line of stdout is one JSON object with the run's
+ * figures. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -21,22 +24,27 @@
 #include "fullsim.h"
 #include "mesh_io.h"
 #include "samples.h"
+#include "world_scene.h"
 
 typedef struct {
-    const char *scene, *out_dir, *data_dir;
+    const char *scene, *out_dir, *data_dir, *world;
     int tets, frames, json, threads;
     sw_fullsim_params params;
 } options;
 
 static void usage(FILE *f) {
     fprintf(f, "usage: sinew-fullsim --scene NAME [--tets N] [--frames F] [--dynamic] [--newmark]\n"
-               "                     [--no-self-contact] [--ground HEIGHT] [--threads T]\n"
+               "                     [--no-self-contact] [--ground HEIGHT] [--world FILE.json]\n"
+               "                     [--threads T]\n"
                "                     [reference options] [--data DIR] [--out DIR] [--json]\n"
                "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n"
                "  --tets N      procedural resolution (default 20000)\n"
                "  --frames F    frames to simulate (default: procedural 30, assets their clip)\n"
                "  --dynamic     backward Euler dynamics (default quasistatic); --newmark: "
-               "Newmark\n" SW_REFERENCE_USAGE
+               "Newmark\n"
+               "  --world FILE  collide with a world file's colliders (JSON, schema 1; see\n"
+               "                samples/worlds/README.md); --frames defaults to its "
+               "length\n" SW_REFERENCE_USAGE
                "  --out DIR     write each frame's surface as DIR/frame_NNNN.obj\n"
                "  --json        print one JSON object with the figures as the last line\n");
 }
@@ -50,6 +58,7 @@ static int parse_args(int argc, char **argv, options *o) {
     const sw_tool_opt opts[] = {{"--scene", &o->scene, NULL, 0},
                                 {"--out", &o->out_dir, NULL, 0},
                                 {"--data", &o->data_dir, NULL, 0},
+                                {"--world", &o->world, NULL, 0},
                                 {"--no-self-contact", NULL, &o->params.self_contact, 0},
                                 {"--json", NULL, &o->json, 1}};
     int ok = 1;
@@ -160,6 +169,24 @@ int main(int argc, char **argv) {
         return sw_tool_failed(r, &err, "sinew-fullsim: cannot make scene '%s': ", o.scene);
     int frames = ch.clip.nframes;
     if (o.frames > 0 && o.frames < frames) frames = o.frames;
+    const double *poses = ch.clip.T;
+    double *world_poses = NULL;
+    sw_world_scene ws;
+    memset(&ws, 0, sizeof ws);
+    if (o.world) {
+        if ((r = sw_world_scene_load(o.world, &ws, &err)) != SINEW_OK) {
+            sw_character_free(&ch);
+            return sw_tool_failed(r, &err, "sinew-fullsim: ");
+        }
+        world_poses = sw_world_scene_poses(&ws, ch.clip.T, ch.clip.nframes, ch.skel.nbones,
+                                           o.frames, &frames);
+        if (!world_poses) {
+            fprintf(stderr, "sinew-fullsim: out of memory\n");
+            return 1;
+        }
+        poses = world_poses;
+        o.params.world = ws.world;
+    }
     sw_fullsim *sim = NULL;
     if ((r = sw_fullsim_create(&ch, &o.params, &sim, &err)) != SINEW_OK) {
         fprintf(stderr, "sinew-fullsim: %s (%s)\n", err.msg, sinew_result_string(r));
@@ -191,13 +218,21 @@ int main(int argc, char **argv) {
                                                   : "dynamic (backward Euler)",
             o.params.self_contact ? ", self-contact on" : ", self-contact off");
     double *ms = malloc((size_t)frames * sizeof(double));
-    double newton_sum = 0, pcg_sum = 0, max_pen = 0, max_ground = 0, total = 0;
+    double newton_sum = 0, pcg_sum = 0, max_pen = 0, max_ground = 0, total = 0, pen_world = 0;
     int unconverged = 0, failed = 0, unsettled = 0, newton_max = 0, factors = 0;
+    int world_frames = 0; /* frames with a vertex in contact with a collider */
     double ms_max = 0;
     sw_linear_solver solver = SW_SOLVER_AUTO;
     for (int f = 0; f < frames && ms; ++f) {
         sw_fullsim_stats st;
-        r = sw_fullsim_step(sim, ch.clip.T + (size_t)f * 12 * ch.clip.nbones, &st);
+        if (o.world && (r = sw_world_scene_at(&ws, f, &err)) != SINEW_OK) {
+            fprintf(stderr, "sinew-fullsim: %s\n", err.msg);
+            failed++;
+            break;
+        }
+        r = sw_fullsim_step(sim, poses + (size_t)f * 12 * ch.skel.nbones, &st);
+        pen_world = fmax(pen_world, st.world_penetration);
+        world_frames += st.world_contacts > 0;
         if (r == SINEW_ERROR_NOT_CONVERGED)
             unconverged++;
         else if (r != SINEW_OK)
@@ -216,9 +251,10 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "  frame %4d/%d  %8.1f ms  newton %2d  pcg %5d  factor %3d  |g| %.2e -> %.2e  "
                 "contacts %5d  "
-                "penetration %.3g  rounds %d%s%s\n",
+                "penetration %.3g  world %d (%.3g)  rounds %d%s%s\n",
                 f + 1, frames, ms[f], st.newton_iters, st.pcg_iters, st.factorizations,
-                st.grad_norm0, st.grad_norm, st.contacts, st.max_penetration, st.contact_rounds,
+                st.grad_norm0, st.grad_norm, st.contacts, st.max_penetration, st.world_contacts,
+                st.world_penetration, st.contact_rounds,
                 st.contacts_unsettled ? "  (contact set unsettled)" : "",
                 r == SINEW_OK                    ? ""
                 : r == SINEW_ERROR_NOT_CONVERGED ? "  (not converged)"
@@ -238,10 +274,11 @@ int main(int argc, char **argv) {
     fprintf(stderr,
             "sinew-fullsim: %s solver, ms/frame median %.1f mean %.1f max %.1f, %.2f Newton "
             "(max %d), %.1f PCG iterations and %.2f factorisations a frame, max penetration "
-            "%.4g, %d unconverged, %d failed frames, %d unsettled frames (round cap %d)\n",
+            "%.4g, %d unconverged, %d failed frames, %d unsettled frames (round cap %d); world "
+            "contact in %d frames, deepest %.4g\n",
             sw_linear_solver_name(solver), median, mean, ms_max, newton_sum / frames, newton_max,
             pcg_sum / frames, (double)factors / frames, max_pen, unconverged, failed, unsettled,
-            o.params.contact_rounds);
+            o.params.contact_rounds, world_frames, pen_world);
     if (o.json)
         printf("{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"driven_verts\":%d,\"surface_tris\":%d,"
                "\"frames\":%d,\"mode\":\"%s\",\"self_contact\":%s,\"threads\":%d,"
@@ -250,7 +287,8 @@ int main(int argc, char **argv) {
                "\"newton_iters_mean\":%.3f,\"newton_iters_max\":%d,\"pcg_iters_mean\":%.2f,"
                "\"factorizations_mean\":%.3f,\"max_penetration\":%.6g,"
                "\"max_ground_penetration\":%.6g,\"unconverged_frames\":%d,\"failed_frames\":%d,"
-               "\"unsettled_frames\":%d}\n",
+               "\"unsettled_frames\":%d,\"world\":%s%s%s,\"world_contact_frames\":%d,"
+               "\"pen_world_full\":%.6g}\n",
                o.scene, ch.mesh.ntets, ch.mesh.nverts, sw_fullsim_driven_count(sim), surf->ntris,
                frames,
                o.params.integrator == SW_QUASISTATIC ? "quasistatic"
@@ -259,8 +297,11 @@ int main(int argc, char **argv) {
                o.params.self_contact ? "true" : "false", o.params.threads,
                sw_linear_solver_name(solver), median, mean, ms_max, newton_sum / frames, newton_max,
                pcg_sum / frames, (double)factors / frames, max_pen, max_ground, unconverged, failed,
-               unsettled);
+               unsettled, o.world ? "\"" : "", o.world ? o.world : "null", o.world ? "\"" : "",
+               world_frames, pen_world);
     free(ms);
+    free(world_poses);
+    sw_world_scene_free(&ws);
     free(scratch);
     free(tris);
     sw_fullsim_destroy(sim);

@@ -445,7 +445,7 @@ static sinew_result parse_json_error(const wctx *c, const char *text, size_t len
 }
 
 static sinew_result read_root(wctx *c, const cJSON *root, sw_world_file *out) {
-    static const char *const top_keys[] = {"sinew_world", "frames", "colliders", NULL};
+    static const char *const top_keys[] = {"sinew_world", "frames", "pose", "colliders", NULL};
     sinew_result rc;
     const cJSON *v;
     if (!cJSON_IsObject(root))
@@ -466,6 +466,15 @@ static sinew_result read_root(wctx *c, const cJSON *root, sw_world_file *out) {
     if ((v = cJSON_GetObjectItemCaseSensitive(root, "frames")) &&
         (rc = get_int(c, v, "\"frames\"", 1, INT32_MAX, &out->frames)))
         return rc;
+    out->rest_pose = 0;
+    if ((v = cJSON_GetObjectItemCaseSensitive(root, "pose"))) {
+        if (!cJSON_IsString(v) ||
+            (strcmp(v->valuestring, "clip") && strcmp(v->valuestring, "rest")))
+            return fail(c, SINEW_ERROR_INVALID_ARGUMENT, "\"pose\"",
+                        "must be \"clip\" (the character plays its clip) or \"rest\" (it holds "
+                        "its rest pose while the colliders move)");
+        out->rest_pose = !strcmp(v->valuestring, "rest");
+    }
     if ((rc = required(c, root, "colliders", "\"colliders\"", &v))) return rc;
     if (!cJSON_IsArray(v))
         return fail(c, SINEW_ERROR_INVALID_ARGUMENT, "\"colliders\"", "must be an array");

@@ -5,6 +5,9 @@
  * Schema version 1 (samples/worlds/README.md shows examples):
  *   {"sinew_world": 1,              required, the integer 1 (else SINEW_ERROR_VERSION)
  *    "frames": 30,                  optional, the scene length (integer >= 1)
+ *    "pose": "clip",                optional: "clip" (default: the character plays its
+ *                                   clip) or "rest" (it holds its rest pose while the
+ *                                   colliders move)
  *    "colliders": [ {...}, ... ]}   required, at most SW_WORLD_MAX_COLLIDERS (may be empty)
  * A collider:
  *   "name"       optional string (< 64 bytes, unique); default "collider<i>"
@@ -73,6 +76,7 @@ typedef struct sw_world_file {
     sw_world_collider_spec *colliders;
     int32_t ncolliders;
     int32_t frames; /* the "frames" entry, -1 if absent */
+    int rest_pose;  /* "pose": "rest" */
 } sw_world_file;
 
 /* Reads a world file (at most SW_WORLD_MAX_FILE_BYTES); mesh paths are relative to its

@@ -2,6 +2,8 @@
  * formulation, fullsim_internal.h for how the files divide it). */
 #include "fullsim_internal.h"
 
+#include "bbox.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -38,6 +40,8 @@ sw_fullsim_params sw_fullsim_params_default(void) {
     p.pcg_rtol = 1e-3;
     p.pcg_max = 1000;
     p.threads = 0;
+    p.world = NULL;
+    p.world_radius = 0;
     return p;
 }
 
@@ -69,6 +73,10 @@ static sinew_result check_params(const sw_fullsim_params *p, sw_error *err) {
             p->contact_alpha, p->ground_k);
     if (!sw_fullsim_all_finite(p->gravity, 3) || !isfinite(p->ground_height))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "gravity or ground not finite");
+    if (!(p->world_radius >= 0) || !isfinite(p->world_radius))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "world detection radius %g is not a finite length >= 0",
+                            p->world_radius);
     if (p->hessian < SW_HESSIAN_ADAPTIVE || p->hessian > SW_HESSIAN_EXACT ||
         p->contact_rounds < 1 || p->contact_rounds > 100)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
@@ -136,6 +144,7 @@ void sw_fullsim_destroy(sw_fullsim *sim) {
     free(sim->free_mask);
     sw_surface_free(&sim->surf);
     free(sim->vert_area);
+    sw_ref_world_free(&sim->world);
     sw_selfcontact_destroy(sim->sc);
     sw_bsr_free(&sim->K);
     free(sim->Kn);
@@ -225,16 +234,14 @@ sinew_result sw_fullsim_create(const sw_character *c, const sw_fullsim_params *p
         sim->free_mask[v] = c->bone_of_vertex[v] < 0;
         sim->ndriven += c->bone_of_vertex[v] >= 0;
     }
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t v = 0; v < nv; ++v)
-        for (int i = 0; i < 3; ++i) {
-            lo[i] = fmin(lo[i], X[3 * v + i]);
-            hi[i] = fmax(hi[i], X[3 * v + i]);
-        }
-    double diag2 = 0;
-    for (int i = 0; i < 3; ++i)
-        diag2 += (hi[i] - lo[i]) * (hi[i] - lo[i]);
-    sim->gfloor = 1e-12 * c->youngs * diag2 * sqrt((double)nv);
+    double lo[3], hi[3];
+    sw_bbox_empty(lo, hi);
+    sw_bbox_add(lo, hi, nv, X);
+    double size = sw_bbox_diagonal(lo, hi);
+    sim->gfloor = 1e-12 * c->youngs * size * size * sqrt((double)nv);
+    sim->world.world = p.world;
+    sim->world.blob_k = p.contact_k;
+    sim->world.radius = p.world_radius > 0 ? p.world_radius : 0.02 * size;
 
     if ((r = sw_tetmesh_surface(&c->mesh, &sim->surf, err)) != SINEW_OK ||
         (r = sw_bsr_create_from_tets(nv, nt, tets, &sim->K, err)) != SINEW_OK ||

@@ -27,6 +27,7 @@
 #define SW_FULLSIM_H
 
 #include "selfcontact.h"
+#include "sinew/sinew_world.h"
 #include "sw_mesh.h"
 
 typedef enum sw_integrator {
@@ -85,6 +86,10 @@ typedef struct sw_fullsim_params {
     double pcg_rtol;         /* PCG relative residual (default 1e-3) */
     int pcg_max;             /* default 1000 */
     int threads;             /* 0: all cores */
+    /* the collision world (NULL: none), with the runtime's law (world_penalty.h); the
+     * caller moves its colliders between steps and keeps it alive */
+    const sinew_world *world;
+    double world_radius; /* detection radius; 0: 2% of the rest bounding-box diagonal */
 } sw_fullsim_params;
 
 sw_fullsim_params sw_fullsim_params_default(void);
@@ -105,6 +110,9 @@ typedef struct sw_fullsim_stats {
     int factorizations;        /* numeric factorisations (direct solver) */
     double max_penetration;    /* deepest self-penetration at the final iterate (world units) */
     double ground_penetration; /* deepest vertex below the ground plane */
+    double world_penetration;  /* deepest surface vertex inside a world collider */
+    int32_t world_candidates;  /* (vertex, collider) candidates of the final round */
+    int32_t world_contacts;    /* surface vertices inside a collider at the final positions */
     double seconds;            /* wall time of the step */
     double energy_elastic;     /* E(x) at exit */
     double energy_kinetic;     /* 1/2 v^T M v at exit (0 in quasistatic) */

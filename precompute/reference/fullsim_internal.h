@@ -9,6 +9,7 @@
 #include "bsr_matrix.h"
 #include "pcg.h"
 #include "sparse_chol.h"
+#include "worldcontact.h"
 
 struct sw_fullsim {
     sw_fullsim_params p;
@@ -42,6 +43,7 @@ struct sw_fullsim {
     uint32_t hess_flags;  /* sw_corot_eval flags of the current evaluation */
     sw_contact *active;   /* the step's contact set: surf.nverts slots, one per vertex */
     int32_t *active_slot; /* nv: slot of a vertex in `active`, or -1 */
+    sw_ref_world world;   /* the collision world's candidates of the step */
 };
 enum { EVAL_ENERGY = 0, EVAL_FORCE = 1, EVAL_HESSIAN = 2 };
 

@@ -6,6 +6,7 @@
 
 #include "clock.h"
 #include "fem_corot.h"
+#include "penalty.h"
 #include "sw_mesh.h"
 
 /* ---- the step ----------------------------------------------------------------- */
@@ -218,12 +219,22 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
     sinew_result result = SINEW_ERROR_NOT_CONVERGED;
     double gref = -1;
     clear_contacts(sim);
-    int capped = 0;
+    int capped = 0, rounds = sim->p.self_contact || sim->world.world;
+    sim->world.ncand = 0;
     for (int round = 0;; ++round) {
-        if (sim->p.self_contact && contact_round(sim) == 0 && round > 0) break; /* complete */
-        st.contact_rounds += sim->p.self_contact;
+        int32_t changed = sim->p.self_contact ? contact_round(sim) : 0;
+        if (sim->world.world) { /* world candidates at the current positions */
+            int32_t fresh = sw_ref_world_detect(&sim->world, nv, sim->x, sim->vert_area);
+            if (fresh < 0) {
+                result = SINEW_ERROR_OUT_OF_MEMORY;
+                break;
+            }
+            changed += fresh;
+        }
+        if (round > 0 && changed == 0) break; /* complete */
+        st.contact_rounds += rounds;
         result = newton_solve(sim, &st, &gref, sim->p.newton_rtol);
-        if (result == SINEW_ERROR_NOT_FINITE || !sim->p.self_contact) break;
+        if (result == SINEW_ERROR_NOT_FINITE || !rounds) break;
         if (round + 1 >= sim->p.contact_rounds) {
             capped = 1;
             break;
@@ -245,6 +256,21 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
     st.contacts = found;
     if (sim->p.self_contact && capped) /* would one more round have changed the set? */
         st.contacts_unsettled = set_would_change(sim, pen, found);
+    if (sim->world.world) {
+        int32_t fresh;
+        st.world_penetration =
+            sw_ref_world_max_penetration(&sim->world, nv, sim->x, sim->vert_area, &fresh);
+        st.world_candidates = sim->world.ncand;
+        for (int32_t i = 0; i < sim->world.ncand; ++i) {
+            const sw_ref_world_cand *wc = &sim->world.cand[i];
+            double d[3];
+            for (int k = 0; k < 3; ++k)
+                d[k] = wc->law.a[k] - sim->x[3 * wc->v + k];
+            st.world_contacts += sw_penalty_gap(wc->law.n, d) > 0;
+        }
+        /* capped with vertices inside colliders that are no candidates: unsettled */
+        if (capped && fresh > 0) st.contacts_unsettled = 1;
+    }
     if (sim->p.ground)
         for (int32_t v = 0; v < nv; ++v)
             if (sim->vert_area[v] > 0)

@@ -82,6 +82,7 @@ double sw_fullsim_potential(sw_fullsim *sim, const double *x, double elastic) {
     if (sim->p.self_contact && sim->ncontacts)
         phi += sw_contact_energy(sim->contacts, sim->ncontacts, x, sim->p.contact_k,
                                  sim->p.contact_alpha);
+    phi += sw_ref_world_eval(&sim->world, x, NULL);
     for (int32_t v = 0; v < sim->nv; ++v) {
         const double *xv = x + 3 * v;
         if (sim->p.ground && sim->vert_area[v] > 0 && xv[1] < sim->p.ground_height) {
@@ -128,6 +129,12 @@ double sw_fullsim_gradient(sw_fullsim *sim, const double *x) {
         for (int64_t k = 0; k < m; ++k)
             g[k] -= sim->tmp[k];
     }
+    if (sim->world.ncand) {
+        memset(sim->tmp, 0, (size_t)m * sizeof(double));
+        sw_ref_world_eval(&sim->world, x, sim->tmp);
+        for (int64_t k = 0; k < m; ++k)
+            g[k] -= sim->tmp[k];
+    }
     for (int32_t v = 0; v < nv; ++v) {
         if (sim->p.ground && sim->vert_area[v] > 0 && x[3 * v + 1] < sim->p.ground_height)
             g[3 * v + 1] -=
@@ -169,6 +176,15 @@ static void finish_system(sw_fullsim *sim, const double *x) {
             K->val[i] += cb * sim->Kn[i];
     }
     double cm = sw_fullsim_dynamic(sim) ? sim->c_m + sim->c_d * sim->p.rayleigh_alpha : 0.0;
+    for (int32_t i = 0; i < sim->world.ncand; ++i) { /* world contact: diagonal blocks */
+        const sw_ref_world_cand *c = &sim->world.cand[i];
+        double f[3], H[9];
+        if (K->diag[c->v] < 0) continue;
+        sw_world_penalty(&c->law, x + 3 * c->v, f, H);
+        double *B = K->val + 9 * K->diag[c->v];
+        for (int k = 0; k < 9; ++k)
+            B[k] += H[k];
+    }
     for (int32_t v = 0; v < sim->nv; ++v) {
         if (K->diag[v] < 0) continue;
         double *B = K->val + 9 * K->diag[v];

@@ -21,24 +21,38 @@
 #include "collision_internal.h"
 #include "svd3.h"
 
-/* The query point as a ball (libccd's second object). */
-typedef struct ball {
-    double c[3], r;
-} ball;
+/* Support evaluations one MPR call may make. libccd 2.1's portal refinement loops until
+ * its tolerance test passes, with no iteration cap: measured here, a point near a hull's
+ * edge made it spin forever (tests/test_collision_contract.c hung in ccdMPRPenetration).
+ * Past this budget both support functions answer with the Minkowski difference's point
+ * farthest *against* the direction, which fails libccd's "can encapsulate the origin"
+ * test and passes its tolerance test, so either loop ends (the call then reports no
+ * intersection for that ray). Normal calls take 10-60 evaluations. */
+#define SW_MPR_SUPPORT_BUDGET 2000
 
-/* The hull with the interior point MPR casts its ray from (libccd's first object). */
+/* The hull with the interior point MPR casts its ray from (libccd's first object), and
+ * the support evaluations of the current MPR call. */
 typedef struct hull_obj {
     const sw_hull *h;
     double c[3];
+    int calls;
 } hull_obj;
 
+/* The query point as a ball (libccd's second object); it shares the hull's budget. */
+typedef struct ball {
+    double c[3], r;
+    const hull_obj *o;
+} ball;
+
 static void hull_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out) {
-    const sw_hull *h = ((const hull_obj *)obj)->h;
+    hull_obj *o = (hull_obj *)(uintptr_t)obj; /* libccd passes our own object back */
+    const sw_hull *h = o->h;
+    double sign = ++o->calls > SW_MPR_SUPPORT_BUDGET ? -1.0 : 1.0;
     const double *d = dir->v, *p = h->points;
     uint32_t best = 0;
     double bd = -HUGE_VAL;
     for (uint32_t i = 0; i < h->count; ++i) {
-        double s = d[0] * p[3 * i] + d[1] * p[3 * i + 1] + d[2] * p[3 * i + 2];
+        double s = sign * (d[0] * p[3 * i] + d[1] * p[3 * i + 1] + d[2] * p[3 * i + 2]);
         if (s > bd) bd = s, best = i;
     }
     memcpy(out->v, p + 3 * best, 3 * sizeof(double));
@@ -52,6 +66,7 @@ static void ball_support(const void *obj, const ccd_vec3_t *dir, ccd_vec3_t *out
     const ball *b = obj;
     double n = sqrt(dir->v[0] * dir->v[0] + dir->v[1] * dir->v[1] + dir->v[2] * dir->v[2]);
     double s = n > 0 ? b->r / n : 0.0;
+    if (b->o->calls > SW_MPR_SUPPORT_BUDGET) s = -s; /* see SW_MPR_SUPPORT_BUDGET */
     for (int i = 0; i < 3; ++i)
         out->v[i] = b->c[i] + s * dir->v[i];
 }
@@ -63,10 +78,12 @@ static void ball_center(const void *obj, ccd_vec3_t *out) {
 /* One MPR penetration: 1 with the depth and the unit direction (moving the ball, libccd's
  * second object, by depth along it separates them: the hull's outward normal), 0 when
  * they do not intersect or libccd gave no usable direction. */
-static int mpr(const hull_obj *o, const ball *b, const ccd_t *ccd, double *depth, double n[3]) {
+static int mpr(hull_obj *o, const ball *b, const ccd_t *ccd, double *depth, double n[3]) {
     ccd_real_t d = 0;
     ccd_vec3_t dir, pos;
-    if (ccdMPRPenetration(o, b, ccd, &d, &dir, &pos) != 0) return 0;
+    o->calls = 0;
+    if (ccdMPRPenetration(o, b, ccd, &d, &dir, &pos) != 0 || o->calls > SW_MPR_SUPPORT_BUDGET)
+        return 0;
     for (int i = 0; i < 3; ++i)
         n[i] = dir.v[i];
     if (!(sw_v3_normalize(n) > 0) || !sw_v3_isfinite(n) || !isfinite(d)) return 0;
@@ -117,8 +134,8 @@ static void search(hull_obj *o, const ball *b, const ccd_t *ccd, double *depth, 
  * the ball-swept hull. */
 int sw_hull_query(const sw_collider *c, const double y[3], double radius, sw_collider_hit *h) {
     const sw_hull *hl = &c->hull;
-    hull_obj o = {hl, {hl->center[0], hl->center[1], hl->center[2]}};
-    ball b = {{y[0], y[1], y[2]}, 0.0};
+    hull_obj o = {hl, {hl->center[0], hl->center[1], hl->center[2]}, 0};
+    ball b = {{y[0], y[1], y[2]}, 0.0, &o};
     ccd_t ccd;
     CCD_INIT(&ccd);
     ccd.support1 = hull_support;
@@ -128,13 +145,19 @@ int sw_hull_query(const sw_collider *c, const double y[3], double radius, sw_col
     ccd.max_iterations = 200;
     ccd.mpr_tolerance = hl->tolerance + 1e-9 * radius;
     double depth, n[3];
-    if (!mpr(&o, &b, &ccd, &depth, n)) {
+    int inside = mpr(&o, &b, &ccd, &depth, n);
+    if (!inside) {
         b.r = radius;
         memcpy(o.c, hl->center, sizeof o.c);
         if (!mpr(&o, &b, &ccd, &depth, n)) return 0; /* farther than the radius */
     }
     search(&o, &b, &ccd, &depth, n);
+    /* Outside, the ball's depth can be overestimated near edges and corners (see the
+     * head comment); the point itself is known to be outside, so it is never reported
+     * inside: the distance may read short, never negative (a contact then engages at
+     * most that much early, and never pushes a vertex that does not touch the hull). */
     double phi = b.r - depth;
+    if (!inside && phi < 0) phi = 0;
     h->phi = phi;
     for (int i = 0; i < 3; ++i) {
         h->point[i] = y[i] - phi * n[i];

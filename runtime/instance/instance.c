@@ -17,6 +17,7 @@ typedef struct {
     int32_t nact;      /* active vertices (active_vertices) */
     int32_t rmax;      /* the largest domain rank */
     int32_t max_pairs; /* the contact pair budget */
+    int32_t max_world; /* the world candidate budget */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -72,6 +73,17 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->blk_pos, nd);
     TAKE(s->blk_nz, nd * nd);
     TAKE(s->blk_adj, nd * nd);
+    /* the collision world's candidates and the surface clusters of its broad phase */
+    sw_world_contacts *wc = &in->wc;
+    const uint64_t ncl = (uint64_t)sw_world_cluster_bound(v), nc = (uint64_t)v->nsurf_copies;
+    TAKE(wc->cand, (uint64_t)z->max_world);
+    TAKE(wc->cl_begin, ncl + 1);
+    TAKE(wc->cl_copy, nc);
+    TAKE(wc->cl_bones, ncl);
+    TAKE(wc->cl_box, 6 * ncl);
+    TAKE(wc->cl_pass, ncl);
+    TAKE(wc->copy_area, nc);
+    TAKE(wc->copy_x, 3 * nc);
     /* the output */
     TAKE(in->surf_x, 3 * ns);
     TAKE(in->surf_n, 3 * ns);
@@ -195,6 +207,12 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->max_pairs = d->max_contact_pairs == 0 || d->max_contact_pairs > (uint32_t)need
                        ? need
                        : (int32_t)d->max_contact_pairs;
+    /* one candidate per surface copy and collider at most is what a step can use: the
+     * default is one per copy, and a budget above four per copy is capped there */
+    int64_t wneed = v->nsurf_copies > 0 ? v->nsurf_copies : 1;
+    z->max_world = d->max_world_contacts == 0          ? (int32_t)wneed
+                   : d->max_world_contacts > 4 * wneed ? (int32_t)(4 * wneed)
+                                                       : (int32_t)d->max_world_contacts;
     return SINEW_OK;
 }
 
@@ -255,6 +273,10 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     (void)active_vertices(v, in->red.act_vert);
     visit_active(v, &in->red, assign_active, &in->red);
     in->ps.max_pairs = z.max_pairs;
+    in->wc.max_cand = z.max_world;
+    sw_world_contacts_build(&in->wc, v);
+    /* 2% of the character's size: what a surface vertex can travel in one step */
+    in->wc.radius = 0.02 * in->size;
     sw_pose_space_link_twins(v, in->ps.twin_next);
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     sw_solver_order_blocks(&in->solver, v);
@@ -289,6 +311,8 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
         sw_dq_from_transform(ph->T_cur + 12 * b, &inst->bone_dq[b]);
     ph->history = 0;
     sw_pose_space_reset(&inst->ps, nb);
+    inst->wc.boxes_valid = 0;
+    inst->wc.ncand = 0;
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;
         memset(V, 0, 9 * sizeof(double));

@@ -8,6 +8,7 @@
 #include "pose_space.h"
 #include "reduced_map.h"
 #include "solver.h"
+#include "world_contact.h"
 
 struct sinew_instance {
     const sw_blob_view *v;
@@ -19,6 +20,7 @@ struct sinew_instance {
     sw_reduced red;          /* the subspace map and the evaluation accumulators */
     sw_pose_space ps;        /* training poses near the current one, contact pairs */
     sw_solver solver;        /* state and Newton */
+    sw_world_contacts wc;    /* the collision world's candidates of the step */
     double *surf_x, *surf_n; /* 3 per output surface vertex each */
     sinew_step_stats stats;
 };

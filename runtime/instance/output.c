@@ -18,13 +18,16 @@ void sw_instance_write_surface(sinew_instance *in) {
             double x[3];
             sw_reduced_position(&in->red, D, v->surf_copies[2 * i + 1], in->red.copy_act[i],
                                 in->solver.q + D->q_offset, x, NULL);
-            for (int k = 0; k < 3; ++k)
+            for (int k = 0; k < 3; ++k) {
                 acc[k] += x[k];
+                in->wc.copy_x[3 * i + k] = x[k]; /* the world's broad phase next step */
+            }
         }
         for (int k = 0; k < 3; ++k)
             in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
     }
     sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
+    if (in->wc.world) sw_world_contacts_update_boxes(&in->wc);
 }
 
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
@@ -102,7 +105,8 @@ double sw_instance_potential(sinew_instance *inst, const double *q, double *g, d
     sw_reduced_skin(&inst->red, inst->bone_dq);
     sw_pose_space_lookup(&inst->ps, inst->v, inst->pose.T_cur);
     sw_pose_space_gather_pairs(&inst->ps, inst->v);
-    double phi = sw_potential(&inst->red, &inst->ps, &inst->solver, q, &dc, g || H, H != NULL);
+    sw_step_contacts ct = {&inst->ps, inst->wc.world ? &inst->wc : NULL};
+    double phi = sw_potential(&inst->red, &ct, &inst->solver, q, &dc, g || H, H != NULL);
     if (g) memcpy(g, inst->red.g, R * sizeof(double));
     if (H) memcpy(H, inst->red.H, R * R * sizeof(double));
     return phi;

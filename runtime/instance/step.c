@@ -3,7 +3,10 @@
  *   skin      dual-quaternion skinning of the active vertices (eq. 4.13)
  *   contact   the training poses nearest to the pose, their contact pairs (§3.2.3)
  *   dynamics  teleports, inertial forces, the start state, the frozen damping Hessian
- *   solve     Newton on the step's potential (eqs. 2.11-2.12, 3.4-3.6, 4.20)
+ *   world     the surface copies near colliders at the start state (world_contact.h)
+ *   solve     Newton on the step's potential (eqs. 2.11-2.12, 3.4-3.6, 4.20); when it
+ *             ran into colliders the start state did not touch, one more detection
+ *             round and solve from there
  *   advance   the velocity and the pose history
  *   output    the output surface and its normals
  * Nothing here allocates, locks or touches a vertex that is not active: the cost follows
@@ -101,7 +104,8 @@ static void phase_dynamics(sw_step_ctx *c) {
         sw_inertial_forces(in->v, &in->pose, s, c->dc.h);
         sw_dyn_coef statics = c->dc;
         statics.dynamic = 0;
-        sw_potential(&in->red, &in->ps, s, s->q, &statics, 1, 1);
+        sw_step_contacts self = {&in->ps, NULL}; /* H_n: the material and self-contact */
+        sw_potential(&in->red, &self, s, s->q, &statics, 1, 1);
         c->st.potential_evals++;
         memcpy(s->Hn, in->red.H, (size_t)R * R * sizeof(double));
     } else if (in->ps.nearest >= 0) {
@@ -111,11 +115,48 @@ static void phase_dynamics(sw_step_ctx *c) {
     c->st.ms_dynamics = lap(c);
 }
 
+/* World candidates at the start state; the broad phase starts from the last output's
+ * boxes when the last step's pose is the one before this (pose history). */
+static void phase_world(sw_step_ctx *c) {
+    sinew_instance *in = c->in;
+    sw_world_contacts *wc = &in->wc;
+    if (!wc->world) return;
+    const double *T_last = in->pose.history >= 1 ? in->pose.T_prev : NULL;
+    sw_world_contacts_detect(wc, &in->red, in->solver.q, in->pose.T_cur, T_last);
+    c->st.world_rounds = 1;
+    c->st.ms_world = lap(c);
+}
+
+/* Newton; with a world, a second round when the solution entered colliders at copies
+ * that were not candidates (they join with their law frozen there). */
 static sinew_result phase_solve(sw_step_ctx *c) {
     sinew_instance *in = c->in;
-    sinew_result r = sw_newton_solve(&in->red, &in->ps, &in->solver, &c->dc, &c->st);
+    sw_world_contacts *wc = &in->wc;
+    sw_step_contacts ct = {&in->ps, wc->world ? wc : NULL};
+    sinew_result r = sw_newton_solve(&in->red, &ct, &in->solver, &c->dc, &c->st);
+    double ms_round2 = 0; /* the second detection, counted as world time */
+    if (r == SINEW_OK && wc->world) {
+        double t = sw_now_seconds();
+        int32_t added = sw_world_contacts_add_missed(wc, &in->red, in->solver.q);
+        ms_round2 = 1e3 * (sw_now_seconds() - t);
+        c->st.ms_world += ms_round2;
+        if (added > 0) {
+            c->st.world_rounds = 2;
+            r = sw_newton_solve(&in->red, &ct, &in->solver, &c->dc, &c->st);
+        }
+        if (r == SINEW_OK) sw_world_contacts_finish(wc, &in->red, in->solver.q);
+        c->st.world_queries = wc->queries;
+        c->st.world_candidates = (uint32_t)wc->ncand;
+        for (int32_t j = 0; j < wc->ncand; ++j)
+            c->st.world_contacts += (uint32_t)wc->cand[j].active;
+        if (wc->dropped > 0) {
+            c->st.status |= SINEW_STEP_BUDGET;
+            c->st.budget_exceeded |= SINEW_BUDGET_WORLD_CONTACTS;
+            c->st.world_contacts_dropped = (uint32_t)wc->dropped;
+        }
+    }
     c->st.cubature_tets = (uint32_t)in->v->ncub;
-    c->st.ms_solve = lap(c);
+    c->st.ms_solve = lap(c) - ms_round2;
     return r;
 }
 
@@ -142,6 +183,7 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     phase_skin(&c);
     phase_contact(&c);
     phase_dynamics(&c);
+    phase_world(&c);
     sinew_result r = phase_solve(&c); /* a non-finite state is undone: nothing advances */
     if (r == SINEW_OK) {
         phase_advance(&c);

@@ -63,19 +63,19 @@ static int newton_direction(sw_reduced *red, sw_solver *s) {
 }
 
 /* Phi at q with its gradient and Hessian, counted. */
-static double evaluate(sw_reduced *red, const sw_pose_space *ps, const sw_solver *s,
+static double evaluate(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
                        const double *q, const sw_dyn_coef *dc, sinew_step_stats *st) {
     st->potential_evals++;
-    return sw_potential(red, ps, s, q, dc, 1, 1);
+    return sw_potential(red, ct, s, q, dc, 1, 1);
 }
 
-sinew_result sw_newton_solve(sw_reduced *red, const sw_pose_space *ps, sw_solver *s,
+sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
                              const sw_dyn_coef *dc, sinew_step_stats *st) {
     int32_t R = red->R;
     /* The trial point's evaluation (energy, gradient and Hessian) is the next
      * iteration's, so an accepted step costs one cubature pass; a rejected one halves
      * the step and evaluates again. */
-    double phi = evaluate(red, ps, s, s->q, dc, st);
+    double phi = evaluate(red, ct, s, s->q, dc, st);
     double gn = sqrt(sw_dot(red->g, red->g, R)), g0 = gn;
     for (uint32_t it = 0;; ++it) {
         if (!isfinite(phi) || !isfinite(gn)) {
@@ -109,7 +109,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_pose_space *ps, sw_solver
         for (int ls = 0; ls < 5; ++ls, step *= 0.5) {
             for (int32_t i = 0; i < R; ++i)
                 s->q[i] = s->qtrial[i] + step * s->dq[i];
-            phi = evaluate(red, ps, s, s->q, dc, st);
+            phi = evaluate(red, ct, s, s->q, dc, st);
             if (isfinite(phi) && phi <= phi0 + 1e-12 * fabs(phi0)) {
                 accepted = 1;
                 break;

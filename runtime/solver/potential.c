@@ -1,5 +1,5 @@
 /* The potential of one step (thesis eqs. 2.11, 4.20 and the backward-Euler terms):
- *   Phi(q) = E_cub(q) + E_contact(q) + 1/2 q^T H_s q
+ *   Phi(q) = E_cub(q) + E_contact(q) + E_world(q) + 1/2 q^T H_s q
  *          [ + cm/2 |q - q_n - h qdot_n|_M^2 + cd/2 |q - q_n|_D^2 - q^T f_in ],
  * D = alpha M + beta H(q_n), H_s the constant interface-spring Hessian, M the constant
  * reduced mass, f_in the inertial forces of the domains riding their bones. */
@@ -10,14 +10,15 @@
 #include "pose_contact.h"
 #include "solver.h"
 
-double sw_potential(sw_reduced *red, const sw_pose_space *ps, const sw_solver *s, const double *q,
-                    const sw_dyn_coef *dc, int want_grad, int want_hess) {
+double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
+                    const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess) {
     int32_t R = red->R;
     const sw_blob_view *v = red->v;
     if (want_grad) memset(red->g, 0, (size_t)R * sizeof(double));
     if (want_hess) memcpy(red->H, v->spring_hessian, (size_t)R * R * sizeof(double));
     double phi = sw_cubature_eval(red, q, want_grad, want_hess);
-    phi += sw_pose_contact_eval(red, ps, q, want_grad, want_hess);
+    phi += sw_pose_contact_eval(red, ct->ps, q, want_grad, want_hess);
+    if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
     sw_matvec(v->spring_hessian, R, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);
     if (want_grad)

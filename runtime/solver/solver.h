@@ -8,6 +8,7 @@
 
 #include "pose_space.h"
 #include "reduced_map.h"
+#include "world_contact.h"
 #include "sinew/sinew.h"
 
 typedef struct sw_solver {
@@ -35,10 +36,18 @@ typedef struct sw_dyn_coef {
 /* The block layout of H and its minimum-degree elimination order, once at creation. */
 void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v);
 
-/* Phi(q): cubature + contact + springs [+ inertia, damping and inertial forces]. With
- * want_grad also red->g (and red->H with want_hess); H_n is frozen for the step. */
-double sw_potential(sw_reduced *red, const sw_pose_space *ps, const sw_solver *s, const double *q,
-                    const sw_dyn_coef *dc, int want_grad, int want_hess);
+/* The contact terms of a step: pose-space self-contact pairs and world candidates
+ * (either may be empty; wc may be NULL). */
+typedef struct sw_step_contacts {
+    const sw_pose_space *ps;
+    const sw_world_contacts *wc;
+} sw_step_contacts;
+
+/* Phi(q): cubature + contact (self and world) + springs [+ inertia, damping and inertial
+ * forces]. With want_grad also red->g (and red->H with want_hess); H_n is frozen for the
+ * step. */
+double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
+                    const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess);
 
 /* The structural block pattern of H for this step: spring-coupled domains and the
  * domains the contact pairs in use join (no scan of H's values). */
@@ -47,7 +56,7 @@ void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_pose_
 /* Newton from s->q with the energy guard, into s->q; fills st's iterations, status
  * (CONVERGED, GUARD), residual, energy and potential_evals. A non-finite potential
  * restores q_n, sets FAILED and returns SINEW_ERROR_NOT_FINITE. */
-sinew_result sw_newton_solve(sw_reduced *red, const sw_pose_space *ps, sw_solver *s,
+sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
                              const sw_dyn_coef *dc, sinew_step_stats *st);
 
 #endif

@@ -106,6 +106,11 @@ typedef struct sinew_instance_def {
      * steps serially and rejects a def whose enqueue or finish is set
      * (SINEW_ERROR_UNSUPPORTED); keep it zero. */
     sinew_task_callbacks tasks;
+    /** Budget: the (surface vertex, collider) candidates one step may hold against the
+     * collision world (sinew_world.h). 0 means one per output-surface vertex copy. A
+     * step that finds more keeps those found first, drops the rest and flags
+     * SINEW_STEP_BUDGET with SINEW_BUDGET_WORLD_CONTACTS. */
+    uint32_t max_world_contacts;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -121,6 +126,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.tasks.finish = NULL;
     d.tasks.worker_count = 0;
     d.tasks.user = NULL;
+    d.max_world_contacts = 0;
     return d;
 }
 
@@ -136,7 +142,8 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
 #define SINEW_STEP_BUDGET 32u
 
 /** Budgets of an instance (sinew_step_stats.budget_exceeded bits). */
-#define SINEW_BUDGET_CONTACT_PAIRS 1u /**< sinew_instance_def.max_contact_pairs */
+#define SINEW_BUDGET_CONTACT_PAIRS 1u  /**< sinew_instance_def.max_contact_pairs */
+#define SINEW_BUDGET_WORLD_CONTACTS 2u /**< sinew_instance_def.max_world_contacts */
 
 /** Figures of an instance's last step. */
 typedef struct sinew_step_stats {
@@ -158,6 +165,14 @@ typedef struct sinew_step_stats {
     uint32_t contact_pairs;   /**< pose-space contact pairs in use */
     uint32_t contact_pairs_dropped; /**< pairs the max_contact_pairs budget left out */
     uint32_t budget_exceeded;       /**< SINEW_BUDGET_* bits of the budgets that ran out */
+    /* The collision world (zero without one): */
+    double ms_world;                 /**< detection against the world (broad and narrow) */
+    uint32_t world_queries;          /**< collider queries (vertex, collider) made */
+    uint32_t world_candidates;       /**< (vertex copy, collider) candidates in the solve */
+    uint32_t world_contacts;         /**< candidates in contact at the solution */
+    uint32_t world_contacts_dropped; /**< candidates the max_world_contacts budget left out */
+    uint32_t world_rounds;           /**< detections: 2 when the solve ran into new contact */
+    uint32_t reserved2;              /**< zero */
 } sinew_step_stats;
 
 #ifdef __cplusplus

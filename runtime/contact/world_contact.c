@@ -1,0 +1,361 @@
+#include "world_contact.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "collision.h"
+
+/* ---- creation: clusters and areas ------------------------------------------------ */
+
+int32_t sw_world_cluster_bound(const sw_blob_view *v) {
+    /* median splits of n copies into leaves of <= C give < 2n/C + 1 leaves per domain */
+    return v->ndomains + 2 * (v->nsurf_copies / SW_WORLD_CLUSTER) + 2;
+}
+
+/* The rest position of surface copy i. */
+static const double *copy_rest(const sw_blob_view *v, int32_t i) {
+    const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+    return v->rest + 3 * (int64_t)v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
+}
+
+/* Orders idx[0, n) so that idx[k] is the k-th by (coordinate ax of its rest position,
+ * copy index): Hoare's selection, in place, deterministic. */
+static void select_kth(const sw_blob_view *v, int32_t *idx, int32_t n, int32_t k, int ax) {
+    int32_t lo = 0, hi = n - 1;
+    while (lo < hi) {
+        int32_t pv = idx[lo + (hi - lo) / 2];
+        double pk = copy_rest(v, pv)[ax];
+        int32_t i = lo, j = hi;
+        while (i <= j) {
+            while (copy_rest(v, idx[i])[ax] < pk || (copy_rest(v, idx[i])[ax] == pk && idx[i] < pv))
+                ++i;
+            while (copy_rest(v, idx[j])[ax] > pk || (copy_rest(v, idx[j])[ax] == pk && idx[j] > pv))
+                --j;
+            if (i <= j) {
+                int32_t t = idx[i];
+                idx[i++] = idx[j];
+                idx[j--] = t;
+            }
+        }
+        if (k <= j)
+            hi = j;
+        else if (k >= i)
+            lo = i;
+        else
+            return;
+    }
+}
+
+/* Splits cl_copy[b, e) at the median of its longest rest axis until every part holds at
+ * most SW_WORLD_CLUSTER copies, appending the parts as clusters (an explicit stack). */
+static void split_range(sw_world_contacts *wc, const sw_blob_view *v, int32_t b, int32_t e) {
+    int32_t stack[2 * 64], top = 0;
+    stack[top++] = b;
+    stack[top++] = e;
+    while (top > 0) {
+        e = stack[--top];
+        b = stack[--top];
+        if (e - b <= SW_WORLD_CLUSTER || top >= 2 * 64 - 4) {
+            wc->cl_begin[wc->ncl++] = b;
+            continue;
+        }
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int32_t i = b; i < e; ++i)
+            for (int k = 0; k < 3; ++k) {
+                lo[k] = fmin(lo[k], copy_rest(v, wc->cl_copy[i])[k]);
+                hi[k] = fmax(hi[k], copy_rest(v, wc->cl_copy[i])[k]);
+            }
+        int ax = 0;
+        for (int k = 1; k < 3; ++k)
+            if (hi[k] - lo[k] > hi[ax] - lo[ax]) ax = k;
+        int32_t m = b + (e - b) / 2;
+        select_kth(v, wc->cl_copy + b, e - b, m - b, ax);
+        /* the right half is pushed first so clusters come out left to right */
+        stack[top++] = m;
+        stack[top++] = e;
+        stack[top++] = b;
+        stack[top++] = m;
+    }
+}
+
+/* Rest area of each copy: a third of its surface vertex's triangles, shared evenly by
+ * the vertex's copies (the area weight of eqs. 3.4-3.6). */
+static void copy_areas(sw_world_contacts *wc, const sw_blob_view *v) {
+    memset(wc->copy_area, 0, (size_t)v->nsurf_copies * sizeof(double));
+    for (int32_t t = 0; t < v->nsurf_tris; ++t) {
+        const int32_t *tri = v->surf_tris + 3 * (int64_t)t;
+        const double *a = copy_rest(v, v->surf_copy_ptr[tri[0]]),
+                     *b = copy_rest(v, v->surf_copy_ptr[tri[1]]),
+                     *c = copy_rest(v, v->surf_copy_ptr[tri[2]]);
+        double u[3], w[3], n[3];
+        for (int k = 0; k < 3; ++k) {
+            u[k] = b[k] - a[k];
+            w[k] = c[k] - a[k];
+        }
+        n[0] = u[1] * w[2] - u[2] * w[1];
+        n[1] = u[2] * w[0] - u[0] * w[2];
+        n[2] = u[0] * w[1] - u[1] * w[0];
+        double third = sqrt(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]) / 6;
+        for (int k = 0; k < 3; ++k) {
+            int32_t s = tri[k], cb = v->surf_copy_ptr[s], ce = v->surf_copy_ptr[s + 1];
+            for (int32_t i = cb; i < ce; ++i)
+                wc->copy_area[i] += third / (double)(ce - cb);
+        }
+    }
+}
+
+void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
+    int32_t n = 0;
+    wc->ncl = 0;
+    for (int32_t d = 0; d < v->ndomains; ++d) {
+        int32_t b = n;
+        for (int32_t i = 0; i < v->nsurf_copies; ++i)
+            if (v->surf_copies[2 * i] == d) wc->cl_copy[n++] = i;
+        if (n > b) split_range(wc, v, b, n);
+    }
+    wc->cl_begin[wc->ncl] = n;
+    /* clusters were appended per range start; order them by start (ranges are disjoint) */
+    for (int32_t c = 1; c < wc->ncl; ++c)
+        for (int32_t j = c; j > 0 && wc->cl_begin[j - 1] > wc->cl_begin[j]; --j) {
+            int32_t t = wc->cl_begin[j];
+            wc->cl_begin[j] = wc->cl_begin[j - 1];
+            wc->cl_begin[j - 1] = t;
+        }
+    for (int32_t c = 0; c < wc->ncl; ++c) {
+        uint64_t mask = 0;
+        for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i) {
+            const sw_blob_domain *D = &v->domains[v->surf_copies[2 * wc->cl_copy[i]]];
+            int32_t gv = v->domain_verts[D->vert_begin + v->surf_copies[2 * wc->cl_copy[i] + 1]];
+            for (int k = 0; k < SW_BLOB_INFLUENCES; ++k)
+                if (v->skin_weight[4 * gv + k] > 0) {
+                    int32_t bone = v->skin_bone[4 * gv + k];
+                    mask |= bone < 64 ? 1ull << bone : ~0ull;
+                }
+        }
+        wc->cl_bones[c] = v->nbones > 64 ? ~0ull : mask;
+    }
+    copy_areas(wc, v);
+    wc->boxes_valid = 0;
+    wc->ncand = 0;
+}
+
+/* ---- detection ------------------------------------------------------------------- */
+
+/* How far a point of the box (centre c, half-diagonal rho) moves under the rigid motion
+ * from T0 to T1 (12 doubles: R row-major, t): |D(c) - c| + ||dR - I|| rho with
+ * D = T1 T0^-1 and ||dR - I||_2 = sqrt(3 - tr dR). */
+static double box_motion(const double *T0, const double *T1, const double c[3], double rho) {
+    double dR[9], tr = 0;
+    for (int r = 0; r < 3; ++r)
+        for (int k = 0; k < 3; ++k) {
+            double acc = 0;
+            for (int j = 0; j < 3; ++j)
+                acc += T1[3 * r + j] * T0[3 * k + j]; /* R1 R0^T */
+            dR[3 * r + k] = acc;
+        }
+    tr = dR[0] + dR[4] + dR[8];
+    double y[3], m2 = 0; /* D(c) = R1 R0^T (c - t0) + t1 */
+    for (int r = 0; r < 3; ++r) {
+        double acc = T1[9 + r];
+        for (int k = 0; k < 3; ++k)
+            acc += dR[3 * r + k] * (c[k] - T0[9 + k]);
+        y[r] = acc - c[r];
+        m2 += y[r] * y[r];
+    }
+    return sqrt(m2) + sqrt(fmax(0.0, 3 - tr)) * rho;
+}
+
+static int boxes_overlap(const double a[6], const double b[6]) {
+    for (int k = 0; k < 3; ++k)
+        if (a[k] > b[3 + k] || b[k] > a[3 + k]) return 0;
+    return 1;
+}
+
+static int box_holds(const double b[6], const double x[3]) {
+    for (int k = 0; k < 3; ++k)
+        if (x[k] < b[k] || x[k] > b[3 + k]) return 0;
+    return 1;
+}
+
+/* The position of surface copy i at q. */
+static void copy_position(const sw_reduced *red, int32_t i, const double *q, double x[3],
+                          double *J) {
+    const sw_blob_view *v = red->v;
+    const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+    sw_reduced_position(red, D, v->surf_copies[2 * i + 1], red->copy_act[i], q + D->q_offset, x, J);
+}
+
+static int is_candidate(const sw_world_contacts *wc, int32_t copy, int32_t slot) {
+    for (int32_t j = 0; j < wc->ncand; ++j)
+        if (wc->cand[j].copy == copy && wc->cand[j].slot == slot) return 1;
+    return 0;
+}
+
+/* Queries copy i at x against world slot s; a hit within the radius (or, with
+ * penetrating_only, inside) becomes a candidate unless it is one already. */
+static void try_candidate(sw_world_contacts *wc, int32_t i, const double x[3], uint32_t s,
+                          double blob_k, int penetrating_only) {
+    const sw_collider *c = sw_world_slot(wc->world, s);
+    sw_collider_hit hit;
+    wc->queries++;
+    if (!sw_collider_query(c, x, wc->radius, &hit)) return;
+    if (penetrating_only && (!(hit.phi < 0) || is_candidate(wc, i, (int32_t)s))) return;
+    if (wc->ncand >= wc->max_cand) {
+        wc->dropped++;
+        return;
+    }
+    sw_world_cand *cd = &wc->cand[wc->ncand++];
+    double ks = sw_collider_stiffness(c);
+    cd->law.k = (ks > 0 ? ks : blob_k) * wc->copy_area[i];
+    for (int k = 0; k < 3; ++k) {
+        cd->law.a[k] = hit.point[k];
+        cd->law.n[k] = hit.normal[k];
+    }
+    /* lagged friction: the cap is mu times the normal force at detection */
+    cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
+    cd->copy = i;
+    cd->slot = (int32_t)s;
+    cd->id = sw_collider_id_of(wc->world, s);
+    cd->active = 0;
+    cd->f[0] = cd->f[1] = cd->f[2] = 0;
+}
+
+/* The world box of slot s grown by the detection radius; 0 for an empty slot. */
+static int collider_box(const sw_world_contacts *wc, uint32_t s, double box[6]) {
+    const sw_collider *c = sw_world_slot(wc->world, s);
+    if (!c) return 0;
+    sw_collider_bounds(c, wc->radius, box, box + 3);
+    return 1;
+}
+
+/* The broad-phase box of cluster c: its box at the last output grown by the motion of
+ * the bones that skin it since (T_last -> T) and the detection radius. */
+static void cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                        const double *T, const double *T_last, double box[6]) {
+    const double *b = wc->cl_box + 6 * c;
+    double ctr[3], rho = 0, grow = 0;
+    for (int k = 0; k < 3; ++k) {
+        ctr[k] = 0.5 * (b[k] + b[3 + k]);
+        rho += 0.25 * (b[3 + k] - b[k]) * (b[3 + k] - b[k]);
+    }
+    rho = sqrt(rho);
+    for (int32_t bone = 0; bone < v->nbones; ++bone)
+        if (wc->cl_bones[c] >> (bone < 64 ? bone : 63) & 1)
+            grow = fmax(grow, box_motion(T_last + 12 * bone, T + 12 * bone, ctr, rho));
+    /* a dual-quaternion blend of bone motions moves a point no further than about the
+     * largest of them; 1.25 x leaves room for the blend and the correction's change */
+    grow = 1.25 * grow + wc->radius;
+    for (int k = 0; k < 3; ++k) {
+        box[k] = b[k] - grow;
+        box[3 + k] = b[3 + k] + grow;
+    }
+}
+
+/* Narrow phase of cluster c at q against every collider whose box meets `box` (NULL:
+ * all), the cluster's positions computed once. */
+static void narrow_cluster(sw_world_contacts *wc, const sw_reduced *red, const double *q, int32_t c,
+                           const double *box, int penetrating_only) {
+    double x[SW_WORLD_CLUSTER][3];
+    int32_t b = wc->cl_begin[c], n = wc->cl_begin[c + 1] - b, have = 0;
+    uint32_t ns = sw_world_slot_count(wc->world);
+    for (uint32_t s = 0; s < ns; ++s) {
+        double cb[6];
+        if (!collider_box(wc, s, cb) || (box && !boxes_overlap(box, cb))) continue;
+        if (!have)
+            for (int32_t j = 0; j < n; ++j)
+                copy_position(red, wc->cl_copy[b + j], q, x[j], NULL);
+        have = 1;
+        for (int32_t j = 0; j < n; ++j)
+            if (box_holds(cb, x[j]))
+                try_candidate(wc, wc->cl_copy[b + j], x[j], s, red->v->contact_k, penetrating_only);
+    }
+    if (have && !penetrating_only) wc->cl_pass[wc->npass++] = c;
+}
+
+int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, const double *q,
+                                 const double *T, const double *T_last) {
+    wc->ncand = wc->dropped = wc->npass = 0;
+    wc->queries = 0;
+    if (!wc->world) return 0;
+    int use_boxes = wc->boxes_valid && T_last;
+    for (int32_t c = 0; c < wc->ncl; ++c) {
+        double box[6];
+        if (use_boxes) cluster_box(wc, red->v, c, T, T_last, box);
+        narrow_cluster(wc, red, q, c, use_boxes ? box : NULL, 0);
+    }
+    return wc->ncand;
+}
+
+int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red,
+                                     const double *q) {
+    if (!wc->world) return 0;
+    int32_t before = wc->ncand;
+    /* a copy that entered a collider during the solve is in a cluster the detection
+     * passed (its grown box holds where the copy can reach) */
+    for (int32_t p = 0; p < wc->npass; ++p)
+        narrow_cluster(wc, red, q, wc->cl_pass[p], NULL, 1);
+    return wc->ncand - before;
+}
+
+/* ---- energy, gradient, Hessian --------------------------------------------------- */
+
+double sw_world_contact_eval(sw_reduced *red, const sw_world_contacts *wc, const double *q,
+                             int want_grad, int want_hess) {
+    const sw_blob_view *v = red->v;
+    double E = 0;
+    for (int32_t j = 0; j < wc->ncand; ++j) {
+        const sw_world_cand *cd = &wc->cand[j];
+        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * cd->copy]];
+        int32_t r = D->rank;
+        double x[3], f[3], H3[9];
+        double *J = red->Jc;
+        copy_position(red, cd->copy, q, x, want_grad ? J : NULL);
+        E += sw_world_penalty(&cd->law, x, f, want_hess ? H3 : NULL);
+        if (!want_grad) continue;
+        double *g = red->g + D->q_offset;
+        for (int32_t a = 0; a < r; ++a)
+            g[a] -= J[a] * f[0] + J[r + a] * f[1] + J[2 * r + a] * f[2];
+        if (!want_hess || (H3[0] == 0 && H3[4] == 0 && H3[8] == 0)) continue;
+        double *HJ = red->hc; /* H3 J: 3 x r */
+        for (int i = 0; i < 3; ++i)
+            for (int32_t a = 0; a < r; ++a)
+                HJ[i * r + a] =
+                    H3[3 * i] * J[a] + H3[3 * i + 1] * J[r + a] + H3[3 * i + 2] * J[2 * r + a];
+        for (int32_t a = 0; a < r; ++a) {
+            double *Ha = red->H + (int64_t)(D->q_offset + a) * red->R + D->q_offset;
+            double j0 = J[a], j1 = J[r + a], j2 = J[2 * r + a];
+            for (int32_t b = 0; b < r; ++b)
+                Ha[b] += j0 * HJ[b] + j1 * HJ[r + b] + j2 * HJ[2 * r + b];
+        }
+    }
+    return E;
+}
+
+void sw_world_contacts_finish(sw_world_contacts *wc, sw_reduced *red, const double *q) {
+    for (int32_t j = 0; j < wc->ncand; ++j) {
+        sw_world_cand *cd = &wc->cand[j];
+        double x[3];
+        copy_position(red, cd->copy, q, x, NULL);
+        (void)sw_world_penalty(&cd->law, x, cd->f, NULL);
+        double d[3] = {cd->law.a[0] - x[0], cd->law.a[1] - x[1], cd->law.a[2] - x[2]};
+        cd->active = sw_penalty_gap(cd->law.n, d) > 0;
+    }
+}
+
+void sw_world_contacts_update_boxes(sw_world_contacts *wc) {
+    for (int32_t c = 0; c < wc->ncl; ++c) {
+        double *b = wc->cl_box + 6 * c;
+        for (int k = 0; k < 3; ++k) {
+            b[k] = INFINITY;
+            b[3 + k] = -INFINITY;
+        }
+        for (int32_t j = wc->cl_begin[c]; j < wc->cl_begin[c + 1]; ++j) {
+            const double *x = wc->copy_x + 3 * wc->cl_copy[j];
+            for (int k = 0; k < 3; ++k) {
+                b[k] = fmin(b[k], x[k]);
+                b[3 + k] = fmax(b[3 + k], x[k]);
+            }
+        }
+    }
+    wc->boxes_valid = 1;
+}

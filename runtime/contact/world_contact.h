@@ -1,0 +1,85 @@
+/* Contact of the flesh with the collision world inside the step (DESIGN.md §4.5, thesis
+ * §3.3.1 with a collider's surface as the contact surface): the output surface's vertex
+ * copies against the world's colliders, with the penalty and friction of
+ * world_penalty.h in the reduced Newton.
+ *
+ * Detection is two-phase and its cost follows the copies near colliders, not the mesh:
+ *  - broad: the surface copies are grouped at creation into clusters of at most
+ *    SW_WORLD_CLUSTER copies (median splits of each domain's copies in rest space). Each
+ *    cluster's box is taken from the last step's output and grown by how far the bones
+ *    that skin it moved since (their rigid motion applied to the box), plus the
+ *    detection radius; only clusters whose grown box meets a collider's box go on.
+ *  - narrow: each copy of those clusters, at the step's start state, is queried against
+ *    each collider whose box holds it (collision.h); a copy within the detection radius
+ *    becomes a candidate with its frozen law (world_penalty.h).
+ * Without a valid last output (the first step, after a reset or a teleport) every
+ * cluster goes to the narrow phase once. */
+#ifndef SW_WORLD_CONTACT_H
+#define SW_WORLD_CONTACT_H
+
+#include <stdint.h>
+
+#include "reduced_map.h"
+#include "sinew/sinew_world.h"
+#include "world_penalty.h"
+
+/* Copies per cluster at most. */
+#define SW_WORLD_CLUSTER 32
+
+/* One (surface copy, collider) candidate of the step. */
+typedef struct sw_world_cand {
+    sw_world_pair law;
+    int32_t copy; /* surface copy index */
+    int32_t slot; /* the collider's slot */
+    sinew_collider_id id;
+    int32_t active; /* in contact (gap > 0) at the step's solution */
+    double f[3];    /* force on the vertex copy at the solution */
+} sw_world_cand;
+
+typedef struct sw_world_contacts {
+    const sinew_world *world;
+    int32_t max_cand, ncand, dropped;
+    sw_world_cand *cand; /* max_cand */
+    int32_t ncl;         /* clusters */
+    int32_t *cl_begin;   /* ncl + 1: cluster c holds cl_copy[cl_begin[c] .. cl_begin[c+1]) */
+    int32_t *cl_copy;    /* nsurf_copies, in cluster order */
+    uint64_t *cl_bones;  /* ncl: bits of the bones skinning the cluster (all when > 64) */
+    double *cl_box;      /* 6 per cluster: its copies' box at the last output */
+    double *copy_area;   /* nsurf_copies: rest area per copy */
+    double *copy_x;      /* 3 per copy: positions at the last output */
+    int32_t *cl_pass;    /* ncl: the clusters the last broad phase passed */
+    int32_t npass;
+    int boxes_valid;  /* cl_box holds the last output */
+    double radius;    /* detection radius (world units) */
+    uint32_t queries; /* collider queries of the last detection */
+} sw_world_contacts;
+
+/* Upper bound of the cluster count for a blob (sizes the instance's memory). */
+int32_t sw_world_cluster_bound(const sw_blob_view *v);
+
+/* Builds the clusters, their bone masks and the copies' rest areas into wc's arrays
+ * (laid out by the instance). Creation time; no allocation. */
+void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v);
+
+/* Candidates at the state q for the pose T (12 per bone) and the pose of the last output
+ * T_last (NULL: no valid last output). Returns the candidates found; wc->dropped counts
+ * those over the budget. */
+int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, const double *q,
+                                 const double *T, const double *T_last);
+
+/* Appends the copies that penetrate a collider at q without being candidates yet (a
+ * second detection round after a solve); returns how many were added. */
+int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red, const double *q);
+
+/* The world contact energy at q; with want_grad its gradient into red->g, with
+ * want_hess its (domain-diagonal) Hessian blocks into red->H. */
+double sw_world_contact_eval(sw_reduced *red, const sw_world_contacts *wc, const double *q,
+                             int want_grad, int want_hess);
+
+/* Records each candidate's force and activity at the solution q (the readback). */
+void sw_world_contacts_finish(sw_world_contacts *wc, sw_reduced *red, const double *q);
+
+/* Takes the cluster boxes from the copies' output positions wc->copy_x. */
+void sw_world_contacts_update_boxes(sw_world_contacts *wc);
+
+#endif

@@ -1,0 +1,155 @@
+#include "world_bench.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "blob_load.h"
+#include "clock.h"
+#include "collision.h"
+#include "instance.h"
+#include "rt_interpose.h"
+#include "tool_common.h"
+
+/* Deepest penetration of the points x (n) into the world's colliders. */
+static double penetration(const sinew_world *w, int32_t n, const double *x) {
+    double pen = 0;
+    for (uint32_t s = 0; s < sw_world_slot_count(w); ++s) {
+        const sw_collider *c = sw_world_slot(w, s);
+        double lo[3], hi[3];
+        if (!c) continue;
+        sw_collider_bounds(c, 0, lo, hi);
+        for (int32_t i = 0; i < n; ++i) {
+            const double *p = x + 3 * i;
+            sw_collider_hit hit;
+            if (p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] || p[2] < lo[2] ||
+                p[2] > hi[2])
+                continue;
+            if (sw_collider_query(c, p, 1e-6, &hit)) pen = fmax(pen, -hit.phi);
+        }
+    }
+    return pen;
+}
+
+/* The reference over the scene: positions of every frame into x_full, which frames touch
+ * a collider into touch. */
+static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
+                                  const sw_fullsim_params *fp, const double *T, int nf,
+                                  double *x_full, unsigned char *touch, double *mass,
+                                  sw_world_bench *out, sw_error *err) {
+    sw_fullsim_params p = *fp;
+    p.world = ws->world;
+    sw_fullsim *sim;
+    sinew_result r = sw_fullsim_create(ch, &p, &sim, err);
+    if (r != SINEW_OK) return r;
+    size_t nv3 = (size_t)3 * ch->mesh.nverts;
+    memcpy(mass, sw_fullsim_masses(sim), sizeof(double) * ch->mesh.nverts);
+    double *ms = malloc(sizeof(double) * nf);
+    for (int f = 0; f < nf && ms; ++f) {
+        sw_fullsim_stats st;
+        if ((r = sw_world_scene_at(ws, f, err)) != SINEW_OK) break;
+        sinew_result sr = sw_fullsim_step(sim, T + (size_t)f * 12 * ch->skel.nbones, &st);
+        out->ref_failed += sr != SINEW_OK && sr != SINEW_ERROR_NOT_CONVERGED;
+        out->ref_unsettled += st.contacts_unsettled;
+        out->pen_world_full = fmax(out->pen_world_full, st.world_penetration);
+        touch[f] = st.world_contacts > 0;
+        out->world_contact_frames += touch[f];
+        ms[f] = 1e3 * st.seconds;
+        memcpy(x_full + (size_t)f * nv3, sw_fullsim_positions(sim), nv3 * sizeof(double));
+        fprintf(stderr,
+                "sinew-bench: world reference frame %d/%d: %.1f ms, %d in contact, "
+                "penetration %.4g\n",
+                f + 1, nf, ms[f], st.world_contacts, st.world_penetration);
+    }
+    out->full_ms = ms ? sw_median(ms, nf) : 0;
+    free(ms);
+    sw_fullsim_destroy(sim);
+    return r;
+}
+
+/* The runtime over the scene: its figures, and the correction error over the frames the
+ * reference touches a collider in. */
+static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, const double *T,
+                                 int nf, const double *x_full, const unsigned char *touch,
+                                 const double *mass, sw_world_bench *out, sw_error *err) {
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    sinew_instance *inst;
+    sinew_result r = sinew_instance_create(blob, NULL, &inst);
+    if (r != SINEW_OK) return sw_error_set(err, r, "cannot create an instance");
+    sinew_instance_set_world(inst, ws->world);
+    int32_t n = v->nverts;
+    double *xs = malloc(sizeof(double) * 3 * n), *cnt = malloc(sizeof(double) * n),
+           *xd = malloc(sizeof(double) * 3 * n), *qms = malloc(sizeof(double) * nf),
+           *sms = malloc(sizeof(double) * nf);
+    double num = 0, den = 0;
+    for (int f = 0; f < nf && xs && cnt && xd && qms && sms; ++f) {
+        if ((r = sw_world_scene_at(ws, f, err)) != SINEW_OK) break;
+        double t0 = sw_now_seconds();
+        sw_instance_set_pose_d(inst, T + (size_t)f * 12 * v->nbones);
+        out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
+        sms[f] = 1e3 * (sw_now_seconds() - t0);
+        sinew_step_stats st = {.struct_size = sizeof st};
+        sinew_instance_get_stats(inst, &st);
+        qms[f] = st.ms_world;
+        out->world_queries += st.world_queries / (double)nf;
+        out->world_contacts += st.world_contacts / (double)nf;
+        out->pen_world_sub = fmax(
+            out->pen_world_sub, penetration(ws->world, v->nsurf_verts, sw_instance_surface(inst)));
+        if (!touch[f]) continue;
+        sw_instance_full_positions(inst, xs, cnt);
+        sw_instance_dqs_positions(inst, xd);
+        const double *xf = x_full + (size_t)f * 3 * n;
+        for (int32_t i = 0; i < n; ++i)
+            for (int k = 0; k < 3; ++k) {
+                double a = xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - xd[3 * i + k];
+                num += mass[i] * a * a;
+                den += mass[i] * b * b;
+            }
+    }
+    out->err_world_sub = den > 0 ? sqrt(num / den) : 0;
+    out->world_query_ms = qms ? sw_median(qms, nf) : 0;
+    out->sub_ms = sms ? sw_median(sms, nf) : 0;
+    /* the real-time contract with world contact active */
+    out->allocs = out->locks = -1;
+    unsigned active = sw_rt_interpose_active();
+    if (out->contract_steps > 0 && r == SINEW_OK) {
+        sw_rt_count_begin();
+        for (int s = 0; s < out->contract_steps; ++s) {
+            sw_world_scene_at(ws, s % nf, err);
+            sw_instance_set_pose_d(inst, T + (size_t)(s % nf) * 12 * v->nbones);
+            out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
+        }
+        sw_rt_counts c = sw_rt_count_end();
+        if (active & SW_RT_CAT_ALLOCS)
+            out->allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
+        if (active & SW_RT_CAT_LOCKS) out->locks = (long)c.locks;
+    }
+    free(xs), free(cnt), free(xd), free(qms), free(sms);
+    sinew_instance_destroy(inst);
+    return r;
+}
+
+sinew_result sw_world_bench_run(const sw_character *ch, const sinew_blob *blob, sw_world_scene *ws,
+                                const sw_fullsim_params *fp, int frames, int contract_steps,
+                                sw_world_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    out->contract_steps = contract_steps;
+    int nf;
+    double *T =
+        sw_world_scene_poses(ws, ch->clip.T, ch->clip.nframes, ch->skel.nbones, frames, &nf);
+    double *x_full = T ? malloc(sizeof(double) * 3 * ch->mesh.nverts * (size_t)nf) : NULL;
+    double *mass = malloc(sizeof(double) * ch->mesh.nverts);
+    unsigned char *touch = calloc((size_t)(nf > 0 ? nf : 1), 1);
+    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!T || !x_full || !mass || !touch) {
+        sw_error_set(err, r, "out of memory for the world scene");
+        goto done;
+    }
+    out->frames = nf;
+    if ((r = run_reference(ch, ws, fp, T, nf, x_full, touch, mass, out, err)) != SINEW_OK)
+        goto done;
+    r = run_subspace(blob, ws, T, nf, x_full, touch, mass, out, err);
+done:
+    free(T), free(x_full), free(mass), free(touch);
+    return r;
+}
