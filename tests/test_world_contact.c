@@ -1,12 +1,12 @@
 /* Contact with the collision world in the step and in the reference: the shared law's
  * derivatives, the reduced gradient and Hessian, the real-time contract with world
- * contact, instances sharing one world across threads, the force readback, and the
- * flesh pushed out of a collider in both the subspace and full space. */
+ * contact, the force readback, and the flesh pushed out of a collider in the subspace
+ * (as far as it can: it locks) and in full space. Instances sharing one world across
+ * threads: test_world_threads.c (run under TSan). */
 #include <math.h>
-#include <pthread.h>
 #include <stdint.h>
 
-#include "bake_fixture.h"
+#include "world_fixture.h"
 #include "collision.h"
 #include "fullsim.h"
 #include "instance.h"
@@ -16,38 +16,9 @@
 #include "sw_test.h"
 #include "world_penalty.h"
 
-static bake_fixture fx;
-static int fx_ok = -1;
-
-static const bake_fixture *fixture(void) {
-    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 2000, 12, 0);
-    return fx_ok ? &fx : NULL;
-}
-
 static double urand(uint64_t *s) {
     *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
     return (double)(*s >> 11) / 9007199254740992.0;
-}
-
-/* The finger (along +x from 0 to 3.6, radius 0.45 at the root) pressed `depth` into a
- * table under it: a box whose top face is at y = -0.44 + depth. */
-static sinew_world *table_world(double depth, float friction, sinew_collider_id *id) {
-    sinew_world *w;
-    sinew_world_def wd = sinew_world_def_default();
-    if (sinew_world_create(&wd, &w) != SINEW_OK) return NULL;
-    sinew_collider_def c = sinew_collider_def_default();
-    c.shape = SINEW_SHAPE_BOX;
-    c.half_extents[0] = 2.5f;
-    c.half_extents[1] = 0.2f;
-    c.half_extents[2] = 1.0f;
-    c.friction = friction;
-    c.transform.position[0] = 1.8f;
-    c.transform.position[1] = (float)(-0.44 + depth - 0.2);
-    if (sinew_world_add_collider(w, &c, id) != SINEW_OK) {
-        sinew_world_destroy(w);
-        return NULL;
-    }
-    return w;
 }
 
 static float *rest_pose(int nb) {
@@ -270,32 +241,6 @@ TEST(world_contact_pushes_the_flesh_out_and_readback_sums_the_forces) {
     sinew_world_destroy(w);
 }
 
-/* A sphere that moves along the finger every step (no rebuild) while the finger folds. */
-typedef struct {
-    const bake_fixture *f;
-    sinew_world *w;
-    sinew_collider_id ball;
-} moving_scene;
-
-static void ball_at(int s, sinew_transform *t) {
-    *t = sinew_transform_identity();
-    t->position[0] = (float)(0.5 + 0.1 * (s % 25));
-    t->position[1] = -0.5f;
-}
-
-static int moving_scene_make(moving_scene *m) {
-    m->f = fixture();
-    if (!m->f) return 0;
-    sinew_collider_id table;
-    m->w = table_world(0.05, 0.3f, &table);
-    if (!m->w) return 0;
-    sinew_collider_def c = sinew_collider_def_default();
-    c.shape = SINEW_SHAPE_SPHERE;
-    c.radius = 0.2f;
-    ball_at(0, &c.transform);
-    return sinew_world_add_collider(m->w, &c, &m->ball) == SINEW_OK;
-}
-
 TEST(world_steps_allocate_and_lock_nothing) {
     moving_scene m;
     ENSURE(moving_scene_make(&m));
@@ -347,70 +292,6 @@ TEST(world_steps_allocate_and_lock_nothing) {
     sinew_world_destroy(m.w);
 }
 
-/* ---- instances sharing one world ------------------------------------------------ */
-
-enum { NTHREADS = 4, THREAD_STEPS = 40 };
-
-typedef struct {
-    const moving_scene *m;
-    int offset;
-    uint64_t hash;
-} run_arg;
-
-static uint64_t hash_floats(uint64_t h, const float *x, size_t n) {
-    const unsigned char *p = (const unsigned char *)x;
-    for (size_t i = 0; i < n * sizeof(float); ++i)
-        h = (h ^ p[i]) * 0x100000001b3ULL;
-    return h;
-}
-
-/* Instance `offset` steps its clip from frame `offset` against the shared, fixed world. */
-static void *run_instance(void *vp) {
-    run_arg *a = vp;
-    const bake_fixture *f = a->m->f;
-    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
-    sinew_instance *inst;
-    a->hash = 0;
-    if (sinew_instance_create(f->blob, NULL, &inst) != SINEW_OK) return NULL;
-    sinew_instance_set_world(inst, a->m->w);
-    float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 3 * ns);
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (int s = 0; s < THREAD_STEPS; ++s) {
-        bake_fixture_pose(f, s + a->offset, pose);
-        sinew_instance_set_pose(inst, pose, nb);
-        sinew_instance_step(inst, 1.0f / 30);
-        sinew_instance_read_surface(inst, x, NULL, ns);
-        h = hash_floats(h, x, 3 * ns);
-    }
-    a->hash = h;
-    free(pose);
-    free(x);
-    sinew_instance_destroy(inst);
-    return NULL;
-}
-
-TEST(instances_on_threads_sharing_a_world_match_a_sequential_run) {
-    moving_scene m;
-    ENSURE(moving_scene_make(&m));
-    run_arg seq[NTHREADS], par[NTHREADS];
-    pthread_t th[NTHREADS];
-    for (int i = 0; i < NTHREADS; ++i) {
-        seq[i] = (run_arg){&m, 3 * i, 0};
-        run_instance(&seq[i]);
-        par[i] = (run_arg){&m, 3 * i, 0};
-    }
-    for (int i = 0; i < NTHREADS; ++i)
-        ENSURE(pthread_create(&th[i], NULL, run_instance, &par[i]) == 0);
-    for (int i = 0; i < NTHREADS; ++i)
-        pthread_join(th[i], NULL);
-    for (int i = 0; i < NTHREADS; ++i) {
-        ENSURE(seq[i].hash != 0);
-        ENSURE(par[i].hash == seq[i].hash);
-    }
-    ENSURE(seq[0].hash != seq[1].hash);
-    sinew_world_destroy(m.w);
-}
-
 /* ---- the reference ------------------------------------------------------------- */
 
 TEST(reference_pushes_the_flesh_out_of_a_box) {
@@ -455,5 +336,4 @@ SW_TEST_MAIN(CASE(world_penalty_derivatives_match_finite_differences),
              CASE(reduced_world_gradient_and_hessian_match_finite_differences),
              CASE(world_contact_pushes_the_flesh_out_and_readback_sums_the_forces),
              CASE(world_steps_allocate_and_lock_nothing),
-             CASE(instances_on_threads_sharing_a_world_match_a_sequential_run),
              CASE(reference_pushes_the_flesh_out_of_a_box), CASE(release_fixture))
