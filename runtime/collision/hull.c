@@ -11,7 +11,9 @@
  * 1e-15. Outside within the radius, the ball-swept hull has round edges and corners and
  * the normal iteration converges slowly there: measured up to 2e-2 (boxes) and 0.15
  * (a regular tetrahedron) of a 0.3 radius, always too deep rather than too shallow
- * (tests/test_collision_hull.c). Open item: a better outside iteration.
+ * (tests/test_collision_hull.c); since the point itself is known to be outside, such a
+ * distance is clamped at 0, so an outside point is never reported inside. Open item: a
+ * better outside iteration.
  */
 #include <ccd/ccd.h>
 #include <math.h>

@@ -121,6 +121,16 @@ void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
             wc->cl_begin[j] = wc->cl_begin[j - 1];
             wc->cl_begin[j - 1] = t;
         }
+    for (int32_t c = 0; c < wc->ncl; ++c) { /* in basis-row order within a cluster */
+        int32_t *cc = wc->cl_copy + wc->cl_begin[c], m = wc->cl_begin[c + 1] - wc->cl_begin[c];
+        for (int32_t i = 1; i < m; ++i)
+            for (int32_t j = i;
+                 j > 0 && v->surf_copies[2 * cc[j - 1] + 1] > v->surf_copies[2 * cc[j] + 1]; --j) {
+                int32_t t = cc[j];
+                cc[j] = cc[j - 1];
+                cc[j - 1] = t;
+            }
+    }
     for (int32_t c = 0; c < wc->ncl; ++c) {
         uint64_t mask = 0;
         for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i) {
@@ -135,6 +145,22 @@ void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
         wc->cl_bones[c] = v->nbones > 64 ? ~0ull : mask;
     }
     copy_areas(wc, v);
+    for (int32_t i = 0; i < v->nsurf_copies; ++i)
+        wc->copy_first[i] = -1;
+    for (int32_t d = 0; d < v->ndomains; ++d) { /* max over copies of |U rows|_F */
+        const sw_blob_domain *D = &v->domains[d];
+        double m = 0;
+        for (int32_t i = 0; i < v->nsurf_copies; ++i) {
+            if (v->surf_copies[2 * i] != d) continue;
+            const double *U =
+                v->basis + D->basis_offset + (int64_t)3 * v->surf_copies[2 * i + 1] * D->rank;
+            double f2 = 0;
+            for (int32_t k = 0; k < 3 * D->rank; ++k)
+                f2 += U[k] * U[k];
+            m = fmax(m, sqrt(f2));
+        }
+        wc->dom_umax[d] = m;
+    }
     wc->boxes_valid = 0;
     wc->ncand = 0;
 }
@@ -186,9 +212,15 @@ static void copy_position(const sw_reduced *red, int32_t i, const double *q, dou
 }
 
 static int is_candidate(const sw_world_contacts *wc, int32_t copy, int32_t slot) {
-    for (int32_t j = 0; j < wc->ncand; ++j)
-        if (wc->cand[j].copy == copy && wc->cand[j].slot == slot) return 1;
+    for (int32_t j = wc->copy_first[copy]; j >= 0; j = wc->cand[j].next)
+        if (wc->cand[j].slot == slot) return 1;
     return 0;
+}
+
+void sw_world_contacts_clear(sw_world_contacts *wc) {
+    for (int32_t j = 0; j < wc->ncand; ++j)
+        wc->copy_first[wc->cand[j].copy] = -1;
+    wc->ncand = 0;
 }
 
 /* Queries copy i at x against world slot s; a hit within the radius (or, with
@@ -197,9 +229,10 @@ static void try_candidate(sw_world_contacts *wc, int32_t i, const double x[3], u
                           double blob_k, int penetrating_only) {
     const sw_collider *c = sw_world_slot(wc->world, s);
     sw_collider_hit hit;
+    if (penetrating_only && is_candidate(wc, i, (int32_t)s)) return;
     wc->queries++;
     if (!sw_collider_query(c, x, wc->radius, &hit)) return;
-    if (penetrating_only && (!(hit.phi < 0) || is_candidate(wc, i, (int32_t)s))) return;
+    if (penetrating_only && !(hit.phi < 0)) return;
     if (wc->ncand >= wc->max_cand) {
         wc->dropped++;
         return;
@@ -218,6 +251,8 @@ static void try_candidate(sw_world_contacts *wc, int32_t i, const double x[3], u
     cd->id = sw_collider_id_of(wc->world, s);
     cd->active = 0;
     cd->f[0] = cd->f[1] = cd->f[2] = 0;
+    cd->next = wc->copy_first[i];
+    wc->copy_first[i] = wc->ncand - 1;
 }
 
 /* The world box of slot s grown by the detection radius; 0 for an empty slot. */
@@ -252,18 +287,21 @@ static void cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int3
 }
 
 /* Narrow phase of cluster c at q against every collider whose box meets `box` (NULL:
- * all), the cluster's positions computed once. */
+ * all), the cluster's positions computed once (or, with copy_x, read from there). */
 static void narrow_cluster(sw_world_contacts *wc, const sw_reduced *red, const double *q, int32_t c,
-                           const double *box, int penetrating_only) {
+                           const double *box, const double *copy_x, int penetrating_only) {
     double x[SW_WORLD_CLUSTER][3];
     int32_t b = wc->cl_begin[c], n = wc->cl_begin[c + 1] - b, have = 0;
     uint32_t ns = sw_world_slot_count(wc->world);
     for (uint32_t s = 0; s < ns; ++s) {
         double cb[6];
         if (!collider_box(wc, s, cb) || (box && !boxes_overlap(box, cb))) continue;
-        if (!have)
-            for (int32_t j = 0; j < n; ++j)
+        for (int32_t j = 0; j < n && !have; ++j) {
+            if (copy_x)
+                memcpy(x[j], copy_x + 3 * wc->cl_copy[b + j], sizeof x[j]);
+            else
                 copy_position(red, wc->cl_copy[b + j], q, x[j], NULL);
+        }
         have = 1;
         for (int32_t j = 0; j < n; ++j)
             if (box_holds(cb, x[j]))
@@ -274,14 +312,16 @@ static void narrow_cluster(sw_world_contacts *wc, const sw_reduced *red, const d
 
 int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, const double *q,
                                  const double *T, const double *T_last) {
-    wc->ncand = wc->dropped = wc->npass = 0;
+    sw_world_contacts_clear(wc);
+    wc->dropped = wc->npass = 0;
     wc->queries = 0;
     if (!wc->world) return 0;
+    memcpy(wc->q_detect, q, (size_t)red->R * sizeof(double));
     int use_boxes = wc->boxes_valid && T_last;
     for (int32_t c = 0; c < wc->ncl; ++c) {
         double box[6];
         if (use_boxes) cluster_box(wc, red->v, c, T, T_last, box);
-        narrow_cluster(wc, red, q, c, use_boxes ? box : NULL, 0);
+        narrow_cluster(wc, red, q, c, use_boxes ? box : NULL, NULL, 0);
     }
     return wc->ncand;
 }
@@ -289,11 +329,28 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
 int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red,
                                      const double *q) {
     if (!wc->world) return 0;
+    const sw_blob_view *v = red->v;
     int32_t before = wc->ncand;
-    /* a copy that entered a collider during the solve is in a cluster the detection
-     * passed (its grown box holds where the copy can reach) */
-    for (int32_t p = 0; p < wc->npass; ++p)
-        narrow_cluster(wc, red, q, wc->cl_pass[p], NULL, 1);
+    /* A copy that was no candidate was at least the detection radius from every
+     * collider; the skinning is fixed within the step, so it moved by at most
+     * umax_d |q_d - q_detect_d| (the Frobenius bound of its basis rows). A domain that
+     * moved less than the radius cannot have entered a collider: its clusters are
+     * skipped. Those that did are in clusters the detection passed (their grown boxes
+     * hold where the copies can reach). */
+    for (int32_t d = 0; d < v->ndomains; ++d) {
+        const sw_blob_domain *D = &v->domains[d];
+        double m2 = 0;
+        for (int32_t j = 0; j < D->rank; ++j) {
+            double e = q[D->q_offset + j] - wc->q_detect[D->q_offset + j];
+            m2 += e * e;
+        }
+        wc->dom_moved[d] = wc->dom_umax[d] * sqrt(m2) >= wc->radius;
+    }
+    for (int32_t p = 0; p < wc->npass; ++p) {
+        int32_t c = wc->cl_pass[p];
+        if (wc->dom_moved[v->surf_copies[2 * wc->cl_copy[wc->cl_begin[c]]]])
+            narrow_cluster(wc, red, q, c, NULL, wc->copy_x, 1);
+    }
     return wc->ncand - before;
 }
 

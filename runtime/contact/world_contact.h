@@ -24,7 +24,7 @@
 #include "world_penalty.h"
 
 /* Copies per cluster at most. */
-#define SW_WORLD_CLUSTER 32
+#define SW_WORLD_CLUSTER 16
 
 /* One (surface copy, collider) candidate of the step. */
 typedef struct sw_world_cand {
@@ -33,21 +33,26 @@ typedef struct sw_world_cand {
     int32_t slot; /* the collider's slot */
     sinew_collider_id id;
     int32_t active; /* in contact (gap > 0) at the step's solution */
+    int32_t next;   /* the copy's next candidate (another collider), or -1 */
     double f[3];    /* force on the vertex copy at the solution */
 } sw_world_cand;
 
 typedef struct sw_world_contacts {
     const sinew_world *world;
     int32_t max_cand, ncand, dropped;
-    sw_world_cand *cand; /* max_cand */
-    int32_t ncl;         /* clusters */
-    int32_t *cl_begin;   /* ncl + 1: cluster c holds cl_copy[cl_begin[c] .. cl_begin[c+1]) */
-    int32_t *cl_copy;    /* nsurf_copies, in cluster order */
-    uint64_t *cl_bones;  /* ncl: bits of the bones skinning the cluster (all when > 64) */
-    double *cl_box;      /* 6 per cluster: its copies' box at the last output */
-    double *copy_area;   /* nsurf_copies: rest area per copy */
-    double *copy_x;      /* 3 per copy: positions at the last output */
-    int32_t *cl_pass;    /* ncl: the clusters the last broad phase passed */
+    sw_world_cand *cand;      /* max_cand */
+    int32_t ncl;              /* clusters */
+    int32_t *cl_begin;        /* ncl + 1: cluster c holds cl_copy[cl_begin[c] .. cl_begin[c+1]) */
+    int32_t *cl_copy;         /* nsurf_copies, in cluster order */
+    uint64_t *cl_bones;       /* ncl: bits of the bones skinning the cluster (all when > 64) */
+    double *cl_box;           /* 6 per cluster: its copies' box at the last output */
+    double *copy_area;        /* nsurf_copies: rest area per copy */
+    int32_t *copy_first;      /* nsurf_copies: the copy's first candidate, or -1 */
+    double *dom_umax;         /* ndomains: the largest |U rows|_F of a surface copy */
+    unsigned char *dom_moved; /* ndomains: moved by the radius since detection */
+    double *q_detect;         /* R: the state of the last detection */
+    double *copy_x;           /* 3 per copy: positions at the last output */
+    int32_t *cl_pass;         /* ncl: the clusters the last broad phase passed */
     int32_t npass;
     int boxes_valid;  /* cl_box holds the last output */
     double radius;    /* detection radius (world units) */
@@ -61,6 +66,9 @@ int32_t sw_world_cluster_bound(const sw_blob_view *v);
  * (laid out by the instance). Creation time; no allocation. */
 void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v);
 
+/* Forgets the candidates (O(candidates)). */
+void sw_world_contacts_clear(sw_world_contacts *wc);
+
 /* Candidates at the state q for the pose T (12 per bone) and the pose of the last output
  * T_last (NULL: no valid last output). Returns the candidates found; wc->dropped counts
  * those over the budget. */
@@ -68,7 +76,8 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
                                  const double *T, const double *T_last);
 
 /* Appends the copies that penetrate a collider at q without being candidates yet (a
- * second detection round after a solve); returns how many were added. */
+ * second detection round after a solve), reading their positions at q from copy_x (the
+ * output wrote them); returns how many were added. */
 int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red, const double *q);
 
 /* The world contact energy at q; with want_grad its gradient into red->g, with

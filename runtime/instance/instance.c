@@ -83,6 +83,10 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(wc->cl_box, 6 * ncl);
     TAKE(wc->cl_pass, ncl);
     TAKE(wc->copy_area, nc);
+    TAKE(wc->copy_first, nc);
+    TAKE(wc->dom_umax, nd);
+    TAKE(wc->dom_moved, nd);
+    TAKE(wc->q_detect, R);
     TAKE(wc->copy_x, 3 * nc);
     /* the output */
     TAKE(in->surf_x, 3 * ns);
@@ -276,7 +280,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->wc.max_cand = z.max_world;
     sw_world_contacts_build(&in->wc, v);
     /* 2% of the character's size: what a surface vertex can travel in one step */
-    in->wc.radius = 0.02 * in->size;
+    in->wc.radius = 0.01 * in->size;
     sw_pose_space_link_twins(v, in->ps.twin_next);
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     sw_solver_order_blocks(&in->solver, v);
@@ -312,7 +316,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     ph->history = 0;
     sw_pose_space_reset(&inst->ps, nb);
     inst->wc.boxes_valid = 0;
-    inst->wc.ncand = 0;
+    sw_world_contacts_clear(&inst->wc);
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;
         memset(V, 0, 9 * sizeof(double));

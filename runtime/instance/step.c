@@ -22,6 +22,7 @@ typedef struct sw_step_ctx {
     sw_dyn_coef dc;      /* quasistatic, or backward Euler over dt */
     sinew_step_stats st; /* this step's figures */
     double t;            /* the clock at the last phase boundary */
+    int written;         /* the output surface holds this step's solution */
 } sw_step_ctx;
 
 /* Milliseconds since the last phase boundary, which moves here. */
@@ -127,23 +128,36 @@ static void phase_world(sw_step_ctx *c) {
     c->st.ms_world = lap(c);
 }
 
+/* The output surface (and the copies' positions the world's second round reads),
+ * timed as the output phase. */
+static void write_output(sw_step_ctx *c) {
+    double t = sw_now_seconds();
+    sw_instance_write_surface(c->in);
+    c->st.ms_output += 1e3 * (sw_now_seconds() - t);
+    c->written = 1;
+}
+
 /* Newton; with a world, a second round when the solution entered colliders at copies
- * that were not candidates (they join with their law frozen there). */
+ * that were not candidates (they join with their law frozen there). The check reads
+ * the copies' positions the output computes anyway, so the output is written here. */
 static sinew_result phase_solve(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_world_contacts *wc = &in->wc;
     sw_step_contacts ct = {&in->ps, wc->world ? wc : NULL};
     sinew_result r = sw_newton_solve(&in->red, &ct, &in->solver, &c->dc, &c->st);
-    double ms_round2 = 0; /* the second detection, counted as world time */
+    double ms_aside = 0; /* the second detection and the output, counted as theirs */
     if (r == SINEW_OK && wc->world) {
+        write_output(c);
         double t = sw_now_seconds();
         int32_t added = sw_world_contacts_add_missed(wc, &in->red, in->solver.q);
-        ms_round2 = 1e3 * (sw_now_seconds() - t);
-        c->st.ms_world += ms_round2;
-        if (added > 0) {
+        double ms_missed = 1e3 * (sw_now_seconds() - t);
+        c->st.ms_world += ms_missed;
+        if (added > 0) { /* (a failed second solve leaves the first round's surface) */
             c->st.world_rounds = 2;
             r = sw_newton_solve(&in->red, &ct, &in->solver, &c->dc, &c->st);
+            if (r == SINEW_OK) write_output(c);
         }
+        ms_aside = c->st.ms_output + ms_missed;
         if (r == SINEW_OK) sw_world_contacts_finish(wc, &in->red, in->solver.q);
         c->st.world_queries = wc->queries;
         c->st.world_candidates = (uint32_t)wc->ncand;
@@ -156,7 +170,7 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         }
     }
     c->st.cubature_tets = (uint32_t)in->v->ncub;
-    c->st.ms_solve = lap(c) - ms_round2;
+    c->st.ms_solve = lap(c) - ms_aside;
     return r;
 }
 
@@ -172,8 +186,8 @@ static void phase_advance(sw_step_ctx *c) {
 }
 
 static void phase_output(sw_step_ctx *c) {
-    sw_instance_write_surface(c->in);
-    c->st.ms_output = lap(c);
+    if (!c->written) sw_instance_write_surface(c->in);
+    c->st.ms_output += lap(c);
 }
 
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
