@@ -7,6 +7,7 @@
 #include <stdint.h>
 
 #include "world_fixture.h"
+#include "world_scene.h"
 #include "collision.h"
 #include "fullsim.h"
 #include "instance.h"
@@ -327,6 +328,69 @@ TEST(reference_pushes_the_flesh_out_of_a_box) {
     sinew_world_destroy(w);
 }
 
+/* The shipped world files build their worlds, and the finger's table scene runs in the
+ * step and in the reference: contact once the table has risen, no failed step. */
+TEST(sample_worlds_run_in_the_step_and_the_reference) {
+    static const char *names[] = {"finger_table", "capsule_pipe", "hand_handle"};
+    for (int i = 0; i < 3; ++i) {
+        char path[1024];
+        snprintf(path, sizeof path, "%s/samples/worlds/%s.json", SINEW_SOURCE_DIR, names[i]);
+        sw_world_scene ws;
+        sw_error err;
+        ENSUREF(sw_world_scene_load(path, &ws, &err) == SINEW_OK, "%s", err.msg);
+        ENSURE(sinew_world_collider_count(ws.world) == (uint32_t)ws.file.ncolliders);
+        sw_world_scene_free(&ws);
+    }
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/samples/worlds/finger_table.json", SINEW_SOURCE_DIR);
+    sw_world_scene ws;
+    sw_error err;
+    ENSURE(sw_world_scene_load(path, &ws, &err) == SINEW_OK);
+    int nf;
+    double *T =
+        sw_world_scene_poses(&ws, f->ch.clip.T, f->ch.clip.nframes, f->ch.skel.nbones, 0, &nf);
+    ENSURE(T && nf == 30); /* "pose": "rest", "frames": 30 */
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(inst, ws.world) == SINEW_OK);
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.world = ws.world;
+    p.threads = 2;
+    sw_fullsim *sim;
+    ENSURE(sw_fullsim_create(&f->ch, &p, &sim, &err) == SINEW_OK);
+    uint32_t sub_touch = 0;
+    double pen_full = 0;
+    int full_touch = 0;
+    for (int k = 0; k < nf; k += 4) {
+        ENSURE(sw_world_scene_at(&ws, k, &err) == SINEW_OK);
+        sw_instance_set_pose_d(inst, T + (size_t)k * 12 * f->ch.skel.nbones);
+        ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
+        sinew_step_stats st;
+        st.struct_size = sizeof st;
+        sinew_instance_get_stats(inst, &st);
+        sw_fullsim_stats fs;
+        sinew_result r = sw_fullsim_step(sim, T + (size_t)k * 12 * f->ch.skel.nbones, &fs);
+        ENSURE(r == SINEW_OK || r == SINEW_ERROR_NOT_CONVERGED);
+        if (k >= 20) {
+            sub_touch += st.world_contacts;
+            full_touch += fs.world_contacts;
+        }
+        pen_full = fmax(pen_full, fs.world_penetration);
+    }
+    fprintf(stderr,
+            "    finger_table: contacts after the rise: step %u, reference %d; reference "
+            "penetration %.5f\n",
+            sub_touch, full_touch, pen_full);
+    ENSURE(sub_touch > 0 && full_touch > 0);
+    ENSURE(pen_full < 0.009); /* 1% of the finger's thickness */
+    free(T);
+    sw_fullsim_destroy(sim);
+    sinew_instance_destroy(inst);
+    sw_world_scene_free(&ws);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
     fx_ok = -1;
@@ -336,4 +400,5 @@ SW_TEST_MAIN(CASE(world_penalty_derivatives_match_finite_differences),
              CASE(reduced_world_gradient_and_hessian_match_finite_differences),
              CASE(world_contact_pushes_the_flesh_out_and_readback_sums_the_forces),
              CASE(world_steps_allocate_and_lock_nothing),
-             CASE(reference_pushes_the_flesh_out_of_a_box), CASE(release_fixture))
+             CASE(reference_pushes_the_flesh_out_of_a_box),
+             CASE(sample_worlds_run_in_the_step_and_the_reference), CASE(release_fixture))

@@ -167,28 +167,39 @@ void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
 
 /* ---- detection ------------------------------------------------------------------- */
 
-/* How far a point of the box (centre c, half-diagonal rho) moves under the rigid motion
- * from T0 to T1 (12 doubles: R row-major, t): |D(c) - c| + ||dR - I|| rho with
- * D = T1 T0^-1 and ||dR - I||_2 = sqrt(3 - tr dR). */
-static double box_motion(const double *T0, const double *T1, const double c[3], double rho) {
-    double dR[9], tr = 0;
-    for (int r = 0; r < 3; ++r)
-        for (int k = 0; k < 3; ++k) {
-            double acc = 0;
-            for (int j = 0; j < 3; ++j)
-                acc += T1[3 * r + j] * T0[3 * k + j]; /* R1 R0^T */
-            dR[3 * r + k] = acc;
+/* Each bone's rigid motion since the last output, D = T1 T0^-1 (12 doubles: R row-major,
+ * t) and ||dR - I||_2 = sqrt(3 - tr dR), once per detection into wc->bone_motion (13 per
+ * bone). */
+static void bone_motions(sw_world_contacts *wc, int32_t nbones, const double *T, const double *T0) {
+    for (int32_t b = 0; b < nbones; ++b) {
+        const double *A = T0 + 12 * b, *B = T + 12 * b;
+        double *D = wc->bone_motion + 13 * b;
+        for (int r = 0; r < 3; ++r)
+            for (int k = 0; k < 3; ++k) {
+                double acc = 0;
+                for (int j = 0; j < 3; ++j)
+                    acc += B[3 * r + j] * A[3 * k + j]; /* R1 R0^T */
+                D[3 * r + k] = acc;
+            }
+        for (int r = 0; r < 3; ++r) { /* t = t1 - dR t0 */
+            double acc = B[9 + r];
+            for (int k = 0; k < 3; ++k)
+                acc -= D[3 * r + k] * A[9 + k];
+            D[9 + r] = acc;
         }
-    tr = dR[0] + dR[4] + dR[8];
-    double y[3], m2 = 0; /* D(c) = R1 R0^T (c - t0) + t1 */
-    for (int r = 0; r < 3; ++r) {
-        double acc = T1[9 + r];
-        for (int k = 0; k < 3; ++k)
-            acc += dR[3 * r + k] * (c[k] - T0[9 + k]);
-        y[r] = acc - c[r];
-        m2 += y[r] * y[r];
+        D[12] = sqrt(fmax(0.0, 3 - (D[0] + D[4] + D[8])));
     }
-    return sqrt(m2) + sqrt(fmax(0.0, 3 - tr)) * rho;
+}
+
+/* How far a point of the box (centre c, half-diagonal rho) moves under bone motion D:
+ * |D(c) - c| + ||dR - I|| rho. */
+static double box_motion(const double *D, const double c[3], double rho) {
+    double m2 = 0;
+    for (int r = 0; r < 3; ++r) {
+        double y = D[9 + r] + D[3 * r] * c[0] + D[3 * r + 1] * c[1] + D[3 * r + 2] * c[2] - c[r];
+        m2 += y * y;
+    }
+    return sqrt(m2) + D[12] * rho;
 }
 
 static int boxes_overlap(const double a[6], const double b[6]) {
@@ -266,7 +277,7 @@ static int collider_box(const sw_world_contacts *wc, uint32_t s, double box[6]) 
 /* The broad-phase box of cluster c: its box at the last output grown by the motion of
  * the bones that skin it since (T_last -> T) and the detection radius. */
 static void cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
-                        const double *T, const double *T_last, double box[6]) {
+                        double box[6]) {
     const double *b = wc->cl_box + 6 * c;
     double ctr[3], rho = 0, grow = 0;
     for (int k = 0; k < 3; ++k) {
@@ -276,7 +287,7 @@ static void cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int3
     rho = sqrt(rho);
     for (int32_t bone = 0; bone < v->nbones; ++bone)
         if (wc->cl_bones[c] >> (bone < 64 ? bone : 63) & 1)
-            grow = fmax(grow, box_motion(T_last + 12 * bone, T + 12 * bone, ctr, rho));
+            grow = fmax(grow, box_motion(wc->bone_motion + 13 * bone, ctr, rho));
     /* a dual-quaternion blend of bone motions moves a point no further than about the
      * largest of them; 1.25 x leaves room for the blend and the correction's change */
     grow = 1.25 * grow + wc->radius;
@@ -318,9 +329,10 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
     if (!wc->world) return 0;
     memcpy(wc->q_detect, q, (size_t)red->R * sizeof(double));
     int use_boxes = wc->boxes_valid && T_last;
+    if (use_boxes) bone_motions(wc, red->v->nbones, T, T_last);
     for (int32_t c = 0; c < wc->ncl; ++c) {
         double box[6];
-        if (use_boxes) cluster_box(wc, red->v, c, T, T_last, box);
+        if (use_boxes) cluster_box(wc, red->v, c, box);
         narrow_cluster(wc, red, q, c, use_boxes ? box : NULL, NULL, 0);
     }
     return wc->ncand;

@@ -87,6 +87,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(wc->dom_umax, nd);
     TAKE(wc->dom_moved, nd);
     TAKE(wc->q_detect, R);
+    TAKE(wc->bone_motion, 13 * nb);
     TAKE(wc->copy_x, 3 * nc);
     /* the output */
     TAKE(in->surf_x, 3 * ns);
