@@ -150,16 +150,8 @@ static double surface_min_y(const sinew_instance *inst) {
 
 /* Deepest penetration of the output surface into the world's colliders. */
 static double surface_penetration(const sinew_instance *inst, const sinew_world *w) {
-    double pen = 0;
-    const double *x = sw_instance_surface(inst);
-    for (uint32_t s = 0; s < sw_world_slot_count(w); ++s) {
-        const sw_collider *c = sw_world_slot(w, s);
-        for (int32_t i = 0; c && i < inst->v->nsurf_verts; ++i) {
-            sw_collider_hit hit;
-            if (sw_collider_query(c, x + 3 * i, 1.0, &hit)) pen = fmax(pen, -hit.phi);
-        }
-    }
-    return pen;
+    return sw_world_max_penetration(w, inst->v->nsurf_verts, sw_instance_surface(inst), NULL, NULL,
+                                    NULL);
 }
 
 TEST(world_contact_pushes_the_flesh_out_and_readback_sums_the_forces) {

@@ -11,26 +11,6 @@
 #include "rt_interpose.h"
 #include "tool_common.h"
 
-/* Deepest penetration of the points x (n) into the world's colliders. */
-static double penetration(const sinew_world *w, int32_t n, const double *x) {
-    double pen = 0;
-    for (uint32_t s = 0; s < sw_world_slot_count(w); ++s) {
-        const sw_collider *c = sw_world_slot(w, s);
-        double lo[3], hi[3];
-        if (!c) continue;
-        sw_collider_bounds(c, 0, lo, hi);
-        for (int32_t i = 0; i < n; ++i) {
-            const double *p = x + 3 * i;
-            sw_collider_hit hit;
-            if (p[0] < lo[0] || p[0] > hi[0] || p[1] < lo[1] || p[1] > hi[1] || p[2] < lo[2] ||
-                p[2] > hi[2])
-                continue;
-            if (sw_collider_query(c, p, 1e-6, &hit)) pen = fmax(pen, -hit.phi);
-        }
-    }
-    return pen;
-}
-
 /* The reference over the scene: positions of every frame into x_full, which frames touch
  * a collider into touch. */
 static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
@@ -119,8 +99,10 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
         if ((r = sw_world_scene_at(ws, f, err)) != SINEW_OK) break;
         sw_instance_set_pose_d(inst, T + (size_t)f * 12 * v->nbones);
         out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
-        out->pen_world_sub = fmax(
-            out->pen_world_sub, penetration(ws->world, v->nsurf_verts, sw_instance_surface(inst)));
+        out->pen_world_sub =
+            fmax(out->pen_world_sub,
+                 sw_world_max_penetration(ws->world, v->nsurf_verts, sw_instance_surface(inst),
+                                          NULL, NULL, NULL));
         if (!touch[f]) continue;
         sw_instance_full_positions(inst, xs, cnt);
         sw_instance_dqs_positions(inst, xd);

@@ -1,10 +1,11 @@
 /* The full-space reference simulator (thesis §2.1, §3.1): co-rotational linear tets,
  * vertices inside bones driven kinematically by the skeleton, quasistatic Newton or
  * implicit dynamics (backward Euler or Newmark average acceleration) with Rayleigh
- * damping, penalty self-contact (eqs. 3.4-3.6) and a ground plane.
+ * damping, penalty self-contact (eqs. 3.4-3.6), a ground plane and the collision world
+ * (sinew_world.h, worldcontact.h: the runtime's law, detected every contact round).
  *
  * Every step minimises one incremental potential over the free vertices,
- *   Phi(x) = E(x) + Ec(x) + Eg(x) + c_m/2 |x - xhat|_M^2 + c_d/2 |x - x_n|_D^2
+ *   Phi(x) = E(x) + Ec(x) + Eg(x) + Ew(x) + c_m/2 |x - xhat|_M^2 + c_d/2 |x - x_n|_D^2
  *            - s (x - x_n)^T D v_n - f_ext^T x,
  * with D = alpha M + beta K(x_n) frozen at the start of the step (Rayleigh), so a
  * backtracking line search on Phi makes Newton robust:

@@ -5,6 +5,7 @@
 #include <string.h>
 
 #include "clock.h"
+#include "collision.h"
 #include "fem_corot.h"
 #include "penalty.h"
 #include "sw_mesh.h"
@@ -258,8 +259,8 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
         st.contacts_unsettled = set_would_change(sim, pen, found);
     if (sim->world.world) {
         int32_t fresh;
-        st.world_penetration =
-            sw_ref_world_max_penetration(&sim->world, nv, sim->x, sim->vert_area, &fresh);
+        st.world_penetration = sw_world_max_penetration(sim->world.world, nv, sim->x,
+                                                        sim->vert_area, sim->world.is_cand, &fresh);
         st.world_candidates = sim->world.ncand;
         for (int32_t i = 0; i < sim->world.ncand; ++i) {
             const sw_ref_world_cand *wc = &sim->world.cand[i];

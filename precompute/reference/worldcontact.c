@@ -6,11 +6,6 @@
 
 #include "collision.h"
 
-static int in_box(const double lo[3], const double hi[3], const double x[3]) {
-    return x[0] >= lo[0] && x[0] <= hi[0] && x[1] >= lo[1] && x[1] <= hi[1] && x[2] >= lo[2] &&
-           x[2] <= hi[2];
-}
-
 static int push(sw_ref_world *w, const sw_ref_world_cand *c) {
     if (w->ncand == w->cap) {
         int32_t cap = w->cap ? 2 * w->cap : 1024;
@@ -37,7 +32,7 @@ int32_t sw_ref_world_detect(sw_ref_world *w, int32_t nv, const double *x, const 
         sw_collider_bounds(c, w->radius, lo, hi);
         for (int32_t v = 0; v < nv; ++v) {
             sw_collider_hit hit;
-            if (!(area[v] > 0) || !in_box(lo, hi, x + 3 * v) ||
+            if (!(area[v] > 0) || !sw_box_contains(lo, hi, x + 3 * v) ||
                 !sw_collider_query(c, x + 3 * v, w->radius, &hit))
                 continue;
             sw_ref_world_cand cd;
@@ -68,29 +63,6 @@ double sw_ref_world_eval(const sw_ref_world *w, const double *x, double *f) {
                 f[3 * c->v + k] += fv[k];
     }
     return E;
-}
-
-double sw_ref_world_max_penetration(const sw_ref_world *w, int32_t nv, const double *x,
-                                    const double *area, int32_t *fresh) {
-    double pen = 0;
-    if (fresh) *fresh = 0;
-    if (!w->world) return 0;
-    uint32_t ns = sw_world_slot_count(w->world);
-    for (uint32_t s = 0; s < ns; ++s) {
-        const sw_collider *c = sw_world_slot(w->world, s);
-        if (!c) continue;
-        double lo[3], hi[3];
-        sw_collider_bounds(c, w->radius, lo, hi);
-        for (int32_t v = 0; v < nv; ++v) {
-            sw_collider_hit hit;
-            if (area[v] > 0 && in_box(lo, hi, x + 3 * v) &&
-                sw_collider_query(c, x + 3 * v, w->radius, &hit)) {
-                pen = fmax(pen, -hit.phi);
-                if (fresh && hit.phi < 0 && !(w->is_cand && w->is_cand[v])) ++*fresh;
-            }
-        }
-    }
-    return pen;
 }
 
 void sw_ref_world_free(sw_ref_world *w) {

@@ -37,12 +37,6 @@ int32_t sw_ref_world_detect(sw_ref_world *w, int32_t nv, const double *x, const 
  * Hessian blocks are added by the caller per candidate: sw_world_penalty). */
 double sw_ref_world_eval(const sw_ref_world *w, const double *x, double *f);
 
-/* The deepest penetration of any vertex with area > 0 into any collider at x; with
- * fresh, also how many of those inside a collider are not candidates (a detection
- * round would add them). */
-double sw_ref_world_max_penetration(const sw_ref_world *w, int32_t nv, const double *x,
-                                    const double *area, int32_t *fresh);
-
 void sw_ref_world_free(sw_ref_world *w);
 
 #endif

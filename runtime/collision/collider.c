@@ -99,3 +99,24 @@ int sw_collider_query(const sw_collider *c, const double x[3], double radius,
     }
     return 1;
 }
+
+double sw_world_max_penetration(const sinew_world *w, int32_t n, const double *x,
+                                const double *mask, const unsigned char *known, int32_t *inside) {
+    double pen = 0;
+    if (inside) *inside = 0;
+    for (uint32_t s = 0; w && s < sw_world_slot_count(w); ++s) {
+        const sw_collider *c = sw_world_slot(w, s);
+        double lo[3], hi[3];
+        if (!c) continue;
+        sw_collider_bounds(c, 0, lo, hi);
+        for (int32_t i = 0; i < n; ++i) {
+            sw_collider_hit hit;
+            if ((mask && !(mask[i] > 0)) || !sw_box_contains(lo, hi, x + 3 * i) ||
+                !sw_collider_query(c, x + 3 * i, 1e-9, &hit) || !(hit.phi < 0))
+                continue;
+            pen = fmax(pen, -hit.phi);
+            if (inside && !(known && known[i])) ++*inside;
+        }
+    }
+    return pen;
+}

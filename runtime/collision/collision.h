@@ -54,4 +54,17 @@ void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], doubl
  * `radius` (> 0, finite) of its surface, else 0 (hit untouched). */
 int sw_collider_query(const sw_collider *c, const double x[3], double radius, sw_collider_hit *hit);
 
+/* Whether x lies in the box [lo, hi] (boundary included). */
+static inline int sw_box_contains(const double lo[3], const double hi[3], const double x[3]) {
+    return x[0] >= lo[0] && x[0] <= hi[0] && x[1] >= lo[1] && x[1] <= hi[1] && x[2] >= lo[2] &&
+           x[2] <= hi[2];
+}
+
+/* The deepest penetration into any of the world's colliders of the n points x (3 each),
+ * only those with mask[i] > 0 when mask is not NULL (a measurement, not for the step:
+ * O(points x colliders)). With inside, also counts the points inside a collider whose
+ * known[i] is 0 (known NULL: all of them). */
+double sw_world_max_penetration(const sinew_world *w, int32_t n, const double *x,
+                                const double *mask, const unsigned char *known, int32_t *inside);
+
 #endif

@@ -208,12 +208,6 @@ static int boxes_overlap(const double a[6], const double b[6]) {
     return 1;
 }
 
-static int box_holds(const double b[6], const double x[3]) {
-    for (int k = 0; k < 3; ++k)
-        if (x[k] < b[k] || x[k] > b[3 + k]) return 0;
-    return 1;
-}
-
 /* The position of surface copy i at q. */
 static void copy_position(const sw_reduced *red, int32_t i, const double *q, double x[3],
                           double *J) {
@@ -315,7 +309,7 @@ static void narrow_cluster(sw_world_contacts *wc, const sw_reduced *red, const d
         }
         have = 1;
         for (int32_t j = 0; j < n; ++j)
-            if (box_holds(cb, x[j]))
+            if (sw_box_contains(cb, cb + 3, x[j]))
                 try_candidate(wc, wc->cl_copy[b + j], x[j], s, red->v->contact_k, penetrating_only);
     }
     if (have && !penetrating_only) wc->cl_pass[wc->npass++] = c;
