@@ -2,6 +2,7 @@
  * and the query, which maps the point into the collider's frame, asks the shape there,
  * and maps the answer back: moving a collider never rebuilds anything. */
 #include <math.h>
+#include <string.h>
 
 #include "collision_internal.h"
 
@@ -22,7 +23,7 @@ void sw_collider_transform(const sw_collider *c, double R[9], double t[3]) {
 
 /* The plane's world box: unbounded, except on the axis its world normal lies along
  * (within 1e-12 in each other component), where the solid ends at the plane. */
-static void plane_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]) {
+static void plane_box(const sw_collider *c, double lo[3], double hi[3]) {
     const double *nl = c->u.plane.n, *R = c->R;
     double n[3];
     for (int i = 0; i < 3; ++i) {
@@ -34,15 +35,18 @@ static void plane_bounds(const sw_collider *c, double margin, double lo[3], doub
     for (int k = 0; k < 3; ++k) {
         if (!(fabs(n[(k + 1) % 3]) <= 1e-12 && fabs(n[(k + 2) % 3]) <= 1e-12)) continue;
         if (n[k] > 0)
-            hi[k] = off / n[k] + margin;
+            hi[k] = off / n[k];
         else
-            lo[k] = off / n[k] - margin;
+            lo[k] = off / n[k];
     }
 }
 
-void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]) {
+void sw_collider_place(sw_collider *c, const double R[9], const double t[3]) {
+    memcpy(c->R, R, sizeof c->R);
+    memcpy(c->t, t, sizeof c->t);
+    double *lo = c->box, *hi = c->box + 3;
     if (c->shape == SINEW_SHAPE_PLANE) {
-        plane_bounds(c, margin, lo, hi);
+        plane_box(c, lo, hi);
         return;
     }
     /* The local box's centre moves with R, its half extents grow to |R| e. */
@@ -54,9 +58,16 @@ void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], doubl
     for (int i = 0; i < 3; ++i) {
         const double *r = c->R + 3 * i;
         double cw = r[0] * m[0] + r[1] * m[1] + r[2] * m[2] + c->t[i];
-        double ew = fabs(r[0]) * e[0] + fabs(r[1]) * e[1] + fabs(r[2]) * e[2] + margin;
+        double ew = fabs(r[0]) * e[0] + fabs(r[1]) * e[1] + fabs(r[2]) * e[2];
         lo[i] = cw - ew;
         hi[i] = cw + ew;
+    }
+}
+
+void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]) {
+    for (int i = 0; i < 3; ++i) {
+        lo[i] = c->box[i] - margin;
+        hi[i] = c->box[3 + i] + margin;
     }
 }
 

@@ -45,6 +45,7 @@ struct sw_collider {
     sinew_shape shape;
     double R[9], t[3];   /* world = R local + t */
     double lo[3], hi[3]; /* local box of the solid (plane: +-HUGE_VAL where unbounded) */
+    double box[6];       /* world box of the solid (lo, hi) at R, t: sw_collider_place */
     double stiffness, friction;
     union {
         struct {
@@ -70,6 +71,10 @@ struct sinew_world {
     sw_collider **slots; /* capacity pointers, NULL when free */
     uint16_t *generation;
 };
+
+/* Sets the collider's transform and the world box it gives (outside any step: the
+ * detection reads the box for every cluster of every character). */
+void sw_collider_place(sw_collider *c, const double R[9], const double t[3]);
 
 /* The signed distance, closest point and outward normal in the collider's own frame
  * (hit in that frame); 0 when y is outside and farther than `radius`. */

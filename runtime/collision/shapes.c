@@ -33,6 +33,9 @@ static int ball_query(const double q[3], double r, const double y[3], const doub
                       double radius, sw_collider_hit *h) {
     double n[3];
     sw_v3_sub(y, q, n);
+    /* farther than r + radius (with a margin for rounding): no hit, no square root */
+    double reach = r + radius;
+    if (sw_v3_dot(n, n) > reach * reach * (1 + 1e-9)) return 0;
     double d = sw_v3_normalize(n);
     /* d == 0, or so small that its square underflowed: no direction to trust. */
     if (!(d > 0) || !sw_v3_isfinite(n) || fabs(sw_v3_norm(n) - 1.0) > 1e-6)
@@ -50,7 +53,7 @@ int sw_sphere_query(const sw_collider *c, const double y[3], double radius, sw_c
 int sw_capsule_query(const sw_collider *c, const double y[3], double radius, sw_collider_hit *h) {
     static const double side[3] = {1, 0, 0}; /* perpendicular to the axis */
     double hh = c->u.capsule.half_height;
-    double q[3] = {0, fmin(fmax(y[1], -hh), hh), 0};
+    double q[3] = {0, sw_min(sw_max(y[1], -hh), hh), 0};
     return ball_query(q, c->u.capsule.radius, y, side, radius, h);
 }
 
@@ -77,12 +80,13 @@ int sw_box_query(const sw_collider *c, const double y[3], double radius, sw_coll
     int outside = 0, k = 0;
     double qmax = -HUGE_VAL;
     for (int i = 0; i < 3; ++i) {
-        p[i] = fmin(fmax(y[i], -e[i]), e[i]);
+        p[i] = sw_min(sw_max(y[i], -e[i]), e[i]);
         double q = fabs(y[i]) - e[i];
         if (q > 0) outside = 1;
         if (q > qmax) qmax = q, k = i;
     }
     if (!outside) return box_inside(e, y, radius, h);
+    if (qmax > radius) return 0; /* the distance is at least the largest axis excess */
     sw_v3_sub(y, p, n);
     double d = sw_v3_normalize(n);
     if (!(d > 0) || fabs(sw_v3_norm(n) - 1.0) > 1e-6) { /* underflow: the farthest axis */

@@ -211,6 +211,7 @@ sinew_result sinew_world_add_collider(sinew_world *world, const sinew_collider_d
         sw_free(&world->allocator, c);
         return r;
     }
+    sw_collider_place(c, R, t); /* the world box needs the shape's local box */
     world->slots[slot] = c;
     world->live++;
     if ((uint32_t)slot >= world->used) world->used = (uint32_t)slot + 1;
@@ -244,9 +245,7 @@ sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collid
     double R[9], t[3];
     sinew_result r = read_transform(world, transform, fn, R, t);
     if (r != SINEW_OK) return r; /* the old transform stays */
-    sw_collider *c = world->slots[s];
-    memcpy(c->R, R, sizeof R);
-    memcpy(c->t, t, sizeof t);
+    sw_collider_place(world->slots[s], R, t);
     return SINEW_OK;
 }
 

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "collision.h"
+#include "vec3.h"
 
 /* ---- creation: clusters and areas ------------------------------------------------ */
 
@@ -281,7 +282,7 @@ static void cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int3
     rho = sqrt(rho);
     for (int32_t bone = 0; bone < v->nbones; ++bone)
         if (wc->cl_bones[c] >> (bone < 64 ? bone : 63) & 1)
-            grow = fmax(grow, box_motion(wc->bone_motion + 13 * bone, ctr, rho));
+            grow = sw_max(grow, box_motion(wc->bone_motion + 13 * bone, ctr, rho));
     /* a dual-quaternion blend of bone motions moves a point no further than about the
      * largest of them; 1.25 x leaves room for the blend and the correction's change */
     grow = 1.25 * grow + wc->radius;
@@ -415,8 +416,8 @@ void sw_world_contacts_update_boxes(sw_world_contacts *wc) {
         for (int32_t j = wc->cl_begin[c]; j < wc->cl_begin[c + 1]; ++j) {
             const double *x = wc->copy_x + 3 * wc->cl_copy[j];
             for (int k = 0; k < 3; ++k) {
-                b[k] = fmin(b[k], x[k]);
-                b[3 + k] = fmax(b[3 + k], x[k]);
+                b[k] = sw_min(b[k], x[k]);
+                b[3 + k] = sw_max(b[3 + k], x[k]);
             }
         }
     }

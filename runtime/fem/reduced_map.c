@@ -15,12 +15,14 @@ void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t l
     int32_t r = D->rank, gv = v->domain_verts[D->vert_begin + lv];
     const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
     const double *Rm = m->act_R + 9 * a, *t = m->act_t + 3 * a, *X = v->rest + 3 * (int64_t)gv;
-    double y[3];
-    for (int i = 0; i < 3; ++i) {
-        double acc = X[i];
-        for (int32_t j = 0; j < r; ++j)
-            acc += U[i * r + j] * qd[j];
-        y[i] = acc;
+    /* the three rows' sums run side by side: three independent add chains instead of one
+     * after another (each row still sums in j order, so the result is bitwise the same) */
+    const double *U0 = U, *U1 = U + r, *U2 = U + 2 * r;
+    double y[3] = {X[0], X[1], X[2]};
+    for (int32_t j = 0; j < r; ++j) {
+        y[0] += U0[j] * qd[j];
+        y[1] += U1[j] * qd[j];
+        y[2] += U2[j] * qd[j];
     }
     for (int i = 0; i < 3; ++i)
         x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];

@@ -58,6 +58,17 @@ static inline double sw_v3_normalize(double a[3]) {
     return n;
 }
 
+/* The smaller and the larger of two finite numbers, as one minsd/maxsd: without
+ * -ffast-math the compiler cannot inline fmin/fmax (their NaN and signed-zero rules) and
+ * calls libm, which showed as 5% of the world detection's profile. For finite operands
+ * they equal fmin/fmax except that of -0.0 and +0.0 they return b. */
+static inline double sw_min(double a, double b) {
+    return a < b ? a : b;
+}
+static inline double sw_max(double a, double b) {
+    return a > b ? a : b;
+}
+
 /* Whether all three components are finite. */
 static inline int sw_v3_isfinite(const double a[3]) {
     return isfinite(a[0]) && isfinite(a[1]) && isfinite(a[2]);
