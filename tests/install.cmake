@@ -1,0 +1,12 @@
+# Packaging tests: `cmake --install` into a scratch prefix, then the sample host
+# (samples/host) built against that prefix with find_package(sinew) and with pkg-config,
+# shared and static, and run (tests/install/check_install.sh). In sanitizer builds the
+# hosts are built with the same -fsanitize: a sanitized libsinew cannot serve a plain
+# host (the sanitizer runtime must be loaded first).
+foreach(mode find_package pkg_config)
+  add_test(NAME install_${mode}
+    COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/install/check_install.sh ${mode} ${CMAKE_BINARY_DIR}
+            ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/install_${mode}
+            ${CMAKE_C_COMPILER} "${SINEW_SANITIZE}")
+  set_tests_properties(install_${mode} PROPERTIES LABELS install TIMEOUT 120)
+endforeach()
