@@ -8,5 +8,6 @@ foreach(mode find_package pkg_config)
     COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/install/check_install.sh ${mode} ${CMAKE_BINARY_DIR}
             ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/install_${mode}
             ${CMAKE_C_COMPILER} "${SINEW_SANITIZE}")
-  set_tests_properties(install_${mode} PROPERTIES LABELS install TIMEOUT 120)
+  set_tests_properties(install_${mode} PROPERTIES LABELS install TIMEOUT 120
+    RESOURCE_LOCK sinew_install_manifest) # both write <build>/install_manifest.txt
 endforeach()
