@@ -1,13 +1,14 @@
 # Packaging tests: `cmake --install` into a scratch prefix, then the sample host
 # (samples/host) built against that prefix with find_package(sinew) and with pkg-config,
-# shared and static, and run (tests/install/check_install.sh). In sanitizer builds the
-# hosts are built with the same -fsanitize: a sanitized libsinew cannot serve a plain
-# host (the sanitizer runtime must be loaded first).
+# shared and static, and run on a small blob baked by the build's sinew-bake
+# (tests/install/check_install.sh). In sanitizer builds the hosts are built with the same
+# -fsanitize: a sanitized libsinew cannot serve a plain host (the shared one aborts, the
+# sanitizer runtime not being loaded first; the static one does not link).
 foreach(mode find_package pkg_config)
   add_test(NAME install_${mode}
     COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/install/check_install.sh ${mode} ${CMAKE_BINARY_DIR}
             ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/install_${mode}
-            ${CMAKE_C_COMPILER} "${SINEW_SANITIZE}")
+            ${CMAKE_C_COMPILER} "${SINEW_SANITIZE}" $<TARGET_FILE:sinew-bake>)
   set_tests_properties(install_${mode} PROPERTIES LABELS install TIMEOUT 120
     RESOURCE_LOCK sinew_install_manifest) # both write <build>/install_manifest.txt
 endforeach()

@@ -1,17 +1,20 @@
 #!/bin/sh
 # Installs a build tree into a scratch prefix and builds the sample host
 # (samples/host) against that prefix alone, as an engine would, both with the shared and
-# with the static library; then runs the hosts. tests/install.cmake registers it.
+# with the static library; then runs the hosts, each loading and stepping a small blob
+# when a bake tool is given. tests/install.cmake registers it.
 #
-# usage: check_install.sh MODE BUILD_DIR SOURCE_DIR SCRATCH_DIR CC [SANITIZE]
+# usage: check_install.sh MODE BUILD_DIR SOURCE_DIR SCRATCH_DIR CC [SANITIZE [BAKE]]
 #   MODE       find_package: a separate CMake project, find_package(sinew CONFIG REQUIRED)
 #              pkg_config:   plain CC with `pkg-config --cflags --libs sinew`
 #   SANITIZE   the build's SINEW_SANITIZE (may be empty): a sanitized libsinew needs a
 #              host built with the same -fsanitize (the runtime must come first), so the
 #              host gets it too.
+#   BAKE       the build's sinew-bake: bakes a 1000-tet finger (under a second) for
+#              the hosts to step (the bake is the build tree's, not part of the package)
 set -eu
 
-mode=$1 build=$2 src=$3 scratch=$4 cc=$5 sanitize=${6:-}
+mode=$1 build=$2 src=$3 scratch=$4 cc=$5 sanitize=${6:-} bake=${7:-}
 prefix=$scratch/prefix
 fail() {
     echo "check_install($mode): $*" >&2
@@ -52,6 +55,13 @@ if readelf -d "$libdir/libsinew.so" | grep -iE 'NEEDED.*(lapack|openblas|cholmod
     fail "libsinew.so needs a precompute library"
 fi
 
+blob=
+if [ -n "$bake" ]; then
+    blob=$scratch/finger.blob
+    "$bake" --scene finger --tets 1000 --frames 4 --out "$blob" >"$scratch/bake.log" 2>&1 ||
+        { cat "$scratch/bake.log" >&2; fail "the bake of the test blob failed"; }
+fi
+
 # usage: run_host EXE KIND; KIND shared: must load libsinew from $libdir; static: none
 run_host() {
     exe=$1 kind=$2
@@ -63,7 +73,8 @@ run_host() {
         [ "$(readlink -f "$loaded")" = "$real" ] ||
             fail "$exe loads libsinew from '$loaded', not from the prefix ($real)"
     fi
-    out=$("$exe") || fail "$exe failed: $out"
+    # shellcheck disable=SC2086 # $blob is one word or none
+    out=$("$exe" $blob) || fail "$exe failed: $out"
     echo "$kind: $out"
 }
 
