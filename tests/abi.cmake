@@ -93,3 +93,16 @@ endforeach()
 if(TEST test_thread_pool)
   set_tests_properties(test_thread_pool PROPERTIES LABELS threads)
 endif()
+
+# --- the exported ABI against the committed baseline (abidiff) ------------------------
+# tests/abi/abi_check.sh says what fails. Regenerate the baseline after an intended
+# change from a Release build: cmake --build build --target abi-baseline
+set(SW_ABI_BASELINE ${SW_ABI_DIR}/libsinew.abi)
+add_test(NAME abi_abidiff
+  COMMAND sh ${SW_ABI_DIR}/abi_check.sh ${SW_ABI_BASELINE} $<TARGET_FILE:sinew> ${SW_ABI_HEADERS})
+set_tests_properties(abi_abidiff PROPERTIES LABELS abi TIMEOUT 60 SKIP_RETURN_CODE 77)
+add_custom_target(abi-baseline
+  COMMAND sh ${SW_ABI_DIR}/abi_check.sh --write ${SW_ABI_BASELINE} $<TARGET_FILE:sinew>
+          ${SW_ABI_HEADERS}
+  DEPENDS sinew
+  COMMENT "Writing the ABI baseline tests/abi/libsinew.abi" VERBATIM)

@@ -1,0 +1,19 @@
+# Packaging tests: `cmake --install` into a scratch prefix, then the sample host
+# (samples/host) built against that prefix with find_package(sinew) and with pkg-config,
+# shared and static, and run on a small blob baked by the build's sinew-bake
+# (tests/install/check_install.sh). In sanitizer builds the hosts are built with the same
+# -fsanitize: a sanitized libsinew cannot serve a plain host (the shared one aborts, the
+# sanitizer runtime not being loaded first; the static one does not link).
+# SINEW_SANITIZE may be OFF (its option() default) as well as empty: as the top level does.
+set(sw_install_sanitize "")
+if(SINEW_SANITIZE)
+  set(sw_install_sanitize "${SINEW_SANITIZE}")
+endif()
+foreach(mode find_package pkg_config)
+  add_test(NAME install_${mode}
+    COMMAND sh ${CMAKE_CURRENT_SOURCE_DIR}/install/check_install.sh ${mode} ${CMAKE_BINARY_DIR}
+            ${CMAKE_SOURCE_DIR} ${CMAKE_CURRENT_BINARY_DIR}/install_${mode}
+            ${CMAKE_C_COMPILER} "${sw_install_sanitize}" $<TARGET_FILE:sinew-bake>)
+  set_tests_properties(install_${mode} PROPERTIES LABELS install TIMEOUT 120
+    RESOURCE_LOCK sinew_install_manifest) # both write <build>/install_manifest.txt
+endforeach()
