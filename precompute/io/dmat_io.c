@@ -104,6 +104,46 @@ static sinew_result read_ascii(sw_text_reader *r, int64_t rows, int64_t cols, do
     return SINEW_OK;
 }
 
+/* Parses the opened reader `r` (outputs zeroed by the caller) and closes it. */
+static sinew_result read_dmat(sw_text_reader *r, int32_t *rows, int32_t *cols, double **data) {
+    sinew_result rc = SINEW_OK;
+    int64_t c = 0, n = 0;
+    double *d = NULL;
+    if (!sw_text_skip_blank_lines(r))
+        rc = sw_text_fail(r, 1, SINEW_ERROR_PARSE, "empty file: expected \"cols rows\" header");
+    if (!rc) rc = read_header(r, 0, &c, &n);
+    if (!rc && c > INT32_MAX / (n ? n : 1)) /* product must index an int32 array */
+        rc = sw_text_fail(r, r->tline, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large",
+                          (long long)n, (long long)c);
+    if (!rc) {
+        size_t save = r->pos;
+        int64_t line = r->line;
+        const char *t;
+        if (c == 0 && n == 0 && sw_text_token(r, &t) > 0) { /* binary part follows */
+            r->pos = save;
+            r->line = line;
+            rc = read_binary(r, &n, &c, &d);
+        } else if (c * n > 0) {
+            r->pos = save;
+            r->line = line;
+            rc = read_ascii(r, n, c, &d);
+        }
+    }
+    if (!rc && c > INT32_MAX / (n ? n : 1)) {
+        rc = sw_text_fail(r, 2, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large", (long long)n,
+                          (long long)c);
+    }
+    sw_text_close(r);
+    if (rc) {
+        free(d);
+        return rc;
+    }
+    *rows = (int32_t)n;
+    *cols = (int32_t)c;
+    *data = d;
+    return SINEW_OK;
+}
+
 sinew_result sw_read_dmat(const char *path, int32_t *rows, int32_t *cols, double **data,
                           sw_error *err) {
     if (rows) *rows = 0;
@@ -113,42 +153,19 @@ sinew_result sw_read_dmat(const char *path, int32_t *rows, int32_t *cols, double
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_dmat: no output");
     sw_text_reader r;
     sinew_result rc = sw_text_open(&r, path, 0, err);
-    if (rc) return rc;
-    int64_t c = 0, n = 0;
-    double *d = NULL;
-    if (!sw_text_skip_blank_lines(&r))
-        rc = sw_text_fail(&r, 1, SINEW_ERROR_PARSE, "empty file: expected \"cols rows\" header");
-    if (!rc) rc = read_header(&r, 0, &c, &n);
-    if (!rc && c > INT32_MAX / (n ? n : 1)) /* product must index an int32 array */
-        rc = sw_text_fail(&r, r.tline, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large",
-                          (long long)n, (long long)c);
-    if (!rc) {
-        size_t save = r.pos;
-        int64_t line = r.line;
-        const char *t;
-        if (c == 0 && n == 0 && sw_text_token(&r, &t) > 0) { /* binary part follows */
-            r.pos = save;
-            r.line = line;
-            rc = read_binary(&r, &n, &c, &d);
-        } else if (c * n > 0) {
-            r.pos = save;
-            r.line = line;
-            rc = read_ascii(&r, n, c, &d);
-        }
-    }
-    if (!rc && c > INT32_MAX / (n ? n : 1)) {
-        rc = sw_text_fail(&r, 2, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large", (long long)n,
-                          (long long)c);
-    }
-    sw_text_close(&r);
-    if (rc) {
-        free(d);
-        return rc;
-    }
-    *rows = (int32_t)n;
-    *cols = (int32_t)c;
-    *data = d;
-    return SINEW_OK;
+    return rc ? rc : read_dmat(&r, rows, cols, data);
+}
+
+sinew_result sw_parse_dmat(const char *text, size_t len, const char *name_for_errors, int32_t *rows,
+                           int32_t *cols, double **data, sw_error *err) {
+    if (rows) *rows = 0;
+    if (cols) *cols = 0;
+    if (data) *data = NULL;
+    if (!rows || !cols || !data)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_dmat: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open_mem(&r, name_for_errors, text, len, 0, err);
+    return rc ? rc : read_dmat(&r, rows, cols, data);
 }
 
 static void store_le64(double x, unsigned char *p) {
@@ -183,14 +200,11 @@ sinew_result sw_write_dmat(const char *path, int32_t rows, int32_t cols, const d
     return SINEW_OK;
 }
 
-sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, sw_weights *out,
-                             sw_error *err) {
-    if (out) memset(out, 0, sizeof *out);
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_weights: no output");
-    int32_t rows, cols;
-    double *w;
-    sinew_result rc = sw_read_dmat(path, &rows, &cols, &w, err);
-    if (rc) return rc;
+/* Checks and normalises the rows x cols matrix `w` (owned; freed on error) read from
+ * `path` as the weights of nverts x nbones. */
+static sinew_result weights_from(const char *path, int32_t rows, int32_t cols, double *w,
+                                 int32_t nverts, int32_t nbones, sw_weights *out, sw_error *err) {
+    sinew_result rc = SINEW_OK;
     if (rows != nverts || cols != nbones) {
         free(w);
         return sw_error_set(err, SINEW_ERROR_PARSE,
@@ -222,4 +236,27 @@ sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, s
     out->nbones = nbones;
     out->w = w;
     return SINEW_OK;
+}
+
+sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, sw_weights *out,
+                             sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_weights: no output");
+    int32_t rows, cols;
+    double *w;
+    sinew_result rc = sw_read_dmat(path, &rows, &cols, &w, err);
+    if (rc) return rc;
+    return weights_from(path, rows, cols, w, nverts, nbones, out, err);
+}
+
+sinew_result sw_parse_weights(const char *text, size_t len, const char *name_for_errors,
+                              int32_t nverts, int32_t nbones, sw_weights *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_weights: no output");
+    int32_t rows, cols;
+    double *w;
+    const char *name = name_for_errors ? name_for_errors : "<text>";
+    sinew_result rc = sw_parse_dmat(text, len, name, &rows, &cols, &w, err);
+    if (rc) return rc;
+    return weights_from(name, rows, cols, w, nverts, nbones, out, err);
 }

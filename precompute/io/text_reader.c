@@ -63,6 +63,29 @@ sinew_result sw_text_open(sw_text_reader *r, const char *path, char comment, sw_
     return SINEW_OK;
 }
 
+sinew_result sw_text_open_mem(sw_text_reader *r, const char *name, const void *data, size_t len,
+                              char comment, sw_error *err) {
+    memset(r, 0, sizeof *r);
+    r->path = name ? name : "<text>";
+    r->err = err;
+    r->comment = comment;
+    r->line = r->tline = 1;
+    if (!data && len)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: no text given", r->path);
+    if (len > SW_TEXT_MAX_BYTES)
+        return sw_error_set(err, SINEW_ERROR_IO, "%s: text larger than %zu bytes", r->path,
+                            SW_TEXT_MAX_BYTES);
+    char *buf = malloc(len + 1);
+    if (!buf)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory reading text",
+                            r->path);
+    if (len) memcpy(buf, data, len);
+    buf[len] = '\0';
+    r->buf = buf;
+    r->len = len;
+    return SINEW_OK;
+}
+
 void sw_text_close(sw_text_reader *r) {
     if (!r) return;
     free(r->buf);
