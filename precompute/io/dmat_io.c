@@ -59,8 +59,8 @@ static sinew_result read_binary(sw_text_reader *r, int64_t *rows, int64_t *cols,
         return sw_text_fail(r, line, SINEW_ERROR_PARSE,
                             "%llu bytes after the %lld x %lld binary data (wrong size header?)",
                             (unsigned long long)(have - want), (long long)n, (long long)c);
-    double *d = malloc((size_t)(want ? want : 8));
-    if (!d) return sw_text_fail(r, line, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    double *d = want ? malloc((size_t)want) : NULL; /* empty: NULL, as the ASCII reader */
+    if (want && !d) return sw_text_fail(r, line, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     const unsigned char *p = (const unsigned char *)r->buf + r->pos;
     for (int64_t j = 0; j < c; ++j)
         for (int64_t i = 0; i < n; ++i, p += 8) {
@@ -127,6 +127,10 @@ static sinew_result read_dmat(sw_text_reader *r, int32_t *rows, int32_t *cols, d
             r->pos = save;
             r->line = line;
             rc = read_ascii(r, n, c, &d);
+        } else if (sw_text_token(r, &t) > 0) { /* "3 0", "0 3": no values may follow */
+            rc = sw_text_fail(r, r->tline, SINEW_ERROR_PARSE,
+                              "values after the empty %lld x %lld matrix the header declares",
+                              (long long)n, (long long)c);
         }
     }
     if (!rc && c > INT32_MAX / (n ? n : 1)) {
@@ -205,6 +209,11 @@ sinew_result sw_write_dmat(const char *path, int32_t rows, int32_t cols, const d
 static sinew_result weights_from(const char *path, int32_t rows, int32_t cols, double *w,
                                  int32_t nverts, int32_t nbones, sw_weights *out, sw_error *err) {
     sinew_result rc = SINEW_OK;
+    if (rows > 0 && cols < 1) { /* a vertex with no bone columns cannot be normalised */
+        free(w);
+        return sw_error_set(err, SINEW_ERROR_DEGENERATE, "%s:1: weights of %d vertices for no bone",
+                            path, rows);
+    }
     if (rows != nverts || cols != nbones) {
         free(w);
         return sw_error_set(err, SINEW_ERROR_PARSE,
