@@ -219,6 +219,10 @@ TEST(medit_rejects_malformed) {
         {"Triangles\n1\n1 2 3 0\n", "Triangles\n1\n1 2 zz 0\n", SINEW_ERROR_PARSE, 12, "zz"},
         {"Edges\n", "Bogus\n", SINEW_ERROR_PARSE, 18, "Bogus"},
         {"Dimension 3", "Dimension 2", SINEW_ERROR_PARSE, 2, "3D"},
+        /* finite coordinates whose volume overflows (it was accepted as +inf) */
+        {"1.000000 0.000000 0.000000 0\n0.000000 1.000000 0.000000 0\n0.000000 0.000000 "
+         "1.000000 0",
+         "1e200 0 0 0\n0 1e200 0 0\n0 0 1e200 0", SINEW_ERROR_NOT_FINITE, 16, "overflows"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char *s = replace(k_medit, cases[i].from, cases[i].to);

@@ -95,7 +95,7 @@ static size_t next_token(anim_reader *r, const char **tok) {
     }
     *tok = r->buf + r->pos;
     size_t start = r->pos;
-    while (r->pos < r->len && !is_space(r->buf[r->pos]) && r->buf[r->pos] != '\0')
+    while (r->pos < r->len && !is_space(r->buf[r->pos])) /* a NUL byte is garbage, not the end */
         r->pos++;
     if (r->pos > start) r->last_line = r->line;
     return r->pos - start;
@@ -232,7 +232,16 @@ static sinew_result read_frames(anim_reader *r, const sw_skeleton *s, int32_t nf
             else
                 memcpy(local + 9 * b, q, sizeof q);
         }
-        sw_forward_kinematics(s, local, dT, out->T + (size_t)f * nb * 12);
+        double *T = out->T + (size_t)f * nb * 12;
+        sw_forward_kinematics(s, local, dT, T);
+        for (int32_t k = 0; k < 12 * nb; ++k)
+            if (!isfinite(T[k])) { /* finite numbers whose differences or sums overflow */
+                rc = sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                  "%s:%d: the transforms of frame %d overflow (translations too "
+                                  "large)",
+                                  r->path, r->last_line, f);
+                goto done;
+            }
     }
     const char *tok;
     if (next_token(r, &tok) != 0)

@@ -343,6 +343,10 @@ sinew_result sw_text_check_tets(const sw_text_reader *r, const char *format, int
                                         (long long)(q[k] + base));
         double vol = sw_tet_signed_volume(X + 3 * (size_t)q[0], X + 3 * (size_t)q[1],
                                           X + 3 * (size_t)q[2], X + 3 * (size_t)q[3]);
+        if (!isfinite(vol)) /* finite coordinates whose products overflow */
+            return sw_text_fail(r, lines[t], SINEW_ERROR_NOT_FINITE,
+                                "tet %d has a volume that overflows (coordinates too large)",
+                                t + (int32_t)base);
         if (vol == 0.0)
             return sw_text_fail(r, lines[t], SINEW_ERROR_DEGENERATE, "tet %d has zero volume",
                                 t + (int32_t)base);
