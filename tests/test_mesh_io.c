@@ -613,6 +613,10 @@ TEST(weights_are_checked_and_normalised) {
     double *d = (double *)&r; /* an empty binary matrix has no data, as an ASCII one */
     ENSURE(sw_read_dmat(write_bytes("bempty.dmat", "0 0\n3 0\n", 8), &r, &c, &d, &e) == SINEW_OK);
     ENSURE(r == 0 && c == 3 && d == NULL);
+    /* 1e9 empty columns (fuzz_dmat: took a minute looping over them) */
+    ENSURE(sw_read_dmat(write_bytes("bwide.dmat", "0 0\n1000000000 0\n", 17), &r, &c, &d, &e) ==
+           SINEW_OK);
+    ENSURE(r == 0 && c == 1000000000 && d == NULL);
 }
 
 /* The from-memory readers (the fuzz harnesses' entries) give what the path readers give,

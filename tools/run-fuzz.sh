@@ -3,7 +3,8 @@
 # for a few seconds only). Configures build/ when it has no cache, builds the harnesses
 # (targets <name>_harness; clang with libFuzzer), runs each for SECONDS on a scratch copy
 # of its seed corpus (the seeds stay untouched), and prints per harness the executions,
-# executions per second, crashes, and the time 1e7 executions would take. Exits non-zero
+# executions per second, crashes, slow inputs (one run over 10 s), and the seconds 1e7
+# executions would take. Exits non-zero
 # when any harness crashed (ASan, UBSan, a leak, a broken reader promise = abort) or did
 # not run; the crashing inputs are kept in BUILD/fuzz-artifacts/<name>/.
 #
@@ -71,7 +72,15 @@ for name in "${names[@]}"; do
     [ -n "$execs" ] || execs=$(sed -n 's/^#\([0-9]*\)[[:space:]]*DONE.*/\1/p' "$dir/log" | tail -n 1)
     ran=$(sed -n 's/^Done [0-9]* runs in \([0-9]*\) second.*/\1/p' "$dir/log" | tail -n 1)
     [ -n "$ran" ] && [ "$ran" -gt 0 ] || ran=$secs
-    crashes=$(find "$dir/artifacts" -type f | wc -l)
+    # crash-, leak-, timeout-, oom- inputs fail the run; slow-unit- inputs (one input took
+    # longer than libFuzzer's -report_slow_units, 10 s) are kept and counted, not failed
+    crashes=$(find "$dir/artifacts" -type f ! -name 'slow-unit-*' | wc -l)
+    slow=$(find "$dir/artifacts" -type f -name 'slow-unit-*' | wc -l)
+    if [ "$slow" -gt 0 ]; then
+        mkdir -p "$build/fuzz-artifacts/$name"
+        cp "$dir/artifacts/"slow-unit-* "$build/fuzz-artifacts/$name/"
+        echo "=== run-fuzz: $name: $slow slow input(s) kept in $build/fuzz-artifacts/$name" >&2
+    fi
     if [ "$rc" -ne 0 ] || [ "$crashes" -gt 0 ] || [ -z "$execs" ]; then
         failed=1
         [ "$crashes" -gt 0 ] || crashes=1
@@ -79,6 +88,7 @@ for name in "${names[@]}"; do
         mkdir -p "$keep"
         cp "$dir/log" "$keep/log"
         cp "$dir/artifacts/"* "$keep/" 2>/dev/null
+        find "$keep" -name 'slow-unit-*' -delete
         echo "=== run-fuzz: $name FAILED (exit $rc); log and inputs in $keep" >&2
         grep -E 'ERROR|runtime error|SUMMARY|deadly|Test unit written' "$dir/log" | head -n 8 >&2
     fi
@@ -86,11 +96,12 @@ for name in "${names[@]}"; do
     rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$dir/log" | tail -n 1)
     [ -n "$rate" ] && [ "$rate" -gt 0 ] || rate=$((execs / ran))
     if [ "$rate" -gt 0 ]; then need=$(((10000000 + rate - 1) / rate)); else need=-; fi
-    report+=("$(printf '%-16s %8s %12s %10s %8s %14s' "$name" "$ran" "$execs" "$rate" \
-        "$crashes" "$need")")
+    report+=("$(printf '%-16s %8s %12s %10s %8s %5s %10s' "$name" "$ran" "$execs" "$rate" \
+        "$crashes" "$slow" "$need")")
 done
 
-printf '%-16s %8s %12s %10s %8s %14s\n' harness seconds executions execs/s crashes 's_for_1e7'
+printf '%-16s %8s %12s %10s %8s %5s %10s\n' harness seconds executions execs/s crashes slow \
+    's_for_1e7'
 printf '%s\n' "${report[@]}"
 [ "${SINEW_FUZZ_KEEP:-0}" = 1 ] && echo "scratch corpora kept in $scratch_root"
 exit "$failed"

@@ -62,7 +62,7 @@ static sinew_result read_binary(sw_text_reader *r, int64_t *rows, int64_t *cols,
     double *d = want ? malloc((size_t)want) : NULL; /* empty: NULL, as the ASCII reader */
     if (want && !d) return sw_text_fail(r, line, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     const unsigned char *p = (const unsigned char *)r->buf + r->pos;
-    for (int64_t j = 0; j < c; ++j)
+    for (int64_t j = 0; j < (n ? c : 0); ++j) /* "1000000000 0" is empty: no empty loops */
         for (int64_t i = 0; i < n; ++i, p += 8) {
             uint64_t u = load_le64(p);
             double x;
