@@ -88,7 +88,6 @@ for name in "${names[@]}"; do
         mkdir -p "$keep"
         cp "$dir/log" "$keep/log"
         cp "$dir/artifacts/"* "$keep/" 2>/dev/null
-        find "$keep" -name 'slow-unit-*' -delete
         echo "=== run-fuzz: $name FAILED (exit $rc); log and inputs in $keep" >&2
         grep -E 'ERROR|runtime error|SUMMARY|deadly|Test unit written' "$dir/log" | head -n 8 >&2
     fi
