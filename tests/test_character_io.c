@@ -205,6 +205,26 @@ TEST(cd_anim_malformed) {
     ENSURE(parse_text(buf, &err) == SINEW_ERROR_PARSE);
     ENSURE(parse_text("", &err) == SINEW_ERROR_PARSE);
     ENSURE(parse_text("3 0\n", &err) == SINEW_ERROR_PARSE);
+    /* finite translations whose difference overflows: frame 1's transforms (were +inf) */
+    snprintf(buf, sizeof buf, "3 2\n-1e308 5 5\n%s", strstr(FORK_ANIM, "0 0 0\n"));
+    q = strstr(buf, "6 7 8");
+    snprintf(q, sizeof buf - (size_t)(q - buf), "1e308 7 8\n90 0 0\n0 0 0\n0 0 0\n");
+    ENSURE(parse_text(buf, &err) == SINEW_ERROR_NOT_FINITE);
+    ENSUREF(strstr(err.msg, "bad.txt:16:") && strstr(err.msg, "frame 1 overflow"), "%s", err.msg);
+    /* a NUL byte after the frames is trailing garbage, not the end of the text */
+    {
+        sw_skeleton s = {0};
+        make_fork(&s);
+        sw_clip c = {0};
+        size_t n = strlen(FORK_ANIM);
+        memcpy(buf, FORK_ANIM, n);
+        memcpy(buf + n, "\0junk\n", 6);
+        ENSURE(sw_parse_cd_anim(buf, n, "mem.txt", &s, 30, &c, &err) == SINEW_OK);
+        sw_clip_free(&c);
+        ENSURE(sw_parse_cd_anim(buf, n + 6, "mem.txt", &s, 30, &c, &err) == SINEW_ERROR_PARSE);
+        ENSUREF(strstr(err.msg, "mem.txt:17:") && c.T == NULL, "%s", err.msg);
+        sw_skeleton_free(&s);
+    }
     /* missing file */
     sw_skeleton s = {0};
     make_fork(&s);

@@ -219,6 +219,10 @@ TEST(medit_rejects_malformed) {
         {"Triangles\n1\n1 2 3 0\n", "Triangles\n1\n1 2 zz 0\n", SINEW_ERROR_PARSE, 12, "zz"},
         {"Edges\n", "Bogus\n", SINEW_ERROR_PARSE, 18, "Bogus"},
         {"Dimension 3", "Dimension 2", SINEW_ERROR_PARSE, 2, "3D"},
+        /* finite coordinates whose volume overflows (it was accepted as +inf) */
+        {"1.000000 0.000000 0.000000 0\n0.000000 1.000000 0.000000 0\n0.000000 0.000000 "
+         "1.000000 0",
+         "1e200 0 0 0\n0 1e200 0 0\n0 0 1e200 0", SINEW_ERROR_NOT_FINITE, 16, "overflows"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         char *s = replace(k_medit, cases[i].from, cases[i].to);
@@ -567,6 +571,9 @@ TEST(dmat_rejects_malformed) {
          "finite"},
         {BIN("0 0\n2 1 \n\0\0\0\0\0\0\xf8\x3f\0\0\0\0\0\0\0\0"), SINEW_ERROR_PARSE, 2, "newline"},
         {"0 0\n2 x\n", 0, SINEW_ERROR_PARSE, 2, "x"},
+        /* an empty matrix declared with one nonzero size is not followed by values */
+        {"0 2\n1 2\n", 0, SINEW_ERROR_PARSE, 2, "empty"},
+        {"3 0\n\n7\n", 0, SINEW_ERROR_PARSE, 3, "empty"},
     };
     for (size_t i = 0; i < sizeof cases / sizeof cases[0]; ++i) {
         size_t len = cases[i].len ? cases[i].len : strlen(cases[i].text);
@@ -599,6 +606,64 @@ TEST(weights_are_checked_and_normalised) {
     p = write_text("wzero.dmat", "2 2\n1 0\n0 0\n");
     ENSURE(err_is(sw_read_weights(p, 2, 2, &w, &e), &e, SINEW_ERROR_DEGENERATE, p, 0));
     ENSURE(all_zero(&w, sizeof w));
+    p = write_text("wnobone.dmat", "0 2\n"); /* 2 vertices, no bone column (fuzz_dmat) */
+    ENSURE(err_is(sw_read_weights(p, 2, 0, &w, &e), &e, SINEW_ERROR_DEGENERATE, p, 1));
+    ENSURE(all_zero(&w, sizeof w));
+    int32_t r, c;
+    double *d = (double *)&r; /* an empty binary matrix has no data, as an ASCII one */
+    ENSURE(sw_read_dmat(write_bytes("bempty.dmat", "0 0\n3 0\n", 8), &r, &c, &d, &e) == SINEW_OK);
+    ENSURE(r == 0 && c == 3 && d == NULL);
+    /* 1e9 empty columns (fuzz_dmat: took a minute looping over them) */
+    ENSURE(sw_read_dmat(write_bytes("bwide.dmat", "0 0\n1000000000 0\n", 17), &r, &c, &d, &e) ==
+           SINEW_OK);
+    ENSURE(r == 0 && c == 1000000000 && d == NULL);
+}
+
+/* The from-memory readers (the fuzz harnesses' entries) give what the path readers give,
+ * and name the text as told in their messages. */
+TEST(parse_from_memory_matches_files) {
+    static const char mesh[] = "MeshVersionFormatted 2\nDimension 3\nVertices\n4\n0 0 0 0\n"
+                               "1 0 0 0\n0 1 0 0\n0 0 1 0\nTetrahedra\n1\n1 3 2 4 0\nEnd\n";
+    static const char node[] = "4 3 0 0\n0 0 0 0\n1 1 0 0\n2 0 1 0\n3 0 0 1\n";
+    static const char ele[] = "1 4 0\n0 0 1 2 3\n";
+    static const char obj[] = "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n";
+    static const char tgf[] = "1 0 0 0\n2 0 1 0\n#\n1 2\n";
+    static const char dmat[] = "2 2\n1 3\n2 4\n";
+    sw_error e;
+    sw_tetmesh a, b;
+    ENSURE(sw_read_medit(write_text("m.mesh", mesh), &a, &e) == SINEW_OK);
+    ENSURE(sw_parse_medit(mesh, strlen(mesh), "mem.mesh", &b, &e) == SINEW_OK);
+    ENSURE(a.nverts == b.nverts && a.ntets == b.ntets);
+    ENSURE(!memcmp(a.X, b.X, 12 * sizeof(double)) && !memcmp(a.tets, b.tets, 4 * sizeof(int32_t)));
+    sw_tetmesh_free(&a);
+    sw_tetmesh_free(&b);
+    ENSURE(sw_parse_tetgen(node, strlen(node), NULL, ele, strlen(ele), NULL, &b, &e) == SINEW_OK);
+    ENSURE(b.nverts == 4 && b.ntets == 1);
+    sw_tetmesh_free(&b);
+    ENSURE(sw_parse_tetgen(node, strlen(node), "n.node", ele, 5, "e.ele", &b, &e) ==
+           SINEW_ERROR_PARSE);
+    ENSUREF(!strncmp(e.msg, "e.ele:", 6) && all_zero(&b, sizeof b), "%s", e.msg);
+    sw_trimesh t;
+    ENSURE(sw_parse_obj(obj, strlen(obj), "mem.obj", &t, &e) == SINEW_OK);
+    ENSURE(t.nverts == 3 && t.ntris == 1 && t.tris[2] == 2);
+    sw_trimesh_free(&t);
+    ENSURE(sw_parse_obj(obj, strlen(obj) - 2, "mem.obj", &t, &e) == SINEW_ERROR_PARSE);
+    ENSUREF(!strncmp(e.msg, "mem.obj:4:", 10), "%s", e.msg);
+    sw_skeleton s;
+    ENSURE(sw_parse_tgf(tgf, strlen(tgf), NULL, &s, &e) == SINEW_OK);
+    ENSURE(s.njoints == 2 && s.nbones == 1 && s.parent[0] == -1);
+    sw_skeleton_free(&s);
+    int32_t r, c;
+    double *d;
+    ENSURE(sw_parse_dmat(dmat, strlen(dmat), NULL, &r, &c, &d, &e) == SINEW_OK);
+    ENSURE(r == 2 && c == 2 && d[0] == 1 && d[1] == 2 && d[2] == 3 && d[3] == 4);
+    free(d);
+    ENSURE(sw_parse_dmat(dmat, 6, NULL, &r, &c, &d, &e) == SINEW_ERROR_PARSE);
+    ENSUREF(!strncmp(e.msg, "<text>:", 7) && d == NULL, "%s", e.msg);
+    sw_weights w;
+    ENSURE(sw_parse_weights(dmat, strlen(dmat), "w", 2, 2, &w, &e) == SINEW_OK);
+    ENSURE_NEAR(w.w[0], 1.0 / 3.0, 1e-15);
+    sw_weights_free(&w);
 }
 
 /* ---- writers round trip -------------------------------------------------------- */
@@ -1050,7 +1115,8 @@ SW_TEST_MAIN(CASE(medit_reads_small_mesh), CASE(medit_reorients_negative_tets),
              CASE(obj_reads_polygons_and_relative_indices), CASE(obj_rejects_malformed),
              CASE(tgf_reads_and_derives_parents), CASE(tgf_rejects_malformed),
              CASE(dmat_round_trips_ascii_and_binary), CASE(dmat_rejects_malformed),
-             CASE(weights_are_checked_and_normalised), CASE(medit_and_obj_round_trip),
-             CASE(surface_of_small_meshes), CASE(quality_of_known_tets), CASE(real_tet_meshes),
+             CASE(weights_are_checked_and_normalised), CASE(parse_from_memory_matches_files),
+             CASE(medit_and_obj_round_trip), CASE(surface_of_small_meshes),
+             CASE(quality_of_known_tets), CASE(real_tet_meshes),
              CASE(real_surfaces_skeletons_and_matrices), CASE(real_every_asset_reads),
              CASE(real_truncation_sweep), CASE(byte_flips_never_crash))

@@ -67,6 +67,21 @@ static sinew_result load_file(const char *path, anim_reader *r, sw_error *err) {
     return SINEW_OK;
 }
 
+static sinew_result load_mem(const char *name, const char *text, size_t len, anim_reader *r,
+                             sw_error *err) {
+    memset(r, 0, sizeof *r);
+    r->path = name;
+    r->line = 1;
+    if (!text && len) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: no text", name);
+    char *buf = malloc(len + 1);
+    if (!buf) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    if (len) memcpy(buf, text, len);
+    buf[len] = '\0';
+    r->buf = buf;
+    r->len = len;
+    return SINEW_OK;
+}
+
 static int is_space(char c) {
     return c == ' ' || c == '\t' || c == '\n' || c == '\r' || c == '\v' || c == '\f';
 }
@@ -80,7 +95,7 @@ static size_t next_token(anim_reader *r, const char **tok) {
     }
     *tok = r->buf + r->pos;
     size_t start = r->pos;
-    while (r->pos < r->len && !is_space(r->buf[r->pos]) && r->buf[r->pos] != '\0')
+    while (r->pos < r->len && !is_space(r->buf[r->pos])) /* a NUL byte is garbage, not the end */
         r->pos++;
     if (r->pos > start) r->last_line = r->line;
     return r->pos - start;
@@ -217,7 +232,16 @@ static sinew_result read_frames(anim_reader *r, const sw_skeleton *s, int32_t nf
             else
                 memcpy(local + 9 * b, q, sizeof q);
         }
-        sw_forward_kinematics(s, local, dT, out->T + (size_t)f * nb * 12);
+        double *T = out->T + (size_t)f * nb * 12;
+        sw_forward_kinematics(s, local, dT, T);
+        for (int32_t k = 0; k < 12 * nb; ++k)
+            if (!isfinite(T[k])) { /* finite numbers whose differences or sums overflow */
+                rc = sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                  "%s:%d: the transforms of frame %d overflow (translations too "
+                                  "large)",
+                                  r->path, r->last_line, f);
+                goto done;
+            }
     }
     const char *tok;
     if (next_token(r, &tok) != 0)
@@ -230,35 +254,40 @@ done:
     return rc;
 }
 
-sinew_result sw_read_cd_anim(const char *path, const sw_skeleton *s, double fps, sw_clip *out,
-                             sw_error *err) {
+/* Checks the arguments every entry shares. */
+static sinew_result check_args(const char *name, const sw_skeleton *s, double fps, sw_clip *out,
+                               sw_error *err) {
     if (!out)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_cd_anim: out is NULL");
     memset(out, 0, sizeof *out);
-    if (!path || !s)
+    if (!name || !s)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_cd_anim: NULL argument");
     if (!(fps > 0) || !isfinite(fps))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: fps must be positive, got %g",
-                            path, fps);
-    sinew_result rc = sw_skeleton_validate(s, err);
-    if (rc) return rc;
-    anim_reader r;
-    if ((rc = load_file(path, &r, err))) return rc;
+                            name, fps);
+    return sw_skeleton_validate(s, err);
+}
+
+/* Parses the loaded reader `r` into *out (zeroed by check_args) and frees its text. */
+static sinew_result read_anim(anim_reader *r, const sw_skeleton *s, double fps, sw_clip *out,
+                              sw_error *err) {
+    const char *path = r->path;
     long nb, nf;
-    if ((rc = read_int(&r, &nb, "the bone count", err))) goto fail;
-    if ((rc = read_int(&r, &nf, "the frame count", err))) goto fail;
+    sinew_result rc;
+    if ((rc = read_int(r, &nb, "the bone count", err))) goto fail;
+    if ((rc = read_int(r, &nf, "the frame count", err))) goto fail;
     if (nb != s->nbones) {
         rc = sw_error_set(err, SINEW_ERROR_PARSE, "%s:%d: animation has %ld bones, skeleton has %d",
-                          path, r.line, nb, s->nbones);
+                          path, r->line, nb, s->nbones);
         goto fail;
     }
     /* Each number takes at least two bytes (digit and separator), so a frame count the
      * file cannot hold is rejected before allocating for it. */
     double need = 6.0 + 3.0 * (double)nb + (double)nf * (6.0 + 3.0 * (double)nb);
-    if (nf < 1 || 2.0 * need - 1.0 > (double)r.len) {
+    if (nf < 1 || 2.0 * need - 1.0 > (double)r->len) {
         rc = sw_error_set(err, SINEW_ERROR_PARSE,
                           "%s:%d: frame count %ld is impossible for a file of %zu bytes", path,
-                          r.line, nf, r.len);
+                          r->line, nf, r->len);
         goto fail;
     }
     out->T = malloc(sizeof(double) * 12 * (size_t)nb * (size_t)nf);
@@ -270,11 +299,30 @@ sinew_result sw_read_cd_anim(const char *path, const sw_skeleton *s, double fps,
     out->nbones = (int32_t)nb;
     out->nframes = (int32_t)nf;
     out->fps = fps;
-    if ((rc = read_frames(&r, s, (int32_t)nf, out, err))) goto fail;
-    free(r.buf);
+    if ((rc = read_frames(r, s, (int32_t)nf, out, err))) goto fail;
+    free(r->buf);
     return SINEW_OK;
 fail:
-    free(r.buf);
+    free(r->buf);
     sw_clip_free(out);
     return rc;
+}
+
+sinew_result sw_read_cd_anim(const char *path, const sw_skeleton *s, double fps, sw_clip *out,
+                             sw_error *err) {
+    sinew_result rc = check_args(path, s, fps, out, err);
+    if (rc) return rc;
+    anim_reader r;
+    if ((rc = load_file(path, &r, err))) return rc;
+    return read_anim(&r, s, fps, out, err);
+}
+
+sinew_result sw_parse_cd_anim(const char *text, size_t len, const char *name_for_errors,
+                              const sw_skeleton *s, double fps, sw_clip *out, sw_error *err) {
+    const char *name = name_for_errors ? name_for_errors : "<text>";
+    sinew_result rc = check_args(name, s, fps, out, err);
+    if (rc) return rc;
+    anim_reader r;
+    if ((rc = load_mem(name, text, len, &r, err))) return rc;
+    return read_anim(&r, s, fps, out, err);
 }

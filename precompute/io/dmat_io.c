@@ -59,10 +59,10 @@ static sinew_result read_binary(sw_text_reader *r, int64_t *rows, int64_t *cols,
         return sw_text_fail(r, line, SINEW_ERROR_PARSE,
                             "%llu bytes after the %lld x %lld binary data (wrong size header?)",
                             (unsigned long long)(have - want), (long long)n, (long long)c);
-    double *d = malloc((size_t)(want ? want : 8));
-    if (!d) return sw_text_fail(r, line, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    double *d = want ? malloc((size_t)want) : NULL; /* empty: NULL, as the ASCII reader */
+    if (want && !d) return sw_text_fail(r, line, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     const unsigned char *p = (const unsigned char *)r->buf + r->pos;
-    for (int64_t j = 0; j < c; ++j)
+    for (int64_t j = 0; j < (n ? c : 0); ++j) /* "1000000000 0" is empty: no empty loops */
         for (int64_t i = 0; i < n; ++i, p += 8) {
             uint64_t u = load_le64(p);
             double x;
@@ -104,6 +104,50 @@ static sinew_result read_ascii(sw_text_reader *r, int64_t rows, int64_t cols, do
     return SINEW_OK;
 }
 
+/* Parses the opened reader `r` (outputs zeroed by the caller) and closes it. */
+static sinew_result read_dmat(sw_text_reader *r, int32_t *rows, int32_t *cols, double **data) {
+    sinew_result rc = SINEW_OK;
+    int64_t c = 0, n = 0;
+    double *d = NULL;
+    if (!sw_text_skip_blank_lines(r))
+        rc = sw_text_fail(r, 1, SINEW_ERROR_PARSE, "empty file: expected \"cols rows\" header");
+    if (!rc) rc = read_header(r, 0, &c, &n);
+    if (!rc && c > INT32_MAX / (n ? n : 1)) /* product must index an int32 array */
+        rc = sw_text_fail(r, r->tline, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large",
+                          (long long)n, (long long)c);
+    if (!rc) {
+        size_t save = r->pos;
+        int64_t line = r->line;
+        const char *t;
+        if (c == 0 && n == 0 && sw_text_token(r, &t) > 0) { /* binary part follows */
+            r->pos = save;
+            r->line = line;
+            rc = read_binary(r, &n, &c, &d);
+        } else if (c * n > 0) {
+            r->pos = save;
+            r->line = line;
+            rc = read_ascii(r, n, c, &d);
+        } else if (sw_text_token(r, &t) > 0) { /* "3 0", "0 3": no values may follow */
+            rc = sw_text_fail(r, r->tline, SINEW_ERROR_PARSE,
+                              "values after the empty %lld x %lld matrix the header declares",
+                              (long long)n, (long long)c);
+        }
+    }
+    if (!rc && c > INT32_MAX / (n ? n : 1)) {
+        rc = sw_text_fail(r, 2, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large", (long long)n,
+                          (long long)c);
+    }
+    sw_text_close(r);
+    if (rc) {
+        free(d);
+        return rc;
+    }
+    *rows = (int32_t)n;
+    *cols = (int32_t)c;
+    *data = d;
+    return SINEW_OK;
+}
+
 sinew_result sw_read_dmat(const char *path, int32_t *rows, int32_t *cols, double **data,
                           sw_error *err) {
     if (rows) *rows = 0;
@@ -113,42 +157,19 @@ sinew_result sw_read_dmat(const char *path, int32_t *rows, int32_t *cols, double
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_dmat: no output");
     sw_text_reader r;
     sinew_result rc = sw_text_open(&r, path, 0, err);
-    if (rc) return rc;
-    int64_t c = 0, n = 0;
-    double *d = NULL;
-    if (!sw_text_skip_blank_lines(&r))
-        rc = sw_text_fail(&r, 1, SINEW_ERROR_PARSE, "empty file: expected \"cols rows\" header");
-    if (!rc) rc = read_header(&r, 0, &c, &n);
-    if (!rc && c > INT32_MAX / (n ? n : 1)) /* product must index an int32 array */
-        rc = sw_text_fail(&r, r.tline, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large",
-                          (long long)n, (long long)c);
-    if (!rc) {
-        size_t save = r.pos;
-        int64_t line = r.line;
-        const char *t;
-        if (c == 0 && n == 0 && sw_text_token(&r, &t) > 0) { /* binary part follows */
-            r.pos = save;
-            r.line = line;
-            rc = read_binary(&r, &n, &c, &d);
-        } else if (c * n > 0) {
-            r.pos = save;
-            r.line = line;
-            rc = read_ascii(&r, n, c, &d);
-        }
-    }
-    if (!rc && c > INT32_MAX / (n ? n : 1)) {
-        rc = sw_text_fail(&r, 2, SINEW_ERROR_PARSE, "matrix %lld x %lld is too large", (long long)n,
-                          (long long)c);
-    }
-    sw_text_close(&r);
-    if (rc) {
-        free(d);
-        return rc;
-    }
-    *rows = (int32_t)n;
-    *cols = (int32_t)c;
-    *data = d;
-    return SINEW_OK;
+    return rc ? rc : read_dmat(&r, rows, cols, data);
+}
+
+sinew_result sw_parse_dmat(const char *text, size_t len, const char *name_for_errors, int32_t *rows,
+                           int32_t *cols, double **data, sw_error *err) {
+    if (rows) *rows = 0;
+    if (cols) *cols = 0;
+    if (data) *data = NULL;
+    if (!rows || !cols || !data)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_dmat: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open_mem(&r, name_for_errors, text, len, 0, err);
+    return rc ? rc : read_dmat(&r, rows, cols, data);
 }
 
 static void store_le64(double x, unsigned char *p) {
@@ -183,14 +204,16 @@ sinew_result sw_write_dmat(const char *path, int32_t rows, int32_t cols, const d
     return SINEW_OK;
 }
 
-sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, sw_weights *out,
-                             sw_error *err) {
-    if (out) memset(out, 0, sizeof *out);
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_weights: no output");
-    int32_t rows, cols;
-    double *w;
-    sinew_result rc = sw_read_dmat(path, &rows, &cols, &w, err);
-    if (rc) return rc;
+/* Checks and normalises the rows x cols matrix `w` (owned; freed on error) read from
+ * `path` as the weights of nverts x nbones. */
+static sinew_result weights_from(const char *path, int32_t rows, int32_t cols, double *w,
+                                 int32_t nverts, int32_t nbones, sw_weights *out, sw_error *err) {
+    sinew_result rc = SINEW_OK;
+    if (rows > 0 && cols < 1) { /* a vertex with no bone columns cannot be normalised */
+        free(w);
+        return sw_error_set(err, SINEW_ERROR_DEGENERATE, "%s:1: weights of %d vertices for no bone",
+                            path, rows);
+    }
     if (rows != nverts || cols != nbones) {
         free(w);
         return sw_error_set(err, SINEW_ERROR_PARSE,
@@ -222,4 +245,27 @@ sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, s
     out->nbones = nbones;
     out->w = w;
     return SINEW_OK;
+}
+
+sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, sw_weights *out,
+                             sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_weights: no output");
+    int32_t rows, cols;
+    double *w;
+    sinew_result rc = sw_read_dmat(path, &rows, &cols, &w, err);
+    if (rc) return rc;
+    return weights_from(path, rows, cols, w, nverts, nbones, out, err);
+}
+
+sinew_result sw_parse_weights(const char *text, size_t len, const char *name_for_errors,
+                              int32_t nverts, int32_t nbones, sw_weights *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_weights: no output");
+    int32_t rows, cols;
+    double *w;
+    const char *name = name_for_errors ? name_for_errors : "<text>";
+    sinew_result rc = sw_parse_dmat(text, len, name, &rows, &cols, &w, err);
+    if (rc) return rc;
+    return weights_from(name, rows, cols, w, nverts, nbones, out, err);
 }

@@ -147,19 +147,15 @@ static sinew_result parse(sw_text_reader *r, medit_state *s) {
     return sw_text_check_tets(r, "Medit", 1, s->nverts, s->X, s->ntets, s->tets, s->lines);
 }
 
-sinew_result sw_read_medit(const char *path, sw_tetmesh *out, sw_error *err) {
-    if (out) memset(out, 0, sizeof *out);
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_medit: no output");
-    sw_text_reader r;
-    sinew_result rc = sw_text_open(&r, path, '#', err);
-    if (rc) return rc;
+/* Parses the opened reader `r` into *out (zeroed by the caller) and closes it. */
+static sinew_result read_medit(sw_text_reader *r, sw_tetmesh *out) {
     medit_state s;
     memset(&s, 0, sizeof s);
-    rc = parse(&r, &s);
+    sinew_result rc = parse(r, &s);
     sw_tetmesh m = {s.nverts, s.ntets, s.X, s.tets};
-    if (!rc) rc = sw_text_validate_tets(&r, &m);
+    if (!rc) rc = sw_text_validate_tets(r, &m);
     free(s.lines);
-    sw_text_close(&r);
+    sw_text_close(r);
     if (rc) {
         free(s.X);
         free(s.tets);
@@ -167,6 +163,23 @@ sinew_result sw_read_medit(const char *path, sw_tetmesh *out, sw_error *err) {
     }
     *out = m;
     return SINEW_OK;
+}
+
+sinew_result sw_read_medit(const char *path, sw_tetmesh *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_medit: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open(&r, path, '#', err);
+    return rc ? rc : read_medit(&r, out);
+}
+
+sinew_result sw_parse_medit(const char *text, size_t len, const char *name_for_errors,
+                            sw_tetmesh *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_medit: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open_mem(&r, name_for_errors, text, len, '#', err);
+    return rc ? rc : read_medit(&r, out);
 }
 
 sinew_result sw_write_medit(const char *path, const sw_tetmesh *m, sw_error *err) {

@@ -5,9 +5,16 @@
  * SINEW_ERROR_PARSE (or NOT_FINITE / DEGENERATE / IO) and a message of the form
  * "path:line: what is wrong": truncated files, wrong counts, out-of-range indices,
  * 0/1-based confusion, NaN coordinates, zero-volume tets. On error the output struct
- * is left zeroed and nothing leaks. */
+ * is left zeroed and nothing leaks.
+ *
+ * Every reader has a from-memory twin, sw_parse_*, that reads `len` bytes of `text` (no
+ * NUL needed; the bytes are copied) with the same rules and messages, naming the text
+ * `name_for_errors` where the path would be (NULL: "<text>"). The fuzz harnesses of
+ * tests/fuzz/ call these. */
 #ifndef SW_MESH_IO_H
 #define SW_MESH_IO_H
+
+#include <stddef.h>
 
 #include "sw_mesh.h"
 
@@ -15,9 +22,15 @@
  * Negatively oriented tets are reoriented (two vertices swapped); zero-volume tets
  * are an error. */
 sinew_result sw_read_medit(const char *path, sw_tetmesh *out, sw_error *err);
+sinew_result sw_parse_medit(const char *text, size_t len, const char *name_for_errors,
+                            sw_tetmesh *out, sw_error *err);
 /* TetGen .node + .ele (0- or 1-based, as the .node's first index says). */
 sinew_result sw_read_tetgen(const char *node_path, const char *ele_path, sw_tetmesh *out,
                             sw_error *err);
+/* Names NULL: "<node>" and "<ele>". */
+sinew_result sw_parse_tetgen(const char *node_text, size_t node_len, const char *node_name,
+                             const char *ele_text, size_t ele_len, const char *ele_name,
+                             sw_tetmesh *out, sw_error *err);
 /* Dispatch on the extension: ".mesh" -> Medit; ".node" or ".ele" -> TetGen with the
  * sibling file of the same stem. */
 sinew_result sw_read_tetmesh(const char *path, sw_tetmesh *out, sw_error *err);
@@ -26,17 +39,23 @@ sinew_result sw_write_medit(const char *path, const sw_tetmesh *m, sw_error *err
 /* Wavefront OBJ surface: v and f lines (polygons fan-triangulated, v/vt/vn and
  * negative indices accepted), other lines ignored. */
 sinew_result sw_read_obj(const char *path, sw_trimesh *out, sw_error *err);
+sinew_result sw_parse_obj(const char *text, size_t len, const char *name_for_errors,
+                          sw_trimesh *out, sw_error *err);
 sinew_result sw_write_obj(const char *path, int32_t nverts, const double *X, int32_t ntris,
                           const int32_t *tris, sw_error *err);
 
 /* libigl .tgf: joint lines "index x y z", a "#" separator, edge lines "a b [flags...]"
  * (1-based). Bones keep file order; parents are derived from shared joints. */
 sinew_result sw_read_tgf(const char *path, sw_skeleton *out, sw_error *err);
+sinew_result sw_parse_tgf(const char *text, size_t len, const char *name_for_errors,
+                          sw_skeleton *out, sw_error *err);
 
 /* libigl .dmat, ASCII ("cols rows" header, column-major values) or binary ("0 0"
  * header line followed by the binary one). Returns a row-major rows x cols array. */
 sinew_result sw_read_dmat(const char *path, int32_t *rows, int32_t *cols, double **data,
                           sw_error *err);
+sinew_result sw_parse_dmat(const char *text, size_t len, const char *name_for_errors, int32_t *rows,
+                           int32_t *cols, double **data, sw_error *err);
 sinew_result sw_write_dmat(const char *path, int32_t rows, int32_t cols, const double *data,
                            int binary, sw_error *err);
 
@@ -44,6 +63,8 @@ sinew_result sw_write_dmat(const char *path, int32_t rows, int32_t cols, const d
  * are checked (finite, >= 0 within 1e-6, not all zero) and normalised to sum 1. */
 sinew_result sw_read_weights(const char *path, int32_t nverts, int32_t nbones, sw_weights *out,
                              sw_error *err);
+sinew_result sw_parse_weights(const char *text, size_t len, const char *name_for_errors,
+                              int32_t nverts, int32_t nbones, sw_weights *out, sw_error *err);
 
 /* Boundary faces of a tet mesh (faces owned by exactly one tet), outward CCW. */
 sinew_result sw_tetmesh_surface(const sw_tetmesh *m, sw_surface *out, sw_error *err);

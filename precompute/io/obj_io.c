@@ -121,31 +121,28 @@ static sinew_result read_face(sw_text_reader *r, obj_state *s) {
     return SINEW_OK;
 }
 
-sinew_result sw_read_obj(const char *path, sw_trimesh *out, sw_error *err) {
-    if (out) memset(out, 0, sizeof *out);
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_obj: no output");
-    sw_text_reader r;
-    sinew_result rc = sw_text_open(&r, path, '#', err);
-    if (rc) return rc;
+/* Parses the opened reader `r` into *out (zeroed by the caller) and closes it. */
+static sinew_result read_obj(sw_text_reader *r, sw_trimesh *out) {
+    sinew_result rc = SINEW_OK;
     obj_state s;
     memset(&s, 0, sizeof s);
-    while (!rc && sw_text_skip_blank_lines(&r)) {
+    while (!rc && sw_text_skip_blank_lines(r)) {
         const char *t;
-        size_t n = sw_text_word(&r, &t);
+        size_t n = sw_text_word(r, &t);
         if (word_is(t, n, "v")) {
-            rc = read_vertex(&r, &s);
+            rc = read_vertex(r, &s);
         } else if (word_is(t, n, "f")) {
-            rc = read_face(&r, &s);
+            rc = read_face(r, &s);
         } else if (!ignored_statement(t, n)) {
-            rc = sw_text_fail(&r, r.tline, SINEW_ERROR_PARSE, "unknown OBJ statement '%.*s'",
+            rc = sw_text_fail(r, r->tline, SINEW_ERROR_PARSE, "unknown OBJ statement '%.*s'",
                               (int)(n < 24 ? n : 24), t);
         }
-        if (!sw_text_next_line(&r)) break;
+        if (!sw_text_next_line(r)) break;
     }
     if (!rc && (s.nv == 0 || s.nt == 0))
-        rc = sw_text_fail(&r, sw_text_eof_line(&r), SINEW_ERROR_PARSE, "no %s in the file",
+        rc = sw_text_fail(r, sw_text_eof_line(r), SINEW_ERROR_PARSE, "no %s in the file",
                           s.nv == 0 ? "vertices" : "faces");
-    sw_text_close(&r);
+    sw_text_close(r);
     if (rc) {
         free(s.X);
         free(s.tris);
@@ -156,6 +153,23 @@ sinew_result sw_read_obj(const char *path, sw_trimesh *out, sw_error *err) {
     out->X = s.X;
     out->tris = s.tris;
     return SINEW_OK;
+}
+
+sinew_result sw_read_obj(const char *path, sw_trimesh *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_obj: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open(&r, path, '#', err);
+    return rc ? rc : read_obj(&r, out);
+}
+
+sinew_result sw_parse_obj(const char *text, size_t len, const char *name_for_errors,
+                          sw_trimesh *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_obj: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open_mem(&r, name_for_errors, text, len, '#', err);
+    return rc ? rc : read_obj(&r, out);
 }
 
 sinew_result sw_write_obj(const char *path, int32_t nverts, const double *X, int32_t ntris,

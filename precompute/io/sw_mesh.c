@@ -91,6 +91,8 @@ sinew_result sw_tetmesh_validate(const sw_tetmesh *m, double min_volume, sw_erro
         }
         double vol = sw_tet_signed_volume(m->X + 3 * q[0], m->X + 3 * q[1], m->X + 3 * q[2],
                                           m->X + 3 * q[3]);
+        if (!isfinite(vol))
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE, "tet %d has volume %g", t, vol);
         if (!(vol > min_volume))
             return sw_error_set(err, SINEW_ERROR_DEGENERATE,
                                 "tet %d has volume %g (must be > %g; inverted or flat)", t, vol,

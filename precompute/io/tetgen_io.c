@@ -118,6 +118,29 @@ static sinew_result read_ele(sw_text_reader *r, int32_t *ntets, int32_t **tets, 
     return SINEW_OK;
 }
 
+/* Parses the opened .node and .ele readers into *out (zeroed by the caller) and closes
+ * both. */
+static sinew_result read_tetgen(sw_text_reader *rn, sw_text_reader *re, sw_tetmesh *out) {
+    sw_tetmesh m = {0, 0, NULL, NULL};
+    int64_t base = 0, *lines = NULL;
+    sinew_result rc = read_node(rn, &base, &m.nverts, &m.X);
+    if (!rc) rc = read_ele(re, &m.ntets, &m.tets, &lines);
+    if (!rc && (m.nverts < 4 || m.ntets < 1))
+        rc = sw_text_fail(re, 1, SINEW_ERROR_DEGENERATE, "empty mesh (%d points, %d tetrahedra)",
+                          m.nverts, m.ntets);
+    if (!rc) rc = sw_text_check_tets(re, "TetGen", base, m.nverts, m.X, m.ntets, m.tets, lines);
+    if (!rc) rc = sw_text_validate_tets(re, &m);
+    free(lines);
+    sw_text_close(rn);
+    sw_text_close(re);
+    if (rc) {
+        sw_tetmesh_free(&m);
+        return rc;
+    }
+    *out = m;
+    return SINEW_OK;
+}
+
 sinew_result sw_read_tetgen(const char *node_path, const char *ele_path, sw_tetmesh *out,
                             sw_error *err) {
     if (out) memset(out, 0, sizeof *out);
@@ -129,24 +152,23 @@ sinew_result sw_read_tetgen(const char *node_path, const char *ele_path, sw_tetm
         sw_text_close(&rn);
         return rc;
     }
-    sw_tetmesh m = {0, 0, NULL, NULL};
-    int64_t base = 0, *lines = NULL;
-    rc = read_node(&rn, &base, &m.nverts, &m.X);
-    if (!rc) rc = read_ele(&re, &m.ntets, &m.tets, &lines);
-    if (!rc && (m.nverts < 4 || m.ntets < 1))
-        rc = sw_text_fail(&re, 1, SINEW_ERROR_DEGENERATE, "empty mesh (%d points, %d tetrahedra)",
-                          m.nverts, m.ntets);
-    if (!rc) rc = sw_text_check_tets(&re, "TetGen", base, m.nverts, m.X, m.ntets, m.tets, lines);
-    if (!rc) rc = sw_text_validate_tets(&re, &m);
-    free(lines);
-    sw_text_close(&rn);
-    sw_text_close(&re);
-    if (rc) {
-        sw_tetmesh_free(&m);
+    return read_tetgen(&rn, &re, out);
+}
+
+sinew_result sw_parse_tetgen(const char *node_text, size_t node_len, const char *node_name,
+                             const char *ele_text, size_t ele_len, const char *ele_name,
+                             sw_tetmesh *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_tetgen: no output");
+    sw_text_reader rn, re;
+    sinew_result rc =
+        sw_text_open_mem(&rn, node_name ? node_name : "<node>", node_text, node_len, '#', err);
+    if (rc) return rc;
+    if ((rc = sw_text_open_mem(&re, ele_name ? ele_name : "<ele>", ele_text, ele_len, '#', err))) {
+        sw_text_close(&rn);
         return rc;
     }
-    *out = m;
-    return SINEW_OK;
+    return read_tetgen(&rn, &re, out);
 }
 
 static int has_suffix(const char *s, const char *suf) {

@@ -63,6 +63,29 @@ sinew_result sw_text_open(sw_text_reader *r, const char *path, char comment, sw_
     return SINEW_OK;
 }
 
+sinew_result sw_text_open_mem(sw_text_reader *r, const char *name, const void *data, size_t len,
+                              char comment, sw_error *err) {
+    memset(r, 0, sizeof *r);
+    r->path = name ? name : "<text>";
+    r->err = err;
+    r->comment = comment;
+    r->line = r->tline = 1;
+    if (!data && len)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: no text given", r->path);
+    if (len > SW_TEXT_MAX_BYTES)
+        return sw_error_set(err, SINEW_ERROR_IO, "%s: text larger than %zu bytes", r->path,
+                            SW_TEXT_MAX_BYTES);
+    char *buf = malloc(len + 1);
+    if (!buf)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory reading text",
+                            r->path);
+    if (len) memcpy(buf, data, len);
+    buf[len] = '\0';
+    r->buf = buf;
+    r->len = len;
+    return SINEW_OK;
+}
+
 void sw_text_close(sw_text_reader *r) {
     if (!r) return;
     free(r->buf);
@@ -320,6 +343,10 @@ sinew_result sw_text_check_tets(const sw_text_reader *r, const char *format, int
                                         (long long)(q[k] + base));
         double vol = sw_tet_signed_volume(X + 3 * (size_t)q[0], X + 3 * (size_t)q[1],
                                           X + 3 * (size_t)q[2], X + 3 * (size_t)q[3]);
+        if (!isfinite(vol)) /* finite coordinates whose products overflow */
+            return sw_text_fail(r, lines[t], SINEW_ERROR_NOT_FINITE,
+                                "tet %d has a volume that overflows (coordinates too large)",
+                                t + (int32_t)base);
         if (vol == 0.0)
             return sw_text_fail(r, lines[t], SINEW_ERROR_DEGENERATE, "tet %d has zero volume",
                                 t + (int32_t)base);

@@ -1,8 +1,9 @@
-/* Private helper of the asset readers (Medit, TetGen, OBJ, TGF, DMAT): the whole file in
- * memory, a cursor that knows its line, whitespace tokens with strict number parsing,
- * and errors formatted "path:line: what is wrong". Holding the whole file lets every
- * reader bound a declared count by the bytes that remain (an absurd count is rejected
- * before anything is allocated) and lets the DMAT reader find its binary tail. */
+/* Private helper of the asset readers (Medit, TetGen, OBJ, TGF, DMAT): the whole file (or
+ * a caller's buffer: the sw_parse_* entries of mesh_io.h) in memory, a cursor that knows
+ * its line, whitespace tokens with strict number parsing, and errors formatted
+ * "path:line: what is wrong". Holding the whole file lets every reader bound a declared
+ * count by the bytes that remain (an absurd count is rejected before anything is
+ * allocated) and lets the DMAT reader find its binary tail. */
 #ifndef SW_TEXT_READER_H
 #define SW_TEXT_READER_H
 
@@ -24,6 +25,10 @@ typedef struct sw_text_reader {
 
 /* Reads `path` whole. Missing or unreadable file: SINEW_ERROR_IO. */
 sinew_result sw_text_open(sw_text_reader *r, const char *path, char comment, sw_error *err);
+/* The same reader over `len` bytes in memory (copied, so `data` needs no NUL and may be
+ * freed at once); `name` stands for the path in messages (NULL: "<text>"). */
+sinew_result sw_text_open_mem(sw_text_reader *r, const char *name, const void *data, size_t len,
+                              char comment, sw_error *err);
 void sw_text_close(sw_text_reader *r);
 
 /* Next token on the current line (comments skipped); returns its length, 0 at the end of

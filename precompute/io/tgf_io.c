@@ -133,16 +133,12 @@ static sinew_result parse(sw_text_reader *r, tgf_state *s) {
     return derive_parents(r, s);
 }
 
-sinew_result sw_read_tgf(const char *path, sw_skeleton *out, sw_error *err) {
-    if (out) memset(out, 0, sizeof *out);
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_tgf: no output");
-    sw_text_reader r;
-    sinew_result rc = sw_text_open(&r, path, 0, err);
-    if (rc) return rc;
+/* Parses the opened reader `r` into *out (zeroed by the caller) and closes it. */
+static sinew_result read_tgf(sw_text_reader *r, sw_skeleton *out) {
     tgf_state s;
     memset(&s, 0, sizeof s);
-    rc = parse(&r, &s);
-    sw_text_close(&r);
+    sinew_result rc = parse(r, &s);
+    sw_text_close(r);
     free(s.bone_line);
     if (rc) {
         free(s.joints);
@@ -156,4 +152,21 @@ sinew_result sw_read_tgf(const char *path, sw_skeleton *out, sw_error *err) {
     out->bones = s.bones;
     out->parent = s.parent;
     return SINEW_OK;
+}
+
+sinew_result sw_read_tgf(const char *path, sw_skeleton *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_tgf: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open(&r, path, 0, err);
+    return rc ? rc : read_tgf(&r, out);
+}
+
+sinew_result sw_parse_tgf(const char *text, size_t len, const char *name_for_errors,
+                          sw_skeleton *out, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_tgf: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open_mem(&r, name_for_errors, text, len, 0, err);
+    return rc ? rc : read_tgf(&r, out);
 }
