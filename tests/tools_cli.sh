@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # The tools never mislead (issue 15): every error exits non-zero with a message that
 # names what is wrong; flags that do not apply to the input, values out of range and
-# files of the wrong format are rejected; the bake and the bench report the same
-# training and held-out error for the same blob. Small meshes only (about 1-2K tets).
+# files of the wrong format are rejected; the bake and the bench --blob --bake-errors
+# report the same training and held-out error for the same blob, and the bench --blob
+# alone reports its clip-frame errors under their own names. Small meshes only (about
+# 1-2K tets).
 #   bash tests/tools_cli.sh BUILD_DIR SOURCE_DIR
 set -uo pipefail
 build=$1
@@ -100,13 +102,16 @@ expect bench_blob_reason 1 "cannot load the blob .*zero\.blob: .*magic" \
     "$bench" "${small[@]}" --frames 4 --blob "$tmp/zero.blob"
 expect bench_blob_missing 1 "cannot load the blob .*none\.blob: .*No such file" \
     "$bench" "${small[@]}" --frames 4 --blob "$tmp/none.blob"
+expect bench_bake_errors_without_blob 2 "--bake-errors applies only with --blob" \
+    "$bench" "${small[@]}" --frames 4 --bake-errors
 
-# one definition of the training and held-out error: the bake and the bench agree
+# one definition of the training and held-out error: the bake and the bench
+# --blob --bake-errors (the bake's poses solved anew) agree
+key() { tail -n 1 "$1" | grep -oE "\"$2\":(\"[a-z_]*\"|[0-9.]+|null)" | cut -d: -f2; }
 if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --json >"$tmp/bake.json" \
     2>"$tmp/bake.err" &&
-    "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --contract-steps 10 \
-        --json >"$tmp/bench.json" 2>"$tmp/bench.err"; then
-    key() { tail -n 1 "$1" | grep -oE "\"$2\":[0-9.]+" | cut -d: -f2; }
+    "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --bake-errors \
+        --contract-steps 10 --json >"$tmp/bench.json" 2>"$tmp/bench.err"; then
     for k in err_train err_heldout; do
         a=$(key "$tmp/bake.json" $k) b=$(key "$tmp/bench.json" $k)
         if [ -z "$a" ] || [ "$a" != "$b" ]; then
@@ -116,9 +121,34 @@ if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --json >"$t
             echo "ok   same_errors $k $a"
         fi
     done
+    [ "$(key "$tmp/bench.json" err_source)" = '"bake_default_poses"' ] ||
+        { echo "FAIL same_errors: err_source is not bake_default_poses" >&2; fails=$((fails + 1)); }
 else
     echo "FAIL same_errors: the bake or the bench failed" >&2
     tail -n 3 "$tmp/bake.err" "$tmp/bench.err" >&2
+    fails=$((fails + 1))
+fi
+
+# the bench --blob alone measures the clip frames it solved (cheap) and says so: err_clip_*
+# with err_source "clip", never err_train/err_heldout (those name the bake's figures)
+if [ -s "$tmp/f.blob" ] &&
+    "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --contract-steps 10 \
+        --json >"$tmp/clip.json" 2>"$tmp/clip.err"; then
+    ok=1
+    for k in err_clip_train err_clip_heldout; do
+        [[ $(key "$tmp/clip.json" $k) =~ ^[0-9.]+$ ]] ||
+            { echo "FAIL clip_errors: no $k in the JSON" >&2; ok=0; }
+    done
+    [ "$(key "$tmp/clip.json" err_source)" = '"clip"' ] ||
+        { echo "FAIL clip_errors: err_source is not clip" >&2; ok=0; }
+    ! tail -n 1 "$tmp/clip.json" | grep -qE '"err_(train|heldout)"' ||
+        { echo "FAIL clip_errors: the JSON names them err_train/err_heldout" >&2; ok=0; }
+    grep -q "correction error on clip frames" "$tmp/clip.err" ||
+        { echo "FAIL clip_errors: the summary does not say clip frames" >&2; ok=0; }
+    if [ "$ok" -eq 1 ]; then echo "ok   clip_errors"; else fails=$((fails + 1)); fi
+else
+    echo "FAIL clip_errors: the bench failed" >&2
+    tail -n 3 "$tmp/clip.err" >&2
     fails=$((fails + 1))
 fi
 

@@ -2,23 +2,34 @@
  * subspace runtime and plain dual-quaternion skinning of the same render surface.
  *
  *   sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
- *               [--blob FILE] [--full-frames K] [--contract-steps S] [--threads T] --json
+ *               [--blob FILE [--bake-errors]] [--full-frames K] [--contract-steps S]
+ *               [--threads T] --json
  *
  * Bakes the character (or loads --blob), then:
  *   full_ms   median full-space quasistatic ms/frame (self-contact on) over the clip (or
  *             its first K frames)
  *   sub_ms    median subspace step + surface read ms/frame over the clip
  *   dqs_ms    median ms/frame of DQS of the render surface (positions and normals)
- *   err_*     correction error |x_sub - x_full|_M / |x_full - x_dqs|_M on the bake's
- *             training poses and held-out poses: sw_bake_errors, the figures sinew-bake
- *             prints for the same blob. With --blob the bake's poses and reference
- *             solutions are made anew with the default bake parameters (sw_bake_solutions;
- *             err_source "bake_default_poses"), so a blob baked with other pose options
- *             (--return-path, --no-self-contact) is measured on the default poses
+ *   correction error |x_sub - x_full|_M / |x_full - x_dqs|_M, always through
+ *             sw_bake_errors (one definition), on one of three pose sets (err_source):
+ *   err_train, err_heldout  without --blob: on the bake's training and held-out poses,
+ *             the figures sinew-bake prints (err_source "bake")
+ *   err_clip_train, err_clip_heldout  with --blob: on the clip frames the reference
+ *             above solved (the first K), split as the bake splits a clip: training = the
+ *             first floor(K (1 - heldout_fraction)) frames, held-out = the rest
+ *             (err_source "clip"; err_clip_train_frames, err_clip_heldout_frames; null
+ *             when a part is empty, e.g. --full-frames 1). Costs
+ *             nothing beyond the timing run, but these are not the bake's figures: the
+ *             bake also trains on joint sweeps and caps the clip frames it trains on
+ *   err_train, err_heldout  with --blob --bake-errors: the bake's poses and reference
+ *             solutions made anew with the default bake parameters (sw_bake_solutions,
+ *             as costly as the bake's simulate stage; err_source "bake_default_poses"), so
+ *             a blob baked with other pose options (--return-path, --no-self-contact) is
+ *             measured on the default poses
  *   allocs_in_step, locks_in_step: calls counted by the interposer over S steps after
  *             warm-up (-1 when this build cannot observe them)
  *   failed_steps  steps that returned an error (a non-finite state) in all of the above
- *   ref_unsettled reference solutions behind err_* whose self-contact set the
+ *   ref_unsettled reference solutions behind the errors whose self-contact set the
  *             simulator's round cap stopped while it still changed (their fold, and the
  *             error measured against it, depend on the cap)
  *   phase_ms  median ms/frame of each phase of the step (the step's own stats: skin,
@@ -72,11 +83,19 @@ static void usage(FILE *f) {
     fprintf(f,
             "usage: sinew-bench (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
             "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-            "                    [--clip FILE [--frames F]]) [--blob FILE] [--full-frames K]\n"
-            "                   [--contract-steps S] [--threads T] [reference options]\n"
-            "                   [--out DIR] [--world FILE.json] [--json]\n"
+            "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
+            "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
+            "                   [reference options] [--out DIR] [--world FILE.json] [--json]\n"
             "character:\n" SW_CHARACTER_USAGE "bench:\n"
-            "  --blob FILE         a blob sinew-bake wrote for this character (default: bake)\n"
+            "  --blob FILE         a blob sinew-bake wrote for this character (default: bake,\n"
+            "                      and report the bake's err_train/err_heldout). The errors are\n"
+            "                      then measured on the clip frames the reference solved, split\n"
+            "                      as the bake splits a clip: err_clip_train, err_clip_heldout\n"
+            "                      (err_source \"clip\"), not the bake's figures\n"
+            "  --bake-errors       with --blob: re-solve the bake's training and held-out poses\n"
+            "                      (default bake parameters; as slow as the bake's simulate\n"
+            "                      stage) and report the bake's err_train/err_heldout\n"
+            "                      (err_source \"bake_default_poses\")\n"
             "  --full-frames K     time the reference over the first K clip frames, 1..100000\n"
             "                      (default: the whole clip)\n"
             "  --contract-steps S  steps counted for allocations and locks, 0..100000000\n"
@@ -179,7 +198,7 @@ int main(int argc, char **argv) {
     sw_character_args ca;
     sw_character_args_init(&ca, tool);
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
-    int json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
+    int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -200,6 +219,8 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 0, 100000000, &contract_steps);
         else if (!strcmp(a, "--threads") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--bake-errors"))
+            bake_errors = 1;
         else if (!strcmp(a, "--json"))
             json = 1;
         else if (!sw_tool_help(a, usage))
@@ -207,6 +228,13 @@ int main(int argc, char **argv) {
         if (!ok) return 2; /* the value's message is out */
     }
     if (!sw_character_args_valid(&ca)) return 2;
+    if (bake_errors && !blob_path) {
+        fprintf(stderr,
+                "%s: --bake-errors applies only with --blob (without --blob the bench bakes and "
+                "reports the bake's own err_train/err_heldout already)\n",
+                tool);
+        return 2;
+    }
     if (world_path && !sw_tool_format(tool, "--world", world_path, "json", ".json (world file)"))
         return 2;
     /* the output folder before the long run: an unwritable one is an error now */
@@ -270,7 +298,8 @@ int main(int argc, char **argv) {
     int kf = full_frames > 0 && full_frames < nf ? full_frames : nf; /* default: the whole clip */
     double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));
     double *full_x = malloc((size_t)(kf > 0 ? kf : 1) * 3 * ch.mesh.nverts * sizeof(double));
-    if (!full || !full_x) {
+    double *mass = malloc((size_t)ch.mesh.nverts * sizeof(double)); /* the reference's */
+    if (!full || !full_x || !mass) {
         fprintf(stderr, "sinew-bench: out of memory\n");
         return 1;
     }
@@ -295,6 +324,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "sinew-bench: full-space frame %d/%d: %.1f ms\n", f + 1, kf, full[f]);
     }
     double full_ms = sw_median(full, kf);
+    memcpy(mass, sw_fullsim_masses(sim), sizeof(double) * ch.mesh.nverts);
     sw_fullsim_destroy(sim);
 
     /* 3. subspace: step + read over the clip */
@@ -341,14 +371,37 @@ int main(int argc, char **argv) {
            *xn = malloc((size_t)ns * 3 * sizeof(double));
     double d_ms = dqs_ms(v, &ch.clip, nf, surf_vert, xs, xn);
 
-    /* 5. errors against the full-space solutions: the bake's definition (sw_bake_errors) on
-       the bake's poses; a given blob gets them solved anew with the default parameters */
+    /* 5. errors against full-space solutions, always by the bake's definition
+       (sw_bake_errors): on the bake's poses when it baked here; a given blob on the clip
+       frames the reference solved above (split as the bake splits a clip), or, with
+       --bake-errors, on the bake's poses solved anew with the default parameters */
     sw_eval_result et, eh;
-    const char *err_source = blob_path ? "bake_default_poses" : "bake";
-    if (blob_path && (r = sw_bake_solutions(&ch, &bp, &res, &err)) != SINEW_OK)
-        return sw_tool_failed(r, &err, "%s: the bake's reference solutions: ", tool);
-    if ((r = sw_bake_errors(blob, &res, &et, &eh, &err)) != SINEW_OK)
-        return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+    int clip_errors = blob_path && !bake_errors;
+    const char *err_source = !blob_path ? "bake" : clip_errors ? "clip" : "bake_default_poses";
+    int ref_unsettled;
+    if (clip_errors) {
+        /* borrows the clip's poses and the solutions above: never sw_bake_result_free'd */
+        sw_bake_result clip;
+        memset(&clip, 0, sizeof clip);
+        int ntr = (int)floor(kf * (1.0 - bp.heldout_fraction));
+        size_t pt = (size_t)12 * ch.skel.nbones, px = (size_t)3 * ch.mesh.nverts;
+        clip.mass = mass;
+        clip.ntrain = ntr;
+        clip.train_T = ch.clip.T;
+        clip.train_x = full_x;
+        clip.nheldout = kf - ntr;
+        clip.heldout_T = ch.clip.T + ntr * pt;
+        clip.heldout_x = full_x + ntr * px;
+        if ((r = sw_bake_errors(blob, &clip, &et, &eh, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        ref_unsettled = full_unsettled;
+    } else {
+        if (blob_path && (r = sw_bake_solutions(&ch, &bp, &res, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "%s: the bake's reference solutions: ", tool);
+        if ((r = sw_bake_errors(blob, &res, &et, &eh, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        ref_unsettled = res.train_unsettled + res.heldout_unsettled;
+    }
 
     /* 6. the real-time contract: allocation and lock calls inside the step */
     long allocs = -1, locks = -1;
@@ -391,14 +444,24 @@ int main(int argc, char **argv) {
                 wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.allocs,
                 wb.locks);
     }
-    fprintf(
-        stderr,
-        "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, "
-        "cost %.1fx DQS;\n"
-        "             correction error (%s) train %.4f held-out %.4f; allocs %ld, locks %ld in %d "
-        "steps\n",
-        full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms, err_source, et.correction_error,
-        eh.correction_error, allocs, locks, contract_steps);
+    /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
+    char e_tr[32] = "null", e_ho[32] = "null";
+    if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
+    if (!clip_errors || eh.frames > 0) snprintf(e_ho, sizeof e_ho, "%.5f", eh.correction_error);
+    fprintf(stderr,
+            "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, "
+            "cost %.1fx DQS;\n",
+            full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms);
+    if (clip_errors)
+        fprintf(stderr,
+                "             correction error on clip frames (not the bake's figures): train "
+                "%s (%d frames) held-out %s (%d frames);\n",
+                et.frames > 0 ? e_tr : "n/a", et.frames, eh.frames > 0 ? e_ho : "n/a", eh.frames);
+    else
+        fprintf(stderr, "             correction error (%s) train %.4f held-out %.4f;\n",
+                err_source, et.correction_error, eh.correction_error);
+    fprintf(stderr, "             allocs %ld, locks %ld in %d steps\n", allocs, locks,
+            contract_steps);
     fprintf(stderr,
             "             step phases (median ms): skin %.4f, contact %.4f, dynamics %.4f, solve "
             "%.4f, output %.4f; %.1f potential evaluations a step\n",
@@ -406,7 +469,7 @@ int main(int argc, char **argv) {
     if (json)
         printf(
             "{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
-            "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
+            "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"%s\":%s,\"%s\":%s,"
             "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
             "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_"
             "seconds\":%.2f,"
@@ -415,11 +478,15 @@ int main(int argc, char **argv) {
             "\"output\":%.4f},\"potential_evals\":%.2f,\"solver\":\"%s\",\"unsettled_frames\":%d,"
             "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f",
             ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
-            sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub, allocs,
+            sub_ms / d_ms, clip_errors ? "err_clip_train" : "err_train", e_tr,
+            clip_errors ? "err_clip_heldout" : "err_heldout", e_ho, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
-            res.train_unsettled + res.heldout_unsettled, phase_ms[0], phase_ms[1], phase_ms[2],
-            phase_ms[3], phase_ms[4], evals, sw_linear_solver_name(full_solver), full_unsettled,
-            full_newton_max, full_mean, full_max);
+            ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
+            sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
+            full_max);
+    if (json && clip_errors)
+        printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
+               et.frames + et.failed, eh.frames + eh.failed);
     if (json && world_path)
         printf(",\"world\":\"%s\",\"world_frames\":%d,\"world_contact_frames\":%d,"
                "\"err_world_sub\":%.5f,\"pen_world_full\":%.6g,\"pen_world_sub\":%.6g,"
@@ -432,6 +499,7 @@ int main(int argc, char **argv) {
     if (json) printf("}\n");
     free(full);
     free(full_x);
+    free(mass);
     free(sub);
     free(pos);
     free(nrm);
