@@ -4,11 +4,14 @@
  *              [--weights FILE.dmat] [--clip FILE]) --out FILE.blob
  *              [--selector greedy|importance|nnhtp] [--tol 0.05] [--max-rank R]
  *              [--compare-cubature] [--no-self-contact] [--return-path] [--threads T] [--data DIR]
- * [--json]
+ *              [--force] [--json]
  *
  * Shows progress per stage on stderr and ends with a summary (per-stage time, ranks,
  * cubature sizes, training and held-out errors); with --json the last stdout line is
- * one JSON object. The blob is written atomically (temporary file + rename). */
+ * one JSON object. The blob is measured (sw_bake_errors, the definition sinew-bench
+ * reports too) before it is written; a training error of SW_BAKE_MAX_TRAIN_ERROR or more
+ * is an error and writes nothing, unless --force. The blob is written atomically
+ * (temporary file + rename). Exit status: 0 written, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -29,20 +32,33 @@
 static void usage(FILE *f) {
     fprintf(
         f,
-        "usage: sinew-bake (--scene NAME [--tets N] [--frames F] |\n"
-        "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat] [--clip FILE])\n"
+        "usage: sinew-bake (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+        "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+        "                   [--clip FILE [--frames F]])\n"
         "                  --out FILE.blob [--selector greedy|importance|nnhtp] [--tol T]\n"
-        "                  [--max-rank R] [--spring-k K] [--compare-cubature] [--no-self-contact]\n"
-        "                  [--return-path]\n"
-        "                  [--threads T] [--data DIR] [--json]\n"
-        "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n");
+        "                  [--max-rank R] [--spring-k K] [--compare-cubature]\n"
+        "                  [--no-self-contact] [--return-path] [--threads T] [--force] [--json]\n"
+        "character:\n" SW_CHARACTER_USAGE "bake:\n"
+        "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
+        "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
+        "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
+        "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
+        "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
+        "  --threads T      0..256 (default 0: all cores)\n"
+        "  --force          write the blob even when its training error is %.2f or more\n"
+        "                   (the share of the physics correction it misses on its own\n"
+        "                   training poses; without --force that is an error)\n"
+        "  --json           one JSON object with the figures as the last stdout line\n"
+        "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
+        SW_BAKE_MAX_TRAIN_ERROR);
 }
 
 int main(int argc, char **argv) {
+    static const char *tool = "sinew-bake";
     sw_character_args ca;
-    sw_character_args_init(&ca);
+    sw_character_args_init(&ca, tool);
     const char *out_path = NULL;
-    int json = 0;
+    int json = 0, force = 0;
     sw_bake_params p = sw_bake_params_default();
     p.progress = 1;
     for (int i = 1; i < argc; ++i) {
@@ -53,14 +69,12 @@ int main(int argc, char **argv) {
         } else if (!strcmp(a, "--out") && next)
             out_path = argv[++i];
         else if (!strcmp(a, "--threads") && next)
-            ok = sw_parse_int(argv[++i], 0, 256, &p.threads);
+            ok = sw_tool_int(tool, a, argv[++i], 0, 256, &p.threads);
         else if (!strcmp(a, "--max-rank") && next)
-            ok = sw_parse_int(argv[++i], 1, 1024, &p.max_rank);
-        else if (!strcmp(a, "--tol") && next) {
-            char *end;
-            p.cubature_tol = strtod(argv[++i], &end);
-            ok = !*end && p.cubature_tol > 0 && p.cubature_tol < 1;
-        } else if (!strcmp(a, "--selector") && next) {
+            ok = sw_tool_int(tool, a, argv[++i], 1, 1024, &p.max_rank);
+        else if (!strcmp(a, "--tol") && next)
+            ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in the open range 0..1", &p.cubature_tol);
+        else if (!strcmp(a, "--selector") && next) {
             const char *s = argv[++i];
             if (!strcmp(s, "greedy"))
                 p.selector = SW_CUBATURE_GREEDY;
@@ -68,75 +82,86 @@ int main(int argc, char **argv) {
                 p.selector = SW_CUBATURE_IMPORTANCE;
             else if (!strcmp(s, "nnhtp"))
                 p.selector = SW_CUBATURE_NNHTP;
-            else
+            else {
+                fprintf(stderr, "%s: --selector wants greedy | importance | nnhtp, got '%s'\n",
+                        tool, s);
                 ok = 0;
-        } else if (!strcmp(a, "--spring-k") && next) {
-            char *end;
-            p.spring_k = strtod(argv[++i], &end);
-            ok = !*end && p.spring_k > 0 && isfinite(p.spring_k);
-        } else if (!strcmp(a, "--compare-cubature"))
+            }
+        } else if (!strcmp(a, "--spring-k") && next)
+            ok = sw_tool_real(tool, a, argv[++i], 0, INFINITY, "above 0", &p.spring_k);
+        else if (!strcmp(a, "--compare-cubature"))
             p.compare_selectors = 1;
         else if (!strcmp(a, "--no-self-contact"))
             p.self_contact = 0;
         else if (!strcmp(a, "--return-path"))
             p.return_path = 1;
+        else if (!strcmp(a, "--force"))
+            force = 1;
         else if (!strcmp(a, "--json"))
             json = 1;
         else if (!sw_tool_help(a, usage))
-            ok = 0;
-        if (!ok) return sw_tool_bad_arg("sinew-bake", a, usage);
+            return sw_tool_bad_arg(tool, a, usage);
+        if (!ok) return 2; /* the value's message is out */
     }
-    if (!out_path || !sw_character_args_valid(&ca)) {
-        fprintf(stderr, "sinew-bake: give --out and either --scene or --mesh with --skeleton\n");
+    if (!out_path) {
+        fprintf(stderr, "%s: give --out FILE.blob\n", tool);
         usage(stderr);
         return 2;
     }
+    if (!sw_character_args_valid(&ca)) return 2;
     sw_error err;
     sw_character ch;
     double t0 = sw_now_seconds();
     sinew_result r = sw_character_args_make(&ca, &ch, &err);
-    if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bake: ");
-    fprintf(stderr, "sinew-bake: %s: %d tets, %d vertices, %d bones, %d clip frames\n",
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
+    fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
             ch.name[0] ? ch.name : (ca.scene ? ca.scene : ca.mesh), ch.mesh.ntets, ch.mesh.nverts,
             ch.skel.nbones, ch.clip.nframes);
     sw_bake_result res;
     r = sw_bake(&ch, &p, &res, &err);
     if (r != SINEW_OK) {
-        fprintf(stderr, "sinew-bake: %s (%s)\n", err.msg, sinew_result_string(r));
         sw_character_free(&ch);
-        return 1;
+        return sw_tool_failed(r, &err, "%s: ", tool);
     }
-    if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
-        fprintf(stderr, "sinew-bake: cannot write %s: %s (%s)\n", out_path, err.msg,
-                sinew_result_string(r));
-        sw_bake_result_free(&res);
-        sw_character_free(&ch);
-        return 1;
-    }
-    double bake_seconds = sw_now_seconds() - t0;
-    /* evaluate the written blob against the full-space solutions */
-    sinew_blob_def bd = sinew_blob_def_default();
-    bd.path = out_path;
+    /* measure the blob's bytes before they go to the file */
+    void *mem = NULL;
+    size_t size = 0;
     sinew_blob *blob = NULL;
     sw_eval_result et, eh;
     memset(&et, 0, sizeof et);
     memset(&eh, 0, sizeof eh);
-    double t1 = sw_now_seconds();
-    if ((r = sinew_blob_load(&bd, &blob)) != SINEW_OK ||
-        (r = sw_eval_correction(blob, res.mass, res.train_T, res.train_x, res.ntrain, 20, &et,
-                                &err)) != SINEW_OK ||
-        (r = sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh,
-                                &err)) != SINEW_OK) {
-        fprintf(stderr, "sinew-bake: cannot evaluate the blob: %s (%s)\n", err.msg,
-                sinew_result_string(r));
-        sinew_blob_destroy(blob);
-        sw_bake_result_free(&res);
-        sw_character_free(&ch);
-        return 1;
+    double bake_seconds = sw_now_seconds() - t0, t1 = sw_now_seconds();
+    sinew_blob_def bd = sinew_blob_def_default();
+    int status = 1;
+    if ((r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
+        sw_tool_failed(r, &err, "%s: cannot serialise the blob: ", tool);
+        goto done;
+    }
+    bd.data = mem;
+    bd.data_size = size;
+    if (sw_tool_blob_load(tool, "just baked", bd, &blob) != SINEW_OK) goto done;
+    if ((r = sw_bake_errors(blob, &res, &et, &eh, &err)) != SINEW_OK) {
+        sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        goto done;
     }
     double eval_seconds = sw_now_seconds() - t1;
+    int absurd = !(et.correction_error < SW_BAKE_MAX_TRAIN_ERROR);
+    if (absurd && !force) {
+        fprintf(stderr,
+                "%s: error: the bake's training error is %.4f (at least %.2f: the subspace misses "
+                "that share of the physics correction on its own training poses; a sound bake "
+                "misses a few percent); %s not written. Give a clip with more frames or joint "
+                "motion or a higher --max-rank, or --force to write it anyway\n",
+                tool, et.correction_error, SW_BAKE_MAX_TRAIN_ERROR, out_path);
+        goto done;
+    }
+    if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
+        sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
+        goto done;
+    }
+    status = 0;
     const sw_blob_view *v = &res.view;
-    fprintf(stderr, "sinew-bake: wrote %s\n", out_path);
+    fprintf(stderr, "%s: wrote %s\n", tool, out_path);
     fprintf(stderr,
             "  stages (s): prepare %.2f, domains %.2f, simulate %.2f, basis %.2f, cubature %.2f, "
             "reduce %.2f; total %.2f\n",
@@ -159,9 +184,14 @@ int main(int argc, char **argv) {
             "%d held-out solutions (their fold depends on the cap)\n",
             res.train_unsettled, res.heldout_unsettled);
     fprintf(stderr,
-            "  correction error (subspace vs full, share of the correction missed): train %.4f, "
-            "held-out %.4f (%d failed steps)\n",
+            "  correction error (subspace vs full, share of the correction missed, on the bake's "
+            "poses): train %.4f, held-out %.4f (%d failed steps)\n",
             et.correction_error, eh.correction_error, et.failed + eh.failed);
+    if (absurd)
+        fprintf(stderr,
+                "%s: WARNING: written with --force although its training error %.4f is at least "
+                "%.2f: this blob misses most of the physics correction\n",
+                tool, et.correction_error, SW_BAKE_MAX_TRAIN_ERROR);
     if (p.compare_selectors) {
         static const char *names[3] = {"greedy", "importance", "nnhtp"};
         for (int s = 0; s < 3; ++s)
@@ -188,10 +218,12 @@ int main(int argc, char **argv) {
                    res.selector_points[0], res.selector_seconds[0], res.selector_error[0],
                    res.selector_points[1], res.selector_seconds[1], res.selector_error[1],
                    res.selector_points[2], res.selector_seconds[2], res.selector_error[2]);
-        printf("}\n");
+        printf(",\"forced\":%s}\n", absurd ? "true" : "false");
     }
+done:
     sinew_blob_destroy(blob);
+    free(mem);
     sw_bake_result_free(&res);
     sw_character_free(&ch);
-    return 0;
+    return status;
 }

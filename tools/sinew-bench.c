@@ -2,20 +2,34 @@
  * subspace runtime and plain dual-quaternion skinning of the same render surface.
  *
  *   sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
- *               [--blob FILE] [--full-frames K] [--contract-steps S] [--threads T] --json
+ *               [--blob FILE [--bake-errors]] [--full-frames K] [--contract-steps S]
+ *               [--threads T] --json
  *
- * Bakes the character (or loads --blob, then the errors are measured against fresh
- * full-space solutions of the clip's held-out frames), then:
+ * Bakes the character (or loads --blob), then:
  *   full_ms   median full-space quasistatic ms/frame (self-contact on) over the clip (or
  *             its first K frames)
  *   sub_ms    median subspace step + surface read ms/frame over the clip
  *   dqs_ms    median ms/frame of DQS of the render surface (positions and normals)
- *   err_*     correction error |x_sub - x_full|_M / |x_full - x_dqs|_M on the bake's
- *             training poses and held-out poses
+ *   correction error |x_sub - x_full|_M / |x_full - x_dqs|_M, always through
+ *             sw_bake_errors (one definition), on one of three pose sets (err_source):
+ *   err_train, err_heldout  without --blob: on the bake's training and held-out poses,
+ *             the figures sinew-bake prints (err_source "bake")
+ *   err_clip_train, err_clip_heldout  with --blob: on the clip frames the reference
+ *             above solved (the first K), split as the bake splits a clip: training = the
+ *             first floor(K (1 - heldout_fraction)) frames, held-out = the rest
+ *             (err_source "clip"; err_clip_train_frames, err_clip_heldout_frames; null
+ *             when a part is empty, e.g. --full-frames 1). Costs
+ *             nothing beyond the timing run, but these are not the bake's figures: the
+ *             bake also trains on joint sweeps and caps the clip frames it trains on
+ *   err_train, err_heldout  with --blob --bake-errors: the bake's poses and reference
+ *             solutions made anew with the default bake parameters (sw_bake_solutions,
+ *             as costly as the bake's simulate stage; err_source "bake_default_poses"), so
+ *             a blob baked with other pose options (--return-path, --no-self-contact) is
+ *             measured on the default poses
  *   allocs_in_step, locks_in_step: calls counted by the interposer over S steps after
  *             warm-up (-1 when this build cannot observe them)
  *   failed_steps  steps that returned an error (a non-finite state) in all of the above
- *   ref_unsettled reference solutions behind err_* whose self-contact set the
+ *   ref_unsettled reference solutions behind the errors whose self-contact set the
  *             simulator's round cap stopped while it still changed (their fold, and the
  *             error measured against it, depend on the cap)
  *   phase_ms  median ms/frame of each phase of the step (the step's own stats: skin,
@@ -31,7 +45,7 @@
  *                         mean collider queries a step; world_contacts, the mean copies
  *                         in contact
  *   world_allocs_in_step, world_locks_in_step  the contract counts with world contact
- * The last stdout line is one JSON object. */
+ * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -39,6 +53,7 @@
 #include <string.h>
 #include <sys/stat.h>
 #include <time.h>
+#include <unistd.h>
 
 #define SW_TOOL_CHARACTER_ARGS
 #define SW_TOOL_REFERENCE_ARGS
@@ -65,18 +80,54 @@
 enum { NPHASES = 5 };
 
 static void usage(FILE *f) {
-    fprintf(
-        f,
-        "usage: sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton "
-        "FILE.tgf\n"
-        "                   [--weights FILE.dmat] [--clip FILE]) [--blob FILE] [--full-frames K]\n"
-        "                   [--contract-steps S] [--threads T] [reference options] [--data DIR]\n"
-        "                   [--out DIR] [--world FILE.json] --json\n"
-        "  --out DIR  write the subspace surface of every clip frame as DIR/frame_NNNN.obj\n"
-        "  --world F  also run reference and runtime against world file F (JSON schema 1,\n"
-        "             samples/worlds/README.md) and report the world figures\n"
-        "reference options (the full-space run the bench times; a bake it runs uses the\n"
-        "defaults):\n" SW_REFERENCE_USAGE);
+    fprintf(f,
+            "usage: sinew-bench (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+            "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+            "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
+            "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
+            "                   [reference options] [--out DIR] [--world FILE.json] [--json]\n"
+            "character:\n" SW_CHARACTER_USAGE "bench:\n"
+            "  --blob FILE         a blob sinew-bake wrote for this character (default: bake,\n"
+            "                      and report the bake's err_train/err_heldout). The errors are\n"
+            "                      then measured on the clip frames the reference solved, split\n"
+            "                      as the bake splits a clip: err_clip_train, err_clip_heldout\n"
+            "                      (err_source \"clip\"), not the bake's figures\n"
+            "  --bake-errors       with --blob: re-solve the bake's training and held-out poses\n"
+            "                      (default bake parameters; as slow as the bake's simulate\n"
+            "                      stage) and report the bake's err_train/err_heldout\n"
+            "                      (err_source \"bake_default_poses\")\n"
+            "  --full-frames K     time the reference over the first K clip frames, 1..100000\n"
+            "                      (default: the whole clip)\n"
+            "  --contract-steps S  steps counted for allocations and locks, 0..100000000\n"
+            "                      (default 10000)\n"
+            "  --threads T         0..256 (default 0: all cores)\n"
+            "  --out DIR           write the subspace surface of every clip frame as\n"
+            "                      DIR/frame_NNNN.obj\n"
+            "  --world F           also run reference and runtime against world file F (.json,\n"
+            "                      schema 1, samples/worlds/README.md) and report its figures\n"
+            "  --json              one JSON object with the figures as the last stdout line\n"
+            "reference options (the full-space run the bench times; a bake it runs uses the\n"
+            "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
+}
+
+/* mkdir -p: creates dir and its missing parents; 1 when dir is a writable folder
+ * afterwards. */
+static int make_dirs(const char *dir) {
+    char path[4096];
+    size_t n = strlen(dir);
+    if (n == 0 || n >= sizeof path) return 0;
+    memcpy(path, dir, n + 1);
+    for (size_t i = 1; i <= n; ++i)
+        if (path[i] == '/' || path[i] == '\0') {
+            char c = path[i];
+            path[i] = '\0';
+            if (mkdir(path, 0777) != 0 && errno != EEXIST) return 0;
+            path[i] = c;
+        }
+    struct stat st;
+    if (stat(dir, &st) != 0) return 0;
+    if (!S_ISDIR(st.st_mode)) return (errno = ENOTDIR), 0;
+    return access(dir, W_OK | X_OK) == 0;
 }
 
 /* Plain DQS of the render surface (positions and area-weighted normals): the cost a
@@ -121,7 +172,6 @@ static sinew_result write_frames(const char *dir, const sinew_blob *blob, sinew_
     if ((r = sinew_blob_surface_triangles(blob, tu, 3 * nt)) != SINEW_OK) goto done;
     for (uint32_t i = 0; i < 3 * nt; ++i)
         ti[i] = (int32_t)tu[i];
-    mkdir(dir, 0777);
     sinew_instance_reset(inst);
     for (int f = 0; f < ch->clip.nframes; ++f) {
         char path[4096];
@@ -144,10 +194,11 @@ done:
 }
 
 int main(int argc, char **argv) {
+    static const char *tool = "sinew-bench";
     sw_character_args ca;
-    sw_character_args_init(&ca);
+    sw_character_args_init(&ca, tool);
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
-    int json = 0, full_frames = 0, contract_steps = 10000, threads = 0;
+    int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -163,25 +214,39 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--world") && next)
             world_path = argv[++i];
         else if (!strcmp(a, "--full-frames") && next)
-            ok = sw_parse_int(argv[++i], 1, 100000, &full_frames);
+            ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &full_frames);
         else if (!strcmp(a, "--contract-steps") && next)
-            ok = sw_parse_int(argv[++i], 0, 100000000, &contract_steps);
+            ok = sw_tool_int(tool, a, argv[++i], 0, 100000000, &contract_steps);
         else if (!strcmp(a, "--threads") && next)
-            ok = sw_parse_int(argv[++i], 0, 256, &threads);
+            ok = sw_tool_int(tool, a, argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--bake-errors"))
+            bake_errors = 1;
         else if (!strcmp(a, "--json"))
             json = 1;
         else if (!sw_tool_help(a, usage))
-            ok = 0;
-        if (!ok) return sw_tool_bad_arg("sinew-bench", a, usage);
+            return sw_tool_bad_arg(tool, a, usage);
+        if (!ok) return 2; /* the value's message is out */
     }
-    if (!sw_character_args_valid(&ca)) {
-        usage(stderr);
+    if (!sw_character_args_valid(&ca)) return 2;
+    if (bake_errors && !blob_path) {
+        fprintf(stderr,
+                "%s: --bake-errors applies only with --blob (without --blob the bench bakes and "
+                "reports the bake's own err_train/err_heldout already)\n",
+                tool);
         return 2;
+    }
+    if (world_path && !sw_tool_format(tool, "--world", world_path, "json", ".json (world file)"))
+        return 2;
+    /* the output folder before the long run: an unwritable one is an error now */
+    if (out_dir && !make_dirs(out_dir)) {
+        fprintf(stderr, "%s: --out '%s': cannot create or write the folder: %s\n", tool, out_dir,
+                strerror(errno ? errno : EACCES));
+        return 1;
     }
     sw_error err;
     sw_character ch;
     sinew_result r = sw_character_args_make(&ca, &ch, &err);
-    if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bench: ");
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
     int nf = ch.clip.nframes;
 
     /* 1. bake (or load) */
@@ -206,10 +271,8 @@ int main(int argc, char **argv) {
         bd.data = mem;
         bd.data_size = size;
     }
-    if ((r = sinew_blob_load(&bd, &blob)) != SINEW_OK) {
-        fprintf(stderr, "sinew-bench: cannot load the blob: %s\n", sinew_result_string(r));
+    if (sw_tool_blob_load(tool, blob_path ? blob_path : "just baked", bd, &blob) != SINEW_OK)
         return 1;
-    }
     const sw_blob_view *v = sw_blob_get_view(blob);
     if (v->nverts != ch.mesh.nverts || v->nbones != ch.skel.nbones) {
         fprintf(stderr,
@@ -235,14 +298,13 @@ int main(int argc, char **argv) {
     int kf = full_frames > 0 && full_frames < nf ? full_frames : nf; /* default: the whole clip */
     double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));
     double *full_x = malloc((size_t)(kf > 0 ? kf : 1) * 3 * ch.mesh.nverts * sizeof(double));
-    if (!full || !full_x) {
+    double *mass = malloc((size_t)ch.mesh.nverts * sizeof(double)); /* the reference's */
+    if (!full || !full_x || !mass) {
         fprintf(stderr, "sinew-bench: out of memory\n");
         return 1;
     }
-    if ((r = sw_fullsim_create(&ch, &fp, &sim, &err)) != SINEW_OK) {
-        fprintf(stderr, "sinew-bench: %s\n", err.msg);
-        return 1;
-    }
+    if ((r = sw_fullsim_create(&ch, &fp, &sim, &err)) != SINEW_OK)
+        return sw_tool_failed(r, &err, "%s: ", tool);
     /* the full reference steps every clip frame up to the last timed one, from rest */
     int full_unsettled = 0; /* frames whose contact set did not settle */
     int full_newton_max = 0;
@@ -262,6 +324,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "sinew-bench: full-space frame %d/%d: %.1f ms\n", f + 1, kf, full[f]);
     }
     double full_ms = sw_median(full, kf);
+    memcpy(mass, sw_fullsim_masses(sim), sizeof(double) * ch.mesh.nverts);
     sw_fullsim_destroy(sim);
 
     /* 3. subspace: step + read over the clip */
@@ -295,8 +358,8 @@ int main(int argc, char **argv) {
     for (int k = 0; k < NPHASES; ++k)
         phase_ms[k] = sw_median(phase + (size_t)k * nf, nf);
     free(phase);
-    if (out_dir && write_frames(out_dir, blob, inst, &ch, &err) != SINEW_OK)
-        fprintf(stderr, "sinew-bench: %s\n", err.msg);
+    if (out_dir && (r = write_frames(out_dir, blob, inst, &ch, &err)) != SINEW_OK)
+        return sw_tool_failed(r, &err, "%s: --out %s: ", tool, out_dir);
 
     /* 4. plain DQS of the same surface */
     int32_t *surf_vert = malloc((size_t)ns * sizeof(int32_t));
@@ -308,30 +371,36 @@ int main(int argc, char **argv) {
            *xn = malloc((size_t)ns * 3 * sizeof(double));
     double d_ms = dqs_ms(v, &ch.clip, nf, surf_vert, xs, xn);
 
-    /* 5. errors against the full-space solutions */
+    /* 5. errors against full-space solutions, always by the bake's definition
+       (sw_bake_errors): on the bake's poses when it baked here; a given blob on the clip
+       frames the reference solved above (split as the bake splits a clip), or, with
+       --bake-errors, on the bake's poses solved anew with the default parameters */
     sw_eval_result et, eh;
-    memset(&et, 0, sizeof et);
-    memset(&eh, 0, sizeof eh);
-    const char *err_source;
-    if (!blob_path) { /* the bake's own training poses (clip frames and sweeps) and held-out */
-        err_source = "bake";
-        sw_eval_correction(blob, res.mass, res.train_T, res.train_x, res.ntrain, 20, &et, &err);
-        sw_eval_correction(blob, res.mass, res.heldout_T, res.heldout_x, res.nheldout, 20, &eh,
-                           &err);
-    } else { /* a given blob: the clip's frames solved above, split as the bake splits them */
-        err_source = "clip";
-        double *mass = calloc((size_t)ch.mesh.nverts, sizeof(double));
-        sw_fullsim *ms = NULL;
-        if (mass && sw_fullsim_create(&ch, &fp, &ms, &err) == SINEW_OK) {
-            memcpy(mass, sw_fullsim_masses(ms), sizeof(double) * ch.mesh.nverts);
-            sw_fullsim_destroy(ms);
-        }
+    int clip_errors = blob_path && !bake_errors;
+    const char *err_source = !blob_path ? "bake" : clip_errors ? "clip" : "bake_default_poses";
+    int ref_unsettled;
+    if (clip_errors) {
+        /* borrows the clip's poses and the solutions above: never sw_bake_result_free'd */
+        sw_bake_result clip;
+        memset(&clip, 0, sizeof clip);
         int ntr = (int)floor(kf * (1.0 - bp.heldout_fraction));
         size_t pt = (size_t)12 * ch.skel.nbones, px = (size_t)3 * ch.mesh.nverts;
-        sw_eval_correction(blob, mass, ch.clip.T, full_x, ntr, 20, &et, &err);
-        sw_eval_correction(blob, mass, ch.clip.T + ntr * pt, full_x + ntr * px, kf - ntr, 20, &eh,
-                           &err);
-        free(mass);
+        clip.mass = mass;
+        clip.ntrain = ntr;
+        clip.train_T = ch.clip.T;
+        clip.train_x = full_x;
+        clip.nheldout = kf - ntr;
+        clip.heldout_T = ch.clip.T + ntr * pt;
+        clip.heldout_x = full_x + ntr * px;
+        if ((r = sw_bake_errors(blob, &clip, &et, &eh, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        ref_unsettled = full_unsettled;
+    } else {
+        if (blob_path && (r = sw_bake_solutions(&ch, &bp, &res, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "%s: the bake's reference solutions: ", tool);
+        if ((r = sw_bake_errors(blob, &res, &et, &eh, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        ref_unsettled = res.train_unsettled + res.heldout_unsettled;
     }
 
     /* 6. the real-time contract: allocation and lock calls inside the step */
@@ -375,13 +444,24 @@ int main(int argc, char **argv) {
                 wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.allocs,
                 wb.locks);
     }
+    /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
+    char e_tr[32] = "null", e_ho[32] = "null";
+    if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
+    if (!clip_errors || eh.frames > 0) snprintf(e_ho, sizeof e_ho, "%.5f", eh.correction_error);
     fprintf(stderr,
             "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, "
-            "cost %.1fx DQS;\n"
-            "             correction error train %.4f held-out %.4f; allocs %ld, locks %ld in %d "
-            "steps\n",
-            full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms, et.correction_error,
-            eh.correction_error, allocs, locks, contract_steps);
+            "cost %.1fx DQS;\n",
+            full_ms, sub_ms, d_ms, full_ms / sub_ms, sub_ms / d_ms);
+    if (clip_errors)
+        fprintf(stderr,
+                "             correction error on clip frames (not the bake's figures): train "
+                "%s (%d frames) held-out %s (%d frames);\n",
+                et.frames > 0 ? e_tr : "n/a", et.frames, eh.frames > 0 ? e_ho : "n/a", eh.frames);
+    else
+        fprintf(stderr, "             correction error (%s) train %.4f held-out %.4f;\n",
+                err_source, et.correction_error, eh.correction_error);
+    fprintf(stderr, "             allocs %ld, locks %ld in %d steps\n", allocs, locks,
+            contract_steps);
     fprintf(stderr,
             "             step phases (median ms): skin %.4f, contact %.4f, dynamics %.4f, solve "
             "%.4f, output %.4f; %.1f potential evaluations a step\n",
@@ -389,7 +469,7 @@ int main(int argc, char **argv) {
     if (json)
         printf(
             "{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
-            "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"err_train\":%.5f,\"err_heldout\":%.5f,"
+            "\"speedup_vs_full\":%.2f,\"cost_vs_dqs\":%.2f,\"%s\":%s,\"%s\":%s,"
             "\"rank\":%d,\"cubature_tets\":%d,\"allocs_in_step\":%ld,\"locks_in_step\":%ld,"
             "\"contract_steps\":%d,\"full_ms\":%.3f,\"sub_ms\":%.4f,\"dqs_ms\":%.4f,\"bake_"
             "seconds\":%.2f,"
@@ -398,12 +478,15 @@ int main(int argc, char **argv) {
             "\"output\":%.4f},\"potential_evals\":%.2f,\"solver\":\"%s\",\"unsettled_frames\":%d,"
             "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f",
             ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
-            sub_ms / d_ms, et.correction_error, eh.correction_error, v->rank_total, v->ncub, allocs,
+            sub_ms / d_ms, clip_errors ? "err_clip_train" : "err_train", e_tr,
+            clip_errors ? "err_clip_heldout" : "err_heldout", e_ho, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
-            blob_path ? full_unsettled : res.train_unsettled + res.heldout_unsettled, phase_ms[0],
-            phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
+            ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
             sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
             full_max);
+    if (json && clip_errors)
+        printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
+               et.frames + et.failed, eh.frames + eh.failed);
     if (json && world_path)
         printf(",\"world\":\"%s\",\"world_frames\":%d,\"world_contact_frames\":%d,"
                "\"err_world_sub\":%.5f,\"pen_world_full\":%.6g,\"pen_world_sub\":%.6g,"
@@ -416,6 +499,7 @@ int main(int argc, char **argv) {
     if (json) printf("}\n");
     free(full);
     free(full_x);
+    free(mass);
     free(sub);
     free(pos);
     free(nrm);

@@ -33,20 +33,31 @@ typedef struct {
 } options;
 
 static void usage(FILE *f) {
-    fprintf(f, "usage: sinew-fullsim --scene NAME [--tets N] [--frames F] [--dynamic] [--newmark]\n"
-               "                     [--no-self-contact] [--ground HEIGHT] [--world FILE.json]\n"
-               "                     [--threads T]\n"
-               "                     [reference options] [--data DIR] [--out DIR] [--json]\n"
-               "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n"
-               "  --tets N      procedural resolution (default 20000)\n"
-               "  --frames F    frames to simulate (default: procedural 30, assets their clip)\n"
-               "  --dynamic     backward Euler dynamics (default quasistatic); --newmark: "
-               "Newmark\n"
-               "  --world FILE  collide with a world file's colliders (JSON, schema 1; see\n"
-               "                samples/worlds/README.md); --frames defaults to its "
-               "length\n" SW_REFERENCE_USAGE
-               "  --out DIR     write each frame's surface as DIR/frame_NNNN.obj\n"
-               "  --json        print one JSON object with the figures as the last line\n");
+    fprintf(f,
+            "usage: sinew-fullsim --scene NAME [--tets N] [--frames F] [--dynamic] [--newmark]\n"
+            "                     [--no-self-contact] [--ground HEIGHT] [--world FILE.json]\n"
+            "                     [--threads T]\n"
+            "                     [reference options] [--data DIR] [--out DIR] [--json]\n"
+            "  NAME: cylinder | finger | capsule (procedural) | elephant-cd | hand-libigl\n"
+            "  --tets N      procedural resolution, 1000..2000000 (default 20000; samples only)\n"
+            "  --frames F    frames to simulate, 1..1000000 (default: procedural 30, assets\n"
+            "                their clip)\n"
+            "  --threads T   0..256 (default 0: all cores)\n"
+            "  --data DIR    the real assets' folder (asset scenes only)\n"
+            "  --dynamic     backward Euler dynamics (default quasistatic); --newmark: "
+            "Newmark\n"
+            "  --world FILE  collide with a world file's colliders (JSON, schema 1; see\n"
+            "                samples/worlds/README.md); --frames defaults to its "
+            "length\n" SW_REFERENCE_USAGE
+            "  --out DIR     write each frame's surface as DIR/frame_NNNN.obj\n"
+            "  --json        print one JSON object with the figures as the last line\n"
+            "exit status: 0 done, 1 failed (a failed frame too), 2 bad arguments\n");
+}
+
+static int is_sample(const char *name) {
+    for (const char *const *n = sw_sample_names(); *n; ++n)
+        if (!strcmp(*n, name)) return 1;
+    return 0;
 }
 
 static int parse_args(int argc, char **argv, options *o) {
@@ -61,9 +72,11 @@ static int parse_args(int argc, char **argv, options *o) {
                                 {"--world", &o->world, NULL, 0},
                                 {"--no-self-contact", NULL, &o->params.self_contact, 0},
                                 {"--json", NULL, &o->json, 1}};
-    int ok = 1;
+    int ok = 1, tets_given = 0, data_given = 0, integrators = 0;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        tets_given |= !strcmp(a, "--tets");
+        data_given |= !strcmp(a, "--data");
         if (sw_tool_take(opts, sizeof opts / sizeof opts[0], argc, argv, &i)) {
             /* taken */
         } else if (!strcmp(a, "--tets") && next) {
@@ -73,7 +86,8 @@ static int parse_args(int argc, char **argv, options *o) {
             }
         } else if (!strcmp(a, "--frames") && next) {
             if (!sw_parse_int(argv[++i], 1, 1000000, &o->frames)) {
-                fprintf(stderr, "sinew-fullsim: --frames wants a positive count, got '%s'\n",
+                fprintf(stderr,
+                        "sinew-fullsim: --frames wants an integer in 1..1000000, got '%s'\n",
                         argv[i]);
                 return 0;
             }
@@ -94,8 +108,10 @@ static int parse_args(int argc, char **argv, options *o) {
             if (!ok) return 0;
         } else if (!strcmp(a, "--dynamic")) {
             o->params.integrator = SW_BACKWARD_EULER;
+            integrators++;
         } else if (!strcmp(a, "--newmark")) {
             o->params.integrator = SW_NEWMARK;
+            integrators++;
         } else if (!sw_tool_help(a, usage)) {
             return sw_tool_unknown_arg("sinew-fullsim", a);
         }
@@ -104,13 +120,26 @@ static int parse_args(int argc, char **argv, options *o) {
         fprintf(stderr, "sinew-fullsim: --scene is required\n");
         return 0;
     }
-    return 1;
-}
-
-static int is_sample(const char *name) {
-    for (const char *const *n = sw_sample_names(); *n; ++n)
-        if (!strcmp(*n, name)) return 1;
-    return 0;
+    if (tets_given && !is_sample(o->scene)) {
+        fprintf(stderr,
+                "sinew-fullsim: --tets does not apply to scene '%s' (a real asset with its own "
+                "mesh); it sets a procedural sample's resolution\n",
+                o->scene);
+        return 0;
+    }
+    if (data_given && is_sample(o->scene)) {
+        fprintf(stderr,
+                "sinew-fullsim: --data does not apply to scene '%s' (a procedural sample); it "
+                "locates the real assets\n",
+                o->scene);
+        return 0;
+    }
+    if (integrators > 1) {
+        fprintf(stderr, "sinew-fullsim: give one of --dynamic and --newmark\n");
+        return 0;
+    }
+    return !o->world ||
+           sw_tool_format("sinew-fullsim", "--world", o->world, "json", ".json (world file)");
 }
 
 /* mkdir -p: creates dir and its missing parents; 1 when dir exists afterwards. */
@@ -217,7 +246,11 @@ int main(int argc, char **argv) {
             : o.params.integrator == SW_NEWMARK   ? "dynamic (Newmark)"
                                                   : "dynamic (backward Euler)",
             o.params.self_contact ? ", self-contact on" : ", self-contact off");
-    double *ms = malloc((size_t)frames * sizeof(double));
+    double *ms = malloc((size_t)(frames > 0 ? frames : 1) * sizeof(double));
+    if (!ms) {
+        fprintf(stderr, "sinew-fullsim: out of memory\n");
+        return 1;
+    }
     double newton_sum = 0, pcg_sum = 0, max_pen = 0, max_ground = 0, total = 0, pen_world = 0;
     int unconverged = 0, failed = 0, unsettled = 0, newton_max = 0, factors = 0;
     int world_frames = 0; /* frames with a vertex in contact with a collider */

@@ -34,20 +34,25 @@ typedef struct {
 } options;
 
 static void usage(FILE *f) {
-    fprintf(f, "usage: sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [options]\n"
-               "       sinew-render --frames DIR --out IMAGE.png [--grid N] [options]\n"
-               "  --obj FILE      a Wavefront OBJ surface; several make a contact sheet\n"
-               "  --frames DIR    every DIR/frame_NNNN.obj (as written by sinew-fullsim --out)\n"
-               "  --grid N        with --frames: at most N x N evenly spaced frames (default 4)\n"
-               "  --out FILE      the PNG to write (written to FILE.tmp, then renamed)\n"
-               "  --width W       image width in pixels (default 640, contact sheet 1280)\n"
-               "  --height H      image height in pixels (default 480, contact sheet 960)\n"
-               "  --supersample S S x S rays a pixel, 1..4 (default 2)\n"
-               "  --azimuth DEG   camera turned from the front (+Z, Y up) toward +X (default 35)\n"
-               "  --elevation DEG camera height above the horizon, -89..89 (default 20)\n"
-               "  --threads T     render threads (default: all cores)\n"
-               "  --no-ground     no checkered ground plane\n"
-               "  --quiet         no summary line on stderr\n");
+    fprintf(f,
+            "usage: sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [options]\n"
+            "       sinew-render --frames DIR --out IMAGE.png [--grid N] [options]\n"
+            "  --obj FILE      a Wavefront OBJ surface; several make a contact sheet\n"
+            "  --frames DIR    every DIR/frame_NNNN.obj (as written by sinew-fullsim --out)\n"
+            "  --grid N        with --frames: at most N x N evenly spaced frames, 1..64\n"
+            "                  (default 4)\n"
+            "  --out FILE      the PNG to write (written to FILE.tmp, then renamed)\n"
+            "  --width W       image width in pixels, 1..%d (default 640, contact sheet 1280)\n"
+            "  --height H      image height in pixels, 1..%d (default 480, contact sheet 960)\n"
+            "  --supersample S S x S rays a pixel, 1..4 (default 2)\n"
+            "  --azimuth DEG   camera turned from the front (+Z, Y up) toward +X, -360..360\n"
+            "                  (default 35)\n"
+            "  --elevation DEG camera height above the horizon, -89..89 (default 20)\n"
+            "  --threads T     render threads, 1..64 (default: all cores)\n"
+            "  --no-ground     no checkered ground plane\n"
+            "  --quiet         no summary line on stderr\n"
+            "exit status: 0 written, 1 failed, 2 bad arguments\n",
+            SW_PNG_MAX_DIM, SW_PNG_MAX_DIM);
 }
 
 static int parse_args(int argc, char **argv, options *o) {
@@ -78,9 +83,11 @@ static int parse_args(int argc, char **argv, options *o) {
                                 {"--out", &o->out, NULL, 0},
                                 {"--no-ground", NULL, &o->ground, 0},
                                 {"--quiet", NULL, &o->quiet, 1}};
+    int grid_given = 0;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int matched = 0;
+        grid_given |= !strcmp(a, "--grid");
         for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) {
             if (strcmp(a, ints[k].flag)) continue;
             matched = 1;
@@ -104,7 +111,14 @@ static int parse_args(int argc, char **argv, options *o) {
         fprintf(stderr, "sinew-render: need --out and either --obj (one or more) or --frames\n");
         return 0;
     }
-    return 1;
+    if (grid_given && !o->frames_dir) {
+        fprintf(stderr, "sinew-render: --grid does not apply to --obj (it thins --frames)\n");
+        return 0;
+    }
+    for (int k = 0; k < o->nobjs; ++k)
+        if (!sw_tool_format("sinew-render", "--obj", o->objs[k], "obj", ".obj (Wavefront)"))
+            return 0;
+    return sw_tool_format("sinew-render", "--out", o->out, "png", ".png");
 }
 
 /* ---- --frames: frame_NNNN.obj files, sorted by number, evenly thinned --------------- */

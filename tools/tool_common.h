@@ -9,6 +9,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "sinew/sinew.h"
 #include "sw_error.h"
 
 #ifndef SINEW_SHARED_DATA_DIR
@@ -28,6 +29,55 @@ static inline int sw_parse_int(const char *s, int lo, int hi, int *out) {
     if (errno || *end || end == s || v < lo || v > hi) return 0;
     *out = (int)v;
     return 1;
+}
+
+/* Parses flag's value s as an integer in [lo, hi] into *out; otherwise names the flag, its
+ * range and the value on stderr and returns 0. */
+static inline int sw_tool_int(const char *tool, const char *flag, const char *s, int lo, int hi,
+                              int *out) {
+    if (s && sw_parse_int(s, lo, hi, out)) return 1;
+    fprintf(stderr, "%s: %s wants an integer in %d..%d, got '%s'\n", tool, flag, lo, hi,
+            s ? s : "(nothing)");
+    return 0;
+}
+
+/* Parses flag's value s as a finite number with lo < value < hi (open bounds) into *out;
+ * otherwise names the flag, its range and the value on stderr and returns 0. */
+static inline int sw_tool_real(const char *tool, const char *flag, const char *s, double lo,
+                               double hi, const char *range, double *out) {
+    char *end = NULL;
+    double v = s ? strtod(s, &end) : 0;
+    if (s && end != s && !*end && v > lo && v < hi) {
+        *out = v;
+        return 1;
+    }
+    fprintf(stderr, "%s: %s wants a number %s, got '%s'\n", tool, flag, range, s ? s : "(nothing)");
+    return 0;
+}
+
+/* 1 when path ends (case-insensitively) with one of the space-separated extensions in
+ * exts ("mesh node ele"); otherwise names the flag, the file and the accepted formats on
+ * stderr and returns 0. */
+static inline int sw_tool_format(const char *tool, const char *flag, const char *path,
+                                 const char *exts, const char *what) {
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    if (dot && (!slash || dot > slash)) {
+        size_t n = strlen(dot + 1);
+        for (const char *e = exts; *e;) {
+            size_t k = strcspn(e, " ");
+            if (k == n && n > 0) {
+                size_t i = 0;
+                while (i < n && (dot[1 + i] | 0x20) == (e[i] | 0x20))
+                    ++i;
+                if (i == n) return 1;
+            }
+            e += k;
+            while (*e == ' ')
+                ++e;
+        }
+    }
+    fprintf(stderr, "%s: %s '%s': not a format it reads; accepted: %s\n", tool, flag, path, what);
+    return 0;
 }
 
 static inline int sw_cmp_double(const void *a, const void *b) {
@@ -100,6 +150,34 @@ static inline int sw_tool_failed(sinew_result r, const sw_error *err, const char
     fprintf(stderr, "%s (%s)\n", err->msg, sinew_result_string(r));
     return 1;
 }
+
+/* The loader's last error message, kept by sw_tool_log_keep (a sinew_logger hook). */
+typedef struct sw_tool_log {
+    char msg[512];
+} sw_tool_log;
+
+static inline void sw_tool_log_keep(sinew_log_level level, uint32_t id, const char *message,
+                                    void *user) {
+    (void)id;
+    sw_tool_log *l = (sw_tool_log *)user;
+    if (level == SINEW_LOG_ERROR && l && message) snprintf(l->msg, sizeof l->msg, "%s", message);
+}
+
+/* sinew_blob_load of def with a logger that keeps the loader's reason; on failure prints
+ * "TOOL: cannot load the blob WHAT: REASON (RESULT)" on stderr. */
+static inline sinew_result sw_tool_blob_load(const char *tool, const char *what, sinew_blob_def def,
+                                             sinew_blob **out) {
+    sw_tool_log log;
+    log.msg[0] = '\0';
+    def.logger.log = sw_tool_log_keep;
+    def.logger.user = &log;
+    def.logger.max_level = SINEW_LOG_WARNING;
+    sinew_result r = sinew_blob_load(&def, out);
+    if (r != SINEW_OK)
+        fprintf(stderr, "%s: cannot load the blob %s: %s (%s)\n", tool, what,
+                log.msg[0] ? log.msg : "no reason given", sinew_result_string(r));
+    return r;
+}
 #endif
 
 #ifdef SW_TOOL_CHARACTER_ARGS
@@ -108,18 +186,37 @@ static inline int sw_tool_failed(sinew_result r, const sw_error *err, const char
 #include "samples.h"
 
 typedef struct sw_character_args {
+    const char *tool; /* for messages */
     const char *scene, *mesh, *tgf, *weights, *clip, *data_dir;
     int tets, frames;
+    int tets_given, data_given;
 } sw_character_args;
 
-static inline void sw_character_args_init(sw_character_args *c) {
+/* The least --frames: the fewest clip frames a bake trains on (bake.h). */
+#define SW_CHARACTER_MIN_FRAMES 4
+#define SW_CHARACTER_USAGE                                                                         \
+    "  --scene NAME     cylinder | finger | capsule (procedural samples) | elephant-cd |\n"        \
+    "                   hand-libigl (real assets under --data DIR, default $SINEW_DATA_DIR or\n"   \
+    "                   the build's shared data; --data only with these)\n"                        \
+    "  --tets N         a procedural sample's resolution, 1000..2000000 (default 20000)\n"         \
+    "  --frames F       clip frames, 4..1000000 (procedural default 30; an asset's or --clip's\n"  \
+    "                   own length at most F): the bake trains on the first 60%% and holds out\n"  \
+    "                   the rest, and a clip starting at rest needs 2 training frames\n"           \
+    "  --mesh FILE      a tet mesh: .mesh (MEDIT) | .node/.ele (TetGen); needs --skeleton\n"       \
+    "  --skeleton FILE  a .tgf skeleton (with --mesh only)\n"                                      \
+    "  --weights FILE   .dmat skin weights (with --mesh only; default: computed)\n"                \
+    "  --clip FILE      a .txt bone animation or a .dmat pose (with --mesh only)\n"
+
+static inline void sw_character_args_init(sw_character_args *c, const char *tool) {
     memset(c, 0, sizeof *c);
+    c->tool = tool;
     c->data_dir = sw_tool_data_dir();
     c->tets = 20000;
 }
 
 /* When argv[*i] is a character option, consumes it and its value and returns 1, with
- * *ok = 0 for a bad value; returns 0 for any other argument. */
+ * *ok = 0 (and a message naming the flag and its range) for a bad value; returns 0 for
+ * any other argument. */
 static inline int sw_character_args_take(sw_character_args *c, int argc, char **argv, int *i,
                                          int *ok) {
     const char *a = argv[*i], *next = *i + 1 < argc ? argv[*i + 1] : NULL;
@@ -133,16 +230,84 @@ static inline int sw_character_args_take(sw_character_args *c, int argc, char **
                                                 : NULL;
     if (s) {
         *s = argv[++*i];
+        c->data_given |= s == &c->data_dir;
         return 1;
     }
-    if (!strcmp(a, "--tets")) return (*ok = sw_parse_int(argv[++*i], 1000, 2000000, &c->tets)), 1;
-    if (!strcmp(a, "--frames")) return (*ok = sw_parse_int(argv[++*i], 2, 1000000, &c->frames)), 1;
+    if (!strcmp(a, "--tets")) {
+        c->tets_given = 1;
+        return (*ok = sw_tool_int(c->tool, a, argv[++*i], 1000, 2000000, &c->tets)), 1;
+    }
+    if (!strcmp(a, "--frames"))
+        return (*ok = sw_tool_int(c->tool, a, argv[++*i], SW_CHARACTER_MIN_FRAMES, 1000000,
+                                  &c->frames)),
+               1;
     return 0;
 }
 
-/* Exactly one of --scene and --mesh, and --mesh needs --skeleton. */
+static inline int sw_character_is_sample(const char *name) {
+    for (const char *const *n = sw_sample_names(); *n; ++n)
+        if (!strcmp(*n, name)) return 1;
+    return 0;
+}
+
+/* Exactly one of --scene and --mesh, --mesh needs --skeleton, and no option that does
+ * not apply to the chosen input (each named on stderr); 1 when valid. */
 static inline int sw_character_args_valid(const sw_character_args *c) {
-    return !c->scene != !c->mesh && (!c->mesh || c->tgf);
+    const char *t = c->tool;
+    if (!c->scene == !c->mesh) {
+        fprintf(stderr, "%s: give either --scene or --mesh (with --skeleton)\n", t);
+        return 0;
+    }
+    if (c->scene) {
+        const char *files[] = {c->tgf, c->weights, c->clip},
+                   *names[] = {"--skeleton", "--weights", "--clip"};
+        for (int k = 0; k < 3; ++k)
+            if (files[k]) {
+                fprintf(stderr,
+                        "%s: %s does not apply to --scene (the scene brings its own); it "
+                        "goes with --mesh\n",
+                        t, names[k]);
+                return 0;
+            }
+        int sample = sw_character_is_sample(c->scene);
+        if (!sample && c->tets_given) {
+            fprintf(stderr,
+                    "%s: --tets does not apply to scene '%s' (a real asset with its own mesh); "
+                    "it sets a procedural sample's resolution\n",
+                    t, c->scene);
+            return 0;
+        }
+        if (sample && c->data_given) {
+            fprintf(stderr,
+                    "%s: --data does not apply to scene '%s' (a procedural sample); it locates "
+                    "the real assets\n",
+                    t, c->scene);
+            return 0;
+        }
+        return 1;
+    }
+    if (!c->tgf) {
+        fprintf(stderr, "%s: --mesh needs --skeleton\n", t);
+        return 0;
+    }
+    if (c->tets_given || c->data_given) {
+        fprintf(stderr, "%s: %s does not apply to --mesh (it goes with --scene)\n", t,
+                c->tets_given ? "--tets" : "--data");
+        return 0;
+    }
+    if (c->frames && !c->clip) {
+        fprintf(stderr,
+                "%s: --frames does not apply to --mesh without --clip (it bounds the clip's "
+                "frames)\n",
+                t);
+        return 0;
+    }
+    return sw_tool_format(t, "--mesh", c->mesh, "mesh node ele",
+                          ".mesh (MEDIT), .node or .ele (TetGen)") &&
+           sw_tool_format(t, "--skeleton", c->tgf, "tgf", ".tgf") &&
+           (!c->weights || sw_tool_format(t, "--weights", c->weights, "dmat", ".dmat")) &&
+           (!c->clip || sw_tool_format(t, "--clip", c->clip, "txt dmat",
+                                       ".txt (bone animation), .dmat (pose quaternions)"));
 }
 
 /* Builds the character into *ch (zeroed first; err cleared first). When the asset has no
@@ -169,7 +334,7 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
 
 #define SW_REFERENCE_USAGE                                                                         \
     "  --solver S          the reference's linear solver: auto (default) | cholmod | pcg\n"        \
-    "  --contact-rounds R  the round cap (default 30)\n"                                           \
+    "  --contact-rounds R  the round cap, 1..100 (default 30)\n"                                   \
     "  --hessian M         adaptive (default) | projected | exact element Hessians\n"
 
 /* When argv[*i] is a reference option, consumes it and its value and returns 1, with
@@ -200,7 +365,12 @@ static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **
         --*i;
         return 0;
     }
-    if (!*ok) fprintf(stderr, "%s: %s: bad value '%s' (see --help)\n", argv[0], a, v);
+    if (!*ok)
+        fprintf(stderr, "%s: %s wants %s, got '%s'\n", argv[0], a,
+                !strcmp(a, "--solver")    ? "one of auto | cholmod | pcg"
+                : !strcmp(a, "--hessian") ? "one of adaptive | projected | exact"
+                                          : "an integer in 1..100",
+                v);
     return 1;
 }
 #endif

@@ -204,11 +204,9 @@ static void progress(const sw_bake_params *p, const char *stage, double secs, co
     if (p->progress) fprintf(stderr, "sinew-bake: %-9s %7.2f s  %s\n", stage, secs, what);
 }
 
-sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bake_result *out,
-                     sw_error *err) {
-    memset(out, 0, sizeof *out);
-    sw_bake_params p = params ? *params : sw_bake_params_default();
-    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
+/* The parameters sw_bake takes. */
+static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
+    sw_bake_params p = *pp;
     if (p.max_rank < 1 || p.max_rank > 1024 || !(p.pca_energy > 0 && p.pca_energy <= 1) ||
         !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 || p.sweep_samples < 1 ||
         p.sweep_samples > 1000 || p.max_train_frames < 1 ||
@@ -219,10 +217,71 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
                             "max %d, sweep %d, frames %d, held-out %g, spring %g)",
                             p.max_rank, p.pca_energy, p.cubature_tol, p.cubature_max,
                             p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k);
+    return SINEW_OK;
+}
+
+/* The stages poses and simulate, and what the result keeps of them for evaluation. */
+static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sinew_result r;
+    if ((r = sw_bake_poses(s, err)) != SINEW_OK || (r = sw_bake_simulate(s, err)) != SINEW_OK)
+        return r;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i) {
+        out->ntrain += s->train[i].npose;
+        out->train_unsettled += s->train[i].unsettled;
+    }
+    out->nheldout = s->heldout.npose;
+    out->heldout_unsettled = s->heldout.unsettled;
+    if ((r = keep_solutions(s, out, err)) != SINEW_OK) return r;
+    if (!(out->mass = malloc((size_t)s->nv * sizeof(double))))
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    memcpy(out->mass, s->mass, (size_t)s->nv * sizeof(double));
+    return SINEW_OK;
+}
+
+sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *params,
+                               sw_bake_result *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    sw_bake_params p = params ? *params : sw_bake_params_default();
+    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
+    sinew_result r = check_params(&p, err);
+    if (r != SINEW_OK) return r;
     sw_bake_state s;
     memset(&s, 0, sizeof s);
     s.p = &p;
-    sinew_result r;
+    if ((r = prepare(&s, c, c->weights.w == NULL, err)) != SINEW_OK) goto done;
+    if (!(s.pool = sw_pool_create(p.threads))) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
+        goto done;
+    }
+    r = solve_poses(&s, out, err);
+done:
+    free_state(&s);
+    if (r != SINEW_OK) sw_bake_result_free(out);
+    return r;
+}
+
+sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
+                            sw_eval_result *train, sw_eval_result *heldout, sw_error *err) {
+    memset(train, 0, sizeof *train);
+    memset(heldout, 0, sizeof *heldout);
+    sinew_result r = sw_eval_correction(blob, res->mass, res->train_T, res->train_x, res->ntrain,
+                                        SW_BAKE_EVAL_NEWTON, train, err);
+    if (r == SINEW_OK)
+        r = sw_eval_correction(blob, res->mass, res->heldout_T, res->heldout_x, res->nheldout,
+                               SW_BAKE_EVAL_NEWTON, heldout, err);
+    return r;
+}
+
+sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bake_result *out,
+                     sw_error *err) {
+    memset(out, 0, sizeof *out);
+    sw_bake_params p = params ? *params : sw_bake_params_default();
+    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
+    sinew_result r = check_params(&p, err);
+    if (r != SINEW_OK) return r;
+    sw_bake_state s;
+    memset(&s, 0, sizeof s);
+    s.p = &p;
     double t0 = sw_now_seconds(), t1;
     int heat = c->weights.w == NULL;
     if ((r = prepare(&s, c, heat, err)) != SINEW_OK) goto done;
@@ -245,22 +304,9 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     }
 
     t0 = t1;
-    if ((r = sw_bake_poses(&s, err)) != SINEW_OK || (r = sw_bake_simulate(&s, err)) != SINEW_OK)
-        goto done;
+    if ((r = solve_poses(&s, out, err)) != SINEW_OK) goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[2] = t1 - t0;
-    for (int32_t i = 0; i < s.ntrain_seq; ++i) {
-        out->ntrain += s.train[i].npose;
-        out->train_unsettled += s.train[i].unsettled;
-    }
-    out->nheldout = s.heldout.npose;
-    out->heldout_unsettled = s.heldout.unsettled;
-    if ((r = keep_solutions(&s, out, err)) != SINEW_OK) goto done;
-    if (!(out->mass = malloc((size_t)s.nv * sizeof(double)))) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-        goto done;
-    }
-    memcpy(out->mass, s.mass, (size_t)s.nv * sizeof(double));
     {
         char msg[160];
         snprintf(msg, sizeof msg,
@@ -283,6 +329,14 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
 
     t0 = t1;
     if ((r = sw_bake_cubature(&s, out, err)) != SINEW_OK) goto done;
+    for (int32_t d = 0; d < s.nd; ++d)
+        if (s.cub_n[d] < 1) { /* a blob needs one at least: say why here, not at the write */
+            r = sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                             "domain %d: no cubature tets (rank %d): the training poses do not "
+                             "deform it; give a clip that bends its joint",
+                             d, s.rank[d]);
+            goto done;
+        }
     t1 = sw_now_seconds();
     out->stage_seconds[4] = t1 - t0;
     {

@@ -22,6 +22,7 @@
 
 #include "blob_view.h"
 #include "cubature_train.h"
+#include "subspace_eval.h"
 #include "sw_mesh.h"
 
 typedef struct sw_bake_params {
@@ -76,8 +77,39 @@ typedef struct sw_bake_result {
     double *train_T;
 } sw_bake_result;
 
+/* The fewest clip frames a bake can train on: it trains on the first
+ * floor((1 - heldout_fraction) F) frames and holds out the rest, and learns its basis and
+ * cubature from the deformation of the training poses (each joint is also swept up to the
+ * largest bend those frames give it). A clip that starts at rest (every procedural
+ * sample's, every pose clip's) bends nothing in its first frame, so it needs 2 training
+ * frames: 4 frames at the default held-out 0.4. Fewer is rejected by sw_bake. */
+int32_t sw_bake_min_frames(double heldout_fraction);
+
 sinew_result sw_bake(const sw_character *c, const sw_bake_params *p, sw_bake_result *out,
                      sw_error *err);
 void sw_bake_result_free(sw_bake_result *r);
+
+/* Only the bake's evaluation data: the stages prepare, poses and simulate of sw_bake with
+ * the same parameters, filling out's ntrain, nheldout, *_unsettled, mass, train_T/x and
+ * heldout_T/x exactly as sw_bake does (no view). For a blob baked elsewhere with the
+ * same parameters (sinew-bench --blob), so that sw_bake_errors measures it on the very
+ * poses and reference solutions its bake measured it on. */
+sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *p, sw_bake_result *out,
+                               sw_error *err);
+
+/* The one definition of a bake's training and held-out error (sinew-bake and
+ * sinew-bench report these): sw_eval_correction of `blob` over res's training poses (the
+ * clip's training frames, then the return path when baked, then every joint sweep, in
+ * that order, one quasistatic instance stepped through them all) and, separately, over
+ * its held-out poses, SW_BAKE_EVAL_NEWTON Newton iterations a step. */
+#define SW_BAKE_EVAL_NEWTON 20
+sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
+                            sw_eval_result *train, sw_eval_result *heldout, sw_error *err);
+
+/* A training error at or above this share of the correction missed is no usable bake:
+ * the subspace misses half of the physics correction on the very poses it was built
+ * from (a sound bake misses 1-3%; 1 is no better than plain skinning). sinew-bake
+ * refuses to write such a blob unless --force. */
+#define SW_BAKE_MAX_TRAIN_ERROR 0.5
 
 #endif

@@ -82,6 +82,12 @@ static uint64_t splitmix(uint64_t *s) {
     return z ^ (z >> 31);
 }
 
+int32_t sw_bake_min_frames(double heldout_fraction) {
+    for (int32_t f = 2; f < 1000000; ++f)
+        if ((int32_t)floor(f * (1.0 - heldout_fraction)) >= 2) return f;
+    return 1000000;
+}
+
 sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     const sw_skeleton *sk = &s->ch.skel;
     const sw_clip *clip = &s->ch.clip;
@@ -129,6 +135,22 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     int32_t njoint = 0;
     for (int32_t b = 0; b < nb; ++b)
         njoint += sweep_angle[b] > 1e-3;
+    if (njoint == 0) { /* nothing to learn: every training snapshot is the rest shape */
+        free(sweep_axis);
+        free(sweep_angle);
+        free(local);
+        return sw_error_set(
+            err, SINEW_ERROR_INVALID_ARGUMENT,
+            nf < 2 ? "no training poses: the skeleton has no joint to bend"
+                   : "too few poses to train: the clip's %d training frames (the first %.0f%% of "
+                     "its %d; "
+                     "the rest is held out) bend no joint, and the basis and the cubature are "
+                     "learnt from "
+                     "the training poses' deformation; a clip that starts at rest needs at least 2 "
+                     "training frames, i.e. at least %d frames",
+            ntrain_frames, 100 * (1 - s->p->heldout_fraction), nf,
+            sw_bake_min_frames(s->p->heldout_fraction));
+    }
 
     int32_t nclip = ntrain_frames < s->p->max_train_frames ? ntrain_frames : s->p->max_train_frames;
     int32_t nreturn = s->p->return_path && nclip >= 2 ? nclip - 1 : 0;

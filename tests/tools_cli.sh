@@ -1,0 +1,168 @@
+#!/usr/bin/env bash
+# The tools never mislead (issue 15): every error exits non-zero with a message that
+# names what is wrong; flags that do not apply to the input, values out of range and
+# files of the wrong format are rejected; the bake and the bench --blob --bake-errors
+# report the same training and held-out error for the same blob, and the bench --blob
+# alone reports its clip-frame errors under their own names. Small meshes only (about
+# 1-2K tets).
+#   bash tests/tools_cli.sh BUILD_DIR SOURCE_DIR
+set -uo pipefail
+build=$1
+src=$2
+bake=$build/tools/sinew-bake
+bench=$build/tools/sinew-bench
+fullsim=$build/tools/sinew-fullsim
+render=$build/tools/sinew-render
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+fails=0
+
+# expect NAME STATUS PATTERN CMD...: CMD exits with STATUS and its stderr matches PATTERN
+expect() {
+    local name=$1 want=$2 pattern=$3
+    shift 3
+    "$@" >"$tmp/out" 2>"$tmp/err"
+    local rc=$?
+    if [ "$rc" -ne "$want" ] || ! grep -qE -- "$pattern" "$tmp/err"; then
+        echo "FAIL $name: exit $rc (want $want), stderr:" >&2
+        tail -n 5 "$tmp/err" >&2
+        echo "  (wanted a match for: $pattern)" >&2
+        fails=$((fails + 1))
+    else
+        echo "ok   $name"
+    fi
+}
+
+small=(--scene finger --tets 1000)
+
+# too few frames to train: the minimum and why
+expect bake_frames_2 2 "--frames wants an integer in 4\.\.1000000, got '2'" \
+    "$bake" "${small[@]}" --frames 2 --out "$tmp/a.blob"
+expect bench_frames_3 2 "--frames wants an integer in 4\.\.1000000" \
+    "$bench" "${small[@]}" --frames 3
+"$bake" --help | grep -q "the bake trains on the first 60% and holds out" ||
+    { echo "FAIL bake_help_frames: --help does not say why --frames starts at 4" >&2; fails=$((fails + 1)); }
+
+# flags that do not apply to the input
+expect bake_clip_with_scene 2 "--clip does not apply to --scene" \
+    "$bake" "${small[@]}" --clip x.txt --out "$tmp/a.blob"
+expect bench_weights_with_scene 2 "--weights does not apply to --scene" \
+    "$bench" "${small[@]}" --weights w.dmat
+expect bake_tets_with_asset 2 "--tets does not apply to scene 'elephant-cd'" \
+    "$bake" --scene elephant-cd --tets 2000 --out "$tmp/a.blob"
+expect bake_data_with_sample 2 "--data does not apply to scene 'finger'" \
+    "$bake" "${small[@]}" --data "$tmp" --out "$tmp/a.blob"
+expect bake_tets_with_mesh 2 "--tets does not apply to --mesh" \
+    "$bake" --mesh m.mesh --skeleton s.tgf --tets 2000 --out "$tmp/a.blob"
+expect bake_frames_without_clip 2 "--frames does not apply to --mesh without --clip" \
+    "$bake" --mesh m.mesh --skeleton s.tgf --frames 8 --out "$tmp/a.blob"
+expect fullsim_tets_with_asset 2 "--tets does not apply to scene 'hand-libigl'" \
+    "$fullsim" --scene hand-libigl --tets 2000
+expect render_grid_with_obj 2 "--grid does not apply to --obj" \
+    "$render" --obj a.obj --grid 3 --out "$tmp/a.png"
+
+# numeric ranges and file formats
+expect bake_tol_range 2 "--tol wants a number in the open range 0\.\.1, got '2'" \
+    "$bake" "${small[@]}" --tol 2 --out "$tmp/a.blob"
+expect bake_rank_range 2 "--max-rank wants an integer in 1\.\.1024, got '0'" \
+    "$bake" "${small[@]}" --max-rank 0 --out "$tmp/a.blob"
+expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'" \
+    "$bench" --scene finger --tets 10
+expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \
+    "$bench" "${small[@]}" --full-frames 0
+expect bench_rounds_range 2 "--contact-rounds wants an integer in 1\.\.100, got '0'" \
+    "$bench" "${small[@]}" --contact-rounds 0
+expect bake_mesh_format 2 "--mesh 'a\.obj': not a format it reads; accepted: \.mesh \(MEDIT\), \.node or \.ele" \
+    "$bake" --mesh a.obj --skeleton s.tgf --out "$tmp/a.blob"
+expect bake_clip_format 2 "--clip 'c\.bvh': not a format it reads; accepted: \.txt" \
+    "$bake" --mesh a.mesh --skeleton s.tgf --clip c.bvh --out "$tmp/a.blob"
+expect bench_world_format 2 "--world 'w\.yaml': not a format it reads; accepted: \.json" \
+    "$bench" "${small[@]}" --world w.yaml
+expect render_out_format 2 "--out '.*a\.jpg': not a format it reads; accepted: \.png" \
+    "$render" --obj a.obj --out "$tmp/a.jpg"
+"$bake" --help | grep -q -- "--tets N         a procedural sample's resolution, 1000\.\.2000000" ||
+    { echo "FAIL bake_help_ranges: --help does not state --tets's range" >&2; fails=$((fails + 1)); }
+
+# an absurd training error is an error (nothing written) unless --force
+expect bake_absurd_error 1 "training error is [0-9.]+ \(at least 0\.50.*not written" \
+    "$bake" "${small[@]}" --frames 4 --max-rank 1 --out "$tmp/absurd.blob"
+[ ! -e "$tmp/absurd.blob" ] ||
+    { echo "FAIL bake_absurd_error: the blob was written" >&2; fails=$((fails + 1)); }
+expect bake_absurd_forced 0 "WARNING: written with --force" \
+    "$bake" "${small[@]}" --frames 4 --max-rank 1 --force --out "$tmp/absurd.blob"
+[ -s "$tmp/absurd.blob" ] ||
+    { echo "FAIL bake_absurd_forced: no blob written" >&2; fails=$((fails + 1)); }
+
+# error paths exit non-zero with the reason
+touch "$tmp/plainfile"
+expect bench_out_unwritable 1 "--out '.*plainfile/sub': cannot create or write the folder" \
+    "$bench" "${small[@]}" --frames 4 --out "$tmp/plainfile/sub"
+head -c 4096 /dev/zero >"$tmp/zero.blob"
+expect bench_blob_reason 1 "cannot load the blob .*zero\.blob: .*magic" \
+    "$bench" "${small[@]}" --frames 4 --blob "$tmp/zero.blob"
+expect bench_blob_missing 1 "cannot load the blob .*none\.blob: .*No such file" \
+    "$bench" "${small[@]}" --frames 4 --blob "$tmp/none.blob"
+expect bench_bake_errors_without_blob 2 "--bake-errors applies only with --blob" \
+    "$bench" "${small[@]}" --frames 4 --bake-errors
+
+# one definition of the training and held-out error: the bake and the bench
+# --blob --bake-errors (the bake's poses solved anew) agree
+key() { tail -n 1 "$1" | grep -oE "\"$2\":(\"[a-z_]*\"|[0-9.]+|null)" | cut -d: -f2; }
+if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --json >"$tmp/bake.json" \
+    2>"$tmp/bake.err" &&
+    "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --bake-errors \
+        --contract-steps 10 --json >"$tmp/bench.json" 2>"$tmp/bench.err"; then
+    for k in err_train err_heldout; do
+        a=$(key "$tmp/bake.json" $k) b=$(key "$tmp/bench.json" $k)
+        if [ -z "$a" ] || [ "$a" != "$b" ]; then
+            echo "FAIL same_errors: $k bake '$a' bench '$b'" >&2
+            fails=$((fails + 1))
+        else
+            echo "ok   same_errors $k $a"
+        fi
+    done
+    [ "$(key "$tmp/bench.json" err_source)" = '"bake_default_poses"' ] ||
+        { echo "FAIL same_errors: err_source is not bake_default_poses" >&2; fails=$((fails + 1)); }
+else
+    echo "FAIL same_errors: the bake or the bench failed" >&2
+    tail -n 3 "$tmp/bake.err" "$tmp/bench.err" >&2
+    fails=$((fails + 1))
+fi
+
+# the bench --blob alone measures the clip frames it solved (cheap) and says so: err_clip_*
+# with err_source "clip", never err_train/err_heldout (those name the bake's figures)
+if [ -s "$tmp/f.blob" ] &&
+    "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --contract-steps 10 \
+        --json >"$tmp/clip.json" 2>"$tmp/clip.err"; then
+    ok=1
+    for k in err_clip_train err_clip_heldout; do
+        [[ $(key "$tmp/clip.json" $k) =~ ^[0-9.]+$ ]] ||
+            { echo "FAIL clip_errors: no $k in the JSON" >&2; ok=0; }
+    done
+    [ "$(key "$tmp/clip.json" err_source)" = '"clip"' ] ||
+        { echo "FAIL clip_errors: err_source is not clip" >&2; ok=0; }
+    ! tail -n 1 "$tmp/clip.json" | grep -qE '"err_(train|heldout)"' ||
+        { echo "FAIL clip_errors: the JSON names them err_train/err_heldout" >&2; ok=0; }
+    grep -q "correction error on clip frames" "$tmp/clip.err" ||
+        { echo "FAIL clip_errors: the summary does not say clip frames" >&2; ok=0; }
+    if [ "$ok" -eq 1 ]; then echo "ok   clip_errors"; else fails=$((fails + 1)); fi
+else
+    echo "FAIL clip_errors: the bench failed" >&2
+    tail -n 3 "$tmp/clip.err" >&2
+    fails=$((fails + 1))
+fi
+
+# run-main.sh checks its arguments before it deletes anything
+mkdir -p "$tmp/repo/tools" "$tmp/repo/out/main"
+cp "$src/tools/run-main.sh" "$tmp/repo/tools/"
+touch "$tmp/repo/out/main/keep"
+for args in abc "999" "2000 3" "2000 x" "2000 30 1" "-5" "2000 1e3"; do
+    # shellcheck disable=SC2086
+    expect "run_main_args_[$args]" 2 "run-main.sh: .*(wants an integer in|at most 2 arguments)" \
+        bash "$tmp/repo/tools/run-main.sh" $args
+    [ -e "$tmp/repo/out/main/keep" ] ||
+        { echo "FAIL run_main_args_[$args]: out/main was deleted" >&2; fails=$((fails + 1)); }
+done
+
+[ "$fails" -eq 0 ] || { echo "$fails failures" >&2; exit 1; }
+echo "all passed"
