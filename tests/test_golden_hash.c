@@ -5,7 +5,12 @@
  * recorded golden value. The value was recorded before the runtime was laid out by
  * subsystem (issue 9); a change that claims to keep behaviour must not move it, and a
  * change that means to change the physics records the new value here and says why in
- * its commit. */
+ * its commit. Issue 15 moved it (from 0x019bee093313695e): the old teleport test took the
+ * fixture clip's own distal-bone swings (52-65 degrees a frame at 30 Hz) for teleports,
+ * because it measured the motion of the world origin under the bone's transform, and
+ * dropped their inertia; and a Newton update shorter than a billionth of the size now
+ * ends the solve as converged instead of line-searching rounding noise (steps near
+ * rest). */
 #include <pthread.h>
 #include <stdint.h>
 
@@ -15,7 +20,7 @@
 enum { NINST = 4, STEPS = 24 };
 
 /* FNV-1a 64 of the four instances' surfaces, instance after instance. */
-#define GOLDEN_SURFACE_HASH 0x019bee093313695eull
+#define GOLDEN_SURFACE_HASH 0x301362ecd8596037ull
 
 static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
     const unsigned char *p = data;

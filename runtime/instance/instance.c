@@ -92,6 +92,10 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     /* the output */
     TAKE(in->surf_x, 3 * ns);
     TAKE(in->surf_n, 3 * ns);
+    /* the state's bounds */
+    TAKE(in->bone_ball, 4 * nb);
+    TAKE(in->q_bound, nd);
+    TAKE(in->u_max, nd);
 #undef TAKE
 }
 
@@ -244,6 +248,47 @@ static double rest_size(const sw_blob_view *v) {
     return sw_bbox_diagonal(lo, hi);
 }
 
+/* The balls of the rest vertices each bone skins (sw_pose_jump) and the bound of each
+ * domain's reduced coordinates (instance_internal.h). O(N r), at creation only. */
+static void state_bounds(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    for (int32_t b = 0; b < v->nbones; ++b) {
+        double lo[3], hi[3], *ball = in->bone_ball + 4 * b;
+        sw_bbox_empty(lo, hi);
+        for (int32_t gv = 0; gv < v->nverts; ++gv)
+            for (int k = 0; k < SW_BLOB_INFLUENCES; ++k)
+                if (v->skin_bone[SW_BLOB_INFLUENCES * gv + k] == b &&
+                    v->skin_weight[SW_BLOB_INFLUENCES * gv + k] > 0)
+                    sw_bbox_add(lo, hi, 1, v->rest + 3 * gv);
+        int any = lo[0] <= hi[0];
+        for (int i = 0; i < 3; ++i)
+            ball[i] = any ? 0.5 * (lo[i] + hi[i]) : 0;
+        ball[3] = any ? 0.5 * sw_bbox_diagonal(lo, hi) : -1;
+    }
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank;
+        double umax = 0, qmax = 0;
+        for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+            const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+            double f2 = 0;
+            for (int32_t j = 0; j < 3 * r; ++j)
+                f2 += U[j] * U[j];
+            umax = fmax(umax, sqrt(f2));
+        }
+        for (int32_t t = 0; t < v->ntrain; ++t) {
+            const double *q = v->train_q + (int64_t)v->rank_total * t + D->q_offset;
+            double n2 = 0;
+            for (int32_t j = 0; j < r; ++j)
+                n2 += q[j] * q[j];
+            qmax = fmax(qmax, sqrt(n2));
+        }
+        in->u_max[k] = umax;
+        in->q_bound[k] = SW_LIMIT_TRAIN * qmax;
+        if (umax > 0) in->q_bound[k] = fmax(in->q_bound[k], SW_LIMIT_SIZE * in->size / umax);
+    }
+}
+
 SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew_instance_def *def,
                                              sinew_instance **out) {
     if (!out) return SINEW_ERROR_INVALID_ARGUMENT;
@@ -271,6 +316,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->allocator = d.allocator;
     in->mode = d.mode;
     in->size = rest_size(v);
+    state_bounds(in);
     in->red.v = v;
     in->red.R = v->rank_total;
     in->red.rmax = z.rmax;
@@ -284,6 +330,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->wc.radius = 0.01 * in->size;
     sw_pose_space_link_twins(v, in->ps.twin_next);
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
+    in->solver.dq_tiny = 1e-9 * in->size;
     sw_solver_order_blocks(&in->solver, v);
     sinew_instance_reset(in);
     sw_log(&d.logger, SINEW_LOG_INFO, SINEW_MSG_INSTANCE_CREATED,
@@ -315,6 +362,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     for (int32_t b = 0; b < nb; ++b)
         sw_dq_from_transform(ph->T_cur + 12 * b, &inst->bone_dq[b]);
     ph->history = 0;
+    ph->h_prev = 0;
     sw_pose_space_reset(&inst->ps, nb);
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);

@@ -33,4 +33,14 @@ double sw_instance_potential(sinew_instance *inst, const double *q, double *g, d
 /* Evaluation only (O(N)): plain DQS of every simulation vertex at the current pose. */
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x);
 
+/* Evaluation only (O(N)): the output surface of the current pose with no correction
+ * (q = 0), the plain DQS surface the step's output deviates from (3 per surface vertex). */
+void sw_instance_skinned_surface(const sinew_instance *inst, double *x);
+
+/* The state's bounds (sinew_types.h, status flags): the largest distance of an output
+ * vertex from its skinned position the step allows, max_k max(4 u_k Q_k, L / 4), and
+ * the largest |q_k| / bound_k of the current state (<= 1). */
+double sw_instance_displacement_bound(const sinew_instance *inst);
+double sw_instance_bound_usage(const sinew_instance *inst);
+
 #endif

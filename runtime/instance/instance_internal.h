@@ -15,6 +15,10 @@ struct sinew_instance {
     sinew_allocator allocator; /* frees the block */
     sinew_step_mode mode;
     double size;             /* rest bounding-box diagonal */
+    double *bone_ball;       /* 4 nbones: the ball of the rest vertices each bone skins
+                                (centre, radius; radius -1: none), sw_pose_jump's */
+    double *q_bound;         /* ndomains: the largest |q_k| a step may leave (step.c) */
+    double *u_max;           /* ndomains: the largest |U_v|_F of a domain's vertex */
     sw_dualquat *bone_dq;    /* nbones: the current pose */
     sw_pose_history pose;    /* the current pose and the two before */
     sw_reduced red;          /* the subspace map and the evaluation accumulators */
@@ -24,6 +28,14 @@ struct sinew_instance {
     double *surf_x, *surf_n; /* 3 per output surface vertex each */
     sinew_step_stats stats;
 };
+
+/* The state's bounds (DESIGN.md §3, "never blow up"), per domain k with
+ * u_k = u_max[k], Q_k the largest |q_k| of the blob's training solutions and L = size:
+ *   |q_k| <= q_bound[k] = max(SW_LIMIT_TRAIN Q_k, SW_LIMIT_SIZE L / u_k),
+ * so no vertex copy's correction |U_v q_k| exceeds max(SW_LIMIT_TRAIN u_k Q_k,
+ * SW_LIMIT_SIZE L); and (dynamic) |qdot_k| u_k <= SW_JUMP_MAX_SPIN L. */
+#define SW_LIMIT_TRAIN 4.0
+#define SW_LIMIT_SIZE 0.25
 
 /* The output surface (positions and normals) of the state q (output.c). */
 void sw_instance_write_surface(sinew_instance *in);

@@ -115,3 +115,41 @@ double sw_instance_potential(sinew_instance *inst, const double *q, double *g, d
 void sw_instance_set_q(sinew_instance *inst, const double *q) {
     memcpy(inst->solver.q, q, (size_t)inst->red.R * sizeof(double));
 }
+
+void sw_instance_skinned_surface(const sinew_instance *inst, double *x) {
+    const sw_blob_view *v = inst->v;
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        double acc[3] = {0, 0, 0};
+        int32_t b = v->surf_copy_ptr[s], e = v->surf_copy_ptr[s + 1];
+        for (int32_t i = b; i < e; ++i) {
+            const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+            int32_t gv = v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
+            double R[9], t[3];
+            const double *X = v->rest + 3 * gv;
+            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            for (int k = 0; k < 3; ++k)
+                acc[k] += R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + t[k];
+        }
+        for (int k = 0; k < 3; ++k)
+            x[3 * s + k] = acc[k] / (double)(e - b);
+    }
+}
+
+double sw_instance_displacement_bound(const sinew_instance *inst) {
+    double D = 0;
+    for (int32_t k = 0; k < inst->v->ndomains; ++k)
+        D = fmax(D, inst->u_max[k] * inst->q_bound[k]);
+    return D;
+}
+
+double sw_instance_bound_usage(const sinew_instance *inst) {
+    double use = 0;
+    for (int32_t k = 0; k < inst->v->ndomains; ++k) {
+        const sw_blob_domain *D = &inst->v->domains[k];
+        double n2 = 0;
+        for (int32_t j = 0; j < D->rank; ++j)
+            n2 += inst->solver.q[D->q_offset + j] * inst->solver.q[D->q_offset + j];
+        if (inst->q_bound[k] > 0) use = fmax(use, sqrt(n2) / inst->q_bound[k]);
+    }
+    return use;
+}

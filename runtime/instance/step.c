@@ -12,6 +12,7 @@
  * Nothing here allocates, locks or touches a vertex that is not active: the cost follows
  * the cubature, contact and surface sizes, not the tet count. Each phase's wall time
  * and counts land in the step's stats. */
+#include <math.h>
 #include <string.h>
 
 #include "clock.h"
@@ -90,18 +91,21 @@ static void pose_space_start(sinew_instance *in) {
         in->solver.q[i] = (1 - in->ps.blend) * q0[i] + in->ps.blend * q1[i];
 }
 
-/* Dynamic: no inertia from a teleport, the inertial forces of the bones' motion, and
- * the Rayleigh stiffness H(q_n) frozen for the step. Quasistatic: the pose-space start. */
+/* A jump of the pose (sw_pose_jump: teleport, snap, or a small dt that implies a speed no
+ * joint makes) starts the pose history afresh in either mode: no velocity and no
+ * inertia are taken from it, and the world's broad phase does not reuse the last boxes.
+ * Dynamic: the inertial forces of the bones' motion, and the Rayleigh stiffness H(q_n)
+ * frozen for the step. Quasistatic: the pose-space start. */
 static void phase_dynamics(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_solver *s = &in->solver;
     int32_t R = in->red.R;
+    if (in->pose.history >= 1 && sw_pose_jump(in->v, &in->pose, in->bone_ball, in->size, c->dc.h)) {
+        memset(s->qdot, 0, (size_t)R * sizeof(double));
+        in->pose.history = 0;
+        c->st.status |= SINEW_STEP_TELEPORT;
+    }
     if (c->dc.dynamic) {
-        if (in->pose.history >= 1 && sw_pose_teleported(in->v, &in->pose, in->size)) {
-            memset(s->qdot, 0, (size_t)R * sizeof(double));
-            in->pose.history = 0;
-            c->st.status |= SINEW_STEP_TELEPORT;
-        }
         sw_inertial_forces(in->v, &in->pose, s, c->dc.h);
         sw_dyn_coef statics = c->dc;
         statics.dynamic = 0;
@@ -174,14 +178,49 @@ static sinew_result phase_solve(sw_step_ctx *c) {
     return r;
 }
 
-/* The velocity of the step (dynamic) and the pose history. */
+/* |x| of n doubles. */
+static double norm(const double *x, int32_t n) {
+    double s = 0;
+    for (int32_t i = 0; i < n; ++i)
+        s += x[i] * x[i];
+    return sqrt(s);
+}
+
+/* The state's bounds (instance_internal.h), the velocity of the step (dynamic) and the
+ * pose history. A domain whose |q_k| exceeds its bound is scaled back onto it (radially:
+ * the shape of the correction is kept, its size limited) and its velocity zeroed; a
+ * velocity beyond the speed bound is scaled down to it. Either flags LIMITED, and the
+ * output is written from the limited state. O(R). */
 static void phase_advance(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_solver *s = &in->solver;
-    if (c->dc.dynamic)
-        for (int32_t i = 0; i < in->red.R; ++i)
-            s->qdot[i] = (s->q[i] - s->qn[i]) / c->dc.h;
-    sw_pose_history_advance(&in->pose, in->v->nbones);
+    const sw_blob_view *v = in->v;
+    double vmax = SW_JUMP_MAX_SPIN * in->size;
+    int limited = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        int32_t o = v->domains[k].q_offset, r = v->domains[k].rank;
+        double *q = s->q + o, *qd = s->qdot + o, n = norm(q, r), B = in->q_bound[k];
+        int at_bound = !(n <= B);
+        if (at_bound) {
+            for (int32_t j = 0; j < r; ++j)
+                q[j] = n > 0 ? q[j] * (B / n) : 0;
+            limited = 1;
+        }
+        if (!c->dc.dynamic) continue;
+        for (int32_t j = 0; j < r; ++j)
+            qd[j] = at_bound ? 0 : (q[j] - s->qn[o + j]) / c->dc.h;
+        double u = in->u_max[k] * norm(qd, r);
+        if (u > vmax) {
+            for (int32_t j = 0; j < r; ++j)
+                qd[j] *= vmax / u;
+            limited = 1;
+        }
+    }
+    if (limited) {
+        c->st.status |= SINEW_STEP_LIMITED;
+        c->written = 0;
+    }
+    sw_pose_history_advance(&in->pose, v->nbones, c->dc.h);
     c->st.ms_dynamics += lap(c);
 }
 

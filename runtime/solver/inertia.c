@@ -21,19 +21,26 @@ static void angular_velocity(const double *Ta, const double *Tb, double h, doubl
 void sw_inertial_forces(const sw_blob_view *v, const sw_pose_history *ph, sw_solver *s, double h) {
     memset(s->fin, 0, (size_t)v->rank_total * sizeof(double));
     if (ph->history < 1) return;
+    const double hp = ph->history >= 2 ? ph->h_prev : h;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         int32_t b = D->bone, r = D->rank, o = D->q_offset;
         const double *Tc = ph->T_cur + 12 * b, *Tp = ph->T_prev + 12 * b,
                      *Tq = ph->T_prev2 + 12 * b;
         double acc[3], c[3], w1[3], w0[3], al[3];
-        for (int i = 0; i < 3; ++i)
-            acc[i] = ph->history >= 2 ? (Tc[9 + i] - 2 * Tp[9 + i] + Tq[9 + i]) / (h * h) : 0.0;
+        for (int i = 0; i < 3; ++i) {
+            if (ph->history < 2)
+                acc[i] = 0.0;
+            else if (hp == h) /* the uniform formula, bitwise as before */
+                acc[i] = (Tc[9 + i] - 2 * Tp[9 + i] + Tq[9 + i]) / (h * h);
+            else
+                acc[i] = ((Tc[9 + i] - Tp[9 + i]) / h - (Tp[9 + i] - Tq[9 + i]) / hp) / h;
+        }
         for (int i = 0; i < 3; ++i)
             c[i] = Tc[i] * acc[0] + Tc[3 + i] * acc[1] + Tc[6 + i] * acc[2];
         angular_velocity(Tp, Tc, h, w1);
         if (ph->history >= 2)
-            angular_velocity(Tq, Tp, h, w0);
+            angular_velocity(Tq, Tp, hp, w0);
         else
             memcpy(w0, w1, sizeof w0);
         for (int i = 0; i < 3; ++i)
@@ -63,21 +70,30 @@ void sw_inertial_forces(const sw_blob_view *v, const sw_pose_history *ph, sw_sol
     }
 }
 
-int sw_pose_teleported(const sw_blob_view *v, const sw_pose_history *ph, double size) {
+unsigned sw_pose_jump(const sw_blob_view *v, const sw_pose_history *ph, const double *ball,
+                      double size, double h) {
+    unsigned why = 0;
     for (int32_t b = 0; b < v->nbones; ++b) {
-        const double *Tc = ph->T_cur + 12 * b, *Tp = ph->T_prev + 12 * b;
-        double d2 = 0, tr = 0;
-        for (int i = 0; i < 3; ++i)
-            d2 += (Tc[9 + i] - Tp[9 + i]) * (Tc[9 + i] - Tp[9 + i]);
-        for (int i = 0; i < 3; ++i)
-            tr += Tc[i] * Tp[i] + Tc[3 + i] * Tp[3 + i] + Tc[6 + i] * Tp[6 + i];
-        if (d2 > 0.25 * size * size || tr < 0.0) return 1; /* > half size, > 90 deg */
+        const double *Tc = ph->T_cur + 12 * b, *Tp = ph->T_prev + 12 * b, *c = ball + 4 * b;
+        if (c[3] < 0) continue; /* skins nothing */
+        double s2 = 0, m[3];
+        for (int i = 0; i < 9; ++i) /* |R_cur - R_prev|_F^2 = 8 sin^2(theta / 2) */
+            s2 += (Tc[i] - Tp[i]) * (Tc[i] - Tp[i]);
+        for (int i = 0; i < 3; ++i) /* the ball centre's motion */
+            m[i] = (Tc[3 * i] - Tp[3 * i]) * c[0] + (Tc[3 * i + 1] - Tp[3 * i + 1]) * c[1] +
+                   (Tc[3 * i + 2] - Tp[3 * i + 2]) * c[2] + Tc[9 + i] - Tp[9 + i];
+        double sh = sqrt(s2 / 8), theta = 2 * asin(sh < 1 ? sh : 1), /* |dR|_2 = 2 sin */
+            d = sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]) + 2 * sh * c[3];
+        if (s2 > 6.0) why |= SW_JUMP_ANGLE; /* cos theta < -1/2: > 120 degrees */
+        if (d > 0.5 * size) why |= SW_JUMP_DISTANCE;
+        if (theta > SW_JUMP_MAX_SPIN * h || d > SW_JUMP_MAX_SPIN * size * h) why |= SW_JUMP_SPEED;
     }
-    return 0;
+    return why;
 }
 
-void sw_pose_history_advance(sw_pose_history *ph, int32_t nbones) {
+void sw_pose_history_advance(sw_pose_history *ph, int32_t nbones, double h) {
     memcpy(ph->T_prev2, ph->T_prev, 12 * (size_t)nbones * sizeof(double));
     memcpy(ph->T_prev, ph->T_cur, 12 * (size_t)nbones * sizeof(double));
     if (ph->history < 2) ph->history++;
+    ph->h_prev = h;
 }

@@ -130,16 +130,47 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     return d;
 }
 
-/** Status flags of a step (sinew_step_stats.status). */
-#define SINEW_STEP_CONVERGED 1u /**< Newton reached its tolerance */
-#define SINEW_STEP_GUARD 2u     /**< the energy guard stopped Newton early (best iterate kept) */
-#define SINEW_STEP_TELEPORT 4u  /**< the pose jumped: no inertia taken from that jump */
-#define SINEW_STEP_FAILED 8u    /**< non-finite state: the step was undone */
+/** Status flags of a step (sinew_step_stats.status). Any combination may be set; a step
+ * that returned SINEW_OK left a finite state within the bounds below, whatever it flags.
+ *
+ * The bounds (L the rest bounding-box diagonal of the blob, q_k domain k's reduced
+ * coordinates, u_k the largest norm of its basis rows, Q_k the largest |q_k| of the
+ * blob's training solutions):
+ *  - |q_k| <= max(4 Q_k, L / (4 u_k)): no vertex strays further from its skinned position
+ *    than max(4 u_k Q_k, L / 4) (four times the largest correction the bake trained, at
+ *    least a quarter of the size), so the elastic energy is bounded too;
+ *  - dynamic: the flesh's speed relative to its bone, u_k |dq_k/dt| <= 200 L per second.
+ * A pose jump (SINEW_STEP_TELEPORT) is any bone, between the last step's pose and this
+ * one, turning by more than 120 degrees, moving a rest point it skins by more than L / 2,
+ * or implying a joint spin above 200 rad/s (no human joint exceeds ~140 rad/s) or a
+ * point speed above 200 L/s at this dt; a 5 degree change over dt = 1e-6 s is one.
+ * Poses are checked by sinew_instance_set_pose before any step: a non-finite value gives
+ * SINEW_ERROR_NOT_FINITE, a rotation part that is not orthonormal within 1e-3 (scale,
+ * shear) or is a reflection gives SINEW_ERROR_INVALID_ARGUMENT; either way the pose and
+ * the state stay as they were. */
+/** Newton stopped at a solution: its gradient fell below 1e-5 of the step's first (or
+ * was zero), the last update moved the shape by less than 0.3% of its correction, or the
+ * predicted decrease of a further update is below the energy's rounding (a state already
+ * at its minimum, e.g. a step at rest, converges with 0 iterations). */
+#define SINEW_STEP_CONVERGED 1u
+/** the energy guard stopped Newton before convergence: no step along the Newton direction
+ * (halved up to five times) lowered the energy; the best iterate is kept */
+#define SINEW_STEP_GUARD 2u
+/** the pose jumped (see above): the velocity was zeroed and the pose history restarted,
+ * so no inertia is taken from the jump; the flesh keeps its shape relative to the bones
+ * and settles from there */
+#define SINEW_STEP_TELEPORT 4u
+/** non-finite state: the step was undone (the call returns SINEW_ERROR_NOT_FINITE) */
+#define SINEW_STEP_FAILED 8u
 /** quasistatic: started from the pose-space blend of training solutions */
 #define SINEW_STEP_POSE_SPACE 16u
 /** a budget of the instance def ran out (budget_exceeded says which): the step did what
  * fit */
 #define SINEW_STEP_BUDGET 32u
+/** the solve left the bounds above and the state was limited: a domain's coordinates
+ * scaled back onto their bound (its velocity zeroed), or a velocity scaled down to the
+ * speed bound; the output is the limited state */
+#define SINEW_STEP_LIMITED 64u
 
 /** Budgets of an instance (sinew_step_stats.budget_exceeded bits). */
 #define SINEW_BUDGET_CONTACT_PAIRS 1u  /**< sinew_instance_def.max_contact_pairs */
