@@ -110,26 +110,6 @@ static void usage(FILE *f) {
             "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
 }
 
-/* mkdir -p: creates dir and its missing parents; 1 when dir is a writable folder
- * afterwards. */
-static int make_dirs(const char *dir) {
-    char path[4096];
-    size_t n = strlen(dir);
-    if (n == 0 || n >= sizeof path) return 0;
-    memcpy(path, dir, n + 1);
-    for (size_t i = 1; i <= n; ++i)
-        if (path[i] == '/' || path[i] == '\0') {
-            char c = path[i];
-            path[i] = '\0';
-            if (mkdir(path, 0777) != 0 && errno != EEXIST) return 0;
-            path[i] = c;
-        }
-    struct stat st;
-    if (stat(dir, &st) != 0) return 0;
-    if (!S_ISDIR(st.st_mode)) return (errno = ENOTDIR), 0;
-    return access(dir, W_OK | X_OK) == 0;
-}
-
 /* Plain DQS of the render surface (positions and area-weighted normals): the cost a
  * host pays today, timed per frame over the clip. */
 static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames,
@@ -238,7 +218,7 @@ int main(int argc, char **argv) {
     if (world_path && !sw_tool_format(tool, "--world", world_path, "json", ".json (world file)"))
         return 2;
     /* the output folder before the long run: an unwritable one is an error now */
-    if (out_dir && !make_dirs(out_dir)) {
+    if (out_dir && !sw_tool_make_dirs(out_dir)) {
         fprintf(stderr, "%s: --out '%s': cannot create or write the folder: %s\n", tool, out_dir,
                 strerror(errno ? errno : EACCES));
         return 1;

@@ -142,23 +142,6 @@ static int parse_args(int argc, char **argv, options *o) {
            sw_tool_format("sinew-fullsim", "--world", o->world, "json", ".json (world file)");
 }
 
-/* mkdir -p: creates dir and its missing parents; 1 when dir exists afterwards. */
-static int make_dirs(const char *dir) {
-    char path[4096];
-    size_t n = strlen(dir);
-    if (n == 0 || n >= sizeof path) return 0;
-    memcpy(path, dir, n + 1);
-    for (size_t i = 1; i <= n; ++i)
-        if (path[i] == '/' || path[i] == '\0') {
-            char c = path[i];
-            path[i] = '\0';
-            if (mkdir(path, 0777) != 0 && errno != EEXIST) return 0;
-            path[i] = c;
-        }
-    struct stat st;
-    return stat(dir, &st) == 0 && S_ISDIR(st.st_mode);
-}
-
 /* Writes the simulator's surface at positions x as an OBJ of the surface vertices. */
 static int write_frame(const char *dir, int frame, const sw_surface *s, const double *x,
                        double *scratch, int32_t *tris, sw_error *err) {
@@ -226,7 +209,7 @@ int main(int argc, char **argv) {
     double *scratch = NULL;
     int32_t *tris = NULL;
     if (o.out_dir) {
-        if (!make_dirs(o.out_dir)) {
+        if (!sw_tool_make_dirs(o.out_dir)) {
             fprintf(stderr, "sinew-fullsim: cannot create output folder '%s': %s\n", o.out_dir,
                     strerror(errno));
             sw_fullsim_destroy(sim);

@@ -8,6 +8,8 @@
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
+#include <sys/stat.h>
+#include <unistd.h>
 
 #include "sinew/sinew.h"
 #include "sw_error.h"
@@ -53,6 +55,27 @@ static inline int sw_tool_real(const char *tool, const char *flag, const char *s
     }
     fprintf(stderr, "%s: %s wants a number %s, got '%s'\n", tool, flag, range, s ? s : "(nothing)");
     return 0;
+}
+
+/* mkdir -p: creates dir and its missing parents; 1 when dir is a writable folder
+ * afterwards, else 0 with errno saying why (the tools check an output folder before a long
+ * run). */
+static inline int sw_tool_make_dirs(const char *dir) {
+    char path[4096];
+    size_t n = strlen(dir);
+    if (n == 0 || n >= sizeof path) return (errno = ENAMETOOLONG), 0;
+    memcpy(path, dir, n + 1);
+    for (size_t i = 1; i <= n; ++i)
+        if (path[i] == '/' || path[i] == '\0') {
+            char c = path[i];
+            path[i] = '\0';
+            if (mkdir(path, 0777) != 0 && errno != EEXIST) return 0;
+            path[i] = c;
+        }
+    struct stat st;
+    if (stat(dir, &st) != 0) return 0;
+    if (!S_ISDIR(st.st_mode)) return (errno = ENOTDIR), 0;
+    return access(dir, W_OK | X_OK) == 0;
 }
 
 /* 1 when path ends (case-insensitively) with one of the space-separated extensions in

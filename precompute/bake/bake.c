@@ -238,23 +238,28 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
     return SINEW_OK;
 }
 
+/* The start of every bake: the parameters checked, the state prepared (weights by heat
+ * diffusion when the character has none) and the worker pool started. On an error the
+ * caller frees the state (free_state) as after any stage. */
+static sinew_result bake_begin(sw_bake_state *s, const sw_bake_params *p, const sw_character *c,
+                               sw_error *err) {
+    memset(s, 0, sizeof *s);
+    s->p = p;
+    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
+    sinew_result r = check_params(p, err);
+    if (r == SINEW_OK) r = prepare(s, c, c->weights.w == NULL, err);
+    if (r == SINEW_OK && !(s->pool = sw_pool_create(p->threads)))
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
+    return r;
+}
+
 sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *params,
                                sw_bake_result *out, sw_error *err) {
     memset(out, 0, sizeof *out);
     sw_bake_params p = params ? *params : sw_bake_params_default();
-    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
-    sinew_result r = check_params(&p, err);
-    if (r != SINEW_OK) return r;
     sw_bake_state s;
-    memset(&s, 0, sizeof s);
-    s.p = &p;
-    if ((r = prepare(&s, c, c->weights.w == NULL, err)) != SINEW_OK) goto done;
-    if (!(s.pool = sw_pool_create(p.threads))) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
-        goto done;
-    }
-    r = solve_poses(&s, out, err);
-done:
+    sinew_result r = bake_begin(&s, &p, c, err);
+    if (r == SINEW_OK) r = solve_poses(&s, out, err);
     free_state(&s);
     if (r != SINEW_OK) sw_bake_result_free(out);
     return r;
@@ -276,19 +281,11 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
                      sw_error *err) {
     memset(out, 0, sizeof *out);
     sw_bake_params p = params ? *params : sw_bake_params_default();
-    if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
-    sinew_result r = check_params(&p, err);
-    if (r != SINEW_OK) return r;
     sw_bake_state s;
-    memset(&s, 0, sizeof s);
-    s.p = &p;
     double t0 = sw_now_seconds(), t1;
+    sinew_result r = bake_begin(&s, &p, c, err);
+    if (r != SINEW_OK) goto done;
     int heat = c->weights.w == NULL;
-    if ((r = prepare(&s, c, heat, err)) != SINEW_OK) goto done;
-    if (!(s.pool = sw_pool_create(p.threads))) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
-        goto done;
-    }
     t1 = sw_now_seconds();
     out->stage_seconds[0] = t1 - t0;
     progress(&p, "prepare", t1 - t0, heat ? "heat-diffusion weights" : "asset weights");
