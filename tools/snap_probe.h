@@ -11,20 +11,7 @@
 
 #include "blob_load.h"
 #include "instance.h"
-
-/* Row-major rotation by `angle` radians about the unit axis a. */
-static inline void snap_axis_angle(const double a[3], double angle, double R[9]) {
-    double c = cos(angle), s = sin(angle), C = 1 - c;
-    R[0] = c + a[0] * a[0] * C;
-    R[1] = a[0] * a[1] * C - a[2] * s;
-    R[2] = a[0] * a[2] * C + a[1] * s;
-    R[3] = a[1] * a[0] * C + a[2] * s;
-    R[4] = c + a[1] * a[1] * C;
-    R[5] = a[1] * a[2] * C - a[0] * s;
-    R[6] = a[2] * a[0] * C - a[1] * s;
-    R[7] = a[2] * a[1] * C + a[0] * s;
-    R[8] = c + a[2] * a[2] * C;
-}
+#include "mat3.h"
 
 /* y = T x for a transform T (12: R row-major, t). */
 static inline void snap_apply(const double *T, const double x[3], double y[3]) {
@@ -61,7 +48,7 @@ static inline void snap_rotate(const sw_blob_view *v, const double *T, int32_t b
     for (int i = 0; i < 3; ++i)
         ax[i] = n > 0 ? ax[i] / n : (i == 2);
     double Q[9];
-    snap_axis_angle(ax, angle, Q);
+    sw_m3_axis_angle(ax, angle, Q);
     memcpy(out, T, 12 * (size_t)v->nbones * sizeof(double));
     for (int32_t b = 0; b < v->nbones; ++b) {
         if (!snap_in_subtree(v, b, bone)) continue;

@@ -15,6 +15,7 @@
 
 #include "bake_internal.h"
 #include "fullsim.h"
+#include "mat3.h"
 #include "vec3.h"
 
 /* Rotation part of a clip's bone transform relative to its parent: L = R_p^T R_b. */
@@ -52,19 +53,6 @@ static double rotation_axis_angle(const double R[9], double axis[3]) {
     for (int i = 0; i < 3; ++i)
         axis[i] = a[i] / n;
     return angle;
-}
-
-static void rotation_from_axis_angle(const double k[3], double angle, double R[9]) {
-    double c = cos(angle), s = sin(angle), C = 1 - c;
-    R[0] = c + k[0] * k[0] * C;
-    R[1] = k[0] * k[1] * C - k[2] * s;
-    R[2] = k[0] * k[2] * C + k[1] * s;
-    R[3] = k[1] * k[0] * C + k[2] * s;
-    R[4] = c + k[1] * k[1] * C;
-    R[5] = k[1] * k[2] * C - k[0] * s;
-    R[6] = k[2] * k[0] * C - k[1] * s;
-    R[7] = k[2] * k[1] * C + k[0] * s;
-    R[8] = c + k[2] * k[2] * C;
 }
 
 static int seq_alloc(sw_pose_seq *q, int32_t npose, int32_t nb, int32_t nv) {
@@ -187,8 +175,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
                 memset(L, 0, 9 * sizeof(double));
                 L[0] = L[4] = L[8] = 1;
             }
-            rotation_from_axis_angle(sweep_axis + 3 * b, sweep_angle[b] * (i + 1) / n,
-                                     local + 9 * b);
+            sw_m3_axis_angle(sweep_axis + 3 * b, sweep_angle[b] * (i + 1) / n, local + 9 * b);
             sw_forward_kinematics(sk, local, NULL, s->train[qi].T + (size_t)i * 12 * nb);
         }
         qi++;
@@ -216,7 +203,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
         for (int32_t i = 0; i < n; ++i) {
             for (int32_t k = 0; k < nb; ++k) {
                 double u = (double)(splitmix(&seed) >> 11) * 0x1.0p-53;
-                rotation_from_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
+                sw_m3_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
                 if (!(sweep_angle[k] > 0)) {
                     memset(local + 9 * k, 0, 9 * sizeof(double));
                     local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;

@@ -38,4 +38,18 @@ static inline void sw_m3_identity(double A[9]) {
         A[i] = (i % 4 == 0) ? 1.0 : 0.0;
 }
 
+/* The rotation by `angle` radians about the unit axis k (Rodrigues), row-major. */
+static inline void sw_m3_axis_angle(const double k[3], double angle, double R[9]) {
+    double c = cos(angle), s = sin(angle), C = 1 - c;
+    R[0] = c + k[0] * k[0] * C;
+    R[1] = k[0] * k[1] * C - k[2] * s;
+    R[2] = k[0] * k[2] * C + k[1] * s;
+    R[3] = k[1] * k[0] * C + k[2] * s;
+    R[4] = c + k[1] * k[1] * C;
+    R[5] = k[1] * k[2] * C - k[0] * s;
+    R[6] = k[2] * k[0] * C - k[1] * s;
+    R[7] = k[2] * k[1] * C + k[0] * s;
+    R[8] = c + k[2] * k[2] * C;
+}
+
 #endif
