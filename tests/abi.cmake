@@ -35,6 +35,27 @@ add_test(NAME abi_exports_rejects_violations
           "'sinew_result_string' is declared SINEW_API in a public header but not exported"
           "SONAME is 'libsinew_bad.so.9', expected 'libsinew.so.")
 
+# --- imports of the shared library against the committed allow-list ------------------
+# tests/abi/libsinew.imports lists what libsinew.so may import (sanitizer builds add
+# their runtimes' entry points); the negative control is a stand-in that imports stdio
+# and lock functions it must not.
+set(SW_ABI_IMPORTS ${SW_ABI_DIR}/libsinew.imports)
+set(SW_ABI_IMPORTS_EXTRA)
+if(SINEW_SANITIZE)
+  list(APPEND SW_ABI_IMPORTS_EXTRA ${SW_ABI_DIR}/libsinew.imports.sanitize)
+endif()
+add_test(NAME abi_imports
+  COMMAND sh ${SW_ABI_DIR}/check_imports.sh $<TARGET_FILE:sinew> ${SW_ABI_IMPORTS}
+          ${SW_ABI_IMPORTS_EXTRA})
+add_library(sw_abi_bad_imports SHARED ${SW_ABI_DIR}/bad_imports.c)
+target_link_libraries(sw_abi_bad_imports PRIVATE Threads::Threads)
+set_target_properties(sw_abi_bad_imports PROPERTIES OUTPUT_NAME sinew_bad_imports)
+add_test(NAME abi_imports_rejects_violations
+  COMMAND sh ${SW_ABI_DIR}/expect_violations.sh ${SW_ABI_DIR}/check_imports.sh
+          $<TARGET_FILE:sw_abi_bad_imports> ${SW_ABI_IMPORTS}
+          "'fopen' (not in" "'fclose' (not in" "'pthread_spin_lock' (not in"
+          "'pthread_spin_unlock' (not in")
+
 # --- the header in strict C: C99 and C11 against the shared library, C99 static -------
 # C_STANDARD on the target overrides the project-wide CMAKE_C_STANDARD 17; the source
 # checks __STDC_VERSION__ against SW_ABI_EXPECT_STDC, so a lost override fails the build.
@@ -77,7 +98,8 @@ set_target_properties(abi_host_soname PROPERTIES
   C_STANDARD 99 C_STANDARD_REQUIRED ON C_EXTENSIONS OFF)
 add_test(NAME abi_host_soname COMMAND abi_host_soname)
 
-set_tests_properties(abi_exports abi_exports_rejects_violations abi_header_c99
+set_tests_properties(abi_exports abi_exports_rejects_violations abi_imports
+  abi_imports_rejects_violations abi_header_c99
   abi_header_c11 abi_static_c99 abi_header_cxx abi_host_soname
   PROPERTIES LABELS abi TIMEOUT 60)
 

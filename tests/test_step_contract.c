@@ -1,444 +1,551 @@
-/* The runtime's contract (DESIGN.md §3): no allocation and no lock inside the step
- * (counted by the interposer over 10,000 steps after warm-up), identical output for
- * identical runs, clear errors for bad input with the state kept, and an instance that
- * recovers from them; its memory is one planned block, its budgets are reported when they
- * run out, and every phase of a step reports its figures. */
+/* The runtime's real-time contract (DESIGN.md §3): sinew_instance_step and everything it
+ * calls never allocates and never takes a lock, and all memory is reserved at creation,
+ * through the host's allocator when it gives one. One counted run of a few hundred steps
+ * drives every path of the step and asserts that each was taken (by the status flags and
+ * the stats): quasistatic and dynamic, the pose-space start, teleports by translation and
+ * by a rotation snap, the state bounds (LIMITED), the energy guard (GUARD), a failed
+ * step (FAILED), the contact pair and world contact budgets (BUDGET), a reset between
+ * steps, and a collision world whose collider moves every step. Every return code is
+ * checked; the interposer (tools/rt_interpose.h) counts allocations, frees, mappings and
+ * locks over all of it, and the host allocator counts its own calls.
+ *
+ * Built twice from this source: test_step_contract against the static library, and
+ * test_step_contract_shared (SW_CONTRACT_SHARED) against libsinew.so, whose executable
+ * holds no runtime code of its own (contract_fixture.h) and proves that the interposer
+ * sees the shared library's calls.
+ *
+ * A category the interposer cannot observe in this build (sanitizer builds: mappings and
+ * locks) is never dropped silently: every check that can run runs, then the contract
+ * case SKIPs naming what it could not count, and CTest reports the test as skipped
+ * (SKIP_REGULAR_EXPRESSION in tests/CMakeLists.txt). In a normal glibc build every
+ * category must be observable, or the test fails. */
+#define _GNU_SOURCE /* dladdr */
+
+#include <dlfcn.h>
 #include <math.h>
 #include <stdint.h>
 
-#include "bake_fixture.h"
+#include "contract_fixture.h"
 #include "rt_interpose.h"
+#include "sinew/sinew_world.h"
 #include "sw_test.h"
 
-static bake_fixture fx;
+#if defined(SW_CONTRACT_SHARED)
+#define VARIANT "libsinew.so"
+#else
+#define VARIANT "static"
+#include "bake_fixture.h"
+#include "instance.h" /* sw_instance_set_q: the failed step's state (see the FAILED path) */
+#endif
+
+#if defined(__SANITIZE_ADDRESS__) || defined(__SANITIZE_THREAD__)
+#define SANITIZED 1
+#elif defined(__has_feature)
+#if __has_feature(address_sanitizer) || __has_feature(thread_sanitizer)
+#define SANITIZED 1
+#endif
+#endif
+
+static contract_fixture fx;
 static int fx_ok = -1;
 
-static const bake_fixture *fixture(void) {
-    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 2000, 12, 1);
+static const contract_fixture *fixture(void) {
+    if (fx_ok >= 0) return fx_ok ? &fx : NULL;
+#if defined(SW_CONTRACT_SHARED)
+    fx_ok = contract_fixture_load(SINEW_BINARY_DIR "/tests/contract_fixture", &fx);
+    if (!fx_ok)
+        fprintf(stderr,
+                "  no fixture in %s/tests/contract_fixture (the CTest fixture "
+                "contract_fixture_write makes it)\n",
+                SINEW_BINARY_DIR);
+#else
+    bake_fixture b;
+    fx_ok = bake_fixture_make(&b, "finger", 2000, 12, 1);
+    if (!fx_ok) return NULL;
+    memset(&fx, 0, sizeof fx);
+    fx.nb = (uint32_t)b.ch.skel.nbones;
+    fx.frames = b.ch.clip.nframes;
+    fx.size = b.size;
+    fx.data = malloc(b.size);
+    fx.poses = malloc(sizeof(float) * 12 * fx.nb * (size_t)fx.frames);
+    fx_ok = fx.data && fx.poses;
+    if (fx_ok) {
+        memcpy(fx.data, b.data, b.size);
+        for (int k = 0; k < fx.frames; ++k)
+            bake_fixture_pose(&b, k, fx.poses + (size_t)12 * fx.nb * k);
+        fx_ok = contract_fixture_from_bytes(&fx);
+    }
+    bake_fixture_free(&b);
+#endif
     return fx_ok ? &fx : NULL;
 }
 
-/* FNV-1a over float outputs: a bitwise fingerprint of a run. */
-static uint64_t hash_floats(uint64_t h, const float *x, size_t n) {
-    const unsigned char *p = (const unsigned char *)x;
-    for (size_t i = 0; i < n * sizeof(float); ++i)
-        h = (h ^ p[i]) * 0x100000001b3ULL;
-    return h;
+static const float *clip_pose(const contract_fixture *f, int k) {
+    return f->poses + (size_t)12 * f->nb * (size_t)(k % f->frames);
 }
 
-static uint64_t run_hash(sinew_step_mode mode, int steps) {
-    const bake_fixture *f = fixture();
-    sinew_instance_def d = sinew_instance_def_default();
-    d.mode = mode;
-    sinew_instance *inst;
-    if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
-    uint32_t ns = sinew_blob_surface_vertex_count(f->blob);
-    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones),
-          *x = malloc(sizeof(float) * 3 * ns);
-    uint64_t h = 0xcbf29ce484222325ULL;
-    for (int s = 0; s < steps; ++s) {
-        bake_fixture_pose(f, s, pose);
-        sinew_instance_set_pose(inst, pose, (uint32_t)f->ch.skel.nbones);
-        sinew_instance_step(inst, 1.0f / 30);
-        sinew_instance_read_surface(inst, x, NULL, ns);
-        h = hash_floats(h, x, 3 * ns);
-    }
-    free(pose);
-    free(x);
-    sinew_instance_destroy(inst);
-    return h;
+static const char *describe(const sw_rt_counts *c) {
+    static char buf[1024];
+    return sw_rt_counts_describe(c, buf, sizeof buf);
 }
 
-static void count_steps(sinew_step_mode mode) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    unsigned active = sw_rt_interpose_active(); /* outside the counted section */
-    sinew_instance_def d = sinew_instance_def_default();
-    d.mode = mode;
-    sinew_instance *inst;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
-    uint32_t ns = sinew_blob_surface_vertex_count(f->blob), nb = (uint32_t)f->ch.skel.nbones;
-    int frames = f->ch.clip.nframes;
-    float *poses = malloc(sizeof(float) * 12 * nb * frames), *x = malloc(sizeof(float) * 3 * ns),
-          *n = malloc(sizeof(float) * 3 * ns);
-    for (int k = 0; k < frames; ++k)
-        bake_fixture_pose(f, k, poses + (size_t)12 * nb * k);
-    for (int s = 0; s < 20; ++s) { /* warm-up */
-        sinew_instance_set_pose(inst, poses + (size_t)12 * nb * (s % frames), nb);
-        sinew_instance_step(inst, 1.0f / 30);
-    }
-    sinew_step_stats st;
-    st.struct_size = sizeof st;
-    sw_rt_count_begin();
-    for (int s = 0; s < 10000; ++s) {
-        sinew_instance_set_pose(inst, poses + (size_t)12 * nb * (s % frames), nb);
-        sinew_instance_step(inst, 1.0f / 30);
-        sinew_instance_read_surface(inst, x, n, ns);
-        sinew_instance_get_stats(inst, &st);
-    }
-    sw_rt_counts c = sw_rt_count_end();
-    char buf[512];
-    fprintf(stderr, "    10000 steps: %s\n", sw_rt_counts_describe(&c, buf, sizeof buf));
-    if (active & SW_RT_CAT_ALLOCS) ENSUREF(c.allocs == 0, "%s", buf);
-    if (active & SW_RT_CAT_FREES) ENSUREF(c.frees == 0, "%s", buf);
-    if (active & SW_RT_CAT_MAPS) ENSUREF(c.maps == 0, "%s", buf);
-    if (active & SW_RT_CAT_LOCKS) ENSUREF(c.locks == 0, "%s", buf);
-    if (!(active & SW_RT_CAT_LOCKS)) fprintf(stderr, "    (locks not observable in this build)\n");
-    free(poses);
-    free(x);
-    free(n);
-    sinew_instance_destroy(inst);
-}
-
-TEST(quasistatic_step_allocates_and_locks_nothing) {
-    count_steps(SINEW_STEP_QUASISTATIC);
-}
-TEST(dynamic_step_allocates_and_locks_nothing) {
-    count_steps(SINEW_STEP_DYNAMIC);
-}
-
-TEST(identical_runs_give_identical_output) {
-    ENSURE(fixture());
-    uint64_t a = run_hash(SINEW_STEP_QUASISTATIC, 40), b = run_hash(SINEW_STEP_QUASISTATIC, 40);
-    uint64_t c = run_hash(SINEW_STEP_DYNAMIC, 40), d = run_hash(SINEW_STEP_DYNAMIC, 40);
-    ENSURE(a != 0 && a == b);
-    ENSURE(c != 0 && c == d);
-    ENSURE(a != c); /* the two modes really differ */
-}
-
-TEST(bad_input_is_rejected_and_state_kept) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    sinew_instance *inst;
-    sinew_instance_def d = sinew_instance_def_default();
-    ENSURE(sinew_instance_create(NULL, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    d.mode = (sinew_step_mode)7;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    d = sinew_instance_def_default();
-    d.struct_size = 2;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
-    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
-    float *pose = malloc(sizeof(float) * 12 * nb), *x0 = malloc(sizeof(float) * 3 * ns),
-          *x1 = malloc(sizeof(float) * 3 * ns);
-    bake_fixture_pose(f, 4, pose);
-    ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
-    for (int k = 0; k < 10; ++k) /* converged: a repeated step leaves the shape */
-        ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
-    ENSURE(sinew_instance_read_surface(inst, x0, NULL, ns) == SINEW_OK);
-    /* wrong counts, NaN, a non-rigid transform, absurd dt: errors, nothing changes */
-    ENSURE(sinew_instance_set_pose(inst, pose, nb + 1) == SINEW_ERROR_INVALID_ARGUMENT);
-    pose[5] = NAN;
-    ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_ERROR_NOT_FINITE);
-    bake_fixture_pose(f, 4, pose);
-    pose[0] = 3.0f;
-    ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_step(inst, 0.0f) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_step(inst, NAN) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_step(inst, 1e6f) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_read_surface(inst, x1, NULL, ns + 1) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_read_surface(inst, x1, NULL, ns) == SINEW_OK);
-    ENSURE(memcmp(x0, x1, sizeof(float) * 3 * ns) == 0);
-    /* the instance goes on: the same pose again gives the same result */
-    bake_fixture_pose(f, 4, pose);
-    ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
-    ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
-    ENSURE(sinew_instance_read_surface(inst, x1, NULL, ns) == SINEW_OK);
-    for (uint32_t i = 0; i < 3 * ns; ++i)
-        ENSURE(isfinite(x1[i]) && fabsf(x1[i] - x0[i]) < 1e-3f);
-    free(pose);
-    free(x0);
-    free(x1);
-    sinew_instance_destroy(inst);
-}
-
-TEST(teleport_gives_a_status_and_a_finite_state) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    sinew_instance_def d = sinew_instance_def_default();
-    d.mode = SINEW_STEP_DYNAMIC;
-    sinew_instance *inst;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
-    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
-    float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 3 * ns);
-    for (int s = 0; s < 5; ++s) {
-        bake_fixture_pose(f, s, pose);
-        sinew_instance_set_pose(inst, pose, nb);
-        ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
-    }
-    for (uint32_t b = 0; b < nb; ++b)
-        pose[12 * b + 9] += 1000.0f; /* jump far away */
-    ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
-    ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
-    sinew_step_stats st;
-    st.struct_size = sizeof st;
-    ENSURE(sinew_instance_get_stats(inst, &st) == SINEW_OK);
-    ENSURE(st.status & SINEW_STEP_TELEPORT);
-    ENSURE(sinew_instance_read_surface(inst, x, NULL, ns) == SINEW_OK);
-    for (uint32_t i = 0; i < 3 * ns; ++i)
-        ENSURE(isfinite(x[i]));
-    free(pose);
-    free(x);
-    sinew_instance_destroy(inst);
-}
-
-TEST(dynamic_flesh_overshoots_and_settles_when_the_clip_stops) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    sinew_instance_def d = sinew_instance_def_default();
-    d.mode = SINEW_STEP_DYNAMIC;
-    sinew_instance *dyn;
-    ENSURE(sinew_instance_create(f->blob, &d, &dyn) == SINEW_OK);
-    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
-    float *pose = malloc(sizeof(float) * 12 * nb), *a = malloc(sizeof(float) * 3 * ns),
-          *b = malloc(sizeof(float) * 3 * ns);
-    int peak = f->ch.clip.nframes / 2;
-    double after = 0, settled = 0;
-    for (int s = 0; s < peak + 150; ++s) { /* bend to the peak, then hold the pose */
-        bake_fixture_pose(f, s < peak ? s : peak, pose);
-        sinew_instance_set_pose(dyn, pose, nb);
-        ENSURE(sinew_instance_step(dyn, 1.0f / 30) == SINEW_OK);
-        memcpy(a, b, sizeof(float) * 3 * ns);
-        sinew_instance_read_surface(dyn, b, NULL, ns);
-        double move = 0; /* surface motion during this frame while the bones stand still */
-        for (uint32_t i = 0; i < 3 * ns; ++i)
-            move = fmax(move, fabs((double)a[i] - b[i]));
-        if (s >= peak + 1 && s <= peak + 3) after = fmax(after, move);
-        if (s == peak + 149) settled = move;
-    }
-    fprintf(stderr, "    surface motion per frame after the clip stops: %.3g, 5 s later %.3g\n",
-            after, settled);
-    ENSUREF(after > 1e-4, "the flesh stops dead with the bones (%.3g): no inertia", after);
-    ENSUREF(settled < 0.05 * after, "the flesh did not settle (%.3g -> %.3g)", after, settled);
-    free(pose);
-    free(a);
-    free(b);
-    sinew_instance_destroy(dyn);
-}
-
-static void cleanup(void) {
-    if (fx_ok > 0) bake_fixture_free(&fx);
-}
-
-/* ---- the memory plan, budgets, def checks and step figures ------------------------
- * Creation reserves exactly the bytes sinew_instance_memory_size reports, in one block
- * through the host allocator, and nothing else; a contact pair budget that runs out is
- * reported by the step (flag, budget bit, dropped count) and never grows; a bad def is
- * rejected with a logged reason; every phase's time and count is reported. */
+/* ---- the host allocator: counts its calls, serves aligned blocks ------------------ */
 
 typedef struct {
     int allocs, frees;
-    size_t last_size, last_align;
-} alloc_count;
+    size_t last_size, last_align, bytes;
+} host_heap;
 
-static void *count_alloc(size_t size, size_t align, void *user) {
-    alloc_count *a = user;
-    a->allocs++;
-    a->last_size = size;
-    a->last_align = align;
+static void *host_alloc(size_t size, size_t align, void *user) {
+    host_heap *h = user;
+    h->allocs++;
+    h->last_size = size;
+    h->last_align = align;
+    h->bytes += size;
     void *p = NULL;
-    return posix_memalign(&p, align, size) == 0 ? p : NULL;
+    return posix_memalign(&p, align < sizeof(void *) ? sizeof(void *) : align, size) == 0 ? p
+                                                                                          : NULL;
 }
 
-static void count_free(void *p, void *user) {
-    ((alloc_count *)user)->frees++;
+static void host_free(void *p, void *user) {
+    ((host_heap *)user)->frees++;
     free(p);
 }
 
+/* ---- the library itself, and the interposer seeing it ----------------------------- */
+
+/* Where a function's code lives: the file dladdr names for it. */
+static const char *object_of(void (*fn)(void)) {
+    Dl_info info;
+    void *p;
+    memcpy(&p, &fn, sizeof p);
+    return dladdr(p, &info) && info.dli_fname ? info.dli_fname : "?";
+}
+
+/* The run against libsinew.so must call libsinew.so, not a copy linked into the
+ * executable; and the interposer must count what the library calls (a positive control:
+ * creation with the default allocator allocates inside the library, destruction frees). */
+TEST(the_interposer_sees_the_librarys_own_calls) {
+    const contract_fixture *f = fixture();
+    ENSURE(f);
+    int active = sw_rt_interpose_active();
+    const char *lib = object_of((void (*)(void))sinew_instance_step);
+    const char *exe = object_of((void (*)(void))sw_rt_count_begin);
+    fprintf(stderr, "    %s: sinew_instance_step in %s, the interposer in %s, active mask %d\n",
+            VARIANT, lib, exe, active);
+#if defined(SW_CONTRACT_SHARED)
+    static void (*const api[])(void) = {(void (*)(void))sinew_instance_create,
+                                        (void (*)(void))sinew_instance_step,
+                                        (void (*)(void))sinew_instance_set_pose,
+                                        (void (*)(void))sinew_instance_reset,
+                                        (void (*)(void))sinew_instance_read_surface,
+                                        (void (*)(void))sinew_instance_get_stats,
+                                        (void (*)(void))sinew_instance_set_world,
+                                        (void (*)(void))sinew_world_create,
+                                        (void (*)(void))sinew_world_set_collider_transform,
+                                        (void (*)(void))sinew_blob_load};
+    for (size_t i = 0; i < sizeof api / sizeof api[0]; ++i)
+        ENSUREF(strstr(object_of(api[i]), "libsinew.so") != NULL,
+                "API function %zu resolves into %s, not libsinew.so", i, object_of(api[i]));
+    ENSUREF(strstr(exe, "libsinew.so") == NULL, "the interposer is in %s", exe);
+#endif
+    ENSURE(active & SW_RT_CAT_ALLOCS && active & SW_RT_CAT_FREES);
+    sinew_instance *inst = NULL;
+    sw_rt_count_begin();
+    sinew_result r = sinew_instance_create(f->blob, NULL, &inst); /* the default allocator */
+    sw_rt_counts made = sw_rt_count_end();
+    ENSURE(r == SINEW_OK && inst);
+    sw_rt_count_begin();
+    sinew_instance_destroy(inst);
+    sw_rt_counts gone = sw_rt_count_end();
+    fprintf(stderr, "    create: %s\n", describe(&made));
+    fprintf(stderr, "    destroy: %s\n", describe(&gone));
+    ENSUREF(made.allocs >= 1, "the library's allocation was not seen: %s", describe(&made));
+    ENSUREF(gone.frees >= 1, "the library's free was not seen: %s", describe(&gone));
+    if (active & SW_RT_DETAIL) /* the library's one call: posix_memalign (core/alloc.c) */
+        ENSUREF(made.by_fn[SW_RT_POSIX_MEMALIGN] == 1 && gone.by_fn[SW_RT_FREE] == 1, "%s",
+                describe(&made));
+}
+
+/* ---- every path of the step, counted ---------------------------------------------- */
+
+enum {
+    P_QUASISTATIC,  /* the clip, quasistatic: the pose-space start every step */
+    P_DYNAMIC,      /* the clip, dynamic */
+    P_TRANSLATE,    /* dynamic: every bone 1000 units away in one step, and back (TELEPORT) */
+    P_ROTATE,       /* dynamic: every bone turned by 180 degrees in one step (TELEPORT) */
+    P_DT_SPIKES,    /* dynamic: the clip at dt = 1e-9 and 1 in turn (TELEPORT) */
+    P_LIMITED,      /* dynamic inside a box: the state limited by its bounds (LIMITED) */
+    P_GUARD,        /* quasistatic inside a box of stiffness 1e15: the energy guard (GUARD) */
+    P_FAILED,       /* dynamic from a state whose energy overflows: the step undone (FAILED) */
+    P_RESET,        /* the first step after sinew_instance_reset */
+    P_PAIR_BUDGET,  /* max_contact_pairs = 1 (BUDGET) */
+    P_WORLD,        /* quasistatic and dynamic against a table and a moving ball */
+    P_WORLD_BUDGET, /* the same, max_world_contacts = 1 (BUDGET) */
+    P_COUNT
+};
+static const char *const path_names[P_COUNT] = {
+    "quasistatic", "dynamic", "translate jump", "rotation snap", "dt spikes", "limited",
+    "guard",       "failed",  "reset",          "pair budget",   "world",     "world budget"};
+
 typedef struct {
-    int calls;
-    uint32_t last_id;
-    sinew_log_level last_level;
-} log_count;
+    int steps, failed;         /* steps made; of them, returning an error */
+    uint32_t any, all;         /* OR and AND of the status flags */
+    uint32_t iters, min_iters; /* Newton iterations: total, fewest in one step */
+    uint32_t pairs_dropped, world_dropped, world_contacts, world_rounds;
+    uint32_t budget_bits;
+} path_record;
 
-static void count_log(sinew_log_level level, uint32_t id, const char *msg, void *user) {
-    log_count *l = user;
-    (void)msg;
-    l->calls++;
-    l->last_id = id;
-    l->last_level = level;
-}
+typedef struct {
+    const contract_fixture *f;
+    path_record rec[P_COUNT];
+    float *x, *n;         /* output scratch */
+    int steps, nonfinite; /* all steps; outputs with a non-finite value */
+    int bad_calls;        /* other API calls that did not return SINEW_OK */
+} contract_run;
 
-/* Steps an instance through the fixture's clip; the largest contact pair count seen and
- * whether any step flagged a budget. 0 when a step failed or its surface is not finite. */
-static int run_clip(const bake_fixture *f, sinew_instance *inst, uint32_t *max_pairs,
-                    uint32_t *budget_steps, uint32_t *max_dropped) {
-    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
-    float pose[12 * 16], *x = malloc(sizeof(float) * 3 * ns);
-    int ok = x && nb <= 16;
-    *max_pairs = *budget_steps = *max_dropped = 0;
-    for (int k = 0; k < f->ch.clip.nframes && ok; ++k) {
-        bake_fixture_pose(f, k, pose);
-        ok = sinew_instance_set_pose(inst, pose, nb) == SINEW_OK &&
-             sinew_instance_step(inst, 1.0f / 30) == SINEW_OK &&
-             sinew_instance_read_surface(inst, x, NULL, ns) == SINEW_OK;
-        for (uint32_t i = 0; ok && i < 3 * ns; ++i)
-            ok = isfinite(x[i]);
-        sinew_step_stats st = {.struct_size = sizeof st};
-        ok = ok && sinew_instance_get_stats(inst, &st) == SINEW_OK;
-        if (st.contact_pairs > *max_pairs) *max_pairs = st.contact_pairs;
-        if (st.status & SINEW_STEP_BUDGET) {
-            ok = ok && (st.budget_exceeded & SINEW_BUDGET_CONTACT_PAIRS);
-            (*budget_steps)++;
+/* One step of path p: sets the pose, steps, and (when it worked) reads the surface, the
+ * stats and checks the output is finite. Returns the step's result. */
+static sinew_result step_path(contract_run *cr, int p, sinew_instance *inst, const float *pose,
+                              float dt) {
+    const contract_fixture *f = cr->f;
+    path_record *r = &cr->rec[p];
+    if (sinew_instance_set_pose(inst, pose, f->nb) != SINEW_OK) cr->bad_calls++;
+    sinew_result res = sinew_instance_step(inst, dt);
+    sinew_step_stats st = {.struct_size = sizeof st};
+    if (sinew_instance_get_stats(inst, &st) != SINEW_OK) cr->bad_calls++;
+    if (sinew_instance_read_surface(inst, cr->x, cr->n, f->ns) != SINEW_OK) cr->bad_calls++;
+    for (uint32_t i = 0; i < 3 * f->ns; ++i)
+        if (!isfinite(cr->x[i]) || !isfinite(cr->n[i])) {
+            cr->nonfinite++;
+            break;
         }
-        if (st.contact_pairs_dropped > *max_dropped) *max_dropped = st.contact_pairs_dropped;
+    if (r->steps == 0) {
+        r->all = ~0u;
+        r->min_iters = UINT32_MAX;
     }
-    free(x);
-    return ok;
+    r->steps++;
+    cr->steps++;
+    if (res != SINEW_OK) r->failed++;
+    r->any |= st.status;
+    r->all &= st.status;
+    r->iters += st.newton_iterations;
+    if (st.newton_iterations < r->min_iters) r->min_iters = st.newton_iterations;
+    if (st.contact_pairs_dropped > r->pairs_dropped) r->pairs_dropped = st.contact_pairs_dropped;
+    if (st.world_contacts_dropped > r->world_dropped) r->world_dropped = st.world_contacts_dropped;
+    r->world_contacts += st.world_contacts;
+    if (st.world_rounds > r->world_rounds) r->world_rounds = st.world_rounds;
+    r->budget_bits |= st.budget_exceeded;
+    return res;
 }
 
-TEST(create_reserves_the_reported_size_in_one_block) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    alloc_count ac = {0};
-    sinew_instance_def d = sinew_instance_def_default();
-    d.allocator = (sinew_allocator){count_alloc, count_free, &ac};
-    size_t bytes = 0;
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_OK);
-    ENSURE(ac.allocs == 0); /* the query never allocates */
-    ENSURE(bytes > 0 && bytes % 64 == 0);
-    sinew_instance *inst;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
-    ENSUREF(ac.allocs == 1 && ac.last_size == bytes && ac.last_align == 64,
-            "%d allocations, the last %zu bytes aligned %zu; reported %zu", ac.allocs, ac.last_size,
-            ac.last_align, bytes);
-    uint32_t pairs, budget, dropped;
-    ENSURE(run_clip(f, inst, &pairs, &budget, &dropped));
-    ENSURE(ac.allocs == 1 && ac.frees == 0);
-    sinew_instance_destroy(inst);
-    ENSURE(ac.frees == 1);
-    /* the same layout for a quasistatic and a dynamic instance, and the default def */
-    size_t dyn = 0, dflt = 0;
-    d.mode = SINEW_STEP_DYNAMIC;
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &dyn) == SINEW_OK && dyn == bytes);
-    ENSURE(sinew_instance_memory_size(f->blob, NULL, &dflt) == SINEW_OK && dflt == bytes);
-    ENSURE(sinew_instance_memory_size(NULL, &d, &dyn) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(sinew_instance_memory_size(f->blob, &d, NULL) == SINEW_ERROR_INVALID_ARGUMENT);
+/* The pose k of the clip with every bone carried by x -> R x + t. */
+static void moved_pose(const contract_fixture *f, int k, const float R[9], const float t[3],
+                       float *out) {
+    const float *T = clip_pose(f, k);
+    for (uint32_t b = 0; b < f->nb; ++b) {
+        const float *A = T + 12 * b;
+        float *B = out + 12 * b;
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j)
+                B[3 * i + j] = R[3 * i] * A[j] + R[3 * i + 1] * A[3 + j] + R[3 * i + 2] * A[6 + j];
+            B[9 + i] = R[3 * i] * A[9] + R[3 * i + 1] * A[10] + R[3 * i + 2] * A[11] + t[i];
+        }
+    }
 }
 
-TEST(a_contact_budget_that_runs_out_is_reported_never_grown) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    sinew_instance *inst;
-    uint32_t full_pairs, budget, dropped;
-    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
-    ENSURE(run_clip(f, inst, &full_pairs, &budget, &dropped));
-    sinew_instance_destroy(inst);
-    ENSUREF(full_pairs >= 2, "the clip needs %u pairs at most: no contact to budget", full_pairs);
-    ENSURE(budget == 0 && dropped == 0); /* the default budget never runs out */
-
-    sinew_instance_def d = sinew_instance_def_default();
-    size_t full_bytes = 0, small_bytes = 0, huge_bytes = 0;
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &full_bytes) == SINEW_OK);
-    d.max_contact_pairs = 0xffffffffu; /* more than the blob can need: what it needs */
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &huge_bytes) == SINEW_OK);
-    ENSURE(huge_bytes == full_bytes);
-    d.max_contact_pairs = 1;
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &small_bytes) == SINEW_OK);
-    ENSURE(small_bytes <= full_bytes);
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
-    uint32_t pairs;
-    ENSURE(run_clip(f, inst, &pairs, &budget, &dropped));
-    sinew_instance_destroy(inst);
-    ENSUREF(pairs == 1 && budget > 0 && dropped == full_pairs - 1,
-            "in use %u, flagged steps %u, dropped %u of %u", pairs, budget, dropped, full_pairs);
+/* A world of one box (centre, half extents, stiffness; 0: the blob's) and, when ball is
+ * not NULL, a sphere of radius 0.2 that the run moves along under the finger. */
+static sinew_world *make_world(const float centre[3], const float half[3], float stiffness,
+                               sinew_collider_id *ball) {
+    sinew_world *w = NULL;
+    sinew_world_def wd = sinew_world_def_default();
+    if (sinew_world_create(&wd, &w) != SINEW_OK) return NULL;
+    sinew_collider_def c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_BOX;
+    memcpy(c.half_extents, half, sizeof c.half_extents);
+    memcpy(c.transform.position, centre, sizeof c.transform.position);
+    c.friction = ball ? 0.3f : 0.0f; /* the table: some friction */
+    c.stiffness = stiffness;
+    sinew_collider_id box;
+    int ok = sinew_world_add_collider(w, &c, &box) == SINEW_OK;
+    if (ok && ball) {
+        c = sinew_collider_def_default();
+        c.shape = SINEW_SHAPE_SPHERE;
+        c.radius = 0.2f;
+        c.transform.position[0] = 0.5f;
+        c.transform.position[1] = -0.5f;
+        ok = sinew_world_add_collider(w, &c, ball) == SINEW_OK;
+    }
+    if (!ok) {
+        sinew_world_destroy(w);
+        return NULL;
+    }
+    return w;
 }
 
-TEST(bad_defs_are_rejected_with_a_logged_reason) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    log_count lc = {0};
-    sinew_instance_def d = sinew_instance_def_default();
-    d.logger = (sinew_logger){count_log, &lc, SINEW_LOG_DEBUG};
-    sinew_instance *inst = (sinew_instance *)&lc;
-    d.mode = (sinew_step_mode)7;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(inst == NULL);
-    ENSURE(lc.calls == 1 && lc.last_id == SINEW_MSG_INSTANCE_INVALID_ARGUMENT &&
-           lc.last_level == SINEW_LOG_ERROR);
-    d.mode = SINEW_STEP_QUASISTATIC;
-    d.max_newton_iters = 101;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(lc.calls == 2);
-    d.max_newton_iters = 0;
-    d.allocator.alloc = count_alloc; /* half an allocator */
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSURE(lc.calls == 3);
-    d.allocator.alloc = NULL;
-    d.tasks.worker_count = 4; /* reserved: the step is serial in this version */
-    d.tasks.finish = count_free;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_UNSUPPORTED);
-    ENSURE(lc.calls == 4 && lc.last_id == SINEW_MSG_INSTANCE_UNSUPPORTED);
-    size_t bytes;
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_ERROR_UNSUPPORTED);
-    d.tasks = sinew_instance_def_default().tasks;
-    d.struct_size = 4; /* smaller than the fields every caller has */
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
-    d.struct_size = sizeof d;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
-    ENSURE(lc.last_id == SINEW_MSG_INSTANCE_CREATED && lc.last_level == SINEW_LOG_INFO);
-    sinew_instance_destroy(inst);
-    /* an old host's def: only the fields up to the logger, garbage after them ignored */
-    unsigned char old[sizeof d];
-    memset(old, 0xab, sizeof old);
-    d = sinew_instance_def_default();
-    d.struct_size = (uint32_t)(offsetof(sinew_instance_def, logger) + sizeof(sinew_logger));
-    memcpy(old, &d, d.struct_size);
-    ENSURE(sinew_instance_create(f->blob, (const sinew_instance_def *)(void *)old, &inst) ==
-           SINEW_OK);
-    sinew_instance_destroy(inst);
+static sinew_transform ball_at(int s) {
+    sinew_transform t = sinew_transform_identity();
+    t.position[0] = (float)(0.5 + 0.1 * (s % 25));
+    t.position[1] = -0.5f;
+    return t;
 }
 
-TEST(every_phase_reports_its_time_and_counts) {
-    const bake_fixture *f = fixture();
+enum { I_Q, I_D, I_PAIRS, I_WQ, I_WD, I_WBUDGET, I_LIMIT, I_GUARD, I_FRESH, I_COUNT };
+
+TEST(every_path_of_the_step_allocates_and_locks_nothing) {
+    const contract_fixture *f = fixture();
     ENSURE(f);
-    for (int mode = 0; mode < 2; ++mode) {
+    const int active = sw_rt_interpose_active(); /* its self-check counts: not in the run */
+    const uint32_t nb = f->nb, ns = f->ns;
+    const int frames = f->frames;
+
+    /* ---- creation, all through the host allocator: one block of the planned size each */
+    host_heap heap = {0};
+    sinew_instance *in[I_COUNT] = {0};
+    for (int i = 0; i < I_COUNT; ++i) {
         sinew_instance_def d = sinew_instance_def_default();
-        d.mode = mode ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
-        sinew_instance *inst;
-        ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
-        uint32_t nb = (uint32_t)f->ch.skel.nbones;
-        float pose[12 * 16];
-        ENSURE(nb <= 16);
-        bake_fixture_pose(f, 5, pose);
-        ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
-        ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
-        sinew_step_stats st = {.struct_size = sizeof st};
-        ENSURE(sinew_instance_get_stats(inst, &st) == SINEW_OK && st.struct_size == sizeof st);
-        const double ms[5] = {st.ms_skin, st.ms_contact, st.ms_dynamics, st.ms_solve, st.ms_output};
-        for (int i = 0; i < 5; ++i)
-            ENSUREF(isfinite(ms[i]) && ms[i] >= 0 && ms[i] < 1e4, "phase %d: %g ms", i, ms[i]);
-        ENSURE(st.active_vertices > 0 && st.cubature_tets > 0);
-        /* the start point's evaluation (an update below 0.3% of the correction is taken
-         * without one at its end) and, dynamic, the frozen damping Hessian's */
-        ENSUREF(st.potential_evals >= 1 + (uint32_t)mode &&
-                    st.potential_evals >= st.newton_iterations + (uint32_t)mode,
-                "%u evaluations, %u iterations", st.potential_evals, st.newton_iterations);
-        /* a host built against the first stats struct gets only those fields */
-        sinew_step_stats old;
-        memset(&old, 0x5a, sizeof old);
-        old.struct_size = (uint32_t)offsetof(sinew_step_stats, ms_skin);
-        ENSURE(sinew_instance_get_stats(inst, &old) == SINEW_OK);
-        ENSURE(old.struct_size == offsetof(sinew_step_stats, ms_skin));
-        ENSURE(old.newton_iterations == st.newton_iterations && old.energy == st.energy);
-        unsigned char tail[sizeof old - offsetof(sinew_step_stats, ms_skin)];
-        memset(tail, 0x5a, sizeof tail);
-        ENSURE(memcmp((unsigned char *)&old + offsetof(sinew_step_stats, ms_skin), tail,
-                      sizeof tail) == 0);
-        sinew_instance_destroy(inst);
+        d.allocator = (sinew_allocator){host_alloc, host_free, &heap};
+        d.mode = (i == I_D || i == I_WD || i == I_WBUDGET || i == I_LIMIT) ? SINEW_STEP_DYNAMIC
+                                                                           : SINEW_STEP_QUASISTATIC;
+        if (i == I_PAIRS) d.max_contact_pairs = 1;
+        if (i == I_WBUDGET) d.max_world_contacts = 1;
+        size_t bytes = 0;
+        int before = heap.allocs;
+        ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_OK);
+        ENSURE(heap.allocs == before); /* the query reserves nothing */
+        ENSURE(sinew_instance_create(f->blob, &d, &in[i]) == SINEW_OK && in[i]);
+        ENSUREF(heap.allocs == before + 1 && heap.last_size == bytes && heap.last_align == 64,
+                "instance %d: %d host allocations, the last %zu bytes aligned %zu; the plan "
+                "says one block of %zu",
+                i, heap.allocs - before, heap.last_size, heap.last_align, bytes);
     }
+    ENSURE(heap.frees == 0);
+    /* The finger lies along +x from 0 to 3.6 (radius 0.45 at the root) and bends down.
+     * world: a table whose top is at y = -0.39, the ball moving along under the finger.
+     * inside: a box holding the whole finger 0.05 above its bottom face: the contact
+     * pushes the flesh towards that face, further than the state's bounds allow.
+     * stiff: the same deeper in a box as stiff as a world allows (1e15): no update
+     * along the Newton direction lowers the energy, and the guard stops Newton. */
+    sinew_collider_id ball;
+    static const float table_at[3] = {1.8f, -0.59f, 0}, table_half[3] = {2.5f, 0.2f, 1.0f},
+                       inside_at[3] = {0, 0.5f, 0}, stiff_at[3] = {0, 1.5f, 0},
+                       box_half[3] = {5, 2, 5};
+    sinew_world *world = make_world(table_at, table_half, 0, &ball),
+                *inside = make_world(inside_at, box_half, 0, NULL),
+                *stiff = make_world(stiff_at, box_half, 1e15f, NULL);
+    ENSURE(world && inside && stiff);
+    ENSURE(sinew_instance_set_world(in[I_WQ], world) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in[I_WD], world) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in[I_WBUDGET], world) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in[I_LIMIT], inside) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in[I_GUARD], stiff) == SINEW_OK);
+
+    contract_run cr;
+    memset(&cr, 0, sizeof cr);
+    cr.f = f;
+    cr.x = malloc(sizeof(float) * 3 * ns);
+    cr.n = malloc(sizeof(float) * 3 * ns);
+    float *pose = malloc(sizeof(float) * 12 * nb), *x0 = malloc(sizeof(float) * 3 * ns);
+    ENSURE(cr.x && cr.n && pose && x0);
+    static const float I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1}, turn[9] = {-1, 0, 0, 0, 1, 0, 0, 0, -1};
+    static const float far[3] = {1000, 0, 0}, still[3] = {0, 0, 0};
+    int reset_same = 0, failed_kept = 0, failed_results = 0;
+    float F[3], M[3];
+#if !defined(SW_CONTRACT_SHARED)
+    const int32_t R = sw_blob_get_view(f->blob)->rank_total;
+    double *qbig = malloc(sizeof(double) * (size_t)R);
+    ENSURE(qbig);
+    for (int32_t i = 0; i < R; ++i)
+        qbig[i] = 1e200;
+#endif
+
+    const int heap_allocs = heap.allocs;
+    sw_rt_count_begin(); /* ================= counted from here ================= */
+    for (int s = 0; s < 2 * frames; ++s) {
+        step_path(&cr, P_QUASISTATIC, in[I_Q], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_DYNAMIC, in[I_D], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_PAIR_BUDGET, in[I_PAIRS], clip_pose(f, s), 1.0f / 30);
+    }
+    /* teleports: away and back, then a half turn of the whole character */
+    moved_pose(f, 0, I3, far, pose);
+    step_path(&cr, P_TRANSLATE, in[I_D], pose, 1.0f / 30);
+    step_path(&cr, P_TRANSLATE, in[I_D], clip_pose(f, 0), 1.0f / 30);
+    step_path(&cr, P_DYNAMIC, in[I_D], clip_pose(f, 1), 1.0f / 30);
+    moved_pose(f, 1, turn, still, pose);
+    step_path(&cr, P_ROTATE, in[I_D], pose, 1.0f / 30);
+    /* dt spikes: the clip at alternating dt = 1e-9 and 1 */
+    for (int s = 0; s < frames; ++s)
+        step_path(&cr, P_DT_SPIKES, in[I_D], clip_pose(f, s), s % 2 ? 1.0f : 1e-9f);
+    /* the state's bounds, and the energy guard */
+    for (int s = 0; s < 8; ++s) {
+        step_path(&cr, P_LIMITED, in[I_LIMIT], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_GUARD, in[I_GUARD], clip_pose(f, s), 1.0f / 30);
+    }
+#if !defined(SW_CONTRACT_SHARED)
+    /* a failed step: a state whose energy overflows (|q| = 1e200, set through the internal
+     * test hook sw_instance_set_q; no input of the public API reaches a non-finite
+     * state, see the report of this test); the step is undone, the output kept; it fails
+     * until a reset */
+    step_path(&cr, P_DYNAMIC, in[I_D], clip_pose(f, 1), 1.0f / 30);
+    step_path(&cr, P_DYNAMIC, in[I_D], clip_pose(f, 2), 1.0f / 30);
+    memcpy(x0, cr.x, sizeof(float) * 3 * ns);
+    sw_instance_set_q(in[I_D], qbig);
+    for (int k = 0; k < 2; ++k) {
+        failed_results +=
+            step_path(&cr, P_FAILED, in[I_D], clip_pose(f, 3), 1.0f / 30) == SINEW_ERROR_NOT_FINITE;
+        failed_kept += memcmp(x0, cr.x, sizeof(float) * 3 * ns) == 0;
+    }
+    if (sinew_instance_reset(in[I_D]) != SINEW_OK) cr.bad_calls++;
+    step_path(&cr, P_RESET, in[I_D], clip_pose(f, 3), 1.0f / 30);
+#endif
+    /* reset between steps: then the same pose as a fresh instance's first step */
+    if (sinew_instance_reset(in[I_Q]) != SINEW_OK) cr.bad_calls++;
+    step_path(&cr, P_RESET, in[I_Q], clip_pose(f, 5), 1.0f / 30);
+    memcpy(x0, cr.x, sizeof(float) * 3 * ns);
+    step_path(&cr, P_QUASISTATIC, in[I_FRESH], clip_pose(f, 5), 1.0f / 30);
+    reset_same = memcmp(x0, cr.x, sizeof(float) * 3 * ns) == 0;
+    /* the world: the ball moves every step */
+    for (int s = 0; s < 2 * frames; ++s) {
+        sinew_transform t = ball_at(s);
+        if (sinew_world_set_collider_transform(world, ball, &t) != SINEW_OK) cr.bad_calls++;
+        step_path(&cr, P_WORLD, in[I_WQ], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_WORLD, in[I_WD], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_WORLD_BUDGET, in[I_WBUDGET], clip_pose(f, s), 1.0f / 30);
+        if (sinew_instance_collider_force(in[I_WQ], ball, F, M) != SINEW_OK) cr.bad_calls++;
+    }
+    sw_rt_counts c = sw_rt_count_end(); /* ================= to here ================= */
+
+    fprintf(stderr, "    %s, %d steps: %s; host allocator %d allocs %d frees\n", VARIANT, cr.steps,
+            describe(&c), heap.allocs, heap.frees);
+    fprintf(stderr, "    path            steps errors  flags any/all  newton (min)  dropped "
+                    "pairs/world  world contacts (rounds)\n");
+    for (int p = 0; p < P_COUNT; ++p) {
+        const path_record *r = &cr.rec[p];
+        fprintf(stderr, "    %-15s %5d %6d   0x%02x / 0x%02x  %6u (%u)  %5u / %-5u  %8u (%u)\n",
+                path_names[p], r->steps, r->failed, r->any, r->steps ? r->all : 0, r->iters,
+                r->steps ? r->min_iters : 0, r->pairs_dropped, r->world_dropped, r->world_contacts,
+                r->world_rounds);
+    }
+
+    const int heap_in_run = heap.allocs - heap_allocs, heap_frees_in_run = heap.frees;
+    for (int i = 0; i < I_COUNT; ++i)
+        sinew_instance_destroy(in[i]);
+    sinew_world_destroy(world);
+    sinew_world_destroy(inside);
+    sinew_world_destroy(stiff);
+    free(cr.x);
+    free(cr.n);
+    free(pose);
+    free(x0);
+#if !defined(SW_CONTRACT_SHARED)
+    free(qbig);
+#endif
+
+    /* ---- every call did what it should; the output stayed finite */
+    ENSUREF(cr.bad_calls == 0, "%d set_pose/read/stats/reset/world calls failed", cr.bad_calls);
+    ENSUREF(cr.nonfinite == 0, "%d outputs with a non-finite value", cr.nonfinite);
+    for (int p = 0; p < P_COUNT; ++p) {
+        const path_record *r = &cr.rec[p];
+#if defined(SW_CONTRACT_SHARED)
+        if (p == P_FAILED) {
+            ENSURE(r->steps == 0);
+            continue;
+        }
+#endif
+        ENSUREF(r->steps > 0, "path %s never ran", path_names[p]);
+        ENSUREF(r->failed == (p == P_FAILED ? r->steps : 0), "path %s: %d of %d steps failed",
+                path_names[p], r->failed, r->steps);
+        if (p != P_FAILED) {
+            ENSUREF(r->iters > 0, "path %s: Newton never ran", path_names[p]);
+            ENSUREF(!(r->any & SINEW_STEP_FAILED), "path %s flagged FAILED", path_names[p]);
+        }
+        /* Newton ran in every step of the paths that do not stop it early */
+        if (p != P_FAILED && p != P_GUARD && p != P_LIMITED)
+            ENSUREF(r->min_iters >= 1, "path %s: a step with no Newton iteration", path_names[p]);
+        /* a quasistatic step starts from the pose space, a dynamic one never */
+        int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET;
+        if (quasi) ENSUREF(r->all & SINEW_STEP_POSE_SPACE, "path %s", path_names[p]);
+        if (!quasi && p != P_RESET && p != P_WORLD)
+            ENSUREF(!(r->any & SINEW_STEP_POSE_SPACE), "path %s", path_names[p]);
+    }
+    const path_record *rec = cr.rec;
+    ENSURE(rec[P_QUASISTATIC].any & SINEW_STEP_CONVERGED &&
+           rec[P_DYNAMIC].any & SINEW_STEP_CONVERGED);
+    ENSURE(!(rec[P_QUASISTATIC].any & ~(SINEW_STEP_CONVERGED | SINEW_STEP_POSE_SPACE)));
+    ENSURE(!(rec[P_DYNAMIC].any & ~SINEW_STEP_CONVERGED)); /* the clip is no jump */
+    /* teleports: both jumps of the translation, the half turn, the 1e-9 s steps */
+    ENSURE(rec[P_TRANSLATE].steps == 2 && rec[P_TRANSLATE].all & SINEW_STEP_TELEPORT);
+    ENSURE(rec[P_ROTATE].all & SINEW_STEP_TELEPORT);
+    ENSURE(rec[P_DT_SPIKES].any & SINEW_STEP_TELEPORT);
+    /* the bounds and the guard, each by the contact of its box */
+    ENSUREF(rec[P_LIMITED].any & SINEW_STEP_LIMITED && rec[P_LIMITED].world_contacts > 0,
+            "flags 0x%02x", rec[P_LIMITED].any);
+    ENSUREF(rec[P_GUARD].any & SINEW_STEP_GUARD && rec[P_GUARD].world_contacts > 0, "flags 0x%02x",
+            rec[P_GUARD].any);
+#if !defined(SW_CONTRACT_SHARED)
+    /* the failed steps: NOT_FINITE, FAILED, the output of the step before kept */
+    ENSURE(rec[P_FAILED].steps == 2 && failed_results == 2 && failed_kept == 2);
+    ENSURE(rec[P_FAILED].all & SINEW_STEP_FAILED);
+#else
+    (void)failed_results;
+    (void)failed_kept;
+    fprintf(stderr, "    NOT COVERED here: the failed step (FAILED). No input of the public API "
+                    "reaches a non-finite state; test_step_contract (static) drives it "
+                    "through the internal hook sw_instance_set_q, which libsinew.so does not "
+                    "export\n");
+#endif
+    /* reset: no jump from the pose before, and the same output as a fresh instance's */
+    ENSURE(!(rec[P_RESET].any & SINEW_STEP_TELEPORT));
+    ENSUREF(reset_same, "the step after a reset differs from a fresh instance's first step");
+    /* budgets */
+    ENSURE(rec[P_PAIR_BUDGET].any & SINEW_STEP_BUDGET && rec[P_PAIR_BUDGET].pairs_dropped > 0 &&
+           rec[P_PAIR_BUDGET].budget_bits == SINEW_BUDGET_CONTACT_PAIRS);
+    ENSURE(rec[P_WORLD_BUDGET].any & SINEW_STEP_BUDGET && rec[P_WORLD_BUDGET].world_dropped > 0 &&
+           rec[P_WORLD_BUDGET].budget_bits == SINEW_BUDGET_WORLD_CONTACTS);
+    /* the world with its moving ball */
+    ENSURE(rec[P_WORLD].world_contacts > 0 && rec[P_WORLD].world_rounds >= 1);
+    ENSURE(!(rec[P_WORLD].any & SINEW_STEP_BUDGET));
+
+    /* ---- memory: the host allocator, once per instance at creation, never in a step */
+    ENSUREF(heap_in_run == 0 && heap_frees_in_run == 0,
+            "the run called the host allocator: %d allocations, %d frees", heap_in_run,
+            heap_frees_in_run);
+    ENSURE(heap.allocs == I_COUNT && heap.frees == I_COUNT);
+
+    /* ---- allocations, mappings and locks: zero in every category this build observes */
+    static const struct {
+        int cat;
+        const char *name;
+    } cats[] = {{SW_RT_CAT_ALLOCS, "allocations"},
+                {SW_RT_CAT_FREES, "frees"},
+                {SW_RT_CAT_MAPS, "mappings"},
+                {SW_RT_CAT_LOCKS, "locks"}};
+    const uint64_t counted[4] = {c.allocs, c.frees, c.maps, c.locks};
+    char unseen[128] = "";
+    for (int k = 0; k < 4; ++k) {
+        if (active & cats[k].cat) {
+            ENSUREF(counted[k] == 0, "%s in the run: %s", cats[k].name, describe(&c));
+            continue;
+        }
+#if !defined(SANITIZED) && defined(__GLIBC__) && defined(__linux__)
+        ENSUREF(0,
+                "%s cannot be observed in this build (active mask %d): the contract is "
+                "unproven",
+                cats[k].name, active);
+#endif
+        size_t used = strlen(unseen);
+        snprintf(unseen + used, sizeof unseen - used, "%s%s", used ? ", " : "", cats[k].name);
+    }
+    if (unseen[0])
+        SKIP("every path ran and every observable count is 0, but %s cannot be observed in "
+             "this build (%s: the sanitizer runtime owns those functions): not proven here",
+             unseen, VARIANT);
 }
 
 TEST(release_fixture) {
-    cleanup();
+    if (fx_ok > 0) contract_fixture_free(&fx);
 }
 
-SW_TEST_MAIN(CASE(quasistatic_step_allocates_and_locks_nothing),
-             CASE(dynamic_step_allocates_and_locks_nothing),
-             CASE(identical_runs_give_identical_output), CASE(bad_input_is_rejected_and_state_kept),
-             CASE(teleport_gives_a_status_and_a_finite_state),
-             CASE(dynamic_flesh_overshoots_and_settles_when_the_clip_stops),
-             CASE(create_reserves_the_reported_size_in_one_block),
-             CASE(a_contact_budget_that_runs_out_is_reported_never_grown),
-             CASE(bad_defs_are_rejected_with_a_logged_reason),
-             CASE(every_phase_reports_its_time_and_counts), CASE(release_fixture))
+SW_TEST_MAIN(CASE(the_interposer_sees_the_librarys_own_calls),
+             CASE(every_path_of_the_step_allocates_and_locks_nothing), CASE(release_fixture))

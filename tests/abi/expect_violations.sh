@@ -1,8 +1,11 @@
 #!/bin/sh
-# Proves that check_exports.sh can fail: runs it on a deliberately broken library and
-# requires exit status 1 and every expected complaint in its output.
+# Proves that a library checker (check_exports.sh, check_imports.sh) can fail: runs it on
+# a deliberately broken library and requires exit status 1 and every expected complaint
+# in its output.
 #
-# usage: expect_violations.sh CHECKER LIBRARY PUBLIC_HEADER_DIR EXPECTED_TEXT...
+# usage: expect_violations.sh CHECKER LIBRARY CHECKER_ARG EXPECTED_TEXT...
+#   CHECKER_ARG: the checker's second argument (the public header folder of
+#   check_exports.sh, the allow-list of check_imports.sh)
 set -u
 checker=$1 lib=$2 headers=$3
 shift 3
