@@ -209,7 +209,7 @@ static const forge_case k_cases[] = {
     FN("domains copies sum < ndomain_verts", f_ndv_more, CORRUPT, "DOMAINS", "hold 17 vertex"),
     FN("basis longer than the domains", f_basis_more, CORRUPT, "BASIS", "holds 151"),
     FN("inertia_u shorter than the domains", f_inertia_u_less, CORRUPT, "INERTIA_U", "holds 260"),
-    FN("no surface copies", f_copies_none, CORRUPT, "SURF_COPIES", "0 copies"),
+    FN("no surface copies", f_copies_none, CORRUPT, "SURF_COPIES", "0 copies outside"),
     /* other sections' negative and first indices */
     I32("surf copy ptr first", SURF_COPY_PTR, 0, 1, CORRUPT, "SURF_COPY_PTR", "element 0 is 1"),
     I32("surf tri negative", SURF_TRIS, 4, -1, CORRUPT, "SURF_TRIS", "triangle 1 corner 1"),
