@@ -12,6 +12,7 @@
  * Nothing here allocates, locks or touches a vertex that is not active: the cost follows
  * the cubature, contact and surface sizes, not the tet count. Each phase's wall time
  * and counts land in the step's stats. */
+#include <float.h>
 #include <math.h>
 #include <string.h>
 
@@ -229,6 +230,22 @@ static void phase_output(sw_step_ctx *c) {
     c->st.ms_output += lap(c);
 }
 
+/* The output within float range (what sinew_instance_read_surface hands out). A blob
+ * whose values are finite but absurd (a hostile one passes validation so) can still
+ * overflow it from a finite state: the step then fails as a non-finite solve does, with
+ * the state back at the step's start and no velocity. O(surface). */
+static sinew_result check_output(sw_step_ctx *c) {
+    sinew_instance *in = c->in;
+    for (int64_t i = 0; i < 3 * (int64_t)in->v->nsurf_verts; ++i)
+        if (!(fabs(in->surf_x[i]) <= FLT_MAX) || !(fabs(in->surf_n[i]) <= FLT_MAX)) {
+            memcpy(in->solver.q, in->solver.qn, (size_t)in->red.R * sizeof(double));
+            memset(in->solver.qdot, 0, (size_t)in->red.R * sizeof(double));
+            c->st.status |= SINEW_STEP_FAILED;
+            return SINEW_ERROR_NOT_FINITE;
+        }
+    return SINEW_OK;
+}
+
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     if (!inst || !(dt > 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
     sw_step_ctx c;
@@ -241,6 +258,7 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     if (r == SINEW_OK) {
         phase_advance(&c);
         phase_output(&c);
+        r = check_output(&c);
     }
     inst->stats = c.st;
     return r;

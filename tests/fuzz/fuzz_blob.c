@@ -1,24 +1,35 @@
 /* libFuzzer harness for the blob parser (STYLE.md §9: a fuzz harness for every loader).
- * Not part of the default build. Build and run (clang with libFuzzer):
+ * Built by tests/CMakeLists.txt (sinew_fuzz_harness) when clang has libFuzzer; by hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/blob -Iruntime/math \
  *     tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c -lm -o build-fuzz-blob
  *   mkdir -p /tmp/blob-corpus && ./build-fuzz-blob -max_len=65536 /tmp/blob-corpus
  *
- * Seed the corpus with real blobs (e.g. the bake's output, or the bytes test_blob writes)
- * for coverage beyond the header: random bytes almost never pass the checksum. Define
- * SW_FUZZ_FIX_CHECKSUM to have the harness overwrite the checksum field before parsing,
- * so mutations reach the semantic checks (hostile blobs).
+ * Two flavours, chosen at compile time:
+ *   fuzz_blob        the parser alone, on the bytes as given: random bytes almost never
+ *                    pass the checksum, so this mostly fuzzes the header and table checks;
+ *   fuzz_blob_fixed  (fuzz_blob_fixed.c: SW_FUZZ_FIX_CHECKSUM and SW_FUZZ_STEP, linked
+ *                    with the whole runtime) overwrites the checksum field before parsing,
+ *                    so mutations reach the semantic checks (hostile blobs), and steps
+ *                    every accepted blob: an instance in each step mode, the rest pose and
+ *                    a bent one, a few steps each, the surface read back. A step that
+ *                    reports success must leave a finite surface; nothing may crash.
  *
  * Every input is copied into a 64-byte aligned buffer of exactly its size, so that ASan
  * reports a read one byte past it. An accepted blob is re-validated and every index
- * chain a runtime follows is walked. */
+ * chain a runtime follows is walked, the contact references with explicit bounds checks
+ * (a wrong index into one buffer mostly lands inside another section, unseen by ASan). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "blob_load.h"
+#ifdef SW_FUZZ_STEP
+#include <math.h>
+
+#include "sinew/sinew.h"
+#endif
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
@@ -54,8 +65,75 @@ static double walk(const sw_blob_view *v) {
             s += v->rest[3 * v->domain_verts[dom->vert_begin + v->surf_copies[2 * c + 1]]];
         }
     }
+    /* the pose-space contacts: every training pose's range, every reference of its pairs */
+    if (v->contact_ptr[0] != 0 || v->contact_ptr[v->ntrain] != v->ncontacts) abort();
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        s += v->train_q[(int64_t)R * t + R - 1] +
+             v->train_pose[(int64_t)4 * v->nbones * (t + 1) - 1];
+        if (v->contact_ptr[t + 1] < v->contact_ptr[t]) abort();
+        for (int32_t c = v->contact_ptr[t]; c < v->contact_ptr[t + 1]; ++c) {
+            for (int k = 0; k < 4; ++k) {
+                int32_t d = v->contact_verts[8 * (int64_t)c + 2 * k];
+                int32_t l = v->contact_verts[8 * (int64_t)c + 2 * k + 1];
+                if (d < 0 || d >= v->ndomains || l < 0 || l >= v->domains[d].vert_count) abort();
+                s += v->rest[3 * (int64_t)v->domain_verts[v->domains[d].vert_begin + l]];
+            }
+            if (!(v->contact_data[7 * (int64_t)c + 6] > 0)) abort();
+        }
+    }
     return s;
 }
+
+#ifdef SW_FUZZ_STEP
+/* Pose of bone b: the rest pose (bent = 0) or every bone turned about its own axis and a
+ * bend axis, with a shift (rigid: an exact rotation in doubles, rounded to float). */
+static void pose(float *T, int32_t nbones, double bent) {
+    for (int32_t b = 0; b < nbones; ++b) {
+        double a = bent * (0.3 + 0.2 * (b % 3)), c = cos(a), s = sin(a);
+        const double R[9] = {c, -s, 0, s, c, 0, 0, 0, 1};
+        for (int i = 0; i < 9; ++i)
+            T[12 * b + i] = (float)R[i];
+        T[12 * b + 9] = (float)(0.1 * bent);
+        T[12 * b + 10] = (float)(-0.05 * bent * b);
+        T[12 * b + 11] = 0.0f;
+    }
+}
+
+/* An accepted blob, stepped: quasistatic then dynamic, rest pose and a bent one. */
+static void step_blob(const void *data, size_t size, const sw_blob_view *v) {
+    sinew_blob_def bd = sinew_blob_def_default();
+    bd.data = data;
+    bd.data_size = size;
+    bd.logger.max_level = SINEW_LOG_ERROR;
+    sinew_blob *blob = NULL;
+    if (sinew_blob_load(&bd, &blob) != SINEW_OK) abort(); /* sw_blob_parse accepted it */
+    const int32_t nb = v->nbones, ns = v->nsurf_verts;
+    float *T = malloc((size_t)12 * nb * sizeof(float));
+    float *pos = malloc((size_t)3 * ns * sizeof(float)),
+          *nrm = malloc((size_t)3 * ns * sizeof(float));
+    for (int mode = 0; mode < 2 && T && pos && nrm; ++mode) {
+        sinew_instance_def d = sinew_instance_def_default();
+        d.mode = mode ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+        d.max_newton_iters = 3;
+        sinew_instance *in = NULL;
+        if (sinew_instance_create(blob, &d, &in) != SINEW_OK) continue; /* e.g. too large */
+        const double bends[4] = {0.0, 0.6, 1.2, 0.0};
+        for (int f = 0; f < 4; ++f) {
+            pose(T, nb, bends[f]);
+            if (sinew_instance_set_pose(in, T, (uint32_t)nb) != SINEW_OK) abort();
+            if (sinew_instance_step(in, 1.0f / 30.0f) != SINEW_OK) continue;
+            if (sinew_instance_read_surface(in, pos, nrm, (uint32_t)ns) != SINEW_OK) abort();
+            for (int64_t i = 0; i < 3 * (int64_t)ns; ++i)
+                if (!isfinite(pos[i]) || !isfinite(nrm[i])) abort(); /* OK but not finite */
+        }
+        sinew_instance_destroy(in);
+    }
+    free(nrm);
+    free(pos);
+    free(T);
+    sinew_blob_destroy(blob);
+}
+#endif
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     void *copy = NULL;
@@ -73,6 +151,9 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
         if (sw_blob_validate_view(&v, msg, sizeof msg) != SINEW_OK) abort();
         volatile double sink = walk(&v);
         (void)sink;
+#ifdef SW_FUZZ_STEP
+        step_blob(copy, size, &v);
+#endif
     }
     free(copy);
     return 0;

@@ -1,0 +1,340 @@
+/* The blob tests' synthetic character: a small, complete, consistent view (4 bones, 3
+ * domains, 2 training poses with 2 contact pairs) written by the real writer, and the
+ * helpers that forge its bytes (table entries, sections, checksum fix-up) and walk an
+ * accepted view along every index chain a runtime follows. Shared by test_blob.c and
+ * test_blob_forged.c; everything is static inline (a test uses what it needs). */
+#ifndef SW_BLOB_SYNTH_H
+#define SW_BLOB_SYNTH_H
+
+#include <stdint.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "blob_load.h"
+#include "blob_write.h"
+#include "sinew/sinew.h"
+
+/* ---- a small, complete, consistent synthetic character -------------------------- */
+
+enum {
+    NB = 4,       /* bones */
+    NV = 12,      /* simulation vertices */
+    ND = 3,       /* domains */
+    NDV = 17,     /* vertex copies */
+    RT = 9,       /* rank_total = 2 + 3 + 4 */
+    NCUB = 8,     /* cubature tets: 3 + 2 + 3 */
+    NSV = 8,      /* surface vertices */
+    NST = 6,      /* surface triangles */
+    NBASIS = 150, /* 6*3*2 + 6*3*3 + 5*3*4 */
+    NIU = 261,    /* 9 * (4 + 9 + 16) */
+    MAXCOP = 16,
+    NTR = 2 /* training poses */
+};
+
+typedef struct fixture {
+    double rest[3 * NV];
+    int32_t skin_bone[4 * NV];
+    double skin_weight[4 * NV];
+    int32_t bone_parent[NB];
+    double bone_joints[6 * NB];
+    sw_blob_domain domains[ND];
+    int32_t domain_verts[NDV];
+    double basis[NBASIS];
+    int32_t cub_tets[4 * NCUB];
+    double cub_weight[NCUB], cub_dminv[9 * NCUB], cub_vol[NCUB];
+    double spring_hessian[RT * RT], mass[RT * RT], inertia_s[3 * RT], inertia_x[9 * RT];
+    double inertia_u[NIU];
+    int32_t surf_tris[3 * NST], surf_copy_ptr[NSV + 1], surf_copies[2 * MAXCOP];
+    double train_q[NTR * RT], train_pose[NTR * 4 * NB];
+    int32_t contact_ptr[NTR + 1], contact_verts[8 * 2];
+    double contact_data[7 * 2];
+    sw_blob_view v;
+} fixture;
+
+static uint64_t rng_state;
+static inline uint32_t rng_next(void) {
+    rng_state = rng_state * 6364136223846793005ull + 1442695040888963407ull;
+    return (uint32_t)(rng_state >> 33);
+}
+/* Uniform in [0, 1) and in [-1, 1). */
+static inline double rng_unit(void) {
+    return rng_next() / 2147483648.0;
+}
+static inline double rng_sym(void) {
+    return 2.0 * rng_unit() - 1.0;
+}
+
+/* k distinct values of [0, n) into out. */
+static inline void rng_distinct(int32_t *out, int k, int32_t n) {
+    int32_t pool[64];
+    for (int32_t i = 0; i < n; ++i)
+        pool[i] = i;
+    for (int i = 0; i < k; ++i) {
+        int32_t j = i + (int32_t)(rng_next() % (uint32_t)(n - i));
+        int32_t t = pool[i];
+        pool[i] = pool[j];
+        pool[j] = t;
+        out[i] = pool[i];
+    }
+}
+
+static inline void fixture_init(fixture *f, uint64_t seed) {
+    static const int32_t dverts[NDV] = {0, 1, 2, 3, 4, 5, 4, 5, 6, 7, 8, 9, 8, 9, 10, 11, 0};
+    static const int32_t vc[ND] = {6, 6, 5}, rank[ND] = {2, 3, 4}, ncub[ND] = {3, 2, 3};
+    memset(f, 0, sizeof *f);
+    rng_state = seed;
+    for (int i = 0; i < 3 * NV; ++i)
+        f->rest[i] = rng_sym();
+    for (int v = 0; v < NV; ++v) {
+        double w[4], sum = 0.0;
+        int used = 1 + (int)(rng_next() % 4u); /* 1..4 influences, unused slots bone 0 */
+        for (int k = 0; k < 4; ++k) {
+            w[k] = k < used ? 0.05 + rng_unit() : 0.0;
+            sum += w[k];
+            f->skin_bone[4 * v + k] = k < used ? (int32_t)(rng_next() % NB) : 0;
+        }
+        for (int k = 0; k < 4; ++k)
+            f->skin_weight[4 * v + k] = w[k] / sum;
+    }
+    const int32_t parents[NB] = {-1, 0, 1, 1};
+    memcpy(f->bone_parent, parents, sizeof parents);
+    for (int i = 0; i < 6 * NB; ++i)
+        f->bone_joints[i] = rng_sym();
+    memcpy(f->domain_verts, dverts, sizeof dverts);
+    int32_t vb = 0, q = 0, cb = 0;
+    int64_t bo = 0, io = 0;
+    for (int d = 0; d < ND; ++d) {
+        sw_blob_domain *dom = &f->domains[d];
+        dom->bone = d + 1, dom->vert_begin = vb, dom->vert_count = vc[d], dom->rank = rank[d];
+        dom->q_offset = q, dom->cub_begin = cb, dom->cub_count = ncub[d];
+        dom->basis_offset = bo, dom->inertia_offset = io;
+        for (int c = cb; c < cb + ncub[d]; ++c)
+            rng_distinct(&f->cub_tets[4 * c], 4, vc[d]);
+        vb += vc[d], q += rank[d], cb += ncub[d];
+        bo += (int64_t)vc[d] * 3 * rank[d], io += 9 * rank[d] * rank[d];
+    }
+    for (int i = 0; i < NBASIS; ++i)
+        f->basis[i] = rng_sym();
+    for (int c = 0; c < NCUB; ++c) {
+        f->cub_weight[c] = 0.1 + rng_unit();
+        f->cub_vol[c] = 0.01 + rng_unit();
+        for (int k = 0; k < 9; ++k)
+            f->cub_dminv[9 * c + k] = rng_sym() * 10.0;
+    }
+    for (int i = 0; i < RT; ++i)
+        for (int j = 0; j <= i; ++j) {
+            f->spring_hessian[i * RT + j] = f->spring_hessian[j * RT + i] = rng_sym();
+            f->mass[i * RT + j] = f->mass[j * RT + i] = i == j ? 1.0 + rng_unit() : 0.0;
+        }
+    for (int i = 0; i < 3 * RT; ++i)
+        f->inertia_s[i] = rng_sym();
+    for (int i = 0; i < 9 * RT; ++i)
+        f->inertia_x[i] = rng_sym();
+    for (int i = 0; i < NIU; ++i)
+        f->inertia_u[i] = rng_sym();
+    for (int i = 0; i < NTR * RT; ++i)
+        f->train_q[i] = rng_sym();
+    for (int i = 0; i < NTR * 4 * NB; ++i)
+        f->train_pose[i] = rng_sym();
+    f->contact_ptr[0] = 0, f->contact_ptr[1] = 2, f->contact_ptr[2] = 2; /* pose 0: 2 pairs */
+    for (int c = 0; c < 2; ++c) {
+        for (int k = 0; k < 4; ++k) {
+            int32_t d = (int32_t)(rng_next() % ND);
+            f->contact_verts[8 * c + 2 * k] = d;
+            f->contact_verts[8 * c + 2 * k + 1] = (int32_t)(rng_next() % (uint32_t)vc[d]);
+        }
+        for (int k = 0; k < 6; ++k)
+            f->contact_data[7 * c + k] = rng_sym();
+        f->contact_data[7 * c + 6] = 0.5 + rng_unit();
+    }
+    for (int t = 0; t < NST; ++t)
+        rng_distinct(&f->surf_tris[3 * t], 3, NSV);
+    int32_t nc = 0;
+    for (int s = 0; s < NSV; ++s) {
+        f->surf_copy_ptr[s] = nc;
+        for (int k = 0; k < (s % 3 == 0 ? 2 : 1); ++k, ++nc) {
+            int32_t d = (int32_t)(rng_next() % ND);
+            f->surf_copies[2 * nc] = d;
+            f->surf_copies[2 * nc + 1] = (int32_t)(rng_next() % (uint32_t)vc[d]);
+        }
+    }
+    f->surf_copy_ptr[NSV] = nc;
+
+    sw_blob_view *v = &f->v;
+    v->nverts = NV, v->nbones = NB, v->ndomains = ND, v->rank_total = RT;
+    v->ndomain_verts = NDV, v->ncub = NCUB, v->nsurf_verts = NSV, v->nsurf_tris = NST;
+    v->mu = 1e5, v->lambda = 4e5, v->rayleigh_alpha = 0.1, v->rayleigh_beta = 0.01;
+    v->contact_k = 1e3;
+    v->nbasis = NBASIS, v->ninertia_u = NIU, v->nsurf_copies = nc;
+    v->ntrain = NTR, v->ncontacts = 2;
+    /* The fixture's arrays carry the view's field names. */
+#define POINT(id, NAME, elem_size, type, field, ...) v->field = f->field;
+    SINEW_BLOB_ARRAY_SECTIONS(POINT)
+#undef POINT
+}
+
+/* ---- helpers --------------------------------------------------------------------- */
+
+/* First field in which two views differ (counts, scalars bitwise, arrays bitwise), or
+ * NULL when they are identical. */
+static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
+#define SAME_BITS(f)                                                                               \
+    if (memcmp(&a->f, &b->f, sizeof a->f) != 0) return #f;
+    SW_BLOB_META_FIELDS(SAME_BITS)
+    SAME_BITS(nbasis)
+    SAME_BITS(ninertia_u)
+    SAME_BITS(nsurf_copies)
+#undef SAME_BITS
+    SW_BLOB_COUNT_LOCALS(a);
+#define SAME_ARRAY(id, NAME, elem_size, type, field, by_meta, count, formula)                      \
+    if (memcmp(a->field, b->field, (size_t)(count) * sizeof a->field[0]) != 0) return #field;
+    SINEW_BLOB_ARRAY_SECTIONS(SAME_ARRAY)
+#undef SAME_ARRAY
+    return NULL;
+}
+
+/* A copy of n bytes in a 64-byte aligned allocation of exactly n bytes (so that ASan
+ * catches a read past the end). */
+static inline uint8_t *copy_exact(const void *src, size_t n) {
+    void *p = NULL;
+    if (posix_memalign(&p, 64, n ? n : 1) != 0) return NULL;
+    if (n) memcpy(p, src, n);
+    return p;
+}
+
+static inline sinew_blob_header *hdr(uint8_t *blob) {
+    return (sinew_blob_header *)(void *)blob;
+}
+
+static inline sinew_blob_section *entry(uint8_t *blob, uint32_t id) {
+    sinew_blob_section *t = (sinew_blob_section *)(void *)(blob + 64);
+    for (uint32_t i = 0; i < hdr(blob)->section_count; ++i)
+        if (t[i].id == id) return &t[i];
+    return NULL;
+}
+
+static inline void *section(uint8_t *blob, uint32_t id) {
+    return blob + entry(blob, id)->offset;
+}
+
+static inline void fix_checksum(uint8_t *blob, size_t size) {
+    hdr(blob)->checksum = sw_blob_checksum(blob + 64, size - 64);
+}
+
+/* The whole range [p, p + bytes) lies inside [base, base + size). */
+static inline int inside(const void *p, int64_t bytes, const uint8_t *base, size_t size) {
+    const uint8_t *q = p;
+    return q >= base && bytes >= 0 && (uint64_t)(q - base) + (uint64_t)bytes <= size;
+}
+
+/* The training poses and their contacts, as the pose-space code follows them: each
+ * pose's reduced solution and feature, the pairs of its range [contact_ptr[t],
+ * contact_ptr[t+1]), each pair's four (domain, local vertex) references on to a vertex
+ * copy and a simulation vertex, its barycentrics, normal and area weight. 0 when an index
+ * would leave its array or an area weight is not positive (the loader must have
+ * rejected that blob): bounds are checked here, not left to ASan, because a wrong index
+ * into one buffer mostly lands in another section. */
+static inline int walk_training(const sw_blob_view *v, double *acc) {
+    const int64_t R = v->rank_total, F = 4 * (int64_t)v->nbones;
+    double s = 0.0;
+    if (v->contact_ptr[0] != 0 || v->contact_ptr[v->ntrain] != v->ncontacts) return 0;
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        for (int64_t i = 0; i < R; ++i)
+            s += v->train_q[R * t + i];
+        for (int64_t i = 0; i < F; ++i)
+            s += v->train_pose[F * t + i];
+        const int32_t c0 = v->contact_ptr[t], c1 = v->contact_ptr[t + 1];
+        if (c0 < 0 || c1 < c0 || c1 > v->ncontacts) return 0;
+        for (int32_t c = c0; c < c1; ++c) {
+            for (int k = 0; k < 4; ++k) {
+                const int32_t d = v->contact_verts[8 * (int64_t)c + 2 * k];
+                const int32_t l = v->contact_verts[8 * (int64_t)c + 2 * k + 1];
+                if (d < 0 || d >= v->ndomains) return 0;
+                const sw_blob_domain *dom = &v->domains[d];
+                if (l < 0 || l >= dom->vert_count) return 0;
+                s += v->rest[3 * (int64_t)v->domain_verts[dom->vert_begin + l]];
+            }
+            for (int k = 0; k < 7; ++k)
+                s += v->contact_data[7 * (int64_t)c + k];
+            if (!(v->contact_data[7 * (int64_t)c + 6] > 0.0)) return 0;
+        }
+    }
+    *acc += s;
+    return 1;
+}
+
+/* Everything a runtime would dereference, from an accepted view: every array inside the
+ * buffer, and every index chain followed. Under ASan an out-of-range index aborts. */
+static inline int walk_view(const sw_blob_view *v, const uint8_t *base, size_t size, double *acc) {
+    const int64_t R = v->rank_total;
+    SW_BLOB_COUNT_LOCALS(v);
+    const struct {
+        const void *p;
+        int64_t bytes;
+    } arrays[] = {
+#define EXTENT(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
+    {v->field, (int64_t)(elem_size * (count))},
+        SINEW_BLOB_ARRAY_SECTIONS(EXTENT)
+#undef EXTENT
+    };
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
+        if (!inside(arrays[i].p, arrays[i].bytes, base, size)) return 0;
+    double s = 0.0;
+    for (int32_t d = 0; d < v->ndomains; ++d) {
+        const sw_blob_domain *dom = &v->domains[d];
+        s += v->bone_joints[6 * dom->bone];
+        for (int32_t k = 0; k < dom->vert_count; ++k) {
+            int32_t x = v->domain_verts[dom->vert_begin + k];
+            s += v->rest[3 * x + 2];
+            for (int j = 0; j < 4; ++j) {
+                int32_t b = v->skin_bone[4 * x + j];
+                s += v->skin_weight[4 * x + j] * v->bone_joints[6 * b + 5];
+                for (int32_t p = v->bone_parent[b]; p >= 0; p = v->bone_parent[p])
+                    s += 1.0;
+            }
+            for (int32_t a = 0; a < 3; ++a)
+                for (int32_t i = 0; i < dom->rank; ++i)
+                    s += v->basis[dom->basis_offset + (3 * k + a) * dom->rank + i];
+        }
+        for (int32_t i = 0; i < dom->rank; ++i) {
+            s += v->mass[(dom->q_offset + i) * R + dom->q_offset + i];
+            s += v->spring_hessian[(dom->q_offset + i) * R + R - 1];
+            s += v->inertia_s[3 * (dom->q_offset + i) + 2] +
+                 v->inertia_x[9 * (dom->q_offset + i) + 8];
+        }
+        s += v->inertia_u[dom->inertia_offset + 9 * dom->rank * dom->rank - 1];
+        for (int32_t c = dom->cub_begin; c < dom->cub_begin + dom->cub_count; ++c) {
+            s += v->cub_weight[c] * v->cub_vol[c] + v->cub_dminv[9 * c + 8];
+            for (int k = 0; k < 4; ++k)
+                s += v->rest[3 * v->domain_verts[dom->vert_begin + v->cub_tets[4 * c + k]]];
+        }
+    }
+    for (int32_t t = 0; t < 3 * v->nsurf_tris; ++t) {
+        int32_t sv = v->surf_tris[t];
+        for (int32_t c = v->surf_copy_ptr[sv]; c < v->surf_copy_ptr[sv + 1]; ++c) {
+            const sw_blob_domain *dom = &v->domains[v->surf_copies[2 * c]];
+            s += v->rest[3 * v->domain_verts[dom->vert_begin + v->surf_copies[2 * c + 1]]];
+        }
+    }
+    *acc += s;
+    return walk_training(v, acc);
+}
+
+static inline int contains(const char *haystack, const char *needle) {
+    return strstr(haystack, needle) != NULL;
+}
+
+/* The fixture written to memory (64-aligned buffer, caller frees). */
+static inline uint8_t *write_fixture(const fixture *f, size_t *size) {
+    void *data = NULL;
+    sw_error err;
+    sw_error_clear(&err);
+    if (sw_blob_write_memory(&f->v, &data, size, &err) != SINEW_OK) {
+        fprintf(stderr, "  write failed: %s\n", err.msg);
+        return NULL;
+    }
+    return data;
+}
+
+#endif
