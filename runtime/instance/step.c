@@ -233,13 +233,16 @@ static void phase_output(sw_step_ctx *c) {
 /* The output within float range (what sinew_instance_read_surface hands out). A blob
  * whose values are finite but absurd (a hostile one passes validation so) can still
  * overflow it from a finite state: the step then fails as a non-finite solve does, with
- * the state back at the step's start and no velocity. O(surface). */
+ * the state back at the step's start, no velocity, and the surface written again from
+ * that state at this pose (so the host never reads the overflowed one). O(surface), as
+ * the output itself. */
 static sinew_result check_output(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     for (int64_t i = 0; i < 3 * (int64_t)in->v->nsurf_verts; ++i)
         if (!(fabs(in->surf_x[i]) <= FLT_MAX) || !(fabs(in->surf_n[i]) <= FLT_MAX)) {
             memcpy(in->solver.q, in->solver.qn, (size_t)in->red.R * sizeof(double));
             memset(in->solver.qdot, 0, (size_t)in->red.R * sizeof(double));
+            sw_instance_write_surface(in);
             c->st.status |= SINEW_STEP_FAILED;
             return SINEW_ERROR_NOT_FINITE;
         }

@@ -67,7 +67,10 @@ SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float
 /** Advances the instance by dt seconds (0 < dt <= 1) to the current pose: quasistatic
  * or dynamic per the instance def. Never allocates, locks or blocks; its cost depends
  * on the blob's cubature and surface sizes, not on the tet count. A non-finite result
- * is undone and reported as SINEW_ERROR_NOT_FINITE. */
+ * (a non-finite solve, or an output surface beyond float range) is undone and reported
+ * as SINEW_ERROR_NOT_FINITE with SINEW_STEP_FAILED: the reduced state goes back to the
+ * step's start with no velocity, the surface is that state's at the current pose, and
+ * the pose counts as the last one for the next step's jump test. */
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt);
 
 /** Copies the output surface of the last step into host buffers of `vertex_count`
