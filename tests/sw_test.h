@@ -1,7 +1,8 @@
 /* A tiny test runner: TEST(name) { ... ENSURE(cond); ... } and a main() from
  * SW_TEST_MAIN(). Run a subset with a substring filter: ./test_x name_part.
  * Exit code: 0 all passed, 1 any failed, 77 (CTest "skipped") when every test ran
- * skipped itself with SKIP(). Prints "N passed, N failed, N skipped". */
+ * skipped itself with SKIP() (NEED_DATA: a real asset absent; a failure with CI=true).
+ * Prints "N passed, N failed, N skipped". */
 #ifndef SW_TEST_H
 #define SW_TEST_H
 
@@ -85,9 +86,43 @@ extern int sw_test_skipped_; /* current test skipped itself */
 #define CASE(fn)                                                                                   \
     { #fn, fn }
 
-/* Path of a real asset under ../shared/data, or NULL when that folder is absent. */
+/* The folder of real assets (tests/CMakeLists.txt passes ../shared/data). */
 #ifndef SINEW_SHARED_DATA_DIR
 #define SINEW_SHARED_DATA_DIR "../shared/data"
 #endif
+
+/* 1 when the real asset `rel` (a path below SINEW_SHARED_DATA_DIR) can be opened. */
+static inline int sw_test_have_data(const char *rel) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", SINEW_SHARED_DATA_DIR, rel);
+    FILE *f = fopen(path, "rb");
+    if (f) fclose(f);
+    return f != NULL;
+}
+
+/* 1 in CI: the environment variable CI is "true" (.ci/run runs with CI=true). */
+static inline int sw_test_in_ci(void) {
+    const char *ci = getenv("CI");
+    return ci && strcmp(ci, "true") == 0;
+}
+
+/* The one decision of what a test that needs a real asset does without it: outside CI
+ * it skips (exit 77 when every test of the file skipped); in CI it FAILS, so that CI
+ * never passes by skipping the tests on real data. */
+#define NEED_DATA(rel)                                                                             \
+    do {                                                                                           \
+        if (!sw_test_have_data(rel)) {                                                             \
+            if (sw_test_in_ci()) {                                                                 \
+                fprintf(stderr,                                                                    \
+                        "  FAILED: the real asset %s/%s is missing and CI=true: CI must run "      \
+                        "the tests on real data (put the assets in %s)\n",                         \
+                        SINEW_SHARED_DATA_DIR, rel, SINEW_SHARED_DATA_DIR);                        \
+                sw_test_failed_++;                                                                 \
+                return;                                                                            \
+            }                                                                                      \
+            SKIP("%s/%s absent (real assets; CI=true makes this a failure)",                       \
+                 SINEW_SHARED_DATA_DIR, rel);                                                      \
+        }                                                                                          \
+    } while (0)
 
 #endif

@@ -12,12 +12,6 @@
 
 static const double PI = 3.14159265358979323846;
 
-static int file_exists(const char *path) {
-    FILE *f = fopen(path, "rb");
-    if (f) fclose(f);
-    return f != NULL;
-}
-
 static int write_text(const char *path, const char *text) {
     FILE *f = fopen(path, "wb");
     if (!f) return 0;
@@ -235,7 +229,7 @@ TEST(cd_anim_malformed) {
 
 /* Joint positions of every frame: head and tail of every bone under its transform. */
 TEST(cd_anim_elephant) {
-    if (!file_exists(ELEPHANT_DIR "/elephant_anim.txt")) SKIP("%s absent", ELEPHANT_DIR);
+    NEED_DATA("elephant-cd/elephant_anim.txt");
     sw_error err = {0};
     sw_skeleton s = {0};
     sw_clip c = {0};
@@ -582,7 +576,7 @@ static int every_bone_driven(const sw_character *c, int atleast) {
 }
 
 TEST(dataset_elephant) {
-    if (!file_exists(ELEPHANT_DIR "/elephant.mesh")) SKIP("%s absent", ELEPHANT_DIR);
+    NEED_DATA("elephant-cd/elephant.mesh");
     sw_character c = {0};
     sw_error err = {0};
     ENSUREF(sw_character_from_dataset(SINEW_SHARED_DATA_DIR, "elephant-cd", 0, &c, &err) ==
@@ -607,7 +601,7 @@ TEST(dataset_elephant) {
 }
 
 TEST(dataset_hand) {
-    if (!file_exists(HAND_DIR "/hand.mesh")) SKIP("%s absent", HAND_DIR);
+    NEED_DATA("hand-libigl/hand.mesh");
     sw_character c = {0};
     sw_error err = {0};
     ENSUREF(sw_character_from_dataset(SINEW_SHARED_DATA_DIR, "hand-libigl", 41, &c, &err) ==
@@ -643,7 +637,7 @@ TEST(corrupt_inputs) {
     ENSURE(sw_character_from_dataset(SINEW_SHARED_DATA_DIR, "dragon", 0, &c, &err) ==
            SINEW_ERROR_UNSUPPORTED);
     ENSURE(sw_character_from_dataset(TMP("nowhere"), "elephant-cd", 0, &c, &err) == SINEW_ERROR_IO);
-    if (!file_exists(ELEPHANT_DIR "/elephant.mesh")) SKIP("%s absent", ELEPHANT_DIR);
+    NEED_DATA("elephant-cd/elephant.mesh");
     /* weights with 23 columns instead of 24 */
     FILE *f = fopen(TMP("w23.dmat"), "wb");
     ENSURE(f);
@@ -670,7 +664,7 @@ TEST(corrupt_inputs) {
     rc = sw_character_from_files(ELEPHANT_DIR "/elephant.mesh", ELEPHANT_DIR "/elephant.tgf", NULL,
                                  ELEPHANT_DIR "/elephant.json", 0, &c, &err);
     ENSURE(rc == SINEW_ERROR_UNSUPPORTED);
-    if (!file_exists(HAND_DIR "/hand-pose.dmat")) return;
+    NEED_DATA("hand-libigl/hand-pose.dmat");
     rc = sw_character_from_files(ELEPHANT_DIR "/elephant.mesh", ELEPHANT_DIR "/elephant.tgf", NULL,
                                  HAND_DIR "/hand-pose.dmat", 5, &c, &err);
     ENSURE(rc == SINEW_ERROR_PARSE);

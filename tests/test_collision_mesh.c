@@ -81,8 +81,9 @@ static void sample(const float *v, const sw_trimesh *m, int k, double y[3]) {
 }
 
 TEST(arm_mesh_matches_brute_force) {
+    NEED_DATA("arm-libigl/arm.obj");
     const sw_trimesh *m = load();
-    if (!m) SKIP("arm-libigl/arm.obj not readable");
+    ENSUREF(m, "arm-libigl/arm.obj is present but not readable");
     float *v;
     uint32_t *ix;
     sinew_collider_def d = mesh_def(m, &v, &ix);
@@ -129,8 +130,9 @@ TEST(arm_mesh_matches_brute_force) {
 }
 
 TEST(arm_mesh_query_cost) {
+    NEED_DATA("arm-libigl/arm.obj");
     const sw_trimesh *m = load();
-    if (!m) SKIP("arm-libigl/arm.obj not readable");
+    ENSUREF(m, "arm-libigl/arm.obj is present but not readable");
     float *v;
     uint32_t *ix;
     sinew_collider_def d = mesh_def(m, &v, &ix);

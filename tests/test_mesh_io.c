@@ -821,12 +821,6 @@ static const char *data_path(const char *rel) {
     return p;
 }
 
-static int have_data(void) {
-    FILE *f = fopen(data_path("elephant-cd/elephant.mesh"), "rb");
-    if (f) fclose(f);
-    return f != NULL;
-}
-
 static const struct {
     const char *rel;
     int32_t nverts, ntets, nsurf;
@@ -837,7 +831,7 @@ static const struct {
 };
 
 TEST(real_tet_meshes) {
-    if (!have_data()) SKIP("no %s", SINEW_SHARED_DATA_DIR);
+    NEED_DATA("elephant-cd/elephant.mesh");
     for (size_t i = 0; i < sizeof k_meshes / sizeof k_meshes[0]; ++i) {
         sw_tetmesh m;
         sw_error e;
@@ -895,7 +889,7 @@ static int ends_with(const char *s, const char *suf) {
 }
 
 TEST(real_surfaces_skeletons_and_matrices) {
-    if (!have_data()) SKIP("no %s", SINEW_SHARED_DATA_DIR);
+    NEED_DATA("elephant-cd/elephant.mesh");
     for (size_t i = 0; i < sizeof k_assets / sizeof k_assets[0]; ++i) {
         const char *p = data_path(k_assets[i].rel);
         sw_error e;
@@ -940,7 +934,7 @@ TEST(real_surfaces_skeletons_and_matrices) {
 
 /* Every .mesh/.obj/.tgf/.dmat under the data folder reads, and is one we check above. */
 TEST(real_every_asset_reads) {
-    if (!have_data()) SKIP("no %s", SINEW_SHARED_DATA_DIR);
+    NEED_DATA("elephant-cd/elephant.mesh");
     DIR *top = opendir(SINEW_SHARED_DATA_DIR);
     ENSURE(top);
     struct dirent *de;
@@ -1001,7 +995,7 @@ TEST(real_every_asset_reads) {
 /* Cut elephant.mesh at ~200 offsets: every prefix fails cleanly with PARSE, except the
  * ones that keep all the data (then it must read the whole mesh). */
 TEST(real_truncation_sweep) {
-    if (!have_data()) SKIP("no %s", SINEW_SHARED_DATA_DIR);
+    NEED_DATA("elephant-cd/elephant.mesh");
     size_t n;
     char *full = read_all(data_path("elephant-cd/elephant.mesh"), &n);
     ENSURE(full && n > 1000);

@@ -70,23 +70,34 @@ static void column(void *vctx, int64_t cand, double *col) {
     }
 }
 
+/* The domain's tets are summed in fixed chunks of SUM_CHUNK tets, each chunk into its
+ * own slot, and the chunks then in order: the sum's rounding is the same for any number
+ * of bake threads (per-worker partial sums were not: their split follows the pool's
+ * size, and the cubature weights moved with it). */
+#define SUM_CHUNK 64
+
 typedef struct {
     const cub_ctx *c;
     int64_t ntets;
-    double *partial; /* workers x nsamples x r */
+    double *partial; /* chunks x nsamples x r */
 } sum_ctx;
 
 static void sum_worker(void *vctx, int64_t begin, int64_t end, int worker) {
+    (void)worker;
     sum_ctx *sc = vctx;
     const cub_ctx *c = sc->c;
     size_t block = (size_t)c->nsamples * c->r;
-    double *acc = sc->partial + (size_t)worker * block, a[1024];
-    for (int64_t i = begin; i < end; ++i)
-        for (int32_t smp = 0; smp < c->nsamples; ++smp) {
-            tet_reduced_force(c, i, smp, a);
-            for (int32_t j = 0; j < c->r; ++j)
-                acc[(size_t)smp * c->r + j] += a[j];
-        }
+    double a[1024];
+    for (int64_t k = begin; k < end; ++k) {
+        double *acc = sc->partial + (size_t)k * block;
+        int64_t last = (k + 1) * SUM_CHUNK < sc->ntets ? (k + 1) * SUM_CHUNK : sc->ntets;
+        for (int64_t i = k * SUM_CHUNK; i < last; ++i)
+            for (int32_t smp = 0; smp < c->nsamples; ++smp) {
+                tet_reduced_force(c, i, smp, a);
+                for (int32_t j = 0; j < c->r; ++j)
+                    acc[(size_t)smp * c->r + j] += a[j];
+            }
+    }
 }
 
 static double gauss(uint64_t *state) {
@@ -157,17 +168,18 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, 0, 0};
     sw_lame(s->ch.youngs, s->ch.poisson, &c.mu, &c.lambda);
     /* b: the domain's full reduced force per sample (Krysl projection), summed in
-     * parallel per worker and then in worker order */
+     * parallel per chunk of tets and then in chunk order (SUM_CHUNK) */
     int workers = sw_pool_size(s->pool);
     size_t block = (size_t)ns * r;
-    partial = calloc((size_t)workers * block, sizeof(double));
+    int64_t nchunks = ((int64_t)ntd + SUM_CHUNK - 1) / SUM_CHUNK;
+    partial = calloc((size_t)nchunks * block, sizeof(double));
     b = calloc(block, sizeof(double));
     if (!partial || !b) goto done;
     sum_ctx sc = {&c, ntd, partial};
-    sw_pool_parallel_for(s->pool, ntd, sum_worker, &sc);
-    for (int w = 0; w < workers; ++w)
+    sw_pool_parallel_for(s->pool, nchunks, sum_worker, &sc);
+    for (int64_t k = 0; k < nchunks; ++k)
         for (size_t i = 0; i < block; ++i)
-            b[i] += partial[(size_t)w * block + i];
+            b[i] += partial[(size_t)k * block + i];
     double bmax = 0;
     for (int32_t smp = 0; smp < ns; ++smp) {
         double n2 = 0;

@@ -21,4 +21,21 @@ typedef struct sw_eval_result {
 sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,
                                 const double *x_full, int32_t npose, uint32_t max_newton,
                                 sw_eval_result *out, sw_error *err);
+
+/* How sw_eval_correction_opts steps: the instance's mode, the step's dt, Newton's
+ * iterations a step, and `skip` leading poses stepped but not compared (a dynamic path's
+ * lead-in: its held-out frames depend on the frames before them). */
+typedef struct sw_eval_options {
+    sinew_step_mode mode;
+    float dt;
+    uint32_t max_newton;
+    int32_t skip;
+} sw_eval_options;
+
+/* As sw_eval_correction with options: steps through all npose poses and compares the
+ * last npose - skip of them with x_full (3 nverts per compared pose). sw_eval_correction
+ * is {quasistatic, 1/30 s, max_newton, 0}. */
+sinew_result sw_eval_correction_opts(const sinew_blob *blob, const double *mass, const double *T,
+                                     const double *x_full, int32_t npose, const sw_eval_options *o,
+                                     sw_eval_result *out, sw_error *err);
 #endif

@@ -8,6 +8,7 @@
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess) {
     const sw_blob_view *v = m->v;
     double E = 0;
+    uint32_t project = want_hess == SW_CUB_HESSIAN_EXACT ? 0u : SW_COROT_PROJECT_PSD;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
@@ -20,7 +21,7 @@ double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_
             double w = v->cub_weight[c];
             E += w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
                                          want_grad ? f : NULL, want_hess ? wm : NULL, gm,
-                                         m->svd_V + 9 * (int64_t)c, SW_COROT_PROJECT_PSD);
+                                         m->svd_V + 9 * (int64_t)c, project);
             if (!want_grad) continue;
             for (int32_t j = 0; j < r; ++j) {
                 double acc = 0;

@@ -9,8 +9,11 @@
 #include "reduced_map.h"
 
 /* Cubature energy at q. With want_grad it adds -sum w J^T f to m->g; with want_hess it
- * adds the domain blocks sum w J^T K J to m->H (both initialised by the caller). Warm
- * starts each element's SVD from m->svd_V and updates it. */
+ * adds the domain blocks sum w J^T K J to m->H (both initialised by the caller), K
+ * projected to PSD, or exact with want_hess == SW_CUB_HESSIAN_EXACT (the finite-difference
+ * tests; the step never asks for it). Warm starts each element's SVD from m->svd_V and
+ * updates it. */
+#define SW_CUB_HESSIAN_EXACT 2
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess);
 
 #endif

@@ -30,6 +30,24 @@ void sw_instance_set_q(sinew_instance *inst, const double *q);
  * (PSD-projected) Hessian into H (rank_total^2, row-major) when they are not NULL. */
 double sw_instance_potential(sinew_instance *inst, const double *q, double *g, double *H);
 
+/* Tests: the first phases of the step sinew_instance_step(inst, dt) would take from the
+ * current state and pose (skinning, pose-space contact pairs, teleport check, in dynamic
+ * mode q_n, the inertial forces and the frozen H(q_n), world candidates at the start
+ * state), without the solve and without advancing: afterwards
+ * sw_instance_step_potential evaluates the very potential that step minimises. The
+ * instance is left mid-step (a quasistatic one at its pose-space start): set a pose
+ * before stepping it again. */
+void sw_instance_step_prepare(sinew_instance *inst, float dt);
+
+/* Tests: the potential of the step prepared by sw_instance_step_prepare with the step's
+ * own coefficients for dt and the instance's mode (cubature, springs, pose-space and
+ * world contact; dynamic: backward-Euler inertia, Rayleigh damping, inertial forces) at
+ * q, its gradient into g and its Hessian into H (rank_total^2, row-major) when not NULL:
+ * the step's Newton matrix (the material part projected to PSD), or with exact_hessian
+ * the exact second derivative. */
+double sw_instance_step_potential(sinew_instance *inst, float dt, const double *q, double *g,
+                                  double *H, int exact_hessian);
+
 /* Evaluation only (O(N)): plain DQS of every simulation vertex at the current pose. */
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x);
 

@@ -17,6 +17,8 @@
 #include <string.h>
 
 #include "clock.h"
+#include "cubature.h"
+#include "instance.h"
 #include "instance_internal.h"
 
 typedef struct sw_step_ctx {
@@ -34,17 +36,23 @@ static double lap(sw_step_ctx *c) {
     return ms;
 }
 
-static void step_begin(sw_step_ctx *c, sinew_instance *in, float dt) {
+/* The time discretisation of a step of dt seconds in the instance's mode. */
+static sw_dyn_coef step_coef(const sinew_instance *in, float dt) {
     const sw_blob_view *v = in->v;
+    sw_dyn_coef dc = {
+        dt, 0, 0, v->rayleigh_alpha, v->rayleigh_beta, in->mode == SINEW_STEP_DYNAMIC};
+    if (dc.dynamic) {
+        dc.cm = 1.0 / ((double)dt * dt);
+        dc.cd = 1.0 / dt;
+    }
+    return dc;
+}
+
+static void step_begin(sw_step_ctx *c, sinew_instance *in, float dt) {
     memset(c, 0, sizeof *c);
     c->in = in;
     c->st.struct_size = sizeof c->st;
-    c->dc = (sw_dyn_coef){
-        dt, 0, 0, v->rayleigh_alpha, v->rayleigh_beta, in->mode == SINEW_STEP_DYNAMIC};
-    if (c->dc.dynamic) {
-        c->dc.cm = 1.0 / ((double)dt * dt);
-        c->dc.cd = 1.0 / dt;
-    }
+    c->dc = step_coef(in, dt);
     memcpy(in->solver.qn, in->solver.q, (size_t)in->red.R * sizeof(double));
     c->t = sw_now_seconds();
 }
@@ -265,4 +273,25 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     }
     inst->stats = c.st;
     return r;
+}
+
+void sw_instance_step_prepare(sinew_instance *inst, float dt) {
+    sw_step_ctx c;
+    step_begin(&c, inst, dt);
+    phase_skin(&c);
+    phase_contact(&c);
+    phase_dynamics(&c);
+    phase_world(&c);
+}
+
+double sw_instance_step_potential(sinew_instance *inst, float dt, const double *q, double *g,
+                                  double *H, int exact_hessian) {
+    sw_dyn_coef dc = step_coef(inst, dt);
+    size_t R = (size_t)inst->red.R;
+    sw_step_contacts ct = {&inst->ps, inst->wc.world ? &inst->wc : NULL};
+    int want_hess = H ? (exact_hessian ? SW_CUB_HESSIAN_EXACT : 1) : 0;
+    double phi = sw_potential(&inst->red, &ct, &inst->solver, q, &dc, g || H, want_hess);
+    if (g) memcpy(g, inst->red.g, R * sizeof(double));
+    if (H) memcpy(H, inst->red.H, R * R * sizeof(double));
+    return phi;
 }

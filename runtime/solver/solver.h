@@ -45,8 +45,9 @@ typedef struct sw_step_contacts {
 } sw_step_contacts;
 
 /* Phi(q): cubature + contact (self and world) + springs [+ inertia, damping and inertial
- * forces]. With want_grad also red->g (and red->H with want_hess); H_n is frozen for the
- * step. */
+ * forces]. With want_grad also red->g (and red->H with want_hess: the material part
+ * projected to PSD, exact with want_hess == SW_CUB_HESSIAN_EXACT, cubature.h); H_n is frozen
+ * for the step. */
 double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
                     const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess);
 

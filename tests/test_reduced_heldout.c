@@ -1,0 +1,158 @@
+/* The runtime against the full-space reference on HELD-OUT poses (issue 15): clip frames
+ * the bake did not train on, where no step starts from a stored solution. Two characters:
+ * the procedural finger (about 3,000 tets, a fold with self-contact) and the real
+ * elephant of ../shared/data/elephant-cd (1,502 tets, 24 bones, its own clip; skipped
+ * without the folder, a failure in CI: NEED_DATA). For each, one bake (the clip's first
+ * 60% trains, the rest is held out), then the correction error
+ *   |x_sub - x_full|_M / |x_full - x_dqs|_M   (sw_eval_correction_opts, subspace_eval.h)
+ * over the held-out frames:
+ *   quasistatic  the bake's own held-out solutions (sw_fullsim quasistatic along the
+ *                clip's path, sw_bake_errors: the figure sinew-bake reports);
+ *   dynamic      sw_fullsim backward Euler (the blob's Rayleigh alpha and beta, the
+ *                clip's frame time) and a dynamic instance, both played from rest through
+ *                the whole clip, compared on the held-out frames only.
+ * The bounds are the measured values (Release, x86-64, 2 bake threads) times about 1.25,
+ * rounded up; the measurements are stated beside each.
+ *
+ * Measured: finger quasistatic 0.152 on 5 held-out poses (0.021 on its 19 training
+ * poses), dynamic 0.286 on 5 held-out frames (0.171 on its 7 training frames); elephant
+ * quasistatic 0.147 on 8 held-out poses (0.007 on 69 training poses), dynamic 1.049 on
+ * 24 held-out frames (0.980 on its 36 training frames). The elephant's dynamic figure
+ * is a known gap, not a held-out effect: its dynamic instance misses the reference's
+ * backward-Euler correction as much on the training frames as on the held-out ones (no
+ * better than skinning); its bound only guards against it getting worse. */
+#include <math.h>
+#include <stdint.h>
+
+#include "bake.h"
+#include "blob_load.h"
+#include "blob_write.h"
+#include "character_io.h"
+#include "fullsim.h"
+#include "samples.h"
+#include "subspace_eval.h"
+#include "sw_test.h"
+
+typedef struct {
+    sw_character ch;
+    sw_bake_result res;
+    void *data;
+    size_t size;
+    sinew_blob *blob;
+    int32_t ntrain_frames; /* clip frames [0, ntrain_frames) train, the rest is held out */
+} baked;
+
+static void baked_free(baked *b) {
+    sinew_blob_destroy(b->blob);
+    free(b->data);
+    sw_bake_result_free(&b->res);
+    sw_character_free(&b->ch);
+}
+
+/* Bakes b->ch (the fixture's parameters: 3 samples a joint sweep, 8 clip frames and the
+ * return path). 1 on success. */
+static int bake(baked *b) {
+    sw_error err;
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 3;
+    p.max_train_frames = 8;
+    p.return_path = 1;
+    p.threads = 2;
+    b->ntrain_frames = (int32_t)floor(b->ch.clip.nframes * (1.0 - p.heldout_fraction));
+    if (sw_bake(&b->ch, &p, &b->res, &err) != SINEW_OK) {
+        fprintf(stderr, "  bake failed: %s\n", err.msg);
+        return 0;
+    }
+    if (sw_blob_write_memory(&b->res.view, &b->data, &b->size, &err) != SINEW_OK) return 0;
+    sinew_blob_def d = sinew_blob_def_default();
+    d.data = b->data;
+    d.data_size = b->size;
+    return sinew_blob_load(&d, &b->blob) == SINEW_OK;
+}
+
+/* Quasistatic on the bake's held-out poses; dynamic on the clip's held-out frames after
+ * playing its training frames. Fails above the bounds. */
+static void compare(baked *b, const char *name, double qs_bound, double dyn_bound) {
+    const sw_blob_view *v = sw_blob_get_view(b->blob);
+    sw_eval_result et, eh;
+    sw_error err;
+    ENSUREF(sw_bake_errors(b->blob, &b->res, &et, &eh, &err) == SINEW_OK, "%s", err.msg);
+    fprintf(stderr,
+            "  %s (%d tets, rank %d): quasistatic correction error, %d training poses %.4f, "
+            "%d held-out poses %.4f\n",
+            name, b->ch.mesh.ntets, v->rank_total, et.frames, et.correction_error, eh.frames,
+            eh.correction_error);
+    ENSURE(eh.failed == 0 && eh.frames == b->res.nheldout && eh.frames > 0);
+
+    /* dynamic: the reference's backward Euler through the whole clip */
+    int32_t nf = b->ch.clip.nframes, nb = b->ch.skel.nbones, nv = b->ch.mesh.nverts;
+    int32_t first = b->ntrain_frames;
+    float dt = (float)(1.0 / (b->ch.clip.fps > 0 ? b->ch.clip.fps : 30.0));
+    sw_fullsim_params fp = sw_fullsim_params_default();
+    fp.integrator = SW_BACKWARD_EULER;
+    fp.dt = dt;
+    fp.rayleigh_alpha = v->rayleigh_alpha;
+    fp.rayleigh_beta = v->rayleigh_beta;
+    fp.threads = 2;
+    sw_fullsim *sim;
+    ENSUREF(sw_fullsim_create(&b->ch, &fp, &sim, &err) == SINEW_OK, "%s", err.msg);
+    double *xref = malloc(sizeof(double) * 3 * nv * (size_t)nf);
+    int unconverged = 0;
+    for (int32_t f = 0; f < nf; ++f) {
+        sw_fullsim_stats st;
+        sinew_result r = sw_fullsim_step(sim, b->ch.clip.T + (size_t)f * 12 * nb, &st);
+        unconverged += r == SINEW_ERROR_NOT_CONVERGED;
+        if (r != SINEW_OK && r != SINEW_ERROR_NOT_CONVERGED) break;
+        memcpy(xref + (size_t)f * 3 * nv, sw_fullsim_positions(sim), sizeof(double) * 3 * nv);
+    }
+    sw_fullsim_destroy(sim);
+    /* the training frames too, for the record: a dynamic step never starts from a stored
+       solution, so they are not much easier than the held-out ones */
+    sw_eval_options o = {SINEW_STEP_DYNAMIC, dt, SW_BAKE_EVAL_NEWTON, 0};
+    sw_eval_result ed, edt;
+    sinew_result r =
+        sw_eval_correction_opts(b->blob, b->res.mass, b->ch.clip.T, xref, first, &o, &edt, &err);
+    o.skip = first;
+    if (r == SINEW_OK)
+        r = sw_eval_correction_opts(b->blob, b->res.mass, b->ch.clip.T,
+                                    xref + (size_t)first * 3 * nv, nf, &o, &ed, &err);
+    free(xref);
+    ENSUREF(r == SINEW_OK, "%s", err.msg);
+    fprintf(stderr,
+            "  %s: dynamic (dt %.4g s, alpha %g, beta %g) correction error on %d held-out "
+            "frames (after %d): %.4f (training frames %.4f; reference unconverged steps: %d)\n",
+            name, (double)dt, v->rayleigh_alpha, v->rayleigh_beta, ed.frames, first,
+            ed.correction_error, edt.correction_error, unconverged);
+    ENSURE(ed.failed == 0 && ed.frames == nf - first);
+    ENSUREF(eh.correction_error <= qs_bound, "%s quasistatic held-out error %.4f > %.3f", name,
+            eh.correction_error, qs_bound);
+    ENSUREF(ed.correction_error <= dyn_bound, "%s dynamic held-out error %.4f > %.3f", name,
+            ed.correction_error, dyn_bound);
+}
+
+TEST(finger_heldout_matches_the_reference) {
+    baked b;
+    memset(&b, 0, sizeof b);
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 12, &b.ch, &err) == SINEW_OK);
+    ENSURE(bake(&b));
+    compare(&b, "finger", 0.19, 0.36); /* measured 0.152, 0.286 */
+    baked_free(&b);
+}
+
+TEST(elephant_heldout_matches_the_reference) {
+    NEED_DATA("elephant-cd/elephant.mesh");
+    baked b;
+    memset(&b, 0, sizeof b);
+    sw_error err;
+    int32_t frames = 60; /* at 100 fps: 36 train (8 of them used), 24 held out */
+    ENSUREF(sw_character_from_dataset(SINEW_SHARED_DATA_DIR, "elephant-cd", frames, &b.ch, &err) ==
+                SINEW_OK,
+            "%s", err.msg);
+    ENSURE(bake(&b));
+    compare(&b, "elephant-cd", 0.19, 1.32); /* measured 0.147, 1.049 (a known gap) */
+    baked_free(&b);
+}
+
+SW_TEST_MAIN(CASE(finger_heldout_matches_the_reference),
+             CASE(elephant_heldout_matches_the_reference))
