@@ -44,10 +44,20 @@ static void overshoot(const double *hs, int H, const double *m, int32_t ns, doub
     *settle = rms_m(hs + (size_t)(H - 2) * 3 * ns, last, m, ns);
 }
 
+static double mass_total(const double *m, int32_t n) {
+    double s = 0;
+    for (int32_t i = 0; i < n; ++i)
+        s += m[i];
+    return s;
+}
+
 typedef struct dyn_run {
     sw_fullsim *ref;
     sinew_instance *inst;
     sw_eval_acc clip, hold;
+    sinew_instance *qs;      /* quasistatic runtime alongside, for the increment */
+    double *xd, *xq, *cnt;   /* its and the dynamic instance's full positions */
+    double inc_num, inc_den; /* the dynamic increment's sums */
     double *full_ms, *sub_ms, *hs_full, *hs_sub, *sm; /* per step; hold surfaces; masses */
     int32_t *sv;
 } dyn_run;
@@ -55,6 +65,10 @@ typedef struct dyn_run {
 static void run_free(dyn_run *r) {
     sw_fullsim_destroy(r->ref);
     sinew_instance_destroy(r->inst);
+    sinew_instance_destroy(r->qs);
+    free(r->xd);
+    free(r->xq);
+    free(r->cnt);
     sw_eval_acc_free(&r->clip);
     sw_eval_acc_free(&r->hold);
     free(r->full_ms);
@@ -102,9 +116,22 @@ static sinew_result start_settled(const sw_character *ch, const sinew_blob *blob
     return SINEW_OK;
 }
 
+/* Adds a frame to the dynamic increment: the runtime's dynamic minus quasistatic shape
+ * against the reference's (xf dynamic, xfq quasistatic at the same pose). */
+static void add_increment(dyn_run *r, const double *mass, int32_t nv, const double *xf,
+                          const double *xfq) {
+    sw_instance_full_positions(r->inst, r->xd, r->cnt);
+    sw_instance_full_positions(r->qs, r->xq, r->cnt);
+    for (int64_t i = 0; i < 3 * (int64_t)nv; ++i) {
+        double df = xf[i] - xfq[i], e = r->xd[i] - r->xq[i] - df;
+        r->inc_num += mass[i / 3] * e * e;
+        r->inc_den += mass[i / 3] * df * df;
+    }
+}
+
 sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
-                              const sw_fullsim_params *fp, int hold_frames, sw_dyn_bench *out,
-                              sw_error *err) {
+                              const sw_fullsim_params *fp, int hold_frames, const double *full_qs,
+                              sw_dyn_bench *out, sw_error *err) {
     memset(out, 0, sizeof *out);
     const sw_blob_view *v = sw_blob_get_view(blob);
     int F = ch->clip.nframes, H = hold_frames, N = F + H;
@@ -148,6 +175,16 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         (res = sw_eval_acc_init(&r.hold, blob, mass, err)) != SINEW_OK)
         goto done;
     sw_eval_acc_add(&r.clip, r.inst, sw_fullsim_positions(r.ref)); /* frame 0, settled */
+    int32_t nv = ch->mesh.nverts;
+    if (full_qs) {
+        r.xd = malloc((size_t)nv * 3 * sizeof(double));
+        r.xq = malloc((size_t)nv * 3 * sizeof(double));
+        r.cnt = malloc((size_t)nv * sizeof(double));
+        if (!r.xd || !r.xq || !r.cnt || sinew_instance_create(blob, NULL, &r.qs) != SINEW_OK) {
+            res = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+    }
     int nstep = 0;
     for (int f = 1; f < N; ++f, ++nstep) {
         const double *T = ch->clip.T + (size_t)(f < F ? f : F - 1) * 12 * nb;
@@ -164,6 +201,9 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         out->sub_failed += sr != SINEW_OK;
         const double *x = sw_fullsim_positions(r.ref);
         if (sr == SINEW_OK) sw_eval_acc_add(f < F ? &r.clip : &r.hold, r.inst, x);
+        if (r.qs && sr == SINEW_OK && sw_instance_set_pose_d(r.qs, T) == SINEW_OK &&
+            sinew_instance_step(r.qs, h) == SINEW_OK)
+            add_increment(&r, mass, nv, x, full_qs + (size_t)(f < F ? f : F - 1) * 3 * nv);
         if (f >= F) { /* the hold: both surfaces, for the overshoot */
             double *a = r.hs_full + (size_t)(f - F) * 3 * ns,
                    *b = r.hs_sub + (size_t)(f - F) * 3 * ns;
@@ -180,6 +220,8 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
     overshoot(r.hs_sub, H, r.sm, ns, &out->overshoot_sub, &out->settle_sub);
     overshoot(r.hs_full, H, r.sm, ns, &out->overshoot_full, &out->settle_full);
     out->overshoot_ratio = out->overshoot_full > 0 ? out->overshoot_sub / out->overshoot_full : NAN;
+    out->err_increment = r.inc_den > 0 ? sqrt(r.inc_num / r.inc_den) : NAN;
+    out->increment_rms = sqrt(r.inc_den / (N - 1) / mass_total(mass, nv));
     out->full_ms = sw_median(r.full_ms, nstep);
     out->sub_ms = sw_median(r.sub_ms, nstep);
     res = SINEW_OK;

@@ -22,6 +22,12 @@ typedef struct sw_dyn_bench {
     double overshoot_sub, overshoot_full, overshoot_ratio;
     double settle_sub, settle_full; /* the surface's mass-weighted RMS motion over the last
                                        hold step: how far from settled the end still is */
+    double err_increment;           /* with the reference's quasistatic clip: |d_sub - d_full|_M /
+                                       |d_full|_M over frames 1 .. F+H-1, d = dynamic - quasistatic
+                                       shape (the runtime's d against a quasistatic instance): the
+                                       error of the dynamics alone, without the subspace's static
+                                       error (NaN without it) */
+    double increment_rms;           /* |d_full|_M RMS a frame per unit mass: how dynamic it is */
     double full_ms, sub_ms;         /* median ms a dynamic step */
     int ref_failed, ref_unconverged, ref_unsettled, sub_failed;
 } sw_dyn_bench;
@@ -30,7 +36,7 @@ typedef struct sw_dyn_bench {
  * reference's solver options (threads, solver, Hessian, contact rounds); its integrator,
  * dt and Rayleigh coefficients are set here: backward Euler, 1 / clip fps, the blob's. */
 sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
-                              const sw_fullsim_params *fp, int hold_frames, sw_dyn_bench *out,
-                              sw_error *err);
+                              const sw_fullsim_params *fp, int hold_frames, const double *full_qs,
+                              sw_dyn_bench *out, sw_error *err);
 
 #endif

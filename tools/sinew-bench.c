@@ -467,16 +467,18 @@ int main(int argc, char **argv) {
     sw_dyn_bench db;
     memset(&db, 0, sizeof db);
     if (dynamic) {
-        r = sw_dyn_bench_run(&ch, blob, &fp, hold_frames ? hold_frames : 30, &db, &err);
+        r = sw_dyn_bench_run(&ch, blob, &fp, hold_frames ? hold_frames : 30,
+                             kf == nf ? full_x : NULL, &db, &err);
         if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bench: dynamic run failed: ");
         failed_steps += db.sub_failed + db.ref_failed;
         fprintf(stderr,
                 "sinew-bench: dynamic (dt %g, Rayleigh %g %g, %d + %d hold frames): err_dynamic "
                 "%.4f (hold %.4f); overshoot sub %.5g full %.5g ratio %.3f; settle sub %.3g "
-                "full %.3g; %.2f / %.3f ms a step\n",
+                "full %.3g; dynamic increment error %.4f (rms %.3g); %.2f / %.3f ms a step\n",
                 db.dt, db.rayleigh_alpha, db.rayleigh_beta, db.frames, db.hold_frames,
                 db.err_dynamic, db.err_dynamic_hold, db.overshoot_sub, db.overshoot_full,
-                db.overshoot_ratio, db.settle_sub, db.settle_full, db.full_ms, db.sub_ms);
+                db.overshoot_ratio, db.settle_sub, db.settle_full, db.err_increment,
+                db.increment_rms, db.full_ms, db.sub_ms);
     }
     /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
     char e_tr[32] = "null", e_ho[32] = "null";
@@ -532,17 +534,20 @@ int main(int argc, char **argv) {
                wb.sub_ms, wb.ref_unsettled, wb.allocs, wb.locks);
     char ratio[32] = "null"; /* no reference overshoot: no ratio */
     if (isfinite(db.overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db.overshoot_ratio);
+    char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */
+    if (isfinite(db.err_increment)) snprintf(inc, sizeof inc, "%.5f", db.err_increment);
     if (json && dynamic)
         printf(",\"dyn_dt\":%.9g,\"dyn_rayleigh_alpha\":%g,\"dyn_rayleigh_beta\":%g,"
                "\"hold_frames\":%d,\"err_dynamic\":%.5f,\"err_dynamic_hold\":%.5f,"
                "\"overshoot_sub\":%.6g,\"overshoot_full\":%.6g,\"overshoot_ratio\":%s,"
                "\"settle_sub\":%.6g,\"settle_full\":%.6g,\"dyn_full_ms\":%.3f,"
                "\"dyn_sub_ms\":%.4f,\"dyn_ref_failed\":%d,\"dyn_ref_unconverged\":%d,"
-               "\"dyn_ref_unsettled\":%d,\"dyn_sub_failed\":%d",
+               "\"dyn_ref_unsettled\":%d,\"dyn_sub_failed\":%d,\"err_dyn_increment\":%s,"
+               "\"dyn_increment_rms\":%.6g",
                db.dt, db.rayleigh_alpha, db.rayleigh_beta, db.hold_frames, db.err_dynamic,
                db.err_dynamic_hold, db.overshoot_sub, db.overshoot_full, ratio, db.settle_sub,
                db.settle_full, db.full_ms, db.sub_ms, db.ref_failed, db.ref_unconverged,
-               db.ref_unsettled, db.sub_failed);
+               db.ref_unsettled, db.sub_failed, inc, db.increment_rms);
     if (json) printf("}\n");
     free(full);
     free(full_x);
