@@ -45,6 +45,29 @@
  *                         mean collider queries a step; world_contacts, the mean copies
  *                         in contact
  *   world_allocs_in_step, world_locks_in_step  the contract counts with world contact
+ * With --dynamic [--hold-frames H] it then runs the runtime in dynamic mode
+ * (SINEW_STEP_DYNAMIC) and the reference's backward-Euler run of the same clip followed
+ * by H frames (default 30) holding its last pose (dyn_bench.h): both at h = 1 / the clip's
+ * fps (dyn_dt), both with the blob's Rayleigh damping D = alpha M + beta K(x_n)
+ * (dyn_rayleigh_alpha, dyn_rayleigh_beta: the reference's rayleigh_alpha/beta set to
+ * them), both with the same lumped masses (density x volume / 4 per tet corner; the
+ * runtime's reduced mass is U^T M U of those), both starting settled at the first
+ * frame (its quasistatic solution, zero velocity), and adds
+ *   err_dynamic       correction error |x_sub - x_full|_M / |x_full - x_dqs|_M over the
+ *                     clip's frames (sw_eval_acc, sw_bake_errors' formula), x_full the
+ *                     reference's dynamic positions; err_dynamic_hold, over the hold frames
+ *   overshoot_sub, overshoot_full  after the clip stops: the largest, over hold frames
+ *                     0 .. H-2, mass-weighted RMS distance of the output surface from
+ *                     its position at the last hold frame (H-1),
+ *                     sqrt(sum_s m_s |x_s(f) - x_s(H-1)|^2 / sum_s m_s), m_s the
+ *                     reference's lumped mass of surface vertex s (world units); it counts
+ *                     the lag the flesh still has when the skeleton stops and every swing
+ *                     past the settled shape after it
+ *   overshoot_ratio   overshoot_sub / overshoot_full (target |ratio - 1| <= 0.2)
+ *   settle_sub, settle_full  the same distance between hold frames H-2 and H-1: motion
+ *                     left at the end (small against the overshoot: H was long enough)
+ *   dyn_full_ms, dyn_sub_ms  median ms of a dynamic step; dyn_ref_failed,
+ *                     dyn_ref_unconverged, dyn_ref_unsettled, dyn_sub_failed
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
@@ -75,6 +98,7 @@
 #include "vec3.h"
 #include "weights_heat.h"
 #include "world_bench.h"
+#include "dyn_bench.h"
 
 /* The step's phases as sinew_step_stats reports them. */
 enum { NPHASES = 5 };
@@ -85,7 +109,8 @@ static void usage(FILE *f) {
             "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
             "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
             "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
-            "                   [reference options] [--out DIR] [--world FILE.json] [--json]\n"
+            "                   [reference options] [--out DIR] [--world FILE.json]\n"
+            "                   [--dynamic [--hold-frames H]] [--json]\n"
             "character:\n" SW_CHARACTER_USAGE "bench:\n"
             "  --blob FILE         a blob sinew-bake wrote for this character (default: bake,\n"
             "                      and report the bake's err_train/err_heldout). The errors are\n"
@@ -105,6 +130,11 @@ static void usage(FILE *f) {
             "                      DIR/frame_NNNN.obj\n"
             "  --world F           also run reference and runtime against world file F (.json,\n"
             "                      schema 1, samples/worlds/README.md) and report its figures\n"
+            "  --dynamic           also run the runtime in dynamic mode against the reference's\n"
+            "                      backward-Euler run of the clip (same dt, damping, masses)\n"
+            "                      and report err_dynamic and the overshoot after the clip\n"
+            "  --hold-frames H     with --dynamic: frames holding the last pose, 2..100000\n"
+            "                      (default 30)\n"
             "  --json              one JSON object with the figures as the last stdout line\n"
             "reference options (the full-space run the bench times; a bake it runs uses the\n"
             "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
@@ -179,6 +209,7 @@ int main(int argc, char **argv) {
     sw_character_args_init(&ca, tool);
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
+    int dynamic = 0, hold_frames = 0;
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -199,6 +230,10 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 0, 100000000, &contract_steps);
         else if (!strcmp(a, "--threads") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--hold-frames") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 2, 100000, &hold_frames);
+        else if (!strcmp(a, "--dynamic"))
+            dynamic = 1;
         else if (!strcmp(a, "--bake-errors"))
             bake_errors = 1;
         else if (!strcmp(a, "--json"))
@@ -213,6 +248,10 @@ int main(int argc, char **argv) {
                 "%s: --bake-errors applies only with --blob (without --blob the bench bakes and "
                 "reports the bake's own err_train/err_heldout already)\n",
                 tool);
+        return 2;
+    }
+    if (hold_frames && !dynamic) {
+        fprintf(stderr, "%s: --hold-frames applies only with --dynamic\n", tool);
         return 2;
     }
     if (world_path && !sw_tool_format(tool, "--world", world_path, "json", ".json (world file)"))
@@ -424,6 +463,23 @@ int main(int argc, char **argv) {
                 wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.allocs,
                 wb.locks);
     }
+    /* 8. dynamics against the reference's backward Euler, when asked */
+    sw_dyn_bench db;
+    memset(&db, 0, sizeof db);
+    if (dynamic) {
+        r = sw_dyn_bench_run(&ch, blob, &fp, hold_frames ? hold_frames : 30,
+                             kf == nf ? full_x : NULL, &db, &err);
+        if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bench: dynamic run failed: ");
+        failed_steps += db.sub_failed + db.ref_failed;
+        fprintf(stderr,
+                "sinew-bench: dynamic (dt %g, Rayleigh %g %g, %d + %d hold frames): err_dynamic "
+                "%.4f (hold %.4f); overshoot sub %.5g full %.5g ratio %.3f; settle sub %.3g "
+                "full %.3g; dynamic increment error %.4f (rms %.3g); %.2f / %.3f ms a step\n",
+                db.dt, db.rayleigh_alpha, db.rayleigh_beta, db.frames, db.hold_frames,
+                db.err_dynamic, db.err_dynamic_hold, db.overshoot_sub, db.overshoot_full,
+                db.overshoot_ratio, db.settle_sub, db.settle_full, db.err_increment,
+                db.increment_rms, db.full_ms, db.sub_ms);
+    }
     /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
     char e_tr[32] = "null", e_ho[32] = "null";
     if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
@@ -476,6 +532,22 @@ int main(int argc, char **argv) {
                world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
                wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.full_ms,
                wb.sub_ms, wb.ref_unsettled, wb.allocs, wb.locks);
+    char ratio[32] = "null"; /* no reference overshoot: no ratio */
+    if (isfinite(db.overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db.overshoot_ratio);
+    char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */
+    if (isfinite(db.err_increment)) snprintf(inc, sizeof inc, "%.5f", db.err_increment);
+    if (json && dynamic)
+        printf(",\"dyn_dt\":%.9g,\"dyn_rayleigh_alpha\":%g,\"dyn_rayleigh_beta\":%g,"
+               "\"hold_frames\":%d,\"err_dynamic\":%.5f,\"err_dynamic_hold\":%.5f,"
+               "\"overshoot_sub\":%.6g,\"overshoot_full\":%.6g,\"overshoot_ratio\":%s,"
+               "\"settle_sub\":%.6g,\"settle_full\":%.6g,\"dyn_full_ms\":%.3f,"
+               "\"dyn_sub_ms\":%.4f,\"dyn_ref_failed\":%d,\"dyn_ref_unconverged\":%d,"
+               "\"dyn_ref_unsettled\":%d,\"dyn_sub_failed\":%d,\"err_dyn_increment\":%s,"
+               "\"dyn_increment_rms\":%.6g",
+               db.dt, db.rayleigh_alpha, db.rayleigh_beta, db.hold_frames, db.err_dynamic,
+               db.err_dynamic_hold, db.overshoot_sub, db.overshoot_full, ratio, db.settle_sub,
+               db.settle_full, db.full_ms, db.sub_ms, db.ref_failed, db.ref_unconverged,
+               db.ref_unsettled, db.sub_failed, inc, db.increment_rms);
     if (json) printf("}\n");
     free(full);
     free(full_x);

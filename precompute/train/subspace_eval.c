@@ -8,6 +8,55 @@
 #include "blob_load.h"
 #include "instance.h"
 
+sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const double *mass,
+                              sw_error *err) {
+    memset(a, 0, sizeof *a);
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    if (!v || !mass)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "bad evaluation arguments");
+    a->mass = mass;
+    a->rest = v->rest;
+    a->nverts = v->nverts;
+    size_t n3 = (size_t)v->nverts * 3 * sizeof(double);
+    a->xs = malloc(n3);
+    a->xd = malloc(n3);
+    a->cnt = malloc((size_t)v->nverts * sizeof(double));
+    if (!a->xs || !a->xd || !a->cnt) {
+        sw_eval_acc_free(a);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    }
+    return SINEW_OK;
+}
+
+void sw_eval_acc_add(sw_eval_acc *a, const sinew_instance *inst, const double *xf) {
+    sw_instance_full_positions(inst, a->xs, a->cnt);
+    sw_instance_dqs_positions(inst, a->xd);
+    for (int32_t i = 0; i < a->nverts; ++i)
+        for (int k = 0; k < 3; ++k) {
+            double e = a->xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - a->xd[3 * i + k];
+            double c = xf[3 * i + k] - a->rest[3 * i + k];
+            a->num += a->mass[i] * e * e;
+            a->den += a->mass[i] * b * b;
+            a->l2n += e * e;
+            a->l2d += c * c;
+        }
+    a->frames++;
+}
+
+void sw_eval_acc_result(const sw_eval_acc *a, sw_eval_result *out) {
+    memset(out, 0, sizeof *out);
+    out->correction_error = a->den > 0 ? sqrt(a->num / a->den) : 0;
+    out->rel_l2 = a->l2d > 0 ? sqrt(a->l2n / a->l2d) : 0;
+    out->frames = a->frames;
+}
+
+void sw_eval_acc_free(sw_eval_acc *a) {
+    free(a->xs);
+    free(a->cnt);
+    free(a->xd);
+    a->xs = a->cnt = a->xd = NULL;
+}
+
 sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,
                                 const double *x_full, int32_t npose, uint32_t max_newton,
                                 sw_eval_result *out, sw_error *err) {
@@ -30,44 +79,25 @@ sinew_result sw_eval_correction_opts(const sinew_blob *blob, const double *mass,
     sinew_result r = sinew_instance_create(blob, &def, &inst);
     if (r != SINEW_OK)
         return sw_error_set(err, r, "cannot create an instance: %s", sinew_result_string(r));
-    int32_t n = v->nverts;
-    double *xs = malloc((size_t)n * 3 * sizeof(double)), *cnt = malloc((size_t)n * sizeof(double));
-    double *xd = malloc((size_t)n * 3 * sizeof(double));
-    if (!xs || !cnt || !xd) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-        goto done;
+    sw_eval_acc acc;
+    if ((r = sw_eval_acc_init(&acc, blob, mass, err)) != SINEW_OK) {
+        sinew_instance_destroy(inst);
+        return r;
     }
-    double num = 0, den = 0, l2n = 0, l2d = 0;
+    int32_t n = v->nverts, failed = 0;
     for (int32_t f = 0; f < npose; ++f) {
         const double *Tf = T + (size_t)f * 12 * v->nbones;
         if (sw_instance_set_pose_d(inst, Tf) != SINEW_OK ||
             sinew_instance_step(inst, o->dt) != SINEW_OK) {
-            out->failed++;
+            failed++;
             continue;
         }
         if (f < o->skip) continue;
-        const double *xf = x_full + (size_t)(f - o->skip) * 3 * n;
-        sw_instance_full_positions(inst, xs, cnt);
-        sw_instance_dqs_positions(inst, xd);
-        for (int32_t i = 0; i < n; ++i)
-            for (int k = 0; k < 3; ++k) {
-                double a = xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - xd[3 * i + k];
-                double c = xf[3 * i + k] - v->rest[3 * i + k];
-                num += mass[i] * a * a;
-                den += mass[i] * b * b;
-                l2n += a * a;
-                l2d += c * c;
-            }
-        out->frames++;
+        sw_eval_acc_add(&acc, inst, x_full + (size_t)(f - o->skip) * 3 * n);
     }
-    out->correction_error = den > 0 ? sqrt(num / den) : 0;
-    out->rel_l2 = l2d > 0 ? sqrt(l2n / l2d) : 0;
-    r = SINEW_OK;
-done:
-    free(xs);
-    free(cnt);
-    free(xd);
-
+    sw_eval_acc_result(&acc, out);
+    out->failed = failed;
+    sw_eval_acc_free(&acc);
     sinew_instance_destroy(inst);
-    return r;
+    return SINEW_OK;
 }

@@ -15,6 +15,26 @@ typedef struct sw_eval_result {
     int32_t failed; /* steps that did not return SINEW_OK */
 } sw_eval_result;
 
+/* The sums behind the correction error, one frame at a time, for a caller that steps
+ * its own instance (sinew-bench --dynamic: a dynamic instance with a pre-roll); the
+ * formula is this one, sw_eval_correction adds its frames through it too. */
+typedef struct sw_eval_acc {
+    const double *mass, *rest; /* nverts vertex masses, the blob's rest positions */
+    int32_t nverts;
+    double num, den, l2n, l2d;
+    int32_t frames;
+    double *xs, *cnt, *xd; /* scratch: subspace, copy counts, DQS (3 nverts each) */
+} sw_eval_acc;
+
+sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const double *mass,
+                              sw_error *err);
+/* Adds the frame of the instance's last step (its pose and state) against x_full
+ * (3 nverts). O(N): evaluation only. */
+void sw_eval_acc_add(sw_eval_acc *a, const sinew_instance *inst, const double *x_full);
+/* correction_error, rel_l2 and frames of the frames added so far (failed is 0). */
+void sw_eval_acc_result(const sw_eval_acc *a, sw_eval_result *out);
+void sw_eval_acc_free(sw_eval_acc *a);
+
 /* Steps a fresh quasistatic instance of `blob` through npose poses (12 doubles per bone
  * each) in order with at most max_newton iterations a step, comparing every frame with
  * x_full (3 nverts per pose) under vertex masses `mass` (nverts). */

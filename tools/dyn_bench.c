@@ -1,0 +1,231 @@
+/* sinew-bench --dynamic (dyn_bench.h): the reference and the runtime step the same
+ * frames side by side, so no frame of the reference is stored. */
+#include "dyn_bench.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "blob_load.h"
+#include "clock.h"
+#include "instance.h"
+#include "subspace_eval.h"
+#include "tool_common.h"
+
+/* The simulation vertex behind each output surface vertex (its first copy). */
+static void surface_vertices(const sw_blob_view *v, int32_t *sv) {
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        const int32_t *c = v->surf_copies + 2 * v->surf_copy_ptr[s];
+        sv[s] = v->domain_verts[v->domains[c[0]].vert_begin + c[1]];
+    }
+}
+
+/* The mass-weighted RMS distance between two surfaces (3 ns each), weights m (ns). */
+static double rms_m(const double *a, const double *b, const double *m, int32_t ns) {
+    double s = 0, w = 0;
+    for (int32_t i = 0; i < ns; ++i) {
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k)
+            d2 += (a[3 * i + k] - b[3 * i + k]) * (a[3 * i + k] - b[3 * i + k]);
+        s += m[i] * d2;
+        w += m[i];
+    }
+    return w > 0 ? sqrt(s / w) : 0;
+}
+
+/* Overshoot (sinew-bench.c): the largest distance of a hold frame's surface from the
+ * last hold frame's; settle: the last hold step's motion. hs holds H surfaces. */
+static void overshoot(const double *hs, int H, const double *m, int32_t ns, double *over,
+                      double *settle) {
+    const double *last = hs + (size_t)(H - 1) * 3 * ns;
+    *over = 0;
+    for (int f = 0; f < H - 1; ++f)
+        *over = fmax(*over, rms_m(hs + (size_t)f * 3 * ns, last, m, ns));
+    *settle = rms_m(hs + (size_t)(H - 2) * 3 * ns, last, m, ns);
+}
+
+static double mass_total(const double *m, int32_t n) {
+    double s = 0;
+    for (int32_t i = 0; i < n; ++i)
+        s += m[i];
+    return s;
+}
+
+typedef struct dyn_run {
+    sw_fullsim *ref;
+    sinew_instance *inst;
+    sw_eval_acc clip, hold;
+    sinew_instance *qs;      /* quasistatic runtime alongside, for the increment */
+    double *xd, *xq, *cnt;   /* its and the dynamic instance's full positions */
+    double inc_num, inc_den; /* the dynamic increment's sums */
+    double *full_ms, *sub_ms, *hs_full, *hs_sub, *sm; /* per step; hold surfaces; masses */
+    int32_t *sv;
+} dyn_run;
+
+static void run_free(dyn_run *r) {
+    sw_fullsim_destroy(r->ref);
+    sinew_instance_destroy(r->inst);
+    sinew_instance_destroy(r->qs);
+    free(r->xd);
+    free(r->xq);
+    free(r->cnt);
+    sw_eval_acc_free(&r->clip);
+    sw_eval_acc_free(&r->hold);
+    free(r->full_ms);
+    free(r->sub_ms);
+    free(r->hs_full);
+    free(r->hs_sub);
+    free(r->sm);
+    free(r->sv);
+}
+
+/* Both runs settled at pose T0 (dyn_bench.h). */
+static sinew_result start_settled(const sw_character *ch, const sinew_blob *blob,
+                                  const sw_fullsim_params *fd, const double *T0, dyn_run *r,
+                                  float h, sw_error *err) {
+    sw_fullsim_params fq = *fd;
+    fq.integrator = SW_QUASISTATIC;
+    sw_fullsim *qs = NULL;
+    sinew_result res = sw_fullsim_create(ch, &fq, &qs, err);
+    if (res != SINEW_OK) return res;
+    res = sw_fullsim_step(qs, T0, NULL);
+    if (res == SINEW_OK || res == SINEW_ERROR_NOT_CONVERGED)
+        res = sw_fullsim_create(ch, fd, &r->ref, err);
+    else
+        sw_error_set(err, res, "the reference's quasistatic start failed");
+    if (res == SINEW_OK) sw_fullsim_set_state(r->ref, T0, sw_fullsim_positions(qs), NULL);
+    sw_fullsim_destroy(qs);
+    if (res != SINEW_OK) return res;
+
+    sinew_instance *q0 = NULL;
+    if ((res = sinew_instance_create(blob, NULL, &q0)) != SINEW_OK)
+        return sw_error_set(err, res, "cannot create an instance");
+    sw_instance_set_pose_d(q0, T0);
+    res = sinew_instance_step(q0, h);
+    sinew_instance_def def = sinew_instance_def_default();
+    def.mode = SINEW_STEP_DYNAMIC;
+    if (res == SINEW_OK) res = sinew_instance_create(blob, &def, &r->inst);
+    if (res == SINEW_OK) {
+        sw_instance_set_q(r->inst, sw_instance_q(q0));
+        sw_instance_set_pose_d(r->inst, T0);
+        res = sinew_instance_step(r->inst, h);
+        if (res == SINEW_OK) res = sinew_instance_step(r->inst, h);
+    }
+    sinew_instance_destroy(q0);
+    if (res != SINEW_OK) return sw_error_set(err, res, "the runtime's settled start failed");
+    return SINEW_OK;
+}
+
+/* Adds a frame to the dynamic increment: the runtime's dynamic minus quasistatic shape
+ * against the reference's (xf dynamic, xfq quasistatic at the same pose). */
+static void add_increment(dyn_run *r, const double *mass, int32_t nv, const double *xf,
+                          const double *xfq) {
+    sw_instance_full_positions(r->inst, r->xd, r->cnt);
+    sw_instance_full_positions(r->qs, r->xq, r->cnt);
+    for (int64_t i = 0; i < 3 * (int64_t)nv; ++i) {
+        double df = xf[i] - xfq[i], e = r->xd[i] - r->xq[i] - df;
+        r->inc_num += mass[i / 3] * e * e;
+        r->inc_den += mass[i / 3] * df * df;
+    }
+}
+
+sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
+                              const sw_fullsim_params *fp, int hold_frames, const double *full_qs,
+                              sw_dyn_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    int F = ch->clip.nframes, H = hold_frames, N = F + H;
+    if (!v || F < 1 || H < 2)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "dynamic bench: bad arguments");
+    /* the clip's own time step in both runs, and the blob's damping in the reference */
+    double fps = ch->clip.fps > 0 ? ch->clip.fps : 30;
+    float h = (float)(1.0 / fps);
+    sw_fullsim_params fd = *fp;
+    fd.integrator = SW_BACKWARD_EULER;
+    fd.dt = h; /* the float the runtime steps with, exactly */
+    fd.rayleigh_alpha = v->rayleigh_alpha;
+    fd.rayleigh_beta = v->rayleigh_beta;
+    out->frames = F;
+    out->hold_frames = H;
+    out->dt = fd.dt;
+    out->rayleigh_alpha = fd.rayleigh_alpha;
+    out->rayleigh_beta = fd.rayleigh_beta;
+
+    dyn_run r;
+    memset(&r, 0, sizeof r);
+    int32_t ns = v->nsurf_verts, nb = ch->skel.nbones;
+    size_t hsz = (size_t)H * 3 * ns * sizeof(double);
+    r.full_ms = malloc((size_t)N * sizeof(double));
+    r.sub_ms = malloc((size_t)N * sizeof(double));
+    r.hs_full = malloc(hsz);
+    r.hs_sub = malloc(hsz);
+    r.sm = malloc((size_t)ns * sizeof(double));
+    r.sv = malloc((size_t)ns * sizeof(int32_t));
+    sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!r.full_ms || !r.sub_ms || !r.hs_full || !r.hs_sub || !r.sm || !r.sv) {
+        sw_error_set(err, res, "out of memory");
+        goto done;
+    }
+    surface_vertices(v, r.sv);
+    if ((res = start_settled(ch, blob, &fd, ch->clip.T, &r, h, err)) != SINEW_OK) goto done;
+    const double *mass = sw_fullsim_masses(r.ref);
+    for (int32_t s = 0; s < ns; ++s)
+        r.sm[s] = mass[r.sv[s]];
+    if ((res = sw_eval_acc_init(&r.clip, blob, mass, err)) != SINEW_OK ||
+        (res = sw_eval_acc_init(&r.hold, blob, mass, err)) != SINEW_OK)
+        goto done;
+    sw_eval_acc_add(&r.clip, r.inst, sw_fullsim_positions(r.ref)); /* frame 0, settled */
+    int32_t nv = ch->mesh.nverts;
+    if (full_qs) {
+        r.xd = malloc((size_t)nv * 3 * sizeof(double));
+        r.xq = malloc((size_t)nv * 3 * sizeof(double));
+        r.cnt = malloc((size_t)nv * sizeof(double));
+        if (!r.xd || !r.xq || !r.cnt || sinew_instance_create(blob, NULL, &r.qs) != SINEW_OK) {
+            res = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+            goto done;
+        }
+    }
+    int nstep = 0;
+    for (int f = 1; f < N; ++f, ++nstep) {
+        const double *T = ch->clip.T + (size_t)(f < F ? f : F - 1) * 12 * nb;
+        sw_fullsim_stats st;
+        sinew_result rr = sw_fullsim_step(r.ref, T, &st);
+        out->ref_failed += rr != SINEW_OK && rr != SINEW_ERROR_NOT_CONVERGED;
+        out->ref_unconverged += rr == SINEW_ERROR_NOT_CONVERGED;
+        out->ref_unsettled += st.contacts_unsettled;
+        r.full_ms[nstep] = 1e3 * st.seconds;
+        double t0 = sw_now_seconds();
+        sw_instance_set_pose_d(r.inst, T);
+        sinew_result sr = sinew_instance_step(r.inst, h);
+        r.sub_ms[nstep] = 1e3 * (sw_now_seconds() - t0);
+        out->sub_failed += sr != SINEW_OK;
+        const double *x = sw_fullsim_positions(r.ref);
+        if (sr == SINEW_OK) sw_eval_acc_add(f < F ? &r.clip : &r.hold, r.inst, x);
+        if (r.qs && sr == SINEW_OK && sw_instance_set_pose_d(r.qs, T) == SINEW_OK &&
+            sinew_instance_step(r.qs, h) == SINEW_OK)
+            add_increment(&r, mass, nv, x, full_qs + (size_t)(f < F ? f : F - 1) * 3 * nv);
+        if (f >= F) { /* the hold: both surfaces, for the overshoot */
+            double *a = r.hs_full + (size_t)(f - F) * 3 * ns,
+                   *b = r.hs_sub + (size_t)(f - F) * 3 * ns;
+            for (int32_t s = 0; s < ns; ++s)
+                memcpy(a + 3 * s, x + 3 * (size_t)r.sv[s], 3 * sizeof(double));
+            memcpy(b, sw_instance_surface(r.inst), 3 * (size_t)ns * sizeof(double));
+        }
+    }
+    sw_eval_result e;
+    sw_eval_acc_result(&r.clip, &e);
+    out->err_dynamic = e.correction_error;
+    sw_eval_acc_result(&r.hold, &e);
+    out->err_dynamic_hold = e.correction_error;
+    overshoot(r.hs_sub, H, r.sm, ns, &out->overshoot_sub, &out->settle_sub);
+    overshoot(r.hs_full, H, r.sm, ns, &out->overshoot_full, &out->settle_full);
+    out->overshoot_ratio = out->overshoot_full > 0 ? out->overshoot_sub / out->overshoot_full : NAN;
+    out->err_increment = r.inc_den > 0 ? sqrt(r.inc_num / r.inc_den) : NAN;
+    out->increment_rms = sqrt(r.inc_den / (N - 1) / mass_total(mass, nv));
+    out->full_ms = sw_median(r.full_ms, nstep);
+    out->sub_ms = sw_median(r.sub_ms, nstep);
+    res = SINEW_OK;
+done:
+    run_free(&r);
+    return res;
+}
