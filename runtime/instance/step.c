@@ -257,14 +257,19 @@ static sinew_result check_output(sw_step_ctx *c) {
     return SINEW_OK;
 }
 
+/* The phases before the solve: what the step's potential needs. */
+static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
+    step_begin(c, inst, dt);
+    phase_skin(c);
+    phase_contact(c);
+    phase_dynamics(c);
+    phase_world(c);
+}
+
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     if (!inst || !(dt > 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
     sw_step_ctx c;
-    step_begin(&c, inst, dt);
-    phase_skin(&c);
-    phase_contact(&c);
-    phase_dynamics(&c);
-    phase_world(&c);
+    phases_to_solve(&c, inst, dt);
     sinew_result r = phase_solve(&c); /* a non-finite state is undone: nothing advances */
     if (r == SINEW_OK) {
         phase_advance(&c);
@@ -277,11 +282,7 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
 
 void sw_instance_step_prepare(sinew_instance *inst, float dt) {
     sw_step_ctx c;
-    step_begin(&c, inst, dt);
-    phase_skin(&c);
-    phase_contact(&c);
-    phase_dynamics(&c);
-    phase_world(&c);
+    phases_to_solve(&c, inst, dt);
 }
 
 double sw_instance_step_potential(sinew_instance *inst, float dt, const double *q, double *g,
