@@ -396,8 +396,79 @@ TEST(direct_and_pcg_solves_agree) {
     sw_character_free(&c);
 }
 
+/* sw_fullsim_rest_response against the simulator's own quasistatic step: a small
+ * gravity g at the rest pose is the load M g, and the step's solution must be the rest
+ * shape plus the response to it (linear elasticity: the co-rotational model at rest, up
+ * to O(|u|/size) terms, negligible at a displacement of 1e-4 of the size). */
+TEST(rest_response_is_the_small_load_solution) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("cylinder", 1500, 3, &c, &err) == SINEW_OK);
+    int32_t nv = c.mesh.nverts;
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.self_contact = 0;
+    p.pcg_rtol = 1e-10;
+    p.pcg_max = 100000;
+    sw_fullsim *sim;
+    ENSURE(sw_fullsim_create(&c, &p, &sim, &err) == SINEW_OK);
+    const double *m = sw_fullsim_masses(sim);
+    double *f = calloc((size_t)3 * nv, sizeof(double)), *u = malloc(sizeof(double) * 3 * nv);
+    const double dir[3] = {0.6, 0.0, 0.8};
+    for (int32_t v = 0; v < nv; ++v)
+        for (int i = 0; i < 3; ++i)
+            f[3 * v + i] = m[v] * dir[i];
+    ENSURE(sw_fullsim_rest_response(sim, 1, f, u, &err) == SINEW_OK);
+    double un = 0, lo[3] = {1e300, 1e300, 1e300}, hi[3] = {-1e300, -1e300, -1e300};
+    for (int32_t v = 0; v < nv; ++v)
+        for (int i = 0; i < 3; ++i) {
+            un = fmax(un, fabs(u[3 * v + i]));
+            lo[i] = fmin(lo[i], c.mesh.X[3 * v + i]);
+            hi[i] = fmax(hi[i], c.mesh.X[3 * v + i]);
+        }
+    double size = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                       (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    ENSUREF(un > 0 && isfinite(un), "no response (%g)", un);
+    double g = 1e-4 * size / un; /* the gravity that displaces by 1e-4 of the size */
+    sw_fullsim_params pg = p;
+    pg.newton_rtol = 1e-9;
+    for (int i = 0; i < 3; ++i)
+        pg.gravity[i] = g * dir[i];
+    sw_fullsim *sg;
+    ENSURE(sw_fullsim_create(&c, &pg, &sg, &err) == SINEW_OK);
+    double *T = malloc(sizeof(double) * 12 * c.skel.nbones);
+    for (int32_t b = 0; b < c.skel.nbones; ++b) {
+        const double I[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+        memcpy(T + 12 * b, I, sizeof I);
+    }
+    sw_fullsim_stats st;
+    ENSURE(sw_fullsim_step(sg, T, &st) == SINEW_OK);
+    const double *x = sw_fullsim_positions(sg);
+    double num = 0, den = 0;
+    for (int64_t i = 0; i < 3 * (int64_t)nv; ++i) {
+        double d = x[i] - c.mesh.X[i], e = d - g * u[i];
+        num += e * e;
+        den += d * d;
+    }
+    double rel = sqrt(num / den);
+    fprintf(stderr, "    response vs step at g = %.3g: relative difference %.3g\n", g, rel);
+    ENSUREF(rel < 1e-3, "the response differs from the small-load solution by %.3g", rel);
+    /* a dynamic simulator has no static response to give */
+    sw_fullsim_params pd = p;
+    pd.integrator = SW_BACKWARD_EULER;
+    sw_fullsim *sd;
+    ENSURE(sw_fullsim_create(&c, &pd, &sd, &err) == SINEW_OK);
+    ENSURE(sw_fullsim_rest_response(sd, 1, f, u, &err) == SINEW_ERROR_INVALID_ARGUMENT);
+    sw_fullsim_destroy(sd);
+    sw_fullsim_destroy(sg);
+    sw_fullsim_destroy(sim);
+    free(T);
+    free(f);
+    free(u);
+    sw_character_free(&c);
+}
+
 SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy),
-             CASE(newton_converges_quadratically),
+             CASE(rest_response_is_the_small_load_solution), CASE(newton_converges_quadratically),
              CASE(newmark_keeps_energy_of_undamped_oscillation),
              CASE(backward_euler_never_gains_energy),
              CASE(self_contact_removes_most_penetration_of_folded_finger),

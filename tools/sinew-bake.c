@@ -3,7 +3,8 @@
  *   sinew-bake (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf
  *              [--weights FILE.dmat] [--clip FILE]) --out FILE.blob
  *              [--selector greedy|importance|nnhtp] [--tol 0.05] [--max-rank R]
- *              [--compare-cubature] [--no-self-contact] [--return-path] [--threads T] [--data DIR]
+ *              [--compare-cubature] [--no-self-contact] [--return-path] [--inertia-modes]
+ *              [--threads T] [--data DIR]
  *              [--force] [--json]
  *
  * Shows progress per stage on stderr and ends with a summary (per-stage time, ranks,
@@ -30,27 +31,30 @@
 #include "subspace_eval.h"
 
 static void usage(FILE *f) {
-    fprintf(
-        f,
-        "usage: sinew-bake (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-        "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-        "                   [--clip FILE [--frames F]])\n"
-        "                  --out FILE.blob [--selector greedy|importance|nnhtp] [--tol T]\n"
-        "                  [--max-rank R] [--spring-k K] [--compare-cubature]\n"
-        "                  [--no-self-contact] [--return-path] [--threads T] [--force] [--json]\n"
-        "character:\n" SW_CHARACTER_USAGE "bake:\n"
-        "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
-        "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
-        "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
-        "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
-        "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
-        "  --threads T      0..256 (default 0: all cores)\n"
-        "  --force          write the blob even when its training error is %.2f or more\n"
-        "                   (the share of the physics correction it misses on its own\n"
-        "                   training poses; without --force that is an error)\n"
-        "  --json           one JSON object with the figures as the last stdout line\n"
-        "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
-        SW_BAKE_MAX_TRAIN_ERROR);
+    fprintf(f,
+            "usage: sinew-bake (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+            "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+            "                   [--clip FILE [--frames F]])\n"
+            "                  --out FILE.blob [--selector greedy|importance|nnhtp] [--tol T]\n"
+            "                  [--max-rank R] [--spring-k K] [--compare-cubature]\n"
+            "                  [--no-self-contact] [--return-path] [--inertia-modes]\n"
+            "                  [--threads T] [--force] [--json]\n"
+            "character:\n" SW_CHARACTER_USAGE "bake:\n"
+            "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
+            "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
+            "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
+            "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
+            "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
+            "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
+            "                   bones' accelerations (static responses to them), so that the\n"
+            "                   flesh lags and overshoots as the reference does; a higher rank\n"
+            "  --threads T      0..256 (default 0: all cores)\n"
+            "  --force          write the blob even when its training error is %.2f or more\n"
+            "                   (the share of the physics correction it misses on its own\n"
+            "                   training poses; without --force that is an error)\n"
+            "  --json           one JSON object with the figures as the last stdout line\n"
+            "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
+            SW_BAKE_MAX_TRAIN_ERROR);
 }
 
 int main(int argc, char **argv) {
@@ -95,6 +99,8 @@ int main(int argc, char **argv) {
             p.self_contact = 0;
         else if (!strcmp(a, "--return-path"))
             p.return_path = 1;
+        else if (!strcmp(a, "--inertia-modes"))
+            p.inertia_modes = 1;
         else if (!strcmp(a, "--force"))
             force = 1;
         else if (!strcmp(a, "--json"))

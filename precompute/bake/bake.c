@@ -24,6 +24,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.sweep_samples = 6;
     p.max_train_frames = 40;
     p.return_path = 0;
+    p.inertia_modes = 0;
     p.heldout_fraction = 0.4;
     p.random_poses = 10;
     p.self_contact = 1;

@@ -12,7 +12,8 @@
  *             solution's contact set is kept for the runtime (pose-space contact)
  *   basis     un-skinned snapshots d = R^T (x - t) - rest -> per-domain uncentred PCA,
  *             rank by an energy threshold, orthonormal columns, zero rows at
- *             bone-driven vertices (they follow their bone exactly)
+ *             bone-driven vertices (they follow their bone exactly); with
+ *             inertia_modes, plus the static responses to the bones' accelerations
  *   cubature  per domain on the reduced elastic forces of snapshots and perturbed
  *             snapshots (eqs. 2.11-2.19)
  *   reduce    interface-spring Hessian (eq. 4.20), reduced mass, inertial projections
@@ -36,6 +37,10 @@ typedef struct sw_bake_params {
     int return_path;               /* also train on those frames played back from the last one
                                       (default 0; measured: finger held-out error 0.235 -> 0.164 at
                                       20K tets, unchanged at 50K where the rank grows 41 -> 63) */
+    int inertia_modes;             /* for the dynamic step: basis modes for the inertia of the
+                                      bones' accelerations and the cubature trained on them
+                                      (bake_basis.c; default 0: they raise the rank, 33 -> 73
+                                      on the 3K finger) */
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
     int32_t random_poses;          /* held-out poses when there is no clip (default 10) */
     int self_contact;              /* in the training simulations (default 1) */

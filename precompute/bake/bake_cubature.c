@@ -1,7 +1,8 @@
 /* Material cubature per domain (thesis eqs. 2.11-2.14). Training samples are the
  * reduced coordinates of the training snapshots, q = U^T d, and as many perturbed
  * copies (q + 0.5 * rms(q) * gaussian): at the snapshots themselves the reduced force
- * nearly balances, so the perturbations are what shows the force's shape. Column e of
+ * nearly balances, so the perturbations are what shows the force's shape (and with
+ * inertia modes a third set, train_domain). Column e of
  * the fit matrix stacks tet e's reduced elastic force over the samples,
  *   a_e = sum_k (R_k U_k)^T f_{e,k}(x(q)),  x_k = R_k (rest_k + U_k q) + t_k,
  * each sample's block divided by the norm of the domain's full reduced force. */
@@ -21,6 +22,7 @@ typedef struct {
     const double *q;           /* nsamples x r */
     const sw_dualquat *dq;     /* nsamples x nb (pose of each sample) */
     const double *inv_norm;    /* nsamples: 1 / |b_s| (0 drops the sample) */
+    const double *mode_w;      /* r: weight of each reduced force component, or NULL */
     double mu, lambda;
 } cub_ctx;
 
@@ -58,6 +60,39 @@ static void tet_reduced_force(const cub_ctx *c, int64_t i, int32_t smp, double *
             for (int32_t j = 0; j < r; ++j)
                 a[j] += Uv[d * r + j] * g[d];
     }
+    if (c->mode_w)
+        for (int32_t j = 0; j < r; ++j)
+            a[j] *= c->mode_w[j];
+}
+
+/* Per mode j, 1 / sqrt(u_j^T K u_j) with K the domain's rest stiffness: a force error
+ * along a mode moves the solution by the error over its stiffness, so weighting each
+ * reduced force component by this asks the fit for the same displacement accuracy in
+ * every mode (soft inertia modes otherwise get a share of the error they cannot bear). */
+static void mode_weights(const cub_ctx *c, int32_t ntd, double *w) {
+    const sw_bake_state *s = c->s;
+    int32_t r = c->r, base = s->dom_vert_ptr[c->dom];
+    for (int32_t j = 0; j < r; ++j)
+        w[j] = 0;
+    for (int32_t i = 0; i < ntd; ++i) {
+        double xe[12], K[144], f[12];
+        for (int k = 0; k < 4; ++k)
+            memcpy(xe + 3 * k,
+                   s->ch.mesh.X + 3 * (int64_t)s->dom_verts[base + c->tet_local[4 * i + k]], 24);
+        sw_corot_eval(xe, c->dminv + 9 * i, c->vol[i], c->mu, c->lambda, f, K, 0);
+        for (int32_t j = 0; j < r; ++j) {
+            double u[12], ku = 0;
+            for (int k = 0; k < 4; ++k)
+                for (int d = 0; d < 3; ++d)
+                    u[3 * k + d] = c->U[(size_t)(3 * c->tet_local[4 * i + k] + d) * r + j];
+            for (int a = 0; a < 12; ++a)
+                for (int b = 0; b < 12; ++b)
+                    ku += u[a] * K[12 * a + b] * u[b];
+            w[j] += ku;
+        }
+    }
+    for (int32_t j = 0; j < r; ++j)
+        w[j] = w[j] > 0 ? 1.0 / sqrt(w[j]) : 1.0;
 }
 
 static void column(void *vctx, int64_t cand, double *col) {
@@ -115,7 +150,8 @@ static double gauss(uint64_t *state) {
 static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *dsnap, int32_t T,
                                  const sw_dualquat *pose_dq, sw_bake_result *out, sw_error *err) {
     int32_t r = s->rank[dom], base = s->dom_vert_ptr[dom], nvd = s->dom_vert_ptr[dom + 1] - base;
-    int32_t t0 = s->dom_tet_ptr[dom], ntd = s->dom_tet_ptr[dom + 1] - t0, ns = 2 * T;
+    int32_t t0 = s->dom_tet_ptr[dom], ntd = s->dom_tet_ptr[dom + 1] - t0,
+            sets = s->p->inertia_modes ? 3 : 2, ns = sets * T;
     const double *U = s->basis[dom];
     sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
     int32_t *local_of = malloc((size_t)s->nv * sizeof(int32_t));
@@ -125,7 +161,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     double *q = calloc((size_t)ns * r, sizeof(double)),
            *inv_norm = malloc((size_t)ns * sizeof(double));
     sw_dualquat *dq = malloc((size_t)ns * s->nb * sizeof(sw_dualquat));
-    double *b = NULL, *partial = NULL;
+    double *b = NULL, *partial = NULL, *mode_w = NULL;
     sw_cubature_result cr;
     memset(&cr, 0, sizeof cr);
     if (!local_of || !tet_local || !dminv || !vol || !q || !inv_norm || !dq) goto done;
@@ -155,18 +191,37 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
         }
         memcpy(dq + (size_t)a * s->nb, pose_dq + (size_t)a * s->nb,
                (size_t)s->nb * sizeof(sw_dualquat));
-        memcpy(dq + (size_t)(T + a) * s->nb, pose_dq + (size_t)a * s->nb,
-               (size_t)s->nb * sizeof(sw_dualquat));
+        for (int k = 1; k < sets; ++k)
+            memcpy(dq + (size_t)(k * T + a) * s->nb, pose_dq + (size_t)a * s->nb,
+                   (size_t)s->nb * sizeof(sw_dualquat));
     }
     uint64_t seed = s->p->seed ^ (0x9e37ULL * (uint64_t)(dom + 1));
     for (int32_t a = 0; a < T; ++a)
         for (int32_t j = 0; j < r; ++j)
             q[(size_t)(T + a) * r + j] = q[(size_t)a * r + j] + 0.5 * sqrt(rms[j]) * gauss(&seed);
+    if (sets == 3) {
+        /* inertia modes (bake_basis.c) are barely in the snapshots, so the perturbations
+           above hardly move them, and a fit blind to their force leaves them wrongly stiff
+           or soft (finger 3K: training error 0.028 -> 0.21-0.30 with them): a third set
+           perturbs every mode at the largest mode's amplitude (training error 0.062) */
+        double rmax = 0;
+        for (int32_t j = 0; j < r; ++j)
+            rmax = fmax(rmax, sqrt(rms[j]));
+        for (int32_t a = 0; a < T; ++a)
+            for (int32_t j = 0; j < r; ++j)
+                q[(size_t)(2 * T + a) * r + j] = q[(size_t)a * r + j] + 0.5 * rmax * gauss(&seed);
+    }
     free(rms);
     for (int32_t smp = 0; smp < ns; ++smp)
         inv_norm[smp] = 1.0;
-    cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, 0, 0};
+    cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, NULL, 0, 0};
     sw_lame(s->ch.youngs, s->ch.poisson, &c.mu, &c.lambda);
+    if (s->p->inertia_modes) { /* measured with them only (finger 20K: training error
+                                   0.24 without the weights, 0.059 with) */
+        if (!(mode_w = malloc((size_t)r * sizeof(double)))) goto done;
+        mode_weights(&c, ntd, mode_w);
+        c.mode_w = mode_w;
+    }
     /* b: the domain's full reduced force per sample (Krysl projection), summed in
      * parallel per chunk of tets and then in chunk order (SUM_CHUNK) */
     int workers = sw_pool_size(s->pool);
@@ -237,6 +292,7 @@ done:
     free(dq);
     free(b);
     free(partial);
+    free(mode_w);
     return res;
 }
 

@@ -157,6 +157,13 @@ const sw_surface *sw_fullsim_surface(const sw_fullsim *sim);
 const double *sw_fullsim_masses(const sw_fullsim *sim);
 /* Number of vertices driven by bones. */
 int32_t sw_fullsim_driven_count(const sw_fullsim *sim);
+/* Static responses u_j = K^-1 f_j of the rest shape (the linear elasticity of the free
+ * vertices, driven vertices held, no contact) to n loads f_j (3 nverts each; entries of
+ * driven vertices ignored), solved as the simulator's Newton systems are (sparse direct
+ * or PCG to pcg_rtol). A quasistatic simulator only; it leaves the simulator at rest.
+ * The bake's load-dependent Ritz vectors (bake_basis.c). */
+sinew_result sw_fullsim_rest_response(sw_fullsim *sim, int32_t n, const double *f, double *u,
+                                      sw_error *err);
 /* Elastic energy E(x) of the current positions. */
 double sw_fullsim_elastic_energy(sw_fullsim *sim);
 #endif

@@ -258,3 +258,35 @@ sinew_result sw_fullsim_solve_system(sw_fullsim *sim, sw_fullsim_stats *st) {
     }
     return SINEW_OK;
 }
+
+sinew_result sw_fullsim_rest_response(sw_fullsim *sim, int32_t n, const double *f, double *u,
+                                      sw_error *err) {
+    if (sw_fullsim_dynamic(sim))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "rest response: a quasistatic simulator is needed");
+    int64_t m = 3 * (int64_t)sim->nv;
+    size_t v3 = (size_t)m * sizeof(double);
+    const double *X = sim->c->mesh.X;
+    memcpy(sim->x, X, v3);
+    sim->ncontacts = 0;
+    sim->world.ncand = 0;
+    /* at rest the co-rotational Hessian is the linear-elastic stiffness, positive definite
+       over the free vertices; the projection only guards a degenerate element */
+    sim->hess_flags = SW_COROT_PROJECT_PSD;
+    sw_fullsim_evaluate(sim, sim->x, EVAL_HESSIAN);
+    sw_fullsim_stats st;
+    memset(&st, 0, sizeof st);
+    for (int32_t j = 0; j < n; ++j) {
+        const double *fj = f + (size_t)j * m;
+        for (int32_t v = 0; v < sim->nv; ++v)
+            for (int i = 0; i < 3; ++i)
+                sim->rhs[3 * v + i] = sim->free_mask[v] ? fj[3 * v + i] : 0.0;
+        memset(sim->dx_prev, 0, v3);
+        sinew_result r = sw_fullsim_solve_system(sim, &st);
+        if (r != SINEW_OK) return sw_error_set(err, r, "rest response %d: the solve failed", j);
+        if (!sw_fullsim_all_finite(sim->dx, m))
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE, "rest response %d: not finite", j);
+        memcpy(u + (size_t)j * m, sim->dx, v3);
+    }
+    return SINEW_OK;
+}
