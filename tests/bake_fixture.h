@@ -19,19 +19,14 @@ typedef struct {
     sinew_blob *blob;
 } bake_fixture;
 
-/* Bakes `sample` at about `tets` tets with a clip of `frames` frames on `threads` bake
- * threads, with the clip's return path when return_path is set. 1 on success. */
-static inline int bake_fixture_make_threads(bake_fixture *f, const char *sample, int tets,
-                                            int frames, int return_path, int threads) {
+/* Bakes `sample` at about `tets` tets with a clip of `frames` frames and bake parameters
+ * p, writes and loads the blob. 1 on success. */
+static inline int bake_fixture_make_params(bake_fixture *f, const char *sample, int tets,
+                                           int frames, const sw_bake_params *p) {
     sw_error err;
     memset(f, 0, sizeof *f);
     if (sw_sample_make(sample, tets, frames, &f->ch, &err) != SINEW_OK) return 0;
-    sw_bake_params p = sw_bake_params_default();
-    p.sweep_samples = 3;
-    p.max_train_frames = 8;
-    p.threads = threads;
-    p.return_path = return_path;
-    if (sw_bake(&f->ch, &p, &f->res, &err) != SINEW_OK) {
+    if (sw_bake(&f->ch, p, &f->res, &err) != SINEW_OK) {
         fprintf(stderr, "bake failed: %s\n", err.msg);
         return 0;
     }
@@ -40,6 +35,19 @@ static inline int bake_fixture_make_threads(bake_fixture *f, const char *sample,
     d.data = f->data;
     d.data_size = f->size;
     return sinew_blob_load(&d, &f->blob) == SINEW_OK;
+}
+
+/* bake_fixture_make_params with the fixture's quick parameters (3 samples a joint sweep,
+ * 8 clip frames) on `threads` bake threads, with the clip's return path when return_path
+ * is set. */
+static inline int bake_fixture_make_threads(bake_fixture *f, const char *sample, int tets,
+                                            int frames, int return_path, int threads) {
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 3;
+    p.max_train_frames = 8;
+    p.threads = threads;
+    p.return_path = return_path;
+    return bake_fixture_make_params(f, sample, tets, frames, &p);
 }
 
 /* bake_fixture_make_threads on 2 threads. */

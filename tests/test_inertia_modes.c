@@ -13,59 +13,40 @@
 #include <math.h>
 #include <stdint.h>
 
-#include "bake.h"
-#include "blob_load.h"
-#include "blob_write.h"
+#include "bake_fixture.h"
 #include "dyn_bench.h"
-#include "samples.h"
 #include "subspace_eval.h"
 #include "sw_test.h"
 
 typedef struct {
-    sw_bake_result res;
-    void *data;
-    size_t size;
-    sinew_blob *blob;
+    bake_fixture f;
     sw_dyn_bench dyn;
     double err_train;
 } variant;
 
-static int run(const sw_character *ch, int inertia_modes, variant *o) {
+/* Bakes the 1,000-tet finger (default parameters, 2 threads) and measures it. */
+static int run(int inertia_modes, variant *o) {
     sw_error err;
     memset(o, 0, sizeof *o);
     sw_bake_params p = sw_bake_params_default();
     p.threads = 2;
     p.inertia_modes = inertia_modes;
-    if (sw_bake(ch, &p, &o->res, &err) != SINEW_OK) {
-        fprintf(stderr, "bake failed: %s\n", err.msg);
-        return 0;
-    }
-    if (sw_blob_write_memory(&o->res.view, &o->data, &o->size, &err) != SINEW_OK) return 0;
-    sinew_blob_def d = sinew_blob_def_default();
-    d.data = o->data;
-    d.data_size = o->size;
-    if (sinew_blob_load(&d, &o->blob) != SINEW_OK) return 0;
+    if (!bake_fixture_make_params(&o->f, "finger", 1000, 30, &p)) return 0;
     sw_eval_result tr, ho;
-    if (sw_bake_errors(o->blob, &o->res, &tr, &ho, &err) != SINEW_OK) return 0;
+    if (sw_bake_errors(o->f.blob, &o->f.res, &tr, &ho, &err) != SINEW_OK) return 0;
     o->err_train = tr.correction_error;
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.threads = 2;
-    if (sw_dyn_bench_run(ch, o->blob, &fp, 30, NULL, &o->dyn, &err) != SINEW_OK) {
+    if (sw_dyn_bench_run(&o->f.ch, o->f.blob, &fp, 30, NULL, &o->dyn, &err) != SINEW_OK) {
         fprintf(stderr, "dynamic run failed: %s\n", err.msg);
         return 0;
     }
     fprintf(stderr,
             "    inertia modes %d: rank %d, training error %.4f, overshoot ratio %.3f, hold "
             "error %.3f, clip error %.3f\n",
-            inertia_modes, o->res.view.rank_total, o->err_train, o->dyn.overshoot_ratio,
+            inertia_modes, o->f.res.view.rank_total, o->err_train, o->dyn.overshoot_ratio,
             o->dyn.err_dynamic_hold, o->dyn.err_dynamic);
     return 1;
-}
-
-static void variant_free(variant *o) {
-    sinew_blob_destroy(o->blob);
-    free(o->data);
-    sw_bake_result_free(&o->res);
 }
 
 /* Largest |U^T U - I| over the domains of a view, and whether bone-driven rows are 0. */
@@ -92,13 +73,10 @@ static double basis_defect(const sw_blob_view *v, const sw_character *ch, int *d
 }
 
 TEST(inertia_modes_give_the_reference_overshoot) {
-    sw_character ch;
-    sw_error err;
-    ENSURE(sw_sample_make("finger", 1000, 30, &ch, &err) == SINEW_OK);
     variant without, with;
-    ENSURE(run(&ch, 0, &without));
-    ENSURE(run(&ch, 1, &with));
-    const sw_blob_view *a = &without.res.view, *b = &with.res.view;
+    ENSURE(run(0, &without));
+    ENSURE(run(1, &with));
+    const sw_blob_view *a = &without.f.res.view, *b = &with.f.res.view;
     ENSURE(a->ndomains == b->ndomains);
     for (int32_t d = 0; d < a->ndomains; ++d)
         ENSUREF(b->domains[d].rank >= a->domains[d].rank &&
@@ -106,7 +84,7 @@ TEST(inertia_modes_give_the_reference_overshoot) {
                 "domain %d: rank %d without, %d with", d, a->domains[d].rank, b->domains[d].rank);
     ENSUREF(b->rank_total > a->rank_total, "no mode added (rank %d)", b->rank_total);
     int driven_ok;
-    double defect = basis_defect(b, &ch, &driven_ok);
+    double defect = basis_defect(b, &with.f.ch, &driven_ok);
     ENSUREF(defect < 1e-9, "basis not orthonormal: %.3g", defect);
     ENSURE(driven_ok);
     /* the claim, and that it is one: without the modes the overshoot misses */
@@ -121,9 +99,8 @@ TEST(inertia_modes_give_the_reference_overshoot) {
             without.dyn.err_dynamic_hold);
     ENSUREF(with.err_train < 0.08, "training error %.4f with inertia modes", with.err_train);
     ENSURE(with.dyn.sub_failed == 0 && with.dyn.ref_failed == 0);
-    variant_free(&without);
-    variant_free(&with);
-    sw_character_free(&ch);
+    bake_fixture_free(&without.f);
+    bake_fixture_free(&with.f);
 }
 
 SW_TEST_MAIN(CASE(inertia_modes_give_the_reference_overshoot))
