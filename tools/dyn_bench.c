@@ -199,6 +199,13 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         sinew_result sr = sinew_instance_step(r.inst, h);
         r.sub_ms[nstep] = 1e3 * (sw_now_seconds() - t0);
         out->sub_failed += sr != SINEW_OK;
+        sinew_step_stats ss = {.struct_size = sizeof ss};
+        if (sinew_instance_get_stats(r.inst, &ss) == SINEW_OK) {
+            out->sub_limited += (ss.status & SINEW_STEP_LIMITED) != 0;
+            out->sub_teleport += (ss.status & SINEW_STEP_TELEPORT) != 0;
+            out->sub_guard += (ss.status & SINEW_STEP_GUARD) != 0;
+            out->sub_converged += (ss.status & SINEW_STEP_CONVERGED) != 0;
+        }
         const double *x = sw_fullsim_positions(r.ref);
         if (sr == SINEW_OK) sw_eval_acc_add(f < F ? &r.clip : &r.hold, r.inst, x);
         if (r.qs && sr == SINEW_OK && sw_instance_set_pose_d(r.qs, T) == SINEW_OK &&

@@ -30,6 +30,9 @@ typedef struct sw_dyn_bench {
     double increment_rms;           /* |d_full|_M RMS a frame per unit mass: how dynamic it is */
     double full_ms, sub_ms;         /* median ms a dynamic step */
     int ref_failed, ref_unconverged, ref_unsettled, sub_failed;
+    /* the runtime's steps with each status flag: the bounds limited the state, a pose
+       jump, the energy guard, Newton converged */
+    int sub_limited, sub_teleport, sub_guard, sub_converged;
 } sw_dyn_bench;
 
 /* Runs both over the character's clip plus hold_frames (>= 2) held frames. fp gives the

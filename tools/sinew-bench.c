@@ -68,6 +68,8 @@
  *                     left at the end (small against the overshoot: H was long enough)
  *   dyn_full_ms, dyn_sub_ms  median ms of a dynamic step; dyn_ref_failed,
  *                     dyn_ref_unconverged, dyn_ref_unsettled, dyn_sub_failed
+ *   dyn_sub_limited, dyn_sub_teleport, dyn_sub_guard, dyn_sub_converged  the runtime's
+ *                     dynamic steps with each SINEW_STEP_* flag (of frames + hold - 1)
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
@@ -543,11 +545,13 @@ int main(int argc, char **argv) {
                "\"settle_sub\":%.6g,\"settle_full\":%.6g,\"dyn_full_ms\":%.3f,"
                "\"dyn_sub_ms\":%.4f,\"dyn_ref_failed\":%d,\"dyn_ref_unconverged\":%d,"
                "\"dyn_ref_unsettled\":%d,\"dyn_sub_failed\":%d,\"err_dyn_increment\":%s,"
-               "\"dyn_increment_rms\":%.6g",
+               "\"dyn_increment_rms\":%.6g,\"dyn_sub_limited\":%d,\"dyn_sub_teleport\":%d,"
+               "\"dyn_sub_guard\":%d,\"dyn_sub_converged\":%d",
                db.dt, db.rayleigh_alpha, db.rayleigh_beta, db.hold_frames, db.err_dynamic,
                db.err_dynamic_hold, db.overshoot_sub, db.overshoot_full, ratio, db.settle_sub,
                db.settle_full, db.full_ms, db.sub_ms, db.ref_failed, db.ref_unconverged,
-               db.ref_unsettled, db.sub_failed, inc, db.increment_rms);
+               db.ref_unsettled, db.sub_failed, inc, db.increment_rms, db.sub_limited,
+               db.sub_teleport, db.sub_guard, db.sub_converged);
     if (json) printf("}\n");
     free(full);
     free(full_x);
