@@ -74,7 +74,7 @@ TEST(rotation_snaps_stay_bounded_and_are_flagged) {
     for (int a = 0; a < 3; ++a)
         for (int k = 0; k < 4; ++k) {
             snap_rotate(v, T0, bone, angles[a] * 3.14159265358979323846 / 180, T1);
-            snap_result r = snap_run(inst, v, T0, T1, dts[k], 3, 300, skin);
+            snap_result r = snap_run(inst, v, T0, T1, dts[k], 3, 300, 0, skin);
             fprintf(stderr, "    %17.0f  %-8.3g  %13.3f  %8.3f  0x%02x        %d\n", angles[a],
                     (double)dts[k], r.max_ratio, r.max_size, r.snap_status, r.limited_steps);
             ENSURE(r.nonfinite == 0);
@@ -87,6 +87,106 @@ TEST(rotation_snaps_stay_bounded_and_are_flagged) {
     free(T1);
     free(skin);
     sinew_instance_destroy(inst);
+}
+
+/* The snaps the step takes for motion (slower than SW_JUMP_MAX_SPIN, a bone's points
+ * moving less than half the size) as a host declares them: flagged, within the bound. */
+TEST(declared_cuts_are_flagged) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    sinew_instance *inst = make(f, SINEW_STEP_DYNAMIC);
+    ENSURE(inst);
+    int32_t nb = v->nbones, bone = nb > 1 ? 1 : 0;
+    double *T1 = malloc(sizeof(double) * 12 * nb),
+           *skin = malloc(sizeof(double) * 3 * v->nsurf_verts);
+    const double *T0 = clip_pose(f, f->ch.clip.nframes / 2);
+    static const double angles[] = {5, 30, 90};
+    static const float dts[] = {1e-3f, 1.0f / 60};
+    int declared = 0;
+    for (int a = 0; a < 3; ++a)
+        for (int k = 0; k < 2; ++k) {
+            double angle = angles[a] * 3.14159265358979323846 / 180;
+            snap_rotate(v, T0, bone, angle, T1);
+            snap_result as_motion = snap_run(inst, v, T0, T1, dts[k], 3, 100, 0, skin);
+            if (as_motion.snap_status & SINEW_STEP_TELEPORT) continue; /* detected */
+            snap_result cut = snap_run(inst, v, T0, T1, dts[k], 3, 100, 1, skin);
+            fprintf(stderr,
+                    "    %2.0f deg at dt %-6.3g: as motion 0x%02x, %.3f of the bound; declared "
+                    "0x%02x, %.3f\n",
+                    angles[a], (double)dts[k], as_motion.snap_status, as_motion.max_ratio,
+                    cut.snap_status, cut.max_ratio);
+            ENSURE(as_motion.nonfinite == 0 && cut.nonfinite == 0);
+            ENSUREF(!(as_motion.snap_status & SINEW_STEP_TELEPORT), "%g deg at dt %g", angles[a],
+                    (double)dts[k]);
+            ENSUREF(cut.snap_status & SINEW_STEP_TELEPORT, "%g deg at dt %g declared, unflagged",
+                    angles[a], (double)dts[k]);
+            ENSURE(cut.max_ratio <= 1 + 1e-6);
+            declared++;
+        }
+    ENSURE(declared >= 3); /* 5 deg at 1e-3 and 1/60, 30 deg at 1/60 look like motion */
+    free(T1);
+    free(skin);
+    sinew_instance_destroy(inst);
+}
+
+/* A declared cut takes no velocity and no inertia from the pose history: from rest, a
+ * 30 degree snap at 1/60 s declared after steps at the rest pose gives bitwise the output
+ * of a step with no history at all (right after a reset); undeclared, the bone's motion
+ * acts on the flesh and the output differs. The mark holds for the next step only, and a
+ * reset drops it. */
+TEST(a_declared_cut_takes_no_inertia) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    int32_t nb = v->nbones, ns = v->nsurf_verts;
+    double *T0 = calloc(12 * (size_t)nb, sizeof(double)), *T1 = malloc(sizeof(double) * 12 * nb);
+    for (int32_t b = 0; b < nb; ++b) /* the rest pose */
+        T0[12 * b] = T0[12 * b + 4] = T0[12 * b + 8] = 1;
+    snap_rotate(v, T0, nb > 1 ? 1 : 0, 30 * 3.14159265358979323846 / 180, T1);
+    float *x[3];
+    uint32_t status[3];
+    for (int run = 0; run < 3; ++run) { /* no history, declared cut, undeclared snap */
+        sinew_instance *inst = make(f, SINEW_STEP_DYNAMIC);
+        ENSURE(inst);
+        for (int s = 0; run > 0 && s < 3; ++s) {
+            ENSURE(sw_instance_set_pose_d(inst, T0) == SINEW_OK);
+            ENSURE(sinew_instance_step(inst, 1.0f / 60) == SINEW_OK);
+        }
+        if (run == 1) ENSURE(sinew_instance_mark_teleport(inst) == SINEW_OK);
+        ENSURE(sw_instance_set_pose_d(inst, T1) == SINEW_OK);
+        ENSURE(sinew_instance_step(inst, 1.0f / 60) == SINEW_OK);
+        sinew_step_stats st = {.struct_size = sizeof st};
+        sinew_instance_get_stats(inst, &st);
+        status[run] = st.status;
+        x[run] = malloc(sizeof(float) * 3 * (size_t)ns);
+        ENSURE(sinew_instance_read_surface(inst, x[run], NULL, (uint32_t)ns) == SINEW_OK);
+        if (run == 1) { /* the mark was used up; a reset drops a pending one */
+            ENSURE(sinew_instance_step(inst, 1.0f / 60) == SINEW_OK);
+            sinew_instance_get_stats(inst, &st);
+            ENSURE(!(st.status & SINEW_STEP_TELEPORT));
+            ENSURE(sinew_instance_mark_teleport(inst) == SINEW_OK);
+            sinew_instance_reset(inst);
+            ENSURE(sinew_instance_step(inst, 1.0f / 60) == SINEW_OK);
+            sinew_instance_get_stats(inst, &st);
+            ENSURE(!(st.status & SINEW_STEP_TELEPORT));
+        }
+        sinew_instance_destroy(inst);
+    }
+    double diff = 0;
+    for (int32_t i = 0; i < 3 * ns; ++i)
+        diff = fmax(diff, fabs((double)x[2][i] - x[0][i]));
+    fprintf(stderr, "    flags 0x%02x 0x%02x 0x%02x; undeclared differs by %.3g\n", status[0],
+            status[1], status[2], diff);
+    ENSURE(status[1] & SINEW_STEP_TELEPORT);
+    ENSURE(!(status[2] & SINEW_STEP_TELEPORT));
+    ENSURE(memcmp(x[0], x[1], sizeof(float) * 3 * (size_t)ns) == 0);
+    ENSURE(diff > 0);
+    ENSURE(sinew_instance_mark_teleport(NULL) == SINEW_ERROR_INVALID_ARGUMENT);
+    for (int run = 0; run < 3; ++run)
+        free(x[run]);
+    free(T0);
+    free(T1);
 }
 
 TEST(translation_jumps_and_dt_spikes_stay_bounded) {
@@ -109,7 +209,7 @@ TEST(translation_jumps_and_dt_spikes_stay_bounded) {
         memcpy(T1, T0, sizeof(double) * 12 * nb);
         for (int32_t b = 0; b < nb; ++b)
             T1[12 * b + 9] += jumps[j] * size;
-        snap_result r = snap_run(inst, v, T0, T1, dts[j], 3, 100, skin);
+        snap_result r = snap_run(inst, v, T0, T1, dts[j], 3, 100, 0, skin);
         fprintf(stderr,
                 "    translation %.3g x bone extent at dt %g: %.3f of the bound, flags 0x%02x\n",
                 jumps[j], (double)dts[j], r.max_ratio, r.snap_status);
@@ -224,7 +324,8 @@ TEST(release_fixture) {
 }
 
 SW_TEST_MAIN(CASE(the_clips_motion_is_never_flagged_or_limited),
-             CASE(rotation_snaps_stay_bounded_and_are_flagged),
+             CASE(rotation_snaps_stay_bounded_and_are_flagged), CASE(declared_cuts_are_flagged),
+             CASE(a_declared_cut_takes_no_inertia),
              CASE(translation_jumps_and_dt_spikes_stay_bounded),
              CASE(bad_poses_are_rejected_and_the_state_kept), CASE(a_step_at_rest_converges),
              CASE(release_fixture))

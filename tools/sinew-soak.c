@@ -1,8 +1,9 @@
 /* sinew-soak: randomised abuse of several dynamic and quasistatic instances of one blob
  * (issue 15): each frame one instance gets a mocap pose (CMU BVH 01_01: RightArm,
  * RightForeArm and RightHand rotations on the first three bones), a NaN or infinite
- * pose, a scaled, sheared or mirrored pose, a teleport, a rotation snap of a bone, a dt
- * spike anywhere in [1e-9, 1], or a reset, then a step. Counted: step errors, non-finite
+ * pose, a scaled, sheared or mirrored pose, a teleport, a rotation snap of a bone, a snap
+ * at 1/60 s the host declares a cut (sinew_instance_mark_teleport), a dt spike anywhere in
+ * [1e-9, 1], or a reset, then a step. Counted: step errors, non-finite
  * outputs, allocations and locks inside the step (tools/rt_interpose), steps flagged per
  * cause, and the largest distance of an output vertex from its skinned position relative
  * to the instance's bound (sinew_types.h). Deterministic for a seed.
@@ -11,8 +12,8 @@
  *              [--seed S (1)] [--bvh FILE] [--check]
  *
  * The last stdout line is one JSON object. --check exits 1 unless there were 0 non-finite
- * outputs, 0 step errors other than the rejected poses, 0 allocations, 0 locks and every
- * deviation within the bound. */
+ * outputs, 0 step errors other than the rejected poses, 0 allocations, 0 locks, every
+ * declared cut flagged TELEPORT and every deviation within the bound. */
 #include <math.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -110,9 +111,9 @@ static int mocap_read(const char *path, mocap *m) {
 
 /* ---- the soak ---------------------------------------------------------------------- */
 
-enum { A_MOCAP, A_NAN, A_NONRIGID, A_TELEPORT, A_SNAP, A_DT_SPIKE, A_RESET, A_COUNT };
-static const char *action_name[A_COUNT] = {"mocap", "nan",      "nonrigid", "teleport",
-                                           "snap",  "dt_spike", "reset"};
+enum { A_MOCAP, A_NAN, A_NONRIGID, A_TELEPORT, A_SNAP, A_CUT, A_DT_SPIKE, A_RESET, A_COUNT };
+static const char *action_name[A_COUNT] = {"mocap", "nan", "nonrigid", "teleport",
+                                           "snap",  "cut", "dt_spike", "reset"};
 
 int main(int argc, char **argv) {
     long frames = 1000000;
@@ -197,7 +198,8 @@ int main(int argc, char **argv) {
     for (int k = 0; k < ninst; ++k)
         mframe[k] = have_mocap ? (long)(urand() * mc.nframes) : 0;
 
-    uint64_t actions[A_COUNT] = {0}, rejected = 0, errors = 0, nonfinite = 0, over_bound = 0;
+    uint64_t actions[A_COUNT] = {0}, rejected = 0, errors = 0, nonfinite = 0, over_bound = 0,
+             cuts_unflagged = 0;
     uint64_t flag_count[8] = {0}, allocs = 0, locks = 0, frees = 0;
     double worst = 0, bound_min = INFINITY;
     for (int k = 0; k < ninst; ++k)
@@ -213,7 +215,8 @@ int main(int argc, char **argv) {
                   : u < 0.75 ? A_NAN
                   : u < 0.80 ? A_NONRIGID
                   : u < 0.85 ? A_TELEPORT
-                  : u < 0.92 ? A_SNAP
+                  : u < 0.90 ? A_SNAP
+                  : u < 0.92 ? A_CUT
                   : u < 0.99 ? A_DT_SPIKE
                              : A_RESET;
         actions[act]++;
@@ -235,6 +238,10 @@ int main(int argc, char **argv) {
             snap_rotate(v, Tk, (int32_t)(urand() * nb) % nb, (urand() - 0.5) * 2 * 3.14159, T);
             static const float dts[4] = {1e-9f, 1e-6f, 1e-3f, 1.0f / 60};
             dt = dts[(int)(urand() * 4) & 3];
+        } else if (act == A_CUT) { /* a snap at the frame rate the host declares a cut */
+            snap_rotate(v, Tk, (int32_t)(urand() * nb) % nb, (urand() - 0.5) * 3.14159, T);
+            dt = 1.0f / 60;
+            if (sinew_instance_mark_teleport(in) != SINEW_OK) errors++;
         } else if (act == A_RESET) {
             sinew_instance_reset(in);
             for (int32_t b = 0; b < nb; ++b) {
@@ -280,6 +287,7 @@ int main(int argc, char **argv) {
         sinew_instance_get_stats(in, &st);
         for (int bit = 0; bit < 8; ++bit)
             flag_count[bit] += (st.status >> bit) & 1u;
+        cuts_unflagged += act == A_CUT && !(st.status & SINEW_STEP_TELEPORT);
         double d = snap_deviation(in, v, skin);
         if (d < 0) {
             nonfinite++;
@@ -308,13 +316,13 @@ int main(int argc, char **argv) {
     printf("}, \"rejected_poses\": %llu, \"step_errors\": %llu, \"nonfinite_outputs\": %llu, "
            "\"allocs_in_step\": %lld, \"frees_in_step\": %lld, \"locks_in_step\": %lld, "
            "\"max_deviation_over_bound\": %.4f, \"over_bound_steps\": %llu, "
-           "\"bound\": %.4g, \"crashes\": 0}\n",
+           "\"bound\": %.4g, \"cuts_unflagged\": %llu, \"crashes\": 0}\n",
            (unsigned long long)rejected, (unsigned long long)errors, (unsigned long long)nonfinite,
            (active & SW_RT_CAT_ALLOCS) ? (long long)allocs : -1LL,
            (active & SW_RT_CAT_FREES) ? (long long)frees : -1LL,
            (active & SW_RT_CAT_LOCKS) ? (long long)locks : -1LL, worst,
-           (unsigned long long)over_bound, bound_min);
-    int bad = errors || nonfinite || over_bound || allocs || frees || locks;
+           (unsigned long long)over_bound, bound_min, (unsigned long long)cuts_unflagged);
+    int bad = errors || nonfinite || over_bound || allocs || frees || locks || cuts_unflagged;
 
     for (int k = 0; k < ninst; ++k)
         sinew_instance_destroy(inst[k]);

@@ -116,10 +116,11 @@ typedef struct {
 
 /* From the settled pose T0 (held for `settle` steps at dt after 1/30 s steps of the
  * same pose), one step to T1 at dt, then `hold` steps of T1 at dt: the deviation relative
- * to the instance's bound and the flags. T0, T1: 12 per bone. skin: 3 per surface
- * vertex. */
+ * to the instance's bound and the flags. With `declare` the host declares the snap a cut
+ * (sinew_instance_mark_teleport). T0, T1: 12 per bone. skin: 3 per surface vertex. */
 static inline snap_result snap_run(sinew_instance *inst, const sw_blob_view *v, const double *T0,
-                                   const double *T1, float dt, int settle, int hold, double *skin) {
+                                   const double *T1, float dt, int settle, int hold, int declare,
+                                   double *skin) {
     snap_result r = {0, 0, 0, 0, 0};
     double bound = sw_instance_displacement_bound(inst), size = 0;
     {
@@ -138,6 +139,8 @@ static inline snap_result snap_run(sinew_instance *inst, const sw_blob_view *v, 
     for (int s = 0; s < 30 + settle + 1 + hold; ++s) {
         const double *T = s <= 30 + settle - 1 ? T0 : T1;
         float h = s < 30 ? 1.0f / 30 : dt;
+        if (declare && s == 30 + settle && sinew_instance_mark_teleport(inst) != SINEW_OK)
+            r.nonfinite++;
         if (sw_instance_set_pose_d(inst, T) != SINEW_OK ||
             sinew_instance_step(inst, h) != SINEW_OK) {
             r.nonfinite++;

@@ -363,6 +363,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
         sw_dq_from_transform(ph->T_cur + 12 * b, &inst->bone_dq[b]);
     ph->history = 0;
     ph->h_prev = 0;
+    ph->declared_jump = 0;
     sw_pose_space_reset(&inst->ps, nb);
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);

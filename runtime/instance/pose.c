@@ -48,3 +48,9 @@ SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float
         return SINEW_ERROR_INVALID_ARGUMENT;
     return set_pose(inst, NULL, transforms);
 }
+
+SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst) {
+    if (!inst) return SINEW_ERROR_INVALID_ARGUMENT;
+    inst->pose.declared_jump = 1;
+    return SINEW_OK;
+}

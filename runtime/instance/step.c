@@ -101,17 +101,20 @@ static void pose_space_start(sinew_instance *in) {
 }
 
 /* A jump of the pose (sw_pose_jump: teleport, snap, or a small dt that implies a speed no
- * joint makes) starts the pose history afresh in either mode: no velocity and no
- * inertia are taken from it, and the world's broad phase does not reuse the last boxes.
- * Dynamic: the inertial forces of the bones' motion, and the Rayleigh stiffness H(q_n)
- * frozen for the step. Quasistatic: the pose-space start. */
+ * joint makes; or one the host declared, sinew_instance_mark_teleport) starts the pose history
+ * afresh in either mode: no velocity and no inertia are taken from it, and the world's broad phase
+ * does not reuse the last boxes. Dynamic: the inertial forces of the bones' motion, and the
+ * Rayleigh stiffness H(q_n) frozen for the step. Quasistatic: the pose-space start. */
 static void phase_dynamics(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_solver *s = &in->solver;
     int32_t R = in->red.R;
-    if (in->pose.history >= 1 && sw_pose_jump(in->v, &in->pose, in->bone_ball, in->size, c->dc.h)) {
+    if (in->pose.declared_jump ||
+        (in->pose.history >= 1 &&
+         sw_pose_jump(in->v, &in->pose, in->bone_ball, in->size, c->dc.h))) {
         memset(s->qdot, 0, (size_t)R * sizeof(double));
         in->pose.history = 0;
+        in->pose.declared_jump = 0;
         c->st.status |= SINEW_STEP_TELEPORT;
     }
     if (c->dc.dynamic) {

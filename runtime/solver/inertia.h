@@ -14,6 +14,9 @@ typedef struct sw_pose_history {
     double *T_cur, *T_prev, *T_prev2;
     int history;   /* frames of history before T_cur available (0..2) */
     double h_prev; /* seconds from T_prev2 to T_prev (valid when history == 2) */
+    /* The host declared T_cur discontinuous with T_prev (sinew_instance_mark_teleport):
+     * the next step treats it as a jump whatever sw_pose_jump says, then clears this. */
+    int declared_jump;
 } sw_pose_history;
 
 /* Inertial forces s->fin of every domain riding its bone, explicit at q_n and qdot_n

@@ -64,6 +64,15 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst);
 SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float *transforms,
                                                uint32_t bone_count);
 
+/** Declares the pose of the next step discontinuous with the last step's: a camera cut, a
+ * respawn, a switch to another animation, a ragdoll hand-off. The next step treats it as
+ * a pose jump whatever its size (SINEW_STEP_TELEPORT, sinew_types.h): no velocity and no
+ * inertia are taken from it. Steps detect large jumps on their own; this is for a change
+ * the host knows is a cut but that looks like motion (5 degrees in 1/60 s is a joint
+ * spinning at 5 rad/s). Call it before or after sinew_instance_set_pose; it holds until
+ * the next step that runs (or a reset). Never allocates or locks. */
+SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst);
+
 /** Advances the instance by dt seconds (0 < dt <= 1) to the current pose: quasistatic
  * or dynamic per the instance def. Never allocates, locks or blocks; its cost depends
  * on the blob's cubature and surface sizes, not on the tet count. A non-finite result

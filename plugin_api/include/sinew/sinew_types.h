@@ -143,7 +143,9 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
  * A pose jump (SINEW_STEP_TELEPORT) is any bone, between the last step's pose and this
  * one, turning by more than 120 degrees, moving a rest point it skins by more than L / 2,
  * or implying a joint spin above 200 rad/s (no human joint exceeds ~140 rad/s) or a
- * point speed above 200 L/s at this dt; a 5 degree change over dt = 1e-6 s is one.
+ * point speed above 200 L/s at this dt; a 5 degree change over dt = 1e-6 s is one. A
+ * change slower than that is motion, however abrupt the host meant it to be: a host
+ * declares such a cut with sinew_instance_mark_teleport and the step flags it too.
  * Poses are checked by sinew_instance_set_pose before any step: a non-finite value gives
  * SINEW_ERROR_NOT_FINITE, a rotation part that is not orthonormal within 1e-3 (scale,
  * shear) or is a reflection gives SINEW_ERROR_INVALID_ARGUMENT; either way the pose and
