@@ -2,12 +2,12 @@
  * calls never allocates and never takes a lock, and all memory is reserved at creation,
  * through the host's allocator when it gives one. One counted run of a few hundred steps
  * drives every path of the step and asserts that each was taken (by the status flags and
- * the stats): quasistatic and dynamic, the pose-space start, teleports by translation and
- * by a rotation snap, the state bounds (LIMITED), the energy guard (GUARD), a failed
- * step (FAILED), the contact pair and world contact budgets (BUDGET), a reset between
- * steps, and a collision world whose collider moves every step. Every return code is
- * checked; the interposer (tools/rt_interpose.h) counts allocations, frees, mappings and
- * locks over all of it, and the host allocator counts its own calls.
+ * the stats): quasistatic and dynamic, the pose-space start, a declared cut, teleports by
+ * translation and by a rotation snap, the state bounds (LIMITED), the energy guard (GUARD), a
+ * failed step (FAILED), the contact pair and world contact budgets (BUDGET), a reset between steps,
+ * and a collision world whose collider moves every step. Every return code is checked; the
+ * interposer (tools/rt_interpose.h) counts allocations, frees, mappings and locks over all of it,
+ * and the host allocator counts its own calls.
  *
  * Built twice from this source: test_step_contract against the static library, and
  * test_step_contract_shared (SW_CONTRACT_SHARED) against libsinew.so, whose executable
@@ -175,6 +175,7 @@ enum {
     P_TRANSLATE,    /* dynamic: every bone 1000 units away in one step, and back (TELEPORT) */
     P_ROTATE,       /* dynamic: every bone turned by 180 degrees in one step (TELEPORT) */
     P_DT_SPIKES,    /* dynamic: the clip at dt = 1e-9 and 1 in turn (TELEPORT) */
+    P_CUT,          /* dynamic: a clip frame the host declares a cut (TELEPORT) */
     P_LIMITED,      /* dynamic inside a box: the state limited by its bounds (LIMITED) */
     P_GUARD,        /* quasistatic inside a box of stiffness 1e15: the energy guard (GUARD) */
     P_FAILED,       /* dynamic from a state whose energy overflows: the step undone (FAILED) */
@@ -185,8 +186,9 @@ enum {
     P_COUNT
 };
 static const char *const path_names[P_COUNT] = {
-    "quasistatic", "dynamic", "translate jump", "rotation snap", "dt spikes", "limited",
-    "guard",       "failed",  "reset",          "pair budget",   "world",     "world budget"};
+    "quasistatic", "dynamic", "translate jump", "rotation snap", "dt spikes",
+    "cut",         "limited", "guard",          "failed",        "reset",
+    "pair budget", "world",   "world budget"};
 
 typedef struct {
     int steps, failed;         /* steps made; of them, returning an error */
@@ -377,6 +379,9 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     /* dt spikes: the clip at alternating dt = 1e-9 and 1 */
     for (int s = 0; s < frames; ++s)
         step_path(&cr, P_DT_SPIKES, in[I_D], clip_pose(f, s), s % 2 ? 1.0f : 1e-9f);
+    /* a cut the host declares: the next clip frame, motion but for the mark */
+    if (sinew_instance_mark_teleport(in[I_D]) != SINEW_OK) cr.bad_calls++;
+    step_path(&cr, P_CUT, in[I_D], clip_pose(f, frames), 1.0f / 30);
     /* the state's bounds, and the energy guard */
     for (int s = 0; s < 8; ++s) {
         step_path(&cr, P_LIMITED, in[I_LIMIT], clip_pose(f, s), 1.0f / 30);
@@ -478,6 +483,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     ENSURE(rec[P_TRANSLATE].steps == 2 && rec[P_TRANSLATE].all & SINEW_STEP_TELEPORT);
     ENSURE(rec[P_ROTATE].all & SINEW_STEP_TELEPORT);
     ENSURE(rec[P_DT_SPIKES].any & SINEW_STEP_TELEPORT);
+    ENSURE(rec[P_CUT].steps == 1 && rec[P_CUT].all & SINEW_STEP_TELEPORT);
     /* the bounds and the guard, each by the contact of its box */
     ENSUREF(rec[P_LIMITED].any & SINEW_STEP_LIMITED && rec[P_LIMITED].world_contacts > 0,
             "flags 0x%02x", rec[P_LIMITED].any);
