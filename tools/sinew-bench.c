@@ -70,6 +70,8 @@
  *                     dyn_ref_unconverged, dyn_ref_unsettled, dyn_sub_failed
  *   dyn_sub_limited, dyn_sub_teleport, dyn_sub_guard, dyn_sub_converged  the runtime's
  *                     dynamic steps with each SINEW_STEP_* flag (of frames + hold - 1)
+ * Always: instance_bytes (sinew_instance_memory_size with the default def) and
+ * blob_bytes (the blob file's size with --blob, else the size of the blob just baked).
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
@@ -279,9 +281,12 @@ int main(int argc, char **argv) {
     sinew_blob *blob = NULL;
     void *mem = NULL;
     double bake_s = 0;
+    size_t blob_bytes = 0; /* the file's or the baked blob's size */
     sinew_blob_def bd = sinew_blob_def_default();
     if (blob_path) {
         bd.path = blob_path;
+        struct stat sb;
+        if (stat(blob_path, &sb) == 0) blob_bytes = (size_t)sb.st_size;
     } else {
         double t0 = sw_now_seconds();
         size_t size = 0;
@@ -291,10 +296,16 @@ int main(int argc, char **argv) {
         bake_s = sw_now_seconds() - t0;
         bd.data = mem;
         bd.data_size = size;
+        blob_bytes = size;
     }
     if (sw_tool_blob_load(tool, blob_path ? blob_path : "just baked", bd, &blob) != SINEW_OK)
         return 1;
     const sw_blob_view *v = sw_blob_get_view(blob);
+    size_t instance_bytes = 0;
+    if ((r = sinew_instance_memory_size(blob, NULL, &instance_bytes)) != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: cannot size an instance: %s\n", sinew_result_string(r));
+        return 1;
+    }
     if (v->nverts != ch.mesh.nverts || v->nbones != ch.skel.nbones) {
         fprintf(stderr,
                 "sinew-bench: the blob does not belong to this character (%d/%d vertices, %d/%d "
@@ -500,6 +511,8 @@ int main(int argc, char **argv) {
                 err_source, et.correction_error, eh.correction_error);
     fprintf(stderr, "             allocs %ld, locks %ld in %d steps\n", allocs, locks,
             contract_steps);
+    fprintf(stderr, "             memory: %zu bytes an instance, blob %zu bytes\n", instance_bytes,
+            blob_bytes);
     fprintf(stderr,
             "             step phases (median ms): skin %.4f, contact %.4f, dynamics %.4f, solve "
             "%.4f, output %.4f; %.1f potential evaluations a step\n",
@@ -522,6 +535,7 @@ int main(int argc, char **argv) {
             ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
             sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
             full_max);
+    if (json) printf(",\"instance_bytes\":%zu,\"blob_bytes\":%zu", instance_bytes, blob_bytes);
     if (json && clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
                et.frames + et.failed, eh.frames + eh.failed);
