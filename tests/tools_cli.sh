@@ -3,8 +3,9 @@
 # names what is wrong; flags that do not apply to the input, values out of range and
 # files of the wrong format are rejected; the bake and the bench --blob --bake-errors
 # report the same training and held-out error for the same blob, and the bench --blob
-# alone reports its clip-frame errors under their own names. Small meshes only (about
-# 1-2K tets).
+# alone reports its clip-frame errors under their own names; the bench's crowd
+# (--instances) prints finite crowd and memory figures. Small meshes only (about 1-2K
+# tets).
 #   bash tests/tools_cli.sh BUILD_DIR SOURCE_DIR
 set -uo pipefail
 build=$1
@@ -70,6 +71,10 @@ expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'"
     "$bench" --scene finger --tets 10
 expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \
     "$bench" "${small[@]}" --full-frames 0
+expect bench_instances_range 2 "--instances wants an integer in 1\.\.4096, got '0'" \
+    "$bench" "${small[@]}" --instances 0
+expect bench_instances_range_high 2 "--instances wants an integer in 1\.\.4096, got '4097'" \
+    "$bench" "${small[@]}" --instances 4097
 expect bench_rounds_range 2 "--contact-rounds wants an integer in 1\.\.100, got '0'" \
     "$bench" "${small[@]}" --contact-rounds 0
 expect bake_mesh_format 2 "--mesh 'a\.obj': not a format it reads; accepted: \.mesh \(MEDIT\), \.node or \.ele" \
@@ -149,6 +154,38 @@ if [ -s "$tmp/f.blob" ] &&
 else
     echo "FAIL clip_errors: the bench failed" >&2
     tail -n 3 "$tmp/clip.err" >&2
+    fails=$((fails + 1))
+fi
+
+# a small crowd prints its figures (finite, scaling > 0; no timing thresholds) and the
+# memory figures; without --instances no crowd field appears
+num() { key "$1" "$2" | grep -E '^[0-9]+(\.[0-9]+)?$'; }
+if [ -s "$tmp/f.blob" ] &&
+    "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --full-frames 1 \
+        --contract-steps 10 --instances 4 --threads 2 --json >"$tmp/crowd.json" \
+        2>"$tmp/crowd.err"; then
+    ok=1
+    for k in crowd_instances crowd_threads crowd_ms crowd_us_per_instance crowd_scaling \
+        crowd_vs_lone crowd_lone_ms instance_bytes blob_bytes; do
+        [ -n "$(num "$tmp/crowd.json" $k)" ] ||
+            { echo "FAIL crowd: $k missing or not a finite number: '$(key "$tmp/crowd.json" $k)'" >&2; ok=0; }
+    done
+    [ "$(key "$tmp/crowd.json" crowd_instances)" = 4 ] && [ "$(key "$tmp/crowd.json" crowd_threads)" = 2 ] ||
+        { echo "FAIL crowd: crowd_instances/crowd_threads are not 4/2" >&2; ok=0; }
+    awk -v s="$(key "$tmp/crowd.json" crowd_scaling)" 'BEGIN { exit !(s > 0) }' ||
+        { echo "FAIL crowd: crowd_scaling is not > 0" >&2; ok=0; }
+    [ "$(key "$tmp/crowd.json" blob_bytes)" = "$(stat -c %s "$tmp/f.blob")" ] ||
+        { echo "FAIL crowd: blob_bytes is not the blob file's size" >&2; ok=0; }
+    [ "$(key "$tmp/crowd.json" failed_steps)" = 0 ] ||
+        { echo "FAIL crowd: failed steps" >&2; ok=0; }
+    grep -q "sinew-bench: crowd of 4 instances on 2 threads" "$tmp/crowd.err" ||
+        { echo "FAIL crowd: no crowd summary line" >&2; ok=0; }
+    ! tail -n 1 "$tmp/clip.json" | grep -q '"crowd_' ||
+        { echo "FAIL crowd: crowd fields without --instances" >&2; ok=0; }
+    if [ "$ok" -eq 1 ]; then echo "ok   crowd"; else fails=$((fails + 1)); fi
+else
+    echo "FAIL crowd: the bench failed" >&2
+    tail -n 3 "$tmp/crowd.err" >&2
     fails=$((fails + 1))
 fi
 

@@ -3,7 +3,7 @@
  *
  *   sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
  *               [--blob FILE [--bake-errors]] [--full-frames K] [--contract-steps S]
- *               [--threads T] --json
+ *               [--threads T] [--instances N] --json
  *
  * Bakes the character (or loads --blob), then:
  *   full_ms   median full-space quasistatic ms/frame (self-contact on) over the clip (or
@@ -70,6 +70,19 @@
  *                     dyn_ref_unconverged, dyn_ref_unsettled, dyn_sub_failed
  *   dyn_sub_limited, dyn_sub_teleport, dyn_sub_guard, dyn_sub_converged  the runtime's
  *                     dynamic steps with each SINEW_STEP_* flag (of frames + hold - 1)
+ * With --instances N it then steps a crowd of N quasistatic instances of the blob over the
+ * clip, instance i offset by i * (clip frames) / N frames, on 1 thread and on T (--threads;
+ * plain pthreads, each stepping a fixed contiguous share every frame, then a barrier;
+ * crowd_bench.h), each instance's frame the work sub_ms times, and adds
+ *   crowd_instances, crowd_threads  N and T (T resolved: 0 is all cores)
+ *   crowd_ms          median wall ms of a frame of all N on T threads
+ *   crowd_us_per_instance  crowd_ms * 1000 / N
+ *   crowd_scaling     median 1-thread frame ms / crowd_ms, same run
+ *   crowd_vs_lone     crowd_ms * T / N over crowd_lone_ms, the median frame ms of one
+ *                     instance stepped alone in the same run on the same clip
+ *   crowd_ms_1thread, crowd_lone_ms, crowd_frames (timed frames, after a warm-up)
+ * Always: instance_bytes (sinew_instance_memory_size with the default def) and
+ * blob_bytes (the blob file's size with --blob, else the size of the blob just baked).
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
@@ -101,6 +114,7 @@
 #include "weights_heat.h"
 #include "world_bench.h"
 #include "dyn_bench.h"
+#include "crowd_bench.h"
 
 /* The step's phases as sinew_step_stats reports them. */
 enum { NPHASES = 5 };
@@ -112,7 +126,7 @@ static void usage(FILE *f) {
             "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
             "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
             "                   [reference options] [--out DIR] [--world FILE.json]\n"
-            "                   [--dynamic [--hold-frames H]] [--json]\n"
+            "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
             "character:\n" SW_CHARACTER_USAGE "bench:\n"
             "  --blob FILE         a blob sinew-bake wrote for this character (default: bake,\n"
             "                      and report the bake's err_train/err_heldout). The errors are\n"
@@ -127,7 +141,7 @@ static void usage(FILE *f) {
             "                      (default: the whole clip)\n"
             "  --contract-steps S  steps counted for allocations and locks, 0..100000000\n"
             "                      (default 10000)\n"
-            "  --threads T         0..256 (default 0: all cores)\n"
+            "  --threads T         0..256 (default 0: all cores); also the crowd's threads\n"
             "  --out DIR           write the subspace surface of every clip frame as\n"
             "                      DIR/frame_NNNN.obj\n"
             "  --world F           also run reference and runtime against world file F (.json,\n"
@@ -137,6 +151,10 @@ static void usage(FILE *f) {
             "                      and report err_dynamic and the overshoot after the clip\n"
             "  --hold-frames H     with --dynamic: frames holding the last pose, 2..100000\n"
             "                      (default 30)\n"
+            "  --instances N       also step a crowd of N instances of the blob over the clip,\n"
+            "                      1..4096, each offset in time, on 1 thread and on T\n"
+            "                      (--threads) host pthreads, and report crowd_ms,\n"
+            "                      crowd_us_per_instance, crowd_scaling, crowd_vs_lone\n"
             "  --json              one JSON object with the figures as the last stdout line\n"
             "reference options (the full-space run the bench times; a bake it runs uses the\n"
             "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
@@ -211,7 +229,7 @@ int main(int argc, char **argv) {
     sw_character_args_init(&ca, tool);
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
-    int dynamic = 0, hold_frames = 0;
+    int dynamic = 0, hold_frames = 0, instances = 0;
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -232,6 +250,8 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 0, 100000000, &contract_steps);
         else if (!strcmp(a, "--threads") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, 256, &threads);
+        else if (!strcmp(a, "--instances") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 4096, &instances);
         else if (!strcmp(a, "--hold-frames") && next)
             ok = sw_tool_int(tool, a, argv[++i], 2, 100000, &hold_frames);
         else if (!strcmp(a, "--dynamic"))
@@ -279,9 +299,12 @@ int main(int argc, char **argv) {
     sinew_blob *blob = NULL;
     void *mem = NULL;
     double bake_s = 0;
+    size_t blob_bytes = 0; /* the file's or the baked blob's size */
     sinew_blob_def bd = sinew_blob_def_default();
     if (blob_path) {
         bd.path = blob_path;
+        struct stat sb;
+        if (stat(blob_path, &sb) == 0) blob_bytes = (size_t)sb.st_size;
     } else {
         double t0 = sw_now_seconds();
         size_t size = 0;
@@ -291,10 +314,16 @@ int main(int argc, char **argv) {
         bake_s = sw_now_seconds() - t0;
         bd.data = mem;
         bd.data_size = size;
+        blob_bytes = size;
     }
     if (sw_tool_blob_load(tool, blob_path ? blob_path : "just baked", bd, &blob) != SINEW_OK)
         return 1;
     const sw_blob_view *v = sw_blob_get_view(blob);
+    size_t instance_bytes = 0;
+    if ((r = sinew_instance_memory_size(blob, NULL, &instance_bytes)) != SINEW_OK) {
+        fprintf(stderr, "sinew-bench: cannot size an instance: %s\n", sinew_result_string(r));
+        return 1;
+    }
     if (v->nverts != ch.mesh.nverts || v->nbones != ch.skel.nbones) {
         fprintf(stderr,
                 "sinew-bench: the blob does not belong to this character (%d/%d vertices, %d/%d "
@@ -482,6 +511,20 @@ int main(int argc, char **argv) {
                 db.overshoot_ratio, db.settle_sub, db.settle_full, db.err_increment,
                 db.increment_rms, db.full_ms, db.sub_ms);
     }
+    /* 9. a crowd of instances on host threads, when asked */
+    sw_crowd_bench cb;
+    memset(&cb, 0, sizeof cb);
+    if (instances) {
+        if ((r = sw_crowd_bench_run(&ch, blob, instances, threads, &cb, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "sinew-bench: crowd run failed: ");
+        failed_steps += cb.failed;
+        fprintf(stderr,
+                "sinew-bench: crowd of %d instances on %d threads (%d frames after %d warm-up): "
+                "%.3f ms a frame (%.1f us an instance), 1 thread %.3f ms, scaling %.2fx; lone "
+                "instance %.4f ms, crowd/lone %.2f\n",
+                cb.instances, cb.threads, cb.frames, cb.warmup_frames, cb.ms, cb.us_per_instance,
+                cb.ms_1thread, cb.scaling, cb.lone_ms, cb.vs_lone);
+    }
     /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
     char e_tr[32] = "null", e_ho[32] = "null";
     if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
@@ -500,6 +543,8 @@ int main(int argc, char **argv) {
                 err_source, et.correction_error, eh.correction_error);
     fprintf(stderr, "             allocs %ld, locks %ld in %d steps\n", allocs, locks,
             contract_steps);
+    fprintf(stderr, "             memory: %zu bytes an instance, blob %zu bytes\n", instance_bytes,
+            blob_bytes);
     fprintf(stderr,
             "             step phases (median ms): skin %.4f, contact %.4f, dynamics %.4f, solve "
             "%.4f, output %.4f; %.1f potential evaluations a step\n",
@@ -522,6 +567,13 @@ int main(int argc, char **argv) {
             ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
             sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
             full_max);
+    if (json) printf(",\"instance_bytes\":%zu,\"blob_bytes\":%zu", instance_bytes, blob_bytes);
+    if (json && instances)
+        printf(",\"crowd_instances\":%d,\"crowd_threads\":%d,\"crowd_frames\":%d,"
+               "\"crowd_ms\":%.4f,\"crowd_us_per_instance\":%.3f,\"crowd_scaling\":%.3f,"
+               "\"crowd_vs_lone\":%.3f,\"crowd_ms_1thread\":%.4f,\"crowd_lone_ms\":%.4f",
+               cb.instances, cb.threads, cb.frames, cb.ms, cb.us_per_instance, cb.scaling,
+               cb.vs_lone, cb.ms_1thread, cb.lone_ms);
     if (json && clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
                et.frames + et.failed, eh.frames + eh.failed);

@@ -1,0 +1,226 @@
+/* sinew-bench --instances N (crowd_bench.h): the host side of a crowd. The library's step
+ * stays lock-free; the workers here meet at a mutex/condition barrier twice a frame (the
+ * frame's start and end), as a game's job system would around its skinning jobs. */
+#include "crowd_bench.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+#include <unistd.h>
+
+#include "clock.h"
+#include "instance.h"
+#include "tool_common.h"
+
+enum { CROWD_WARMUP = 5, CROWD_MIN_FRAMES = 30 };
+
+/* A reusable barrier whose count can shrink while threads wait on it (when a worker
+ * thread cannot be created, the ones that were can still be released and joined). */
+typedef struct barrier {
+    pthread_mutex_t mu;
+    pthread_cond_t cv;
+    int count, waiting;
+    unsigned gen;
+} barrier;
+
+static void barrier_wait(barrier *b) {
+    pthread_mutex_lock(&b->mu);
+    unsigned gen = b->gen;
+    if (++b->waiting >= b->count) {
+        b->waiting = 0;
+        b->gen++;
+        pthread_cond_broadcast(&b->cv);
+    } else {
+        while (gen == b->gen)
+            pthread_cond_wait(&b->cv, &b->mu);
+    }
+    pthread_mutex_unlock(&b->mu);
+}
+
+/* Sets the count, releasing the waiters when as many as it wait already. */
+static void barrier_set_count(barrier *b, int count) {
+    pthread_mutex_lock(&b->mu);
+    b->count = count;
+    if (b->waiting > 0 && b->waiting >= count) {
+        b->waiting = 0;
+        b->gen++;
+        pthread_cond_broadcast(&b->cv);
+    }
+    pthread_mutex_unlock(&b->mu);
+}
+
+/* One instance of the crowd and its host buffers. */
+typedef struct member {
+    sinew_instance *inst;
+    float *pos, *nrm;
+    int offset; /* clip frames it plays ahead of instance 0 */
+} member;
+
+typedef struct crowd {
+    const sw_character *ch;
+    member *m;
+    int n, nf;
+    uint32_t ns;
+    float dt;
+    int frame, quit; /* written by the main thread before the start barrier only */
+    barrier start, done;
+} crowd;
+
+typedef struct worker {
+    crowd *c;
+    int begin, end; /* its fixed share of instances */
+    long failed;
+    pthread_t th;
+} worker;
+
+/* An instance's frame: the work the bench times for a lone instance (sub_ms). */
+static int member_frame(const crowd *c, member *m, int frame) {
+    int f = (frame + m->offset) % c->nf;
+    sw_instance_set_pose_d(m->inst, c->ch->clip.T + (size_t)f * 12 * c->ch->skel.nbones);
+    int failed = sinew_instance_step(m->inst, c->dt) != SINEW_OK;
+    sinew_instance_read_surface(m->inst, m->pos, m->nrm, c->ns);
+    return failed;
+}
+
+static void step_share(worker *w) {
+    long failed = 0;
+    for (int i = w->begin; i < w->end; ++i)
+        failed += member_frame(w->c, &w->c->m[i], w->c->frame);
+    w->failed += failed;
+}
+
+static void *worker_main(void *p) {
+    worker *w = p;
+    for (;;) {
+        barrier_wait(&w->c->start);
+        if (w->c->quit) return NULL;
+        step_share(w);
+        barrier_wait(&w->c->done);
+    }
+}
+
+/* The crowd from rest on T threads (the main thread is worker 0): `warm` untimed frames,
+ * then ms[0 .. frames-1], each frame's wall ms for all instances. */
+static sinew_result crowd_run(crowd *c, int T, int warm, int frames, double *ms, long *failed,
+                              sw_error *err) {
+    worker *w = calloc((size_t)T, sizeof *w);
+    if (!w) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
+    for (int i = 0; i < c->n; ++i)
+        sinew_instance_reset(c->m[i].inst);
+    c->quit = 0;
+    barrier_set_count(&c->start, T);
+    barrier_set_count(&c->done, T);
+    int started = 1;
+    for (int t = 0; t < T; ++t) {
+        w[t].c = c;
+        w[t].begin = (int)((long)t * c->n / T);
+        w[t].end = (int)((long)(t + 1) * c->n / T);
+    }
+    for (; started < T; ++started)
+        if (pthread_create(&w[started].th, NULL, worker_main, &w[started]) != 0) break;
+    sinew_result r = SINEW_OK;
+    if (started < T) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot create crowd thread %d of %d",
+                         started + 1, T);
+    } else {
+        for (int f = 0; f < warm + frames; ++f) {
+            c->frame = f;
+            double t0 = sw_now_seconds();
+            barrier_wait(&c->start);
+            step_share(&w[0]);
+            barrier_wait(&c->done);
+            if (f >= warm) ms[f - warm] = 1e3 * (sw_now_seconds() - t0);
+        }
+    }
+    c->quit = 1;
+    barrier_set_count(&c->start, started); /* releases the workers to see quit */
+    barrier_wait(&c->start);
+    for (int t = 1; t < started; ++t)
+        pthread_join(w[t].th, NULL);
+    for (int t = 0; t < T; ++t)
+        *failed += w[t].failed;
+    free(w);
+    return r;
+}
+
+static void crowd_free(crowd *c) {
+    for (int i = 0; c->m && i < c->n; ++i) {
+        sinew_instance_destroy(c->m[i].inst);
+        free(c->m[i].pos);
+        free(c->m[i].nrm);
+    }
+    free(c->m);
+    pthread_mutex_destroy(&c->start.mu);
+    pthread_cond_destroy(&c->start.cv);
+    pthread_mutex_destroy(&c->done.mu);
+    pthread_cond_destroy(&c->done.cv);
+}
+
+static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, int n, crowd *c,
+                               sw_error *err) {
+    memset(c, 0, sizeof *c);
+    c->ch = ch;
+    c->n = n;
+    c->nf = ch->clip.nframes;
+    c->ns = sinew_blob_surface_vertex_count(blob);
+    c->dt = 1.0f / (float)(ch->clip.fps > 0 ? ch->clip.fps : 30);
+    pthread_mutex_init(&c->start.mu, NULL);
+    pthread_cond_init(&c->start.cv, NULL);
+    pthread_mutex_init(&c->done.mu, NULL);
+    pthread_cond_init(&c->done.cv, NULL);
+    c->m = calloc((size_t)n, sizeof *c->m);
+    if (!c->m) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
+    for (int i = 0; i < n; ++i) {
+        member *m = &c->m[i];
+        m->offset = (int)((long)i * c->nf / n);
+        m->pos = malloc(sizeof(float) * 3 * c->ns);
+        m->nrm = malloc(sizeof(float) * 3 * c->ns);
+        if (!m->pos || !m->nrm)
+            return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
+        sinew_result r = sinew_instance_create(blob, NULL, &m->inst);
+        if (r != SINEW_OK)
+            return sw_error_set(err, r, "cannot create crowd instance %d of %d: %s", i + 1, n,
+                                sinew_result_string(r));
+    }
+    return SINEW_OK;
+}
+
+sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, int instances,
+                                int threads, sw_crowd_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    long nproc = sysconf(_SC_NPROCESSORS_ONLN);
+    int T = threads > 0 ? threads : nproc > 0 ? (int)nproc : 1;
+    int frames = ch->clip.nframes > CROWD_MIN_FRAMES ? ch->clip.nframes : CROWD_MIN_FRAMES;
+    out->instances = instances;
+    out->threads = T;
+    out->warmup_frames = CROWD_WARMUP;
+    out->frames = frames;
+    crowd c;
+    double *ms = malloc(sizeof(double) * (size_t)frames);
+    sinew_result r = ms ? crowd_make(ch, blob, instances, &c, err)
+                        : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    if (r == SINEW_OK) { /* a lone instance: instance 0's motion, nothing else running */
+        member *m0 = &c.m[0];
+        sinew_instance_reset(m0->inst);
+        for (int f = 0; f < CROWD_WARMUP + frames; ++f) {
+            double t0 = sw_now_seconds();
+            out->failed += member_frame(&c, m0, f);
+            if (f >= CROWD_WARMUP) ms[f - CROWD_WARMUP] = 1e3 * (sw_now_seconds() - t0);
+        }
+        out->lone_ms = sw_median(ms, frames);
+        r = crowd_run(&c, 1, CROWD_WARMUP, frames, ms, &out->failed, err);
+    }
+    if (r == SINEW_OK) {
+        out->ms_1thread = sw_median(ms, frames);
+        r = crowd_run(&c, T, CROWD_WARMUP, frames, ms, &out->failed, err);
+    }
+    if (r == SINEW_OK) {
+        out->ms = sw_median(ms, frames);
+        out->us_per_instance = 1e3 * out->ms / instances;
+        out->scaling = out->ms > 0 ? out->ms_1thread / out->ms : 0;
+        out->vs_lone = out->lone_ms > 0 ? out->ms * T / instances / out->lone_ms : 0;
+    }
+    if (ms) crowd_free(&c);
+    free(ms);
+    return r;
+}

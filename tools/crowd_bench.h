@@ -1,0 +1,33 @@
+/* sinew-bench --instances N: a crowd of N quasistatic instances of one blob stepped each
+ * frame over the character's clip, as a host's worker model steps them: plain pthreads
+ * created once, each stepping a fixed contiguous share of the instances every frame,
+ * then a barrier. Instance i plays the clip offset by i * (clip frames) / N frames, so
+ * the crowd is not in lockstep. The crowd runs twice, on 1 thread and on T; a lone
+ * instance (instance 0's motion, alone) is timed in the same run for comparison. */
+#ifndef SW_CROWD_BENCH_H
+#define SW_CROWD_BENCH_H
+
+#include "sinew/sinew.h"
+#include "sw_error.h"
+#include "sw_mesh.h"
+
+typedef struct sw_crowd_bench {
+    int instances, threads;    /* N and T (T resolved: 0 asked for all cores) */
+    int warmup_frames, frames; /* untimed then timed frames of each run */
+    double ms;                 /* median wall ms a frame, all N on T threads */
+    double ms_1thread;         /* the same on 1 thread */
+    double lone_ms;            /* median ms of a lone instance's frame (pose, step, read) */
+    double us_per_instance;    /* 1000 ms / N */
+    double scaling;            /* ms_1thread / ms */
+    double vs_lone;            /* (ms T / N) / lone_ms: an instance's time in the crowd */
+    long failed;               /* steps that did not return SINEW_OK */
+} sw_crowd_bench;
+
+/* Runs the crowd of `instances` (1..4096) instances of `blob` over ch's clip on 1 thread
+ * and on `threads` (0: all cores). Each instance's frame is the work the bench times for
+ * sub_ms: set the pose, step (dt = 1 / clip fps), read the surface's positions and
+ * normals. */
+sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, int instances,
+                                int threads, sw_crowd_bench *out, sw_error *err);
+
+#endif
