@@ -91,8 +91,27 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
         /* L_ij = A_ij L_jj^-T for the later blocks coupled to j */
         for (int32_t a = b + 1; a < nb; ++a) {
             if (!nz[a * nb + b]) continue;
-            int32_t i = order[a];
-            for (int32_t r = 0; r < size[i]; ++r)
+            int32_t i = order[a], r = 0;
+            /* four rows at a time (independent; each in its own order as before) */
+            for (; r + 4 <= size[i]; r += 4) {
+                double *R0 = &BLK(L, i, j, r, 0), *R1 = R0 + n, *R2 = R1 + n, *R3 = R2 + n;
+                for (int32_t c = 0; c < sj; ++c) {
+                    const double *Dc = &BLK(L, j, j, c, 0);
+                    double s0 = R0[c], s1 = R1[c], s2 = R2[c], s3 = R3[c];
+                    for (int32_t k = 0; k < c; ++k) {
+                        double d = Dc[k];
+                        s0 -= R0[k] * d;
+                        s1 -= R1[k] * d;
+                        s2 -= R2[k] * d;
+                        s3 -= R3[k] * d;
+                    }
+                    R0[c] = s0 / Dc[c];
+                    R1[c] = s1 / Dc[c];
+                    R2[c] = s2 / Dc[c];
+                    R3[c] = s3 / Dc[c];
+                }
+            }
+            for (; r < size[i]; ++r)
                 for (int32_t c = 0; c < sj; ++c) {
                     double s = BLK(L, i, j, r, c);
                     for (int32_t k = 0; k < c; ++k)
@@ -113,13 +132,36 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
                         for (int32_t c = 0; c < size[k]; ++c)
                             BLK(L, i, k, r, c) = 0.0;
                 }
-                for (int32_t r = 0; r < size[i]; ++r)
-                    for (int32_t c = 0; c < (e == a ? r + 1 : size[k]); ++c) {
-                        double s = 0;
-                        for (int32_t m = 0; m < sj; ++m)
-                            s += BLK(L, i, j, r, m) * BLK(L, k, j, c, m);
-                        BLK(L, i, k, r, c) -= s;
+                /* four columns at a time: four independent sums, each over m in order
+                 * from 0 as before (bitwise the same), sharing the loads of row r */
+                for (int32_t r = 0; r < size[i]; ++r) {
+                    const double *Lr = &BLK(L, i, j, r, 0);
+                    double *Out = &BLK(L, i, k, r, 0);
+                    int32_t nc = e == a ? r + 1 : size[k], c = 0;
+                    for (; c + 4 <= nc; c += 4) {
+                        const double *K0 = &BLK(L, k, j, c, 0), *K1 = K0 + n, *K2 = K1 + n,
+                                     *K3 = K2 + n;
+                        double s0 = 0, s1 = 0, s2 = 0, s3 = 0;
+                        for (int32_t m = 0; m < sj; ++m) {
+                            double x = Lr[m];
+                            s0 += x * K0[m];
+                            s1 += x * K1[m];
+                            s2 += x * K2[m];
+                            s3 += x * K3[m];
+                        }
+                        Out[c] -= s0;
+                        Out[c + 1] -= s1;
+                        Out[c + 2] -= s2;
+                        Out[c + 3] -= s3;
                     }
+                    for (; c < nc; ++c) {
+                        const double *K0 = &BLK(L, k, j, c, 0);
+                        double s0 = 0;
+                        for (int32_t m = 0; m < sj; ++m)
+                            s0 += Lr[m] * K0[m];
+                        Out[c] -= s0;
+                    }
+                }
             }
         }
     }

@@ -10,6 +10,24 @@
 #include "pose_contact.h"
 #include "solver.h"
 
+/* y = H_s q over the spring-coupled blocks only (and the diagonal ones): each row sums
+ * its nonzero terms in the same column order as the dense product, and the terms it skips
+ * are exact zeros times finite entries, so the result is bitwise the dense one. */
+static void spring_matvec(const sw_blob_view *v, const sw_solver *s, const double *q, double *y) {
+    int32_t R = v->rank_total, nd = v->ndomains;
+    for (int32_t a = 0; a < nd; ++a)
+        for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i) {
+            const double *Ai = v->spring_hessian + (int64_t)i * R;
+            double acc = 0;
+            for (int32_t b = 0; b < nd; ++b) {
+                if (b != a && !s->blk_adj[a * nd + b]) continue;
+                for (int32_t j = s->blk_off[b]; j < s->blk_off[b] + s->blk_size[b]; ++j)
+                    acc += Ai[j] * q[j];
+            }
+            y[i] = acc;
+        }
+}
+
 double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
                     const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess) {
     int32_t R = red->R;
@@ -19,7 +37,7 @@ double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver
     double phi = sw_cubature_eval(red, q, want_grad, want_hess);
     phi += sw_pose_contact_eval(red, ct->ps, q, want_grad, want_hess);
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
-    sw_matvec(v->spring_hessian, R, q, s->tmp);
+    spring_matvec(v, s, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
