@@ -5,6 +5,69 @@
 #include "blob_load.h"
 #include "fem_corot.h"
 
+/* out[k r + j] = J^T v_k for the n vectors v_k (12 each, at vs[k]): each sum over the 12
+ * rows of J (12 x r) in row order from +0, in a register. */
+static void project_rows(const double *J, int32_t r, const double *const *vs, int n, double *out) {
+    for (int k = 0; k < n; ++k) {
+        const double *vk = vs[k];
+        double *o = out + (int64_t)k * r;
+        int32_t j = 0;
+        for (; j + 4 <= r; j += 4) { /* four independent chains, each in row order */
+            double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+            for (int row = 0; row < 12; ++row) {
+                const double *Jr = J + row * r + j;
+                double c = vk[row];
+                a0 += Jr[0] * c;
+                a1 += Jr[1] * c;
+                a2 += Jr[2] * c;
+                a3 += Jr[3] * c;
+            }
+            o[j] = a0;
+            o[j + 1] = a1;
+            o[j + 2] = a2;
+            o[j + 3] = a3;
+        }
+        for (; j < r; ++j) {
+            double acc = 0;
+            for (int row = 0; row < 12; ++row)
+                acc += J[row * r + j] * vk[row];
+            o[j] = acc;
+        }
+    }
+}
+
+/* The upper triangle of the domain block H (row stride R) += sum_k (a_k h_k)(h_k)^T over
+ * the n projections h_k (at hm + k r), a_k their weights: each entry adds its terms in k
+ * order, as n separate rank-1 updates would (bitwise the same), in passes of up to four
+ * modes so that an entry is loaded and stored once a pass. */
+static void add_mode_products(double *H, int32_t R, int32_t r, const double *hm, const double *a,
+                              int n) {
+    for (int k0 = 0; k0 < n; k0 += 4) {
+        int m = n - k0 < 4 ? n - k0 : 4;
+        const double *h0 = hm + (int64_t)k0 * r, *h1 = h0 + r, *h2 = h1 + r, *h3 = h2 + r;
+        for (int32_t i = 0; i < r; ++i) {
+            double *Hi = H + (int64_t)i * R;
+            double c0 = a[k0] * h0[i];
+            if (m == 4) {
+                double c1 = a[k0 + 1] * h1[i], c2 = a[k0 + 2] * h2[i], c3 = a[k0 + 3] * h3[i];
+                for (int32_t j = i; j < r; ++j)
+                    Hi[j] = Hi[j] + c0 * h0[j] + c1 * h1[j] + c2 * h2[j] + c3 * h3[j];
+            } else if (m == 3) {
+                double c1 = a[k0 + 1] * h1[i], c2 = a[k0 + 2] * h2[i];
+                for (int32_t j = i; j < r; ++j)
+                    Hi[j] = Hi[j] + c0 * h0[j] + c1 * h1[j] + c2 * h2[j];
+            } else if (m == 2) {
+                double c1 = a[k0 + 1] * h1[i];
+                for (int32_t j = i; j < r; ++j)
+                    Hi[j] = Hi[j] + c0 * h0[j] + c1 * h1[j];
+            } else {
+                for (int32_t j = i; j < r; ++j)
+                    Hi[j] += c0 * h0[j];
+            }
+        }
+    }
+}
+
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess) {
     const sw_blob_view *v = m->v;
     double E = 0;
@@ -14,7 +77,7 @@ double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_
         int32_t r = D->rank, o = D->q_offset;
         const double *qd = q + o;
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
-            double x[12], f[12], wm[9], gm[108], h[SW_BLOB_MAX_RANK];
+            double x[12], f[12], wm[9], gm[108];
             for (int j = 0; j < 4; ++j)
                 sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], qd,
                                     x + 3 * j, want_grad ? m->Je + 3 * j * r : NULL);
@@ -23,30 +86,21 @@ double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_
                                          want_grad ? f : NULL, want_hess ? wm : NULL, gm,
                                          m->svd_V + 9 * (int64_t)c, project);
             if (!want_grad) continue;
-            for (int32_t j = 0; j < r; ++j) {
-                double acc = 0;
-                for (int row = 0; row < 12; ++row)
-                    acc += m->Je[row * r + j] * f[row];
-                m->g[o + j] -= w * acc;
-            }
-            if (!want_hess) continue;
-            /* eq. 2.12 through the element's modes: J^T K J = sum_k w_k (J^T g_k)(J^T g_k)^T */
-            for (int k = 0; k < 9; ++k) {
-                if (wm[k] == 0.0) continue;
-                const double *gk = gm + 12 * k;
-                for (int32_t j = 0; j < r; ++j) {
-                    double acc = 0;
-                    for (int row = 0; row < 12; ++row)
-                        acc += m->Je[row * r + j] * gk[row];
-                    h[j] = acc;
+            /* J^T f, and J^T g_k of the element's nonzero modes: eq. 2.12 through the
+             * modes, J^T K J = sum_k w_k (J^T g_k)(J^T g_k)^T */
+            const double *vs[10] = {f};
+            double a[9];
+            int n = 1;
+            for (int mk = 0; want_hess && mk < 9; ++mk)
+                if (wm[mk] != 0.0) {
+                    a[n - 1] = w * wm[mk];
+                    vs[n++] = gm + 12 * mk;
                 }
-                double wk = w * wm[k];
-                for (int32_t i = 0; i < r; ++i) {
-                    double *Hi = m->H + (int64_t)(o + i) * m->R + o, hi = wk * h[i];
-                    for (int32_t j = i; j < r; ++j)
-                        Hi[j] += hi * h[j];
-                }
-            }
+            project_rows(m->Je, r, vs, n, m->hm);
+            for (int32_t j = 0; j < r; ++j)
+                m->g[o + j] -= w * m->hm[j];
+            if (n > 1)
+                add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, m->hm + r, a, n - 1);
         }
     }
     /* the domain blocks were filled in their upper triangle: mirror */

@@ -27,6 +27,7 @@ typedef struct sw_reduced {
     double *g;             /* R: gradient accumulator */
     double *H;             /* R x R: Hessian accumulator */
     double *Je;            /* 12 x rmax: one cubature tet's Jacobian */
+    double *hm;            /* 10 x rmax: its J^T f and J^T g_k of its modes (cubature.c) */
     double *Jc, *hc;       /* 4 x 3 x rmax each: one contact's Jacobians and N G */
     double *svd_V;         /* 9 per cubature tet: its last SVD rotation (warm start) */
 } sw_reduced;

@@ -45,6 +45,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->g, R);
     TAKE(m->H, R * R);
     TAKE(m->Je, 12 * rm);
+    TAKE(m->hm, 10 * rm);
     TAKE(m->Jc, 12 * rm);
     TAKE(m->hc, 12 * rm);
     TAKE(m->svd_V, 9 * (uint64_t)v->ncub);
