@@ -197,6 +197,14 @@ static void count_free(void *p, void *user) {
     free(p);
 }
 
+/* A job system that runs every task at once on the caller (worker 0). */
+static void *inline_enqueue(sinew_task_fn *task, uint32_t n, uint32_t min_range, void *ctx,
+                            void *user) {
+    (void)min_range, (void)user;
+    task(0, n, 0, ctx);
+    return NULL;
+}
+
 typedef struct {
     int calls;
     uint32_t last_id;
@@ -317,13 +325,24 @@ TEST(bad_defs_are_rejected_with_a_logged_reason) {
     ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
     ENSURE(lc.calls == 3);
     d.allocator.alloc = NULL;
-    d.tasks.worker_count = 4; /* reserved: the step is serial in this version */
+    d.tasks.worker_count = 4; /* half a job system */
     d.tasks.finish = count_free;
-    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_UNSUPPORTED);
-    ENSURE(lc.calls == 4 && lc.last_id == SINEW_MSG_INSTANCE_UNSUPPORTED);
+    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(lc.calls == 4 && lc.last_id == SINEW_MSG_INSTANCE_INVALID_ARGUMENT);
     size_t bytes;
-    ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_ERROR_UNSUPPORTED);
+    ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_ERROR_INVALID_ARGUMENT);
+    d.tasks.enqueue = inline_enqueue; /* both, but no workers, or too many */
+    d.tasks.worker_count = 0;
+    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
+    d.tasks.worker_count = 257;
+    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(lc.calls == 7 && inst == NULL); /* memory_size logs its reason too */
+    size_t serial_bytes, four_bytes; /* the workers' scratch is reserved up front */
+    d.tasks.worker_count = 4;
+    ENSURE(sinew_instance_memory_size(f->blob, &d, &four_bytes) == SINEW_OK);
     d.tasks = sinew_instance_def_default().tasks;
+    ENSURE(sinew_instance_memory_size(f->blob, &d, &serial_bytes) == SINEW_OK);
+    ENSURE(four_bytes > serial_bytes);
     d.struct_size = 4; /* smaller than the fields every caller has */
     ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
     d.struct_size = sizeof d;

@@ -68,23 +68,38 @@ static void add_mode_products(double *H, int32_t R, int32_t r, const double *hm,
     }
 }
 
-double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess) {
+/* One cubature pass over some domains, by one worker. */
+typedef struct {
+    sw_reduced *m;
+    const double *q;
+    int want_grad, want_hess;
+} cub_pass;
+
+/* Domains [begin, end) of a pass on worker `worker`: each writes only its own blocks of
+ * g and H, its tets' SVD warm starts and weighted energies, and the worker's scratch, so
+ * domains run on any workers in any order with bitwise the same result. */
+static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx) {
+    const cub_pass *p = ctx;
+    sw_reduced *m = p->m;
     const sw_blob_view *v = m->v;
-    double E = 0;
+    int want_grad = p->want_grad, want_hess = p->want_hess;
     uint32_t project = want_hess == SW_CUB_HESSIAN_EXACT ? 0u : SW_COROT_PROJECT_PSD;
-    for (int32_t k = 0; k < v->ndomains; ++k) {
+    double *Je = m->Je + (int64_t)12 * m->rmax * worker,
+           *hm = m->hm + (int64_t)10 * m->rmax * worker;
+    for (uint32_t k = begin; k < end; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
-        const double *qd = q + o;
+        const double *qd = p->q + o;
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12], wm[9], gm[108];
             for (int j = 0; j < 4; ++j)
                 sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], qd,
-                                    x + 3 * j, want_grad ? m->Je + 3 * j * r : NULL);
+                                    x + 3 * j, want_grad ? Je + 3 * j * r : NULL);
             double w = v->cub_weight[c];
-            E += w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
-                                         want_grad ? f : NULL, want_hess ? wm : NULL, gm,
-                                         m->svd_V + 9 * (int64_t)c, project);
+            m->ecub[c] =
+                w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
+                                        want_grad ? f : NULL, want_hess ? wm : NULL, gm,
+                                        m->svd_V + 9 * (int64_t)c, project);
             if (!want_grad) continue;
             /* J^T f, and J^T g_k of the element's nonzero modes: eq. 2.12 through the
              * modes, J^T K J = sum_k w_k (J^T g_k)(J^T g_k)^T */
@@ -96,21 +111,34 @@ double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_
                     a[n - 1] = w * wm[mk];
                     vs[n++] = gm + 12 * mk;
                 }
-            project_rows(m->Je, r, vs, n, m->hm);
+            project_rows(Je, r, vs, n, hm);
             for (int32_t j = 0; j < r; ++j)
-                m->g[o + j] -= w * m->hm[j];
-            if (n > 1)
-                add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, m->hm + r, a, n - 1);
+                m->g[o + j] -= w * hm[j];
+            if (n > 1) add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, hm + r, a, n - 1);
         }
-    }
-    /* the domain blocks were filled in their upper triangle: mirror */
-    if (want_hess)
-        for (int32_t k = 0; k < v->ndomains; ++k) {
-            const sw_blob_domain *D = &v->domains[k];
-            int32_t o = D->q_offset;
-            for (int32_t i = 0; i < D->rank; ++i)
-                for (int32_t j = i + 1; j < D->rank; ++j)
+        if (want_hess) /* the block was filled in its upper triangle: mirror */
+            for (int32_t i = 0; i < r; ++i)
+                for (int32_t j = i + 1; j < r; ++j)
                     m->H[(int64_t)(o + j) * m->R + o + i] = m->H[(int64_t)(o + i) * m->R + o + j];
-        }
+    }
+}
+
+double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess) {
+    const sw_blob_view *v = m->v;
+    cub_pass p = {m, q, want_grad, want_hess};
+    const sinew_task_callbacks *t = m->tasks;
+    if (t && v->ndomains > 1) {
+        void *h = t->enqueue(cub_domains, (uint32_t)v->ndomains, 1, &p, t->user);
+        if (h) t->finish(h, t->user);
+    } else {
+        cub_domains(0, (uint32_t)v->ndomains, 0, &p);
+    }
+    /* the energy summed tet by tet in the blob's order, whoever evaluated them */
+    double E = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
+            E += m->ecub[c];
+    }
     return E;
 }

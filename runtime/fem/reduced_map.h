@@ -13,6 +13,7 @@
 
 #include "blob_view.h"
 #include "dqs.h"
+#include "sinew/sinew_types.h"
 
 typedef struct sw_reduced {
     const sw_blob_view *v;
@@ -26,10 +27,14 @@ typedef struct sw_reduced {
     double *act_R, *act_t; /* 9 and 3 per active vertex: its skinning transform */
     double *g;             /* R: gradient accumulator */
     double *H;             /* R x R: Hessian accumulator */
-    double *Je;            /* 12 x rmax: one cubature tet's Jacobian */
-    double *hm;            /* 10 x rmax: its J^T f and J^T g_k of its modes (cubature.c) */
-    double *Jc, *hc;       /* 4 x 3 x rmax each: one contact's Jacobians and N G */
-    double *svd_V;         /* 9 per cubature tet: its last SVD rotation (warm start) */
+    /* Scratch of each task worker w < nworkers (one without task callbacks): */
+    double *Je;       /* 12 x rmax at Je + 12 rmax w: one cubature tet's Jacobian */
+    double *hm;       /* 10 x rmax at hm + 10 rmax w: its J^T f and J^T g_k (cubature.c) */
+    double *ecub;     /* ncub: each cubature tet's weighted energy */
+    int32_t nworkers; /* the task workers' count, 1 when serial */
+    const sinew_task_callbacks *tasks; /* the host's job system, NULL: serial */
+    double *Jc, *hc;                   /* 4 x 3 x rmax each: one contact's Jacobians and N G */
+    double *svd_V;                     /* 9 per cubature tet: its last SVD rotation (warm start) */
 } sw_reduced;
 
 /* Skins every active vertex with the bones' dual quaternions (act_R, act_t). */

@@ -18,6 +18,7 @@ typedef struct {
     int32_t rmax;      /* the largest domain rank */
     int32_t max_pairs; /* the contact pair budget */
     int32_t max_world; /* the world candidate budget */
+    int32_t nworkers;  /* the host's task workers, 1 without task callbacks */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -44,8 +45,10 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->act_t, 3 * na);
     TAKE(m->g, R);
     TAKE(m->H, R * R);
-    TAKE(m->Je, 12 * rm);
-    TAKE(m->hm, 10 * rm);
+    const uint64_t nw = (uint64_t)z->nworkers;
+    TAKE(m->Je, 12 * rm * nw);
+    TAKE(m->hm, 10 * rm * nw);
+    TAKE(m->ecub, (uint64_t)v->ncub);
     TAKE(m->Jc, 12 * rm);
     TAKE(m->hc, 12 * rm);
     TAKE(m->svd_V, 9 * (uint64_t)v->ncub);
@@ -201,12 +204,20 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
                "sinew_instance_create: %s", bad);
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
-    if (d->tasks.enqueue || d->tasks.finish) {
-        sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_UNSUPPORTED,
-               "sinew_instance_create: task callbacks are reserved in this version (the step "
-               "is serial); leave def->tasks zero");
-        return SINEW_ERROR_UNSUPPORTED;
+    int tasks = d->tasks.enqueue || d->tasks.finish;
+    const char *bad_tasks =
+        !tasks ? NULL
+        : !d->tasks.enqueue || !d->tasks.finish
+            ? "tasks.enqueue and tasks.finish must both be set or both be NULL"
+        : d->tasks.worker_count < 1 || d->tasks.worker_count > SW_MAX_TASK_WORKERS
+            ? "tasks.worker_count must be 1..256 with task callbacks"
+            : NULL;
+    if (bad_tasks) {
+        sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
+               "sinew_instance_create: %s", bad_tasks);
+        return SINEW_ERROR_INVALID_ARGUMENT;
     }
+    z->nworkers = tasks ? (int32_t)d->tasks.worker_count : 1;
     if (!d->allocator.alloc) d->allocator = blob->allocator;
     z->nact = active_vertices(v, NULL);
     z->rmax = 0;
@@ -322,6 +333,9 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.R = v->rank_total;
     in->red.rmax = z.rmax;
     in->red.nact = z.nact; /* counted for the layout; now listed */
+    in->red.nworkers = z.nworkers;
+    in->tasks = d.tasks;
+    in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
     (void)active_vertices(v, in->red.act_vert);
     visit_active(v, &in->red, assign_active, &in->red);
     in->ps.max_pairs = z.max_pairs;

@@ -27,7 +27,11 @@ struct sinew_instance {
     sw_world_contacts wc;    /* the collision world's candidates of the step */
     double *surf_x, *surf_n; /* 3 per output surface vertex each */
     sinew_step_stats stats;
+    sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
 };
+
+/* The most task workers an instance reserves scratch for (sinew_task_callbacks). */
+#define SW_MAX_TASK_WORKERS 256u
 
 /* The state's bounds (DESIGN.md §3, "never blow up"), per domain k with
  * u_k = u_max[k], Q_k the largest |q_k| of the blob's training solutions and L = size:

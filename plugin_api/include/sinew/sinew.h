@@ -39,7 +39,7 @@ SINEW_API sinew_result sinew_blob_surface_triangles(const sinew_blob *blob, uint
 /** Creates an instance of `blob` (which must outlive it), reserving all the memory it
  * will ever use in one block through the def's allocator (or the blob's): see
  * sinew_instance_memory_size. The instance starts at rest in the rest pose. A bad def
- * is INVALID_ARGUMENT (task callbacks: UNSUPPORTED), logged through the def's logger (or
+ * is INVALID_ARGUMENT, logged through the def's logger (or
  * the blob's). Thread-safety: any thread; instances of one blob are independent. */
 SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew_instance_def *def,
                                              sinew_instance **out);

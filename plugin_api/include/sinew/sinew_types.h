@@ -65,8 +65,9 @@ static inline sinew_blob_def sinew_blob_def_default(void) {
 /** Stable log message ids of instance creation (sinew_logger). */
 #define SINEW_MSG_INSTANCE_INVALID_ARGUMENT 0x0200u /**< error: bad def or arguments */
 #define SINEW_MSG_INSTANCE_OUT_OF_MEMORY 0x0201u    /**< error: the allocator returned NULL */
-#define SINEW_MSG_INSTANCE_UNSUPPORTED 0x0202u      /**< error: a def field this version lacks */
-#define SINEW_MSG_INSTANCE_CREATED 0x0203u          /**< info: created, with its memory */
+#define SINEW_MSG_INSTANCE_UNSUPPORTED                                                             \
+    0x0202u /**< error: a def field this version lacks (none today) */
+#define SINEW_MSG_INSTANCE_CREATED 0x0203u /**< info: created, with its memory */
 
 /** A range task of the library: items [begin, end) on the host's worker `worker`. */
 typedef void sinew_task_fn(uint32_t begin, uint32_t end, uint32_t worker, void *task_context);
@@ -75,7 +76,13 @@ typedef void sinew_task_fn(uint32_t begin, uint32_t end, uint32_t worker, void *
  * runs `task` over [0, item_count) split into ranges of at least min_range items on
  * the host's workers and returns a handle (or NULL after running it inline); finish
  * waits for that handle. Called only from inside the step of the instance that owns
- * them. */
+ * them, a few times a Newton iteration (once a cubature pass: the items are the blob's
+ * domains, so a character with one domain never calls them). Every range of one task
+ * must run on a distinct worker index at a time, worker < worker_count; the step's
+ * result is bitwise the same whatever the split and the workers (each domain writes
+ * only its own rows, and sums are taken in the blob's order afterwards). The step
+ * itself still never allocates or locks; what the host's enqueue and finish do is the
+ * host's. */
 typedef struct sinew_task_callbacks {
     void *(*enqueue)(sinew_task_fn *task, uint32_t item_count, uint32_t min_range,
                      void *task_context, void *user);
@@ -102,9 +109,10 @@ typedef struct sinew_instance_def {
      * poses, which never runs out. A step that needs more evaluates the nearest pose's
      * pairs first, drops the rest and flags SINEW_STEP_BUDGET. */
     uint32_t max_contact_pairs;
-    /** The host's job system for one instance's parallel work. Reserved: this version
-     * steps serially and rejects a def whose enqueue or finish is set
-     * (SINEW_ERROR_UNSUPPORTED); keep it zero. */
+    /** The host's job system for one instance's parallel work (the cubature passes),
+     * or zero: the step runs serially on the calling thread. enqueue and finish are
+     * both set or both NULL, with worker_count 1..256 (the instance reserves scratch for
+     * each worker; INVALID_ARGUMENT otherwise). */
     sinew_task_callbacks tasks;
     /** Budget: the (surface vertex, collider) candidates one step may hold against the
      * collision world (sinew_world.h). 0 means one per output-surface vertex copy. A
