@@ -132,12 +132,35 @@ int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off
                         for (int32_t c = 0; c < size[k]; ++c)
                             BLK(L, i, k, r, c) = 0.0;
                 }
-                /* four columns at a time: four independent sums, each over m in order
-                 * from 0 as before (bitwise the same), sharing the loads of row r */
+                /* eight, then four columns at a time: independent sums, each over m in
+                 * order from 0 as before (bitwise the same), sharing the loads of row r */
                 for (int32_t r = 0; r < size[i]; ++r) {
                     const double *Lr = &BLK(L, i, j, r, 0);
                     double *Out = &BLK(L, i, k, r, 0);
                     int32_t nc = e == a ? r + 1 : size[k], c = 0;
+                    for (; c + 8 <= nc; c += 8) {
+                        const double *K0 = &BLK(L, k, j, c, 0);
+                        double s0 = 0, s1 = 0, s2 = 0, s3 = 0, s4 = 0, s5 = 0, s6 = 0, s7 = 0;
+                        for (int32_t m = 0; m < sj; ++m) {
+                            double x = Lr[m];
+                            s0 += x * K0[m];
+                            s1 += x * K0[n + m];
+                            s2 += x * K0[2 * n + m];
+                            s3 += x * K0[3 * n + m];
+                            s4 += x * K0[4 * n + m];
+                            s5 += x * K0[5 * n + m];
+                            s6 += x * K0[6 * n + m];
+                            s7 += x * K0[7 * n + m];
+                        }
+                        Out[c] -= s0;
+                        Out[c + 1] -= s1;
+                        Out[c + 2] -= s2;
+                        Out[c + 3] -= s3;
+                        Out[c + 4] -= s4;
+                        Out[c + 5] -= s5;
+                        Out[c + 6] -= s6;
+                        Out[c + 7] -= s7;
+                    }
                     for (; c + 4 <= nc; c += 4) {
                         const double *K0 = &BLK(L, k, j, c, 0), *K1 = K0 + n, *K2 = K1 + n,
                                      *K3 = K2 + n;
