@@ -337,7 +337,7 @@ TEST(bad_defs_are_rejected_with_a_logged_reason) {
     d.tasks.worker_count = 257;
     ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT);
     ENSURE(lc.calls == 7 && inst == NULL); /* memory_size logs its reason too */
-    size_t serial_bytes, four_bytes; /* the workers' scratch is reserved up front */
+    size_t serial_bytes, four_bytes;       /* the workers' scratch is reserved up front */
     d.tasks.worker_count = 4;
     ENSURE(sinew_instance_memory_size(f->blob, &d, &four_bytes) == SINEW_OK);
     d.tasks = sinew_instance_def_default().tasks;
