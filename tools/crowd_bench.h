@@ -1,9 +1,11 @@
 /* sinew-bench --instances N: a crowd of N quasistatic instances of one blob stepped each
  * frame over the character's clip, as a host's worker model steps them: plain pthreads
- * created once, each stepping a fixed contiguous share of the instances every frame,
- * then a barrier. Instance i plays the clip offset by i * (clip frames) / N frames, so
- * the crowd is not in lockstep. The crowd runs twice, on 1 thread and on T; a lone
- * instance (instance 0's motion, alone) is timed in the same run for comparison. */
+ * created once, worker t stepping instances t, t + T, t + 2T, ... every frame, then a
+ * barrier. Instance i plays the clip offset by i * (clip frames) / N frames, so the
+ * crowd is not in lockstep, and the strided shares give each worker every part of the
+ * clip (a contiguous share would give one worker the clip's costly contact frames). The
+ * crowd runs twice, on 1 thread and on T; a lone instance (instance 0's motion, alone)
+ * is timed in the same run for comparison. */
 #ifndef SW_CROWD_BENCH_H
 #define SW_CROWD_BENCH_H
 
@@ -16,7 +18,10 @@ typedef struct sw_crowd_bench {
     int warmup_frames, frames; /* untimed then timed frames of each run */
     double ms;                 /* median wall ms a frame, all N on T threads */
     double ms_1thread;         /* the same on 1 thread */
-    double lone_ms;            /* median ms of a lone instance's frame (pose, step, read) */
+    double lone_ms;            /* mean ms of a lone instance's frame (pose, step, read) over
+                                  the timed frames: a crowd frame holds one frame of every
+                                  part of the clip, so the mean, not the median, compares */
+    double lone_median_ms;     /* the median of the same frames */
     double us_per_instance;    /* 1000 ms / N */
     double scaling;            /* ms_1thread / ms */
     double vs_lone;            /* (ms T / N) / lone_ms: an instance's time in the crowd */

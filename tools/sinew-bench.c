@@ -72,15 +72,16 @@
  *                     dynamic steps with each SINEW_STEP_* flag (of frames + hold - 1)
  * With --instances N it then steps a crowd of N quasistatic instances of the blob over the
  * clip, instance i offset by i * (clip frames) / N frames, on 1 thread and on T (--threads;
- * plain pthreads, each stepping a fixed contiguous share every frame, then a barrier;
+ * plain pthreads, worker t stepping instances t, t + T, ... every frame, then a barrier;
  * crowd_bench.h), each instance's frame the work sub_ms times, and adds
  *   crowd_instances, crowd_threads  N and T (T resolved: 0 is all cores)
  *   crowd_ms          median wall ms of a frame of all N on T threads
  *   crowd_us_per_instance  crowd_ms * 1000 / N
  *   crowd_scaling     median 1-thread frame ms / crowd_ms, same run
- *   crowd_vs_lone     crowd_ms * T / N over crowd_lone_ms, the median frame ms of one
- *                     instance stepped alone in the same run on the same clip
- *   crowd_ms_1thread, crowd_lone_ms, crowd_frames (timed frames, after a warm-up)
+ *   crowd_vs_lone     crowd_ms * T / N over crowd_lone_ms, the mean frame ms of one
+ *                     instance stepped alone in the same run over the same clip frames
+ *   crowd_ms_1thread, crowd_lone_ms, crowd_lone_median_ms, crowd_frames (timed frames,
+ *                     after a warm-up)
  * Always: instance_bytes (sinew_instance_memory_size with the default def) and
  * blob_bytes (the blob file's size with --blob, else the size of the blob just baked).
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
@@ -571,9 +572,10 @@ int main(int argc, char **argv) {
     if (json && instances)
         printf(",\"crowd_instances\":%d,\"crowd_threads\":%d,\"crowd_frames\":%d,"
                "\"crowd_ms\":%.4f,\"crowd_us_per_instance\":%.3f,\"crowd_scaling\":%.3f,"
-               "\"crowd_vs_lone\":%.3f,\"crowd_ms_1thread\":%.4f,\"crowd_lone_ms\":%.4f",
+               "\"crowd_vs_lone\":%.3f,\"crowd_ms_1thread\":%.4f,\"crowd_lone_ms\":%.4f,"
+               "\"crowd_lone_median_ms\":%.4f",
                cb.instances, cb.threads, cb.frames, cb.ms, cb.us_per_instance, cb.scaling,
-               cb.vs_lone, cb.ms_1thread, cb.lone_ms);
+               cb.vs_lone, cb.ms_1thread, cb.lone_ms, cb.lone_median_ms);
     if (json && clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
                et.frames + et.failed, eh.frames + eh.failed);
