@@ -4,6 +4,7 @@
 #include "crowd_bench.h"
 
 #include <pthread.h>
+#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 #include <unistd.h>
@@ -63,12 +64,12 @@ typedef struct crowd {
     uint32_t ns;
     float dt;
     int frame, quit; /* written by the main thread before the start barrier only */
+    atomic_int next; /* the next instance of this frame a worker takes */
     barrier start, done;
 } crowd;
 
 typedef struct worker {
     crowd *c;
-    int first, stride; /* its fixed share: instances first, first + stride, ... */
     long failed;
     pthread_t th;
 } worker;
@@ -82,9 +83,11 @@ static int member_frame(const crowd *c, member *m, int frame) {
     return failed;
 }
 
+/* Instances taken one at a time from the frame's shared counter until none is left (a
+ * job system's work stealing; each instance's result does not depend on who steps it). */
 static void step_share(worker *w) {
     long failed = 0;
-    for (int i = w->first; i < w->c->n; i += w->stride)
+    for (int i; (i = atomic_fetch_add_explicit(&w->c->next, 1, memory_order_relaxed)) < w->c->n;)
         failed += member_frame(w->c, &w->c->m[i], w->c->frame);
     w->failed += failed;
 }
@@ -111,11 +114,8 @@ static sinew_result crowd_run(crowd *c, int T, int warm, int frames, double *ms,
     barrier_set_count(&c->start, T);
     barrier_set_count(&c->done, T);
     int started = 1;
-    for (int t = 0; t < T; ++t) {
+    for (int t = 0; t < T; ++t)
         w[t].c = c;
-        w[t].first = t;
-        w[t].stride = T;
-    }
     for (; started < T; ++started)
         if (pthread_create(&w[started].th, NULL, worker_main, &w[started]) != 0) break;
     sinew_result r = SINEW_OK;
@@ -125,6 +125,7 @@ static sinew_result crowd_run(crowd *c, int T, int warm, int frames, double *ms,
     } else {
         for (int f = 0; f < warm + frames; ++f) {
             c->frame = f;
+            atomic_store_explicit(&c->next, 0, memory_order_relaxed); /* before the barrier */
             double t0 = sw_now_seconds();
             barrier_wait(&c->start);
             step_share(&w[0]);

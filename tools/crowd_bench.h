@@ -1,9 +1,9 @@
 /* sinew-bench --instances N: a crowd of N quasistatic instances of one blob stepped each
  * frame over the character's clip, as a host's worker model steps them: plain pthreads
- * created once, worker t stepping instances t, t + T, t + 2T, ... every frame, then a
- * barrier. Instance i plays the clip offset by i * (clip frames) / N frames, so the
- * crowd is not in lockstep, and the strided shares give each worker every part of the
- * clip (a contiguous share would give one worker the clip's costly contact frames). The
+ * created once, each taking the frame's instances one at a time from a shared atomic
+ * counter until none is left, then a barrier. Instance i plays the clip offset by
+ * i * (clip frames) / N frames, so the crowd is not in lockstep (fixed shares left one
+ * worker with more of the clip's costly contact frames than the other). The
  * crowd runs twice, on 1 thread and on T; a lone instance (instance 0's motion, alone)
  * is timed in the same run for comparison. */
 #ifndef SW_CROWD_BENCH_H

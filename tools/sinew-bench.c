@@ -72,7 +72,8 @@
  *                     dynamic steps with each SINEW_STEP_* flag (of frames + hold - 1)
  * With --instances N it then steps a crowd of N quasistatic instances of the blob over the
  * clip, instance i offset by i * (clip frames) / N frames, on 1 thread and on T (--threads;
- * plain pthreads, worker t stepping instances t, t + T, ... every frame, then a barrier;
+ * plain pthreads taking the frame's instances one at a time from an atomic counter, then
+ * a barrier;
  * crowd_bench.h), each instance's frame the work sub_ms times, and adds
  *   crowd_instances, crowd_threads  N and T (T resolved: 0 is all cores)
  *   crowd_ms          median wall ms of a frame of all N on T threads
