@@ -27,23 +27,31 @@ static void unskin(const sw_bake_state *s, const double *T, const double *x, dou
     }
 }
 
+/* Removes from the column c (m entries, stride cs) its components along the columns
+ * lo..hi-1 of the orthonormal B (m rows, stride bs), twice (twice is enough, Kahan);
+ * returns the norm of what is left. */
+static double project_out(double *c, int64_t cs, const double *B, int64_t bs, int64_t m, int32_t lo,
+                          int32_t hi) {
+    for (int pass = 0; pass < 2; ++pass)
+        for (int32_t k = lo; k < hi; ++k) {
+            double dot = 0;
+            for (int64_t i = 0; i < m; ++i)
+                dot += B[i * bs + k] * c[i * cs];
+            for (int64_t i = 0; i < m; ++i)
+                c[i * cs] -= dot * B[i * bs + k];
+        }
+    double n = 0;
+    for (int64_t i = 0; i < m; ++i)
+        n += c[i * cs] * c[i * cs];
+    return sqrt(n);
+}
+
 /* Modified Gram-Schmidt on the columns of U (m x r, row-major); returns the number of
  * independent columns kept (dependent ones are dropped, later columns shift left). */
 static int32_t orthonormalise(double *U, int64_t m, int32_t r) {
     int32_t kept = 0;
     for (int32_t j = 0; j < r; ++j) {
-        for (int pass = 0; pass < 2; ++pass) /* twice is enough (Kahan) */
-            for (int32_t k = 0; k < kept; ++k) {
-                double dot = 0;
-                for (int64_t i = 0; i < m; ++i)
-                    dot += U[i * r + k] * U[i * r + j];
-                for (int64_t i = 0; i < m; ++i)
-                    U[i * r + j] -= dot * U[i * r + k];
-            }
-        double n = 0;
-        for (int64_t i = 0; i < m; ++i)
-            n += U[i * r + j] * U[i * r + j];
-        n = sqrt(n);
+        double n = project_out(U + j, r, U, r, m, 0, kept);
         if (n < 1e-10) continue;
         for (int64_t i = 0; i < m; ++i)
             U[i * r + kept] = U[i * r + j] / n;
@@ -169,19 +177,8 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
         int32_t lo = kept ? r0 + kept - 1 : 0, hi = r0 + kept, best = -1;
         double top = tol;
         for (int32_t j = 0; j < nc; ++j) {
-            double *c = R + (size_t)j * m;
-            for (int pass = 0; pass < 2; ++pass) /* twice is enough (Kahan) */
-                for (int32_t k = lo; k < hi; ++k) {
-                    double dot = 0;
-                    for (int64_t i = 0; i < m; ++i)
-                        dot += W[i * rn + k] * c[i];
-                    for (int64_t i = 0; i < m; ++i)
-                        c[i] -= dot * W[i * rn + k];
-                }
-            double n = 0;
-            for (int64_t i = 0; i < m; ++i)
-                n += c[i] * c[i];
-            score[j] = ref[j] > 0 ? sqrt(n) / ref[j] : 0;
+            double n = project_out(R + (size_t)j * m, 1, W, rn, m, lo, hi);
+            score[j] = ref[j] > 0 ? n / ref[j] : 0;
             if (score[j] >= top) top = score[j], best = j;
         }
         if (best < 0 || r0 + kept == rn) break;
@@ -295,6 +292,7 @@ done:
 }
 
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sinew_result r = SINEW_OK;
     int32_t T = 0;
     for (int32_t i = 0; i < s->ntrain_seq; ++i)
         T += s->train[i].npose;
@@ -325,16 +323,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         free(D);
         if (!s->basis[dm]) goto oom;
     }
-    if (s->p->inertia_modes) {
-        sinew_result r = add_inertia_modes(s, err);
-        if (r != SINEW_OK) {
-            free(dall);
-            free(R);
-            free(t);
-            free(dtmp);
-            return r;
-        }
-    }
+    r = s->p->inertia_modes ? add_inertia_modes(s, err) : SINEW_OK;
+    if (r != SINEW_OK) goto done;
     for (int32_t dm = 0; dm < s->nd; ++dm)
         s->rank_total += s->rank[dm];
     /* the pose-space warm start: every training pose's feature and projected solution */
@@ -364,15 +354,13 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         projection_error(s, dtmp, &num, &den);
     }
     out->heldout_proj_error = den > 0 ? sqrt(num / den) : 0;
-    free(dall);
-    free(R);
-    free(t);
-    free(dtmp);
-    return SINEW_OK;
+    goto done;
 oom:
+    r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the basis");
+done:
     free(dall);
     free(R);
     free(t);
     free(dtmp);
-    return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the basis");
+    return r;
 }
