@@ -193,28 +193,21 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
     if (!d->logger.log) d->logger = blob->logger;
-    const char *bad = d->mode != SINEW_STEP_QUASISTATIC && d->mode != SINEW_STEP_DYNAMIC
-                          ? "mode is neither quasistatic nor dynamic"
-                      : d->max_newton_iters > 100 ? "max_newton_iters is above 100"
-                      : sw_allocator_check(&d->allocator) != SINEW_OK
-                          ? "allocator.alloc and allocator.free must both be set or both be NULL"
-                          : NULL;
+    int tasks = d->tasks.enqueue || d->tasks.finish;
+    const char *bad =
+        d->mode != SINEW_STEP_QUASISTATIC && d->mode != SINEW_STEP_DYNAMIC
+            ? "mode is neither quasistatic nor dynamic"
+        : d->max_newton_iters > 100 ? "max_newton_iters is above 100"
+        : sw_allocator_check(&d->allocator) != SINEW_OK
+            ? "allocator.alloc and allocator.free must both be set or both be NULL"
+        : tasks && (!d->tasks.enqueue || !d->tasks.finish)
+            ? "tasks.enqueue and tasks.finish must both be set or both be NULL"
+        : tasks && (d->tasks.worker_count < 1 || d->tasks.worker_count > SW_MAX_TASK_WORKERS)
+            ? "tasks.worker_count must be 1..256 with task callbacks"
+            : NULL;
     if (bad) {
         sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
                "sinew_instance_create: %s", bad);
-        return SINEW_ERROR_INVALID_ARGUMENT;
-    }
-    int tasks = d->tasks.enqueue || d->tasks.finish;
-    const char *bad_tasks =
-        !tasks ? NULL
-        : !d->tasks.enqueue || !d->tasks.finish
-            ? "tasks.enqueue and tasks.finish must both be set or both be NULL"
-        : d->tasks.worker_count < 1 || d->tasks.worker_count > SW_MAX_TASK_WORKERS
-            ? "tasks.worker_count must be 1..256 with task callbacks"
-            : NULL;
-    if (bad_tasks) {
-        sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
-               "sinew_instance_create: %s", bad_tasks);
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
     z->nworkers = tasks ? (int32_t)d->tasks.worker_count : 1;
