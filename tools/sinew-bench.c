@@ -346,6 +346,7 @@ int main(int argc, char **argv) {
     fp.solver = ref_solver.solver;
     fp.contact_rounds = ref_solver.contact_rounds;
     fp.hessian = ref_solver.hessian;
+    fp.contact_set_check = ref_solver.contact_set_check;
     sw_fullsim *sim = NULL;
     int kf = full_frames > 0 && full_frames < nf ? full_frames : nf; /* default: the whole clip */
     double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));

@@ -357,7 +357,9 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
 
 #define SW_REFERENCE_USAGE                                                                         \
     "  --solver S          the reference's linear solver: auto (default) | cholmod | pcg\n"        \
-    "  --contact-rounds R  the round cap, 1..100 (default 30)\n"                                   \
+    "  --contact-rounds R  the round cap, 1..100 (default 60)\n"                                   \
+    "  --set-check C       on (default) | off: end a round's Newton once its contact set\n"        \
+    "                      would change\n"                                                         \
     "  --hessian M         adaptive (default) | projected | exact element Hessians\n"
 
 /* When argv[*i] is a reference option, consumes it and its value and returns 1, with
@@ -376,12 +378,15 @@ static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **
     /* names in enum order: sw_linear_solver, sw_hessian_mode */
     static const char *const solvers[] = {"auto", "cholmod", "pcg", NULL};
     static const char *const hessians[] = {"adaptive", "projected", "exact", NULL};
+    static const char *const off_on[] = {"off", "on", NULL};
     int k;
     ++*i;
     if (!strcmp(a, "--solver")) {
         if ((*ok = (k = sw_tool_choice(v, solvers)) >= 0)) p->solver = (sw_linear_solver)k;
     } else if (!strcmp(a, "--hessian")) {
         if ((*ok = (k = sw_tool_choice(v, hessians)) >= 0)) p->hessian = (sw_hessian_mode)k;
+    } else if (!strcmp(a, "--set-check")) {
+        if ((*ok = (k = sw_tool_choice(v, off_on)) >= 0)) p->contact_set_check = k;
     } else if (!strcmp(a, "--contact-rounds")) {
         *ok = sw_parse_int(v, 1, 100, &p->contact_rounds);
     } else {
@@ -390,9 +395,10 @@ static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **
     }
     if (!*ok)
         fprintf(stderr, "%s: %s wants %s, got '%s'\n", argv[0], a,
-                !strcmp(a, "--solver")    ? "one of auto | cholmod | pcg"
-                : !strcmp(a, "--hessian") ? "one of adaptive | projected | exact"
-                                          : "an integer in 1..100",
+                !strcmp(a, "--solver")      ? "one of auto | cholmod | pcg"
+                : !strcmp(a, "--hessian")   ? "one of adaptive | projected | exact"
+                : !strcmp(a, "--set-check") ? "on or off"
+                                            : "an integer in 1..100",
                 v);
     return 1;
 }

@@ -34,7 +34,8 @@ sw_fullsim_params sw_fullsim_params_default(void) {
     p.ground_k = 0; /* 0: contact_k */
     p.hessian = SW_HESSIAN_ADAPTIVE;
     p.solver = SW_SOLVER_AUTO;
-    p.contact_rounds = 30; /* fullsim.h: 8 left every contact frame of the finger unsettled */
+    p.contact_rounds = 60; /* fullsim.h: 8 left every contact frame of the finger unsettled */
+    p.contact_set_check = 1;
     p.max_newton = 20;
     p.newton_rtol = 1e-4;
     p.pcg_rtol = 1e-3;
@@ -78,10 +79,11 @@ static sinew_result check_params(const sw_fullsim_params *p, sw_error *err) {
                             "world detection radius %g is not a finite length >= 0",
                             p->world_radius);
     if (p->hessian < SW_HESSIAN_ADAPTIVE || p->hessian > SW_HESSIAN_EXACT ||
-        p->contact_rounds < 1 || p->contact_rounds > 100)
+        p->contact_rounds < 1 || p->contact_rounds > 100 ||
+        (p->contact_set_check != 0 && p->contact_set_check != 1))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "hessian mode %d / contact rounds %d out of range", (int)p->hessian,
-                            p->contact_rounds);
+                            "hessian mode %d / contact rounds %d / set check %d out of range",
+                            (int)p->hessian, p->contact_rounds, p->contact_set_check);
     if (p->solver < SW_SOLVER_AUTO || p->solver > SW_SOLVER_PCG)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "linear solver %d unknown",
                             (int)p->solver);
