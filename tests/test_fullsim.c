@@ -292,6 +292,55 @@ TEST(unsettled_contact_set_is_one_another_round_changes) {
     sw_character_free(&c);
 }
 
+/* The set check (fullsim_step.c): a round's Newton ends once its contact set would
+ * change, so only the settled set is converged. Per frame of the fold, from the same
+ * state, a simulator with the check and one without both end converged and settled,
+ * and the check takes fewer Newton iterations over the contact frames. */
+TEST(set_check_converges_only_the_settled_set) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 9, &c, &err) == SINEW_OK);
+    sw_fullsim *sim[2];
+    for (int k = 0; k < 2; ++k) {
+        sw_fullsim_params p = sw_fullsim_params_default();
+        p.contact_set_check = k == 0; /* sim[0] checks, sim[1] converges every round */
+        ENSURE(sw_fullsim_create(&c, &p, &sim[k], &err) == SINEW_OK);
+    }
+    size_t n3 = 3 * (size_t)c.mesh.nverts;
+    double *x = malloc(n3 * sizeof(double));
+    memcpy(x, c.mesh.X, n3 * sizeof(double));
+    int newton[2] = {0, 0}, rounds[2] = {0, 0}, contact_frames = 0;
+    for (int f = 1; f < c.clip.nframes; ++f) {
+        sw_fullsim_stats st[2];
+        for (int k = 0; k < 2; ++k) {
+            sw_fullsim_set_state(sim[k], frame_T(&c, f - 1), x, NULL);
+            ENSURE(sw_fullsim_step(sim[k], frame_T(&c, f), &st[k]) == SINEW_OK);
+            ENSUREF(st[k].converged && !st[k].contacts_unsettled,
+                    "frame %d (%s): converged %d, unsettled %d", f, k ? "no check" : "check",
+                    st[k].converged, st[k].contacts_unsettled);
+        }
+        if (st[1].contact_rounds > 1) { /* a frame whose set changed */
+            contact_frames++;
+            for (int k = 0; k < 2; ++k) {
+                newton[k] += st[k].newton_iters;
+                rounds[k] += st[k].contact_rounds;
+            }
+        }
+        memcpy(x, sw_fullsim_positions(sim[1]), n3 * sizeof(double));
+    }
+    fprintf(stderr,
+            "    %d frames with rounds: Newton iterations %d with the check (%d rounds), %d "
+            "without (%d rounds)\n",
+            contact_frames, newton[0], rounds[0], newton[1], rounds[1]);
+    ENSUREF(contact_frames >= 2, "only %d frames with contact rounds: the test would prove little",
+            contact_frames);
+    ENSURE(newton[0] < newton[1]);
+    free(x);
+    for (int k = 0; k < 2; ++k)
+        sw_fullsim_destroy(sim[k]);
+    sw_character_free(&c);
+}
+
 TEST(ground_plane_pushes_flesh_out) {
     sw_character c;
     sw_error err;
@@ -474,5 +523,5 @@ SW_TEST_MAIN(CASE(rigid_pose_gives_rigid_shape_and_zero_energy),
              CASE(self_contact_removes_most_penetration_of_folded_finger),
              CASE(contacts_push_and_never_pull),
              CASE(unsettled_contact_set_is_one_another_round_changes),
-             CASE(ground_plane_pushes_flesh_out), CASE(bad_input_is_rejected_and_state_kept),
-             CASE(direct_and_pcg_solves_agree))
+             CASE(set_check_converges_only_the_settled_set), CASE(ground_plane_pushes_flesh_out),
+             CASE(bad_input_is_rejected_and_state_kept), CASE(direct_and_pcg_solves_agree))

@@ -77,6 +77,8 @@ expect bench_instances_range_high 2 "--instances wants an integer in 1\.\.4096, 
     "$bench" "${small[@]}" --instances 4097
 expect bench_rounds_range 2 "--contact-rounds wants an integer in 1\.\.100, got '0'" \
     "$bench" "${small[@]}" --contact-rounds 0
+expect fullsim_set_check_choice 2 "--set-check wants on or off, got 'maybe'" \
+    "$fullsim" --scene finger --tets 2000 --set-check maybe
 expect bake_mesh_format 2 "--mesh 'a\.obj': not a format it reads; accepted: \.mesh \(MEDIT\), \.node or \.ele" \
     "$bake" --mesh a.obj --skeleton s.tgf --out "$tmp/a.blob"
 expect bake_clip_format 2 "--clip 'c\.bvh': not a format it reads; accepted: \.txt" \
