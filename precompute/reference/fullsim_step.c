@@ -153,8 +153,8 @@ static int set_changes_now(sw_fullsim *sim) {
  * problem; the solve stops with SINEW_ERROR_NOT_CONVERGED. Only
  * the last round, with a set that no longer changes, is converged to the tolerance.
  * Measured on the finger's 40-frame fold (quasistatic, PCG, the default Hessian): at
- * 20K tets 378 ms a frame on average instead of 1,610 ms, at 50K 1.5 s instead of
- * 20 s, every frame settled; rounds had run to 20 Newton iterations each, most of them
+ * 20K tets 331-378 ms a frame on average instead of 1,610 ms, at 50K 1.2-1.5 s instead
+ * of 20 s, every frame settled; rounds had run to 20 Newton iterations each, most of them
  * crawling along the fold's soft modes for a set the next round replaced. */
 static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *gref, double rtol) {
     int check = sim->p.self_contact && sim->p.contact_set_check && sim->p.contact_rounds > 1;
