@@ -1,0 +1,279 @@
+/* A tet mesh from a render surface: a lattice cut by the generalised winding number
+ * (tet_lattice.h). */
+#include "tet_lattice.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "vec3.h"
+
+/* Lattices of more cubes than this are refused (memory: a byte and an index each). */
+#define SW_LATTICE_MAX_CELLS 100000000LL
+
+double sw_winding_number(const sw_trimesh *surf, const double p[3]) {
+    /* Van Oosterom and Strackee's solid angle of each triangle seen from p */
+    double sum = 0;
+    for (int32_t t = 0; t < surf->ntris; ++t) {
+        const int32_t *f = surf->tris + 3 * t;
+        double a[3], b[3], c[3];
+        sw_v3_sub(surf->X + 3 * (size_t)f[0], p, a);
+        sw_v3_sub(surf->X + 3 * (size_t)f[1], p, b);
+        sw_v3_sub(surf->X + 3 * (size_t)f[2], p, c);
+        double la = sw_v3_norm(a), lb = sw_v3_norm(b), lc = sw_v3_norm(c);
+        double num = sw_v3_triple(a, b, c);
+        double den =
+            la * lb * lc + sw_v3_dot(a, b) * lc + sw_v3_dot(b, c) * la + sw_v3_dot(c, a) * lb;
+        sum += 2.0 * atan2(num, den);
+    }
+    return sum / (16.0 * atan(1.0)); /* 4 pi */
+}
+
+typedef struct {
+    const sw_trimesh *surf;
+    double origin[3], h;
+    int32_t n[3];
+    unsigned char *inside; /* n[0] n[1] n[2] cubes, x fastest */
+} lattice;
+
+static void classify_cells(void *vctx, int64_t begin, int64_t end, int worker) {
+    (void)worker;
+    lattice *L = vctx;
+    for (int64_t c = begin; c < end; ++c) {
+        int64_t i = c % L->n[0], j = (c / L->n[0]) % L->n[1], k = c / ((int64_t)L->n[0] * L->n[1]);
+        double p[3] = {L->origin[0] + (i + 0.5) * L->h, L->origin[1] + (j + 0.5) * L->h,
+                       L->origin[2] + (k + 0.5) * L->h};
+        L->inside[c] = fabs(sw_winding_number(L->surf, p)) >= 0.5;
+    }
+}
+
+/* Classifies the cubes of spacing h over the box [lo, hi]; returns the number inside,
+ * or -1 when out of memory or the lattice is too large. */
+static int64_t classify(lattice *L, const double lo[3], const double hi[3], double h,
+                        sw_pool *pool) {
+    int64_t total = 1;
+    L->h = h;
+    for (int a = 0; a < 3; ++a) {
+        /* half a cube of margin each side: no cube centre on the surface's extremes */
+        double ext = hi[a] - lo[a];
+        L->n[a] = (int32_t)ceil(ext / h) + 1;
+        L->origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * L->n[a] * h;
+        total *= L->n[a];
+        if (total > SW_LATTICE_MAX_CELLS) return -1;
+    }
+    free(L->inside);
+    if (!(L->inside = malloc((size_t)total))) return -1;
+    sw_pool_parallel_for(pool, total, classify_cells, L);
+    int64_t k = 0;
+    for (int64_t c = 0; c < total; ++c)
+        k += L->inside[c];
+    return k;
+}
+
+/* The six Freudenthal tets of a cube, corners numbered x + 2y + 4z: the paths 0 -> 7
+ * along the three axes in each order, each ordered to be positively oriented (checked
+ * on the unit cube; every cube of the lattice is a translate of it). */
+static void freudenthal_tets(int32_t T[6][4]) {
+    static const int perms[6][3] = {{1, 2, 4}, {1, 4, 2}, {2, 1, 4},
+                                    {2, 4, 1}, {4, 1, 2}, {4, 2, 1}};
+    for (int t = 0; t < 6; ++t) {
+        T[t][0] = 0;
+        T[t][1] = perms[t][0];
+        T[t][2] = perms[t][0] + perms[t][1];
+        T[t][3] = 7;
+        double P[4][3];
+        for (int k = 0; k < 4; ++k)
+            for (int a = 0; a < 3; ++a)
+                P[k][a] = (T[t][k] >> a) & 1;
+        double e1[3], e2[3], e3[3];
+        sw_v3_sub(P[1], P[0], e1);
+        sw_v3_sub(P[2], P[0], e2);
+        sw_v3_sub(P[3], P[0], e3);
+        if (sw_v3_triple(e1, e2, e3) < 0) {
+            int32_t s = T[t][1];
+            T[t][1] = T[t][2];
+            T[t][2] = s;
+        }
+    }
+}
+
+static int32_t find_root(int32_t *parent, int32_t x) {
+    while (parent[x] != x)
+        x = parent[x] = parent[parent[x]];
+    return x;
+}
+
+/* Face-connected pieces among the inside cubes (cell_id: compact id or -1). */
+static int32_t count_components(const lattice *L, const int32_t *cell_id, int32_t ncells) {
+    int32_t *parent = malloc((size_t)ncells * sizeof(int32_t));
+    if (!parent) return -1;
+    for (int32_t i = 0; i < ncells; ++i)
+        parent[i] = i;
+    int64_t nx = L->n[0], ny = L->n[1], nz = L->n[2];
+    for (int64_t k = 0; k < nz; ++k)
+        for (int64_t j = 0; j < ny; ++j)
+            for (int64_t i = 0; i < nx; ++i) {
+                int64_t c = i + nx * (j + ny * k);
+                if (cell_id[c] < 0) continue;
+                int64_t nb[3] = {i + 1 < nx ? c + 1 : -1, j + 1 < ny ? c + nx : -1,
+                                 k + 1 < nz ? c + nx * ny : -1};
+                for (int a = 0; a < 3; ++a)
+                    if (nb[a] >= 0 && cell_id[nb[a]] >= 0) {
+                        int32_t ra = find_root(parent, cell_id[c]),
+                                rb = find_root(parent, cell_id[nb[a]]);
+                        if (ra != rb) parent[ra] = rb;
+                    }
+            }
+    int32_t n = 0;
+    for (int32_t i = 0; i < ncells; ++i)
+        n += find_root(parent, i) == i;
+    free(parent);
+    return n;
+}
+
+static sinew_result validate(const sw_trimesh *s, int32_t target, sw_error *err) {
+    if (!s || s->nverts < 3 || s->ntris < 1 || !s->X || !s->tris)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "tet lattice: an empty surface");
+    if (target < 100 || target > 5000000)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "tet lattice: %d tets requested, not in 100..5000000", target);
+    for (int32_t v = 0; v < s->nverts; ++v)
+        if (!sw_v3_isfinite(s->X + 3 * (size_t)v))
+            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                                "tet lattice: vertex %d is not finite", v);
+    for (int64_t i = 0; i < 3 * (int64_t)s->ntris; ++i)
+        if (s->tris[i] < 0 || s->tris[i] >= s->nverts)
+            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                                "tet lattice: triangle %lld names vertex %d of %d",
+                                (long long)(i / 3), s->tris[i], s->nverts);
+    return SINEW_OK;
+}
+
+/* The tets of the inside cubes over compacted lattice vertices. */
+static sinew_result build_tets(const lattice *L, int64_t kept, sw_tetmesh *out, int32_t *components,
+                               sw_error *err) {
+    int64_t nx = L->n[0], ny = L->n[1], nz = L->n[2];
+    int64_t vx = nx + 1, vy = ny + 1, nlat = vx * vy * (nz + 1), ncell = nx * ny * nz;
+    int32_t freudenthal[6][4];
+    freudenthal_tets(freudenthal);
+    int32_t *vid = malloc((size_t)nlat * sizeof(int32_t));
+    int32_t *cell_id = malloc((size_t)ncell * sizeof(int32_t));
+    out->tets = malloc((size_t)kept * 24 * sizeof(int32_t));
+    if (!vid || !cell_id || !out->tets) {
+        free(vid);
+        free(cell_id);
+        sw_tetmesh_free(out);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "tet lattice: out of memory");
+    }
+    for (int64_t i = 0; i < nlat; ++i)
+        vid[i] = -1;
+    int32_t nv = 0, nt = 0, nc = 0;
+    for (int64_t c = 0; c < ncell; ++c) {
+        cell_id[c] = L->inside[c] ? nc++ : -1;
+        if (!L->inside[c]) continue;
+        int64_t i = c % nx, j = (c / nx) % ny, k = c / (nx * ny);
+        int32_t corner[8];
+        for (int q = 0; q < 8; ++q) {
+            int64_t g = (i + (q & 1)) + vx * ((j + ((q >> 1) & 1)) + vy * (k + ((q >> 2) & 1)));
+            if (vid[g] < 0) vid[g] = nv++;
+            corner[q] = vid[g];
+        }
+        for (int t = 0; t < 6; ++t, ++nt)
+            for (int q = 0; q < 4; ++q)
+                out->tets[4 * (size_t)nt + q] = corner[freudenthal[t][q]];
+    }
+    out->ntets = nt;
+    out->nverts = nv;
+    out->X = malloc((size_t)nv * 3 * sizeof(double));
+    if (!out->X) {
+        free(vid);
+        free(cell_id);
+        sw_tetmesh_free(out);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "tet lattice: out of memory");
+    }
+    for (int64_t g = 0; g < nlat; ++g)
+        if (vid[g] >= 0) {
+            int64_t i = g % vx, j = (g / vx) % vy, k = g / (vx * vy);
+            double *x = out->X + 3 * (size_t)vid[g];
+            x[0] = L->origin[0] + i * L->h;
+            x[1] = L->origin[1] + j * L->h;
+            x[2] = L->origin[2] + k * L->h;
+        }
+    *components = count_components(L, cell_id, nc);
+    free(vid);
+    free(cell_id);
+    if (*components < 0) {
+        sw_tetmesh_free(out);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "tet lattice: out of memory");
+    }
+    return SINEW_OK;
+}
+
+sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets, sw_pool *pool,
+                                     sw_tetmesh *out, sw_lattice_report *report, sw_error *err) {
+    double t0 = sw_now_seconds();
+    memset(out, 0, sizeof *out);
+    sw_lattice_report rep;
+    memset(&rep, 0, sizeof rep);
+    sinew_result r = validate(surf, target_tets, err);
+    if (r != SINEW_OK) return r;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t v = 0; v < surf->nverts; ++v)
+        for (int a = 0; a < 3; ++a) {
+            lo[a] = fmin(lo[a], surf->X[3 * (size_t)v + a]);
+            hi[a] = fmax(hi[a], surf->X[3 * (size_t)v + a]);
+        }
+    double box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
+    if (!(box > 0) || !isfinite(box))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "tet lattice: the surface's bounding box is flat");
+    for (int32_t t = 0; t < surf->ntris; ++t) {
+        const int32_t *f = surf->tris + 3 * t;
+        rep.surface_volume += sw_v3_triple(surf->X + 3 * (size_t)f[0], surf->X + 3 * (size_t)f[1],
+                                           surf->X + 3 * (size_t)f[2]) /
+                              6.0;
+    }
+    lattice L = {.surf = surf};
+    /* first pass guessing half the box filled, then the spacing that gives the target
+       for the filled volume it found (once more at a finer spacing while nothing is
+       inside: a thin shape the coarse lattice missed) */
+    double h = cbrt(6.0 * 0.5 * box / target_tets);
+    int64_t kept = 0;
+    for (int pass = 0, halvings = 0; pass < 8; ++pass) {
+        kept = classify(&L, lo, hi, h, pool);
+        if (kept < 0) break;
+        double made = 6.0 * (double)kept;
+        if (kept > 0 && fabs(made - target_tets) <= 0.2 * target_tets) break;
+        if (kept == 0) {
+            if (++halvings > 3) break; /* nothing at an eighth of the spacing: no volume */
+            h *= 0.5;
+            continue;
+        }
+        h *= cbrt(made / target_tets);
+    }
+    if (kept < 0) {
+        free(L.inside);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                            "tet lattice: a lattice of spacing %g is too large", h);
+    }
+    double made = 6.0 * (double)kept;
+    if (kept == 0 || made > 1.5 * target_tets || made < target_tets / 1.5) {
+        free(L.inside);
+        if (kept == 0)
+            return sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                                "tet lattice: the surface encloses no volume");
+        return sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                            "tet lattice: no spacing gives about %d tets (%.0f at best)",
+                            target_tets, made);
+    }
+    r = build_tets(&L, kept, out, &rep.components, err);
+    rep.spacing = L.h;
+    for (int a = 0; a < 3; ++a)
+        rep.cells[a] = L.n[a];
+    rep.cells_inside = (int32_t)kept;
+    rep.volume = (double)kept * L.h * L.h * L.h;
+    free(L.inside);
+    rep.seconds = sw_now_seconds() - t0;
+    if (report) *report = rep;
+    return r;
+}

@@ -1,0 +1,259 @@
+/* The lattice mesher (io/tet_lattice.h): the generalised winding number of known
+ * surfaces, the volume a closed, an open and an inside-out surface enclose, the tet
+ * count against the target, orientation and quality of every tet, components, a real
+ * render surface, and the error paths. */
+#define _POSIX_C_SOURCE 200809L
+#include <unistd.h>
+
+#include "mesh_io.h"
+#include "sw_test.h"
+#include "tet_lattice.h"
+
+#define SW_PI 3.14159265358979323846
+
+/* An axis-aligned box [lo, lo + size] as 12 outward triangles, appended to m at vertex
+ * offset m->nverts (m has room); `skip` leaves out the two triangles of face `skip`
+ * (0..5: -x +x -y +y -z +z) or none (-1). */
+static void add_box(sw_trimesh *m, const double lo[3], double size, int skip) {
+    static const int faces[6][4] = {{0, 4, 6, 2}, {1, 3, 7, 5}, {0, 1, 5, 4},
+                                    {2, 6, 7, 3}, {0, 2, 3, 1}, {4, 5, 7, 6}};
+    int32_t base = m->nverts;
+    for (int q = 0; q < 8; ++q)
+        for (int a = 0; a < 3; ++a)
+            m->X[3 * (base + q) + a] = lo[a] + size * ((q >> a) & 1);
+    m->nverts += 8;
+    for (int f = 0; f < 6; ++f) {
+        if (f == skip) continue;
+        const int *c = faces[f];
+        int32_t *t = m->tris + 3 * m->ntris;
+        t[0] = base + c[0], t[1] = base + c[1], t[2] = base + c[2];
+        t[3] = base + c[0], t[4] = base + c[2], t[5] = base + c[3];
+        m->ntris += 2;
+    }
+}
+
+static sw_trimesh boxes(int n, double (*lo)[3], double size, int skip) {
+    sw_trimesh m = {0};
+    m.X = malloc(sizeof(double) * 24 * n);
+    m.tris = malloc(sizeof(int32_t) * 36 * n);
+    for (int i = 0; i < n; ++i)
+        add_box(&m, lo[i], size, skip);
+    return m;
+}
+
+/* A UV sphere of radius r: nlat x nlon quads split into outward triangles. */
+static sw_trimesh sphere(double r, int nlat, int nlon) {
+    sw_trimesh m = {0};
+    m.nverts = 2 + (nlat - 1) * nlon;
+    m.X = malloc(sizeof(double) * 3 * m.nverts);
+    m.tris = malloc(sizeof(int32_t) * 6 * nlat * nlon);
+    double *x = m.X;
+    x[0] = 0, x[1] = 0, x[2] = r;
+    for (int i = 1; i < nlat; ++i)
+        for (int j = 0; j < nlon; ++j) {
+            double th = SW_PI * i / nlat, ph = 2 * SW_PI * j / nlon;
+            double *p = x + 3 * (1 + (i - 1) * nlon + j);
+            p[0] = r * sin(th) * cos(ph), p[1] = r * sin(th) * sin(ph), p[2] = r * cos(th);
+        }
+    int32_t s = m.nverts - 1;
+    x[3 * s] = 0, x[3 * s + 1] = 0, x[3 * s + 2] = -r;
+    int32_t *t = m.tris;
+    for (int j = 0; j < nlon; ++j) {
+        int32_t a = 1 + j, b = 1 + (j + 1) % nlon;
+        *t++ = 0, *t++ = a, *t++ = b;
+        int32_t c = 1 + (nlat - 2) * nlon + j, d = 1 + (nlat - 2) * nlon + (j + 1) % nlon;
+        *t++ = s, *t++ = d, *t++ = c;
+    }
+    for (int i = 1; i + 1 < nlat; ++i)
+        for (int j = 0; j < nlon; ++j) {
+            int32_t a = 1 + (i - 1) * nlon + j, b = 1 + (i - 1) * nlon + (j + 1) % nlon;
+            int32_t c = a + nlon, d = b + nlon;
+            *t++ = a, *t++ = c, *t++ = d;
+            *t++ = a, *t++ = d, *t++ = b;
+        }
+    m.ntris = (int32_t)((t - m.tris) / 3);
+    return m;
+}
+
+/* Every tet positively oriented and not degenerate, every vertex used; *vol = the
+ * volume. */
+static void check_tets(const sw_tetmesh *t, double *vol_out) {
+    *vol_out = 0;
+    sw_quality q;
+    sw_tetmesh_quality(t, 0, &q);
+    ENSUREF(q.inverted == 0 && q.degenerate == 0, "%d inverted, %d degenerate", q.inverted,
+            q.degenerate);
+    /* Freudenthal tets of a cube: dihedral angles of 45, 60 and 90 degrees only */
+    ENSUREF(q.min_dihedral_deg > 44.9 && q.max_dihedral_deg < 90.1, "dihedral %g..%g",
+            q.min_dihedral_deg, q.max_dihedral_deg);
+    unsigned char *used = calloc((size_t)t->nverts, 1);
+    for (int64_t i = 0; i < 4 * (int64_t)t->ntets; ++i)
+        used[t->tets[i]] = 1;
+    for (int32_t v = 0; v < t->nverts; ++v)
+        ENSUREF(used[v], "vertex %d is in no tet", v);
+    free(used);
+    double vol = 0;
+    for (int32_t e = 0; e < t->ntets; ++e) {
+        const int32_t *k = t->tets + 4 * e;
+        double a[3], b[3], c[3], n[3];
+        for (int i = 0; i < 3; ++i) {
+            a[i] = t->X[3 * k[1] + i] - t->X[3 * k[0] + i];
+            b[i] = t->X[3 * k[2] + i] - t->X[3 * k[0] + i];
+            c[i] = t->X[3 * k[3] + i] - t->X[3 * k[0] + i];
+        }
+        n[0] = b[1] * c[2] - b[2] * c[1], n[1] = b[2] * c[0] - b[0] * c[2],
+        n[2] = b[0] * c[1] - b[1] * c[0];
+        vol += (a[0] * n[0] + a[1] * n[1] + a[2] * n[2]) / 6;
+    }
+    *vol_out = vol;
+}
+
+TEST(winding_number_of_a_closed_and_an_open_box) {
+    double lo[1][3] = {{0, 0, 0}};
+    sw_trimesh closed = boxes(1, lo, 1, -1), open = boxes(1, lo, 1, 5);
+    double in[3] = {0.5, 0.5, 0.5}, out[3] = {2, 0.5, 0.5}, corner[3] = {0.1, 0.2, 0.3};
+    ENSURE(fabs(sw_winding_number(&closed, in) - 1) < 1e-12);
+    ENSURE(fabs(sw_winding_number(&closed, corner) - 1) < 1e-12);
+    ENSURE(fabs(sw_winding_number(&closed, out)) < 1e-12);
+    /* the missing top face takes its solid angle away: 1 - 1/6 seen from the centre */
+    ENSUREF(fabs(sw_winding_number(&open, in) - 5.0 / 6) < 1e-9, "%.12f",
+            sw_winding_number(&open, in));
+    sw_trimesh_free(&closed);
+    sw_trimesh_free(&open);
+}
+
+TEST(sphere_fills_to_its_volume_at_the_target_count) {
+    sw_trimesh s = sphere(1.0, 24, 48);
+    sw_pool *pool = sw_pool_create(2);
+    const int32_t targets[] = {2000, 20000};
+    for (int i = 0; i < 2; ++i) {
+        sw_tetmesh t;
+        sw_lattice_report rep;
+        sw_error e;
+        ENSUREF(sw_tetmesh_from_surface(&s, targets[i], pool, &t, &rep, &e) == SINEW_OK, "%s",
+                e.msg);
+        double vol, exact = 4.0 / 3 * SW_PI;
+        check_tets(&t, &vol);
+        fprintf(stderr,
+                "    target %d: %d tets, %d vertices, spacing %.4g, volume %.4f (sphere %.4f, "
+                "surface %.4f), %d component(s), %.3f s\n",
+                targets[i], t.ntets, t.nverts, rep.spacing, vol, exact, rep.surface_volume,
+                rep.components, rep.seconds);
+        ENSURE(t.ntets <= 1.5 * targets[i] && t.ntets >= targets[i] / 1.5);
+        ENSURE(fabs(vol - rep.volume) < 1e-9 * exact);
+        /* the staircase's error shrinks with the spacing: a shell of a spacing's depth */
+        ENSUREF(fabs(vol - exact) < 4 * SW_PI * rep.spacing, "volume %g against %g", vol, exact);
+        ENSURE(rep.components == 1);
+        ENSURE(fabs(rep.surface_volume - exact) < 0.01 * exact);
+        sw_tetmesh_free(&t);
+    }
+    sw_pool_destroy(pool);
+    sw_trimesh_free(&s);
+}
+
+TEST(open_and_inside_out_surfaces_are_filled) {
+    double lo[1][3] = {{0, 0, 0}};
+    sw_trimesh open = boxes(1, lo, 1, 3), flipped = boxes(1, lo, 1, -1);
+    for (int32_t i = 0; i < flipped.ntris; ++i) { /* inside out */
+        int32_t s = flipped.tris[3 * i + 1];
+        flipped.tris[3 * i + 1] = flipped.tris[3 * i + 2];
+        flipped.tris[3 * i + 2] = s;
+    }
+    const sw_trimesh *cases[2] = {&open, &flipped};
+    for (int c = 0; c < 2; ++c) {
+        sw_tetmesh t;
+        sw_lattice_report rep;
+        sw_error e;
+        ENSUREF(sw_tetmesh_from_surface(cases[c], 6000, NULL, &t, &rep, &e) == SINEW_OK, "%s",
+                e.msg);
+        double vol;
+        check_tets(&t, &vol);
+        fprintf(stderr, "    %s box: %d tets, volume %.4f, surface volume %.4f\n",
+                c ? "inside-out" : "open", t.ntets, vol, rep.surface_volume);
+        ENSUREF(fabs(vol - 1) < 6 * rep.spacing, "volume %g", vol);
+        ENSURE(rep.components == 1);
+        sw_tetmesh_free(&t);
+    }
+    sw_trimesh_free(&open);
+    sw_trimesh_free(&flipped);
+}
+
+TEST(separate_pieces_stay_separate) {
+    double lo[2][3] = {{0, 0, 0}, {3, 0, 0}};
+    sw_trimesh two = boxes(2, lo, 1, -1);
+    sw_tetmesh t;
+    sw_lattice_report rep;
+    sw_error e;
+    ENSUREF(sw_tetmesh_from_surface(&two, 4000, NULL, &t, &rep, &e) == SINEW_OK, "%s", e.msg);
+    double vol;
+    check_tets(&t, &vol);
+    ENSUREF(rep.components == 2, "%d components", rep.components);
+    ENSUREF(fabs(vol - 2) < 12 * rep.spacing, "volume %g", vol);
+    sw_tetmesh_free(&t);
+    sw_trimesh_free(&two);
+}
+
+TEST(real_render_surface) {
+    char path[512];
+    snprintf(path, sizeof path, "%s/arm-libigl/arm.obj", SINEW_SHARED_DATA_DIR);
+    if (access(path, R_OK) != 0) {
+        fprintf(stderr, "    skipped: %s not found\n", path);
+        return;
+    }
+    sw_trimesh arm;
+    sw_error e;
+    ENSUREF(sw_read_obj(path, &arm, &e) == SINEW_OK, "%s", e.msg);
+    sw_tetmesh t;
+    sw_lattice_report rep;
+    sw_pool *pool = sw_pool_create(2);
+    ENSUREF(sw_tetmesh_from_surface(&arm, 3000, pool, &t, &rep, &e) == SINEW_OK, "%s", e.msg);
+    sw_pool_destroy(pool);
+    double vol;
+    check_tets(&t, &vol);
+    fprintf(stderr,
+            "    arm (%d vertices, %d triangles): %d tets, volume %.4g, surface volume %.4g, %d "
+            "component(s), %.2f s\n",
+            arm.nverts, arm.ntris, t.ntets, vol, rep.surface_volume, rep.components, rep.seconds);
+    ENSURE(t.ntets <= 4500 && t.ntets >= 2000);
+    ENSUREF(fabs(vol - fabs(rep.surface_volume)) < 0.25 * fabs(rep.surface_volume),
+            "volume %g against the surface's %g", vol, rep.surface_volume);
+    sw_tetmesh_free(&t);
+    sw_trimesh_free(&arm);
+}
+
+TEST(bad_surfaces_are_rejected) {
+    double lo[1][3] = {{0, 0, 0}};
+    sw_trimesh box = boxes(1, lo, 1, -1);
+    sw_tetmesh t;
+    sw_error e;
+    ENSURE(sw_tetmesh_from_surface(&box, 99, NULL, &t, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(t.ntets == 0 && t.tets == NULL);
+    ENSURE(sw_tetmesh_from_surface(&box, 5000001, NULL, &t, NULL, &e) ==
+           SINEW_ERROR_INVALID_ARGUMENT);
+    sw_trimesh empty = {0};
+    ENSURE(sw_tetmesh_from_surface(&empty, 1000, NULL, &t, NULL, &e) ==
+           SINEW_ERROR_INVALID_ARGUMENT);
+    box.tris[4] = 8; /* out of range */
+    ENSURE(sw_tetmesh_from_surface(&box, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(strstr(e.msg, "triangle 1") != NULL);
+    box.tris[4] = 2;
+    box.X[5] = NAN;
+    ENSURE(sw_tetmesh_from_surface(&box, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    box.X[5] = 0;
+    for (int32_t v = 0; v < box.nverts; ++v) /* flat: every z = 0 */
+        box.X[3 * v + 2] = 0;
+    ENSURE(sw_tetmesh_from_surface(&box, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    /* one tilted triangle encloses nothing (winding number below 1/2 off its plane) */
+    sw_trimesh tri = boxes(1, lo, 1, -1);
+    tri.ntris = 1;
+    tri.tris[0] = 0, tri.tris[1] = 3, tri.tris[2] = 5; /* (0,0,0), (1,1,0), (1,0,1) */
+    ENSURE(sw_tetmesh_from_surface(&tri, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_DEGENERATE);
+    ENSURE(t.ntets == 0 && t.tets == NULL && t.X == NULL);
+    sw_trimesh_free(&tri);
+    sw_trimesh_free(&box);
+}
+
+SW_TEST_MAIN(CASE(winding_number_of_a_closed_and_an_open_box),
+             CASE(sphere_fills_to_its_volume_at_the_target_count),
+             CASE(open_and_inside_out_surfaces_are_filled), CASE(separate_pieces_stay_separate),
+             CASE(real_render_surface), CASE(bad_surfaces_are_rejected))
