@@ -3,6 +3,7 @@
  * count against the target, orientation and quality of every tet, components, a real
  * render surface, and the error paths. */
 #define _POSIX_C_SOURCE 200809L
+#include <stdint.h>
 #include <unistd.h>
 
 #include "mesh_io.h"
@@ -120,6 +121,60 @@ TEST(winding_number_of_a_closed_and_an_open_box) {
             sw_winding_number(&open, in));
     sw_trimesh_free(&closed);
     sw_trimesh_free(&open);
+}
+
+/* The dipole tree against the exact sum: a sphere and the arm's render surface, at
+ * points inside, outside and near the surface: within 0.05 (first order at beta 4), and
+ * the inside test (|w| >= 1/2) agrees wherever the exact value is not within 0.05 of
+ * 1/2. */
+TEST(winding_tree_matches_the_exact_sum) {
+    sw_trimesh s = sphere(1.0, 24, 48), arm = {0};
+    char path[512];
+    snprintf(path, sizeof path, "%s/arm-libigl/arm.obj", SINEW_SHARED_DATA_DIR);
+    sw_error e;
+    int have_arm = access(path, R_OK) == 0 && sw_read_obj(path, &arm, &e) == SINEW_OK;
+    const sw_trimesh *cases[2] = {&s, &arm};
+    for (int c = 0; c < 1 + have_arm; ++c) {
+        const sw_trimesh *m = cases[c];
+        sw_winding_tree *t = sw_winding_tree_create(m);
+        ENSURE(t != NULL);
+        double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+        for (int32_t v = 0; v < m->nverts; ++v)
+            for (int a = 0; a < 3; ++a) {
+                lo[a] = fmin(lo[a], m->X[3 * v + a]);
+                hi[a] = fmax(hi[a], m->X[3 * v + a]);
+            }
+        uint64_t rng = 12345;
+        double worst = 0;
+        int disagree = 0, inside = 0;
+        for (int i = 0; i < 2000; ++i) {
+            double p[3];
+            for (int a = 0; a < 3; ++a) { /* the box grown by a fifth each side */
+                rng = rng * 6364136223846793005ull + 1442695040888963407ull;
+                double u = (double)(rng >> 11) / 9007199254740992.0;
+                p[a] = lo[a] + (hi[a] - lo[a]) * (1.4 * u - 0.2);
+            }
+            if (i % 4 == 0) { /* near a surface vertex */
+                const double *x = m->X + 3 * (size_t)((rng >> 20) % (uint64_t)m->nverts);
+                for (int a = 0; a < 3; ++a)
+                    p[a] = x[a] +
+                           0.01 * (hi[a] - lo[a]) * ((double)((rng >> (a * 8)) & 255) / 255 - 0.5);
+            }
+            double w = sw_winding_number(m, p), wt = sw_winding_tree_eval(t, p);
+            worst = fmax(worst, fabs(w - wt));
+            inside += fabs(w) >= 0.5;
+            if (fabs(fabs(w) - 0.5) > 0.05) disagree += (fabs(w) >= 0.5) != (fabs(wt) >= 0.5);
+        }
+        fprintf(stderr,
+                "    %s: %d triangles, tree error at most %.2e over 2000 points (%d inside)\n",
+                c ? "arm" : "sphere", m->ntris, worst, inside);
+        ENSUREF(worst < 0.05, "tree error %g", worst);
+        ENSURE(disagree == 0);
+        ENSURE(inside > 100);
+        sw_winding_tree_destroy(t);
+    }
+    sw_trimesh_free(&arm);
+    sw_trimesh_free(&s);
 }
 
 TEST(sphere_fills_to_its_volume_at_the_target_count) {
@@ -254,6 +309,7 @@ TEST(bad_surfaces_are_rejected) {
 }
 
 SW_TEST_MAIN(CASE(winding_number_of_a_closed_and_an_open_box),
+             CASE(winding_tree_matches_the_exact_sum),
              CASE(sphere_fills_to_its_volume_at_the_target_count),
              CASE(open_and_inside_out_surfaces_are_filled), CASE(separate_pieces_stay_separate),
              CASE(real_render_surface), CASE(bad_surfaces_are_rejected))

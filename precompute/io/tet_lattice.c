@@ -7,30 +7,13 @@
 #include <string.h>
 
 #include "vec3.h"
+#include "winding.h"
 
 /* Lattices of more cubes than this are refused (memory: a byte and an index each). */
 #define SW_LATTICE_MAX_CELLS 100000000LL
 
-double sw_winding_number(const sw_trimesh *surf, const double p[3]) {
-    /* Van Oosterom and Strackee's solid angle of each triangle seen from p */
-    double sum = 0;
-    for (int32_t t = 0; t < surf->ntris; ++t) {
-        const int32_t *f = surf->tris + 3 * t;
-        double a[3], b[3], c[3];
-        sw_v3_sub(surf->X + 3 * (size_t)f[0], p, a);
-        sw_v3_sub(surf->X + 3 * (size_t)f[1], p, b);
-        sw_v3_sub(surf->X + 3 * (size_t)f[2], p, c);
-        double la = sw_v3_norm(a), lb = sw_v3_norm(b), lc = sw_v3_norm(c);
-        double num = sw_v3_triple(a, b, c);
-        double den =
-            la * lb * lc + sw_v3_dot(a, b) * lc + sw_v3_dot(b, c) * la + sw_v3_dot(c, a) * lb;
-        sum += 2.0 * atan2(num, den);
-    }
-    return sum / (16.0 * atan(1.0)); /* 4 pi */
-}
-
 typedef struct {
-    const sw_trimesh *surf;
+    sw_winding_tree *tree;
     double origin[3], h;
     int32_t n[3];
     unsigned char *inside; /* n[0] n[1] n[2] cubes, x fastest */
@@ -43,7 +26,7 @@ static void classify_cells(void *vctx, int64_t begin, int64_t end, int worker) {
         int64_t i = c % L->n[0], j = (c / L->n[0]) % L->n[1], k = c / ((int64_t)L->n[0] * L->n[1]);
         double p[3] = {L->origin[0] + (i + 0.5) * L->h, L->origin[1] + (j + 0.5) * L->h,
                        L->origin[2] + (k + 0.5) * L->h};
-        L->inside[c] = fabs(sw_winding_number(L->surf, p)) >= 0.5;
+        L->inside[c] = fabs(sw_winding_tree_eval(L->tree, p)) >= 0.5;
     }
 }
 
@@ -233,7 +216,8 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
                                            surf->X + 3 * (size_t)f[2]) /
                               6.0;
     }
-    lattice L = {.surf = surf};
+    lattice L = {.tree = sw_winding_tree_create(surf)};
+    if (!L.tree) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "tet lattice: out of memory");
     /* first pass guessing half the box filled, then the spacing that gives the target
        for the filled volume it found (once more at a finer spacing while nothing is
        inside: a thin shape the coarse lattice missed) */
@@ -251,6 +235,7 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
         }
         h *= cbrt(made / target_tets);
     }
+    sw_winding_tree_destroy(L.tree);
     if (kept < 0) {
         free(L.inside);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,

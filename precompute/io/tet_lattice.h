@@ -5,7 +5,8 @@
  * cube is split the same way); a cube is inside when the generalised winding number of
  * the surface at its centre (Jacobson et al. 2013: the sum of the triangles' solid
  * angles over 4 pi, 1 inside a closed surface, near 1 inside one with holes, 0 outside)
- * has magnitude at least 1/2, so an inside-out surface is filled too. The lattice
+ * has magnitude at least 1/2 (winding.h; through its dipole tree), so an inside-out
+ * surface is filled too. The lattice
  * spacing is chosen from a coarse pass's filled share so that the mesh has about the
  * requested number of tets.
  *
@@ -18,6 +19,7 @@
 
 #include "sw_mesh.h"
 #include "thread_pool.h"
+#include "winding.h"
 
 typedef struct sw_lattice_report {
     double spacing;        /* lattice cube edge (surface units) */
@@ -37,8 +39,5 @@ typedef struct sw_lattice_report {
  * of range; DEGENERATE when the surface encloses no lattice cube; OUT_OF_MEMORY. */
 sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets, sw_pool *pool,
                                      sw_tetmesh *out, sw_lattice_report *report, sw_error *err);
-
-/* The generalised winding number of surf at point p (sum of solid angles / 4 pi). */
-double sw_winding_number(const sw_trimesh *surf, const double p[3]);
 
 #endif
