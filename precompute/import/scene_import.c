@@ -28,6 +28,9 @@ typedef struct scene_state {
     int gltf;
     sw_scene_nodes nodes;
     int32_t *mesh_node;   /* per aiMesh: first node that shows it, or -1 */
+    double *W;            /* per aiMesh: 16, its bind space placed in the world */
+    size_t *bone_base;    /* per aiMesh: where its bones start in bone_at */
+    int32_t *bone_at;     /* per aiBone of every mesh: its node */
     int32_t *node_bone;   /* per node: its bone, or -1 */
     double *offset;       /* per node: 16, the first skin's offset matrix of a joint node */
     int32_t *offset_mesh; /* per node: the mesh that offset came from, -1: not a joint */
@@ -41,6 +44,9 @@ static void state_free(scene_state *s) {
     free(s->nodes.parent);
     free(s->nodes.G);
     free(s->mesh_node);
+    free(s->W);
+    free(s->bone_base);
+    free(s->bone_at);
     free(s->node_bone);
     free(s->offset);
     free(s->offset_mesh);
@@ -131,7 +137,8 @@ static void mesh_bind_world(const scene_state *s, unsigned m, double *W);
 /* The node of a bone of mesh m. assimp ties bones to nodes by name only, and names repeat
  * (robot.glb: Blender named mesh objects after the bones that carry them: "Head" is a mesh
  * node and a joint), so among nodes of that name take the one whose node-pose global
- * transform is nearest the bone's bind transform W offset^-1. */
+ * transform is nearest the bone's bind transform W offset^-1 (W as place_meshes starts
+ * it: the mesh node's for FBX, I for glTF). */
 static int32_t find_bone_node(const scene_state *s, unsigned m, const struct aiBone *bone) {
     int32_t best = find_node(&s->nodes, bone->mName.data), second = -1;
     for (int32_t i = best + 1; best >= 0 && i < s->nodes.n && second < 0; ++i)
@@ -154,11 +161,53 @@ static int32_t find_bone_node(const scene_state *s, unsigned m, const struct aiB
 
 /* W of mesh m: the bind space's placement in the world (see the file comment). */
 static void mesh_bind_world(const scene_state *s, unsigned m, double *W) {
+    memcpy(W, s->W + 16 * m, 16 * sizeof(double));
+}
+
+/* Every mesh's W and every bone's node. FBX: the mesh node's global transform. glTF: the
+ * mesh node does not count, and the skin's bind space is placed where the file's node
+ * pose puts it: W = G_r IBM_r of the mesh's first joint r in node order (a rigid
+ * transform when the node pose is the bind pose: the Z_UP node of COLLADA2GLTF exports,
+ * SimpleSkin's shift by -0.5 in x). Bones are tied to nodes with W = I (find_bone_node). */
+static sinew_result place_meshes(scene_state *s, sw_error *err) {
     static const double I[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    if (s->gltf || s->mesh_node[m] < 0)
-        memcpy(W, I, sizeof I);
-    else
-        memcpy(W, s->nodes.G + 16 * s->mesh_node[m], 16 * sizeof(double));
+    const struct aiScene *sc = s->sc;
+    size_t nbones = 0;
+    s->W = malloc(sizeof(double) * 16 * (sc->mNumMeshes ? sc->mNumMeshes : 1));
+    s->bone_base = malloc(sizeof(size_t) * (sc->mNumMeshes ? sc->mNumMeshes : 1));
+    if (!s->W || !s->bone_base) return oom(s, err);
+    for (unsigned m = 0; m < sc->mNumMeshes; ++m) {
+        s->bone_base[m] = nbones;
+        nbones += sc->mMeshes[m]->mNumBones;
+        if (s->gltf || s->mesh_node[m] < 0)
+            memcpy(s->W + 16 * m, I, sizeof I);
+        else
+            memcpy(s->W + 16 * m, s->nodes.G + 16 * s->mesh_node[m], sizeof I);
+    }
+    s->bone_at = malloc(sizeof(int32_t) * (nbones ? nbones : 1));
+    if (!s->bone_at) return oom(s, err);
+    for (unsigned m = 0; m < sc->mNumMeshes; ++m) {
+        const struct aiMesh *me = sc->mMeshes[m];
+        int32_t first = -1;
+        unsigned first_bone = 0;
+        for (unsigned b = 0; b < me->mNumBones; ++b) {
+            int32_t i = find_bone_node(s, m, me->mBones[b]);
+            if (i < 0)
+                return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                                    "%s: bone '%s' of mesh %u has no node", s->name,
+                                    me->mBones[b]->mName.data, m);
+            s->bone_at[s->bone_base[m] + b] = i;
+            if (first < 0 || i < first) first = i, first_bone = b;
+        }
+        double O[16];
+        if (!s->gltf || first < 0) continue;
+        if (!sw_m4_from_ai(&me->mBones[first_bone]->mOffsetMatrix, O))
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                                "%s: bone '%s' has an offset matrix that is not finite", s->name,
+                                me->mBones[first_bone]->mName.data);
+        sw_m4_mul(s->nodes.G + 16 * first, O, s->W + 16 * m);
+    }
+    return SINEW_OK;
 }
 
 /* Joints: every aiBone's node; bones in node order; B_j and its inverse. */
@@ -178,14 +227,12 @@ static sinew_result find_joints(scene_state *s, sw_error *err) {
                 s->mesh_node[s->nodes.node[i]->mMeshes[k]] = i;
     for (int32_t i = 0; i < nn; ++i)
         s->offset_mesh[i] = -1, s->node_bone[i] = -1;
+    sinew_result rc = place_meshes(s, err);
+    if (rc) return rc;
     for (unsigned m = 0; m < sc->mNumMeshes; ++m)
         for (unsigned b = 0; b < sc->mMeshes[m]->mNumBones; ++b) {
             const struct aiBone *bone = sc->mMeshes[m]->mBones[b];
-            int32_t i = find_bone_node(s, m, bone);
-            if (i < 0)
-                return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                                    "%s: bone '%s' of mesh %u has no node", s->name,
-                                    bone->mName.data, m);
+            int32_t i = s->bone_at[s->bone_base[m] + b];
             if (s->offset_mesh[i] >= 0) continue; /* (later skins of the joint agree or lose) */
             if (!sw_m4_from_ai(&bone->mOffsetMatrix, s->offset + 16 * i))
                 return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
@@ -357,7 +404,7 @@ static sinew_result add_weights(scene_state *s, unsigned m, int32_t base, double
     int32_t nb = s->nbones;
     for (unsigned k = 0; k < me->mNumBones; ++k) {
         const struct aiBone *bone = me->mBones[k];
-        int32_t b = s->node_bone[find_bone_node(s, m, bone)];
+        int32_t b = s->node_bone[s->bone_at[s->bone_base[m] + k]];
         for (unsigned j = 0; j < bone->mNumWeights; ++j) {
             unsigned v = bone->mWeights[j].mVertexId;
             double x = bone->mWeights[j].mWeight;
