@@ -16,6 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gltf_precheck.h"
 #include "scene_internal.h"
 
 #define SW_SCENE_MAX_NODES (1 << 20)
@@ -356,7 +357,10 @@ static sinew_result build_skeleton(scene_state *s, sw_imported_character *out, s
         }
     }
     free(nchild);
-    return sw_skeleton_validate(k, err);
+    sw_error verr;
+    if (sw_skeleton_validate(k, &verr) != SINEW_OK)
+        return sw_error_set(err, verr.code, "%s: skeleton: %s", s->name, verr.msg);
+    return SINEW_OK;
 }
 
 /* Adds mesh m's triangles and positions (through M) at vertex `base`, triangle `tbase`. */
@@ -607,6 +611,12 @@ static sinew_result import_scene(scene_state *s, const sw_import_options *o,
     return SINEW_OK;
 }
 
+/* 1 when `ext` is "glb" (any case). */
+static int is_glb(const char *ext) {
+    return ext && strlen(ext) == 3 && tolower((unsigned char)ext[0]) == 'g' &&
+           tolower((unsigned char)ext[1]) == 'l' && tolower((unsigned char)ext[2]) == 'b';
+}
+
 /* 1 when `ext` names glTF ("gltf" or "glb", any case). */
 static int is_gltf_ext(const char *ext) {
     char e[8] = {0};
@@ -654,6 +664,22 @@ static sinew_result check_options(const sw_import_options *o, const char *name,
     return SINEW_OK;
 }
 
+/* sw_gltf_precheck over a whole glTF file (at most 1 GiB). */
+static sinew_result precheck_file(FILE *f, int binary, const char *name, sw_error *err) {
+    if (fseek(f, 0, SEEK_END) != 0)
+        return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot seek", name);
+    long n = ftell(f);
+    if (n < 0 || n > (1L << 30) || fseek(f, 0, SEEK_SET) != 0)
+        return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot size (or larger than 1 GiB)", name);
+    char *buf = malloc(n ? (size_t)n : 1);
+    if (!buf) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    sinew_result rc = fread(buf, 1, (size_t)n, f) == (size_t)n
+                          ? sw_gltf_precheck(buf, (size_t)n, binary, name, err)
+                          : sw_error_set(err, SINEW_ERROR_IO, "%s: cannot read", name);
+    free(buf);
+    return rc;
+}
+
 sinew_result sw_scene_import(const char *path, const sw_import_options *o,
                              sw_imported_character *out, sw_error *err) {
     memset(out, 0, sizeof *out);
@@ -663,9 +689,11 @@ sinew_result sw_scene_import(const char *path, const sw_import_options *o,
     if (rc) return rc;
     FILE *f = path ? fopen(path, "rb") : NULL;
     if (!f) return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot open", name);
-    fclose(f);
     const char *dot = strrchr(path, '.');
     int gltf = is_gltf_ext(dot ? dot + 1 : NULL);
+    rc = gltf ? precheck_file(f, is_glb(dot + 1), name, err) : SINEW_OK;
+    fclose(f);
+    if (rc) return rc;
     return run(aiImportFile(path, ai_flags(gltf)), name, gltf, &use, out, err);
 }
 
@@ -680,9 +708,17 @@ sinew_result sw_scene_import_memory(const void *data, size_t len, const char *hi
     if (rc) return rc;
     if (!data || len == 0 || len > 0xffffffffu)
         return sw_error_set(err, SINEW_ERROR_IO, "%s: %zu bytes: nothing to read", name, len);
-    return run(
-        aiImportFileFromMemory(data, (unsigned)len, ai_flags(is_gltf_ext(hint)), hint ? hint : ""),
-        name, is_gltf_ext(hint), &use, out, err);
+    int gltf = is_gltf_ext(hint);
+    if (gltf && (rc = sw_gltf_precheck(data, len, is_glb(hint), name, err))) return rc;
+    /* A copy with zero bytes after it: some assimp 5.2.5 readers strlen the buffer. */
+    char *copy = malloc(len + 16);
+    if (!copy) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    memcpy(copy, data, len);
+    memset(copy + len, 0, 16);
+    rc = run(aiImportFileFromMemory(copy, (unsigned)len, ai_flags(gltf), hint ? hint : ""), name,
+             gltf, &use, out, err);
+    free(copy);
+    return rc;
 }
 
 void sw_imported_character_free(sw_imported_character *c) {
