@@ -205,6 +205,67 @@ TEST(fbx_units_and_target_height) {
     ENSURE_NEAR(j1, j0 * 1.7 / h, 1e-9);
 }
 
+/* A hand-written glTF: a 4-vertex skin on joints "root" and "tip" (tip at (0,0.5,0), its
+ * clip turns it 90 deg about z at 1 s), a boneless triangle "hat" as a child of tip at
+ * (0,0.5,0) below it, and the same triangle shown by "lamp", a node outside the
+ * skeleton. */
+static const char rigid_gltf[] =
+    "{\"asset\":{\"version\":\"2.0\"},\"scene\":0,\"scenes\":[{\"nodes\":[0,1,3]}],\"nodes"
+    "\":[{\"name\":\"skin\",\"mesh\":0,\"skin\":0},{\"name\":\"root\",\"children\":[2]},{\""
+    "name\":\"tip\",\"translation\":[0,0.5,0],\"children\":[4]},{\"name\":\"lamp\",\"mesh\""
+    ":1,\"translation\":[5,0,0]},{\"name\":\"hat\",\"mesh\":1,\"translation\":[0,0.5,0]}],"
+    "\"meshes\":[{\"primitives\":[{\"attributes\":{\"POSITION\":0,\"JOINTS_0\":2,\"WEIGHTS_"
+    "0\":3},\"indices\":1}]},{\"primitives\":[{\"attributes\":{\"POSITION\":7}}]}],\"skins"
+    "\":[{\"inverseBindMatrices\":4,\"joints\":[1,2]}],\"animations\":[{\"name\":\"bend\","
+    "\"channels\":[{\"sampler\":0,\"target\":{\"node\":2,\"path\":\"rotation\"}}],\"sampler"
+    "s\":[{\"input\":5,\"output\":6}]}],\"accessors\":[{\"bufferView\":0,\"componentType\":"
+    "5126,\"count\":4,\"type\":\"VEC3\",\"min\":[0,0,0],\"max\":[1,1,0]},{\"bufferView\":1,"
+    "\"componentType\":5123,\"count\":6,\"type\":\"SCALAR\"},{\"bufferView\":2,\"componentT"
+    "ype\":5123,\"count\":4,\"type\":\"VEC4\"},{\"bufferView\":3,\"componentType\":5126,\"c"
+    "ount\":4,\"type\":\"VEC4\"},{\"bufferView\":4,\"componentType\":5126,\"count\":2,\"typ"
+    "e\":\"MAT4\"},{\"bufferView\":5,\"componentType\":5126,\"count\":2,\"type\":\"SCALAR\""
+    ",\"min\":[0],\"max\":[1]},{\"bufferView\":6,\"componentType\":5126,\"count\":2,\"type"
+    "\":\"VEC4\"},{\"bufferView\":7,\"componentType\":5126,\"count\":3,\"type\":\"VEC3\",\""
+    "min\":[0,0,0],\"max\":[0.1,0,0.1]}],\"bufferViews\":[{\"buffer\":0,\"byteOffset\":0,\""
+    "byteLength\":48},{\"buffer\":0,\"byteOffset\":48,\"byteLength\":12},{\"buffer\":0,\"by"
+    "teOffset\":60,\"byteLength\":32},{\"buffer\":0,\"byteOffset\":92,\"byteLength\":64},{"
+    "\"buffer\":0,\"byteOffset\":156,\"byteLength\":128},{\"buffer\":0,\"byteOffset\":284,"
+    "\"byteLength\":8},{\"buffer\":0,\"byteOffset\":292,\"byteLength\":32},{\"buffer\":0,\""
+    "byteOffset\":324,\"byteLength\":36}],\"buffers\":[{\"byteLength\":360,\"uri\":\"data:a"
+    "pplication/octet-stream;base64,AAAAAAAAAAAAAAAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAACAPwA"
+    "AgD8AAAAAAAABAAIAAgABAAMAAAAAAAAAAAAAAAAAAAAAAAEAAAAAAAAAAAABAAAAAAAAAIA/AAAAAAAAAAAAA"
+    "AAAAACAPwAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAAA/AAAAPwAAAAAAAAAAAACAPwAAAAAAAAAAAAA"
+    "AAAAAAAAAAIA/AAAAAAAAAAAAAAAAAAAAAAAAgD8AAAAAAAAAAAAAAAAAAAAAAACAPwAAgD8AAAAAAAAAAAAAA"
+    "AAAAAAAAACAPwAAAAAAAAAAAAAAAAAAAAAAAIA/AAAAAAAAAAAAAAC/AAAAAAAAgD8AAAAAAACAPwAAAAAAAAA"
+    "AAAAAAAAAgD8AAAAAAAAAAPQENT/0BDU/AAAAAAAAAAAAAAAAzczMPQAAAAAAAAAAAAAAAAAAAADNzMw9\"}]}";
+
+/* The hat joins as a rigid prop with weight 1 on tip, placed by its node (y = 1); the lamp
+ * is counted as ignored; at 1 s the hat's corner (0.1, 1, 0) has turned about tip's head
+ * (0, 0.5, 0) to (-0.5, 0.6, 0). */
+TEST(rigid_prop_follows_its_joint) {
+    sw_imported_character c;
+    sw_error e;
+    sw_error_clear(&e);
+    ENSUREF(sw_scene_import_memory(rigid_gltf, sizeof rigid_gltf - 1, "gltf", NULL, &c, &e) ==
+                SINEW_OK,
+            "%s", e.msg);
+    int ok = c.nskinned == 1 && c.nrigid == 1 && c.nignored == 1 && c.render.nverts == 7 &&
+             c.render.ntris == 3 && c.skel.nbones == 2 && c.nclips == 1 &&
+             c.clips[0].clip.nframes == 31;
+    for (int32_t v = 4; v < 7 && ok; ++v)
+        ok = c.render_source[v] == 1 && c.weights.w[2 * v] == 0 && c.weights.w[2 * v + 1] == 1 &&
+             fabs(c.render.X[3 * v + 1] - 1) < 1e-6;
+    double x[21];
+    if (ok) {
+        sw_lbs(c.render.nverts, c.render.X, &c.weights, c.clips[0].clip.T + 12 * 2 * 30, x);
+        ok = fabs(x[3 * 5] + 0.5) < 1e-5 && fabs(x[3 * 5 + 1] - 0.6) < 1e-5 &&
+             fabs(x[3 * 5 + 2]) < 1e-6;
+        if (!ok) fprintf(stderr, "  hat corner at 1 s: %g %g %g\n", x[15], x[16], x[17]);
+    }
+    sw_imported_character_free(&c);
+    ENSURE(ok);
+}
+
 static unsigned char *read_all(const char *rel, size_t *len) {
     char path[1024];
     snprintf(path, sizeof path, "%s/%s", SINEW_SHARED_DATA_DIR, rel);
@@ -278,4 +339,5 @@ TEST(errors_are_reported_not_crashed) {
 
 SW_TEST_MAIN(CASE(simpleskin), CASE(riggedsimple), CASE(riggedfigure), CASE(fox),
              CASE(robot_quaternius), CASE(fbx_skeleton), CASE(simpleskin_joint_by_hand),
-             CASE(fbx_units_and_target_height), CASE(errors_are_reported_not_crashed))
+             CASE(fbx_units_and_target_height), CASE(rigid_prop_follows_its_joint),
+             CASE(errors_are_reported_not_crashed))

@@ -474,30 +474,30 @@ static sinew_result limit_weights(scene_state *s, sw_imported_character *out,
 }
 
 /* Skinned meshes (each aiMesh once, in mesh order), then rigid props (each node that
- * shows a boneless mesh below a joint, in node order), with their weights. */
+ * shows a boneless mesh below a joint, in node order), with their weights. A boneless
+ * mesh shown by a node outside the skeleton counts as ignored, once per node. */
 static sinew_result build_render(scene_state *s, sw_imported_character *out, sw_error *err) {
     const struct aiScene *sc = s->sc;
     int64_t nv = 0, nt = 0;
-    unsigned char *used = calloc(sc->mNumMeshes ? sc->mNumMeshes : 1, 1);
-    if (!used) return oom(s, err);
     for (unsigned m = 0; m < sc->mNumMeshes; ++m)
         if (sc->mMeshes[m]->mNumBones) {
-            used[m] = 1, out->nskinned++;
+            out->nskinned++;
             nv += sc->mMeshes[m]->mNumVertices, nt += count_tris(sc->mMeshes[m]);
         }
     for (int32_t i = 0; i < s->nodes.n; ++i) {
         const struct aiNode *nd = s->nodes.node[i];
-        if (joint_at_or_above(s, i) < 0) continue;
+        int rigid = joint_at_or_above(s, i) >= 0;
         for (unsigned k = 0; k < nd->mNumMeshes; ++k) {
             unsigned m = nd->mMeshes[k];
             if (m >= sc->mNumMeshes || sc->mMeshes[m]->mNumBones) continue;
-            used[m] = 1, out->nrigid++;
+            if (!rigid) {
+                out->nignored++;
+                continue;
+            }
+            out->nrigid++;
             nv += sc->mMeshes[m]->mNumVertices, nt += count_tris(sc->mMeshes[m]);
         }
     }
-    for (unsigned m = 0; m < sc->mNumMeshes; ++m)
-        out->nignored += !used[m];
-    free(used);
     if (nv > SW_SCENE_MAX_VERTS || nt > SW_SCENE_MAX_VERTS ||
         (size_t)nv * (size_t)s->nbones > SW_SCENE_MAX_WEIGHTS)
         return sw_error_set(err, SINEW_ERROR_CAPACITY, "%s: %lld vertices x %d bones is too big",

@@ -41,8 +41,8 @@ typedef struct sw_imported_character {
     double weight_dropped_max; /* largest share of a vertex's weight cut by the 4-influence limit */
     double weight_dropped_mean; /* mean of that share over the skinned vertices */
     int32_t nskinned;           /* meshes with bones merged */
-    int32_t nrigid;             /* meshes without bones below a joint node: weight 1 to it */
-    int32_t nignored;           /* meshes unrelated to the skeleton (not imported) */
+    int32_t nrigid;   /* boneless meshes shown by a node at or below a joint: weight 1 to it */
+    int32_t nignored; /* boneless meshes shown by a node outside the skeleton (not imported) */
     int32_t nclips;
     sw_imported_clip *clips;
     double unit_scale; /* scale applied to the file's coordinates */
