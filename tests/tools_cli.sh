@@ -210,8 +210,10 @@ expect inspect_no_file 2 "usage: sinew-inspect FILE" "$inspect"
 expect inspect_fps_0 2 "--fps wants a number in \(0, 10000\], got '0'" "$inspect" x.glb --fps 0
 expect inspect_missing 1 "sinew-inspect: $tmp/none\.glb: cannot open" "$inspect" "$tmp/none.glb"
 printf 'not a 3D file\n' >"$tmp/text.glb"
-expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: assimp could not read it" \
-    "$inspect" "$tmp/text.glb"
+expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: not a glTF binary" "$inspect" "$tmp/text.glb"
+printf 'not a 3D file\n' >"$tmp/text.fbx"
+expect inspect_text_fbx 1 "sinew-inspect: $tmp/text\.fbx: assimp could not read it" \
+    "$inspect" "$tmp/text.fbx"
 fox=${SINEW_DATA_DIR:-$src/../shared/data}/gltf-fox/Fox.glb
 if [ -f "$fox" ]; then
     if "$inspect" "$fox" --json >"$tmp/fox.out" 2>"$tmp/fox.err" &&
