@@ -205,6 +205,9 @@ TEST(fbx_units_and_target_height) {
     ENSURE_NEAR(j1, j0 * 1.7 / h, 1e-9);
 }
 
+static int fails(sinew_result rc, const sw_imported_character *c, const sw_error *e,
+                 const char *name);
+
 /* A hand-written glTF: a 4-vertex skin on joints "root" and "tip" (tip at (0,0.5,0), its
  * clip turns it 90 deg about z at 1 s), a boneless triangle "hat" as a child of tip at
  * (0,0.5,0) below it, and the same triangle shown by "lamp", a node outside the
@@ -264,6 +267,22 @@ TEST(rigid_prop_follows_its_joint) {
     }
     sw_imported_character_free(&c);
     ENSURE(ok);
+}
+
+/* The same glTF with vertex 0's x a NaN (its first 6 buffer bytes 00 00 c0 7f 00 00: the
+ * base64 "AAAAAAAA" becomes "AADAfwAA"): an error naming the input, no character. */
+TEST(nan_vertex_is_an_error) {
+    char *text = malloc(sizeof rigid_gltf);
+    ENSURE(text);
+    memcpy(text, rigid_gltf, sizeof rigid_gltf);
+    char *b64 = strstr(text, "base64,AAAAAAAA");
+    if (b64) memcpy(b64 + 7, "AADAfwAA", 8);
+    sw_imported_character c;
+    sw_error e;
+    sinew_result rc = SINEW_OK;
+    if (b64) rc = sw_scene_import_memory(text, strlen(text), "gltf", NULL, &c, &e);
+    free(text);
+    ENSURE(b64 && rc == SINEW_ERROR_NOT_FINITE && fails(rc, &c, &e, "memory.gltf"));
 }
 
 static unsigned char *read_all(const char *rel, size_t *len) {
@@ -340,4 +359,4 @@ TEST(errors_are_reported_not_crashed) {
 SW_TEST_MAIN(CASE(simpleskin), CASE(riggedsimple), CASE(riggedfigure), CASE(fox),
              CASE(robot_quaternius), CASE(fbx_skeleton), CASE(simpleskin_joint_by_hand),
              CASE(fbx_units_and_target_height), CASE(rigid_prop_follows_its_joint),
-             CASE(errors_are_reported_not_crashed))
+             CASE(nan_vertex_is_an_error), CASE(errors_are_reported_not_crashed))
