@@ -203,5 +203,29 @@ for args in abc "999" "2000 3" "2000 x" "2000 30 1" "-5" "2000 1e3"; do
         { echo "FAIL run_main_args_[$args]: out/main was deleted" >&2; fails=$((fails + 1)); }
 done
 
+# sinew-inspect: exit 2 on bad arguments, 1 (message naming the file) when the import
+# fails, 0 with the JSON object last on a real asset (when ../shared/data is there)
+inspect=$build/tools/sinew-inspect
+expect inspect_no_file 2 "usage: sinew-inspect FILE" "$inspect"
+expect inspect_fps_0 2 "--fps wants a number in \(0, 10000\], got '0'" "$inspect" x.glb --fps 0
+expect inspect_missing 1 "sinew-inspect: $tmp/none\.glb: cannot open" "$inspect" "$tmp/none.glb"
+printf 'not a 3D file\n' >"$tmp/text.glb"
+expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: not a glTF binary" "$inspect" "$tmp/text.glb"
+printf 'not a 3D file\n' >"$tmp/text.fbx"
+expect inspect_text_fbx 1 "sinew-inspect: $tmp/text\.fbx: assimp could not read it" \
+    "$inspect" "$tmp/text.fbx"
+fox=${SINEW_DATA_DIR:-$src/../shared/data}/gltf-fox/Fox.glb
+if [ -f "$fox" ]; then
+    if "$inspect" "$fox" --json >"$tmp/fox.out" 2>"$tmp/fox.err" &&
+        tail -n 1 "$tmp/fox.out" | grep -q '"vertices": 1728, "triangles": 576, "joints": 24' &&
+        grep -q "Survey *3.417 s *103 frames" "$tmp/fox.out"; then
+        echo "ok   inspect_fox"
+    else
+        echo "FAIL inspect_fox:" >&2
+        tail -n 5 "$tmp/fox.out" "$tmp/fox.err" >&2
+        fails=$((fails + 1))
+    fi
+fi
+
 [ "$fails" -eq 0 ] || { echo "$fails failures" >&2; exit 1; }
 echo "all passed"

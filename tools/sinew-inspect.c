@@ -1,0 +1,130 @@
+/* sinew-inspect FILE [--fps F] [--height H] [--json]: what sw_scene_import makes of a rigged
+ * glTF/FBX file (meshes merged, rigid and ignored, vertices, triangles, the first joints,
+ * the clips, the bounding box, the weight cut to 4 influences). With --json the last line
+ * is one JSON object. Exit 0 ok, 1 import failed (message on stderr), 2 bad arguments. */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "scene_import.h"
+#include "tool_common.h"
+
+static const char *tool = "sinew-inspect";
+
+static int usage(FILE *f) {
+    fprintf(f,
+            "usage: %s FILE [--fps F] [--height H] [--json]\n"
+            "  FILE      a rigged glTF 2.0 (.gltf/.glb) or FBX character\n"
+            "  --fps F   clip sampling rate (default 30)\n"
+            "  --height H  scale the render mesh to H metres tall (default: file units)\n"
+            "  --json    print one JSON object as the last line\n",
+            tool);
+    return f == stdout ? 0 : 2;
+}
+
+/* Prints s as a JSON string (quotes and control characters escaped). */
+static void json_string(const char *s) {
+    putchar('"');
+    for (; *s; ++s) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            printf("\\%c", c);
+        else if (c < 0x20)
+            printf("\\u%04x", c);
+        else
+            putchar(c);
+    }
+    putchar('"');
+}
+
+static void bbox(const sw_trimesh *m, double *size) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t v = 0; v < m->nverts; ++v)
+        for (int c = 0; c < 3; ++c)
+            lo[c] = fmin(lo[c], m->X[3 * v + c]), hi[c] = fmax(hi[c], m->X[3 * v + c]);
+    for (int c = 0; c < 3; ++c)
+        size[c] = m->nverts ? hi[c] - lo[c] : 0;
+}
+
+static void print_text(const char *path, const sw_imported_character *c, const double *size) {
+    printf("%s\n", path);
+    printf("meshes: %d skinned merged, %d rigid, %d ignored\n", c->nskinned, c->nrigid,
+           c->nignored);
+    printf("render: %d vertices, %d triangles, bounding box %.4g x %.4g x %.4g m (scale %g)\n",
+           c->render.nverts, c->render.ntris, size[0], size[1], size[2], c->unit_scale);
+    printf("joints: %d\n", c->skel.nbones);
+    for (int32_t b = 0; b < c->skel.nbones && b < 10; ++b) {
+        int32_t p = c->skel.parent[b];
+        printf("  %3d %-32s parent %s\n", b, c->bone_names[b], p < 0 ? "-" : c->bone_names[p]);
+    }
+    if (c->skel.nbones > 10) printf("  ... %d more\n", c->skel.nbones - 10);
+    printf("weights: share dropped by the 4-influence cut: max %.4g, mean %.4g\n",
+           c->weight_dropped_max, c->weight_dropped_mean);
+    printf("clips: %d\n", c->nclips);
+    for (int32_t i = 0; i < c->nclips; ++i)
+        printf("  %-24s %7.3f s %5d frames at %g fps\n", c->clips[i].name, c->clips[i].duration_s,
+               c->clips[i].clip.nframes, c->clips[i].clip.fps);
+}
+
+static void print_json(const sw_imported_character *c, const double *size) {
+    printf("{\"meshes_skinned\": %d, \"meshes_rigid\": %d, \"meshes_ignored\": %d, "
+           "\"vertices\": %d, \"triangles\": %d, \"joints\": %d, \"bbox\": [%.6g, %.6g, %.6g], "
+           "\"unit_scale\": %.6g, \"weight_dropped_max\": %.6g, \"weight_dropped_mean\": %.6g, "
+           "\"joint_names\": [",
+           c->nskinned, c->nrigid, c->nignored, c->render.nverts, c->render.ntris, c->skel.nbones,
+           size[0], size[1], size[2], c->unit_scale, c->weight_dropped_max, c->weight_dropped_mean);
+    for (int32_t b = 0; b < c->skel.nbones; ++b) {
+        if (b) printf(", ");
+        json_string(c->bone_names[b]);
+    }
+    printf("], \"parents\": [");
+    for (int32_t b = 0; b < c->skel.nbones; ++b)
+        printf("%s%d", b ? ", " : "", c->skel.parent[b]);
+    printf("], \"clips\": [");
+    for (int32_t i = 0; i < c->nclips; ++i) {
+        printf("%s{\"name\": ", i ? ", " : "");
+        json_string(c->clips[i].name);
+        printf(", \"duration_s\": %.6g, \"frames\": %d}", c->clips[i].duration_s,
+               c->clips[i].clip.nframes);
+    }
+    printf("]}\n");
+}
+
+int main(int argc, char **argv) {
+    const char *path = NULL;
+    sw_import_options o = {0};
+    int json = 0;
+    for (int i = 1; i < argc; ++i) {
+        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return usage(stdout);
+        if (!strcmp(argv[i], "--json")) {
+            json = 1;
+        } else if (!strcmp(argv[i], "--fps")) {
+            if (!sw_tool_real(tool, "--fps", i + 1 < argc ? argv[++i] : NULL, 0, 10000.0001,
+                              "in (0, 10000]", &o.fps))
+                return 2;
+        } else if (!strcmp(argv[i], "--height")) {
+            if (!sw_tool_real(tool, "--height", i + 1 < argc ? argv[++i] : NULL, 0, 1e6,
+                              "in (0, 1e6)", &o.target_height))
+                return 2;
+        } else if (argv[i][0] == '-' || path) {
+            fprintf(stderr, "%s: unexpected argument '%s'\n", tool, argv[i]);
+            return usage(stderr);
+        } else {
+            path = argv[i];
+        }
+    }
+    if (!path) return usage(stderr);
+    sw_imported_character c;
+    sw_error err;
+    sw_error_clear(&err);
+    if (sw_scene_import(path, &o, &c, &err) != SINEW_OK) {
+        fprintf(stderr, "%s: %s (%s)\n", tool, err.msg, sinew_result_string(err.code));
+        return 1;
+    }
+    double size[3];
+    bbox(&c.render, size);
+    print_text(path, &c, size);
+    if (json) print_json(&c, size);
+    sw_imported_character_free(&c);
+    return 0;
+}
