@@ -208,6 +208,8 @@ done
 inspect=$build/tools/sinew-inspect
 expect inspect_no_file 2 "usage: sinew-inspect FILE" "$inspect"
 expect inspect_fps_0 2 "--fps wants a number in \(0, 10000\], got '0'" "$inspect" x.glb --fps 0
+expect inspect_tets_range 2 "--tets wants an integer in 100\.\.5000000, got '50'" \
+    "$inspect" x.glb --tets 50
 expect inspect_missing 1 "sinew-inspect: $tmp/none\.glb: cannot open" "$inspect" "$tmp/none.glb"
 printf 'not a 3D file\n' >"$tmp/text.glb"
 expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: not a glTF binary" "$inspect" "$tmp/text.glb"
@@ -223,6 +225,17 @@ if [ -f "$fox" ]; then
     else
         echo "FAIL inspect_fox:" >&2
         tail -n 5 "$tmp/fox.out" "$tmp/fox.err" >&2
+        fails=$((fails + 1))
+    fi
+    # --tets: the lattice fills the fox's render surface with about 5,000 positive tets
+    if "$inspect" "$fox" --tets 5000 --json >"$tmp/foxt.out" 2>"$tmp/foxt.err" &&
+        tail -n 1 "$tmp/foxt.out" | grep -Eq '"sim_tets": ([4-6][0-9]{3}|7[0-4][0-9]{2}),' &&
+        tail -n 1 "$tmp/foxt.out" | grep -q '"sim_inverted": 0}' &&
+        grep -q "0 inverted, 0 degenerate" "$tmp/foxt.out"; then
+        echo "ok   inspect_fox_tets"
+    else
+        echo "FAIL inspect_fox_tets:" >&2
+        tail -n 5 "$tmp/foxt.out" "$tmp/foxt.err" >&2
         fails=$((fails + 1))
     fi
 fi

@@ -1,22 +1,28 @@
-/* sinew-inspect FILE [--fps F] [--height H] [--json]: what sw_scene_import makes of a rigged
- * glTF/FBX file (meshes merged, rigid and ignored, vertices, triangles, the first joints,
- * the clips, the bounding box, the weight cut to 4 influences). With --json the last line
- * is one JSON object. Exit 0 ok, 1 import failed (message on stderr), 2 bad arguments. */
+/* sinew-inspect FILE [--fps F] [--height H] [--tets N] [--json]: what sw_scene_import makes
+ * of a rigged glTF/FBX file (meshes merged, rigid and ignored, vertices, triangles, the first
+ * joints, the clips, the bounding box, the weight cut to 4 influences) and, with --tets, the
+ * simulation tet mesh the lattice mesher fills its render surface with (tet_lattice.h) and
+ * that mesh's quality. With --json the last line is one JSON object. Exit 0 ok, 1 import
+ * or meshing failed (message on stderr), 2 bad arguments. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "mesh_io.h"
 #include "scene_import.h"
+#include "tet_lattice.h"
 #include "tool_common.h"
 
 static const char *tool = "sinew-inspect";
 
 static int usage(FILE *f) {
     fprintf(f,
-            "usage: %s FILE [--fps F] [--height H] [--json]\n"
+            "usage: %s FILE [--fps F] [--height H] [--tets N] [--json]\n"
             "  FILE      a rigged glTF 2.0 (.gltf/.glb) or FBX character\n"
             "  --fps F   clip sampling rate (default 30)\n"
             "  --height H  scale the render mesh to H metres tall (default: file units)\n"
+            "  --tets N  also fill the render surface with a simulation tet mesh of about N\n"
+            "            tets (100..5000000; a lattice cut by the winding number) and report it\n"
             "  --json    print one JSON object as the last line\n",
             tool);
     return f == stdout ? 0 : 2;
@@ -46,6 +52,25 @@ static void bbox(const sw_trimesh *m, double *size) {
         size[c] = m->nverts ? hi[c] - lo[c] : 0;
 }
 
+/* The simulation mesh of --tets and its quality. */
+typedef struct {
+    int on;
+    sw_tetmesh mesh;
+    sw_lattice_report rep;
+    sw_quality q;
+} sim_mesh;
+
+static void print_sim_text(const sim_mesh *s) {
+    printf("simulation mesh: %d tets, %d vertices, lattice spacing %.4g, %d component(s), "
+           "volume %.4g (the surface's own %.4g), %.2f s\n",
+           s->mesh.ntets, s->mesh.nverts, s->rep.spacing, s->rep.components, s->rep.volume,
+           s->rep.surface_volume, s->rep.seconds);
+    printf("  quality: dihedral angles %.1f..%.1f degrees, %d inverted, %d degenerate, %d "
+           "slivers\n",
+           s->q.min_dihedral_deg, s->q.max_dihedral_deg, s->q.inverted, s->q.degenerate,
+           s->q.slivers);
+}
+
 static void print_text(const char *path, const sw_imported_character *c, const double *size) {
     printf("%s\n", path);
     printf("meshes: %d skinned merged, %d rigid, %d ignored\n", c->nskinned, c->nrigid,
@@ -66,7 +91,7 @@ static void print_text(const char *path, const sw_imported_character *c, const d
                c->clips[i].clip.nframes, c->clips[i].clip.fps);
 }
 
-static void print_json(const sw_imported_character *c, const double *size) {
+static void print_json(const sw_imported_character *c, const double *size, const sim_mesh *s) {
     printf("{\"meshes_skinned\": %d, \"meshes_rigid\": %d, \"meshes_ignored\": %d, "
            "\"vertices\": %d, \"triangles\": %d, \"joints\": %d, \"bbox\": [%.6g, %.6g, %.6g], "
            "\"unit_scale\": %.6g, \"weight_dropped_max\": %.6g, \"weight_dropped_mean\": %.6g, "
@@ -87,13 +112,20 @@ static void print_json(const sw_imported_character *c, const double *size) {
         printf(", \"duration_s\": %.6g, \"frames\": %d}", c->clips[i].duration_s,
                c->clips[i].clip.nframes);
     }
-    printf("]}\n");
+    printf("]");
+    if (s->on)
+        printf(", \"sim_tets\": %d, \"sim_verts\": %d, \"sim_components\": %d, \"sim_spacing\": "
+               "%.6g, \"sim_volume\": %.6g, \"surface_volume\": %.6g, \"sim_seconds\": %.4f, "
+               "\"sim_min_dihedral_deg\": %.4g, \"sim_inverted\": %d",
+               s->mesh.ntets, s->mesh.nverts, s->rep.components, s->rep.spacing, s->rep.volume,
+               s->rep.surface_volume, s->rep.seconds, s->q.min_dihedral_deg, s->q.inverted);
+    printf("}\n");
 }
 
 int main(int argc, char **argv) {
     const char *path = NULL;
     sw_import_options o = {0};
-    int json = 0;
+    int json = 0, tets = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return usage(stdout);
         if (!strcmp(argv[i], "--json")) {
@@ -105,6 +137,9 @@ int main(int argc, char **argv) {
         } else if (!strcmp(argv[i], "--height")) {
             if (!sw_tool_real(tool, "--height", i + 1 < argc ? argv[++i] : NULL, 0, 1e6,
                               "in (0, 1e6)", &o.target_height))
+                return 2;
+        } else if (!strcmp(argv[i], "--tets")) {
+            if (!sw_tool_int(tool, "--tets", i + 1 < argc ? argv[++i] : NULL, 100, 5000000, &tets))
                 return 2;
         } else if (argv[i][0] == '-' || path) {
             fprintf(stderr, "%s: unexpected argument '%s'\n", tool, argv[i]);
@@ -124,7 +159,21 @@ int main(int argc, char **argv) {
     double size[3];
     bbox(&c.render, size);
     print_text(path, &c, size);
-    if (json) print_json(&c, size);
+    sim_mesh sim = {.on = tets > 0};
+    if (sim.on) {
+        sw_pool *pool = sw_pool_create(0);
+        sinew_result r = sw_tetmesh_from_surface(&c.render, tets, pool, &sim.mesh, &sim.rep, &err);
+        sw_pool_destroy(pool);
+        if (r != SINEW_OK) {
+            fprintf(stderr, "%s: %s (%s)\n", tool, err.msg, sinew_result_string(r));
+            sw_imported_character_free(&c);
+            return 1;
+        }
+        sw_tetmesh_quality(&sim.mesh, 0, &sim.q);
+        print_sim_text(&sim);
+    }
+    if (json) print_json(&c, size, &sim);
+    sw_tetmesh_free(&sim.mesh);
     sw_imported_character_free(&c);
     return 0;
 }
