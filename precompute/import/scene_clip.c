@@ -67,13 +67,17 @@ static unsigned key_before(const void *keys, size_t stride, unsigned n, double t
     return lo ? lo - 1 : 0;
 }
 
+/* Where tick t lies between key times ta and tb, in [0, 1] (0 when tb is not after ta:
+ * the last key, or two keys at one time). */
+static double key_fraction(double ta, double tb, double t) {
+    return t > ta && tb > ta ? fmin(1.0, (t - ta) / (tb - ta)) : 0.0;
+}
+
 /* Linear interpolation of vector keys at tick t. */
 static void sample_vec(const struct aiVectorKey *k, unsigned n, double t, double *out) {
-    unsigned i = key_before(k, sizeof *k, n, t);
-    double u = 0;
-    if (i + 1 < n && t > k[i].mTime && k[i + 1].mTime > k[i].mTime)
-        u = fmin(1.0, (t - k[i].mTime) / (k[i + 1].mTime - k[i].mTime));
-    const struct aiVector3D *a = &k[i].mValue, *b = &k[i + 1 < n ? i + 1 : i].mValue;
+    unsigned i = key_before(k, sizeof *k, n, t), j = i + 1 < n ? i + 1 : i;
+    double u = key_fraction(k[i].mTime, k[j].mTime, t);
+    const struct aiVector3D *a = &k[i].mValue, *b = &k[j].mValue;
     out[0] = (1 - u) * a->x + u * b->x;
     out[1] = (1 - u) * a->y + u * b->y;
     out[2] = (1 - u) * a->z + u * b->z;
@@ -81,11 +85,9 @@ static void sample_vec(const struct aiVectorKey *k, unsigned n, double t, double
 
 /* Shortest-path slerp of quaternion keys at tick t, normalised; out = (w, x, y, z). */
 static void sample_quat(const struct aiQuatKey *k, unsigned n, double t, double *out) {
-    unsigned i = key_before(k, sizeof *k, n, t);
-    double u = 0;
-    if (i + 1 < n && t > k[i].mTime && k[i + 1].mTime > k[i].mTime)
-        u = fmin(1.0, (t - k[i].mTime) / (k[i + 1].mTime - k[i].mTime));
-    const struct aiQuaternion *qa = &k[i].mValue, *qb = &k[i + 1 < n ? i + 1 : i].mValue;
+    unsigned i = key_before(k, sizeof *k, n, t), j = i + 1 < n ? i + 1 : i;
+    double u = key_fraction(k[i].mTime, k[j].mTime, t);
+    const struct aiQuaternion *qa = &k[i].mValue, *qb = &k[j].mValue;
     double a[4] = {qa->w, qa->x, qa->y, qa->z}, b[4] = {qb->w, qb->x, qb->y, qb->z};
     double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3];
     if (d < 0) {
