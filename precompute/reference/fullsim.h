@@ -17,7 +17,8 @@
  * Cholesky (CHOLMOD, sparse_chol.h; --solver cholmod); assembly and the matrix product
  * run on a pthread pool. Self-contacts are detected once per contact
  * round and frozen while Newton converges (re-detecting every iteration makes Newton
- * chase a changing energy and stall). Between rounds the set is updated as an active
+ * chase a changing energy and stall); a round's Newton ends early once its set would
+ * change (the set check, fullsim_step.c). Between rounds the set is updated as an active
  * set: new penetrations join, and a pair the solve held by pulling (its vertex in
  * front of its surface point, eq. 3.12, by more than half its detection depth: a
  * hysteresis band, fullsim_step.c) leaves, so contacts push but never glue a fold shut;
