@@ -1,6 +1,8 @@
 /* The bake's least input (issue 15): a clip too short to train on is rejected with the
  * minimum and the reason, not written as a blob with empty cubature or a useless basis;
  * sw_bake_solutions gives the very poses and solutions sw_bake keeps. Small meshes. */
+#include <string.h>
+
 #include "sw_test.h"
 
 #include "bake.h"
@@ -51,4 +53,56 @@ TEST(solutions_match_the_bake) {
     ENSURE(same);
 }
 
-SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake))
+/* What the progress callback saw: per stage, its calls, the last done and total, and
+ * whether done ever fell or the elapsed time went back. */
+typedef struct {
+    int calls[2];
+    int64_t done[2], total[2];
+    int bad;
+    double elapsed[2];
+} progress_log;
+
+static void record_progress(void *user, const char *stage, int64_t done, int64_t total,
+                            double elapsed) {
+    progress_log *g = user;
+    int k = !strcmp(stage, "simulate") ? 0 : !strcmp(stage, "cubature") ? 1 : -1;
+    if (k < 0) {
+        g->bad++;
+        return;
+    }
+    if (done != g->done[k] + 1 || done > total || elapsed < g->elapsed[k] ||
+        (g->calls[k] && total != g->total[k]))
+        g->bad++;
+    g->calls[k]++;
+    g->done[k] = done;
+    g->total[k] = total;
+    g->elapsed[k] = elapsed;
+}
+
+/* The progress callback (bake.h): every solved pose and every trained domain once, one
+ * unit at a time up to the stage's total, on 2 threads (the bake serialises the calls). */
+TEST(progress_counts_every_pose_and_domain) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 6, &c, &err) == SINEW_OK);
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 2;
+    p.threads = 2;
+    progress_log g;
+    memset(&g, 0, sizeof g);
+    p.on_progress = record_progress;
+    p.progress_user = &g;
+    sw_bake_result r;
+    ENSUREF(sw_bake(&c, &p, &r, &err) == SINEW_OK, "%s", err.msg);
+    fprintf(stderr, "    simulate %d calls (%lld of %lld), cubature %d (%lld of %lld)\n",
+            g.calls[0], (long long)g.done[0], (long long)g.total[0], g.calls[1],
+            (long long)g.done[1], (long long)g.total[1]);
+    ENSURE(g.bad == 0);
+    ENSURE(g.total[0] == r.ntrain + r.nheldout && g.done[0] == g.total[0]);
+    ENSURE(g.total[1] == r.view.ndomains && g.done[1] == g.total[1]);
+    sw_bake_result_free(&r);
+    sw_character_free(&c);
+}
+
+SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
+             CASE(progress_counts_every_pose_and_domain))

@@ -65,6 +65,10 @@ int main(int argc, char **argv) {
     int json = 0, force = 0;
     sw_bake_params p = sw_bake_params_default();
     p.progress = 1;
+    sw_tool_progress bar;
+    sw_tool_progress_init(&bar, tool);
+    p.on_progress = sw_tool_progress_print;
+    p.progress_user = &bar;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1;

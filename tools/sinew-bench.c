@@ -296,6 +296,10 @@ int main(int argc, char **argv) {
     sw_bake_params bp = sw_bake_params_default();
     bp.threads = threads;
     bp.progress = 1;
+    sw_tool_progress bar;
+    sw_tool_progress_init(&bar, tool);
+    bp.on_progress = sw_tool_progress_print;
+    bp.progress_user = &bar;
     sw_bake_result res;
     memset(&res, 0, sizeof res);
     sinew_blob *blob = NULL;

@@ -203,6 +203,49 @@ static inline sinew_result sw_tool_blob_load(const char *tool, const char *what,
 }
 #endif
 
+/* A bake's stage progress (sw_bake_params.on_progress) on stderr: on a terminal a bar
+ * redrawn in place with the time left, otherwise a plain line at every tenth; nothing for
+ * a stage that ends within two seconds. */
+typedef struct sw_tool_progress {
+    const char *tool;
+    int tty;
+    char stage[32];
+    int shown, tenth;
+} sw_tool_progress;
+
+static inline void sw_tool_progress_init(sw_tool_progress *tp, const char *tool) {
+    memset(tp, 0, sizeof *tp);
+    tp->tool = tool;
+    tp->tty = isatty(STDERR_FILENO);
+}
+
+static inline void sw_tool_progress_print(void *user, const char *stage, int64_t done,
+                                          int64_t total, double elapsed) {
+    sw_tool_progress *tp = user;
+    if (strcmp(tp->stage, stage)) {
+        snprintf(tp->stage, sizeof tp->stage, "%s", stage);
+        tp->shown = tp->tenth = 0;
+    }
+    if (elapsed < 2.0 && !tp->shown) return;
+    double left = done > 0 ? elapsed * (double)(total - done) / (double)done : 0;
+    if (tp->tty) {
+        static const char bar[] = "##############################";
+        static const char dots[] = "..............................";
+        int width = 30, fill = total > 0 ? (int)(width * done / total) : width;
+        fprintf(stderr, "\r%s: %-9s [%.*s%.*s] %lld/%lld  %.0f s, about %.0f s left   ", tp->tool,
+                stage, fill, bar, width - fill, dots, (long long)done, (long long)total, elapsed,
+                left);
+        if (done >= total) fputc('\n', stderr);
+    } else {
+        int tenth = total > 0 ? (int)(10 * done / total) : 10;
+        if (tenth <= tp->tenth) return;
+        tp->tenth = tenth;
+        fprintf(stderr, "%s: %-9s %3d%% (%lld/%lld), %.0f s, about %.0f s left\n", tp->tool, stage,
+                10 * tenth, (long long)done, (long long)total, elapsed, left);
+    }
+    tp->shown = 1;
+}
+
 #ifdef SW_TOOL_CHARACTER_ARGS
 /* The character inputs sinew-bake and sinew-bench share: a named scene, or files. */
 #include "character_io.h"

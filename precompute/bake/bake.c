@@ -32,6 +32,8 @@ sw_bake_params sw_bake_params_default(void) {
     p.threads = 0;
     p.seed = 0x5eed5eedULL;
     p.progress = 0;
+    p.on_progress = NULL;
+    p.progress_user = NULL;
     return p;
 }
 
@@ -139,6 +141,7 @@ static sinew_result prepare(sw_bake_state *s, const sw_character *c, int heat, s
 }
 
 static void free_state(sw_bake_state *s) {
+    pthread_mutex_destroy(&s->progress_lock);
     free(s->weights);
     free(s->skin_bone);
     free(s->skin_weight);
@@ -201,6 +204,24 @@ static sinew_result keep_solutions(const sw_bake_state *s, sw_bake_result *out, 
     return SINEW_OK;
 }
 
+void sw_bake_progress_begin(sw_bake_state *s, const char *stage, int64_t total) {
+    pthread_mutex_lock(&s->progress_lock);
+    s->progress_stage = stage;
+    s->progress_total = total;
+    s->progress_done = 0;
+    s->progress_t0 = sw_now_seconds();
+    pthread_mutex_unlock(&s->progress_lock);
+}
+
+void sw_bake_progress(sw_bake_state *s, int64_t units) {
+    if (!s->p->on_progress) return;
+    pthread_mutex_lock(&s->progress_lock); /* the bake's workers, never the frame */
+    s->progress_done += units;
+    s->p->on_progress(s->p->progress_user, s->progress_stage, s->progress_done, s->progress_total,
+                      sw_now_seconds() - s->progress_t0);
+    pthread_mutex_unlock(&s->progress_lock);
+}
+
 static void progress(const sw_bake_params *p, const char *stage, double secs, const char *what) {
     if (p->progress) fprintf(stderr, "sinew-bake: %-9s %7.2f s  %s\n", stage, secs, what);
 }
@@ -245,6 +266,7 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
 static sinew_result bake_begin(sw_bake_state *s, const sw_bake_params *p, const sw_character *c,
                                sw_error *err) {
     memset(s, 0, sizeof *s);
+    pthread_mutex_init(&s->progress_lock, NULL);
     s->p = p;
     if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
     sinew_result r = check_params(p, err);

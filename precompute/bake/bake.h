@@ -47,7 +47,13 @@ typedef struct sw_bake_params {
     double spring_k; /* interface springs per copy pair; 0: 20 E h (h the mean rest edge) */
     int threads;     /* 0: all cores */
     uint64_t seed;
-    int progress;          /* print stage progress to stderr */
+    int progress; /* print stage progress to stderr */
+    /* Called as a long stage advances: `done` of `total` units (solved poses in
+       "simulate", trained domains in "cubature"), `elapsed` seconds since the stage
+       began. Called from the bake's worker threads, one call at a time (the bake
+       serialises them), with `done` rising to `total`; NULL: none. */
+    void (*on_progress)(void *user, const char *stage, int64_t done, int64_t total, double elapsed);
+    void *progress_user;
     int compare_selectors; /* also train the other two selectors on the same data and
                               report their sizes and times (the blob keeps `selector`) */
 } sw_bake_params;

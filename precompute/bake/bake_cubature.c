@@ -331,8 +331,11 @@ sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *e
                 sw_dq_from_transform(T12 + 12 * b, &pose_dq[(size_t)k * s->nb + b]);
         }
     out->cubature_error_max = 0;
-    for (int32_t d = 0; d < s->nd && res == SINEW_OK; ++d)
+    sw_bake_progress_begin(s, "cubature", s->nd);
+    for (int32_t d = 0; d < s->nd && res == SINEW_OK; ++d) {
         res = train_domain(s, d, dsnap, T, pose_dq, out, err);
+        sw_bake_progress(s, 1);
+    }
 done:
     free(dsnap);
     free(R);

@@ -2,6 +2,8 @@
 #ifndef SW_BAKE_INTERNAL_H
 #define SW_BAKE_INTERNAL_H
 
+#include <pthread.h>
+
 #include "bake.h"
 #include "dqs.h"
 #include "selfcontact.h"
@@ -65,7 +67,17 @@ typedef struct sw_bake_state {
     int32_t **cub_local; /* index into the domain's dom_tets range */
     double **cub_w;
     sw_pool *pool;
+    /* progress of the running stage (sw_bake_progress) */
+    pthread_mutex_t progress_lock;
+    int64_t progress_done, progress_total;
+    double progress_t0;
+    const char *progress_stage;
 } sw_bake_state;
+
+/* Starts stage progress over `total` units; then sw_bake_progress(s, 1) from any thread
+ * as units finish: params->on_progress sees them one call at a time. */
+void sw_bake_progress_begin(sw_bake_state *s, const char *stage, int64_t total);
+void sw_bake_progress(sw_bake_state *s, int64_t units);
 
 /* Per-vertex DQS transforms of all vertices for bone transforms T. */
 void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R /* 9 nv */,

@@ -254,6 +254,7 @@ static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
         memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
                (size_t)s->nv * 3 * sizeof(double));
         if (!keep_contacts(q, k, sim)) q->oom = 1;
+        sw_bake_progress(s, 1);
     }
 }
 
@@ -310,6 +311,10 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     ctx.nseq = n;
     atomic_init(&ctx.next, 0);
     atomic_init(&ctx.failed, 0);
+    int64_t poses = s->heldout.npose;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        poses += s->train[i].npose;
+    sw_bake_progress_begin(s, "simulate", poses);
     /* one task per worker; each worker pulls sequences until none is left */
     sw_pool_parallel_for(s->pool, sw_pool_size(s->pool), simulate_worker, &ctx);
     if (atomic_load(&ctx.failed) > 0)
