@@ -671,7 +671,42 @@ TEST(corrupt_inputs) {
     ENSUREF(strstr(err.msg, "hand-pose.dmat") && strstr(err.msg, "96 x 1"), "%s", err.msg);
 }
 
+/* A character from a render surface (arm-libigl's .obj) filled by the lattice mesher:
+ * the generated mesh is valid, every bone drives some of it, weights are rows of 1, and a
+ * surface that is not a file or encloses nothing gives an error naming it. */
+TEST(surface_arm) {
+    NEED_DATA("arm-libigl/arm.obj");
+    sw_character c = {0};
+    sw_error err = {0};
+    sw_lattice_report rep;
+    ENSUREF(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/arm.obj", 3000,
+                                      SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c,
+                                      &rep, &err) == SINEW_OK,
+            "%s", err.msg);
+    ENSURE(c.mesh.ntets >= 2000 && c.mesh.ntets <= 4500 && c.skel.nbones == 4);
+    ENSURE(sw_tetmesh_validate(&c.mesh, 0.0, &err) == SINEW_OK);
+    ENSURE(every_bone_driven(&c, 1));
+    for (int32_t v = 0; v < c.weights.nverts; ++v) {
+        double sum = 0;
+        for (int32_t b = 0; b < c.weights.nbones; ++b)
+            sum += c.weights.w[(size_t)v * c.weights.nbones + b];
+        ENSURE(fabs(sum - 1) < 1e-9);
+    }
+    ENSURE(strcmp(c.name, "arm") == 0 && c.clip.nframes == 4);
+    fprintf(stderr, "    arm: %d tets, %d vertices, spacing %.4g, %d component(s)\n", c.mesh.ntets,
+            c.mesh.nverts, rep.spacing, rep.components);
+    sw_character_free(&c);
+    ENSURE(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/none.obj", 3000,
+                                     SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c, NULL,
+                                     &err) == SINEW_ERROR_IO);
+    ENSURE(strstr(err.msg, "none.obj") != NULL && c.mesh.ntets == 0);
+    ENSURE(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/arm.obj", 10,
+                                     SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c, NULL,
+                                     &err) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(strstr(err.msg, "arm.obj") != NULL);
+}
+
 SW_TEST_MAIN(CASE(cd_anim_semantics), CASE(cd_anim_malformed), CASE(cd_anim_elephant),
              CASE(pose_clip), CASE(inverse_distance_weights), CASE(bone_vertices_box),
              CASE(bone_vertices_top_up_and_errors), CASE(dataset_elephant), CASE(dataset_hand),
-             CASE(corrupt_inputs))
+             CASE(corrupt_inputs), CASE(surface_arm))

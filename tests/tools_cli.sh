@@ -79,8 +79,12 @@ expect bench_rounds_range 2 "--contact-rounds wants an integer in 1\.\.100, got 
     "$bench" "${small[@]}" --contact-rounds 0
 expect fullsim_set_check_choice 2 "--set-check wants on or off, got 'maybe'" \
     "$fullsim" --scene finger --tets 2000 --set-check maybe
-expect bake_mesh_format 2 "--mesh 'a\.obj': not a format it reads; accepted: \.mesh \(MEDIT\), \.node or \.ele" \
-    "$bake" --mesh a.obj --skeleton s.tgf --out "$tmp/a.blob"
+expect bake_mesh_format 2 "--mesh 'a\.stl': not a format it reads; accepted: \.mesh \(MEDIT\), \.node or \.ele \(TetGen\), \.obj" \
+    "$bake" --mesh a.stl --skeleton s.tgf --out "$tmp/a.blob"
+expect bake_surface_weights 2 "--weights does not apply to a surface --mesh" \
+    "$bake" --mesh a.obj --skeleton s.tgf --weights w.dmat --out "$tmp/a.blob"
+expect bake_surface_missing 1 "a\.obj" "$bake" --mesh "$tmp/a.obj" --skeleton s.tgf --tets 2000 \
+    --out "$tmp/a.blob"
 expect bake_clip_format 2 "--clip 'c\.bvh': not a format it reads; accepted: \.txt" \
     "$bake" --mesh a.mesh --skeleton s.tgf --clip c.bvh --out "$tmp/a.blob"
 expect bench_world_format 2 "--world 'w\.yaml': not a format it reads; accepted: \.json" \

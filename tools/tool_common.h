@@ -78,26 +78,30 @@ static inline int sw_tool_make_dirs(const char *dir) {
     return access(dir, W_OK | X_OK) == 0;
 }
 
+/* 1 when path's extension is the first n characters of ext, case-insensitively. */
+static inline int sw_tool_ext_is(const char *path, const char *ext, size_t n) {
+    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
+    if (!dot || (slash && dot < slash) || strlen(dot + 1) != n || n == 0) return 0;
+    for (size_t i = 0; i < n; ++i)
+        if ((dot[1 + i] | 0x20) != (ext[i] | 0x20)) return 0;
+    return 1;
+}
+
+static inline int sw_tool_has_ext(const char *path, const char *ext) {
+    return sw_tool_ext_is(path, ext, strlen(ext));
+}
+
 /* 1 when path ends (case-insensitively) with one of the space-separated extensions in
  * exts ("mesh node ele"); otherwise names the flag, the file and the accepted formats on
  * stderr and returns 0. */
 static inline int sw_tool_format(const char *tool, const char *flag, const char *path,
                                  const char *exts, const char *what) {
-    const char *dot = strrchr(path, '.'), *slash = strrchr(path, '/');
-    if (dot && (!slash || dot > slash)) {
-        size_t n = strlen(dot + 1);
-        for (const char *e = exts; *e;) {
-            size_t k = strcspn(e, " ");
-            if (k == n && n > 0) {
-                size_t i = 0;
-                while (i < n && (dot[1 + i] | 0x20) == (e[i] | 0x20))
-                    ++i;
-                if (i == n) return 1;
-            }
-            e += k;
-            while (*e == ' ')
-                ++e;
-        }
+    for (const char *e = exts; *e;) {
+        size_t k = strcspn(e, " ");
+        if (sw_tool_ext_is(path, e, k)) return 1;
+        e += k;
+        while (*e == ' ')
+            ++e;
     }
     fprintf(stderr, "%s: %s '%s': not a format it reads; accepted: %s\n", tool, flag, path, what);
     return 0;
@@ -356,9 +360,18 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
         fprintf(stderr, "%s: --mesh needs --skeleton\n", t);
         return 0;
     }
-    if (c->tets_given || c->data_given) {
-        fprintf(stderr, "%s: %s does not apply to --mesh (it goes with --scene)\n", t,
-                c->tets_given ? "--tets" : "--data");
+    int surface = sw_tool_has_ext(c->mesh, "obj");
+    if ((c->tets_given && !surface) || c->data_given) {
+        fprintf(stderr, "%s: %s does not apply to --mesh %s (it goes with --scene%s)\n", t,
+                c->tets_given ? "--tets" : "--data", surface ? "FILE.obj" : "with a tet mesh",
+                c->tets_given ? " or a surface .obj" : "");
+        return 0;
+    }
+    if (surface && c->weights) {
+        fprintf(stderr,
+                "%s: --weights does not apply to a surface --mesh (the bake computes "
+                "heat-diffusion weights for the tets it generates)\n",
+                t);
         return 0;
     }
     if (c->frames && !c->clip) {
@@ -368,8 +381,8 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
                 t);
         return 0;
     }
-    return sw_tool_format(t, "--mesh", c->mesh, "mesh node ele",
-                          ".mesh (MEDIT), .node or .ele (TetGen)") &&
+    return sw_tool_format(t, "--mesh", c->mesh, "mesh node ele obj",
+                          ".mesh (MEDIT), .node or .ele (TetGen), .obj (a render surface)") &&
            sw_tool_format(t, "--skeleton", c->tgf, "tgf", ".tgf") &&
            (!c->weights || sw_tool_format(t, "--weights", c->weights, "dmat", ".dmat")) &&
            (!c->clip || sw_tool_format(t, "--clip", c->clip, "txt dmat",
@@ -385,8 +398,9 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
     sw_error_clear(err);
     memset(ch, 0, sizeof *ch);
     sinew_result r =
-        c->scene
-            ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
+        c->scene ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
+        : sw_tool_has_ext(c->mesh, "obj")
+            ? sw_character_from_surface(c->mesh, c->tets, c->tgf, c->clip, c->frames, ch, NULL, err)
             : sw_character_from_files(c->mesh, c->tgf, c->weights, c->clip, c->frames, ch, err);
     if (r == SINEW_OK && (computed || (c->mesh && !c->weights))) sw_weights_free(&ch->weights);
     return r;

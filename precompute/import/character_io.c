@@ -3,6 +3,8 @@
  * pose clip of libigl's hand (tutorial 403: slerp identity <-> pose, then FK). */
 #include "character_io.h"
 
+#include "tet_lattice.h"
+
 #include "dqs.h"
 
 #include "mesh_io.h"
@@ -216,17 +218,13 @@ static void stem_name(const char *path, char *name, size_t cap) {
     name[n] = '\0';
 }
 
-sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path,
+/* The rest of a character once out->mesh holds a valid tet mesh: the skeleton, the
+ * weights (the file's, or inverse-distance), the motion, the bone vertices and the
+ * default material; mesh_path names the character and the mesh in messages. */
+static sinew_result finish_character(const char *mesh_path, const char *tgf_path,
                                      const char *weights_path, const char *motion_path,
                                      int32_t nframes, sw_character *out, sw_error *err) {
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "character: out is NULL");
-    memset(out, 0, sizeof *out);
-    if (!mesh_path || !tgf_path)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "character: mesh or skeleton path is NULL");
     sinew_result rc;
-    if ((rc = sw_read_tetmesh(mesh_path, &out->mesh, err))) goto fail;
-    if ((rc = sw_tetmesh_validate(&out->mesh, 0.0, err))) goto fail_named_mesh;
     if ((rc = sw_read_tgf(tgf_path, &out->skel, err))) goto fail;
     if ((rc = sw_skeleton_validate(&out->skel, err))) goto fail_named_tgf;
     if (weights_path)
@@ -260,6 +258,50 @@ fail_named_mesh:
 fail:
     sw_character_free(out);
     return rc;
+}
+
+sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path,
+                                     const char *weights_path, const char *motion_path,
+                                     int32_t nframes, sw_character *out, sw_error *err) {
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "character: out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!mesh_path || !tgf_path)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "character: mesh or skeleton path is NULL");
+    sinew_result rc = sw_read_tetmesh(mesh_path, &out->mesh, err);
+    if (!rc && (rc = sw_tetmesh_validate(&out->mesh, 0.0, err))) {
+        char msg[sizeof err->msg]; /* the validator names the item, not the file */
+        snprintf(msg, sizeof msg, "%s", err ? err->msg : "");
+        sw_error_set(err, rc, "%s: %s", mesh_path, msg);
+    }
+    if (rc) {
+        sw_character_free(out);
+        return rc;
+    }
+    return finish_character(mesh_path, tgf_path, weights_path, motion_path, nframes, out, err);
+}
+
+sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets,
+                                       const char *tgf_path, const char *motion_path,
+                                       int32_t nframes, sw_character *out,
+                                       sw_lattice_report *report, sw_error *err) {
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "character: out is NULL");
+    memset(out, 0, sizeof *out);
+    if (!obj_path || !tgf_path)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "character: surface or skeleton path is NULL");
+    sw_trimesh surf;
+    sinew_result rc = sw_read_obj(obj_path, &surf, err);
+    if (rc) return rc;
+    rc = sw_tetmesh_from_surface(&surf, target_tets, NULL, &out->mesh, report, err);
+    sw_trimesh_free(&surf);
+    if (rc) {
+        char msg[sizeof err->msg];
+        snprintf(msg, sizeof msg, "%s", err ? err->msg : "");
+        sw_error_set(err, rc, "%s: %s", obj_path, msg);
+        return rc;
+    }
+    return finish_character(obj_path, tgf_path, NULL, motion_path, nframes, out, err);
 }
 
 /* The number after "key": in a flat JSON object (enough for elephant.json's numbers). */

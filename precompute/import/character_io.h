@@ -5,6 +5,7 @@
 #include "clip_io.h"
 #include "rig.h"
 #include "sw_mesh.h"
+#include "tet_lattice.h"
 
 /* A clip that slerps every bone from identity to the pose given as one quaternion per
  * bone (x, y, z, w; libigl hand-pose.dmat) over `nframes` and back. */
@@ -18,6 +19,15 @@ sinew_result sw_clip_from_pose_quats(const sw_skeleton *s, const double *quats, 
 sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path,
                                      const char *weights_path, const char *motion_path,
                                      int32_t nframes, sw_character *out, sw_error *err);
+
+/* A character from a render surface (.obj; it need not be closed) filled with about
+ * target_tets tets by the lattice mesher (tet_lattice.h; report may be NULL), a .tgf
+ * skeleton and optional motion as in sw_character_from_files; inverse-distance weights
+ * (a caller may compute heat-diffusion weights instead, as sinew-bake does). */
+sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets,
+                                       const char *tgf_path, const char *motion_path,
+                                       int32_t nframes, sw_character *out,
+                                       sw_lattice_report *report, sw_error *err);
 
 /* The real assets of ../shared/data by folder name ("elephant-cd", "hand-libigl"):
  * resolves file names under data_dir and calls sw_character_from_files with the
