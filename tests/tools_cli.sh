@@ -220,28 +220,32 @@ expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: not a glTF binary" "$inspe
 printf 'not a 3D file\n' >"$tmp/text.fbx"
 expect inspect_text_fbx 1 "sinew-inspect: $tmp/text\.fbx: assimp could not read it" \
     "$inspect" "$tmp/text.fbx"
+# expect_stdout NAME CMD...: passes when CMD exits 0 and every extended regex in the
+# array `want` matches a line of its stdout.
+expect_stdout() {
+    local name=$1 ok=1 p
+    shift
+    "$@" >"$tmp/$name.out" 2>"$tmp/$name.err" || ok=0
+    for p in "${want[@]}"; do
+        grep -Eq -- "$p" "$tmp/$name.out" || ok=0
+    done
+    if [ "$ok" -eq 1 ]; then
+        echo "ok   $name"
+    else
+        echo "FAIL $name:" >&2
+        tail -n 5 "$tmp/$name.out" "$tmp/$name.err" >&2
+        fails=$((fails + 1))
+    fi
+}
+
 fox=${SINEW_DATA_DIR:-$src/../shared/data}/gltf-fox/Fox.glb
 if [ -f "$fox" ]; then
-    if "$inspect" "$fox" --json >"$tmp/fox.out" 2>"$tmp/fox.err" &&
-        tail -n 1 "$tmp/fox.out" | grep -q '"vertices": 1728, "triangles": 576, "joints": 24' &&
-        grep -q "Survey *3.417 s *103 frames" "$tmp/fox.out"; then
-        echo "ok   inspect_fox"
-    else
-        echo "FAIL inspect_fox:" >&2
-        tail -n 5 "$tmp/fox.out" "$tmp/fox.err" >&2
-        fails=$((fails + 1))
-    fi
+    want=('"vertices": 1728, "triangles": 576, "joints": 24' 'Survey *3\.417 s *103 frames')
+    expect_stdout inspect_fox "$inspect" "$fox" --json
     # --tets: the lattice fills the fox's render surface with about 5,000 positive tets
-    if "$inspect" "$fox" --tets 5000 --json >"$tmp/foxt.out" 2>"$tmp/foxt.err" &&
-        tail -n 1 "$tmp/foxt.out" | grep -Eq '"sim_tets": ([4-6][0-9]{3}|7[0-4][0-9]{2}),' &&
-        tail -n 1 "$tmp/foxt.out" | grep -q '"sim_inverted": 0}' &&
-        grep -q "0 inverted, 0 degenerate" "$tmp/foxt.out"; then
-        echo "ok   inspect_fox_tets"
-    else
-        echo "FAIL inspect_fox_tets:" >&2
-        tail -n 5 "$tmp/foxt.out" "$tmp/foxt.err" >&2
-        fails=$((fails + 1))
-    fi
+    want=('"sim_tets": ([4-6][0-9]{3}|7[0-4][0-9]{2}),' '"sim_inverted": 0}'
+        '0 inverted, 0 degenerate')
+    expect_stdout inspect_fox_tets "$inspect" "$fox" --tets 5000 --json
 fi
 
 [ "$fails" -eq 0 ] || { echo "$fails failures" >&2; exit 1; }
