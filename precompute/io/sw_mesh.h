@@ -73,6 +73,10 @@ typedef struct sw_character {
     double youngs;  /* Young's modulus E */
     double poisson; /* Poisson ratio nu */
     double density; /* mass per unit rest volume */
+    /* Optional render mesh (render.nverts 0: none). When set, the bake embeds it in the
+     * tets and the runtime's output surface is this mesh in its own vertex order
+     * (issue 14); otherwise the output surface is the tet mesh's boundary. */
+    sw_trimesh render;
 } sw_character;
 
 void sw_tetmesh_free(sw_tetmesh *m);
