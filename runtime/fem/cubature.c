@@ -84,17 +84,19 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
     const sw_blob_view *v = m->v;
     int want_grad = p->want_grad, want_hess = p->want_hess;
     uint32_t project = want_hess == SW_CUB_HESSIAN_EXACT ? 0u : SW_COROT_PROJECT_PSD;
-    double *Je = m->Je + (int64_t)12 * m->rmax * worker,
-           *hm = m->hm + (int64_t)10 * m->rmax * worker;
+    double *hm = m->hm + (int64_t)10 * m->rmax * worker;
     for (uint32_t k = begin; k < end; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
         const double *qd = p->q + o;
+        /* the tets' Jacobians: computed by the step's first gradient pass, then read */
+        int fill_J = want_grad && !m->Jcub_ok[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12], wm[9], gm[108];
+            double *Jc = m->Jcub + m->Jcub_off[k] + (int64_t)12 * r * (c - D->cub_begin);
             for (int j = 0; j < 4; ++j)
                 sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], qd,
-                                    x + 3 * j, want_grad ? Je + 3 * j * r : NULL);
+                                    x + 3 * j, fill_J ? Jc + 3 * j * r : NULL);
             double w = v->cub_weight[c];
             m->ecub[c] =
                 w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
@@ -111,11 +113,12 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
                     a[n - 1] = w * wm[mk];
                     vs[n++] = gm + 12 * mk;
                 }
-            project_rows(Je, r, vs, n, hm);
+            project_rows(Jc, r, vs, n, hm);
             for (int32_t j = 0; j < r; ++j)
                 m->g[o + j] -= w * hm[j];
             if (n > 1) add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, hm + r, a, n - 1);
         }
+        if (fill_J) m->Jcub_ok[k] = 1;
         if (want_hess) /* the block was filled in its upper triangle: mirror */
             for (int32_t i = 0; i < r; ++i)
                 for (int32_t j = i + 1; j < r; ++j)

@@ -28,16 +28,23 @@ typedef struct sw_reduced {
     double *g;             /* R: gradient accumulator */
     double *H;             /* R x R: Hessian accumulator */
     /* Scratch of each task worker w < nworkers (one without task callbacks): */
-    double *Je;       /* 12 x rmax at Je + 12 rmax w: one cubature tet's Jacobian */
     double *hm;       /* 10 x rmax at hm + 10 rmax w: its J^T f and J^T g_k (cubature.c) */
     double *ecub;     /* ncub: each cubature tet's weighted energy */
     int32_t nworkers; /* the task workers' count, 1 when serial */
     const sinew_task_callbacks *tasks; /* the host's job system, NULL: serial */
     double *Jc, *hc;                   /* 4 x 3 x rmax each: one contact's Jacobians and N G */
     double *svd_V;                     /* 9 per cubature tet: its last SVD rotation (warm start) */
+    /* The cubature tets' Jacobians J = R U (12 x r_d each, domain k's from Jcub +
+     * Jcub_off[k]): they depend on the skinning alone, not on q, so the step's first
+     * gradient pass over a domain fills them (Jcub_ok[k] = 1) and its later passes read
+     * them; skinning clears the flags. */
+    double *Jcub;
+    int64_t *Jcub_off;      /* ndomains */
+    unsigned char *Jcub_ok; /* ndomains */
 } sw_reduced;
 
-/* Skins every active vertex with the bones' dual quaternions (act_R, act_t). */
+/* Skins every active vertex with the bones' dual quaternions (act_R, act_t); the cached
+ * cubature Jacobians become stale. */
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 
 /* Position x of copy (domain D, local vertex lv, active index a) for the domain's
