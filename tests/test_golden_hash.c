@@ -18,6 +18,9 @@
  * the runtime: the fixture's training solutions come from the reference, whose Newton
  * now ends a contact round once its set would change and keeps truncated PCG answers
  * that made progress (fullsim_step.c, fullsim_system.c), so the baked blob differs.
+ * Issue 13 moved it (from 0xdeb5a223c1daed2f): the runtime's Newton takes chord updates
+ * on an earlier factor once the iterate converges fast (newton.c), a different path to
+ * the same stationary points within the solve's tolerance.
  * The thread counts here are instances stepped on several host threads (no task
  * callbacks); instances 1 and 3 are dynamic. */
 #include <pthread.h>
@@ -29,7 +32,7 @@
 enum { NINST = 4, STEPS = 24 };
 
 /* FNV-1a 64 of the four instances' surfaces, instance after instance. */
-#define GOLDEN_SURFACE_HASH 0xdeb5a223c1daed2full
+#define GOLDEN_SURFACE_HASH 0x88a0a36667517619ull
 
 static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
     const unsigned char *p = data;

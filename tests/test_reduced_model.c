@@ -3,6 +3,7 @@
  * that depends on the pose and the direction it was arrived at alone, the branch of
  * the reference's path it follows, and its accuracy against the full-space training
  * solutions it was baked from. */
+#include <lapacke.h>
 #include <math.h>
 
 #include "bake_fixture.h"
@@ -130,6 +131,57 @@ TEST(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone) {
     sinew_instance_destroy(b);
 }
 
+/* Chord updates (newton.c) reuse an earlier iterate's factor: every step over the clip
+ * must still end where a full Newton update from its solution, on the exact potential's
+ * own gradient and (projected) Hessian, moves the shape by less than the solve's
+ * convergence test allows (steps the update cap ended are skipped: in the fold, plain
+ * Newton takes more than five updates too), and chord updates must have been taken. */
+TEST(chord_updates_end_at_a_newton_stationary_point) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    int32_t R = sw_blob_get_view(f->blob)->rank_total;
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones);
+    double *q = malloc(sizeof(double) * R), *g = malloc(sizeof(double) * R),
+           *H = malloc(sizeof(double) * R * R);
+    uint32_t updates = 0, factors = 0;
+    int converged = 0;
+    for (int k = 0; k < f->ch.clip.nframes; ++k) {
+        step_to_frame(f, inst, k, pose);
+        sinew_step_stats st = {.struct_size = sizeof st};
+        ENSURE(sinew_instance_get_stats(inst, &st) == SINEW_OK);
+        updates += st.newton_iterations;
+        factors += st.factorizations;
+        if (!(st.status & SINEW_STEP_CONVERGED)) continue; /* the update cap ended it */
+        converged++;
+        memcpy(q, sw_instance_q(inst), sizeof(double) * R);
+        sw_instance_potential(inst, q, g, H);
+        /* g <- H^-1 g: the Newton update, negated */
+        ENSURE(LAPACKE_dposv(LAPACK_ROW_MAJOR, 'L', R, 1, H, R, g, 1) == 0);
+        double dq = 0, qn = 0;
+        for (int32_t i = 0; i < R; ++i) {
+            dq += g[i] * g[i];
+            qn += q[i] * q[i];
+        }
+        dq = sqrt(dq);
+        qn = sqrt(qn);
+        /* the solve's own test is 3e-3 |q| on its last update; one more Newton update
+         * from there is far smaller when the iterate is near the stationary point */
+        ENSUREF(dq <= 3e-3 * qn + 1e-9,
+                "frame %d: a Newton update from the solution moves %g of %g", k, dq, qn);
+    }
+    ENSUREF(2 * converged >= f->ch.clip.nframes, "%d of %d steps converged", converged,
+            f->ch.clip.nframes);
+    ENSUREF(factors < updates, "no chord update taken: %u factorisations for %u updates", factors,
+            updates);
+    free(pose);
+    free(q);
+    free(g);
+    free(H);
+    sinew_instance_destroy(inst);
+}
+
 /* The bake stores the training clip's frames twice, on the way in and on the way back
  * (its return path), with the reference's solution on each branch. Played in the order
  * solved, the instance must land on the branch it arrived along: nearer that branch's
@@ -205,6 +257,7 @@ TEST(release_fixture) {
 }
 
 SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
+             CASE(chord_updates_end_at_a_newton_stationary_point),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
              CASE(branches_follow_the_motion), CASE(training_poses_are_reproduced),
              CASE(release_fixture))

@@ -394,7 +394,7 @@ int main(int argc, char **argv) {
     float *pos = malloc((size_t)ns * 3 * sizeof(float)),
           *nrm = malloc((size_t)ns * 3 * sizeof(float));
     double *sub = malloc((size_t)nf * sizeof(double));
-    double *phase = malloc((size_t)nf * NPHASES * sizeof(double)), evals = 0;
+    double *phase = malloc((size_t)nf * NPHASES * sizeof(double)), evals = 0, factors = 0;
     long failed_steps = 0; /* steps that did not return SINEW_OK (a non-finite state) */
     for (int f = 0; f < nf; ++f) {
         double t0 = sw_now_seconds();
@@ -410,6 +410,7 @@ int main(int argc, char **argv) {
         for (int k = 0; k < NPHASES; ++k)
             phase[(size_t)k * nf + f] = ms[k];
         evals += st.potential_evals / (double)nf;
+        factors += st.factorizations / (double)nf;
     }
     double sub_ms = sw_median(sub, nf), phase_ms[NPHASES];
     for (int k = 0; k < NPHASES; ++k)
@@ -554,8 +555,8 @@ int main(int argc, char **argv) {
             blob_bytes);
     fprintf(stderr,
             "             step phases (median ms): skin %.4f, contact %.4f, dynamics %.4f, solve "
-            "%.4f, output %.4f; %.1f potential evaluations a step\n",
-            phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals);
+            "%.4f, output %.4f; %.1f potential evaluations and %.1f factorisations a step\n",
+            phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals, factors);
     if (json)
         printf(
             "{\"scene\":\"%s\",\"tets\":%d,\"verts\":%d,\"surface_verts\":%u,\"frames\":%d,"
@@ -574,7 +575,9 @@ int main(int argc, char **argv) {
             ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
             sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
             full_max);
-    if (json) printf(",\"instance_bytes\":%zu,\"blob_bytes\":%zu", instance_bytes, blob_bytes);
+    if (json)
+        printf(",\"factorizations\":%.2f,\"instance_bytes\":%zu,\"blob_bytes\":%zu", factors,
+               instance_bytes, blob_bytes);
     if (json && instances)
         printf(",\"crowd_instances\":%d,\"crowd_threads\":%d,\"crowd_frames\":%d,"
                "\"crowd_ms\":%.4f,\"crowd_us_per_instance\":%.3f,\"crowd_scaling\":%.3f,"

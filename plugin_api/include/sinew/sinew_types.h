@@ -213,7 +213,8 @@ typedef struct sinew_step_stats {
     uint32_t world_contacts;         /**< candidates in contact at the solution */
     uint32_t world_contacts_dropped; /**< candidates the max_world_contacts budget left out */
     uint32_t world_rounds;           /**< detections: 2 when the solve ran into new contact */
-    uint32_t reserved2;              /**< zero */
+    /** reduced Hessians factored (the other updates reuse the last factor) */
+    uint32_t factorizations;
 } sinew_step_stats;
 
 #ifdef __cplusplus
