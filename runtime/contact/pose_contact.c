@@ -27,7 +27,7 @@ static double contact_pairs(sw_reduced *red, const int32_t *pairs, int32_t npair
         for (int m = 0; m < 4; ++m) {
             D[m] = &v->domains[cv[2 * m]];
             sw_reduced_position(red, D[m], cv[2 * m + 1], red->contact_act[4 * c + m],
-                                q + D[m]->q_offset, x[m], want_grad ? red->Jc + 3 * m * rm : NULL);
+                                q + D[m]->q_offset, x[m], NULL);
             for (int i = 0; i < 3; ++i)
                 d[i] += coef[m] * x[m][i];
         }
@@ -40,6 +40,10 @@ static double contact_pairs(sw_reduced *red, const int32_t *pairs, int32_t npair
         sw_penalty_apply_N(n, al, d, Nd);
         E += sw_penalty_energy(kk, d, Nd);
         if (!want_grad) continue;
+        /* the Jacobians of a pair in contact only (most pairs of a pose are apart) */
+        for (int m = 0; m < 4; ++m)
+            sw_reduced_jacobian(red, D[m], cv[2 * m + 1], red->contact_act[4 * c + m],
+                                red->Jc + 3 * m * rm);
         /* G per distinct domain (slot `lead[m]` holds the sum of its domain's slots) */
         int lead[4], nlead = 0, leads[4];
         for (int m = 0; m < 4; ++m) {

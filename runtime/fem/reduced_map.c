@@ -12,6 +12,17 @@ void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq) {
     }
 }
 
+void sw_reduced_jacobian(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
+                         double *J) {
+    int32_t r = D->rank;
+    const double *U = m->v->basis + D->basis_offset + (int64_t)3 * lv * r;
+    const double *Rm = m->act_R + 9 * a;
+    for (int i = 0; i < 3; ++i)
+        for (int32_t j = 0; j < r; ++j)
+            J[i * r + j] =
+                Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
+}
+
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J) {
     const sw_blob_view *v = m->v;
@@ -29,9 +40,5 @@ void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t l
     }
     for (int i = 0; i < 3; ++i)
         x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
-    if (J)
-        for (int i = 0; i < 3; ++i)
-            for (int32_t j = 0; j < r; ++j)
-                J[i * r + j] =
-                    Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
+    if (J) sw_reduced_jacobian(m, D, lv, a, J);
 }

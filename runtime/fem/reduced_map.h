@@ -53,4 +53,8 @@ void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J);
 
+/* That copy's Jacobian J = R U alone (3 x r_d, row-major). */
+void sw_reduced_jacobian(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
+                         double *J);
+
 #endif
