@@ -151,40 +151,67 @@ static double tet_distance(const sw_tetmesh *m, int32_t t, const double p[3], co
     return best;
 }
 
-/* One render vertex's search: two passes over the grid's rings around it. Pass 0 finds
- * the nearest tet's distance dmin and, for a vertex inside the tets, the tet it is deepest
- * in; pass 1 (a vertex outside) picks among the tets within dmin + slack the one whose
- * affine map extrapolates least (the largest smallest barycentric), ties to the nearer
- * and then the lower id, so the result depends on nothing but the meshes. */
+/* Distance from p to the box [lo, hi] (0 inside). */
+static double box_distance(const double p[3], const double *lo, const double *hi) {
+    double d2 = 0;
+    for (int a = 0; a < 3; ++a) {
+        double e = p[a] < lo[a] ? lo[a] - p[a] : p[a] > hi[a] ? p[a] - hi[a] : 0;
+        d2 += e * e;
+    }
+    return sqrt(d2);
+}
+
+/* A tet within reach of the vertex: its distance, extrapolation score and barycentrics. */
+typedef struct candidate {
+    int32_t tet;
+    double dist, score, b[4];
+} candidate;
+
+/* One render vertex's search over the grid's rings around it. Every tet within the reach
+ * dmin + slack (dmin the nearest tet's distance so far, so the reach only shrinks) is a
+ * candidate; the chosen one has the largest smallest barycentric among the candidates
+ * still within the final reach: for a vertex inside, the tet it is deepest in; outside,
+ * the one whose affine map extrapolates least; ties to the nearer, then the lower id, so
+ * the result depends on nothing but the meshes. Boxes prune cells and tets before any
+ * barycentric is computed. */
 typedef struct search {
     const sw_tetmesh *m;
     const grid *g;
-    int32_t *stamp, mark; /* stamp[t] == mark: tet t seen in this pass */
-    int pass;
-    double slack; /* how much farther than the nearest a tet may be */
-    double dmin;  /* the nearest tet's distance */
-    int32_t tet;  /* the chosen tet, -1 none yet */
-    double dist;  /* its distance */
-    double score; /* -(its smallest barycentric): <= 0 inside, the extrapolation outside */
-    double b[4];
+    const double *tbox;   /* 6 per tet: its box */
+    int32_t *stamp, mark; /* stamp[t] == mark: tet t seen for this vertex */
+    double slack;         /* how much farther than the nearest a tet may be */
+    double dmin;          /* the nearest tet's distance so far */
+    candidate *cand;
+    int32_t ncand, cap;
+    int oom;
 } search;
 
 static void consider(search *s, int32_t t, const double p[3]) {
     if (s->stamp[t] == s->mark) return;
     s->stamp[t] = s->mark;
-    double b[4];
-    tet_bary(s->m, t, p, b);
-    double d = tet_distance(s->m, t, p, b), score = -min4(b);
-    if (s->pass == 0) s->dmin = fmin(s->dmin, d);
-    if (s->pass == 0 ? d > 0 : d > s->dmin + s->slack) return;
-    int better = s->tet < 0 || score < s->score ||
-                 (score == s->score && (d < s->dist || (d == s->dist && t < s->tet)));
-    if (!better) return;
-    s->tet = t, s->dist = d, s->score = score;
-    memcpy(s->b, b, sizeof b);
+    if (box_distance(p, s->tbox + 6 * (int64_t)t, s->tbox + 6 * (int64_t)t + 3) >
+        s->dmin + s->slack)
+        return;
+    candidate c;
+    c.tet = t;
+    tet_bary(s->m, t, p, c.b);
+    c.dist = tet_distance(s->m, t, p, c.b);
+    c.score = -min4(c.b);
+    s->dmin = fmin(s->dmin, c.dist);
+    if (c.dist > s->dmin + s->slack) return;
+    if (s->ncand == s->cap) {
+        int32_t cap = s->cap ? 2 * s->cap : 256;
+        candidate *grown = realloc(s->cand, (size_t)cap * sizeof *grown);
+        if (!grown) {
+            s->oom = 1;
+            return;
+        }
+        s->cand = grown, s->cap = cap;
+    }
+    s->cand[s->ncand++] = c;
 }
 
-/* The tets of the cells at Chebyshev distance exactly r from cell c0. */
+/* The tets of the cells at Chebyshev distance exactly r from cell c0 within reach. */
 static void visit_ring(search *s, const int32_t c0[3], int32_t r, const double p[3]) {
     const grid *g = s->g;
     int32_t lo[3], hi[3], c[3];
@@ -196,11 +223,14 @@ static void visit_ring(search *s, const int32_t c0[3], int32_t r, const double p
         for (c[1] = lo[1]; c[1] <= hi[1]; ++c[1])
             for (c[0] = lo[0]; c[0] <= hi[0]; ++c[0]) {
                 int32_t ring = 0;
+                double clo[3], chi[3];
                 for (int a = 0; a < 3; ++a) {
                     int32_t da = c[a] > c0[a] ? c[a] - c0[a] : c0[a] - c[a];
                     ring = da > ring ? da : ring;
+                    clo[a] = g->lo[a] + c[a] * g->h;
+                    chi[a] = clo[a] + g->h;
                 }
-                if (ring != r) continue;
+                if (ring != r || box_distance(p, clo, chi) > s->dmin + s->slack) continue;
                 int64_t i = cell_index(g, c);
                 for (int32_t k = g->ptr[i]; k < g->ptr[i + 1]; ++k)
                     consider(s, g->tets[k], p);
@@ -208,25 +238,34 @@ static void visit_ring(search *s, const int32_t c0[3], int32_t r, const double p
 }
 
 /* A cell at ring r + 1 or beyond is at least r h from p (p lies in, or beyond the grid
- * from, its own clamped cell), so a pass stops once r h exceeds its reach: dmin in pass
- * 0, dmin + slack in pass 1. A vertex inside the tets is done after its own cell. */
-static void embed_vertex(search *s, const double p[3]) {
+ * from, its own clamped cell), so the rings stop once r h exceeds the reach; a vertex
+ * inside a tet is done after its own cell, which lists every tet holding it. Returns the
+ * chosen candidate, NULL when out of memory. */
+static const candidate *embed_vertex(search *s, const double p[3]) {
     const grid *g = s->g;
     int32_t c0[3];
     cell_of(g, p, c0);
     int32_t rmax = g->dim[0];
     rmax = g->dim[1] > rmax ? g->dim[1] : rmax;
     rmax = g->dim[2] > rmax ? g->dim[2] : rmax;
-    s->tet = -1;
-    s->dmin = s->dist = s->score = INFINITY;
-    for (s->pass = 0; s->pass < 2; ++s->pass) {
-        s->mark++;
-        for (int32_t r = 0; r <= rmax; ++r) {
-            visit_ring(s, c0, r, p);
-            if (s->tet >= 0 && s->pass == 0) return; /* inside */
-            if (r * g->h > s->dmin + (s->pass ? s->slack : 0)) break;
-        }
+    s->dmin = INFINITY;
+    s->ncand = 0;
+    s->mark++;
+    for (int32_t r = 0; r <= rmax; ++r) {
+        visit_ring(s, c0, r, p);
+        if (s->dmin == 0 || r * g->h > s->dmin + s->slack) break;
     }
+    if (s->oom) return NULL;
+    const candidate *best = NULL;
+    for (int32_t k = 0; k < s->ncand; ++k) {
+        const candidate *c = &s->cand[k];
+        if (c->dist > s->dmin + s->slack) continue;
+        if (!best || c->score < best->score ||
+            (c->score == best->score &&
+             (c->dist < best->dist || (c->dist == best->dist && c->tet < best->tet))))
+            best = c;
+    }
+    return best;
 }
 
 /* ---- weld ---------------------------------------------------------------------- */
@@ -299,7 +338,8 @@ sinew_result sw_embed_render(const sw_tetmesh *mesh, const sw_trimesh *render, s
     out->bary = malloc((size_t)n * 4 * sizeof(double));
     out->weld = malloc((size_t)n * sizeof(int32_t));
     s.stamp = calloc((size_t)mesh->ntets, sizeof(int32_t));
-    if (!out->tet || !out->bary || !out->weld || !s.stamp) {
+    double *tbox = malloc((size_t)mesh->ntets * 6 * sizeof(double));
+    if (!out->tet || !out->bary || !out->weld || !s.stamp || !tbox) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "embed: out of memory");
         goto done;
     }
@@ -308,7 +348,10 @@ sinew_result sw_embed_render(const sw_tetmesh *mesh, const sw_trimesh *render, s
         goto done;
     s.m = mesh;
     s.g = &g;
+    s.tbox = tbox;
     s.slack = 0.25 * g.h;
+    for (int32_t t = 0; t < mesh->ntets; ++t)
+        tet_box(mesh, t, tbox + 6 * (int64_t)t, tbox + 6 * (int64_t)t + 3);
     out->worst = -1;
     for (int32_t i = 0; i < n; ++i) {
         int32_t w = out->weld[i];
@@ -318,25 +361,25 @@ sinew_result sw_embed_render(const sw_tetmesh *mesh, const sw_trimesh *render, s
             continue;
         }
         const double *p = render->X + 3 * (int64_t)i;
-        embed_vertex(&s, p);
-        out->tet[i] = s.tet;
-        memcpy(out->bary + 4 * (int64_t)i, s.b, sizeof s.b);
-        for (int k = 0; k < 4; ++k)
-            out->max_bary = fmax(out->max_bary, fabs(s.b[k]));
+        const candidate *c = embed_vertex(&s, p);
+        if (!c) {
+            r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "embed: out of memory");
+            goto done;
+        }
+        out->tet[i] = c->tet;
+        memcpy(out->bary + 4 * (int64_t)i, c->b, sizeof c->b);
+        double bmax = fmax(fmax(fabs(c->b[0]), fabs(c->b[1])), fmax(fabs(c->b[2]), fabs(c->b[3])));
+        out->max_bary = fmax(out->max_bary, bmax);
         if (s.dmin > 0) {
             out->outside++;
             if (s.dmin > out->max_outside) out->max_outside = s.dmin, out->worst = i;
         }
-        if (fabs(s.b[0]) > SW_EMBED_MAX_BARY || fabs(s.b[1]) > SW_EMBED_MAX_BARY ||
-            fabs(s.b[2]) > SW_EMBED_MAX_BARY || fabs(s.b[3]) > SW_EMBED_MAX_BARY) {
-            r = sw_error_set(
-                err, SINEW_ERROR_UNSUPPORTED,
-                "embed: render vertex %d (%g, %g, %g) lies %g outside the tets; "
-                "reaching it from the nearest tet %d takes barycentrics up to %g "
-                "(at most %g): the render mesh does not fit the simulation mesh",
-                i, p[0], p[1], p[2], s.dmin, s.tet,
-                fmax(fmax(fabs(s.b[0]), fabs(s.b[1])), fmax(fabs(s.b[2]), fabs(s.b[3]))),
-                SW_EMBED_MAX_BARY);
+        if (bmax > SW_EMBED_MAX_BARY) {
+            r = sw_error_set(err, SINEW_ERROR_UNSUPPORTED,
+                             "embed: render vertex %d (%g, %g, %g) lies %g outside the tets; "
+                             "reaching it from tet %d takes barycentrics up to %g (at most %g): "
+                             "the render mesh does not fit the simulation mesh",
+                             i, p[0], p[1], p[2], s.dmin, c->tet, bmax, SW_EMBED_MAX_BARY);
             goto done;
         }
     }
@@ -345,6 +388,8 @@ done:
     free(g.ptr);
     free(g.tets);
     free(s.stamp);
+    free(s.cand);
+    free(tbox);
     if (r != SINEW_OK) sw_embedding_free(out);
     out->seconds = sw_now_seconds() - t0;
     return r;
