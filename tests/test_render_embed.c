@@ -176,7 +176,7 @@ TEST(embedding_refuses_what_does_not_fit) {
     c.render.X[3 * 7] = keep;
     c.render.tris[5] = c.render.nverts;
     ENSURE(sw_embed_render(&c.mesh, &c.render, &e, &err) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSUREF(strstr(err.msg, "render triangle 1"), "%s", err.msg);
+    ENSUREF(strstr(err.msg, "render mesh: triangle 1"), "%s", err.msg);
     sw_character_free(&c);
 }
 

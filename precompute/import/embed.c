@@ -302,29 +302,11 @@ static sinew_result weld_map(const sw_trimesh *r, int32_t *weld, int32_t *nwelde
     return SINEW_OK;
 }
 
-static sinew_result check_render(const sw_trimesh *r, sw_error *err) {
-    if (r->nverts < 1 || r->ntris < 1 || !r->X || !r->tris)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "embed: the render mesh has %d vertices and %d triangles", r->nverts,
-                            r->ntris);
-    for (int64_t i = 0; i < 3 * (int64_t)r->nverts; ++i)
-        if (!isfinite(r->X[i]))
-            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                                "embed: render vertex %lld has a non-finite coordinate",
-                                (long long)(i / 3));
-    for (int64_t i = 0; i < 3 * (int64_t)r->ntris; ++i)
-        if (r->tris[i] < 0 || r->tris[i] >= r->nverts)
-            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                                "embed: render triangle %lld: vertex %d outside [0, %d)",
-                                (long long)(i / 3), r->tris[i], r->nverts);
-    return SINEW_OK;
-}
-
 sinew_result sw_embed_render(const sw_tetmesh *mesh, const sw_trimesh *render, sw_embedding *out,
                              sw_error *err) {
     memset(out, 0, sizeof *out);
     double t0 = sw_now_seconds();
-    sinew_result r = check_render(render, err);
+    sinew_result r = sw_trimesh_validate(render, "embed: the render mesh", err);
     if (r != SINEW_OK) return r;
     if (!mesh || mesh->ntets < 1)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "embed: no tets to embed in");

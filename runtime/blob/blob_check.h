@@ -17,6 +17,23 @@ sinew_result sw_blob_fail(char *msg, size_t msg_size, sinew_result code, const c
 #endif
     ;
 
+/* Every index of a (n elements of k indices each: triangles, tets, one a vertex) lies in
+ * [0, bound); messages name the section, the `elem` (and its corner when k > 1) and the
+ * `what` it indexes. */
+sinew_result sw_blob_check_indices(uint32_t id, const char *elem, int k, const int32_t *a,
+                                   int64_t n, const char *what, int32_t bound, char *msg,
+                                   size_t msg_size);
+
+/* A view's array and the section it holds, for sw_blob_check_arrays. */
+typedef struct sw_blob_array_ref {
+    const void *p;
+    uint32_t id;
+} sw_blob_array_ref;
+
+/* Every array of the list is non-NULL (SINEW_ERROR_INVALID_ARGUMENT naming the first that
+ * is not: a writer's view that lacks one). */
+sinew_result sw_blob_check_arrays(const sw_blob_array_ref *a, size_t n, char *msg, size_t msg_size);
+
 /* ptr (n + 1 entries) starts at 0, rises strictly (every `item` has a copy) and ends at
  * ncopies, which is in [1, SW_BLOB_MAX_COPIES]. */
 sinew_result sw_blob_check_copy_ptr(uint32_t ptr_id, uint32_t copies_id, const char *item,

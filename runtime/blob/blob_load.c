@@ -137,21 +137,35 @@ static sinew_result check_meta(const sw_blob_view *v, char *msg, size_t ms) {
     return SINEW_OK;
 }
 
+sinew_result sw_blob_check_arrays(const sw_blob_array_ref *a, size_t n, char *msg, size_t ms) {
+    for (size_t i = 0; i < n; ++i)
+        if (!a[i].p)
+            return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
+                        "blob section %s: the view's array is NULL", sw_blob_section_name(a[i].id));
+    return SINEW_OK;
+}
+
+sinew_result sw_blob_check_indices(uint32_t id, const char *elem, int k, const int32_t *a,
+                                   int64_t n, const char *what, int32_t bound, char *msg,
+                                   size_t ms) {
+    for (int64_t i = 0; i < k * n; ++i) {
+        if (a[i] >= 0 && a[i] < bound) continue;
+        char corner[32] = "";
+        if (k > 1) snprintf(corner, sizeof corner, " corner %d", (int)(i % k));
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section %s: %s %lld%s: %s %d outside [0, %d)", sw_blob_section_name(id),
+                    elem, (long long)(i / k), corner, what, a[i], bound);
+    }
+    return SINEW_OK;
+}
+
 static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) {
-    const struct {
-        const void *p;
-        uint32_t id;
-    } arrays[] = {
+    const sw_blob_array_ref arrays[] = {
 #define ARRAY(id, NAME, elem_size, type, field, ...) {v->field, id},
         SINEW_BLOB_ARRAY_SECTIONS(ARRAY)
 #undef ARRAY
     };
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
-        if (!arrays[i].p)
-            return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
-                        "blob section %s: the view's array is NULL",
-                        sw_blob_section_name(arrays[i].id));
-    return SINEW_OK;
+    return sw_blob_check_arrays(arrays, sizeof arrays / sizeof arrays[0], msg, ms);
 }
 
 /* One domain record against the running prefix sums of the domains before it. */
@@ -377,12 +391,9 @@ static sinew_result check_domain_indices(const sw_blob_view *v, char *msg, size_
 }
 
 static sinew_result check_surface(const sw_blob_view *v, char *msg, size_t ms) {
-    for (int64_t i = 0; i < 3 * (int64_t)v->nsurf_tris; ++i)
-        if (v->surf_tris[i] < 0 || v->surf_tris[i] >= v->nsurf_verts)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section SURF_TRIS: triangle %lld corner %d: vertex %d outside [0, "
-                        "%d)",
-                        (long long)(i / 3), (int)(i % 3), v->surf_tris[i], v->nsurf_verts);
+    sinew_result r = sw_blob_check_indices(SINEW_SECTION_SURF_TRIS, "triangle", 3, v->surf_tris,
+                                           v->nsurf_tris, "vertex", v->nsurf_verts, msg, ms);
+    if (r != SINEW_OK) return r;
     return sw_blob_check_copies(SINEW_SECTION_SURF_COPIES, v, v->surf_copies, v->nsurf_copies, msg,
                                 ms);
 }

@@ -115,17 +115,13 @@ static sinew_result check_nodes(const sw_blob_view *v, char *msg, size_t ms) {
  * extrapolation the bake would have refused amplifies every motion of the tet) and sum to
  * 1 (so a rigid motion of the tet moves the vertex rigidly). */
 static sinew_result check_embedding(const sw_blob_view *v, char *msg, size_t ms) {
-    for (int64_t i = 0; i < 4 * (int64_t)v->nembed_tets; ++i)
-        if (v->render_tets[i] < 0 || v->render_tets[i] >= v->nrender_nodes)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section RENDER_TETS: tet %lld corner %d: render node %d outside "
-                        "[0, %d)",
-                        (long long)(i / 4), (int)(i % 4), v->render_tets[i], v->nrender_nodes);
+    sinew_result r;
+    if ((r = sw_blob_check_indices(SINEW_SECTION_RENDER_TETS, "tet", 4, v->render_tets,
+                                   v->nembed_tets, "render node", v->nrender_nodes, msg, ms)) ||
+        (r = sw_blob_check_indices(SINEW_SECTION_RENDER_TET, "render vertex", 1, v->render_tet,
+                                   v->nrender_verts, "tet", v->nembed_tets, msg, ms)))
+        return r;
     for (int32_t i = 0; i < v->nrender_verts; ++i) {
-        if (v->render_tet[i] < 0 || v->render_tet[i] >= v->nembed_tets)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section RENDER_TET: render vertex %d: tet %d outside [0, %d)", i,
-                        v->render_tet[i], v->nembed_tets);
         const double *b = v->render_bary + 4 * (int64_t)i;
         double sum = 0;
         for (int k = 0; k < 4; ++k) {
@@ -152,13 +148,12 @@ static sinew_result check_embedding(const sw_blob_view *v, char *msg, size_t ms)
 /* The weld map names a representative that stands for itself: duplicates are copied from
  * a vertex the runtime computes, never from another duplicate. */
 static sinew_result check_weld(const sw_blob_view *v, char *msg, size_t ms) {
+    sinew_result r =
+        sw_blob_check_indices(SINEW_SECTION_RENDER_WELD, "render vertex", 1, v->render_weld,
+                              v->nrender_verts, "representative", v->nrender_verts, msg, ms);
+    if (r != SINEW_OK) return r;
     for (int32_t i = 0; i < v->nrender_verts; ++i) {
         int32_t w = v->render_weld[i];
-        if (w < 0 || w >= v->nrender_verts)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section RENDER_WELD: render vertex %d: representative %d outside "
-                        "[0, %d)",
-                        i, w, v->nrender_verts);
         if (v->render_weld[w] != w)
             return fail(msg, ms, SINEW_ERROR_CORRUPT,
                         "blob section RENDER_WELD: render vertex %d: representative %d is "
@@ -179,26 +174,15 @@ sinew_result sw_blob_render_validate(const sw_blob_view *v, char *msg, size_t ms
     }
     sinew_result r = check_counts(v, msg, ms);
     if (r != SINEW_OK) return r;
-    const struct {
-        const void *p;
-        uint32_t id;
-    } arrays[] = {
+    const sw_blob_array_ref arrays[] = {
 #define ARRAY(id, NAME, elem_size, type, field, ...) {v->field, id},
         SINEW_BLOB_RENDER_ARRAY_SECTIONS(ARRAY)
 #undef ARRAY
     };
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
-        if (!arrays[i].p)
-            return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
-                        "blob section %s: the view's array is NULL",
-                        sw_blob_section_name(arrays[i].id));
-    for (int64_t i = 0; i < 3 * (int64_t)v->nrender_tris; ++i)
-        if (v->render_tris[i] < 0 || v->render_tris[i] >= v->nrender_verts)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section RENDER_TRIS: triangle %lld corner %d: vertex %d outside "
-                        "[0, %d)",
-                        (long long)(i / 3), (int)(i % 3), v->render_tris[i], v->nrender_verts);
-    if ((r = check_nodes(v, msg, ms)) != SINEW_OK) return r;
-    if ((r = check_embedding(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_check_arrays(arrays, sizeof arrays / sizeof arrays[0], msg, ms)) ||
+        (r = sw_blob_check_indices(SINEW_SECTION_RENDER_TRIS, "triangle", 3, v->render_tris,
+                                   v->nrender_tris, "vertex", v->nrender_verts, msg, ms)) ||
+        (r = check_nodes(v, msg, ms)) || (r = check_embedding(v, msg, ms)))
+        return r;
     return check_weld(v, msg, ms);
 }
