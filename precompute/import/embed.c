@@ -275,11 +275,17 @@ typedef struct keyed {
     int32_t i;
 } keyed;
 
-static int keyed_cmp(const void *pa, const void *pb) {
-    const keyed *a = pa, *b = pb;
+/* Position order (-0 and 0 are one position), then index. */
+static int position_cmp(const keyed *a, const keyed *b) {
     for (int k = 0; k < 3; ++k)
         if (a->x[k] != b->x[k]) return a->x[k] < b->x[k] ? -1 : 1;
-    return (a->i > b->i) - (a->i < b->i);
+    return 0;
+}
+
+static int keyed_cmp(const void *pa, const void *pb) {
+    const keyed *a = pa, *b = pb;
+    int c = position_cmp(a, b);
+    return c ? c : (a->i > b->i) - (a->i < b->i);
 }
 
 /* weld[i]: the lowest index among the render vertices at i's rest position. */
@@ -293,7 +299,7 @@ static sinew_result weld_map(const sw_trimesh *r, int32_t *weld, int32_t *nwelde
     qsort(k, (size_t)r->nverts, sizeof *k, keyed_cmp);
     *nwelded = 0;
     for (int32_t j = 0, rep = 0; j < r->nverts; ++j) {
-        if (j > 0 && memcmp(k[j].x, k[j - 1].x, sizeof k[j].x) != 0) rep = j;
+        if (j > 0 && position_cmp(&k[j], &k[j - 1]) != 0) rep = j;
         /* equal keys sort by index: the group's first is its lowest */
         weld[k[j].i] = k[rep].i;
         *nwelded += rep != j;

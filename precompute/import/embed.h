@@ -36,7 +36,7 @@ typedef struct sw_embedding {
  * among the tets within a quarter of a cell of the nearest one, the tet whose affine map
  * extrapolates least to reach it, with barycentrics that still reproduce it exactly
  * (negative ones, |b| <= SW_EMBED_MAX_BARY, else SINEW_ERROR_UNSUPPORTED naming the
- * vertex and its distance). Duplicates (bitwise equal rest positions) share their
+ * vertex and its distance). Duplicates (equal rest positions) share their
  * representative's embedding. A uniform grid over the tets' boxes keeps it about linear:
  * 100K tets and 50K render vertices in well under a second. Errors: INVALID_ARGUMENT
  * (empty or non-finite render mesh, a triangle index out of range), OUT_OF_MEMORY. */
