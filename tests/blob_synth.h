@@ -174,6 +174,44 @@ static inline void fixture_init(fixture *f, uint64_t seed) {
 #undef POINT
 }
 
+/* ---- the optional render mesh (sinew_blob_format.h, ids 27..34) ------------------ */
+
+enum {
+    NRV = 5, /* render vertices: 4 and a duplicate of vertex 0 */
+    NRT = 3, /* render triangles */
+    NET = 2, /* embedding tets */
+    NRN = 5, /* render nodes: simulation vertices 0..4 */
+    NRC = 7  /* their copies: vertices 0 and 4 have two */
+};
+
+typedef struct render_fixture {
+    int32_t render_tris[3 * NRT], render_tet[NRV];
+    double render_bary[4 * NRV];
+    int32_t render_weld[NRV], render_tets[4 * NET], render_node_ptr[NRN + 1];
+    int32_t render_node_copies[2 * NRC];
+} render_fixture;
+
+/* Gives f's view a render mesh held in r: one vertex extrapolated outside its tet, one a
+ * welded duplicate; the nodes' copies are the fixture's (vertex 0 in domains 0 and 2,
+ * vertex 4 in domains 0 and 1). */
+static inline void fixture_add_render(fixture *f, render_fixture *r) {
+    static const render_fixture k = {{0, 1, 2, 1, 3, 2, 4, 2, 3},
+                                     {0, 0, 1, 1, 0},
+                                     {0.25, 0.25, 0.25, 0.25, 0.1, 0.2, 0.3,  0.4,  1.5,  -0.5,
+                                      0,    0,    0.2,  0.2,  0.3, 0.3, 0.25, 0.25, 0.25, 0.25},
+                                     {0, 1, 2, 3, 0},
+                                     {0, 1, 2, 3, 1, 2, 3, 4},
+                                     {0, 2, 3, 4, 5, 7},
+                                     {0, 0, 2, 4, 0, 1, 0, 2, 0, 3, 0, 4, 1, 0}};
+    *r = k;
+    sw_blob_view *v = &f->v;
+    v->nrender_verts = NRV, v->nrender_tris = NRT, v->nembed_tets = NET;
+    v->nrender_nodes = NRN, v->nrender_copies = NRC;
+#define POINT(id, NAME, elem_size, type, field, ...) v->field = r->field;
+    SINEW_BLOB_RENDER_ARRAY_SECTIONS(POINT)
+#undef POINT
+}
+
 /* ---- helpers --------------------------------------------------------------------- */
 
 /* First field in which two views differ (counts, scalars bitwise, arrays bitwise), or

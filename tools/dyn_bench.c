@@ -12,12 +12,23 @@
 #include "subspace_eval.h"
 #include "tool_common.h"
 
-/* The simulation vertex behind each output surface vertex (its first copy). */
-static void surface_vertices(const sw_blob_view *v, int32_t *sv) {
-    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
-        const int32_t *c = v->surf_copies + 2 * v->surf_copy_ptr[s];
-        sv[s] = v->domain_verts[v->domains[c[0]].vert_begin + c[1]];
+/* The reference's lumped mass at each output vertex (sm), as the output places the
+ * vertex: a boundary vertex's own, a render vertex's barycentric blend of its tet's
+ * corners' (at least 0: an extrapolated blend may dip below). 0 when out of memory. */
+static int surface_masses(const sw_blob_view *v, const double *mass, double *sm) {
+    int32_t ns = sw_blob_output_verts(v);
+    double *m3 = malloc(sizeof(double) * 3 * (size_t)v->nverts),
+           *o3 = malloc(sizeof(double) * 3 * (size_t)ns);
+    if (m3 && o3) {
+        for (int32_t i = 0; i < v->nverts; ++i)
+            m3[3 * i] = m3[3 * i + 1] = m3[3 * i + 2] = mass[i];
+        sw_output_from_full(v, m3, o3); /* the output's own map, one component a mass */
+        for (int32_t s = 0; s < ns; ++s)
+            sm[s] = fmax(0, o3[3 * s]);
     }
+    int ok = m3 && o3;
+    free(m3), free(o3);
+    return ok;
 }
 
 /* The mass-weighted RMS distance between two surfaces (3 ns each), weights m (ns). */
@@ -59,7 +70,6 @@ typedef struct dyn_run {
     double *xd, *xq, *cnt;   /* its and the dynamic instance's full positions */
     double inc_num, inc_den; /* the dynamic increment's sums */
     double *full_ms, *sub_ms, *hs_full, *hs_sub, *sm; /* per step; hold surfaces; masses */
-    int32_t *sv;
 } dyn_run;
 
 static void run_free(dyn_run *r) {
@@ -76,7 +86,6 @@ static void run_free(dyn_run *r) {
     free(r->hs_full);
     free(r->hs_sub);
     free(r->sm);
-    free(r->sv);
 }
 
 /* Both runs settled at pose T0 (dyn_bench.h). */
@@ -153,24 +162,24 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
 
     dyn_run r;
     memset(&r, 0, sizeof r);
-    int32_t ns = v->nsurf_verts, nb = ch->skel.nbones;
+    int32_t ns = sw_blob_output_verts(v), nb = ch->skel.nbones;
     size_t hsz = (size_t)H * 3 * ns * sizeof(double);
     r.full_ms = malloc((size_t)N * sizeof(double));
     r.sub_ms = malloc((size_t)N * sizeof(double));
     r.hs_full = malloc(hsz);
     r.hs_sub = malloc(hsz);
     r.sm = malloc((size_t)ns * sizeof(double));
-    r.sv = malloc((size_t)ns * sizeof(int32_t));
     sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
-    if (!r.full_ms || !r.sub_ms || !r.hs_full || !r.hs_sub || !r.sm || !r.sv) {
+    if (!r.full_ms || !r.sub_ms || !r.hs_full || !r.hs_sub || !r.sm) {
         sw_error_set(err, res, "out of memory");
         goto done;
     }
-    surface_vertices(v, r.sv);
     if ((res = start_settled(ch, blob, &fd, ch->clip.T, &r, h, err)) != SINEW_OK) goto done;
     const double *mass = sw_fullsim_masses(r.ref);
-    for (int32_t s = 0; s < ns; ++s)
-        r.sm[s] = mass[r.sv[s]];
+    if (!surface_masses(v, mass, r.sm)) {
+        res = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
     if ((res = sw_eval_acc_init(&r.clip, blob, mass, err)) != SINEW_OK ||
         (res = sw_eval_acc_init(&r.hold, blob, mass, err)) != SINEW_OK)
         goto done;
@@ -214,8 +223,7 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         if (f >= F) { /* the hold: both surfaces, for the overshoot */
             double *a = r.hs_full + (size_t)(f - F) * 3 * ns,
                    *b = r.hs_sub + (size_t)(f - F) * 3 * ns;
-            for (int32_t s = 0; s < ns; ++s)
-                memcpy(a + 3 * s, x + 3 * (size_t)r.sv[s], 3 * sizeof(double));
+            sw_output_from_full(v, x, a); /* the reference through the output's own map */
             memcpy(b, sw_instance_surface(r.inst), 3 * (size_t)ns * sizeof(double));
         }
     }

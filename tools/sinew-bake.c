@@ -187,6 +187,14 @@ int main(int argc, char **argv) {
     fprintf(stderr,
             "  poses: %d training, %d held-out; basis projection error train %.4f held-out %.4f\n",
             res.ntrain, res.nheldout, res.train_proj_error, res.heldout_proj_error);
+    if (v->nrender_verts > 0)
+        fprintf(stderr,
+                "  output: the render mesh, %d vertices (%d welded duplicates), %d triangles, "
+                "embedded in %d tets in %.1f ms; %d vertices outside the tets, by %.4g at most; "
+                "|barycentric| <= %.3g\n",
+                v->nrender_verts, res.render_welded, v->nrender_tris, v->nembed_tets,
+                1e3 * res.embed_seconds, res.render_outside, res.render_max_outside,
+                res.render_max_bary);
     if (res.train_unsettled + res.heldout_unsettled > 0)
         fprintf(
             stderr,
@@ -222,6 +230,12 @@ int main(int argc, char **argv) {
                res.train_unsettled, res.heldout_unsettled, bake_seconds, eval_seconds,
                res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+        printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
+               "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
+               "\"embed_seconds\":%.4f",
+               sw_blob_output_verts(v), sw_blob_output_ntris(v),
+               v->nrender_verts > 0 ? "true" : "false", res.render_outside, res.render_max_outside,
+               res.render_max_bary, res.embed_seconds);
         if (p.compare_selectors)
             printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
                    "\"nnhtp\":[%d,%.3f,%.4f]}",

@@ -9,7 +9,9 @@
  *   full_ms   median full-space quasistatic ms/frame (self-contact on) over the clip (or
  *             its first K frames)
  *   sub_ms    median subspace step + surface read ms/frame over the clip
- *   dqs_ms    median ms/frame of DQS of the render surface (positions and normals)
+ *   dqs_ms    median ms/frame of DQS of the output surface (positions and normals): the
+ *             render mesh's own vertices when the blob embeds one (issue 14), so
+ *             cost_vs_dqs is the cost against skinning the very mesh a host draws
  *   correction error |x_sub - x_full|_M / |x_full - x_dqs|_M, always through
  *             sw_bake_errors (one definition), on one of three pose sets (err_source):
  *   err_train, err_heldout  without --blob: on the bake's training and held-out poses,
@@ -40,7 +42,9 @@
  * runtime with that world on the same mesh and motion (world_bench.h) and adds
  *   world_contact_frames  frames in which the reference touches a collider
  *   err_world_sub         correction error over those frames, subspace vs reference
- *   pen_world_full, pen_world_sub  deepest penetration into any collider (world units)
+ *   pen_world_full, pen_world_sub  deepest penetration into any collider (world units;
+ *                         with a render mesh both of the render mesh, the reference's
+ *                         placed by the blob's embedding)
  *   world_query_ms        median ms of a step's world detection; world_queries, the
  *                         mean collider queries a step; world_contacts, the mean copies
  *                         in contact
@@ -60,7 +64,9 @@
  *                     0 .. H-2, mass-weighted RMS distance of the output surface from
  *                     its position at the last hold frame (H-1),
  *                     sqrt(sum_s m_s |x_s(f) - x_s(H-1)|^2 / sum_s m_s), m_s the
- *                     reference's lumped mass of surface vertex s (world units); it counts
+ *                     reference's lumped mass of surface vertex s (world units; with a
+ *                     render mesh the reference's surface is placed by the blob's own
+ *                     embedding and m_s is its barycentric blend of masses); it counts
  *                     the lag the flesh still has when the skeleton stops and every swing
  *                     past the settled shape after it
  *   overshoot_ratio   overshoot_sub / overshoot_full (target |ratio - 1| <= 0.2)
@@ -162,10 +168,50 @@ static void usage(FILE *f) {
             "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
 }
 
-/* Plain DQS of the render surface (positions and area-weighted normals): the cost a
- * host pays today, timed per frame over the clip. */
-static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames,
-                     const int32_t *surf_vert, double *x, double *n) {
+/* What plain skinning of the output surface reads: per output vertex its rest position
+ * and 4 influences. The boundary's vertices are simulation vertices with their own; a
+ * render mesh's rest positions are its embedding's, and its influences those of the
+ * simulation vertex it weighs most (the blob keeps no render-vertex weights; the cost,
+ * what dqs_ms times, is a 4-influence blend a vertex either way). */
+typedef struct dqs_surface {
+    int32_t n;
+    double *X, *w; /* 3 n rest positions, 4 n weights */
+    int32_t *bone; /* 4 n bone ids */
+} dqs_surface;
+
+static int dqs_surface_make(const sw_blob_view *v, dqs_surface *d) {
+    d->n = sw_blob_output_verts(v);
+    d->X = malloc(sizeof(double) * 3 * (size_t)d->n);
+    d->w = malloc(sizeof(double) * 4 * (size_t)d->n);
+    d->bone = malloc(sizeof(int32_t) * 4 * (size_t)d->n);
+    if (!d->X || !d->w || !d->bone) return 0;
+    sw_output_from_full(v, v->rest, d->X);
+    for (int32_t s = 0; s < d->n; ++s) {
+        int32_t gv;
+        if (v->nrender_verts > 0) {
+            const double *b = v->render_bary + 4 * (int64_t)s;
+            int k = 0;
+            for (int j = 1; j < 4; ++j)
+                k = b[j] > b[k] ? j : k;
+            gv = sw_render_node_vertex(v, v->render_tets[4 * (int64_t)v->render_tet[s] + k]);
+        } else {
+            const int32_t *c = v->surf_copies + 2 * (int64_t)v->surf_copy_ptr[s];
+            gv = v->domain_verts[v->domains[c[0]].vert_begin + c[1]];
+        }
+        memcpy(d->bone + 4 * s, v->skin_bone + 4 * (int64_t)gv, 4 * sizeof(int32_t));
+        memcpy(d->w + 4 * s, v->skin_weight + 4 * (int64_t)gv, 4 * sizeof(double));
+    }
+    return 1;
+}
+
+static void dqs_surface_free(dqs_surface *d) {
+    free(d->X), free(d->w), free(d->bone);
+}
+
+/* Plain DQS of the output surface (positions and area-weighted normals over its own
+ * triangles): the cost a host pays today, timed per frame over the clip. */
+static double dqs_ms(const sw_blob_view *v, const dqs_surface *d, const sw_clip *clip, int frames,
+                     double *x, double *n) {
     double *ms = malloc((size_t)frames * sizeof(double));
     sw_dualquat dq[SW_MAX_BONES];
     for (int f = 0; f < frames && ms; ++f) {
@@ -173,15 +219,14 @@ static double dqs_ms(const sw_blob_view *v, const sw_clip *clip, int frames,
         double t0 = sw_now_seconds();
         for (int32_t b = 0; b < v->nbones; ++b)
             sw_dq_from_transform(T + 12 * b, &dq[b]);
-        for (int32_t s = 0; s < v->nsurf_verts; ++s) {
-            int32_t gv = surf_vert[s];
+        for (int32_t s = 0; s < d->n; ++s) {
             double R[9], t[3];
-            const double *X = v->rest + 3 * gv;
-            sw_dqs_blend(dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            const double *X = d->X + 3 * s;
+            sw_dqs_blend(dq, d->bone + 4 * s, d->w + 4 * s, 4, R, t);
             for (int i = 0; i < 3; ++i)
                 x[3 * s + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
         }
-        sw_surface_normals(v->nsurf_verts, x, v->nsurf_tris, v->surf_tris, n);
+        sw_surface_normals(d->n, x, sw_blob_output_ntris(v), sw_blob_output_tris(v), n);
         ms[f] = 1e3 * (sw_now_seconds() - t0);
     }
     double m = sw_median(ms, frames);
@@ -419,15 +464,15 @@ int main(int argc, char **argv) {
     if (out_dir && (r = write_frames(out_dir, blob, inst, &ch, &err)) != SINEW_OK)
         return sw_tool_failed(r, &err, "%s: --out %s: ", tool, out_dir);
 
-    /* 4. plain DQS of the same surface */
-    int32_t *surf_vert = malloc((size_t)ns * sizeof(int32_t));
-    for (uint32_t s = 0; s < ns; ++s) {
-        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * v->surf_copy_ptr[s]]];
-        surf_vert[s] = v->domain_verts[D->vert_begin + v->surf_copies[2 * v->surf_copy_ptr[s] + 1]];
-    }
+    /* 4. plain DQS of the same surface (the render mesh's own vertices when it has one) */
+    dqs_surface ds;
     double *xs = malloc((size_t)ns * 3 * sizeof(double)),
            *xn = malloc((size_t)ns * 3 * sizeof(double));
-    double d_ms = dqs_ms(v, &ch.clip, nf, surf_vert, xs, xn);
+    if (!dqs_surface_make(v, &ds) || !xs || !xn) {
+        fprintf(stderr, "sinew-bench: out of memory\n");
+        return 1;
+    }
+    double d_ms = dqs_ms(v, &ds, &ch.clip, nf, xs, xn);
 
     /* 5. errors against full-space solutions, always by the bake's definition
        (sw_bake_errors): on the bake's poses when it baked here; a given blob on the clip
@@ -624,7 +669,7 @@ int main(int argc, char **argv) {
     free(nrm);
     free(xs);
     free(xn);
-    free(surf_vert);
+    dqs_surface_free(&ds);
     sinew_instance_destroy(inst);
     sinew_blob_destroy(blob);
     free(mem);

@@ -174,7 +174,7 @@ int main(int argc, char **argv) {
         return 1;
     }
     const sw_blob_view *v = sw_blob_get_view(blob);
-    int32_t nb = v->nbones, ns = v->nsurf_verts;
+    int32_t nb = v->nbones, ns = sw_blob_output_verts(v);
     mocap mc;
     int have_mocap = mocap_read(bvh, &mc);
     if (!have_mocap)

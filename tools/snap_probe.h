@@ -94,7 +94,7 @@ static inline double snap_deviation(const sinew_instance *inst, const sw_blob_vi
     const double *x = sw_instance_surface(inst);
     sw_instance_skinned_surface(inst, skin);
     double m = 0;
-    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+    for (int32_t s = 0; s < sw_blob_output_verts(v); ++s) {
         double d2 = 0;
         for (int k = 0; k < 3; ++k) {
             if (!isfinite(x[3 * s + k])) return -1;

@@ -90,19 +90,26 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
     sinew_result r = sinew_instance_create(blob, NULL, &inst);
     if (r != SINEW_OK) return sw_error_set(err, r, "cannot create an instance");
     sinew_instance_set_world(inst, ws->world);
-    int32_t n = v->nverts;
-    time_subspace(inst, ws, T, nf, v->nbones, (uint32_t)v->nsurf_verts, out, err);
+    int32_t n = v->nverts, ns = sw_blob_output_verts(v);
+    time_subspace(inst, ws, T, nf, v->nbones, (uint32_t)ns, out, err);
     double *xs = malloc(sizeof(double) * 3 * n), *cnt = malloc(sizeof(double) * n),
-           *xd = malloc(sizeof(double) * 3 * n);
+           *xd = malloc(sizeof(double) * 3 * n), *xo = malloc(sizeof(double) * 3 * ns);
     double num = 0, den = 0;
-    for (int f = 0; f < nf && xs && cnt && xd; ++f) {
+    /* a render mesh: the reference's penetration is its render mesh's too, placed by the
+       same embedding, not its tet boundary's (like with like) */
+    if (v->nrender_verts > 0) out->pen_world_full = 0;
+    for (int f = 0; f < nf && xs && cnt && xd && xo; ++f) {
         if ((r = sw_world_scene_at(ws, f, err)) != SINEW_OK) break;
         sw_instance_set_pose_d(inst, T + (size_t)f * 12 * v->nbones);
         out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
-        out->pen_world_sub =
-            fmax(out->pen_world_sub,
-                 sw_world_max_penetration(ws->world, v->nsurf_verts, sw_instance_surface(inst),
-                                          NULL, NULL, NULL));
+        out->pen_world_sub = fmax(
+            out->pen_world_sub,
+            sw_world_max_penetration(ws->world, ns, sw_instance_surface(inst), NULL, NULL, NULL));
+        if (v->nrender_verts > 0) {
+            sw_output_from_full(v, x_full + (size_t)f * 3 * n, xo);
+            out->pen_world_full = fmax(
+                out->pen_world_full, sw_world_max_penetration(ws->world, ns, xo, NULL, NULL, NULL));
+        }
         if (!touch[f]) continue;
         sw_instance_full_positions(inst, xs, cnt);
         sw_instance_dqs_positions(inst, xd);
@@ -130,7 +137,7 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
             out->allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
         if (active & SW_RT_CAT_LOCKS) out->locks = (long)c.locks;
     }
-    free(xs), free(cnt), free(xd);
+    free(xs), free(cnt), free(xd), free(xo);
     sinew_instance_destroy(inst);
     return r;
 }

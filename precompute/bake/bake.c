@@ -179,6 +179,7 @@ static void free_state(sw_bake_state *s) {
     free(s->cub_n);
     free(s->cub_local);
     free(s->cub_w);
+    sw_embedding_free(&s->embed);
     sw_pool_destroy(s->pool);
 }
 
@@ -300,6 +301,19 @@ sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
     return r;
 }
 
+/* embed: the render mesh in the tets (embed.h), its figures into the report. */
+static sinew_result embed_render(sw_bake_state *s, const sw_character *c, sw_bake_result *out,
+                                 sw_error *err) {
+    sinew_result r = sw_embed_render(&c->mesh, &c->render, &s->embed, err);
+    if (r != SINEW_OK) return r;
+    out->render_outside = s->embed.outside;
+    out->render_welded = s->embed.nwelded;
+    out->render_max_outside = s->embed.max_outside;
+    out->render_max_bary = s->embed.max_bary;
+    out->embed_seconds = s->embed.seconds;
+    return SINEW_OK;
+}
+
 sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bake_result *out,
                      sw_error *err) {
     memset(out, 0, sizeof *out);
@@ -312,6 +326,18 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     t1 = sw_now_seconds();
     out->stage_seconds[0] = t1 - t0;
     progress(&p, "prepare", t1 - t0, heat ? "heat-diffusion weights" : "asset weights");
+    if (c->render.nverts > 0) {
+        t0 = t1;
+        if ((r = embed_render(&s, c, out, err)) != SINEW_OK) goto done;
+        t1 = sw_now_seconds();
+        char msg[160];
+        snprintf(msg, sizeof msg,
+                 "%d render vertices (%d welded duplicates), %d outside the tets by %.3g at "
+                 "most, |barycentric| <= %.3g",
+                 c->render.nverts, out->render_welded, out->render_outside, out->render_max_outside,
+                 out->render_max_bary);
+        progress(&p, "embed", t1 - t0, msg);
+    }
 
     t0 = t1;
     if ((r = sw_bake_domains(&s, err)) != SINEW_OK) goto done;
@@ -371,7 +397,8 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
 
     t0 = t1;
     if ((r = sw_bake_contacts(&s, err)) != SINEW_OK ||
-        (r = sw_bake_reduce(&s, out, err)) != SINEW_OK)
+        (r = sw_bake_reduce(&s, out, err)) != SINEW_OK ||
+        (r = sw_bake_render(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;

@@ -17,6 +17,10 @@
  *   cubature  per domain on the reduced elastic forces of snapshots and perturbed
  *             snapshots (eqs. 2.11-2.19)
  *   reduce    interface-spring Hessian (eq. 4.20), reduced mass, inertial projections
+ *   embed     with a render mesh (sw_character.render): its embedding in the tets, computed
+ *             right after prepare (a mesh that does not fit fails before the long
+ *             stages), written as the blob's render sections after reduce: the blob's
+ *             output surface is then the render mesh
  */
 #ifndef SW_BAKE_H
 #define SW_BAKE_H
@@ -63,7 +67,7 @@ sw_bake_params sw_bake_params_default(void);
 /* What the bake made, plus the arrays the view points into (owned). */
 typedef struct sw_bake_result {
     sw_blob_view view;
-    void *storage[32]; /* owned arrays (freed by sw_bake_result_free) */
+    void *storage[48]; /* owned arrays (freed by sw_bake_result_free) */
     int nstorage;
     /* report */
     double stage_seconds[8]; /* prepare, domains, poses+simulate, basis, cubature, reduce */
@@ -75,6 +79,11 @@ typedef struct sw_bake_result {
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     double cubature_error_max; /* worst per-domain relative cubature training error */
+    /* the render mesh's embedding (sw_character.render; all 0 without one): render
+       vertices outside every tet, the largest distance of one from the tets, the largest
+       |barycentric|, duplicates welded to another vertex, seconds (embed.h) */
+    int32_t render_outside, render_welded;
+    double render_max_outside, render_max_bary, embed_seconds;
     /* per selector (greedy, importance, NN-HTP), summed over domains; filled for the
        chosen selector, and for all three with compare_selectors */
     int32_t selector_points[3];

@@ -6,6 +6,7 @@
 
 #include "bake.h"
 #include "dqs.h"
+#include "embed.h"
 #include "selfcontact.h"
 #include "thread_pool.h"
 
@@ -67,6 +68,7 @@ typedef struct sw_bake_state {
     int32_t **cub_local; /* index into the domain's dom_tets range */
     double **cub_w;
     sw_pool *pool;
+    sw_embedding embed; /* the render mesh in the tets (none: nverts 0) */
     /* progress of the running stage (sw_bake_progress) */
     pthread_mutex_t progress_lock;
     int64_t progress_done, progress_total;
@@ -90,6 +92,9 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* The render mesh's sections of the view from s->embed (nothing without a render mesh);
+ * after sw_bake_reduce (bake_render.c). */
+sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 
 /* Records an owned allocation in the result (freed with it); returns p. */
 void *sw_bake_own(sw_bake_result *out, void *p);

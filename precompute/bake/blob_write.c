@@ -1,6 +1,7 @@
-/* Blob layout: header (64 bytes), section table (26 entries), then the 26 sections in id
- * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
- * everything after the header. */
+/* Blob layout: header (64 bytes), section table (26 entries, 34 with a render mesh), then
+ * the sections in id order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum
+ * (FNV-1a 64) covers everything after the header. A view without a render mesh writes
+ * exactly the 26 sections it always did, byte for byte. */
 #include "blob_write.h"
 
 #include <errno.h>
@@ -23,17 +24,28 @@ static uint64_t round_up(uint64_t x) {
     return (x + SINEW_BLOB_ALIGN - 1) / SINEW_BLOB_ALIGN * SINEW_BLOB_ALIGN;
 }
 
-/* The 26 sections of a validated view, in id order; `meta` must outlive the result. */
-static void list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
-                          section_src s[SINEW_SECTION_COUNT_V1]) {
-    SW_BLOB_COUNT_LOCALS(v);
 #define SOURCE(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
     {id, elem_size, v->field, count},
+
+/* The sections of a validated view, in id order, into s; returns their number (26, or 34
+ * with a render mesh). `meta` and `rmeta` must outlive the result. */
+static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
+                         const sinew_blob_render_meta *rmeta, section_src s[SINEW_SECTION_ID_MAX]) {
+    SW_BLOB_COUNT_LOCALS(v);
     const section_src list[SINEW_SECTION_COUNT_V1] = {{SINEW_SECTION_META, sizeof *meta, meta, 1},
                                                       SINEW_BLOB_ARRAY_SECTIONS(SOURCE)};
-#undef SOURCE
     memcpy(s, list, sizeof list);
+    if (v->nrender_verts == 0) return SINEW_SECTION_COUNT_V1;
+#define RENDER_COUNT_LOCAL(name) const uint64_t name = (uint64_t)v->name;
+    SINEW_BLOB_RENDER_COUNTS(RENDER_COUNT_LOCAL)
+#undef RENDER_COUNT_LOCAL
+    const section_src render[SINEW_SECTION_ID_MAX - SINEW_SECTION_COUNT_V1] = {
+        {SINEW_SECTION_RENDER_META, sizeof *rmeta, rmeta, 1},
+        SINEW_BLOB_RENDER_ARRAY_SECTIONS(SOURCE)};
+    memcpy(s + SINEW_SECTION_COUNT_V1, render, sizeof render);
+    return SINEW_SECTION_ID_MAX;
 }
+#undef SOURCE
 
 sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t *size,
                                   sw_error *err) {
@@ -52,12 +64,18 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     SW_BLOB_META_FIELDS(TO_META)
 #undef TO_META
 
-    section_src src[SINEW_SECTION_COUNT_V1];
-    sinew_blob_section table[SINEW_SECTION_COUNT_V1];
-    list_sections(view, &meta, src);
+    sinew_blob_render_meta rmeta;
+    memset(&rmeta, 0, sizeof rmeta);
+#define TO_RENDER_META(field) rmeta.field = view->field;
+    SINEW_BLOB_RENDER_COUNTS(TO_RENDER_META)
+#undef TO_RENDER_META
+
+    section_src src[SINEW_SECTION_ID_MAX];
+    sinew_blob_section table[SINEW_SECTION_ID_MAX];
+    const int nsec = list_sections(view, &meta, &rmeta, src);
     /* Validated counts are bounded (blob_load.h limits), so no sum below overflows. */
-    uint64_t at = round_up(sizeof(sinew_blob_header) + sizeof table);
-    for (int i = 0; i < SINEW_SECTION_COUNT_V1; ++i) {
+    uint64_t at = round_up(sizeof(sinew_blob_header) + (uint64_t)nsec * sizeof table[0]);
+    for (int i = 0; i < nsec; ++i) {
         memset(&table[i], 0, sizeof table[i]);
         table[i].id = src[i].id;
         table[i].elem_size = src[i].elem_size;
@@ -74,8 +92,8 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "blob write: cannot allocate %zu bytes",
                             total);
     memset(buf, 0, total); /* padding is zero */
-    memcpy(buf + sizeof(sinew_blob_header), table, sizeof table);
-    for (int i = 0; i < SINEW_SECTION_COUNT_V1; ++i)
+    memcpy(buf + sizeof(sinew_blob_header), table, (size_t)nsec * sizeof table[0]);
+    for (int i = 0; i < nsec; ++i)
         memcpy(buf + table[i].offset, src[i].src, (size_t)(src[i].count * src[i].elem_size));
 
     sinew_blob_header h;
@@ -84,7 +102,7 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     h.version = SINEW_BLOB_VERSION;
     h.header_size = (uint32_t)sizeof h;
     h.file_size = total;
-    h.section_count = SINEW_SECTION_COUNT_V1;
+    h.section_count = (uint32_t)nsec;
     h.endian_tag = SINEW_BLOB_ENDIAN_TAG;
     h.section_table_offset = sizeof h;
     h.checksum = sw_blob_checksum(buf + sizeof h, total - sizeof h);

@@ -294,13 +294,16 @@ sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets
     sinew_result rc = sw_read_obj(obj_path, &surf, err);
     if (rc) return rc;
     rc = sw_tetmesh_from_surface(&surf, target_tets, NULL, &out->mesh, report, err);
-    sw_trimesh_free(&surf);
     if (rc) {
+        sw_trimesh_free(&surf);
         char msg[sizeof err->msg];
         snprintf(msg, sizeof msg, "%s", err ? err->msg : "");
         sw_error_set(err, rc, "%s: %s", obj_path, msg);
         return rc;
     }
+    /* the artist's surface is what the runtime outputs, carried by the lattice's tets
+       (issue 14); finish_character frees it with the character on an error */
+    out->render = surf;
     return finish_character(obj_path, tgf_path, NULL, motion_path, nframes, out, err);
 }
 

@@ -23,7 +23,8 @@ sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path
 /* A character from a render surface (.obj; it need not be closed) filled with about
  * target_tets tets by the lattice mesher (tet_lattice.h; report may be NULL), a .tgf
  * skeleton and optional motion as in sw_character_from_files; inverse-distance weights
- * (a caller may compute heat-diffusion weights instead, as sinew-bake does). */
+ * (a caller may compute heat-diffusion weights instead, as sinew-bake does). out->render
+ * is the surface itself: a bake embeds it and the blob outputs it (issue 14). */
 sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets,
                                        const char *tgf_path, const char *motion_path,
                                        int32_t nframes, sw_character *out,

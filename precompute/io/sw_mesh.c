@@ -70,6 +70,23 @@ double sw_tet_signed_volume(const double *a, const double *b, const double *c, c
            6.0;
 }
 
+sinew_result sw_trimesh_validate(const sw_trimesh *m, const char *who, sw_error *err) {
+    if (!m || m->nverts < 3 || m->ntris < 1 || !m->X || !m->tris)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "%s: an empty surface (%d vertices, %d triangles)", who,
+                            m ? m->nverts : 0, m ? m->ntris : 0);
+    for (int64_t i = 0; i < 3 * (int64_t)m->nverts; ++i)
+        if (!isfinite(m->X[i]))
+            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: vertex %lld is not finite",
+                                who, (long long)(i / 3));
+    for (int64_t i = 0; i < 3 * (int64_t)m->ntris; ++i)
+        if (m->tris[i] < 0 || m->tris[i] >= m->nverts)
+            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                                "%s: triangle %lld names vertex %d of %d", who, (long long)(i / 3),
+                                m->tris[i], m->nverts);
+    return SINEW_OK;
+}
+
 sinew_result sw_tetmesh_validate(const sw_tetmesh *m, double min_volume, sw_error *err) {
     if (!m || m->nverts < 4 || m->ntets < 1 || !m->X || !m->tets)
         return sw_error_set(err, SINEW_ERROR_DEGENERATE, "tet mesh is empty (%d vertices, %d tets)",

@@ -87,6 +87,11 @@ void sw_weights_free(sw_weights *w);
 void sw_clip_free(sw_clip *c);
 void sw_character_free(sw_character *c);
 
+/* Validates a triangle surface for `who` (the messages' prefix): at least 3 vertices and
+ * one triangle, coordinates finite, indices in range; SINEW_ERROR_INVALID_ARGUMENT naming
+ * the first offending item. */
+sinew_result sw_trimesh_validate(const sw_trimesh *m, const char *who, sw_error *err);
+
 /* Signed volume of tet (a,b,c,d): det[b-a, c-a, d-a] / 6. */
 double sw_tet_signed_volume(const double *a, const double *b, const double *c, const double *d);
 

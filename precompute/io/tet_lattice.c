@@ -115,20 +115,11 @@ static int32_t count_components(const lattice *L, const int32_t *cell_id, int32_
 }
 
 static sinew_result validate(const sw_trimesh *s, int32_t target, sw_error *err) {
-    if (!s || s->nverts < 3 || s->ntris < 1 || !s->X || !s->tris)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "tet lattice: an empty surface");
+    sinew_result r = sw_trimesh_validate(s, "tet lattice", err);
+    if (r != SINEW_OK) return r;
     if (target < 100 || target > 5000000)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "tet lattice: %d tets requested, not in 100..5000000", target);
-    for (int32_t v = 0; v < s->nverts; ++v)
-        if (!sw_v3_isfinite(s->X + 3 * (size_t)v))
-            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                                "tet lattice: vertex %d is not finite", v);
-    for (int64_t i = 0; i < 3 * (int64_t)s->ntris; ++i)
-        if (s->tris[i] < 0 || s->tris[i] >= s->nverts)
-            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                                "tet lattice: triangle %lld names vertex %d of %d",
-                                (long long)(i / 3), s->tris[i], s->nverts);
     return SINEW_OK;
 }
 

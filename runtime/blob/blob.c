@@ -113,10 +113,10 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
     blob->logger = d.logger;
     sw_log(lg, SINEW_LOG_INFO, SINEW_MSG_BLOB_LOADED,
            "sinew_blob_load: '%s': %zu bytes %s; %d vertices, %d bones, %d domains, rank %d, "
-           "%d cubature tets, %d surface vertices, %d triangles",
+           "%d cubature tets, %d surface vertices, %d triangles%s",
            d.path ? d.path : "<host buffer>", size, map ? "mapped" : "in place", view.nverts,
-           view.nbones, view.ndomains, view.rank_total, view.ncub, view.nsurf_verts,
-           view.nsurf_tris);
+           view.nbones, view.ndomains, view.rank_total, view.ncub, sw_blob_output_verts(&view),
+           sw_blob_output_ntris(&view), view.nrender_verts ? " (the embedded render mesh)" : "");
     *out = blob;
     return SINEW_OK;
 }
@@ -136,21 +136,23 @@ SINEW_API uint32_t sinew_blob_bone_count(const sinew_blob *blob) {
     return blob ? (uint32_t)blob->view.nbones : 0u;
 }
 
+/* The output surface is the render mesh when the blob has one (blob_view.h). */
 SINEW_API uint32_t sinew_blob_surface_vertex_count(const sinew_blob *blob) {
-    return blob ? (uint32_t)blob->view.nsurf_verts : 0u;
+    return blob ? (uint32_t)sw_blob_output_verts(&blob->view) : 0u;
 }
 
 SINEW_API uint32_t sinew_blob_surface_triangle_count(const sinew_blob *blob) {
-    return blob ? (uint32_t)blob->view.nsurf_tris : 0u;
+    return blob ? (uint32_t)sw_blob_output_ntris(&blob->view) : 0u;
 }
 
 SINEW_API sinew_result sinew_blob_surface_triangles(const sinew_blob *blob, uint32_t *indices,
                                                     uint32_t capacity) {
     if (!blob || !indices) return SINEW_ERROR_INVALID_ARGUMENT;
-    const uint64_t n = 3 * (uint64_t)blob->view.nsurf_tris;
+    const uint64_t n = 3 * (uint64_t)sw_blob_output_ntris(&blob->view);
+    const int32_t *tris = sw_blob_output_tris(&blob->view);
     if (capacity < n) return SINEW_ERROR_CAPACITY;
-    /* Validated at load: every index is in [0, nsurf_verts). */
+    /* Validated at load: every index is in [0, output vertices). */
     for (uint64_t i = 0; i < n; ++i)
-        indices[i] = (uint32_t)blob->view.surf_tris[i];
+        indices[i] = (uint32_t)tris[i];
     return SINEW_OK;
 }

@@ -13,12 +13,15 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "blob_check.h"
+
 _Static_assert(sizeof(sinew_blob_header) == 64, "blob header is 64 bytes");
 _Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
 /* Each section's C type has the element size of the format. */
 #define SIZE_MATCHES(id, NAME, elem_size, type, ...)                                               \
     _Static_assert(sizeof(type) == elem_size, #NAME " elements are " #elem_size " bytes");
 SINEW_BLOB_SECTIONS(SIZE_MATCHES)
+SINEW_BLOB_RENDER_SECTIONS(SIZE_MATCHES)
 #undef SIZE_MATCHES
 /* SW_BLOB_META_FIELDS covers every byte of META: no field is left uncopied. */
 #define META_FIELD_SIZE(field) +sizeof(((sinew_blob_meta *)0)->field)
@@ -36,8 +39,9 @@ _Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vert
 static const struct {
     const char *name;
     uint32_t elem_size;
-} k_sections[SINEW_SECTION_COUNT_V1 + 1] = {[0] = {"unknown", 0},
-                                            SINEW_BLOB_SECTIONS(SECTION_INFO)};
+} k_sections[SINEW_SECTION_ID_MAX + 1] = {[0] = {"unknown", 0},
+                                          SINEW_BLOB_SECTIONS(SECTION_INFO)
+                                              SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)};
 #undef SECTION_INFO
 
 /* Not instrumented for fuzzing coverage: its loop has no branch worth a fuzzer's
@@ -59,16 +63,10 @@ SW_NO_FUZZ_COVERAGE uint64_t sw_blob_checksum(const void *data, size_t n) {
 }
 
 const char *sw_blob_section_name(uint32_t id) {
-    return k_sections[id >= 1 && id <= SINEW_SECTION_COUNT_V1 ? id : 0].name;
+    return k_sections[id >= 1 && id <= SINEW_SECTION_ID_MAX ? id : 0].name;
 }
 
-static sinew_result fail(char *msg, size_t msg_size, sinew_result code, const char *fmt, ...)
-#if defined(__GNUC__)
-    __attribute__((format(printf, 4, 5)))
-#endif
-    ;
-
-static sinew_result fail(char *msg, size_t msg_size, sinew_result code, const char *fmt, ...) {
+sinew_result sw_blob_fail(char *msg, size_t msg_size, sinew_result code, const char *fmt, ...) {
     if (msg && msg_size) {
         va_list ap;
         va_start(ap, fmt);
@@ -77,6 +75,8 @@ static sinew_result fail(char *msg, size_t msg_size, sinew_result code, const ch
     }
     return code;
 }
+
+#define fail sw_blob_fail
 
 /* ---- layer 2: the view ----------------------------------------------------------- */
 
@@ -137,21 +137,35 @@ static sinew_result check_meta(const sw_blob_view *v, char *msg, size_t ms) {
     return SINEW_OK;
 }
 
+sinew_result sw_blob_check_arrays(const sw_blob_array_ref *a, size_t n, char *msg, size_t ms) {
+    for (size_t i = 0; i < n; ++i)
+        if (!a[i].p)
+            return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
+                        "blob section %s: the view's array is NULL", sw_blob_section_name(a[i].id));
+    return SINEW_OK;
+}
+
+sinew_result sw_blob_check_indices(uint32_t id, const char *elem, int k, const int32_t *a,
+                                   int64_t n, const char *what, int32_t bound, char *msg,
+                                   size_t ms) {
+    for (int64_t i = 0; i < k * n; ++i) {
+        if (a[i] >= 0 && a[i] < bound) continue;
+        char corner[32] = "";
+        if (k > 1) snprintf(corner, sizeof corner, " corner %d", (int)(i % k));
+        return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                    "blob section %s: %s %lld%s: %s %d outside [0, %d)", sw_blob_section_name(id),
+                    elem, (long long)(i / k), corner, what, a[i], bound);
+    }
+    return SINEW_OK;
+}
+
 static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) {
-    const struct {
-        const void *p;
-        uint32_t id;
-    } arrays[] = {
+    const sw_blob_array_ref arrays[] = {
 #define ARRAY(id, NAME, elem_size, type, field, ...) {v->field, id},
         SINEW_BLOB_ARRAY_SECTIONS(ARRAY)
 #undef ARRAY
     };
-    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
-        if (!arrays[i].p)
-            return fail(msg, ms, SINEW_ERROR_INVALID_ARGUMENT,
-                        "blob section %s: the view's array is NULL",
-                        sw_blob_section_name(arrays[i].id));
-    return SINEW_OK;
+    return sw_blob_check_arrays(arrays, sizeof arrays / sizeof arrays[0], msg, ms);
 }
 
 /* One domain record against the running prefix sums of the domains before it. */
@@ -229,27 +243,45 @@ static sinew_result check_domains(const sw_blob_view *v, char *msg, size_t ms) {
     return SINEW_OK;
 }
 
-static sinew_result check_copy_ptr(const sw_blob_view *v, char *msg, size_t ms) {
-    if (v->nsurf_copies < 1 || v->nsurf_copies > SW_BLOB_MAX_COPIES)
-        return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                    "blob section SURF_COPIES: %d copies outside [1, %d]", v->nsurf_copies,
-                    SW_BLOB_MAX_COPIES);
-    if (v->surf_copy_ptr[0] != 0)
-        return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                    "blob section SURF_COPY_PTR: element 0 is %d, not 0", v->surf_copy_ptr[0]);
-    /* Strictly increasing: a surface vertex is the mean of its copies, so it needs one. */
-    for (int32_t i = 0; i < v->nsurf_verts; ++i)
-        if (v->surf_copy_ptr[i + 1] <= v->surf_copy_ptr[i])
+sinew_result sw_blob_check_copy_ptr(uint32_t ptr_id, uint32_t copies_id, const char *item,
+                                    const int32_t *ptr, int32_t n, int32_t ncopies, char *msg,
+                                    size_t ms) {
+    const char *ptr_name = sw_blob_section_name(ptr_id),
+               *copies_name = sw_blob_section_name(copies_id);
+    if (ncopies < 1 || ncopies > SW_BLOB_MAX_COPIES)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section %s: %d copies outside [1, %d]",
+                    copies_name, ncopies, SW_BLOB_MAX_COPIES);
+    if (ptr[0] != 0)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section %s: element 0 is %d, not 0",
+                    ptr_name, ptr[0]);
+    /* Strictly increasing: a vertex is the mean of its copies, so it needs one. */
+    for (int32_t i = 0; i < n; ++i)
+        if (ptr[i + 1] <= ptr[i])
             return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section SURF_COPY_PTR: surface vertex %d has %lld copies (ptr %d "
-                        "-> %d); every surface vertex needs at least one",
-                        i, (long long)v->surf_copy_ptr[i + 1] - v->surf_copy_ptr[i],
-                        v->surf_copy_ptr[i], v->surf_copy_ptr[i + 1]);
-    if (v->surf_copy_ptr[v->nsurf_verts] != v->nsurf_copies)
+                        "blob section %s: %s %d has %lld copies (ptr %d -> %d); every %s needs "
+                        "at least one",
+                        ptr_name, item, i, (long long)ptr[i + 1] - ptr[i], ptr[i], ptr[i + 1],
+                        item);
+    if (ptr[n] != ncopies)
         return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                    "blob section SURF_COPY_PTR: last element %d, but SURF_COPIES holds %d "
-                    "copies",
-                    v->surf_copy_ptr[v->nsurf_verts], v->nsurf_copies);
+                    "blob section %s: last element %d, but %s holds %d copies", ptr_name, ptr[n],
+                    copies_name, ncopies);
+    return SINEW_OK;
+}
+
+sinew_result sw_blob_check_copies(uint32_t id, const sw_blob_view *v, const int32_t *copies,
+                                  int32_t ncopies, char *msg, size_t ms) {
+    for (int32_t c = 0; c < ncopies; ++c) {
+        int32_t d = copies[2 * (int64_t)c], l = copies[2 * (int64_t)c + 1];
+        if (d < 0 || d >= v->ndomains)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s: copy %d: domain %d outside [0, %d)",
+                        sw_blob_section_name(id), c, d, v->ndomains);
+        if (l < 0 || l >= v->domains[d].vert_count)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s: copy %d: local vertex %d outside [0, %d) of domain %d",
+                        sw_blob_section_name(id), c, l, v->domains[d].vert_count, d);
+    }
     return SINEW_OK;
 }
 
@@ -359,25 +391,11 @@ static sinew_result check_domain_indices(const sw_blob_view *v, char *msg, size_
 }
 
 static sinew_result check_surface(const sw_blob_view *v, char *msg, size_t ms) {
-    for (int64_t i = 0; i < 3 * (int64_t)v->nsurf_tris; ++i)
-        if (v->surf_tris[i] < 0 || v->surf_tris[i] >= v->nsurf_verts)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section SURF_TRIS: triangle %lld corner %d: vertex %d outside [0, "
-                        "%d)",
-                        (long long)(i / 3), (int)(i % 3), v->surf_tris[i], v->nsurf_verts);
-    for (int32_t c = 0; c < v->nsurf_copies; ++c) {
-        int32_t d = v->surf_copies[2 * (int64_t)c], l = v->surf_copies[2 * (int64_t)c + 1];
-        if (d < 0 || d >= v->ndomains)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section SURF_COPIES: copy %d: domain %d outside [0, %d)", c, d,
-                        v->ndomains);
-        if (l < 0 || l >= v->domains[d].vert_count)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section SURF_COPIES: copy %d: local vertex %d outside [0, %d) of "
-                        "domain %d",
-                        c, l, v->domains[d].vert_count, d);
-    }
-    return SINEW_OK;
+    sinew_result r = sw_blob_check_indices(SINEW_SECTION_SURF_TRIS, "triangle", 3, v->surf_tris,
+                                           v->nsurf_tris, "vertex", v->nsurf_verts, msg, ms);
+    if (r != SINEW_OK) return r;
+    return sw_blob_check_copies(SINEW_SECTION_SURF_COPIES, v, v->surf_copies, v->nsurf_copies, msg,
+                                ms);
 }
 
 static sinew_result check_positive(uint32_t id, const double *a, int64_t n, int64_t stride,
@@ -428,13 +446,17 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
     if ((r = check_meta(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_pointers(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_domains(v, msg, ms)) != SINEW_OK) return r;
-    if ((r = check_copy_ptr(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_check_copy_ptr(SINEW_SECTION_SURF_COPY_PTR, SINEW_SECTION_SURF_COPIES,
+                                    "surface vertex", v->surf_copy_ptr, v->nsurf_verts,
+                                    v->nsurf_copies, msg, ms)) != SINEW_OK)
+        return r;
     if ((r = check_all_finite(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_bone_tree(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_skin(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_domain_indices(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_surface(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_contacts(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_render_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_positive(SINEW_SECTION_CUB_WEIGHT, v->cub_weight, v->ncub, 1, msg, ms)))
         return r;
     if ((r = check_positive(SINEW_SECTION_CUB_VOL, v->cub_vol, v->ncub, 1, msg, ms))) return r;
@@ -477,7 +499,7 @@ static sinew_result check_header(const sinew_blob_header *h, size_t size, char *
 
 /* Section names in messages: known name, or the unknown id. */
 static const char *entry_name(const sinew_blob_section *s, char buf[32]) {
-    if (s->id >= 1 && s->id <= SINEW_SECTION_COUNT_V1) return sw_blob_section_name(s->id);
+    if (s->id >= 1 && s->id <= SINEW_SECTION_ID_MAX) return sw_blob_section_name(s->id);
     snprintf(buf, 32, "with unknown id %u", (unsigned)s->id);
     return buf;
 }
@@ -490,7 +512,7 @@ static sinew_result check_entries(const sinew_blob_section *s, uint32_t n, size_
     char buf[32];
     for (uint32_t i = 0; i < n; ++i) {
         const char *name = entry_name(&s[i], buf);
-        const int known = s[i].id >= 1 && s[i].id <= SINEW_SECTION_COUNT_V1;
+        const int known = s[i].id >= 1 && s[i].id <= SINEW_SECTION_ID_MAX;
         if (s[i].offset % SINEW_BLOB_ALIGN != 0)
             return fail(msg, ms, SINEW_ERROR_CORRUPT,
                         "blob section %s (table entry %u): offset %llu is not a multiple of %u",
@@ -637,8 +659,8 @@ sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, ch
     uint64_t end[SW_BLOB_MAX_SECTIONS];
     const uint32_t n = h.section_count;
     memcpy(s, bytes + HEADER_SIZE, (size_t)n * sizeof s[0]);
-    int found[SINEW_SECTION_COUNT_V1 + 1];
-    for (int i = 0; i <= SINEW_SECTION_COUNT_V1; ++i)
+    int found[SINEW_SECTION_ID_MAX + 1];
+    for (int i = 0; i <= SINEW_SECTION_ID_MAX; ++i)
         found[i] = -1;
     if ((r = check_entries(s, n, size, end, found, msg, ms)) != SINEW_OK) return r;
     if ((r = check_overlaps(s, n, end, msg, ms)) != SINEW_OK) return r;
@@ -649,6 +671,7 @@ sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, ch
 
     sw_blob_view v;
     if ((r = fill_view(bytes, s, found, &v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_render_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_validate_view(&v, msg, ms)) != SINEW_OK) return r;
     *view = v;
     return SINEW_OK;

@@ -12,6 +12,8 @@
  *   - nverts, ndomain_verts, ncub, nsurf_verts, nsurf_tris <= SW_BLOB_MAX_COUNT,
  *     nbones <= SW_BLOB_MAX_BONES, ndomains <= nbones, rank 1..SW_BLOB_MAX_RANK per
  *     domain, rank_total <= SW_BLOB_MAX_RANK_TOTAL, surface copies <= SW_BLOB_MAX_COPIES;
+ *   - the optional render mesh: its counts <= SW_BLOB_MAX_COUNT, |barycentric| <=
+ *     SW_BLOB_MAX_BARY (blob_render.c);
  *   - domain d's ranges are the prefix sums of the previous domains' sizes in domain
  *     order (vertex copies, q, cubature, basis, inertia_u), every domain has at least
  *     one vertex copy and one cubature tet, every surface vertex at least one copy.
@@ -33,8 +35,12 @@
 #define SW_BLOB_MAX_RANK_TOTAL 32768
 /* 2 * copies < 2^31 (surf_copies holds int32 pairs). */
 #define SW_BLOB_MAX_COPIES 200000000
-/* Tolerance on the sum of a vertex's skin weights. */
+/* Tolerance on the sum of a vertex's skin weights (and of a render vertex's barycentrics). */
 #define SW_BLOB_WEIGHT_SUM_TOL 1e-6
+/* The largest |barycentric| of a render vertex: one outside the tets extrapolates its tet,
+ * and a larger coefficient would amplify the tet's every motion (the bake keeps well
+ * below it, precompute/import/embed.h). */
+#define SW_BLOB_MAX_BARY 64.0
 
 /* A loaded blob: the validated view plus where its bytes live. The view's pointers
  * point into `data`. */

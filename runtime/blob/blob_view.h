@@ -118,6 +118,34 @@ typedef struct sw_blob_view {
     const int32_t *contact_ptr;
     const int32_t *contact_verts;
     const double *contact_data;
+
+    /* the optional render mesh embedded in the tets (issue 14; nrender_verts 0: none, and
+     * every field below is 0 / NULL). Render vertex i sits at
+     *     sum_k render_bary[4i+k] node(render_tets[4 render_tet[i] + k]),
+     * a node the mean of its copies render_node_copies[render_node_ptr[n] ..] (domain,
+     * local vertex), like a surface vertex; render_weld[i] is the vertex whose position and
+     * normal i takes (itself for a representative). When present it is the output surface
+     * (sw_blob_output_*); the tet boundary (surf_*) still carries the world's contact. */
+    int32_t nrender_verts, nrender_tris, nembed_tets, nrender_nodes, nrender_copies;
+    const int32_t *render_tris;        /* 3 * nrender_tris, indices < nrender_verts */
+    const int32_t *render_tet;         /* nrender_verts, < nembed_tets */
+    const double *render_bary;         /* 4 * nrender_verts, each vertex's sum 1 */
+    const int32_t *render_weld;        /* nrender_verts, idempotent */
+    const int32_t *render_tets;        /* 4 * nembed_tets render nodes */
+    const int32_t *render_node_ptr;    /* nrender_nodes + 1, increasing, starts at 0 */
+    const int32_t *render_node_copies; /* 2 * nrender_copies: (domain, local vertex) */
 } sw_blob_view;
+
+/* The output surface a host reads (sinew_instance_read_surface): the render mesh when the
+ * blob has one, else the tet mesh's boundary. */
+static inline int32_t sw_blob_output_verts(const sw_blob_view *v) {
+    return v->nrender_verts > 0 ? v->nrender_verts : v->nsurf_verts;
+}
+static inline int32_t sw_blob_output_ntris(const sw_blob_view *v) {
+    return v->nrender_verts > 0 ? v->nrender_tris : v->nsurf_tris;
+}
+static inline const int32_t *sw_blob_output_tris(const sw_blob_view *v) {
+    return v->nrender_verts > 0 ? v->render_tris : v->surf_tris;
+}
 
 #endif

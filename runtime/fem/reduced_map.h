@@ -1,8 +1,9 @@
 /* The subspace map of the step (thesis §4.4.1, eq. 4.13): a vertex copy k of domain d
  * sits at  x_k = R_k (rest_k + U_k q_d) + t_k,  with (R_k, t_k) the dual-quaternion
  * skinning transform of its vertex and U_k its rows of the domain's basis. Only the
- * "active" vertices are skinned each step: cubature tet corners, output surface copies
- * and pose-space contact vertices, so the cost follows those counts, not the mesh.
+ * "active" vertices are skinned each step: cubature tet corners, boundary surface copies,
+ * render node copies (a blob with a render mesh) and pose-space contact vertices, so the cost
+ * follows those counts, not the mesh.
  *
  * sw_reduced is what every reduced evaluation (cubature, contact, potential) reads and
  * accumulates into; the instance owns its arrays (one memory plan, instance.c). */
@@ -17,16 +18,17 @@
 
 typedef struct sw_reduced {
     const sw_blob_view *v;
-    int32_t R;             /* rank_total: the length of q */
-    int32_t rmax;          /* the largest domain rank */
-    int32_t nact;          /* active vertices */
-    int32_t *act_vert;     /* nact: the global vertex of each, ascending */
-    int32_t *cub_act;      /* 4 ncub: active index of each cubature tet corner */
-    int32_t *copy_act;     /* nsurf_copies: active index of each surface copy */
-    int32_t *contact_act;  /* 4 ncontacts: active index of p, t0, t1, t2 */
-    double *act_R, *act_t; /* 9 and 3 per active vertex: its skinning transform */
-    double *g;             /* R: gradient accumulator */
-    double *H;             /* R x R: Hessian accumulator */
+    int32_t R;              /* rank_total: the length of q */
+    int32_t rmax;           /* the largest domain rank */
+    int32_t nact;           /* active vertices */
+    int32_t *act_vert;      /* nact: the global vertex of each, ascending */
+    int32_t *cub_act;       /* 4 ncub: active index of each cubature tet corner */
+    int32_t *copy_act;      /* nsurf_copies: active index of each surface copy */
+    int32_t *contact_act;   /* 4 ncontacts: active index of p, t0, t1, t2 */
+    int32_t *node_copy_act; /* nrender_copies: active index of each render node copy */
+    double *act_R, *act_t;  /* 9 and 3 per active vertex: its skinning transform */
+    double *g;              /* R: gradient accumulator */
+    double *H;              /* R x R: Hessian accumulator */
     /* Scratch of each task worker w < nworkers (one without task callbacks): */
     double *hm;       /* 10 x rmax at hm + 10 rmax w: its J^T f and J^T g_k (cubature.c) */
     double *ecub;     /* ncub: each cubature tet's weighted energy */

@@ -29,7 +29,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
                    const layout_sizes *z) {
     const uint64_t R = (uint64_t)v->rank_total, nb = (uint64_t)v->nbones,
                    nd = (uint64_t)v->ndomains, na = (uint64_t)z->nact, rm = (uint64_t)z->rmax,
-                   ns = (uint64_t)v->nsurf_verts;
+                   ns = (uint64_t)sw_blob_output_verts(v);
 #define TAKE(ptr, count) ((ptr) = sw_plan_take(p, (count), sizeof *(ptr)))
     (void)sw_plan_take(p, 1, sizeof *in);
     TAKE(in->bone_dq, nb);
@@ -42,6 +42,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->cub_act, 4 * (uint64_t)v->ncub);
     TAKE(m->copy_act, (uint64_t)v->nsurf_copies);
     TAKE(m->contact_act, 4 * (uint64_t)v->ncontacts);
+    TAKE(m->node_copy_act, (uint64_t)v->nrender_copies);
     TAKE(m->act_R, 9 * na);
     TAKE(m->act_t, 3 * na);
     TAKE(m->g, R);
@@ -99,6 +100,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     /* the output */
     TAKE(in->surf_x, 3 * ns);
     TAKE(in->surf_n, 3 * ns);
+    TAKE(in->node_x, 3 * (uint64_t)v->nrender_nodes);
+    TAKE(in->weld_tris, 3 * (uint64_t)v->nrender_tris);
     /* the state's bounds */
     TAKE(in->bone_ball, 4 * nb);
     TAKE(in->q_bound, nd);
@@ -108,8 +111,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
 
 /* ---- active vertices ------------------------------------------------------------- */
 
-/* The vertices the step skins: every cubature tet corner, output surface copy and
- * pose-space contact vertex, each once. visit() is called with the global vertex of
+/* The vertices the step skins: every cubature tet corner, boundary surface copy, render
+ * node copy and pose-space contact vertex, each once. visit() is called with the global vertex of
  * every such reference and the slot that receives its active index. */
 typedef void (*visit_fn)(void *ctx, int32_t gv, int32_t *slot);
 
@@ -125,6 +128,11 @@ static void visit_active(const sw_blob_view *v, sw_reduced *m, visit_fn visit, v
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
         visit(ctx, v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]],
               m ? &m->copy_act[i] : NULL);
+    }
+    for (int32_t i = 0; i < v->nrender_copies; ++i) {
+        const sw_blob_domain *D = &v->domains[v->render_node_copies[2 * i]];
+        visit(ctx, v->domain_verts[D->vert_begin + v->render_node_copies[2 * i + 1]],
+              m ? &m->node_copy_act[i] : NULL);
     }
     for (int32_t c = 0; c < v->ncontacts; ++c)
         for (int k = 0; k < 4; ++k) {
@@ -341,6 +349,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
     (void)active_vertices(v, in->red.act_vert);
     visit_active(v, &in->red, assign_active, &in->red);
+    if (v->nrender_verts > 0) sw_render_weld_tris(v, in->weld_tris);
     in->ps.max_pairs = z.max_pairs;
     in->wc.max_cand = z.max_world;
     sw_world_contacts_build(&in->wc, v);

@@ -10,7 +10,8 @@
 /* Sets the pose from double transforms (12 per bone, rest -> world). */
 sinew_result sw_instance_set_pose_d(sinew_instance *inst, const double *T);
 
-/* Output surface positions (3 per surface vertex) of the last step. */
+/* Output surface positions (3 per output vertex, sw_blob_output_verts: the render mesh's
+ * when the blob has one) of the last step. */
 const double *sw_instance_surface(const sinew_instance *inst);
 
 /* Reduced coordinates (rank_total) of the last step. */
@@ -52,8 +53,17 @@ double sw_instance_step_potential(sinew_instance *inst, float dt, const double *
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x);
 
 /* Evaluation only (O(N)): the output surface of the current pose with no correction
- * (q = 0), the plain DQS surface the step's output deviates from (3 per surface vertex). */
+ * (q = 0), the plain DQS surface the step's output deviates from (3 per output vertex;
+ * a render mesh's through its embedding, from its nodes skinned). */
 void sw_instance_skinned_surface(const sinew_instance *inst, double *x);
+
+/* Evaluation only: the output surface (3 per output vertex) of positions x_full of every
+ * simulation vertex (a reference's solution, say): the boundary's vertices picked out,
+ * or the render mesh through the blob's embedding, as the runtime places it. */
+void sw_output_from_full(const sw_blob_view *v, const double *x_full, double *out);
+
+/* The simulation vertex of render node n (of a blob with a render mesh). */
+int32_t sw_render_node_vertex(const sw_blob_view *v, int32_t n);
 
 /* The state's bounds (sinew_types.h, status flags): the largest distance of an output
  * vertex from its skinned position the step allows, max_k max(4 u_k Q_k, L / 4), and

@@ -25,7 +25,9 @@ struct sinew_instance {
     sw_pose_space ps;        /* training poses near the current one, contact pairs */
     sw_solver solver;        /* state and Newton */
     sw_world_contacts wc;    /* the collision world's candidates of the step */
-    double *surf_x, *surf_n; /* 3 per output surface vertex each */
+    double *surf_x, *surf_n; /* 3 per output surface vertex each (sw_blob_output_verts) */
+    double *node_x;          /* 3 per render node: the mean of its copies (render mesh only) */
+    int32_t *weld_tris;      /* 3 per render triangle: its corners' weld representatives */
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
 };
@@ -43,5 +45,13 @@ struct sinew_instance {
 
 /* The output surface (positions and normals) of the state q (output.c). */
 void sw_instance_write_surface(sinew_instance *in);
+
+/* The render mesh as output surface (output_render.c): positions x (3 per render vertex)
+ * from the render nodes' positions node_x; normals n over the welded triangles
+ * weld_tris (sw_render_weld_tris fills them at creation), duplicates copying their
+ * representative's. */
+void sw_render_positions(const sw_blob_view *v, const double *node_x, double *x);
+void sw_render_normals(const sw_blob_view *v, const int32_t *weld_tris, const double *x, double *n);
+void sw_render_weld_tris(const sw_blob_view *v, int32_t *weld_tris);
 
 #endif

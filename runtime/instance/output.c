@@ -1,6 +1,7 @@
-/* What a step leaves for the host: the output surface (each vertex the mean of its
- * domain copies, area-weighted normals), its float copy, the step's figures; and the
- * O(N) evaluation helpers of tools and tests, which are never part of a step. */
+/* What a step leaves for the host: the output surface (each boundary vertex the mean of
+ * its domain copies, or the render mesh carried by its render nodes, output_render.c;
+ * area-weighted normals), its float copy, the step's figures; and the O(N) evaluation
+ * helpers of tools and tests, which are never part of a step. */
 #include <math.h>
 #include <string.h>
 
@@ -8,31 +9,51 @@
 #include "instance_internal.h"
 #include "surface_normals.h"
 
+/* The mean x of copies [b, e) (domain, local vertex pairs, their active indices act) at
+ * the state q; each copy's own position into copy_x[3 i ..] when copy_x is not NULL. */
+static void copies_mean(const sinew_instance *in, const int32_t *copies, const int32_t *act,
+                        int32_t b, int32_t e, double *copy_x, double x[3]) {
+    const sw_blob_view *v = in->v;
+    double acc[3] = {0, 0, 0};
+    for (int32_t i = b; i < e; ++i) {
+        const sw_blob_domain *D = &v->domains[copies[2 * i]];
+        double y[3];
+        sw_reduced_position(&in->red, D, copies[2 * i + 1], act[i], in->solver.q + D->q_offset, y,
+                            NULL);
+        for (int k = 0; k < 3; ++k) {
+            acc[k] += y[k];
+            if (copy_x) copy_x[3 * i + k] = y[k];
+        }
+    }
+    for (int k = 0; k < 3; ++k)
+        x[k] = acc[k] / (double)(e - b);
+}
+
 void sw_instance_write_surface(sinew_instance *in) {
     const sw_blob_view *v = in->v;
+    /* the boundary's copies carry the world's broad phase next step, render mesh or not */
     for (int32_t s = 0; s < v->nsurf_verts; ++s) {
-        double acc[3] = {0, 0, 0};
-        int32_t b = v->surf_copy_ptr[s], e = v->surf_copy_ptr[s + 1];
-        for (int32_t i = b; i < e; ++i) {
-            const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
-            double x[3];
-            sw_reduced_position(&in->red, D, v->surf_copies[2 * i + 1], in->red.copy_act[i],
-                                in->solver.q + D->q_offset, x, NULL);
-            for (int k = 0; k < 3; ++k) {
-                acc[k] += x[k];
-                in->wc.copy_x[3 * i + k] = x[k]; /* the world's broad phase next step */
-            }
-        }
-        for (int k = 0; k < 3; ++k)
-            in->surf_x[3 * s + k] = acc[k] / (double)(e - b);
+        double x[3];
+        copies_mean(in, v->surf_copies, in->red.copy_act, v->surf_copy_ptr[s],
+                    v->surf_copy_ptr[s + 1], in->wc.copy_x,
+                    v->nrender_verts ? x : in->surf_x + 3 * s);
     }
-    sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
+    if (v->nrender_verts > 0) {
+        for (int32_t n = 0; n < v->nrender_nodes; ++n)
+            copies_mean(in, v->render_node_copies, in->red.node_copy_act, v->render_node_ptr[n],
+                        v->render_node_ptr[n + 1], NULL, in->node_x + 3 * n);
+        sw_render_positions(v, in->node_x, in->surf_x);
+        sw_render_normals(v, in->weld_tris, in->surf_x, in->surf_n);
+    } else {
+        sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
+    }
     if (in->wc.world) sw_world_contacts_update_boxes(&in->wc);
 }
 
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
                                                    float *normals, uint32_t vertex_count) {
-    if (!inst || (!positions && !normals) || vertex_count != (uint32_t)inst->v->nsurf_verts)
+    if (!inst || (!positions && !normals) ||
+        vertex_count != (uint32_t)sw_blob_output_verts(inst->v))
         return SINEW_ERROR_INVALID_ARGUMENT;
     for (uint32_t i = 0; i < 3 * vertex_count; ++i) {
         if (positions) positions[i] = (float)inst->surf_x[i];
@@ -116,22 +137,41 @@ void sw_instance_set_q(sinew_instance *inst, const double *q) {
     memcpy(inst->solver.q, q, (size_t)inst->red.R * sizeof(double));
 }
 
+/* Simulation vertex gv skinned at the current pose (no correction) into y. */
+static void skin_vertex(const sinew_instance *inst, int32_t gv, double y[3]) {
+    const sw_blob_view *v = inst->v;
+    double R[9], t[3];
+    const double *X = v->rest + 3 * (int64_t)gv;
+    sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+    for (int k = 0; k < 3; ++k)
+        y[k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + t[k];
+}
+
 void sw_instance_skinned_surface(const sinew_instance *inst, double *x) {
     const sw_blob_view *v = inst->v;
-    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+    for (int32_t s = 0; s < v->nsurf_verts && v->nrender_verts == 0; ++s) {
         double acc[3] = {0, 0, 0};
         int32_t b = v->surf_copy_ptr[s], e = v->surf_copy_ptr[s + 1];
         for (int32_t i = b; i < e; ++i) {
             const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
-            int32_t gv = v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
-            double R[9], t[3];
-            const double *X = v->rest + 3 * gv;
-            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+            double y[3];
+            skin_vertex(inst, v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]], y);
             for (int k = 0; k < 3; ++k)
-                acc[k] += R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + t[k];
+                acc[k] += y[k];
         }
         for (int k = 0; k < 3; ++k)
             x[3 * s + k] = acc[k] / (double)(e - b);
+    }
+    for (int32_t i = 0; i < v->nrender_verts; ++i) { /* the embedding of the skinned nodes */
+        int32_t w = v->render_weld[i];
+        const int32_t *c = v->render_tets + 4 * (int64_t)v->render_tet[w];
+        const double *bary = v->render_bary + 4 * (int64_t)w;
+        double y[4][3];
+        for (int k = 0; k < 4; ++k)
+            skin_vertex(inst, sw_render_node_vertex(v, c[k]), y[k]);
+        for (int k = 0; k < 3; ++k)
+            x[3 * (int64_t)i + k] =
+                bary[0] * y[0][k] + bary[1] * y[1][k] + bary[2] * y[2][k] + bary[3] * y[3][k];
     }
 }
 

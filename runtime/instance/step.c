@@ -249,7 +249,7 @@ static void phase_output(sw_step_ctx *c) {
  * the output itself. */
 static sinew_result check_output(sw_step_ctx *c) {
     sinew_instance *in = c->in;
-    for (int64_t i = 0; i < 3 * (int64_t)in->v->nsurf_verts; ++i)
+    for (int64_t i = 0; i < 3 * (int64_t)sw_blob_output_verts(in->v); ++i)
         if (!(fabs(in->surf_x[i]) <= FLT_MAX) || !(fabs(in->surf_n[i]) <= FLT_MAX)) {
             memcpy(in->solver.q, in->solver.qn, (size_t)in->red.R * sizeof(double));
             memset(in->solver.qdot, 0, (size_t)in->red.R * sizeof(double));

@@ -3,8 +3,8 @@
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/blob -Iruntime/math \
- *     tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c -lm -o build-fuzz-blob
- *   mkdir -p /tmp/blob-corpus && ./build-fuzz-blob -max_len=65536 /tmp/blob-corpus
+ *     tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c runtime/blob/blob_render.c -lm -o
+ * build-fuzz-blob mkdir -p /tmp/blob-corpus && ./build-fuzz-blob -max_len=65536 /tmp/blob-corpus
  *
  * Two flavours, chosen at compile time:
  *   fuzz_blob        the parser alone, on the bytes as given: random bytes almost never
@@ -68,6 +68,21 @@ static double walk(const sw_blob_view *v) {
             s += v->rest[3 * v->domain_verts[dom->vert_begin + v->surf_copies[2 * c + 1]]];
         }
     }
+    /* the render mesh: every triangle's vertices through their tets' nodes and copies */
+    for (int64_t t = 0; t < 3 * (int64_t)v->nrender_tris; ++t) {
+        int32_t rv = v->render_weld[v->render_tris[t]];
+        if (v->render_weld[rv] != rv) abort();
+        s += v->render_bary[4 * (int64_t)rv + 3];
+        for (int k = 0; k < 4; ++k) {
+            int32_t n = v->render_tets[4 * (int64_t)v->render_tet[rv] + k];
+            for (int32_t c = v->render_node_ptr[n]; c < v->render_node_ptr[n + 1]; ++c) {
+                const sw_blob_domain *dom = &v->domains[v->render_node_copies[2 * (int64_t)c]];
+                s += v->rest[3 *
+                             (int64_t)v->domain_verts[dom->vert_begin +
+                                                      v->render_node_copies[2 * (int64_t)c + 1]]];
+            }
+        }
+    }
     /* the pose-space contacts: every training pose's range, every reference of its pairs */
     if (v->contact_ptr[0] != 0 || v->contact_ptr[v->ntrain] != v->ncontacts) abort();
     for (int32_t t = 0; t < v->ntrain; ++t) {
@@ -119,7 +134,7 @@ static void step_blob(const void *data, size_t size, const sw_blob_view *v) {
     bd.logger.max_level = SINEW_LOG_ERROR;
     sinew_blob *blob = NULL;
     if (sinew_blob_load(&bd, &blob) != SINEW_OK) abort(); /* sw_blob_parse accepted it */
-    const int32_t nb = v->nbones, ns = v->nsurf_verts;
+    const int32_t nb = v->nbones, ns = sw_blob_output_verts(v);
     float *T = malloc((size_t)12 * nb * sizeof(float));
     float *pos = malloc((size_t)3 * ns * sizeof(float)),
           *nrm = malloc((size_t)3 * ns * sizeof(float));

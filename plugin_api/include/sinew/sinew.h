@@ -24,7 +24,8 @@ SINEW_API void sinew_blob_destroy(sinew_blob *blob);
 /** Number of skeleton bones the blob expects in a pose (0 for NULL). Thread-safe. */
 SINEW_API uint32_t sinew_blob_bone_count(const sinew_blob *blob);
 
-/** Number of output surface vertices (0 for NULL). Thread-safe. */
+/** Number of output surface vertices (0 for NULL): the render mesh's when the blob embeds
+ * one (in its own vertex order), else the simulation mesh's boundary's. Thread-safe. */
 SINEW_API uint32_t sinew_blob_surface_vertex_count(const sinew_blob *blob);
 
 /** Number of output surface triangles (0 for NULL). Thread-safe. */

@@ -27,6 +27,23 @@
  *   CONTACT_PTR   training pose t owns contacts [ptr[t], ptr[t+1])
  *   CONTACT_VERTS (domain, local vertex) of p, t0, t1, t2
  *   CONTACT_DATA  barycentrics b0..b2, rest-frame normal, area ka
+ *
+ * Optional sections (SINEW_BLOB_RENDER_SECTIONS, ids 27..34): a render mesh embedded in
+ * the tets, all eight present or none. A blob without them is byte for byte what it was
+ * before they existed (its output surface is the tet mesh's boundary); a blob with them
+ * outputs the render mesh, in its own vertex order, instead. A runtime that predates
+ * them skips them as unknown ids and outputs the boundary. Their counts are in
+ * RENDER_META (sinew_blob_render_meta), their rows:
+ *   RENDER_TRIS        the render mesh's triangles, in its own order
+ *   RENDER_TET         per render vertex, its embedding tet (a row of RENDER_TETS)
+ *   RENDER_BARY        per render vertex, 4 barycentrics summing to 1 that reproduce its
+ *                      rest position from the tet's corners (negative outside the tets)
+ *   RENDER_WELD        per render vertex, the render vertex standing for every vertex at
+ *                      its rest position (a UV seam's duplicates share one): weld[weld[i]]
+ *                      = weld[i]; duplicates get the representative's position and normal
+ *   RENDER_TETS        4 render nodes a tet: the simulation tets the mesh is embedded in
+ *   RENDER_NODE_PTR    render node n (a simulation vertex) owns copies [ptr[n], ptr[n+1])
+ *   RENDER_NODE_COPIES (domain, local vertex) of each copy; a node is the mean of them
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -112,14 +129,35 @@ typedef struct sinew_blob_section {
     X(25, CONTACT_VERTS,   4, int32_t, contact_verts,  1, 8 * ncontacts,       "8 ncontacts")      \
     X(26, CONTACT_DATA,    8, double,  contact_data,   1, 7 * ncontacts,       "7 ncontacts")
 
+/* The optional render mesh (see above): counts named by SINEW_BLOB_RENDER_COUNTS, all from
+ * RENDER_META; rows as in SINEW_BLOB_SECTIONS (by_meta 1: RENDER_META fixes every count). */
+#define SINEW_BLOB_RENDER_COUNTS(X)                                                                \
+    X(nrender_verts) X(nrender_tris) X(nembed_tets) X(nrender_nodes) X(nrender_copies)
+#define SINEW_BLOB_RENDER_SECTIONS(X)                                                              \
+    X(27, RENDER_META,     32, sinew_blob_render_meta, render_meta, 1, 1, "1")                    \
+    SINEW_BLOB_RENDER_ARRAY_SECTIONS(X)
+#define SINEW_BLOB_RENDER_ARRAY_SECTIONS(X)                                                        \
+    X(28, RENDER_TRIS,      4, int32_t, render_tris,   1, 3 * nrender_tris,  "3 nrender_tris")    \
+    X(29, RENDER_TET,       4, int32_t, render_tet,    1, nrender_verts,     "nrender_verts")     \
+    X(30, RENDER_BARY,      8, double,  render_bary,   1, 4 * nrender_verts, "4 nrender_verts")   \
+    X(31, RENDER_WELD,      4, int32_t, render_weld,   1, nrender_verts,     "nrender_verts")     \
+    X(32, RENDER_TETS,      4, int32_t, render_tets,   1, 4 * nembed_tets,   "4 nembed_tets")     \
+    X(33, RENDER_NODE_PTR,  4, int32_t, render_node_ptr, 1, nrender_nodes + 1, "nrender_nodes + 1") \
+    X(34, RENDER_NODE_COPIES, 4, int32_t, render_node_copies, 1, 2 * nrender_copies,               \
+      "2 nrender_copies")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
 #define SINEW_BLOB_PLUS_ONE_(id, NAME, elem_size, type, field, by_meta, count, formula) +1
-/** Section ids; SINEW_SECTION_COUNT_V1 (26) is the number of sections of version 1. */
+/** Section ids; SINEW_SECTION_COUNT_V1 (26) is the number of sections every version-1 blob
+ * has; SINEW_SECTION_RENDER_FIRST .. SINEW_SECTION_ID_MAX are the optional render mesh's. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
-    SINEW_SECTION_COUNT_V1 = 0 SINEW_BLOB_SECTIONS(SINEW_BLOB_PLUS_ONE_)
+    SINEW_SECTION_COUNT_V1 = 0 SINEW_BLOB_SECTIONS(SINEW_BLOB_PLUS_ONE_),
+    SINEW_BLOB_RENDER_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_RENDER_FIRST = SINEW_SECTION_RENDER_META,
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_COUNT_V1 SINEW_BLOB_RENDER_SECTIONS(SINEW_BLOB_PLUS_ONE_)
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
@@ -133,6 +171,16 @@ typedef struct sinew_blob_meta {
     int32_t ntrain;    /**< training poses kept for the pose-space warm start (>= 1) */
     int32_t ncontacts; /**< self-contact pairs over all training poses (>= 0) */
 } sinew_blob_meta;
+
+/** Section RENDER_META: the render mesh's counts (32 bytes), each >= 1. */
+typedef struct sinew_blob_render_meta {
+    int32_t nrender_verts;  /**< render vertices */
+    int32_t nrender_tris;   /**< render triangles */
+    int32_t nembed_tets;    /**< simulation tets holding a render vertex */
+    int32_t nrender_nodes;  /**< simulation vertices at those tets' corners */
+    int32_t nrender_copies; /**< domain copies of those vertices */
+    int32_t reserved[3];    /**< zero */
+} sinew_blob_render_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
 typedef struct sinew_blob_domain_record {
