@@ -67,7 +67,7 @@ void openblas_set_num_threads(int num_threads);
 
 /* Rank-r basis (row-major 3n x r) of a domain from snapshots D (T x 3n, row per pose). */
 static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_rank, double energy,
-                          int32_t *rank_out) {
+                          int32_t *rank_out, double *kept_out) {
     double *G = calloc((size_t)T * T, sizeof(double)), *ev = malloc((size_t)T * sizeof(double));
     double *U = NULL;
     if (!G || !ev) goto done;
@@ -92,6 +92,7 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
         r++;
     }
     if (r == 0) r = 1;
+    *kept_out = total > 0 ? acc / total : 1.0;
     U = calloc((size_t)m * r, sizeof(double));
     if (!U) goto done;
     if (total > 0) {
@@ -303,7 +304,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     double *dtmp = malloc((size_t)n3 * sizeof(double));
     s->rank = calloc((size_t)s->nd, sizeof(int32_t));
     s->basis = calloc((size_t)s->nd, sizeof(double *));
-    if (!dall || !R || !t || !dtmp || !s->rank || !s->basis) goto oom;
+    out->basis_energy = calloc((size_t)s->nd + 1, sizeof(double));
+    if (!dall || !R || !t || !dtmp || !s->rank || !s->basis || !out->basis_energy) goto oom;
     int32_t k = 0;
     for (int32_t i = 0; i < s->ntrain_seq; ++i)
         for (int32_t j = 0; j < s->train[i].npose; ++j, ++k)
@@ -318,8 +320,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
             for (int32_t j = 0; j < n; ++j)
                 memcpy(D + (size_t)a * 3 * n + 3 * j,
                        dall + (size_t)a * n3 + 3 * s->dom_verts[base + j], 3 * sizeof(double));
-        s->basis[dm] =
-            domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy, &s->rank[dm]);
+        s->basis[dm] = domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy,
+                                  &s->rank[dm], &out->basis_energy[dm]);
         free(D);
         if (!s->basis[dm]) goto oom;
     }
