@@ -1,7 +1,8 @@
 /* sinew-bench: in one run on the same mesh and motion, the full-space reference, the
  * subspace runtime and plain dual-quaternion skinning of the same render surface.
  *
- *   sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
+ *   sinew-bench (FILE.glb [--tets N] [--train-clips A,B] [--heldout-clips C] |
+ *               --scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
  *               [--blob FILE [--bake-errors]] [--full-frames K] [--contract-steps S]
  *               [--threads T] [--instances N] --json
  *
@@ -18,7 +19,8 @@
  *             above solved (the first K), split as the bake splits a clip: training = the
  *             first floor(K (1 - heldout_fraction)) frames, held-out = the rest
  *             (err_source "clip"; err_clip_train_frames, err_clip_heldout_frames; null
- *             when a part is empty, e.g. --full-frames 1). Costs
+ *             when a part is empty, e.g. --full-frames 1); a glTF/FBX FILE's clip is its
+ *             first held-out clip, all of it held out (err_clip_train null). Costs
  *             nothing beyond the timing run, but these are not the bake's figures: the
  *             bake also trains on joint sweeps and caps the clip frames it trains on
  *   err_train, err_heldout  with --blob --bake-errors: the bake's poses and reference
@@ -122,14 +124,16 @@
 enum { NPHASES = 5 };
 
 static void usage(FILE *f) {
+    fprintf(f, "usage: sinew-bench (FILE [--tets N] [--train-clips A,B] [--heldout-clips C] |\n"
+               "                    --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+               "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+               "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
+               "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
+               "                   [reference options] [--out DIR] [--world FILE.json]\n"
+               "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
+               "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
-            "usage: sinew-bench (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-            "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-            "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
-            "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
-            "                   [reference options] [--out DIR] [--world FILE.json]\n"
-            "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
-            "character:\n" SW_CHARACTER_USAGE "bench:\n"
+            "bench:\n"
             "  --blob FILE         a blob sinew-bake wrote for this character (default: bake,\n"
             "                      and report the bake's err_train/err_heldout). The errors are\n"
             "                      then measured on the clip frames the reference solved, split\n"
@@ -288,8 +292,11 @@ int main(int argc, char **argv) {
     }
     sw_error err;
     sw_character ch;
-    sinew_result r = sw_character_args_make(&ca, &ch, &err);
+    sw_clip_split clips;
+    sw_scene_character_info info;
+    sinew_result r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
     if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
+    if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
     int nf = ch.clip.nframes;
 
     /* 1. bake (or load) */
@@ -300,6 +307,12 @@ int main(int argc, char **argv) {
     sw_tool_progress_init(&bar, tool);
     bp.on_progress = sw_tool_progress_print;
     bp.progress_user = &bar;
+    if (clips.nheldout > 0) { /* as sinew-bake: the file's clips of their own */
+        bp.train_clips = clips.train;
+        bp.ntrain_clips = clips.ntrain;
+        bp.heldout_clips = clips.heldout;
+        bp.nheldout_clips = clips.nheldout;
+    }
     sw_bake_result res;
     memset(&res, 0, sizeof res);
     sinew_blob *blob = NULL;
@@ -440,7 +453,8 @@ int main(int argc, char **argv) {
         /* borrows the clip's poses and the solutions above: never sw_bake_result_free'd */
         sw_bake_result clip;
         memset(&clip, 0, sizeof clip);
-        int ntr = (int)floor(kf * (1.0 - bp.heldout_fraction));
+        /* a file's held-out clip (the character's clip then) is held out whole */
+        int ntr = bp.nheldout_clips > 0 ? 0 : (int)floor(kf * (1.0 - bp.heldout_fraction));
         size_t pt = (size_t)12 * ch.skel.nbones, px = (size_t)3 * ch.mesh.nverts;
         clip.mass = mass;
         clip.ntrain = ntr;
@@ -627,5 +641,6 @@ int main(int argc, char **argv) {
     free(mem);
     sw_bake_result_free(&res);
     sw_character_free(&ch);
+    sw_clip_split_free(&clips);
     return 0;
 }
