@@ -375,12 +375,25 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
     }
 }
 
+/* Poses solved one after the other from q on: q's and its continuations'. */
+static int64_t path_poses(const sw_pose_seq *q) {
+    return q->npose + (q->then[0] ? q->then[0]->npose : 0) + (q->then[1] ? q->then[1]->npose : 0);
+}
+
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     sw_pose_seq *seqs[4096];
     int32_t n = 0;
     for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
         if (!s->train[i].continues) seqs[n++] = &s->train[i];
     if (s->heldout.npose > 0 && !s->heldout.continues) seqs[n++] = &s->heldout;
+    /* longest path first (stable): a long clip taken last by one worker would leave the
+       others idle at the end (each path's results do not depend on the order) */
+    for (int32_t i = 1; i < n; ++i)
+        for (int32_t j = i; j > 0 && path_poses(seqs[j]) > path_poses(seqs[j - 1]); --j) {
+            sw_pose_seq *t = seqs[j];
+            seqs[j] = seqs[j - 1];
+            seqs[j - 1] = t;
+        }
     sim_ctx ctx;
     ctx.s = s;
     ctx.seqs = seqs;
