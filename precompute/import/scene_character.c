@@ -1,6 +1,7 @@
 /* A simulation character from a glTF/FBX file (scene_character.h). */
 #include "scene_character.h"
 
+#include "character_io.h"
 #include "rig.h"
 
 #include <ctype.h>
@@ -247,15 +248,6 @@ static double tetmesh_volume(const sw_tetmesh *m) {
     return v;
 }
 
-/* The file's name without folder and extension. */
-static void file_stem(const char *path, char *name, size_t cap) {
-    const char *base = strrchr(path, '/');
-    base = base ? base + 1 : path;
-    const char *dot = strrchr(base, '.');
-    size_t n = dot && dot > base ? (size_t)(dot - base) : strlen(base);
-    snprintf(name, cap, "%.*s", (int)(n < cap ? n : cap - 1), base);
-}
-
 /* The steps after the import; ic's skeleton and render mesh move into out. */
 static sinew_result build_character(const char *path, sw_imported_character *ic,
                                     const sw_scene_character_options *o, sw_character *out,
@@ -286,7 +278,7 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
     memset(&ic->render, 0, sizeof ic->render);
     info->size = cbrt(tetmesh_volume(&out->mesh));
     sw_scene_material(info->size, &out->youngs, &out->poisson, &out->density);
-    file_stem(path, out->name, sizeof out->name);
+    sw_file_stem(path, out->name, sizeof out->name);
     return SINEW_OK;
 }
 
