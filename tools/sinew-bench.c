@@ -581,8 +581,11 @@ int main(int argc, char **argv) {
             "\"phase_ms\":{\"skin\":%.4f,\"contact\":%.4f,\"dynamics\":%.4f,\"solve\":%.4f,"
             "\"output\":%.4f},\"potential_evals\":%.2f,\"solver\":\"%s\",\"unsettled_frames\":%d,"
             "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f",
-            ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
-            sub_ms / d_ms, clip_errors ? "err_clip_train" : "err_train", e_tr,
+            ca.file    ? ca.file
+            : ca.scene ? ca.scene
+                       : ca.mesh,
+            ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms, sub_ms / d_ms,
+            clip_errors ? "err_clip_train" : "err_train", e_tr,
             clip_errors ? "err_clip_heldout" : "err_heldout", e_ho, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
             ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,

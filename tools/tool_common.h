@@ -279,7 +279,8 @@ typedef struct sw_character_args {
     "  --scene NAME     cylinder | finger | capsule (procedural samples) | elephant-cd |\n"        \
     "                   hand-libigl (real assets under --data DIR, default $SINEW_DATA_DIR or\n"   \
     "                   the build's shared data; --data only with these)\n"                        \
-    "  --tets N         a procedural sample's resolution, 1000..2000000 (default 20000)\n"         \
+    "  --tets N         simulation tets of a procedural sample, a surface .obj or FILE,\n"         \
+    "                   1000..2000000 (default 20000)\n"                                           \
     "  --frames F       clip frames, 4..1000000 (procedural default 30; an asset's or --clip's\n"  \
     "                   own length at most F): the bake trains on the first 60%% and holds out\n"  \
     "                   the rest, and a clip starting at rest needs 2 training frames\n"           \
