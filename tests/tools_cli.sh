@@ -91,7 +91,7 @@ expect bench_world_format 2 "--world 'w\.yaml': not a format it reads; accepted:
     "$bench" "${small[@]}" --world w.yaml
 expect render_out_format 2 "--out '.*a\.jpg': not a format it reads; accepted: \.png" \
     "$render" --obj a.obj --out "$tmp/a.jpg"
-"$bake" --help | grep -q -- "--tets N         a procedural sample's resolution, 1000\.\.2000000" ||
+"$bake" --help | grep -q -- "^                   1000\.\.2000000 (default 20000)" ||
     { echo "FAIL bake_help_ranges: --help does not state --tets's range" >&2; fails=$((fails + 1)); }
 
 # an absurd training error is an error (nothing written) unless --force
