@@ -66,6 +66,9 @@ TEST(split_rejects_bad_names) {
     ENSUREF(strstr(e.msg, "empty clip name"), "%s", e.msg);
     ENSURE(sw_clip_split_choose(names, frames, 0, "Walk", NULL, ti, &nt, hi, &nh, &e) ==
            SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sw_clip_split_choose(names, frames, 2, NULL, "Idle,Walk", ti, &nt, hi, &nh, &e) ==
+           SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "none is left to train on"), "%s", e.msg);
 }
 
 /* Every dimensionless group of the bake stays the finger's: E / L and rho L constant. */

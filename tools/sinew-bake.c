@@ -150,12 +150,7 @@ int main(int argc, char **argv) {
             ch.name[0] ? ch.name : source, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones,
             ch.clip.nframes);
     if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
-    if (clips.nheldout > 0) { /* clips of their own; one clip alone is split as before */
-        p.train_clips = clips.train;
-        p.ntrain_clips = clips.ntrain;
-        p.heldout_clips = clips.heldout;
-        p.nheldout_clips = clips.nheldout;
-    }
+    sw_tool_bake_clips(&ca, &clips, &p);
     sw_bake_result res;
     r = sw_bake(&ch, &p, &res, &err);
     if (r != SINEW_OK) {

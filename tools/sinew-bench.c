@@ -307,12 +307,7 @@ int main(int argc, char **argv) {
     sw_tool_progress_init(&bar, tool);
     bp.on_progress = sw_tool_progress_print;
     bp.progress_user = &bar;
-    if (clips.nheldout > 0) { /* as sinew-bake: the file's clips of their own */
-        bp.train_clips = clips.train;
-        bp.ntrain_clips = clips.ntrain;
-        bp.heldout_clips = clips.heldout;
-        bp.nheldout_clips = clips.nheldout;
-    }
+    sw_tool_bake_clips(&ca, &clips, &bp);
     sw_bake_result res;
     memset(&res, 0, sizeof res);
     sinew_blob *blob = NULL;

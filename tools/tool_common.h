@@ -254,6 +254,7 @@ static inline void sw_tool_progress_print(void *user, const char *stage, int64_t
 /* The character inputs sinew-bake and sinew-bench share: a named scene, or files. */
 #include "character_io.h"
 #include "samples.h"
+#include "bake.h"
 #include "scene_character.h"
 
 typedef struct sw_character_args {
@@ -462,6 +463,18 @@ static inline void sw_tool_print_scene(const char *tool, const sw_character *ch,
                 clips->heldout[i].nframes);
     if (clips->nheldout == 0) fprintf(stderr, " the last part of the training clip");
     fprintf(stderr, "\n");
+}
+
+/* A FILE's clips for the bake: its training and held-out clips, each its own path
+ * (bake.h). A file of one clip (nothing held out, no --train-clips) is split as a
+ * single clip is (the character's clip then): its last part held out. */
+static inline void sw_tool_bake_clips(const sw_character_args *c, const sw_clip_split *clips,
+                                      sw_bake_params *p) {
+    if (clips->ntrain == 0 || (clips->nheldout == 0 && !c->train_clips)) return;
+    p->train_clips = clips->train;
+    p->ntrain_clips = clips->ntrain;
+    p->heldout_clips = clips->heldout;
+    p->nheldout_clips = clips->nheldout;
 }
 
 /* Builds the character into *ch (zeroed first; err cleared first); a FILE's clip split

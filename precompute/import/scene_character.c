@@ -127,6 +127,14 @@ sinew_result sw_clip_split_choose(const char (*names)[64], const int32_t *frames
                      taken, train_idx, ntrain);
     }
     if (!rc && !heldout) take_longest(frames, n, 1, taken, heldout_idx, nheldout);
+    if (!rc && n > 0 && *ntrain == 0) {
+        char all[1024];
+        list_names(names, n, all, sizeof all);
+        rc = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                          "--heldout-clips holds out every clip, none is left to train on (the "
+                          "file's clips: %s)",
+                          all);
+    }
     free(taken);
     if (rc) *ntrain = *nheldout = 0;
     return rc;

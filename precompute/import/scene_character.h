@@ -51,7 +51,7 @@ typedef struct sw_scene_character_info {
  * holds out its last part). A list given alone takes the others' default from the clips
  * it leaves. Writes clip indices to train_idx / heldout_idx (n each at most).
  * INVALID_ARGUMENT naming the clip and listing the file's clips for an unknown name, a
- * name in both lists or twice in one, or an empty name. */
+ * name in both lists or twice in one, an empty name, or no clip left to train on. */
 sinew_result sw_clip_split_choose(const char (*names)[64], const int32_t *frames, int32_t n,
                                   const char *train, const char *heldout, int32_t *train_idx,
                                   int32_t *ntrain, int32_t *heldout_idx, int32_t *nheldout,
