@@ -91,7 +91,7 @@ expect bench_world_format 2 "--world 'w\.yaml': not a format it reads; accepted:
     "$bench" "${small[@]}" --world w.yaml
 expect render_out_format 2 "--out '.*a\.jpg': not a format it reads; accepted: \.png" \
     "$render" --obj a.obj --out "$tmp/a.jpg"
-"$bake" --help | grep -q -- "--tets N         a procedural sample's resolution, 1000\.\.2000000" ||
+"$bake" --help | grep -q -- "^                   1000\.\.2000000 (default 20000)" ||
     { echo "FAIL bake_help_ranges: --help does not state --tets's range" >&2; fails=$((fails + 1)); }
 
 # an absurd training error is an error (nothing written) unless --force
@@ -246,6 +246,42 @@ if [ -f "$fox" ]; then
     want=('"sim_tets": ([4-6][0-9]{3}|7[0-4][0-9]{2}),' '"sim_inverted": 0}'
         '0 inverted, 0 degenerate')
     expect_stdout inspect_fox_tets "$inspect" "$fox" --tets 5000 --json
+fi
+
+# a glTF/FBX FILE (issue 14): its format, the options that do not apply to it or that
+# apply only to it, an unwritable report folder; with the fox, unknown clip names are
+# an error listing the file's clips, and a small bake writes its report
+expect bake_file_format 2 "FILE 'x\.dae': not a format it reads; accepted: \.glb, \.gltf" \
+    "$bake" x.dae --out "$tmp/a.blob"
+expect bake_two_characters 2 "give one character: a glTF/FBX FILE, --scene NAME or --mesh" \
+    "$bake" x.glb "${small[@]}" --out "$tmp/a.blob"
+expect bake_skeleton_with_file 2 "--skeleton does not apply to a glTF/FBX FILE" \
+    "$bake" x.glb --skeleton s.tgf --out "$tmp/a.blob"
+expect bench_frames_with_file 2 "--frames does not apply to a glTF/FBX FILE" \
+    "$bench" x.glb --frames 8
+expect bake_clips_without_file 2 "--train-clips applies only to a glTF/FBX FILE" \
+    "$bake" "${small[@]}" --train-clips A --out "$tmp/a.blob"
+expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$bench" x.glb --fps 0
+touch "$tmp/plain"
+expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
+    "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"
+if [ -f "$fox" ]; then
+    expect bake_unknown_clip 1 "--heldout-clips: no clip named 'Gallop' \(the file's clips: Survey, Walk, Run\)" \
+        "$bake" "$fox" --tets 1000 --train-clips Survey --heldout-clips Gallop --out "$tmp/f.blob"
+    expect bench_unknown_clip 1 "--train-clips: no clip named 'Trot' \(the file's clips: Survey, Walk, Run\)" \
+        "$bench" "$fox" --tets 1000 --train-clips Trot
+    expect bake_clip_twice 1 "clip 'Walk' is given twice" \
+        "$bake" "$fox" --tets 1000 --train-clips Walk --heldout-clips Walk --out "$tmp/f.blob"
+    want=('"heldout_poses":35,')
+    expect_stdout bake_fox_report "$bake" "$fox" --tets 2000 --train-clips Survey,Walk \
+        --heldout-clips Run --out "$tmp/fox.blob" --report "$tmp/rep" --json
+    if ! grep -Eq '"name":[[:space:]]*"Run"' "$tmp/rep/report.json" ||
+        ! grep -q "<svg" "$tmp/rep/report.html"; then
+        echo "FAIL bake_fox_report_files: report.json without Run or report.html without a plot" >&2
+        fails=$((fails + 1))
+    else
+        echo "ok   bake_fox_report_files"
+    fi
 fi
 
 [ "$fails" -eq 0 ] || { echo "$fails failures" >&2; exit 1; }

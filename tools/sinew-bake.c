@@ -1,7 +1,9 @@
 /* sinew-bake: a rigged character in, a blob out (DESIGN.md §5).
  *
- *   sinew-bake (--scene NAME [--tets N] [--frames F] | --mesh FILE --skeleton FILE.tgf
- *              [--weights FILE.dmat] [--clip FILE]) --out FILE.blob
+ *   sinew-bake (FILE.glb|.gltf|.fbx [--tets N] [--train-clips A,B] [--heldout-clips C]
+ *              [--fps F] [--height H] | --scene NAME [--tets N] [--frames F] |
+ *              --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat] [--clip FILE])
+ *              --out FILE.blob [--report DIR]
  *              [--selector greedy|importance|nnhtp] [--tol 0.05] [--max-rank R]
  *              [--compare-cubature] [--no-self-contact] [--return-path] [--inertia-modes]
  *              [--threads T] [--data DIR]
@@ -9,10 +11,12 @@
  *
  * Shows progress per stage on stderr and ends with a summary (per-stage time, ranks,
  * cubature sizes, training and held-out errors); with --json the last stdout line is
- * one JSON object. The blob is measured (sw_bake_errors, the definition sinew-bench
- * reports too) before it is written; a training error of SW_BAKE_MAX_TRAIN_ERROR or more
- * is an error and writes nothing, unless --force. The blob is written atomically
- * (temporary file + rename). Exit status: 0 written, 1 failed, 2 bad arguments. */
+ * one JSON object; with --report DIR the bake report (bake_report.h: DIR/report.html,
+ * DIR/report.json, a contact sheet of held-out frames). The blob is measured (sw_bake_errors, the
+ * definition sinew-bench reports too) before it is written; a training error of
+ * SW_BAKE_MAX_TRAIN_ERROR or more is an error and writes nothing, unless --force. The blob is
+ * written atomically (temporary file + rename). Exit status: 0 written, 1 failed, 2 bad arguments.
+ */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -25,6 +29,7 @@
 #include "sw_mesh.h"
 
 #include "bake.h"
+#include "bake_report.h"
 #include "blob_write.h"
 #include "character_io.h"
 #include "samples.h"
@@ -32,15 +37,21 @@
 
 static void usage(FILE *f) {
     fprintf(f,
-            "usage: sinew-bake (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+            "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
+            "                   [--fps F] [--height H] |\n"
+            "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
             "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
             "                   [--clip FILE [--frames F]])\n"
-            "                  --out FILE.blob [--selector greedy|importance|nnhtp] [--tol T]\n"
+            "                  --out FILE.blob [--report DIR]\n"
+            "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
             "                  [--max-rank R] [--spring-k K] [--compare-cubature]\n"
             "                  [--no-self-contact] [--return-path] [--inertia-modes]\n"
             "                  [--threads T] [--force] [--json]\n"
             "character:\n" SW_CHARACTER_USAGE "bake:\n"
             "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
+            "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
+            "                   frame's error, ranks, cubature, stage times, a contact sheet of\n"
+            "                   held-out frames) and DIR/report.json (the same figures)\n"
             "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
             "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
             "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
@@ -61,7 +72,7 @@ int main(int argc, char **argv) {
     static const char *tool = "sinew-bake";
     sw_character_args ca;
     sw_character_args_init(&ca, tool);
-    const char *out_path = NULL;
+    const char *out_path = NULL, *report_dir = NULL;
     int json = 0, force = 0;
     sw_bake_params p = sw_bake_params_default();
     p.progress = 1;
@@ -76,6 +87,8 @@ int main(int argc, char **argv) {
             /* a character option, consumed */
         } else if (!strcmp(a, "--out") && next)
             out_path = argv[++i];
+        else if (!strcmp(a, "--report") && next)
+            report_dir = argv[++i];
         else if (!strcmp(a, "--threads") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, 256, &p.threads);
         else if (!strcmp(a, "--max-rank") && next)
@@ -119,18 +132,30 @@ int main(int argc, char **argv) {
         return 2;
     }
     if (!sw_character_args_valid(&ca)) return 2;
+    /* the report's folder before the long run: an unwritable one is an error now */
+    if (report_dir && !sw_tool_make_dirs(report_dir)) {
+        fprintf(stderr, "%s: --report '%s': cannot create or write the folder: %s\n", tool,
+                report_dir, strerror(errno ? errno : EACCES));
+        return 1;
+    }
     sw_error err;
     sw_character ch;
+    sw_clip_split clips;
+    sw_scene_character_info info;
     double t0 = sw_now_seconds();
-    sinew_result r = sw_character_args_make(&ca, &ch, &err);
+    sinew_result r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
     if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
+    const char *source = ca.file ? ca.file : ca.scene ? ca.scene : ca.mesh;
     fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
-            ch.name[0] ? ch.name : (ca.scene ? ca.scene : ca.mesh), ch.mesh.ntets, ch.mesh.nverts,
-            ch.skel.nbones, ch.clip.nframes);
+            ch.name[0] ? ch.name : source, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones,
+            ch.clip.nframes);
+    if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
+    sw_tool_bake_clips(&ca, &clips, &p);
     sw_bake_result res;
     r = sw_bake(&ch, &p, &res, &err);
     if (r != SINEW_OK) {
         sw_character_free(&ch);
+        sw_clip_split_free(&clips);
         return sw_tool_failed(r, &err, "%s: ", tool);
     }
     /* measure the blob's bytes before they go to the file */
@@ -143,6 +168,7 @@ int main(int argc, char **argv) {
     double bake_seconds = sw_now_seconds() - t0, t1 = sw_now_seconds();
     sinew_blob_def bd = sinew_blob_def_default();
     int status = 1;
+    double *frame_err = NULL; /* every training pose's error, then every held-out one's */
     if ((r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot serialise the blob: ", tool);
         goto done;
@@ -150,7 +176,13 @@ int main(int argc, char **argv) {
     bd.data = mem;
     bd.data_size = size;
     if (sw_tool_blob_load(tool, "just baked", bd, &blob) != SINEW_OK) goto done;
-    if ((r = sw_bake_errors(blob, &res, &et, &eh, &err)) != SINEW_OK) {
+    frame_err = malloc(sizeof(double) * ((size_t)res.ntrain + (size_t)res.nheldout + 1));
+    if (!frame_err) {
+        fprintf(stderr, "%s: out of memory\n", tool);
+        goto done;
+    }
+    if ((r = sw_bake_errors_frames(blob, &res, &et, &eh, frame_err, frame_err + res.ntrain,
+                                   &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         goto done;
     }
@@ -168,6 +200,31 @@ int main(int argc, char **argv) {
     if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
         goto done;
+    }
+    if (report_dir) {
+        int scene_clips = p.ntrain_clips > 0;
+        sw_bake_report_input ri = {source,
+                                   &ch,
+                                   &res,
+                                   blob,
+                                   scene_clips ? (const char(*)[64])clips.train_names : NULL,
+                                   scene_clips ? clips.ntrain : 0,
+                                   scene_clips ? (const char(*)[64])clips.heldout_names : NULL,
+                                   scene_clips ? clips.nheldout : 0,
+                                   frame_err,
+                                   frame_err + res.ntrain,
+                                   et.correction_error,
+                                   eh.correction_error,
+                                   et.failed + eh.failed,
+                                   bake_seconds,
+                                   eval_seconds,
+                                   1};
+        if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
+            sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
+            goto done;
+        }
+        fprintf(stderr, "%s: wrote the report %s/report.html and %s/report.json\n", tool,
+                report_dir, report_dir);
     }
     status = 0;
     const sw_blob_view *v = &res.view;
@@ -247,7 +304,9 @@ int main(int argc, char **argv) {
 done:
     sinew_blob_destroy(blob);
     free(mem);
+    free(frame_err);
     sw_bake_result_free(&res);
     sw_character_free(&ch);
+    sw_clip_split_free(&clips);
     return status;
 }

@@ -1,7 +1,8 @@
 /* sinew-bench: in one run on the same mesh and motion, the full-space reference, the
  * subspace runtime and plain dual-quaternion skinning of the same render surface.
  *
- *   sinew-bench (--scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
+ *   sinew-bench (FILE.glb [--tets N] [--train-clips A,B] [--heldout-clips C] |
+ *               --scene NAME [--tets N] [--frames F] | --mesh ... as sinew-bake)
  *               [--blob FILE [--bake-errors]] [--full-frames K] [--contract-steps S]
  *               [--threads T] [--instances N] --json
  *
@@ -20,7 +21,8 @@
  *             above solved (the first K), split as the bake splits a clip: training = the
  *             first floor(K (1 - heldout_fraction)) frames, held-out = the rest
  *             (err_source "clip"; err_clip_train_frames, err_clip_heldout_frames; null
- *             when a part is empty, e.g. --full-frames 1). Costs
+ *             when a part is empty, e.g. --full-frames 1); a glTF/FBX FILE's clip is its
+ *             first held-out clip, all of it held out (err_clip_train null). Costs
  *             nothing beyond the timing run, but these are not the bake's figures: the
  *             bake also trains on joint sweeps and caps the clip frames it trains on
  *   err_train, err_heldout  with --blob --bake-errors: the bake's poses and reference
@@ -128,14 +130,16 @@
 enum { NPHASES = 5 };
 
 static void usage(FILE *f) {
+    fprintf(f, "usage: sinew-bench (FILE [--tets N] [--train-clips A,B] [--heldout-clips C] |\n"
+               "                    --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+               "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+               "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
+               "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
+               "                   [reference options] [--out DIR] [--world FILE.json]\n"
+               "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
+               "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
-            "usage: sinew-bench (--scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-            "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-            "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
-            "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
-            "                   [reference options] [--out DIR] [--world FILE.json]\n"
-            "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
-            "character:\n" SW_CHARACTER_USAGE "bench:\n"
+            "bench:\n"
             "  --blob FILE         a blob sinew-bake wrote for this character (default: bake,\n"
             "                      and report the bake's err_train/err_heldout). The errors are\n"
             "                      then measured on the clip frames the reference solved, split\n"
@@ -333,8 +337,11 @@ int main(int argc, char **argv) {
     }
     sw_error err;
     sw_character ch;
-    sinew_result r = sw_character_args_make(&ca, &ch, &err);
+    sw_clip_split clips;
+    sw_scene_character_info info;
+    sinew_result r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
     if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
+    if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
     int nf = ch.clip.nframes;
 
     /* 1. bake (or load) */
@@ -345,6 +352,7 @@ int main(int argc, char **argv) {
     sw_tool_progress_init(&bar, tool);
     bp.on_progress = sw_tool_progress_print;
     bp.progress_user = &bar;
+    sw_tool_bake_clips(&ca, &clips, &bp);
     sw_bake_result res;
     memset(&res, 0, sizeof res);
     sinew_blob *blob = NULL;
@@ -486,7 +494,8 @@ int main(int argc, char **argv) {
         /* borrows the clip's poses and the solutions above: never sw_bake_result_free'd */
         sw_bake_result clip;
         memset(&clip, 0, sizeof clip);
-        int ntr = (int)floor(kf * (1.0 - bp.heldout_fraction));
+        /* a file's held-out clip (the character's clip then) is held out whole */
+        int ntr = bp.nheldout_clips > 0 ? 0 : (int)floor(kf * (1.0 - bp.heldout_fraction));
         size_t pt = (size_t)12 * ch.skel.nbones, px = (size_t)3 * ch.mesh.nverts;
         clip.mass = mass;
         clip.ntrain = ntr;
@@ -613,8 +622,11 @@ int main(int argc, char **argv) {
             "\"phase_ms\":{\"skin\":%.4f,\"contact\":%.4f,\"dynamics\":%.4f,\"solve\":%.4f,"
             "\"output\":%.4f},\"potential_evals\":%.2f,\"solver\":\"%s\",\"unsettled_frames\":%d,"
             "\"newton_iters_max\":%d,\"full_ms_mean\":%.3f,\"full_ms_max\":%.3f",
-            ca.scene ? ca.scene : ca.mesh, ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms,
-            sub_ms / d_ms, clip_errors ? "err_clip_train" : "err_train", e_tr,
+            ca.file    ? ca.file
+            : ca.scene ? ca.scene
+                       : ca.mesh,
+            ch.mesh.ntets, ch.mesh.nverts, ns, nf, full_ms / sub_ms, sub_ms / d_ms,
+            clip_errors ? "err_clip_train" : "err_train", e_tr,
             clip_errors ? "err_clip_heldout" : "err_heldout", e_ho, v->rank_total, v->ncub, allocs,
             locks, contract_steps, full_ms, sub_ms, d_ms, bake_s, err_source, failed_steps,
             ref_unsettled, phase_ms[0], phase_ms[1], phase_ms[2], phase_ms[3], phase_ms[4], evals,
@@ -675,5 +687,6 @@ int main(int argc, char **argv) {
     free(mem);
     sw_bake_result_free(&res);
     sw_character_free(&ch);
+    sw_clip_split_free(&clips);
     return 0;
 }

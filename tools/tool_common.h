@@ -254,10 +254,15 @@ static inline void sw_tool_progress_print(void *user, const char *stage, int64_t
 /* The character inputs sinew-bake and sinew-bench share: a named scene, or files. */
 #include "character_io.h"
 #include "samples.h"
+#include "bake.h"
+#include "scene_character.h"
 
 typedef struct sw_character_args {
     const char *tool; /* for messages */
     const char *scene, *mesh, *tgf, *weights, *clip, *data_dir;
+    const char *file;                        /* a rigged glTF/FBX character (positional) */
+    const char *train_clips, *heldout_clips; /* its clips by name */
+    double fps, height;                      /* its clip rate and scale (0: defaults) */
     int tets, frames;
     int tets_given, data_given;
 } sw_character_args;
@@ -265,10 +270,18 @@ typedef struct sw_character_args {
 /* The least --frames: the fewest clip frames a bake trains on (bake.h). */
 #define SW_CHARACTER_MIN_FRAMES 4
 #define SW_CHARACTER_USAGE                                                                         \
+    "  FILE             a rigged glTF 2.0 (.gltf, .glb) or FBX character: its render surface\n"    \
+    "                   filled with about --tets N tets, weights from the artist's, clips by\n"    \
+    "                   name (default: the two longest train, the next longest is held out)\n"     \
+    "  --train-clips A,B  FILE's clips to train on\n"                                              \
+    "  --heldout-clips C  FILE's clips held out (never trained on)\n"                              \
+    "  --fps F          FILE's clip sampling rate, 0 < F <= 1000 (default 30)\n"                   \
+    "  --height H       scale FILE to H units tall, 0 < H < 1e6 (default: the file's units)\n"     \
     "  --scene NAME     cylinder | finger | capsule (procedural samples) | elephant-cd |\n"        \
     "                   hand-libigl (real assets under --data DIR, default $SINEW_DATA_DIR or\n"   \
     "                   the build's shared data; --data only with these)\n"                        \
-    "  --tets N         a procedural sample's resolution, 1000..2000000 (default 20000)\n"         \
+    "  --tets N         simulation tets of a procedural sample, a surface .obj or FILE,\n"         \
+    "                   1000..2000000 (default 20000)\n"                                           \
     "  --frames F       clip frames, 4..1000000 (procedural default 30; an asset's or --clip's\n"  \
     "                   own length at most F): the bake trains on the first 60%% and holds out\n"  \
     "                   the rest, and a clip starting at rest needs 2 training frames\n"           \
@@ -290,14 +303,25 @@ static inline void sw_character_args_init(sw_character_args *c, const char *tool
 static inline int sw_character_args_take(sw_character_args *c, int argc, char **argv, int *i,
                                          int *ok) {
     const char *a = argv[*i], *next = *i + 1 < argc ? argv[*i + 1] : NULL;
+    if (a[0] != '-' && !c->file) return (c->file = a), 1; /* the glTF/FBX file */
     if (!next) return 0;
-    const char **s = !strcmp(a, "--scene")      ? &c->scene
-                     : !strcmp(a, "--mesh")     ? &c->mesh
-                     : !strcmp(a, "--skeleton") ? &c->tgf
-                     : !strcmp(a, "--weights")  ? &c->weights
-                     : !strcmp(a, "--clip")     ? &c->clip
-                     : !strcmp(a, "--data")     ? &c->data_dir
-                                                : NULL;
+    if (!strcmp(a, "--fps"))
+        return (*ok = sw_tool_real(c->tool, a, argv[++*i], 0, 1000.0000001, "in 0 < F <= 1000",
+                                   &c->fps)),
+               1;
+    if (!strcmp(a, "--height"))
+        return (*ok = sw_tool_real(c->tool, a, argv[++*i], 0, 1e6, "in 0 < H < 1e6", &c->height)),
+               1;
+    const char **s = !strcmp(a, "--scene")           ? &c->scene
+                     : !strcmp(a, "--train-clips")   ? &c->train_clips
+                     : !strcmp(a, "--heldout-clips") ? &c->heldout_clips
+                     : !strcmp(a, "--mesh")          ? &c->mesh
+                     : !strcmp(a, "--mesh")          ? &c->mesh
+                     : !strcmp(a, "--skeleton")      ? &c->tgf
+                     : !strcmp(a, "--weights")       ? &c->weights
+                     : !strcmp(a, "--clip")          ? &c->clip
+                     : !strcmp(a, "--data")          ? &c->data_dir
+                                                     : NULL;
     if (s) {
         *s = argv[++*i];
         c->data_given |= s == &c->data_dir;
@@ -320,12 +344,41 @@ static inline int sw_character_is_sample(const char *name) {
     return 0;
 }
 
-/* Exactly one of --scene and --mesh, --mesh needs --skeleton, and no option that does
- * not apply to the chosen input (each named on stderr); 1 when valid. */
+/* A glTF/FBX FILE: its format, and no option of the other inputs (each named). */
+static inline int sw_scene_file_args_valid(const sw_character_args *c) {
+    const char *opts[] = {c->tgf, c->weights, c->clip, c->data_given ? c->data_dir : NULL,
+                          c->frames ? "" : NULL},
+               *names[] = {"--skeleton", "--weights", "--clip", "--data", "--frames"};
+    for (int k = 0; k < 5; ++k)
+        if (opts[k]) {
+            fprintf(stderr,
+                    "%s: %s does not apply to a glTF/FBX FILE (it brings its skeleton, weights "
+                    "and clips; choose clips with --train-clips, --heldout-clips)\n",
+                    c->tool, names[k]);
+            return 0;
+        }
+    return sw_tool_format(c->tool, "FILE", c->file, "glb gltf fbx", ".glb, .gltf (glTF 2.0), .fbx");
+}
+
+/* Exactly one of FILE, --scene and --mesh, --mesh needs --skeleton, and no option that
+ * does not apply to the chosen input (each named on stderr); 1 when valid. */
 static inline int sw_character_args_valid(const sw_character_args *c) {
     const char *t = c->tool;
-    if (!c->scene == !c->mesh) {
-        fprintf(stderr, "%s: give either --scene or --mesh (with --skeleton)\n", t);
+    if (!!c->scene + !!c->mesh + !!c->file != 1) {
+        fprintf(stderr,
+                "%s: give one character: a glTF/FBX FILE, --scene NAME or --mesh (with "
+                "--skeleton)\n",
+                t);
+        return 0;
+    }
+    if (c->file) return sw_scene_file_args_valid(c);
+    if (c->train_clips || c->heldout_clips || c->fps > 0 || c->height > 0) {
+        fprintf(stderr,
+                "%s: %s applies only to a glTF/FBX FILE (the clips are chosen by name there)\n", t,
+                c->train_clips     ? "--train-clips"
+                : c->heldout_clips ? "--heldout-clips"
+                : c->fps > 0       ? "--fps"
+                                   : "--height");
         return 0;
     }
     if (c->scene) {
@@ -389,14 +442,58 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
                                        ".txt (bone animation), .dmat (pose quaternions)"));
 }
 
-/* Builds the character into *ch (zeroed first; err cleared first). When the asset has no
+/* What a glTF/FBX FILE became (the mesher's lattice, the material, the clip split). */
+static inline void sw_tool_print_scene(const char *tool, const sw_character *ch,
+                                       const sw_clip_split *clips,
+                                       const sw_scene_character_info *in) {
+    fprintf(stderr,
+            "%s: render mesh %d vertices, %d triangles; lattice spacing %.4g, %d piece(s) (%d "
+            "anchored); size %.4g (cube root of the volume), E %.4g, nu %.3g, density %.4g; %d "
+            "bone(s) skin no vertex most and drive none\n",
+            tool, in->render_verts, in->render_tris, in->lattice.spacing, in->lattice.components,
+            in->anchored_components, in->size, ch->youngs, ch->poisson, ch->density,
+            in->undriven_bones);
+    fprintf(stderr, "%s: clips: training", tool);
+    for (int32_t i = 0; i < clips->ntrain; ++i)
+        fprintf(stderr, "%s %s (%d frames)", i ? "," : "", clips->train_names[i],
+                clips->train[i].nframes);
+    fprintf(stderr, "; held out");
+    for (int32_t i = 0; i < clips->nheldout; ++i)
+        fprintf(stderr, "%s %s (%d frames)", i ? "," : "", clips->heldout_names[i],
+                clips->heldout[i].nframes);
+    if (clips->nheldout == 0) fprintf(stderr, " the last part of the training clip");
+    fprintf(stderr, "\n");
+}
+
+/* A FILE's clips for the bake: its training and held-out clips, each its own path
+ * (bake.h). A file of one clip (nothing held out, no --train-clips) is split as a
+ * single clip is (the character's clip then): its last part held out. */
+static inline void sw_tool_bake_clips(const sw_character_args *c, const sw_clip_split *clips,
+                                      sw_bake_params *p) {
+    if (clips->ntrain == 0 || (clips->nheldout == 0 && !c->train_clips)) return;
+    p->train_clips = clips->train;
+    p->ntrain_clips = clips->ntrain;
+    p->heldout_clips = clips->heldout;
+    p->nheldout_clips = clips->nheldout;
+}
+
+/* Builds the character into *ch (zeroed first; err cleared first); a FILE's clip split
+ * into *clips and what its import did into *info (both may be NULL; zeroed for the other
+ * inputs). When the asset has no
  * skin weights of its own (files without --weights, or an asset folder that ships none)
  * they are dropped, so that the bake computes heat-diffusion weights. */
 static inline sinew_result sw_character_args_make(const sw_character_args *c, sw_character *ch,
-                                                  sw_error *err) {
+                                                  sw_clip_split *clips,
+                                                  sw_scene_character_info *info, sw_error *err) {
     int computed = 0;
     sw_error_clear(err);
     memset(ch, 0, sizeof *ch);
+    if (clips) memset(clips, 0, sizeof *clips);
+    if (c->file) {
+        sw_scene_character_options o = {c->tets, c->fps, c->height, c->train_clips,
+                                        c->heldout_clips};
+        return sw_character_from_scene(c->file, &o, ch, clips, info, err);
+    }
     sinew_result r =
         c->scene ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
         : sw_tool_has_ext(c->mesh, "obj")

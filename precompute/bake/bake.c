@@ -52,6 +52,11 @@ void sw_bake_result_free(sw_bake_result *r) {
     free(r->train_x);
     free(r->train_T);
     free(r->mass);
+    free(r->basis_energy);
+    free(r->train_clip);
+    free(r->train_frame);
+    free(r->heldout_clip);
+    free(r->heldout_frame);
     memset(r, 0, sizeof *r);
 }
 
@@ -158,12 +163,16 @@ static void free_state(sw_bake_state *s) {
         free(s->train[i].x);
         free(s->train[i].contact_ptr);
         free(s->train[i].contacts);
+        free(s->train[i].clip);
+        free(s->train[i].frame);
     }
     free(s->train);
     free(s->heldout.T);
     free(s->heldout.x);
     free(s->heldout.contact_ptr);
     free(s->heldout.contacts);
+    free(s->heldout.clip);
+    free(s->heldout.frame);
     for (int32_t d = 0; d < s->nd; ++d) {
         if (s->basis) free(s->basis[d]);
         if (s->cub_local) free(s->cub_local[d]);
@@ -190,17 +199,27 @@ static sinew_result keep_solutions(const sw_bake_state *s, sw_bake_result *out, 
     out->train_x = malloc((size_t)out->ntrain * px + 1);
     out->heldout_T = malloc((size_t)out->nheldout * pt + 1);
     out->heldout_x = malloc((size_t)out->nheldout * px + 1);
-    if (!out->train_T || !out->train_x || !out->heldout_T || !out->heldout_x)
+    size_t pl = sizeof(int32_t);
+    out->train_clip = malloc((size_t)out->ntrain * pl + 1);
+    out->train_frame = malloc((size_t)out->ntrain * pl + 1);
+    out->heldout_clip = malloc((size_t)out->nheldout * pl + 1);
+    out->heldout_frame = malloc((size_t)out->nheldout * pl + 1);
+    if (!out->train_T || !out->train_x || !out->heldout_T || !out->heldout_x || !out->train_clip ||
+        !out->train_frame || !out->heldout_clip || !out->heldout_frame)
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for solutions");
     int32_t k = 0;
     for (int32_t i = 0; i < s->ntrain_seq; ++i)
         for (int32_t j = 0; j < s->train[i].npose; ++j, ++k) {
             memcpy((char *)out->train_T + k * pt, (const char *)s->train[i].T + j * pt, pt);
             memcpy((char *)out->train_x + k * px, (const char *)s->train[i].x + j * px, px);
+            out->train_clip[k] = s->train[i].clip[j];
+            out->train_frame[k] = s->train[i].frame[j];
         }
     if (out->nheldout) {
         memcpy(out->heldout_T, s->heldout.T, (size_t)out->nheldout * pt);
         memcpy(out->heldout_x, s->heldout.x, (size_t)out->nheldout * px);
+        memcpy(out->heldout_clip, s->heldout.clip, (size_t)out->nheldout * pl);
+        memcpy(out->heldout_frame, s->heldout.frame, (size_t)out->nheldout * pl);
     }
     return SINEW_OK;
 }
@@ -240,6 +259,12 @@ static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
                             "max %d, sweep %d, frames %d, held-out %g, spring %g)",
                             p.max_rank, p.pca_energy, p.cubature_tol, p.cubature_max,
                             p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k);
+    if (p.ntrain_clips < 0 || p.nheldout_clips < 0 || (p.ntrain_clips > 0 && !p.train_clips) ||
+        (p.nheldout_clips > 0 && !p.heldout_clips) || (p.nheldout_clips > 0 && !p.ntrain_clips))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "bake clips: %d training and %d held-out clips (held-out clips need "
+                            "training clips)",
+                            p.ntrain_clips, p.nheldout_clips);
     return SINEW_OK;
 }
 
@@ -271,6 +296,17 @@ static sinew_result bake_begin(sw_bake_state *s, const sw_bake_params *p, const 
     s->p = p;
     if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
     sinew_result r = check_params(p, err);
+    for (int32_t i = 0; r == SINEW_OK && i < p->ntrain_clips + p->nheldout_clips; ++i) {
+        const sw_clip *k =
+            i < p->ntrain_clips ? &p->train_clips[i] : &p->heldout_clips[i - p->ntrain_clips];
+        if (k->nbones != c->skel.nbones || k->nframes < 1 || !k->T)
+            r = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                             "bake clips: %s clip %d has %d bones x %d frames, the skeleton %d "
+                             "bones",
+                             i < p->ntrain_clips ? "training" : "held-out",
+                             i < p->ntrain_clips ? i : i - p->ntrain_clips, k->nbones, k->nframes,
+                             c->skel.nbones);
+    }
     if (r == SINEW_OK) r = prepare(s, c, c->weights.w == NULL, err);
     if (r == SINEW_OK && !(s->pool = sw_pool_create(p->threads)))
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");
@@ -291,13 +327,20 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *para
 
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
                             sw_eval_result *train, sw_eval_result *heldout, sw_error *err) {
+    return sw_bake_errors_frames(blob, res, train, heldout, NULL, NULL, err);
+}
+
+sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
+                                   sw_eval_result *train, sw_eval_result *heldout,
+                                   double *train_frames, double *heldout_frames, sw_error *err) {
     memset(train, 0, sizeof *train);
     memset(heldout, 0, sizeof *heldout);
-    sinew_result r = sw_eval_correction(blob, res->mass, res->train_T, res->train_x, res->ntrain,
-                                        SW_BAKE_EVAL_NEWTON, train, err);
+    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0};
+    sinew_result r = sw_eval_correction_frames(blob, res->mass, res->train_T, res->train_x,
+                                               res->ntrain, &o, train_frames, train, err);
     if (r == SINEW_OK)
-        r = sw_eval_correction(blob, res->mass, res->heldout_T, res->heldout_x, res->nheldout,
-                               SW_BAKE_EVAL_NEWTON, heldout, err);
+        r = sw_eval_correction_frames(blob, res->mass, res->heldout_T, res->heldout_x,
+                                      res->nheldout, &o, heldout_frames, heldout, err);
     return r;
 }
 

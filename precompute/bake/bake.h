@@ -58,6 +58,17 @@ typedef struct sw_bake_params {
        serialises them), with `done` rising to `total`; NULL: none. */
     void (*on_progress)(void *user, const char *stage, int64_t done, int64_t total, double elapsed);
     void *progress_user;
+    /* Training and held-out clips of their own (issue 14: a glTF/FBX file's clips, by
+       name): with ntrain_clips > 0 the training poses are frames of train_clips (each its
+       own path from rest, at most max_train_frames of it) and the joint sweeps, the
+       held-out poses frames of heldout_clips (one path from rest, clip after clip, at most
+       max_train_frames of each), and the character's clip and heldout_fraction are not
+       used for poses. The clips must have the skeleton's bones; held-out clips need
+       training clips. NULL/0 (default): the character's clip, split as above. */
+    const sw_clip *train_clips;
+    int32_t ntrain_clips;
+    const sw_clip *heldout_clips;
+    int32_t nheldout_clips;
     int compare_selectors; /* also train the other two selectors on the same data and
                               report their sizes and times (the blob keeps `selector`) */
 } sw_bake_params;
@@ -84,6 +95,7 @@ typedef struct sw_bake_result {
        |barycentric|, duplicates welded to another vertex, seconds (embed.h) */
     int32_t render_outside, render_welded;
     double render_max_outside, render_max_bary, embed_seconds;
+    double *basis_energy; /* per domain: the share of its snapshots' energy its PCA rank keeps */
     /* per selector (greedy, importance, NN-HTP), summed over domains; filled for the
        chosen selector, and for all three with compare_selectors */
     int32_t selector_points[3];
@@ -95,6 +107,11 @@ typedef struct sw_bake_result {
     double *heldout_T; /* 12 nbones per held-out pose */
     double *train_x;
     double *train_T;
+    /* where each pose came from (the report's per-clip plots): the index of its clip (in
+       sw_bake_params.train_clips / heldout_clips, or 0 for the character's clip) and its
+       frame there; -1 for poses of no clip (joint sweeps, the return path, random poses) */
+    int32_t *train_clip, *train_frame;     /* ntrain */
+    int32_t *heldout_clip, *heldout_frame; /* nheldout */
 } sw_bake_result;
 
 /* The fewest clip frames a bake can train on: it trains on the first
@@ -125,6 +142,12 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *p, s
 #define SW_BAKE_EVAL_NEWTON 20
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
                             sw_eval_result *train, sw_eval_result *heldout, sw_error *err);
+
+/* sw_bake_errors, also writing every pose's own correction error (res->ntrain and
+ * res->nheldout doubles; sw_eval_correction_frames) when the arrays are not NULL. */
+sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
+                                   sw_eval_result *train, sw_eval_result *heldout,
+                                   double *train_frames, double *heldout_frames, sw_error *err);
 
 /* A training error at or above this share of the correction missed is no usable bake:
  * the subspace misses half of the physics correction on the very poses it was built

@@ -67,7 +67,7 @@ void openblas_set_num_threads(int num_threads);
 
 /* Rank-r basis (row-major 3n x r) of a domain from snapshots D (T x 3n, row per pose). */
 static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_rank, double energy,
-                          int32_t *rank_out) {
+                          int64_t unit_row, int32_t *rank_out, double *kept_out) {
     double *G = calloc((size_t)T * T, sizeof(double)), *ev = malloc((size_t)T * sizeof(double));
     double *U = NULL;
     if (!G || !ev) goto done;
@@ -91,10 +91,10 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
         acc += ev[T - 1 - r];
         r++;
     }
-    if (r == 0) r = 1;
-    U = calloc((size_t)m * r, sizeof(double));
+    *kept_out = total > 0 ? acc / total : 1.0;
+    U = calloc((size_t)m * (r > 0 ? r : 1), sizeof(double));
     if (!U) goto done;
-    if (total > 0) {
+    if (r > 0) {
         for (int32_t k = 0; k < r; ++k) {
             int32_t col = T - 1 - k; /* eigenvector column in G (row-major: G[a*T + col]) */
             double sig = sqrt(fmax(ev[col], 1e-300));
@@ -107,10 +107,12 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
         }
         r = orthonormalise(U, m, r);
     }
-    if (r == 0) { /* no deformation at all: one harmless unit mode */
+    if (r == 0) { /* no deformation at all: one harmless unit mode (a zero column would
+                     give the domain a zero reduced mass), on a free vertex when the domain
+                     has one */
         r = 1;
         memset(U, 0, (size_t)m * sizeof(double));
-        U[0] = 1;
+        U[unit_row] = 1;
     }
     *rank_out = r;
 done:
@@ -303,7 +305,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     double *dtmp = malloc((size_t)n3 * sizeof(double));
     s->rank = calloc((size_t)s->nd, sizeof(int32_t));
     s->basis = calloc((size_t)s->nd, sizeof(double *));
-    if (!dall || !R || !t || !dtmp || !s->rank || !s->basis) goto oom;
+    out->basis_energy = calloc((size_t)s->nd + 1, sizeof(double));
+    if (!dall || !R || !t || !dtmp || !s->rank || !s->basis || !out->basis_energy) goto oom;
     int32_t k = 0;
     for (int32_t i = 0; i < s->ntrain_seq; ++i)
         for (int32_t j = 0; j < s->train[i].npose; ++j, ++k)
@@ -318,8 +321,12 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
             for (int32_t j = 0; j < n; ++j)
                 memcpy(D + (size_t)a * 3 * n + 3 * j,
                        dall + (size_t)a * n3 + 3 * s->dom_verts[base + j], 3 * sizeof(double));
+        int32_t free0 = 0; /* the domain's first free vertex (0 when it has none) */
+        while (free0 < n && s->ch.bone_of_vertex[s->dom_verts[base + free0]] >= 0)
+            free0++;
         s->basis[dm] =
-            domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy, &s->rank[dm]);
+            domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy,
+                       free0 < n ? 3 * (int64_t)free0 : 0, &s->rank[dm], &out->basis_energy[dm]);
         free(D);
         if (!s->basis[dm]) goto oom;
     }

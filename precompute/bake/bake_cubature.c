@@ -267,6 +267,22 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
         out->selector_seconds[which] += cr.seconds;
         out->selector_error[which] = fmax(out->selector_error[which], cr.rel_error);
     }
+    if (cr.n == 0) {
+        /* No training pose deforms the domain (a short bone of a coarse generated mesh,
+           its flesh all driven or moving rigidly with it): its snapshots carry no force to
+           fit. One tet standing for all of them keeps its unit mode's stiffness in the
+           reduced system instead of leaving the domain without cubature. */
+        s->cub_n[dom] = 1;
+        s->cub_local[dom] = malloc(sizeof(int32_t));
+        s->cub_w[dom] = malloc(sizeof(double));
+        if (!s->cub_local[dom] || !s->cub_w[dom]) {
+            res = SINEW_ERROR_OUT_OF_MEMORY;
+            goto done;
+        }
+        s->cub_local[dom][0] = 0;
+        s->cub_w[dom][0] = (double)ntd;
+        goto done;
+    }
     s->cub_n[dom] = cr.n;
     s->cub_local[dom] = malloc((size_t)cr.n * sizeof(int32_t));
     s->cub_w[dom] = malloc((size_t)cr.n * sizeof(double));

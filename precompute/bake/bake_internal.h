@@ -13,10 +13,12 @@
 /* A sequence of poses simulated in order (each warm-starts the next). */
 typedef struct sw_pose_seq {
     int32_t npose;
-    double *T;     /* npose * 12 * nbones bone transforms */
-    double *x;     /* npose * 3 * nverts full-space solutions (filled by simulate) */
-    int failed;    /* poses whose solve returned NOT_FINITE */
-    int unsettled; /* poses whose contact set the simulator's round cap left unsettled */
+    double *T;      /* npose * 12 * nbones bone transforms */
+    double *x;      /* npose * 3 * nverts full-space solutions (filled by simulate) */
+    int32_t *clip;  /* npose: the clip a pose is a frame of (sw_bake_result.train_clip), or -1 */
+    int32_t *frame; /* npose: its frame in that clip, or -1 */
+    int failed;     /* poses whose solve returned NOT_FINITE */
+    int unsettled;  /* poses whose contact set the simulator's round cap left unsettled */
     /* the reference's self-contact set of every solution (filled by simulate): pose k
        owns contacts[contact_ptr[k], contact_ptr[k+1]) */
     int32_t *contact_ptr; /* npose + 1 */

@@ -1,13 +1,15 @@
 /* Training and held-out poses, and their full-space solutions (DESIGN.md §5).
- * Training: the first (1 - heldout) frames of the clip (evenly subsampled), with
+ * Training: the first (1 - heldout) frames of the clip (evenly subsampled), or with
+ * training clips of their own (sw_bake_params.train_clips: a glTF file's clips) each of
+ * them as its own path from rest, with
  * return_path the same frames played back from the last one (the return path: a fold
  * that buckled on the way in can stay buckled on the way out, and the runtime picks
  * the branch by the direction the pose arrives from), and, per joint, a sweep from
  * rest to the largest rotation the training frames give it.
- * Held-out: the clip's remaining frames, never used to build the basis or cubature;
- * without a clip, random combined poses with a fixed seed. Each sequence is solved in
- * order (every solve warm-starts the next); sequences run in parallel, one thread
- * each. */
+ * Held-out: the clip's remaining frames, or the held-out clips one after the other on
+ * one path from rest, never used to build the basis or cubature; without a clip, random combined
+ * poses with a fixed seed. Each sequence is solved in order (every solve warm-starts the next);
+ * sequences run in parallel, one thread each. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -60,7 +62,12 @@ static int seq_alloc(sw_pose_seq *q, int32_t npose, int32_t nb, int32_t nv) {
     q->T = malloc((size_t)npose * 12 * nb * sizeof(double));
     q->x = malloc((size_t)npose * 3 * nv * sizeof(double));
     q->contact_ptr = calloc((size_t)npose + 1, sizeof(int32_t));
-    return q->T && q->x && q->contact_ptr;
+    q->clip = malloc(((size_t)npose + 1) * sizeof(int32_t));
+    q->frame = malloc(((size_t)npose + 1) * sizeof(int32_t));
+    if (!q->T || !q->x || !q->contact_ptr || !q->clip || !q->frame) return 0;
+    for (int32_t i = 0; i < npose; ++i)
+        q->clip[i] = q->frame[i] = -1; /* not a clip frame until filled from one */
+    return 1;
 }
 
 static uint64_t splitmix(uint64_t *s) {
@@ -76,88 +83,149 @@ int32_t sw_bake_min_frames(double heldout_fraction) {
     return 1000000;
 }
 
-sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
-    const sw_skeleton *sk = &s->ch.skel;
-    const sw_clip *clip = &s->ch.clip;
-    int32_t nb = s->nb, nf = clip->T && clip->nbones == nb ? clip->nframes : 0;
-    int32_t ntrain_frames = nf >= 2 ? (int32_t)floor(nf * (1.0 - s->p->heldout_fraction)) : 0;
-    if (nf >= 2 && ntrain_frames < 1) ntrain_frames = 1;
-    int32_t nheld_frames = nf >= 2 ? nf - ntrain_frames : 0;
+/* A run of clip frames that becomes a pose sequence: frames [first, first + count) of
+ * `clip`, labelled `label` (the clip's index) in the result. */
+typedef struct clip_range {
+    const sw_clip *clip;
+    int32_t first, count, label;
+} clip_range;
 
-    /* the largest rotation each joint reaches in the training frames: its sweep */
-    double *sweep_axis = calloc((size_t)nb * 3, sizeof(double));
-    double *sweep_angle = calloc((size_t)nb, sizeof(double));
-    double *local = malloc((size_t)nb * 9 * sizeof(double));
-    if (!sweep_axis || !sweep_angle || !local) {
-        free(sweep_axis);
-        free(sweep_angle);
-        free(local);
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for poses");
+/* n frames of r spread evenly (its first and last included) into q's poses [at, at + n). */
+static void fill_from_range(sw_pose_seq *q, int32_t at, const clip_range *r, int32_t n,
+                            int32_t nb) {
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t f = r->first + (n == 1 ? 0 : (int32_t)((int64_t)i * (r->count - 1) / (n - 1)));
+        memcpy(q->T + (size_t)(at + i) * 12 * nb, r->clip->T + (size_t)f * 12 * nb,
+               12 * nb * sizeof(double));
+        q->clip[at + i] = r->label;
+        q->frame[at + i] = f;
     }
-    for (int32_t f = 0; f < ntrain_frames; ++f)
-        for (int32_t b = 0; b < nb; ++b) {
-            if (sk->parent[b] < 0) continue;
-            double L[9], axis[3];
-            local_rotation(sk, clip->T + (size_t)f * 12 * nb, b, L);
-            double a = rotation_axis_angle(L, axis);
-            if (a > sweep_angle[b]) {
-                sweep_angle[b] = a;
-                memcpy(sweep_axis + 3 * b, axis, sizeof axis);
+}
+
+/* The training and held-out clip ranges: the given clips (params train_clips,
+ * heldout_clips), or the first (1 - heldout_fraction) of the character's clip and the
+ * rest. Returns the number of training ranges; *nheld the held-out ones. */
+static int32_t clip_ranges(const sw_bake_state *s, clip_range *train, clip_range *held,
+                           int32_t *nheld) {
+    const sw_bake_params *p = s->p;
+    int32_t nb = s->nb, ntr = 0;
+    *nheld = 0;
+    if (p->ntrain_clips > 0) {
+        for (int32_t i = 0; i < p->ntrain_clips; ++i)
+            if (p->train_clips[i].nbones == nb && p->train_clips[i].nframes > 0)
+                train[ntr++] = (clip_range){&p->train_clips[i], 0, p->train_clips[i].nframes, i};
+        for (int32_t i = 0; i < p->nheldout_clips; ++i)
+            if (p->heldout_clips[i].nbones == nb && p->heldout_clips[i].nframes > 0)
+                held[(*nheld)++] =
+                    (clip_range){&p->heldout_clips[i], 0, p->heldout_clips[i].nframes, i};
+        return ntr;
+    }
+    const sw_clip *clip = &s->ch.clip;
+    int32_t nf = clip->T && clip->nbones == nb ? clip->nframes : 0;
+    int32_t ntf = nf >= 2 ? (int32_t)floor(nf * (1.0 - p->heldout_fraction)) : 0;
+    if (nf >= 2 && ntf < 1) ntf = 1;
+    if (ntf > 0) train[ntr++] = (clip_range){clip, 0, ntf, 0};
+    if (nf - ntf > 0 && nf >= 2) held[(*nheld)++] = (clip_range){clip, ntf, nf - ntf, 0};
+    return ntr;
+}
+
+/* The largest rotation each joint reaches in the training ranges: its sweep. Without a
+ * clip, 90 degrees about an axis across the bone. */
+static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32_t ntr,
+                          double *sweep_axis, double *sweep_angle) {
+    const sw_skeleton *sk = &s->ch.skel;
+    int32_t nb = s->nb;
+    for (int32_t r = 0; r < ntr; ++r)
+        for (int32_t f = train[r].first; f < train[r].first + train[r].count; ++f)
+            for (int32_t b = 0; b < nb; ++b) {
+                if (sk->parent[b] < 0) continue;
+                double L[9], axis[3];
+                local_rotation(sk, train[r].clip->T + (size_t)f * 12 * nb, b, L);
+                double a = rotation_axis_angle(L, axis);
+                if (a > sweep_angle[b]) {
+                    sweep_angle[b] = a;
+                    memcpy(sweep_axis + 3 * b, axis, sizeof axis);
+                }
+            }
+    if (ntr > 0) return;
+    for (int32_t b = 0; b < nb; ++b) {
+        if (sk->parent[b] < 0) continue;
+        const double *h = sk->joints + 3 * sk->bones[2 * b],
+                     *t = sk->joints + 3 * sk->bones[2 * b + 1];
+        double d[3], z[3] = {0, 0, 1}, a[3];
+        sw_v3_sub(t, h, d);
+        if (fabs(d[2]) > 0.9 * sw_v3_norm(d)) z[1] = 1, z[2] = 0;
+        sw_v3_cross(d, z, a);
+        double n = sw_v3_norm(a);
+        if (n == 0) continue;
+        for (int i = 0; i < 3; ++i)
+            sweep_axis[3 * b + i] = a[i] / n;
+        sweep_angle[b] = 1.5707963267948966; /* 90 degrees */
+    }
+}
+
+/* Held-out poses: the held-out ranges in one path (each at most max_train_frames frames);
+ * the character's own clip's continue its training frames' path. Without any, random
+ * combined poses with a fixed seed. Returns 0 when out of memory. */
+static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld,
+                         const double *sweep_axis, const double *sweep_angle, double *local) {
+    int32_t nb = s->nb, cap = s->p->max_train_frames, n = 0;
+    for (int32_t r = 0; r < nheld; ++r)
+        n += held[r].count < cap ? held[r].count : cap;
+    if (n > 0) {
+        if (!seq_alloc(&s->heldout, n, nb, s->nv)) return 0;
+        for (int32_t r = 0, at = 0; r < nheld; ++r) {
+            int32_t k = held[r].count < cap ? held[r].count : cap;
+            fill_from_range(&s->heldout, at, &held[r], k, nb);
+            at += k;
+        }
+        /* the reference is path dependent (contact states, buckled folds): the held-out
+           part of the character's clip is solved along the clip's path, after its
+           training frames, as a host playing the clip sees it; held-out clips of their
+           own start from rest */
+        if (s->p->ntrain_clips == 0 && s->ntrain_seq > 0 && s->train[0].clip[0] == 0) {
+            s->train[0].then[0] = &s->heldout;
+            s->heldout.continues = 1;
+        }
+        return 1;
+    }
+    if (s->p->random_poses <= 0) return 1;
+    n = s->p->random_poses;
+    uint64_t seed = s->p->seed;
+    if (!seq_alloc(&s->heldout, n, nb, s->nv)) return 0;
+    for (int32_t i = 0; i < n; ++i) {
+        for (int32_t k = 0; k < nb; ++k) {
+            double u = (double)(splitmix(&seed) >> 11) * 0x1.0p-53;
+            sw_m3_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
+            if (!(sweep_angle[k] > 0)) {
+                memset(local + 9 * k, 0, 9 * sizeof(double));
+                local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;
             }
         }
-    if (nf < 2) /* no clip: sweep every joint 90 degrees about an axis across its bone */
-        for (int32_t b = 0; b < nb; ++b) {
-            if (sk->parent[b] < 0) continue;
-            const double *h = sk->joints + 3 * sk->bones[2 * b],
-                         *t = sk->joints + 3 * sk->bones[2 * b + 1];
-            double d[3], z[3] = {0, 0, 1}, a[3];
-            sw_v3_sub(t, h, d);
-            if (fabs(d[2]) > 0.9 * sw_v3_norm(d)) z[1] = 1, z[2] = 0;
-            sw_v3_cross(d, z, a);
-            double n = sw_v3_norm(a);
-            if (n == 0) continue;
-            for (int i = 0; i < 3; ++i)
-                sweep_axis[3 * b + i] = a[i] / n;
-            sweep_angle[b] = 1.5707963267948966; /* 90 degrees */
-        }
-    int32_t njoint = 0;
-    for (int32_t b = 0; b < nb; ++b)
-        njoint += sweep_angle[b] > 1e-3;
-    if (njoint == 0) { /* nothing to learn: every training snapshot is the rest shape */
-        free(sweep_axis);
-        free(sweep_angle);
-        free(local);
-        return sw_error_set(
-            err, SINEW_ERROR_INVALID_ARGUMENT,
-            nf < 2 ? "no training poses: the skeleton has no joint to bend"
-                   : "too few poses to train: the clip's %d training frames (the first %.0f%% of "
-                     "its %d; "
-                     "the rest is held out) bend no joint, and the basis and the cubature are "
-                     "learnt from "
-                     "the training poses' deformation; a clip that starts at rest needs at least 2 "
-                     "training frames, i.e. at least %d frames",
-            ntrain_frames, 100 * (1 - s->p->heldout_fraction), nf,
-            sw_bake_min_frames(s->p->heldout_fraction));
+        sw_forward_kinematics(&s->ch.skel, local, NULL, s->heldout.T + (size_t)i * 12 * nb);
     }
+    return 1;
+}
 
-    int32_t nclip = ntrain_frames < s->p->max_train_frames ? ntrain_frames : s->p->max_train_frames;
-    int32_t nreturn = s->p->return_path && nclip >= 2 ? nclip - 1 : 0;
-    s->ntrain_seq = (ntrain_frames > 0) + (nreturn > 0) + njoint;
+/* Training sequences: every training range (at most max_train_frames of it), the first
+ * one's return path when asked, then a sweep per joint. Returns 0 when out of memory. */
+static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t njoint,
+                          const double *sweep_axis, const double *sweep_angle, double *local) {
+    const sw_skeleton *sk = &s->ch.skel;
+    int32_t nb = s->nb, cap = s->p->max_train_frames;
+    int32_t n0 = ntr > 0 ? (train[0].count < cap ? train[0].count : cap) : 0;
+    int32_t nreturn = s->p->return_path && n0 >= 2 ? n0 - 1 : 0;
+    s->ntrain_seq = ntr + (nreturn > 0) + njoint;
     s->train = calloc((size_t)s->ntrain_seq + 1, sizeof(sw_pose_seq));
-    if (!s->train) goto oom;
+    if (!s->train) return 0;
     int32_t qi = 0;
-    if (ntrain_frames > 0) {
-        int32_t n = nclip;
-        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) goto oom;
-        for (int32_t i = 0; i < n; ++i) {
-            int32_t f = n == 1 ? 0 : (int32_t)((int64_t)i * (ntrain_frames - 1) / (n - 1));
-            memcpy(s->train[qi].T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
-                   12 * nb * sizeof(double));
-        }
-        qi++;
+    for (int32_t r = 0; r < ntr; ++r, ++qi) {
+        int32_t n = train[r].count < cap ? train[r].count : cap;
+        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
+        fill_from_range(&s->train[qi], 0, &train[r], n, nb);
     }
     if (nreturn > 0) { /* train[0]'s frames n-2 .. 0, continuing from its last solution */
-        if (!seq_alloc(&s->train[qi], nreturn, nb, s->nv)) goto oom;
+        if (!seq_alloc(&s->train[qi], nreturn, nb, s->nv)) return 0;
         for (int32_t i = 0; i < nreturn; ++i)
             memcpy(s->train[qi].T + (size_t)i * 12 * nb,
                    s->train[0].T + (size_t)(nreturn - 1 - i) * 12 * nb, 12 * nb * sizeof(double));
@@ -168,7 +236,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     for (int32_t b = 0; b < nb; ++b) {
         if (!(sweep_angle[b] > 1e-3)) continue;
         int32_t n = s->p->sweep_samples;
-        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) goto oom;
+        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
         for (int32_t i = 0; i < n; ++i) {
             for (int32_t k = 0; k < nb; ++k) {
                 double *L = local + 9 * k;
@@ -180,50 +248,58 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
         }
         qi++;
     }
-    if (nheld_frames > 0) {
-        int32_t n = nheld_frames < s->p->max_train_frames ? nheld_frames : s->p->max_train_frames;
-        if (!seq_alloc(&s->heldout, n, nb, s->nv)) goto oom;
-        for (int32_t i = 0; i < n; ++i) {
-            int32_t f =
-                ntrain_frames + (n == 1 ? 0 : (int32_t)((int64_t)i * (nheld_frames - 1) / (n - 1)));
-            memcpy(s->heldout.T + (size_t)i * 12 * nb, clip->T + (size_t)f * 12 * nb,
-                   12 * nb * sizeof(double));
-        }
-        /* the reference is path dependent (contact states, buckled folds): the held-out
-           frames are solved along the clip's path, after its training frames, as a host
-           playing the clip sees them */
-        if (ntrain_frames > 0) {
-            s->train[0].then[0] = &s->heldout;
-            s->heldout.continues = 1;
-        }
-    } else if (s->p->random_poses > 0) {
-        int32_t n = s->p->random_poses;
-        uint64_t seed = s->p->seed;
-        if (!seq_alloc(&s->heldout, n, nb, s->nv)) goto oom;
-        for (int32_t i = 0; i < n; ++i) {
-            for (int32_t k = 0; k < nb; ++k) {
-                double u = (double)(splitmix(&seed) >> 11) * 0x1.0p-53;
-                sw_m3_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
-                if (!(sweep_angle[k] > 0)) {
-                    memset(local + 9 * k, 0, 9 * sizeof(double));
-                    local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;
-                }
-            }
-            sw_forward_kinematics(sk, local, NULL, s->heldout.T + (size_t)i * 12 * nb);
-        }
+    return 1;
+}
+
+sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
+    int32_t nb = s->nb, nheld = 0;
+    int32_t nr = s->p->ntrain_clips + s->p->nheldout_clips + 1;
+    clip_range *train = calloc((size_t)nr, sizeof *train), *held = calloc((size_t)nr, sizeof *held);
+    double *sweep_axis = calloc((size_t)nb * 3, sizeof(double));
+    double *sweep_angle = calloc((size_t)nb, sizeof(double));
+    double *local = malloc((size_t)nb * 9 * sizeof(double));
+    sinew_result rc = SINEW_OK;
+    if (!train || !held || !sweep_axis || !sweep_angle || !local) goto oom;
+    int32_t ntr = clip_ranges(s, train, held, &nheld);
+    sweep_extents(s, train, ntr, sweep_axis, sweep_angle);
+    int32_t njoint = 0;
+    for (int32_t b = 0; b < nb; ++b)
+        njoint += sweep_angle[b] > 1e-3;
+    if (njoint == 0) { /* nothing to learn: every training snapshot is the rest shape */
+        const sw_clip *clip = &s->ch.clip;
+        int32_t nf = clip->T && clip->nbones == nb ? clip->nframes : 0;
+        if (s->p->ntrain_clips > 0)
+            rc = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                              "too few poses to train: the %d training clips bend no joint, and "
+                              "the basis and the cubature are learnt from the training poses' "
+                              "deformation",
+                              s->p->ntrain_clips);
+        else
+            rc = sw_error_set(
+                err, SINEW_ERROR_INVALID_ARGUMENT,
+                nf < 2 ? "no training poses: the skeleton has no joint to bend"
+                       : "too few poses to train: the clip's %d training frames (the first "
+                         "%.0f%% of its %d; the rest is held out) bend no joint, and the basis and "
+                         "the cubature are learnt from the training poses' deformation; a clip "
+                         "that starts at rest needs at least 2 training frames, i.e. at least %d "
+                         "frames",
+                ntr > 0 ? train[0].count : 0, 100 * (1 - s->p->heldout_fraction), nf,
+                sw_bake_min_frames(s->p->heldout_fraction));
+        goto done;
     }
-    free(sweep_axis);
-    free(sweep_angle);
-    free(local);
-    if (s->ntrain_seq == 0)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "no training poses: the clip never bends a joint");
-    return SINEW_OK;
+    if (!training_poses(s, train, ntr, njoint, sweep_axis, sweep_angle, local) ||
+        !heldout_poses(s, held, nheld, sweep_axis, sweep_angle, local))
+        goto oom;
+    goto done;
 oom:
+    rc = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for poses");
+done:
+    free(train);
+    free(held);
     free(sweep_axis);
     free(sweep_angle);
     free(local);
-    return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for poses");
+    return rc;
 }
 
 /* Appends the simulator's contact set as pose k's (the pose-space self-contact data,
@@ -299,12 +375,25 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
     }
 }
 
+/* Poses solved one after the other from q on: q's and its continuations'. */
+static int64_t path_poses(const sw_pose_seq *q) {
+    return q->npose + (q->then[0] ? q->then[0]->npose : 0) + (q->then[1] ? q->then[1]->npose : 0);
+}
+
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     sw_pose_seq *seqs[4096];
     int32_t n = 0;
     for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
         if (!s->train[i].continues) seqs[n++] = &s->train[i];
     if (s->heldout.npose > 0 && !s->heldout.continues) seqs[n++] = &s->heldout;
+    /* longest path first (stable): a long clip taken last by one worker would leave the
+       others idle at the end (each path's results do not depend on the order) */
+    for (int32_t i = 1; i < n; ++i)
+        for (int32_t j = i; j > 0 && path_poses(seqs[j]) > path_poses(seqs[j - 1]); --j) {
+            sw_pose_seq *t = seqs[j];
+            seqs[j] = seqs[j - 1];
+            seqs[j - 1] = t;
+        }
     sim_ctx ctx;
     ctx.s = s;
     ctx.seqs = seqs;

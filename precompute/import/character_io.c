@@ -207,8 +207,7 @@ static sinew_result check_character(const sw_character *c, const char *weights_p
     return SINEW_OK;
 }
 
-/* The file's name without folder and extension. */
-static void stem_name(const char *path, char *name, size_t cap) {
+void sw_file_stem(const char *path, char *name, size_t cap) {
     const char *base = strrchr(path, '/');
     base = base ? base + 1 : path;
     const char *dot = strrchr(base, '.');
@@ -242,7 +241,7 @@ static sinew_result finish_character(const char *mesh_path, const char *tgf_path
     if ((rc = sw_select_bone_vertices(&out->mesh, &out->skel, &out->weights, out->bone_of_vertex,
                                       err)))
         goto fail_named_mesh;
-    stem_name(mesh_path, out->name, sizeof out->name);
+    sw_file_stem(mesh_path, out->name, sizeof out->name);
     out->youngs = SW_DEFAULT_YOUNGS;
     out->poisson = SW_DEFAULT_POISSON;
     out->density = SW_DEFAULT_DENSITY;

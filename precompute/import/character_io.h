@@ -30,6 +30,9 @@ sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets
                                        int32_t nframes, sw_character *out,
                                        sw_lattice_report *report, sw_error *err);
 
+/* The file's name without folder and extension, cut to cap - 1 bytes: a character's name. */
+void sw_file_stem(const char *path, char *name, size_t cap);
+
 /* The real assets of ../shared/data by folder name ("elephant-cd", "hand-libigl"):
  * resolves file names under data_dir and calls sw_character_from_files with the
  * asset's material (SOURCE.md / json). */

@@ -138,17 +138,18 @@ static int pair_cmp(const void *pa, const void *pb) {
  * vertices within its reach; bones still short afterwards fall back to top_up. */
 #define SW_BONE_TOPUP_CANDIDATES 32
 static sinew_result shared_top_up(const sw_tetmesh *m, const sw_skeleton *s,
-                                  const unsigned char *surf, const double *reach, int32_t *bov,
-                                  int32_t *ids, cand *c, sw_error *err) {
+                                  const unsigned char *surf, const unsigned char *drives,
+                                  const double *reach, int32_t *bov, int32_t *ids, cand *c,
+                                  sw_error *err) {
     int32_t n, nneedy = 0, np = 0;
     int rank;
     for (int32_t b = 0; b < s->nbones; ++b)
-        nneedy += !satisfied(m, bov, b, ids, &n, &rank);
+        nneedy += drives[b] && !satisfied(m, bov, b, ids, &n, &rank);
     if (nneedy == 0) return SINEW_OK;
     pair *p = malloc(sizeof(pair) * (size_t)nneedy * SW_BONE_TOPUP_CANDIDATES);
     if (!p) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "bone vertices: out of memory");
     for (int32_t b = 0; b < s->nbones; ++b) {
-        if (satisfied(m, bov, b, ids, &n, &rank)) continue;
+        if (!drives[b] || satisfied(m, bov, b, ids, &n, &rank)) continue;
         int32_t nc = 0;
         for (int32_t v = 0; v < m->nverts; ++v)
             if (!surf[v] && bov[v] == -1) {
@@ -212,6 +213,12 @@ static sinew_result check_inputs(const sw_tetmesh *m, const sw_skeleton *s, cons
 
 sinew_result sw_select_bone_vertices(const sw_tetmesh *m, const sw_skeleton *s, const sw_weights *w,
                                      int32_t *bone_of_vertex, sw_error *err) {
+    return sw_select_bone_vertices_of(m, s, w, NULL, bone_of_vertex, err);
+}
+
+sinew_result sw_select_bone_vertices_of(const sw_tetmesh *m, const sw_skeleton *s,
+                                        const sw_weights *w, const unsigned char *drives_in,
+                                        int32_t *bone_of_vertex, sw_error *err) {
     sinew_result rc = check_inputs(m, s, w, bone_of_vertex, err);
     if (rc) return rc;
     sw_surface surface = {0};
@@ -222,7 +229,8 @@ sinew_result sw_select_bone_vertices(const sw_tetmesh *m, const sw_skeleton *s, 
     int32_t *ids = malloc(sizeof(int32_t) * (size_t)n);
     cand *c = malloc(sizeof(cand) * (size_t)n);
     double *radius = malloc(sizeof(double) * (size_t)s->nbones);
-    if (!surf || !dom || !ids || !c || !radius) {
+    unsigned char *drives = malloc((size_t)s->nbones);
+    if (!surf || !dom || !ids || !c || !radius || !drives) {
         rc = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "bone vertices: out of memory");
         goto done;
     }
@@ -239,19 +247,21 @@ sinew_result sw_select_bone_vertices(const sw_tetmesh *m, const sw_skeleton *s, 
         for (int32_t b = 1; b < w->nbones; ++b)
             if (row[b] > row[dom[v]]) dom[v] = b;
     }
+    for (int32_t b = 0; b < s->nbones; ++b)
+        drives[b] = !drives_in || drives_in[b];
     flesh_radii(m, s, surf, dom, radius);
     for (int32_t v = 0; v < n; ++v) {
         bone_of_vertex[v] = ids[v] ? -1 : -2;
-        if (ids[v] && !surf[v] &&
+        if (ids[v] && !surf[v] && drives[dom[v]] &&
             bone_distance(m, s, v, dom[v]) <= SW_BONE_RADIUS_FRACTION * radius[dom[v]])
             bone_of_vertex[v] = dom[v];
     }
     /* a bone reaches interior vertices up to SW_BONE_REACH flesh radii from it */
     for (int32_t b = 0; b < s->nbones; ++b)
         radius[b] *= SW_BONE_REACH;
-    rc = shared_top_up(m, s, surf, radius, bone_of_vertex, ids, c, err);
+    rc = shared_top_up(m, s, surf, drives, radius, bone_of_vertex, ids, c, err);
     for (int32_t b = 0; b < s->nbones && !rc; ++b)
-        rc = top_up(m, s, surf, radius[b], bone_of_vertex, b, ids, c, err);
+        if (drives[b]) rc = top_up(m, s, surf, radius[b], bone_of_vertex, b, ids, c, err);
     for (int32_t v = 0; v < n; ++v)
         if (rc || bone_of_vertex[v] < 0) bone_of_vertex[v] = -1;
 done:
@@ -261,5 +271,82 @@ done:
     free(ids);
     free(c);
     free(radius);
+    free(drives);
+    return rc;
+}
+
+/* Union-find root of v with path halving. */
+static int32_t find_root(int32_t *up, int32_t v) {
+    while (up[v] != v)
+        v = up[v] = up[up[v]];
+    return v;
+}
+
+/* Bone b's summed weight over tet t and the distance of its centroid from b. */
+static int32_t tet_bone_and_distance(const sw_tetmesh *m, const sw_skeleton *s, const sw_weights *w,
+                                     int32_t t, double *dist) {
+    const int32_t *tv = m->tets + 4 * (size_t)t;
+    int32_t best = 0;
+    double best_w = -1, c[3] = {0, 0, 0};
+    for (int32_t b = 0; b < s->nbones; ++b) {
+        double sum = 0;
+        for (int k = 0; k < 4; ++k)
+            sum += w->w[(size_t)tv[k] * s->nbones + b];
+        if (sum > best_w) best_w = sum, best = b;
+    }
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < 3; ++i)
+            c[i] += 0.25 * m->X[3 * (size_t)tv[k] + i];
+    *dist = sw_point_segment_distance(c, s->joints + 3 * s->bones[2 * best],
+                                      s->joints + 3 * s->bones[2 * best + 1]);
+    return best;
+}
+
+sinew_result sw_anchor_free_components(const sw_tetmesh *m, const sw_skeleton *s,
+                                       const sw_weights *w, int32_t *bov, int32_t *anchored,
+                                       sw_error *err) {
+    if (anchored) *anchored = 0;
+    sinew_result rc = check_inputs(m, s, w, bov, err);
+    if (rc) return rc;
+    int32_t n = m->nverts;
+    int32_t *up = malloc(sizeof(int32_t) * (size_t)n);
+    unsigned char *held = calloc((size_t)n, 1);
+    int32_t *best_tet = malloc(sizeof(int32_t) * (size_t)n);
+    double *best_d = malloc(sizeof(double) * (size_t)n);
+    if (!up || !held || !best_tet || !best_d) {
+        rc = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "anchoring components: out of memory");
+        goto done;
+    }
+    for (int32_t v = 0; v < n; ++v)
+        up[v] = v, best_tet[v] = -1, best_d[v] = INFINITY;
+    for (int32_t t = 0; t < m->ntets; ++t)
+        for (int k = 1; k < 4; ++k) {
+            int32_t a = find_root(up, m->tets[4 * (size_t)t]),
+                    b = find_root(up, m->tets[4 * (size_t)t + k]);
+            if (a != b) up[a < b ? b : a] = a < b ? a : b; /* the lower id is the root */
+        }
+    for (int32_t v = 0; v < n; ++v)
+        if (bov[v] >= 0) held[find_root(up, v)] = 1;
+    /* per free component: the tet nearest its dominant bone (ties: the lower tet id) */
+    for (int32_t t = 0; t < m->ntets; ++t) {
+        int32_t r = find_root(up, m->tets[4 * (size_t)t]);
+        if (held[r]) continue;
+        double d;
+        tet_bone_and_distance(m, s, w, t, &d);
+        if (d < best_d[r]) best_d[r] = d, best_tet[r] = t;
+    }
+    for (int32_t r = 0; r < n; ++r) {
+        if (best_tet[r] < 0) continue;
+        double d;
+        int32_t b = tet_bone_and_distance(m, s, w, best_tet[r], &d);
+        for (int k = 0; k < 4; ++k)
+            bov[m->tets[4 * (size_t)best_tet[r] + k]] = b;
+        if (anchored) ++*anchored;
+    }
+done:
+    free(up);
+    free(held);
+    free(best_tet);
+    free(best_d);
     return rc;
 }

@@ -67,6 +67,13 @@ sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, cons
 sinew_result sw_eval_correction_opts(const sinew_blob *blob, const double *mass, const double *T,
                                      const double *x_full, int32_t npose, const sw_eval_options *o,
                                      sw_eval_result *out, sw_error *err) {
+    return sw_eval_correction_frames(blob, mass, T, x_full, npose, o, NULL, out, err);
+}
+
+sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mass, const double *T,
+                                       const double *x_full, int32_t npose,
+                                       const sw_eval_options *o, double *frame_error,
+                                       sw_eval_result *out, sw_error *err) {
     memset(out, 0, sizeof *out);
     const sw_blob_view *v = sw_blob_get_view(blob);
     if (!v || !mass || !o || (!T && npose) || (!x_full && npose > o->skip) || npose < 0 ||
@@ -87,13 +94,19 @@ sinew_result sw_eval_correction_opts(const sinew_blob *blob, const double *mass,
     int32_t n = v->nverts, failed = 0;
     for (int32_t f = 0; f < npose; ++f) {
         const double *Tf = T + (size_t)f * 12 * v->nbones;
+        double *fe = frame_error && f >= o->skip ? frame_error + (f - o->skip) : NULL;
         if (sw_instance_set_pose_d(inst, Tf) != SINEW_OK ||
             sinew_instance_step(inst, o->dt) != SINEW_OK) {
             failed++;
+            if (fe) *fe = NAN;
             continue;
         }
         if (f < o->skip) continue;
+        double num = acc.num, den = acc.den;
         sw_eval_acc_add(&acc, inst, x_full + (size_t)(f - o->skip) * 3 * n);
+        /* the frame's own share, by the same formula; a frame with no correction to miss
+           (the rest pose) counts 0 */
+        if (fe) *fe = acc.den > den ? sqrt((acc.num - num) / (acc.den - den)) : 0.0;
     }
     sw_eval_acc_result(&acc, out);
     out->failed = failed;

@@ -58,4 +58,12 @@ typedef struct sw_eval_options {
 sinew_result sw_eval_correction_opts(const sinew_blob *blob, const double *mass, const double *T,
                                      const double *x_full, int32_t npose, const sw_eval_options *o,
                                      sw_eval_result *out, sw_error *err);
+
+/* As sw_eval_correction_opts, also writing each compared pose's own correction error
+ * (the formula over that frame alone; 0 when the frame has no correction, NaN for a
+ * failed step) to frame_error[0 .. npose - skip) when it is not NULL. */
+sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mass, const double *T,
+                                       const double *x_full, int32_t npose,
+                                       const sw_eval_options *o, double *frame_error,
+                                       sw_eval_result *out, sw_error *err);
 #endif

@@ -1,0 +1,188 @@
+/* Clips of their own in the bake (sw_bake_params.train_clips / heldout_clips) and the bake
+ * report (tools/bake_report.h): training poses come only from training clips (and joint
+ * sweeps), held-out poses only from held-out clips, each labelled with its clip and frame;
+ * the report's JSON parses back (cJSON) with the bake's figures, and the page and the
+ * contact sheet are written. A 1,000-tet finger: a few seconds. */
+#include <cjson/cJSON.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "bake.h"
+#include "bake_report.h"
+#include "blob_write.h"
+#include "samples.h"
+#include "sw_test.h"
+
+static char *read_text(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return NULL;
+    fseek(f, 0, SEEK_END);
+    long n = ftell(f);
+    fseek(f, 0, SEEK_SET);
+    char *s = malloc((size_t)n + 1);
+    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) n = 0;
+    if (s) s[n] = '\0';
+    fclose(f);
+    return s;
+}
+
+static double num(const cJSON *o, const char *key) {
+    const cJSON *v = cJSON_GetObjectItemCaseSensitive(o, key);
+    return cJSON_IsNumber(v) ? v->valuedouble : -1e300;
+}
+
+/* The report's JSON against what the bake made. */
+static void check_json(const char *dir, const sw_bake_result *res, const sw_blob_view *v,
+                       double err_heldout) {
+    char path[1100];
+    snprintf(path, sizeof path, "%.1000s/report.json", dir);
+    char *text = read_text(path);
+    ENSURE(text != NULL);
+    cJSON *j = text ? cJSON_Parse(text) : NULL;
+    ENSURE(j != NULL);
+    if (!j) {
+        free(text);
+        return;
+    }
+    ENSURE(num(j, "sinew_bake_report") == SW_BAKE_REPORT_VERSION);
+    ENSURE_NEAR(num(j, "err_heldout"), err_heldout, 1e-9);
+    const cJSON *ch = cJSON_GetObjectItemCaseSensitive(j, "character");
+    ENSURE(num(ch, "tets") > 500 && num(ch, "bones") == 3);
+    const cJSON *clips = cJSON_GetObjectItemCaseSensitive(j, "clips");
+    ENSURE(cJSON_GetArraySize(clips) == 2);
+    const char *want_name[2] = {"Bend", "Return"}, *want_split[2] = {"train", "heldout"};
+    int want_n[2] = {8, res->nheldout};
+    for (int i = 0; i < 2 && cJSON_GetArraySize(clips) == 2; ++i) {
+        const cJSON *c = cJSON_GetArrayItem(clips, i);
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(c, "name"),
+                    *split = cJSON_GetObjectItemCaseSensitive(c, "split");
+        ENSURE(cJSON_IsString(name) && !strcmp(name->valuestring, want_name[i]));
+        ENSURE(cJSON_IsString(split) && !strcmp(split->valuestring, want_split[i]));
+        ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(c, "frames")) == want_n[i]);
+        ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(c, "error")) == want_n[i]);
+    }
+    const cJSON *doms = cJSON_GetObjectItemCaseSensitive(j, "domains");
+    ENSURE(cJSON_GetArraySize(doms) == v->ndomains);
+    for (int32_t d = 0; d < v->ndomains && cJSON_GetArraySize(doms) == v->ndomains; ++d) {
+        const cJSON *o = cJSON_GetArrayItem(doms, d);
+        ENSURE(num(o, "rank") == v->domains[d].rank &&
+               num(o, "cubature") == v->domains[d].cub_count);
+        ENSURE(num(o, "energy") > 0.9 && num(o, "energy") <= 1.0);
+    }
+    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == 6);
+    const cJSON *sheet = cJSON_GetObjectItemCaseSensitive(j, "contact_sheet");
+    ENSURE(cJSON_IsString(sheet));
+    cJSON_Delete(j);
+    free(text);
+}
+
+TEST(clips_of_their_own_and_the_report) {
+    sw_character ch, other;
+    sw_error e;
+    ENSURE(sw_sample_make("finger", 1000, 8, &ch, &e) == SINEW_OK);
+    ENSURE(sw_sample_make("finger", 1000, 6, &other, &e) == SINEW_OK);
+    /* the held-out clip: the 6-frame fold played backwards (never a training frame) */
+    sw_clip held = other.clip;
+    int32_t nb = held.nbones;
+    double *rev = malloc(sizeof(double) * 12 * (size_t)nb * 6);
+    for (int32_t f = 0; f < 6; ++f)
+        memcpy(rev + (size_t)f * 12 * nb, held.T + (size_t)(5 - f) * 12 * nb,
+               sizeof(double) * 12 * (size_t)nb);
+    held.T = rev;
+    sw_bake_params p = sw_bake_params_default();
+    p.threads = 2;
+    p.train_clips = &ch.clip;
+    p.ntrain_clips = 1;
+    p.heldout_clips = &held;
+    p.nheldout_clips = 1;
+    sw_bake_result res;
+    sinew_result r = sw_bake(&ch, &p, &res, &e);
+    ENSUREF(r == SINEW_OK, "%s", e.msg);
+    if (r) return;
+    ENSURE(res.nheldout == 6);
+    int32_t clip_poses = 0;
+    for (int32_t k = 0; k < res.ntrain; ++k) {
+        ENSURE(res.train_clip[k] == 0 || res.train_clip[k] == -1);
+        clip_poses += res.train_clip[k] == 0;
+    }
+    ENSURE(clip_poses == 8);
+    for (int32_t k = 0; k < res.nheldout; ++k)
+        ENSURE(res.heldout_clip[k] == 0 && res.heldout_frame[k] == k);
+    void *mem = NULL;
+    size_t size = 0;
+    ENSURE(sw_blob_write_memory(&res.view, &mem, &size, &e) == SINEW_OK);
+    sinew_blob_def bd = sinew_blob_def_default();
+    bd.data = mem;
+    bd.data_size = size;
+    sinew_blob *blob = NULL;
+    ENSURE(sinew_blob_load(&bd, &blob) == SINEW_OK);
+    double *fe = malloc(sizeof(double) * (size_t)(res.ntrain + res.nheldout));
+    sw_eval_result et, eh;
+    ENSURE(sw_bake_errors_frames(blob, &res, &et, &eh, fe, fe + res.ntrain, &e) == SINEW_OK);
+    sw_eval_result et2, eh2; /* the aggregate is sw_bake_errors' */
+    ENSURE(sw_bake_errors(blob, &res, &et2, &eh2, &e) == SINEW_OK);
+    ENSURE(et.correction_error == et2.correction_error);
+    ENSURE(eh.correction_error == eh2.correction_error);
+    static const char tn[1][64] = {"Bend"}, hn[1][64] = {"Return"};
+    sw_bake_report_input in = {"finger",
+                               &ch,
+                               &res,
+                               blob,
+                               tn,
+                               1,
+                               hn,
+                               1,
+                               fe,
+                               fe + res.ntrain,
+                               et.correction_error,
+                               eh.correction_error,
+                               0,
+                               1.0,
+                               0.5,
+                               1};
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
+    r = sw_bake_report_write(dir, &in, &e);
+    ENSUREF(r == SINEW_OK, "%s", e.msg);
+    check_json(dir, &res, &res.view, eh.correction_error);
+    char path[1100];
+    snprintf(path, sizeof path, "%.1000s/report.html", dir);
+    char *html = read_text(path);
+    ENSURE(html && strstr(html, "<svg") && strstr(html, "heldout_sheet.png") &&
+           strstr(html, "Return"));
+    free(html);
+    struct stat st;
+    snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);
+    ENSURE(stat(path, &st) == 0 && st.st_size > 1000);
+    free(fe);
+    sinew_blob_destroy(blob);
+    free(mem);
+    sw_bake_result_free(&res);
+    free(rev);
+    sw_character_free(&other);
+    sw_character_free(&ch);
+}
+
+/* Held-out clips need training clips; a clip of another skeleton is named. */
+TEST(bad_clip_lists_rejected) {
+    sw_character ch;
+    sw_error e;
+    ENSURE(sw_sample_make("finger", 1000, 8, &ch, &e) == SINEW_OK);
+    sw_bake_params p = sw_bake_params_default();
+    sw_bake_result res;
+    p.heldout_clips = &ch.clip;
+    p.nheldout_clips = 1;
+    ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "held-out clips need training clips"), "%s", e.msg);
+    sw_clip wrong = ch.clip;
+    wrong.nbones = 2;
+    p.train_clips = &wrong;
+    p.ntrain_clips = 1;
+    ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "training clip 0 has 2 bones"), "%s", e.msg);
+    sw_character_free(&ch);
+}
+
+SW_TEST_MAIN(CASE(clips_of_their_own_and_the_report), CASE(bad_clip_lists_rejected))

@@ -1,0 +1,392 @@
+/* The bake report: figures gathered once, written as JSON (libcjson) and as one HTML
+ * page with inline SVG (bake_report.h).
+ *
+ * report.json (schema 1):
+ *   sinew_bake_report  1
+ *   source, character {name, tets, verts, bones, render_verts, render_tris, youngs,
+ *                      poisson, density}
+ *   err_train, err_heldout, proj_err_train, proj_err_heldout, cubature_fit, failed_steps
+ *   bake_seconds, eval_seconds, stages [{name, seconds}]
+ *   clips [{name, split "train" | "heldout", frames [clip frame], error [per frame]}]
+ *   sweeps {poses, mean_error}: the training poses of no clip (joint sweeps, return path)
+ *   domains [{bone, rank, energy, cubature}]
+ *   contact_sheet: the PNG's file name, or null */
+#include "bake_report.h"
+
+#include <cjson/cJSON.h>
+#include <errno.h>
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+#include <sys/stat.h>
+
+#include "blob_load.h"
+#include "tool_common.h"
+
+static const char *const stage_names[SW_BAKE_REPORT_STAGES] = {"prepare", "domains",  "simulate",
+                                                               "basis",   "cubature", "reduce"};
+
+#define SHEET_NAME "heldout_sheet.png"
+
+/* One clip's frames in the report: the poses of `split` labelled `label`. */
+typedef struct report_clip {
+    char name[80];
+    int heldout;
+    int32_t n;
+    int32_t *frame;
+    double *error;
+} report_clip;
+
+typedef struct report {
+    report_clip *clips;
+    int32_t nclips;
+    int32_t sweep_poses;
+    double sweep_mean;
+} report;
+
+static void report_free(report *r) {
+    for (int32_t i = 0; i < r->nclips; ++i) {
+        free(r->clips[i].frame);
+        free(r->clips[i].error);
+    }
+    free(r->clips);
+    memset(r, 0, sizeof *r);
+}
+
+/* The poses of one split labelled `label` as a clip of the report. */
+static int gather_clip(report_clip *c, int32_t npose, const int32_t *labels, const int32_t *frames,
+                       const double *errors, int32_t label) {
+    c->frame = malloc(sizeof(int32_t) * ((size_t)npose + 1));
+    c->error = malloc(sizeof(double) * ((size_t)npose + 1));
+    if (!c->frame || !c->error) return 0;
+    for (int32_t k = 0; k < npose; ++k)
+        if (labels[k] == label) {
+            c->frame[c->n] = frames[k];
+            c->error[c->n++] = errors[k];
+        }
+    return 1;
+}
+
+static int gather(const sw_bake_report_input *in, report *r) {
+    const sw_bake_result *res = in->res;
+    int32_t nt = in->train_names ? in->ntrain_names : 1,
+            nh = in->heldout_names ? in->nheldout_names : 1;
+    r->clips = calloc((size_t)(nt + nh), sizeof *r->clips);
+    if (!r->clips) return 0;
+    for (int s = 0; s < 2; ++s) {
+        int32_t n = s ? nh : nt, npose = s ? res->nheldout : res->ntrain;
+        const char(*names)[64] = s ? in->heldout_names : in->train_names;
+        for (int32_t i = 0; i < n; ++i) {
+            report_clip *c = &r->clips[r->nclips++];
+            c->heldout = s;
+            if (names)
+                snprintf(c->name, sizeof c->name, "%s", names[i]);
+            else
+                snprintf(c->name, sizeof c->name, "%s (%s part)",
+                         in->ch->name[0] ? in->ch->name : "clip", s ? "held-out" : "training");
+            if (!gather_clip(c, npose, s ? res->heldout_clip : res->train_clip,
+                             s ? res->heldout_frame : res->train_frame,
+                             s ? in->heldout_frames : in->train_frames, i))
+                return 0;
+        }
+    }
+    double sum = 0;
+    for (int32_t k = 0; k < res->ntrain; ++k)
+        if (res->train_clip[k] < 0 && isfinite(in->train_frames[k]))
+            sum += in->train_frames[k], r->sweep_poses++;
+    r->sweep_mean = r->sweep_poses ? sum / r->sweep_poses : 0;
+    return 1;
+}
+
+/* A number for JSON: non-finite (a failed step) becomes null. */
+static cJSON *json_number(double v) {
+    return isfinite(v) ? cJSON_CreateNumber(v) : cJSON_CreateNull();
+}
+
+static cJSON *json_character(const sw_bake_report_input *in) {
+    const sw_character *ch = in->ch;
+    cJSON *c = cJSON_CreateObject();
+    cJSON_AddStringToObject(c, "name", ch->name);
+    cJSON_AddNumberToObject(c, "tets", ch->mesh.ntets);
+    cJSON_AddNumberToObject(c, "verts", ch->mesh.nverts);
+    cJSON_AddNumberToObject(c, "bones", ch->skel.nbones);
+    cJSON_AddNumberToObject(c, "render_verts", ch->render.nverts);
+    cJSON_AddNumberToObject(c, "render_tris", ch->render.ntris);
+    cJSON_AddNumberToObject(c, "youngs", ch->youngs);
+    cJSON_AddNumberToObject(c, "poisson", ch->poisson);
+    cJSON_AddNumberToObject(c, "density", ch->density);
+    return c;
+}
+
+static cJSON *json_clips(const report *r) {
+    cJSON *a = cJSON_CreateArray();
+    for (int32_t i = 0; i < r->nclips; ++i) {
+        const report_clip *c = &r->clips[i];
+        cJSON *o = cJSON_CreateObject(), *f = cJSON_CreateArray(), *e = cJSON_CreateArray();
+        cJSON_AddStringToObject(o, "name", c->name);
+        cJSON_AddStringToObject(o, "split", c->heldout ? "heldout" : "train");
+        for (int32_t k = 0; k < c->n; ++k) {
+            cJSON_AddItemToArray(f, cJSON_CreateNumber(c->frame[k]));
+            cJSON_AddItemToArray(e, json_number(c->error[k]));
+        }
+        cJSON_AddItemToObject(o, "frames", f);
+        cJSON_AddItemToObject(o, "error", e);
+        cJSON_AddItemToArray(a, o);
+    }
+    return a;
+}
+
+static cJSON *json_domains(const sw_bake_report_input *in) {
+    const sw_blob_view *v = sw_blob_get_view(in->blob);
+    cJSON *a = cJSON_CreateArray();
+    for (int32_t d = 0; d < v->ndomains; ++d) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "bone", v->domains[d].bone);
+        cJSON_AddNumberToObject(o, "rank", v->domains[d].rank);
+        cJSON_AddItemToObject(o, "energy",
+                              json_number(in->res->basis_energy ? in->res->basis_energy[d] : NAN));
+        cJSON_AddNumberToObject(o, "cubature", v->domains[d].cub_count);
+        cJSON_AddItemToArray(a, o);
+    }
+    return a;
+}
+
+static char *report_json(const sw_bake_report_input *in, const report *r, int sheet) {
+    const sw_bake_result *res = in->res;
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddNumberToObject(j, "sinew_bake_report", SW_BAKE_REPORT_VERSION);
+    cJSON_AddStringToObject(j, "source", in->source ? in->source : "");
+    cJSON_AddItemToObject(j, "character", json_character(in));
+    cJSON_AddItemToObject(j, "err_train", json_number(in->err_train));
+    cJSON_AddItemToObject(j, "err_heldout", json_number(in->err_heldout));
+    cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
+    cJSON_AddNumberToObject(j, "proj_err_heldout", res->heldout_proj_error);
+    cJSON_AddNumberToObject(j, "cubature_fit", res->cubature_error_max);
+    cJSON_AddNumberToObject(j, "failed_steps", in->failed_steps);
+    cJSON_AddNumberToObject(j, "bake_seconds", in->bake_seconds);
+    cJSON_AddNumberToObject(j, "eval_seconds", in->eval_seconds);
+    cJSON *st = cJSON_AddArrayToObject(j, "stages");
+    for (int k = 0; k < SW_BAKE_REPORT_STAGES; ++k) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddStringToObject(o, "name", stage_names[k]);
+        cJSON_AddNumberToObject(o, "seconds", res->stage_seconds[k]);
+        cJSON_AddItemToArray(st, o);
+    }
+    cJSON_AddItemToObject(j, "clips", json_clips(r));
+    cJSON *sw = cJSON_AddObjectToObject(j, "sweeps");
+    cJSON_AddNumberToObject(sw, "poses", r->sweep_poses);
+    cJSON_AddNumberToObject(sw, "mean_error", r->sweep_mean);
+    cJSON_AddItemToObject(j, "domains", json_domains(in));
+    if (sheet)
+        cJSON_AddStringToObject(j, "contact_sheet", SHEET_NAME);
+    else
+        cJSON_AddNullToObject(j, "contact_sheet");
+    char *text = cJSON_Print(j);
+    cJSON_Delete(j);
+    return text;
+}
+
+/* s with &, <, >, " escaped for HTML text and attributes. */
+static void html_text(FILE *f, const char *s) {
+    for (; *s; ++s)
+        switch (*s) {
+        case '&':
+            fputs("&amp;", f);
+            break;
+        case '<':
+            fputs("&lt;", f);
+            break;
+        case '>':
+            fputs("&gt;", f);
+            break;
+        case '"':
+            fputs("&quot;", f);
+            break;
+        default:
+            fputc(*s, f);
+        }
+}
+
+#define PLOT_W 420
+#define PLOT_H 150
+#define PAD 34
+
+/* A line plot of y over x (n points; NaN points skipped) with y from 0 to ymax. */
+static void svg_line(FILE *f, const char *title, const int32_t *x, const double *y, int32_t n,
+                     double ymax, const char *colour) {
+    fprintf(f, "<figure><figcaption>");
+    html_text(f, title);
+    fprintf(f, "</figcaption><svg width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">", PLOT_W,
+            PLOT_H, PLOT_W, PLOT_H);
+    int32_t xmin = n ? x[0] : 0, xmax = n ? x[n - 1] : 1;
+    if (xmax <= xmin) xmax = xmin + 1;
+    double sx = (PLOT_W - 2.0 * PAD) / (xmax - xmin), sy = (PLOT_H - 2.0 * PAD) / ymax;
+    fprintf(f,
+            "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"#888\"/>"
+            "<line x1=\"%d\" y1=\"%d\" x2=\"%d\" y2=\"%d\" stroke=\"#888\"/>",
+            PAD, PLOT_H - PAD, PLOT_W - PAD, PLOT_H - PAD, PAD, PAD, PAD, PLOT_H - PAD);
+    fprintf(f,
+            "<text x=\"2\" y=\"%d\" font-size=\"10\">%.2g</text><text x=\"2\" y=\"%d\" "
+            "font-size=\"10\">0</text><text x=\"%d\" y=\"%d\" font-size=\"10\">frame %d</text>"
+            "<text x=\"%d\" y=\"%d\" font-size=\"10\" text-anchor=\"end\">%d</text>",
+            PAD + 4, ymax, PLOT_H - PAD, PAD, PLOT_H - PAD + 14, xmin, PLOT_W - PAD,
+            PLOT_H - PAD + 14, xmax);
+    fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", colour);
+    for (int32_t k = 0; k < n; ++k)
+        if (isfinite(y[k]))
+            fprintf(f, "%.1f,%.1f ", PAD + sx * (x[k] - xmin),
+                    PLOT_H - PAD - sy * fmin(y[k], ymax));
+    fprintf(f, "\"/></svg></figure>\n");
+}
+
+/* A bar chart of v[0..n) labelled by index (or labels when not NULL). */
+static void svg_bars(FILE *f, const char *title, const double *v, int32_t n,
+                     const char *const *labels, const char *colour) {
+    double vmax = 0;
+    for (int32_t k = 0; k < n; ++k)
+        vmax = fmax(vmax, isfinite(v[k]) ? v[k] : 0);
+    if (!(vmax > 0)) vmax = 1;
+    int w = PAD + (n > 0 ? n : 1) * 22 + PAD;
+    w = w < PLOT_W ? PLOT_W : w;
+    fprintf(f, "<figure><figcaption>");
+    html_text(f, title);
+    fprintf(f, "</figcaption><svg width=\"%d\" height=\"%d\">", w, PLOT_H);
+    double sy = (PLOT_H - 2.0 * PAD) / vmax;
+    for (int32_t k = 0; k < n; ++k) {
+        double h = isfinite(v[k]) ? sy * v[k] : 0;
+        fprintf(f,
+                "<rect x=\"%d\" y=\"%.1f\" width=\"16\" height=\"%.1f\" fill=\"%s\"><title>%.4g"
+                "</title></rect><text x=\"%d\" y=\"%d\" font-size=\"9\">",
+                PAD + 22 * k, PLOT_H - PAD - h, h, colour, v[k], PAD + 22 * k, PLOT_H - PAD + 12);
+        if (labels)
+            html_text(f, labels[k]);
+        else
+            fprintf(f, "%d", k);
+        fprintf(f, "</text><text x=\"%d\" y=\"%.1f\" font-size=\"8\">%.3g</text>", PAD + 22 * k,
+                PLOT_H - PAD - h - 3, v[k]);
+    }
+    fprintf(f, "</svg></figure>\n");
+}
+
+static void html_summary(FILE *f, const sw_bake_report_input *in) {
+    const sw_character *ch = in->ch;
+    fprintf(f, "<h1>sinew bake report: ");
+    html_text(f, in->source ? in->source : ch->name);
+    fprintf(f, "</h1>\n<table>");
+    fprintf(f, "<tr><td>simulation mesh</td><td>%d tets, %d vertices, %d bones</td></tr>",
+            ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones);
+    if (ch->render.nverts)
+        fprintf(f, "<tr><td>render mesh</td><td>%d vertices, %d triangles</td></tr>",
+                ch->render.nverts, ch->render.ntris);
+    fprintf(f, "<tr><td>material</td><td>E %.4g, &nu; %.3g, density %.4g</td></tr>", ch->youngs,
+            ch->poisson, ch->density);
+    fprintf(f,
+            "<tr><td>correction error</td><td>training %.4f, held-out <b>%.4f</b> (the share of "
+            "the physics correction the runtime misses; 0 exact, 1 no better than "
+            "skinning)</td></tr>",
+            in->err_train, in->err_heldout);
+    fprintf(f,
+            "<tr><td>basis projection error</td><td>training %.4f, held-out %.4f</td></tr>"
+            "<tr><td>worst cubature fit</td><td>%.4f</td></tr><tr><td>failed steps</td><td>%d"
+            "</td></tr><tr><td>bake time</td><td>%.1f s (+ %.1f s evaluation)</td></tr></table>\n",
+            in->res->train_proj_error, in->res->heldout_proj_error, in->res->cubature_error_max,
+            in->failed_steps, in->bake_seconds, in->eval_seconds);
+}
+
+static void html_clips(FILE *f, const report *r) {
+    double ymax = 0.05;
+    for (int32_t i = 0; i < r->nclips; ++i)
+        for (int32_t k = 0; k < r->clips[i].n; ++k)
+            if (isfinite(r->clips[i].error[k])) ymax = fmax(ymax, r->clips[i].error[k]);
+    fprintf(f, "<h2>Correction error of every clip frame</h2><p>Training clips in blue, "
+               "held-out clips (never trained on) in orange; same scale.</p><div class=\"row\">");
+    for (int32_t i = 0; i < r->nclips; ++i) {
+        char title[160];
+        snprintf(title, sizeof title, "%s (%s, %d frames)", r->clips[i].name,
+                 r->clips[i].heldout ? "held out" : "training", r->clips[i].n);
+        svg_line(f, title, r->clips[i].frame, r->clips[i].error, r->clips[i].n, ymax,
+                 r->clips[i].heldout ? "#d2691e" : "#1f77b4");
+    }
+    fprintf(f,
+            "</div><p>Joint sweeps and other training poses of no clip: %d, mean error "
+            "%.4f.</p>\n",
+            r->sweep_poses, r->sweep_mean);
+}
+
+static int html_domains(FILE *f, const sw_bake_report_input *in) {
+    const sw_blob_view *v = sw_blob_get_view(in->blob);
+    int32_t nd = v->ndomains;
+    double *a = malloc(sizeof(double) * 3 * ((size_t)nd + 1));
+    if (!a) return 0;
+    for (int32_t d = 0; d < nd; ++d) {
+        a[d] = v->domains[d].rank;
+        a[nd + d] = in->res->basis_energy ? in->res->basis_energy[d] : NAN;
+        a[2 * nd + d] = v->domains[d].cub_count;
+    }
+    fprintf(f, "<h2>Domains (one per bone that owns flesh)</h2><div class=\"row\">");
+    svg_bars(f, "basis rank per domain", a, nd, NULL, "#2ca02c");
+    svg_bars(f, "PCA energy kept per domain", a + nd, nd, NULL, "#9467bd");
+    svg_bars(f, "cubature tets per domain", a + 2 * nd, nd, NULL, "#8c564b");
+    fprintf(f, "</div>\n");
+    free(a);
+    return 1;
+}
+
+static int write_html(const char *path, const sw_bake_report_input *in, const report *r,
+                      int sheet) {
+    FILE *f = fopen(path, "w");
+    if (!f) return 0;
+    fprintf(f, "<!DOCTYPE html>\n<html><head><meta charset=\"utf-8\"><title>sinew bake report"
+               "</title><style>body{font-family:sans-serif;margin:2em;max-width:1400px}"
+               "td{padding:2px 12px}figure{display:inline-block;margin:6px}"
+               "figcaption{font-size:12px}.row{display:flex;flex-wrap:wrap}</style></head>"
+               "<body>\n");
+    html_summary(f, in);
+    html_clips(f, r);
+    int ok = html_domains(f, in);
+    fprintf(f, "<h2>Stage times</h2>");
+    svg_bars(f, "seconds per stage", in->res->stage_seconds, SW_BAKE_REPORT_STAGES, stage_names,
+             "#7f7f7f");
+    if (sheet)
+        fprintf(f, "<h2>Held-out frames</h2><p>Each row one held-out frame: the runtime, the "
+                   "full-space reference, plain skinning.</p><img src=\"" SHEET_NAME
+                   "\" alt=\"contact sheet\" style=\"max-width:100%%\">\n");
+    fprintf(f, "</body></html>\n");
+    return fclose(f) == 0 && ok;
+}
+
+sinew_result sw_bake_report_write(const char *dir, const sw_bake_report_input *in, sw_error *err) {
+    if (!dir || !in || !in->ch || !in->res || !in->blob || !in->train_frames || !in->heldout_frames)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "report: NULL argument");
+    if (!sw_tool_make_dirs(dir))
+        return sw_error_set(err, SINEW_ERROR_IO, "report: cannot create the folder %s: %s", dir,
+                            strerror(errno ? errno : EACCES));
+    char path[4096];
+    int sheet = 0;
+    if (in->contact_sheet && in->res->nheldout > 0) {
+        snprintf(path, sizeof path, "%s/%s", dir, SHEET_NAME);
+        sinew_result r = sw_bake_report_sheet(path, in->ch, in->res, in->blob, 4, err);
+        if (r != SINEW_OK) return r;
+        sheet = 1;
+    }
+    report r;
+    memset(&r, 0, sizeof r);
+    if (!gather(in, &r)) {
+        report_free(&r);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "report: out of memory");
+    }
+    char *json = report_json(in, &r, sheet);
+    snprintf(path, sizeof path, "%s/report.json", dir);
+    FILE *f = json ? fopen(path, "w") : NULL;
+    int ok = f && fputs(json, f) >= 0 && fputc('\n', f) != EOF;
+    if (f) ok = fclose(f) == 0 && ok;
+    free(json);
+    if (ok) {
+        snprintf(path, sizeof path, "%s/report.html", dir);
+        ok = write_html(path, in, &r, sheet);
+    }
+    report_free(&r);
+    if (!ok) return sw_error_set(err, SINEW_ERROR_IO, "report: cannot write %s", path);
+    return SINEW_OK;
+}

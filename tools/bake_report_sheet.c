@@ -1,0 +1,101 @@
+/* The report's contact sheet of held-out frames (bake_report.h): runtime, full-space
+ * reference and plain skinning side by side, drawn by the Embree renderer
+ * (tools/render). The simulation mesh's boundary is drawn for all three, so the sheet
+ * compares like with like whatever the blob's output surface is. */
+#include "bake_report.h"
+
+#include <stdlib.h>
+#include <string.h>
+
+#include "blob_load.h"
+#include "instance.h"
+#include "mesh_io.h"
+#include "png_write.h"
+#include "render.h"
+
+#define TILE_W 320
+#define TILE_H 240
+#define GAP 4
+
+/* The three surfaces (runtime, reference, skinning) of `rows` held-out poses, 3 nverts
+ * doubles each, stepping a quasistatic instance through every held-out pose in order as
+ * sw_bake_errors does. */
+static sinew_result capture(const sw_bake_result *res, const sinew_blob *blob, int32_t nv,
+                            int32_t rows, double *X, sw_error *err) {
+    sinew_instance_def def = sinew_instance_def_default();
+    def.mode = SINEW_STEP_QUASISTATIC;
+    def.max_newton_iters = SW_BAKE_EVAL_NEWTON;
+    sinew_instance *inst;
+    sinew_result r = sinew_instance_create(blob, &def, &inst);
+    if (r != SINEW_OK) return sw_error_set(err, r, "contact sheet: cannot create an instance");
+    double *cnt = malloc(sizeof(double) * (size_t)nv);
+    if (!cnt) {
+        sinew_instance_destroy(inst);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "contact sheet: out of memory");
+    }
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    size_t n3 = 3 * (size_t)nv;
+    for (int32_t k = 0, row = 0; k < res->nheldout && row < rows; ++k) {
+        sw_instance_set_pose_d(inst, res->heldout_T + (size_t)k * 12 * v->nbones);
+        sinew_instance_step(inst, 1.0f / 30);
+        int32_t want = rows == 1 ? 0 : (int32_t)((int64_t)row * (res->nheldout - 1) / (rows - 1));
+        if (k != want) continue;
+        double *out = X + (size_t)row * 3 * n3;
+        sw_instance_full_positions(inst, out, cnt);
+        memcpy(out + n3, res->heldout_x + (size_t)k * n3, n3 * sizeof(double));
+        sw_instance_dqs_positions(inst, out + 2 * n3);
+        row++;
+    }
+    free(cnt);
+    sinew_instance_destroy(inst);
+    return SINEW_OK;
+}
+
+/* Renders tile (row, col) into the sheet. */
+static sinew_result draw_tile(const sw_render_params *p, int32_t nv, const double *X,
+                              const sw_surface *s, uint8_t *tile, uint8_t *sheet, int W, int row,
+                              int col, sw_error *err) {
+    sinew_result r = sw_render_surface(p, nv, X, s->ntris, s->tris, NULL, tile, err);
+    if (r != SINEW_OK) return r;
+    int x0 = col * (TILE_W + GAP), y0 = row * (TILE_H + GAP);
+    for (int y = 0; y < TILE_H; ++y)
+        memcpy(sheet + 3 * ((size_t)(y0 + y) * W + x0), tile + 3 * (size_t)y * TILE_W, 3 * TILE_W);
+    return SINEW_OK;
+}
+
+sinew_result sw_bake_report_sheet(const char *png_path, const sw_character *ch,
+                                  const sw_bake_result *res, const sinew_blob *blob, int32_t frames,
+                                  sw_error *err) {
+    int32_t nv = ch->mesh.nverts, rows = frames < res->nheldout ? frames : res->nheldout;
+    if (rows < 1)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "contact sheet: no held-out pose");
+    sw_surface surf = {0};
+    sinew_result r = sw_tetmesh_surface(&ch->mesh, &surf, err);
+    if (r != SINEW_OK) return r;
+    int W = 3 * TILE_W + 2 * GAP, H = rows * TILE_H + (rows - 1) * GAP;
+    double *X = malloc(sizeof(double) * 9 * (size_t)nv * (size_t)rows);
+    uint8_t *tile = malloc(3 * (size_t)TILE_W * TILE_H), *sheet = malloc(3 * (size_t)W * H);
+    if (!X || !tile || !sheet) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "contact sheet: out of memory");
+        goto done;
+    }
+    memset(sheet, 64, 3 * (size_t)W * H); /* dark grey gutters */
+    if ((r = capture(res, blob, nv, rows, X, err)) != SINEW_OK) goto done;
+    /* one camera for every tile: the box of all of them */
+    double lo[3], hi[3];
+    if ((r = sw_render_bbox(3 * nv * rows, X, lo, hi, err)) != SINEW_OK) goto done;
+    sw_render_params p = sw_render_params_default(TILE_W, TILE_H);
+    p.ground = 1;
+    if ((r = sw_render_frame_camera(&p, lo, hi, err)) != SINEW_OK) goto done;
+    for (int32_t row = 0; row < rows && r == SINEW_OK; ++row)
+        for (int col = 0; col < 3 && r == SINEW_OK; ++col)
+            r = draw_tile(&p, nv, X + ((size_t)row * 3 + col) * 3 * nv, &surf, tile, sheet, W, row,
+                          col, err);
+    if (r == SINEW_OK) r = sw_write_png(png_path, W, H, sheet, err);
+done:
+    sw_surface_free(&surf);
+    free(X);
+    free(tile);
+    free(sheet);
+    return r;
+}
