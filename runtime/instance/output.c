@@ -31,8 +31,10 @@ static void copies_mean(const sinew_instance *in, const int32_t *copies, const i
 
 void sw_instance_write_surface(sinew_instance *in) {
     const sw_blob_view *v = in->v;
-    /* the boundary's copies carry the world's broad phase next step, render mesh or not */
-    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+    /* the boundary is the output, or (under a render mesh) only what carries the world's
+     * broad phase next step: without a world it is skipped (attaching one invalidates
+     * the boxes, instance_world.c) */
+    for (int32_t s = 0; s < (v->nrender_verts == 0 || in->wc.world ? v->nsurf_verts : 0); ++s) {
         double x[3];
         copies_mean(in, v->surf_copies, in->red.copy_act, v->surf_copy_ptr[s],
                     v->surf_copy_ptr[s + 1], in->wc.copy_x,
