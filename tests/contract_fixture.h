@@ -13,6 +13,7 @@
 #include <string.h>
 
 #include "sinew/sinew.h"
+#include "sw_test.h"
 
 typedef struct {
     void *data; /* the blob's bytes (owned) */
@@ -49,21 +50,6 @@ static inline int contract_fixture_save(const char *dir, const void *blob, size_
     return (fclose(fp) == 0) && ok;
 }
 
-static inline void *contract_read_file(const char *path, size_t *size) {
-    FILE *fp = fopen(path, "rb");
-    if (!fp) return NULL;
-    void *buf = NULL;
-    long n = fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
-    if (n > 0 && fseek(fp, 0, SEEK_SET) == 0 && (buf = malloc((size_t)n)) &&
-        fread(buf, 1, (size_t)n, fp) != (size_t)n) {
-        free(buf);
-        buf = NULL;
-    }
-    fclose(fp);
-    *size = n > 0 ? (size_t)n : 0;
-    return buf;
-}
-
 static inline void contract_fixture_free(contract_fixture *f) {
     sinew_blob_destroy(f->blob);
     free(f->data);
@@ -88,11 +74,11 @@ static inline int contract_fixture_load(const char *dir, contract_fixture *f) {
     size_t n = 0;
     memset(f, 0, sizeof *f);
     if (!contract_path(path, sizeof path, dir, "contract.blob") ||
-        !(f->data = contract_read_file(path, &f->size)))
+        !(f->data = sw_test_read_file(path, &f->size)))
         return 0;
     unsigned char *clip = NULL;
     int ok = contract_path(path, sizeof path, dir, "contract.clip") &&
-             (clip = contract_read_file(path, &n)) && n >= 16 &&
+             (clip = (unsigned char *)sw_test_read_file(path, &n)) && n >= 16 &&
              memcmp(clip, contract_clip_magic, 8) == 0;
     uint32_t head[2] = {0, 0};
     if (ok) memcpy(head, clip + 8, sizeof head);

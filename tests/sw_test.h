@@ -125,4 +125,25 @@ static inline int sw_test_in_ci(void) {
         }                                                                                          \
     } while (0)
 
+/* The whole file at path, with a NUL after its bytes (so text can be read as a string),
+ * its length in *n (0 when the file is missing or unreadable: NULL then). */
+static inline char *sw_test_read_file(const char *path, size_t *n) {
+    *n = 0;
+    FILE *fp = fopen(path, "rb");
+    if (!fp) return NULL;
+    char *buf = NULL;
+    long len = fseek(fp, 0, SEEK_END) == 0 ? ftell(fp) : -1;
+    if (len >= 0 && fseek(fp, 0, SEEK_SET) == 0 && (buf = malloc((size_t)len + 1))) {
+        if (fread(buf, 1, (size_t)len, fp) == (size_t)len) {
+            buf[len] = '\0';
+            *n = (size_t)len;
+        } else {
+            free(buf);
+            buf = NULL;
+        }
+    }
+    fclose(fp);
+    return buf;
+}
+
 #endif

@@ -15,17 +15,10 @@
 #include "samples.h"
 #include "sw_test.h"
 
+/* A text file's contents (NULL when it cannot be read). */
 static char *read_text(const char *path) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long n = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *s = malloc((size_t)n + 1);
-    if (s && fread(s, 1, (size_t)n, f) != (size_t)n) n = 0;
-    if (s) s[n] = '\0';
-    fclose(f);
-    return s;
+    size_t n;
+    return sw_test_read_file(path, &n);
 }
 
 static double num(const cJSON *o, const char *key) {

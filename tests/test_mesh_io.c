@@ -77,19 +77,6 @@ static char *replace(const char *s, const char *from, const char *to) {
     return r;
 }
 
-static char *read_all(const char *path, size_t *n) {
-    *n = 0;
-    FILE *f = fopen(path, "rb");
-    if (!f) return NULL;
-    fseek(f, 0, SEEK_END);
-    long len = ftell(f);
-    fseek(f, 0, SEEK_SET);
-    char *b = malloc((size_t)len + 1);
-    *n = fread(b, 1, (size_t)len, f);
-    fclose(f);
-    return b;
-}
-
 static int all_zero(const void *p, size_t n) {
     const unsigned char *b = p;
     for (size_t i = 0; i < n; ++i)
@@ -536,7 +523,7 @@ TEST(dmat_round_trips_ascii_and_binary) {
     const char *p = tmp_path("lay.dmat");
     ENSURE(sw_write_dmat(p, 1, 2, A, 1, &e) == SINEW_OK);
     size_t n;
-    char *raw = read_all(p, &n);
+    char *raw = sw_test_read_file(p, &n);
     ENSURE(n == 8 + 16 && memcmp(raw, "0 0\n2 1\n", 8) == 0);
     ENSURE(raw[8 + 6] == (char)0xF8 && raw[8 + 7] == (char)0x3F); /* 1.5 = 0x3FF8... */
     free(raw);
@@ -997,7 +984,7 @@ TEST(real_every_asset_reads) {
 TEST(real_truncation_sweep) {
     NEED_DATA("elephant-cd/elephant.mesh");
     size_t n;
-    char *full = read_all(data_path("elephant-cd/elephant.mesh"), &n);
+    char *full = sw_test_read_file(data_path("elephant-cd/elephant.mesh"), &n);
     ENSURE(full && n > 1000);
     size_t data_end = n;
     while (data_end > 0 && (full[data_end - 1] == '\n' || full[data_end - 1] == ' '))
@@ -1030,7 +1017,7 @@ TEST(byte_flips_never_crash) {
     sw_error e;
     ENSURE(sw_write_dmat(tmp_path("flip_src.dmat"), 2, 3, A, 1, &e) == SINEW_OK);
     size_t dn;
-    char *dsrc = read_all(tmp_path("flip_src.dmat"), &dn);
+    char *dsrc = sw_test_read_file(tmp_path("flip_src.dmat"), &dn);
     ENSURE(dsrc && dn < sizeof dm);
     memcpy(dm, dsrc, dn);
     free(dsrc);
