@@ -1,7 +1,8 @@
 /* The report's contact sheet of held-out frames (bake_report.h): runtime, full-space
  * reference and plain skinning side by side, drawn by the Embree renderer
- * (tools/render). The simulation mesh's boundary is drawn for all three, so the sheet
- * compares like with like whatever the blob's output surface is. */
+ * (tools/render). All three are drawn through the blob's output surface: the render
+ * mesh placed by its embedding when the blob has one (the artist's own mesh, runtime,
+ * reference and skinning alike), the simulation mesh's boundary otherwise. */
 #include "bake_report.h"
 
 #include <stdlib.h>
@@ -81,6 +82,27 @@ sinew_result sw_bake_report_sheet(const char *png_path, const sw_character *ch,
     }
     memset(sheet, 64, 3 * (size_t)W * H); /* dark grey gutters */
     if ((r = capture(res, blob, nv, rows, X, err)) != SINEW_OK) goto done;
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    if (v->nrender_verts > 0) { /* every tile through the embedding, in place */
+        double *Y = malloc(sizeof(double) * 9 * (size_t)v->nrender_verts * (size_t)rows);
+        if (!Y) {
+            r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "contact sheet: out of memory");
+            goto done;
+        }
+        for (int32_t t = 0; t < 3 * rows; ++t)
+            sw_output_from_full(v, X + (size_t)t * 3 * nv, Y + (size_t)t * 3 * v->nrender_verts);
+        free(X);
+        X = Y;
+        nv = v->nrender_verts;
+        sw_surface_free(&surf);
+        surf.ntris = v->nrender_tris;
+        surf.tris = malloc(sizeof(int32_t) * 3 * (size_t)surf.ntris);
+        if (!surf.tris) {
+            r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "contact sheet: out of memory");
+            goto done;
+        }
+        memcpy(surf.tris, v->render_tris, sizeof(int32_t) * 3 * (size_t)surf.ntris);
+    }
     /* one camera for every tile: the box of all of them */
     double lo[3], hi[3];
     if ((r = sw_render_bbox(3 * nv * rows, X, lo, hi, err)) != SINEW_OK) goto done;
