@@ -135,7 +135,8 @@ static void usage(FILE *f) {
                "                    --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
                "                    [--clip FILE [--frames F]]) [--blob FILE [--bake-errors]]\n"
                "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
-               "                   [reference options] [--out DIR] [--world FILE.json]\n"
+               "                   [reference options] [--out DIR]\n"
+               "                   [--world FILE.json [--rho R] [--patch-budget N]]\n"
                "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
@@ -157,7 +158,13 @@ static void usage(FILE *f) {
             "  --out DIR           write the subspace surface of every clip frame as\n"
             "                      DIR/frame_NNNN.obj\n"
             "  --world F           also run reference and runtime against world file F (.json,\n"
-            "                      schema 1, samples/worlds/README.md) and report its figures\n"
+            "                      schema 1, samples/worlds/README.md) and report its figures;\n"
+            "                      with a blob holding the tet mesh, also a condensed runtime\n"
+            "                      (full-space patches at novel contact) and its figures\n"
+            "  --rho R             with --world: the patch radius in units of the rest\n"
+            "                      bounding-box diagonal, 0 < R <= 1 (default 0.05)\n"
+            "  --patch-budget N    with --world: max_patch_vertices (default a quarter of\n"
+            "                      the vertices)\n"
             "  --dynamic           also run the runtime in dynamic mode against the reference's\n"
             "                      backward-Euler run of the clip (same dt, damping, masses)\n"
             "                      and report err_dynamic and the overshoot after the clip\n"
@@ -280,7 +287,8 @@ int main(int argc, char **argv) {
     sw_character_args_init(&ca, tool);
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
-    int dynamic = 0, hold_frames = 0, instances = 0;
+    int dynamic = 0, hold_frames = 0, instances = 0, patch_budget = 0;
+    sw_cond_bench_params cond = {0, 0};
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -295,6 +303,10 @@ int main(int argc, char **argv) {
             out_dir = argv[++i];
         else if (!strcmp(a, "--world") && next)
             world_path = argv[++i];
+        else if (!strcmp(a, "--rho") && next)
+            ok = sw_tool_real(tool, a, argv[++i], 0, 1.0000001, "in (0, 1]", &cond.rho);
+        else if (!strcmp(a, "--patch-budget") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 100000000, &patch_budget);
         else if (!strcmp(a, "--full-frames") && next)
             ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &full_frames);
         else if (!strcmp(a, "--contract-steps") && next)
@@ -327,6 +339,11 @@ int main(int argc, char **argv) {
         fprintf(stderr, "%s: --hold-frames applies only with --dynamic\n", tool);
         return 2;
     }
+    if ((cond.rho > 0 || patch_budget > 0) && !world_path) {
+        fprintf(stderr, "%s: --rho and --patch-budget apply only with --world\n", tool);
+        return 2;
+    }
+    cond.budget = (uint32_t)patch_budget;
     if (world_path && !sw_tool_format(tool, "--world", world_path, "json", ".json (world file)"))
         return 2;
     /* the output folder before the long run: an unwritable one is an error now */
@@ -544,7 +561,7 @@ int main(int argc, char **argv) {
         sw_world_scene ws;
         if ((r = sw_world_scene_load(world_path, &ws, &err)) != SINEW_OK)
             return sw_tool_failed(r, &err, "sinew-bench: ");
-        r = sw_world_bench_run(&ch, blob, &ws, &fp, ca.frames, contract_steps, &wb, &err);
+        r = sw_world_bench_run(&ch, blob, &ws, &fp, ca.frames, contract_steps, &cond, &wb, &err);
         sw_world_scene_free(&ws);
         if (r != SINEW_OK) return sw_tool_failed(r, &err, "sinew-bench: world run failed: ");
         failed_steps += wb.sub_failed + wb.ref_failed;
@@ -555,6 +572,16 @@ int main(int argc, char **argv) {
                 world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
                 wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.allocs,
                 wb.locks);
+        const sw_cond_bench *cb = &wb.cond;
+        failed_steps += cb->failed;
+        if (wb.cond_ran)
+            fprintf(stderr,
+                    "sinew-bench: condensed (rho %.4g of the diagonal, budget %u): err_world_cond "
+                    "%.4f (subspace %.4f); speedup mean %.1f worst %.1f; patch %.2f%% mean, "
+                    "%.2f%% max; frame p100/p50 %.2f; %d frames truncated; pop %.2f\n",
+                    cb->rho, cb->budget, cb->err_world_cond, wb.err_world_sub, cb->speedup_mean,
+                    cb->speedup_worst, 100 * cb->patch_frac_mean, 100 * cb->patch_frac_max,
+                    cb->p100_over_p50, cb->truncated_frames, cb->pop_max);
     }
     /* 8. dynamics against the reference's backward Euler, when asked */
     sw_dyn_bench db;
@@ -654,6 +681,16 @@ int main(int argc, char **argv) {
                world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
                wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.full_ms,
                wb.sub_ms, wb.ref_unsettled, wb.allocs, wb.locks);
+    if (json && wb.cond_ran)
+        printf(",\"rho\":%.5g,\"patch_budget\":%u,\"err_world_cond\":%.5f,"
+               "\"speedup_cond_mean\":%.2f,\"speedup_cond_worst\":%.2f,\"patch_frac_mean\":%.5f,"
+               "\"patch_frac_max\":%.5f,\"frame_p100_over_p50\":%.3f,"
+               "\"patch_truncated_frames\":%d,\"pop_max\":%.3f,\"cond_ms_median\":%.4f,"
+               "\"cond_ms_max\":%.4f,\"pcg_iters_max\":%u",
+               wb.cond.rho, wb.cond.budget, wb.cond.err_world_cond, wb.cond.speedup_mean,
+               wb.cond.speedup_worst, wb.cond.patch_frac_mean, wb.cond.patch_frac_max,
+               wb.cond.p100_over_p50, wb.cond.truncated_frames, wb.cond.pop_max, wb.cond.ms_median,
+               wb.cond.ms_max, wb.cond.pcg_iters_max);
     char ratio[32] = "null"; /* no reference overshoot: no ratio */
     if (isfinite(db.overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db.overshoot_ratio);
     char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */

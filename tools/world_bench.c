@@ -15,7 +15,7 @@
  * a collider into touch. */
 static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
                                   const sw_fullsim_params *fp, const double *T, int nf,
-                                  double *x_full, unsigned char *touch, double *mass,
+                                  double *x_full, unsigned char *touch, double *mass, double *ms,
                                   sw_world_bench *out, sw_error *err) {
     sw_fullsim_params p = *fp;
     p.world = ws->world;
@@ -24,8 +24,7 @@ static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
     if (r != SINEW_OK) return r;
     size_t nv3 = (size_t)3 * ch->mesh.nverts;
     memcpy(mass, sw_fullsim_masses(sim), sizeof(double) * ch->mesh.nverts);
-    double *ms = malloc(sizeof(double) * nf);
-    for (int f = 0; f < nf && ms; ++f) {
+    for (int f = 0; f < nf; ++f) {
         sw_fullsim_stats st;
         if ((r = sw_world_scene_at(ws, f, err)) != SINEW_OK) break;
         sinew_result sr = sw_fullsim_step(sim, T + (size_t)f * 12 * ch->skel.nbones, &st);
@@ -41,8 +40,10 @@ static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
                 "penetration %.4g\n",
                 f + 1, nf, ms[f], st.world_contacts, st.world_penetration);
     }
-    out->full_ms = ms ? sw_median(ms, nf) : 0;
-    free(ms);
+    double *sorted = malloc(sizeof(double) * nf);
+    if (sorted) memcpy(sorted, ms, sizeof(double) * nf);
+    out->full_ms = sorted ? sw_median(sorted, nf) : 0;
+    free(sorted);
     sw_fullsim_destroy(sim);
     return r;
 }
@@ -144,7 +145,8 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
 
 sinew_result sw_world_bench_run(const sw_character *ch, const sinew_blob *blob, sw_world_scene *ws,
                                 const sw_fullsim_params *fp, int frames, int contract_steps,
-                                sw_world_bench *out, sw_error *err) {
+                                const sw_cond_bench_params *cp, sw_world_bench *out,
+                                sw_error *err) {
     memset(out, 0, sizeof *out);
     out->contract_steps = contract_steps;
     int nf;
@@ -153,16 +155,21 @@ sinew_result sw_world_bench_run(const sw_character *ch, const sinew_blob *blob, 
     double *x_full = T ? malloc(sizeof(double) * 3 * ch->mesh.nverts * (size_t)nf) : NULL;
     double *mass = malloc(sizeof(double) * ch->mesh.nverts);
     unsigned char *touch = calloc((size_t)(nf > 0 ? nf : 1), 1);
+    double *ref_ms = malloc(sizeof(double) * (size_t)(nf > 0 ? nf : 1));
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
-    if (!T || !x_full || !mass || !touch) {
+    if (!T || !x_full || !mass || !touch || !ref_ms) {
         sw_error_set(err, r, "out of memory for the world scene");
         goto done;
     }
     out->frames = nf;
-    if ((r = run_reference(ch, ws, fp, T, nf, x_full, touch, mass, out, err)) != SINEW_OK)
+    if ((r = run_reference(ch, ws, fp, T, nf, x_full, touch, mass, ref_ms, out, err)) != SINEW_OK)
         goto done;
-    r = run_subspace(blob, ws, T, nf, x_full, touch, mass, out, err);
+    if ((r = run_subspace(blob, ws, T, nf, x_full, touch, mass, out, err)) != SINEW_OK) goto done;
+    if (cp && sw_blob_get_view(blob)->ntets > 0) {
+        r = sw_cond_bench_run(blob, ws, T, nf, x_full, ref_ms, touch, mass, cp, &out->cond, err);
+        out->cond_ran = r == SINEW_OK;
+    }
 done:
-    free(T), free(x_full), free(mass), free(touch);
+    free(T), free(x_full), free(mass), free(touch), free(ref_ms);
     return r;
 }

@@ -3,6 +3,7 @@
 #ifndef SW_WORLD_BENCH_H
 #define SW_WORLD_BENCH_H
 
+#include "cond_bench.h"
 #include "fullsim.h"
 #include "sinew/sinew.h"
 #include "world_scene.h"
@@ -20,13 +21,16 @@ typedef struct sw_world_bench {
     int ref_unsettled, ref_failed, sub_failed;
     long allocs, locks; /* in contract_steps steps with world contact; -1: not observable */
     int contract_steps;
+    sw_cond_bench cond; /* the condensed run (cond_ran: it ran) */
+    int cond_ran;
 } sw_world_bench;
 
 /* Runs the scene `ws` on the character (its clip or rest pose, as the file says; at
  * most `frames` frames when > 0): the reference with params fp, then a quasistatic
- * instance of `blob`, then `contract_steps` counted steps over the same motion. */
+ * instance of `blob`, then `contract_steps` counted steps over the same motion; then,
+ * with cp and a blob that has the tet mesh, a condensed instance (cond_bench.h). */
 sinew_result sw_world_bench_run(const sw_character *ch, const sinew_blob *blob, sw_world_scene *ws,
                                 const sw_fullsim_params *fp, int frames, int contract_steps,
-                                sw_world_bench *out, sw_error *err);
+                                const sw_cond_bench_params *cp, sw_world_bench *out, sw_error *err);
 
 #endif

@@ -134,6 +134,19 @@ typedef struct sw_blob_view {
     const int32_t *render_tets;        /* 4 * nembed_tets render nodes */
     const int32_t *render_node_ptr;    /* nrender_nodes + 1, increasing, starts at 0 */
     const int32_t *render_node_copies; /* 2 * nrender_copies: (domain, local vertex) */
+
+    /* the whole tet mesh for condensation's full-space patches (issue 12; ntets 0: none,
+     * every field below 0 / NULL) */
+    int32_t ntets, nvert_tets;
+    const int32_t *tets;         /* 4 ntets: global simulation vertex ids */
+    const int32_t *tet_domain;   /* ntets: the domain whose copies are the tet's corners */
+    const int32_t *tet_local;    /* 4 ntets: the corners' domain-local indices */
+    const double *tet_dminv;     /* 9 ntets: rest Dm^-1, row-major (as cub_dminv) */
+    const double *tet_vol;       /* ntets: rest volume > 0 (as cub_vol) */
+    const int32_t *vert_tet_ptr; /* nverts + 1: vertex v's tets are vert_tets[ptr[v] ..) */
+    const int32_t *vert_tets;    /* nvert_tets (= 4 ntets): tet ids, ascending per vertex */
+    const double *vert_mass;     /* nverts: lumped mass (> 0) */
+    const int32_t *cub_tet_id;   /* ncub: the global tet id of each cubature tet */
 } sw_blob_view;
 
 /* The output surface a host reads (sinew_instance_read_surface): the render mesh when the

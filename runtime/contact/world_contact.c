@@ -256,6 +256,7 @@ static void try_candidate(sw_world_contacts *wc, int32_t i, const double x[3], u
     cd->slot = (int32_t)s;
     cd->id = sw_collider_id_of(wc->world, s);
     cd->active = 0;
+    cd->patch = -1;
     cd->f[0] = cd->f[1] = cd->f[2] = 0;
     cd->next = wc->copy_first[i];
     wc->copy_first[i] = wc->ncand - 1;
@@ -369,6 +370,7 @@ double sw_world_contact_eval(sw_reduced *red, const sw_world_contacts *wc, const
     double E = 0;
     for (int32_t j = 0; j < wc->ncand; ++j) {
         const sw_world_cand *cd = &wc->cand[j];
+        if (cd->patch >= 0) continue;
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * cd->copy]];
         int32_t r = D->rank;
         double x[3], f[3], H3[9];
@@ -399,7 +401,10 @@ void sw_world_contacts_finish(sw_world_contacts *wc, sw_reduced *red, const doub
     for (int32_t j = 0; j < wc->ncand; ++j) {
         sw_world_cand *cd = &wc->cand[j];
         double x[3];
-        copy_position(red, cd->copy, q, x, NULL);
+        if (cd->patch >= 0)
+            memcpy(x, wc->patch_x + 3 * (int64_t)cd->patch, sizeof x);
+        else
+            copy_position(red, cd->copy, q, x, NULL);
         (void)sw_world_penalty(&cd->law, x, cd->f, NULL);
         double d[3] = {cd->law.a[0] - x[0], cd->law.a[1] - x[1], cd->law.a[2] - x[2]};
         cd->active = sw_penalty_gap(cd->law.n, d) > 0;

@@ -34,6 +34,7 @@ typedef struct sw_world_cand {
     sinew_collider_id id;
     int32_t active; /* in contact (gap > 0) at the step's solution */
     int32_t next;   /* the copy's next candidate (another collider), or -1 */
+    int32_t patch;  /* the copy's vertex's index in a condensation patch, or -1 */
     double f[3];    /* force on the vertex copy at the solution */
 } sw_world_cand;
 
@@ -55,9 +56,11 @@ typedef struct sw_world_contacts {
     double *copy_x;           /* 3 per copy: positions at the last output */
     int32_t *cl_pass;         /* ncl: the clusters the last broad phase passed */
     int32_t npass;
-    int boxes_valid;  /* cl_box holds the last output */
-    double radius;    /* detection radius (world units) */
-    uint32_t queries; /* collider queries of the last detection */
+    const double *patch_x; /* a condensation patch's vertex positions (NULL: none), where
+                              the candidates with patch >= 0 are (condense.h) */
+    int boxes_valid;       /* cl_box holds the last output */
+    double radius;         /* detection radius (world units) */
+    uint32_t queries;      /* collider queries of the last detection */
 } sw_world_contacts;
 
 /* Upper bound of the cluster count for a blob (sizes the instance's memory). */
@@ -81,12 +84,14 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
  * output wrote them); returns how many were added. */
 int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red, const double *q);
 
-/* The world contact energy at q; with want_grad its gradient into red->g, with
+/* The world contact energy at q of the candidates outside a condensation patch (those
+ * in one are the patch's, condense.h); with want_grad its gradient into red->g, with
  * want_hess its (domain-diagonal) Hessian blocks into red->H. */
 double sw_world_contact_eval(sw_reduced *red, const sw_world_contacts *wc, const double *q,
                              int want_grad, int want_hess);
 
-/* Records each candidate's force and activity at the solution q (the readback). */
+/* Records each candidate's force and activity at the solution q (the readback), a patch
+ * candidate's at its patch position. */
 void sw_world_contacts_finish(sw_world_contacts *wc, sw_reduced *red, const double *q);
 
 /* Takes the cluster boxes from the copies' output positions wc->copy_x. */

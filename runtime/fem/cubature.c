@@ -94,10 +94,14 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12], wm[9], gm[108];
             double *Jc = m->Jcub + m->Jcub_off[k] + (int64_t)12 * r * (c - D->cub_begin);
+            double w = m->cub_w[c];
+            if (w == 0.0) { /* in a condensation patch: its tet is evaluated in full space */
+                m->ecub[c] = 0;
+                continue;
+            }
             for (int j = 0; j < 4; ++j)
                 sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], qd,
                                     x + 3 * j, fill_J ? Jc + 3 * j * r : NULL);
-            double w = v->cub_weight[c];
             m->ecub[c] =
                 w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
                                         want_grad ? f : NULL, want_hess ? wm : NULL, gm,

@@ -41,12 +41,16 @@ typedef struct sw_reduced {
      * gradient pass over a domain fills them (Jcub_ok[k] = 1) and its later passes read
      * them; skinning clears the flags. */
     double *Jcub;
-    int64_t *Jcub_off;      /* ndomains */
-    unsigned char *Jcub_ok; /* ndomains */
+    int64_t *Jcub_off;          /* ndomains */
+    unsigned char *Jcub_ok;     /* ndomains */
+    const sw_dualquat *bone_dq; /* the pose of the last sw_reduced_skin */
+    /* The cubature weights in use (ncub): the blob's, except while a condensation patch
+     * holds some tets (0 there, the rest of their domain renormalised, condense.h). */
+    const double *cub_w;
 } sw_reduced;
 
-/* Skins every active vertex with the bones' dual quaternions (act_R, act_t); the cached
- * cubature Jacobians become stale. */
+/* Skins every active vertex with the bones' dual quaternions (act_R, act_t), which m keeps
+ * (bone_dq) for vertices skinned on demand; the cached cubature Jacobians become stale. */
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 
 /* Position x of copy (domain D, local vertex lv, active index a) for the domain's

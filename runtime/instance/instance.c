@@ -14,12 +14,14 @@
 
 /* Sizes of the layout that the blob alone does not fix. */
 typedef struct {
-    int32_t nact;      /* active vertices (active_vertices) */
-    int32_t rmax;      /* the largest domain rank */
-    int32_t max_pairs; /* the contact pair budget */
-    int32_t max_world; /* the world candidate budget */
-    int32_t nworkers;  /* the host's task workers, 1 without task callbacks */
-    uint64_t njcub;    /* the cubature tets' Jacobians: 12 r_d each */
+    int32_t nact;       /* active vertices (active_vertices) */
+    int32_t rmax;       /* the largest domain rank */
+    int32_t max_pairs;  /* the contact pair budget */
+    int32_t max_world;  /* the world candidate budget */
+    int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
+    uint64_t njcub;     /* the cubature tets' Jacobians: 12 r_d each */
+    sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
+    double rho;         /* its radius, in units of the rest diagonal */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -97,6 +99,56 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(wc->q_detect, R);
     TAKE(wc->bone_motion, 13 * nb);
     TAKE(wc->copy_x, 3 * nc);
+    /* subspace condensation: the patch's budget, and per vertex and tet stamps */
+    sw_cond *c = &in->cond;
+    const sw_cond_sizes *cz = &z->cond;
+    if (cz->max_verts > 0) {
+        const uint64_t nv = (uint64_t)v->nverts, nt = (uint64_t)v->ntets,
+                       nf = (uint64_t)cz->max_verts, ntf = (uint64_t)cz->max_tets,
+                       nr = (uint64_t)cz->max_ring, m = R + 3 * nf;
+        TAKE(c->seeds, 3 * (uint64_t)cz->max_seeds);
+        TAKE(c->vis, nv);
+        TAKE(c->in_patch, nv);
+        TAKE(c->vloc, nv);
+        TAKE(c->in_ring, nv);
+        TAKE(c->seeded, nv);
+        TAKE(c->dev, 3 * nv);
+        TAKE(c->dev_at, nv);
+        TAKE(c->tvis, nt);
+        TAKE(c->tet_cub, nt);
+        TAKE(c->dom_vol, nd);
+        TAKE(c->dom_wvol, nd);
+        TAKE(c->dom_fv, nd);
+        TAKE(c->dom_fw, nd);
+        TAKE(c->queue, (uint64_t)cz->max_cand);
+        TAKE(c->cand, (uint64_t)cz->max_cand);
+        TAKE(c->cand_d, (uint64_t)cz->max_cand);
+        TAKE(c->fv, nf);
+        TAKE(c->ft, ntf);
+        TAKE(c->ft_slot, 4 * ntf);
+        TAKE(c->ring_v, nr);
+        TAKE(c->ring_d, nr);
+        TAKE(c->ring_l, nr);
+        TAKE(c->ring_next, nr);
+        TAKE(c->ring_x0, 3 * nr);
+        TAKE(c->ring_J, 3 * (uint64_t)cz->rmax * nr);
+        TAKE(c->ring_x, 3 * nr);
+        TAKE(c->ring_dx, 3 * nr);
+        TAKE(c->x, 3 * nf);
+        TAKE(c->xt, 3 * nf);
+        TAKE(c->dx, 3 * nf);
+        TAKE(c->gf, 3 * nf);
+        TAKE(c->Kt, 144 * ntf);
+        TAKE(c->Dw, 9 * nf);
+        TAKE(c->Pf, 9 * nf);
+        TAKE(c->cg_r, m);
+        TAKE(c->cg_z, m);
+        TAKE(c->cg_p, m);
+        TAKE(c->cg_Ap, m);
+        TAKE(c->rhs, m);
+        TAKE(c->sol, m);
+        TAKE(c->cub_w, (uint64_t)v->ncub);
+    }
     /* the output */
     TAKE(in->surf_x, 3 * ns);
     TAKE(in->surf_n, 3 * ns);
@@ -215,6 +267,10 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
             ? "tasks.enqueue and tasks.finish must both be set or both be NULL"
         : tasks && (d->tasks.worker_count < 1 || d->tasks.worker_count > SW_MAX_TASK_WORKERS)
             ? "tasks.worker_count must be 1..256 with task callbacks"
+        : !(d->patch_radius >= 0 && d->patch_radius <= 1)
+            ? "patch_radius must be 0 (the default) or in (0, 1]"
+        : d->max_patch_vertices > 0 && v->ntets == 0
+            ? "max_patch_vertices needs a blob with the tet mesh (bake it again)"
             : NULL;
     if (bad) {
         sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
@@ -241,6 +297,8 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->max_world = d->max_world_contacts == 0          ? (int32_t)wneed
                    : d->max_world_contacts > 4 * wneed ? (int32_t)(4 * wneed)
                                                        : (int32_t)d->max_world_contacts;
+    z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world);
+    z->rho = d->patch_radius > 0 ? d->patch_radius : SW_COND_DEFAULT_RADIUS;
     return SINEW_OK;
 }
 
@@ -356,6 +414,9 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     /* 2% of the character's size: what a surface vertex can travel in one step */
     in->wc.radius = 0.01 * in->size;
     sw_pose_space_link_twins(v, in->ps.twin_next);
+    in->cond.z = z.cond;
+    if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
+    in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
     sw_solver_order_blocks(&in->solver, v);
@@ -394,6 +455,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     sw_pose_space_reset(&inst->ps, nb);
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);
+    if (inst->cond.z.max_verts > 0) sw_cond_forget(&inst->cond);
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;
         memset(V, 0, 9 * sizeof(double));

@@ -4,6 +4,7 @@
 #define SW_INSTANCE_INTERNAL_H
 
 #include "blob_load.h"
+#include "condense.h"
 #include "inertia.h"
 #include "pose_space.h"
 #include "reduced_map.h"
@@ -25,6 +26,7 @@ struct sinew_instance {
     sw_pose_space ps;        /* training poses near the current one, contact pairs */
     sw_solver solver;        /* state and Newton */
     sw_world_contacts wc;    /* the collision world's candidates of the step */
+    sw_cond cond;            /* subspace condensation (cond.z.max_verts 0: off) */
     double *surf_x, *surf_n; /* 3 per output surface vertex each (sw_blob_output_verts) */
     double *node_x;          /* 3 per render node: the mean of its copies (render mesh only) */
     int32_t *weld_tris;      /* 3 per render triangle: its corners' weld representatives */

@@ -10,10 +10,19 @@
 #include "surface_normals.h"
 
 /* The mean x of copies [b, e) (domain, local vertex pairs, their active indices act) at
- * the state q; each copy's own position into copy_x[3 i ..] when copy_x is not NULL. */
+ * the state q; each copy's own position into copy_x[3 i ..] when copy_x is not NULL. A
+ * vertex in the condensation patch is at its patch position, every copy of it too. */
 static void copies_mean(const sinew_instance *in, const int32_t *copies, const int32_t *act,
                         int32_t b, int32_t e, double *copy_x, double x[3]) {
     const sw_blob_view *v = in->v;
+    const double *xp = sw_cond_position(
+        &in->cond, v->domain_verts[v->domains[copies[2 * b]].vert_begin + copies[2 * b + 1]]);
+    if (xp) {
+        memcpy(x, xp, 3 * sizeof(double));
+        for (int32_t i = b; copy_x && i < e; ++i)
+            memcpy(copy_x + 3 * i, xp, 3 * sizeof(double));
+        return;
+    }
     double acc[3] = {0, 0, 0};
     for (int32_t i = b; i < e; ++i) {
         const sw_blob_domain *D = &v->domains[copies[2 * i]];
@@ -104,7 +113,10 @@ void sw_instance_full_positions(const sinew_instance *inst, double *x, double *c
         }
     }
     for (int32_t gv = 0; gv < v->nverts; ++gv) {
-        if (count[gv] > 0) {
+        const double *xp = sw_cond_position(&inst->cond, gv);
+        if (xp) {
+            memcpy(x + 3 * gv, xp, 3 * sizeof(double));
+        } else if (count[gv] > 0) {
             for (int i = 0; i < 3; ++i)
                 x[3 * gv + i] /= count[gv];
         } else {

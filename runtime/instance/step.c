@@ -4,9 +4,12 @@
  *   contact   the training poses nearest to the pose, their contact pairs (§3.2.3)
  *   dynamics  teleports, inertial forces, the start state, the frozen damping Hessian
  *   world     the surface copies near colliders at the start state (world_contact.h)
- *   solve     Newton on the step's potential (eqs. 2.11-2.12, 3.4-3.6, 4.20); when it
- *             ran into colliders the start state did not touch, one more detection
- *             round and solve from there
+ *   oracle    with a patch budget: the full-space patch around the novel contact
+ *             (condense.h, thesis §4.4.2)
+ *   solve     Newton on the step's potential (eqs. 2.11-2.12, 3.4-3.6, 4.20), coupled to
+ *             the patch when there is one (eqs. 4.11-4.12); when it ran into colliders
+ *             the start state did not touch, one more detection round and solve from
+ *             there
  *   advance   the velocity and the pose history
  *   output    the output surface and its normals
  * Nothing here allocates, locks or touches a vertex that is not active: the cost follows
@@ -144,6 +147,36 @@ static void phase_world(sw_step_ctx *c) {
     c->st.ms_world = lap(c);
 }
 
+/* The partition oracle (condense.h): the patch of this step, from the world contact at
+ * the start state and the seeds of the two steps before. A pose jump forgets them. */
+static void phase_oracle(sw_step_ctx *c) {
+    sinew_instance *in = c->in;
+    sw_cond *cd = &in->cond;
+    if (cd->z.max_verts == 0) return;
+    if (c->st.status & SINEW_STEP_TELEPORT) sw_cond_forget(cd);
+    if (!in->wc.world) {
+        cd->nf = 0;
+        return;
+    }
+    cd->pcg_iters = 0;
+    sw_cond_oracle(cd, &in->red, &in->wc, in->solver.q);
+    c->st.patch_vertices = (uint32_t)cd->nf;
+    c->st.patch_tets = (uint32_t)cd->nt;
+    if (cd->dropped > 0) {
+        c->st.status |= SINEW_STEP_BUDGET;
+        c->st.budget_exceeded |= SINEW_BUDGET_PATCH;
+        c->st.patch_dropped = (uint32_t)cd->dropped;
+    }
+    c->st.ms_oracle = lap(c);
+}
+
+/* Newton on the step's potential: reduced, or coupled to the patch. */
+static sinew_result solve(sw_step_ctx *c, const sw_step_contacts *ct) {
+    sinew_instance *in = c->in;
+    if (in->cond.nf > 0) return sw_cond_solve(&in->cond, &in->red, ct, &in->solver, &c->dc, &c->st);
+    return sw_newton_solve(&in->red, ct, &in->solver, &c->dc, &c->st);
+}
+
 /* The output surface (and the copies' positions the world's second round reads),
  * timed as the output phase. */
 static void write_output(sw_step_ctx *c) {
@@ -160,7 +193,7 @@ static sinew_result phase_solve(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_world_contacts *wc = &in->wc;
     sw_step_contacts ct = {&in->ps, wc->world ? wc : NULL};
-    sinew_result r = sw_newton_solve(&in->red, &ct, &in->solver, &c->dc, &c->st);
+    sinew_result r = solve(c, &ct);
     double ms_aside = 0; /* the second detection and the output, counted as theirs */
     if (r == SINEW_OK && wc->world) {
         write_output(c);
@@ -170,7 +203,8 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         c->st.ms_world += ms_missed;
         if (added > 0) { /* (a failed second solve leaves the first round's surface) */
             c->st.world_rounds = 2;
-            r = sw_newton_solve(&in->red, &ct, &in->solver, &c->dc, &c->st);
+            if (in->cond.nf > 0) sw_cond_tag_candidates(&in->cond, wc);
+            r = solve(c, &ct);
             if (r == SINEW_OK) write_output(c);
         }
         ms_aside = c->st.ms_output + ms_missed;
@@ -186,6 +220,10 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         }
     }
     c->st.cubature_tets = (uint32_t)in->v->ncub;
+    if (in->cond.nf > 0) {
+        if (r == SINEW_OK) sw_cond_finish(&in->cond, &in->red, in->solver.q);
+        c->st.pcg_iterations = in->cond.pcg_iters;
+    }
     c->st.ms_solve = lap(c) - ms_aside;
     return r;
 }
@@ -253,6 +291,7 @@ static sinew_result check_output(sw_step_ctx *c) {
         if (!(fabs(in->surf_x[i]) <= FLT_MAX) || !(fabs(in->surf_n[i]) <= FLT_MAX)) {
             memcpy(in->solver.q, in->solver.qn, (size_t)in->red.R * sizeof(double));
             memset(in->solver.qdot, 0, (size_t)in->red.R * sizeof(double));
+            in->cond.nf = 0; /* no patch: the subspace state alone */
             sw_instance_write_surface(in);
             c->st.status |= SINEW_STEP_FAILED;
             return SINEW_ERROR_NOT_FINITE;
@@ -267,6 +306,7 @@ static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
     phase_contact(c);
     phase_dynamics(c);
     phase_world(c);
+    phase_oracle(c);
 }
 
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {

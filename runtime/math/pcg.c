@@ -32,7 +32,7 @@ void sw_block_jacobi_invert(int32_t n, const double *diag, const unsigned char *
         const double *a = diag + 9 * v;
         double *o = Pinv + 9 * v;
         memset(o, 0, 9 * sizeof(double));
-        if (!free_mask[v]) continue;
+        if (free_mask && !free_mask[v]) continue;
         double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8],
                c02 = a[3] * a[7] - a[4] * a[6];
         double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
@@ -56,9 +56,14 @@ void sw_block_jacobi_invert(int32_t n, const double *diag, const unsigned char *
     }
 }
 
-static void apply_prec(int32_t n, const double *Pinv, const double *r, double *z) {
+static void apply_prec(int32_t n, const double *Pinv, const unsigned char *free_mask,
+                       const double *r, double *z) {
     for (int32_t v = 0; v < n; ++v) {
         const double *P = Pinv + 9 * v, *rv = r + 3 * v;
+        if (free_mask && !free_mask[v]) {
+            z[3 * v] = z[3 * v + 1] = z[3 * v + 2] = 0;
+            continue;
+        }
         z[3 * v] = P[0] * rv[0] + P[1] * rv[1] + P[2] * rv[2];
         z[3 * v + 1] = P[3] * rv[0] + P[4] * rv[1] + P[5] * rv[2];
         z[3 * v + 2] = P[6] * rv[0] + P[7] * rv[1] + P[8] * rv[2];
@@ -72,53 +77,40 @@ static double dot(int64_t n, const double *a, const double *b) {
     return s;
 }
 
-static void mask(int32_t n, const unsigned char *free_mask, double *x) {
-    for (int32_t v = 0; v < n; ++v)
-        if (!free_mask[v]) x[3 * v] = x[3 * v + 1] = x[3 * v + 2] = 0;
-}
-
-/* r = b - A x, masked. */
-static void residual(sw_linop_fn A, void *ctx, const double *b, const unsigned char *free_mask,
-                     sw_pcg_workspace *ws, const double *x) {
-    int64_t m = 3 * (int64_t)ws->n;
-    A(ctx, x, ws->Ap);
+/* r = b - A x. */
+static void residual(sw_linop_fn A, void *ctx, const double *b, int64_t m, double *r, double *Ap,
+                     const double *x) {
+    A(ctx, x, Ap);
     for (int64_t i = 0; i < m; ++i)
-        ws->r[i] = b[i] - ws->Ap[i];
-    mask(ws->n, free_mask, ws->r);
+        r[i] = b[i] - Ap[i];
 }
 
-sw_pcg_stats sw_pcg_solve(sw_linop_fn A, void *ctx, const double *b, const double *Pinv,
-                          const unsigned char *free_mask, double rel_tol, int max_iters,
-                          sw_pcg_workspace *ws, double *x) {
+sw_pcg_stats sw_pcg_run(int64_t m, sw_linop_fn A, void *actx, sw_precond_fn P, void *pctx,
+                        const double *b, double rel_tol, int max_iters, const sw_pcg_vectors *ws,
+                        double *x) {
     sw_pcg_stats st = {0, 0.0, 0, 0};
-    int32_t n = ws->n;
-    int64_t m = 3 * (int64_t)n;
     double *r = ws->r, *z = ws->z, *p = ws->p, *Ap = ws->Ap;
-    mask(n, free_mask, x);
     memcpy(r, b, (size_t)m * sizeof *r);
-    mask(n, free_mask, r);
-    apply_prec(n, Pinv, r, z);
+    P(pctx, r, z);
     double bnorm = dot(m, r, z); /* b^T P^-1 b */
     if (!(bnorm > 0)) {          /* b = 0: x = 0 is the solution */
         memset(x, 0, (size_t)m * sizeof *x);
         st.converged = 1;
         return st;
     }
-    residual(A, ctx, b, free_mask, ws, x);
-    apply_prec(n, Pinv, r, z);
+    residual(A, actx, b, m, r, Ap, x);
+    P(pctx, r, z);
     double rz = dot(m, r, z);
     if (!(rz < bnorm)) { /* the initial guess is worse than zero: start from zero */
         memset(x, 0, (size_t)m * sizeof *x);
         memcpy(r, b, (size_t)m * sizeof *r);
-        mask(n, free_mask, r);
-        apply_prec(n, Pinv, r, z);
+        P(pctx, r, z);
         rz = bnorm;
     }
     memcpy(p, z, (size_t)m * sizeof *p);
     double tol2 = rel_tol * rel_tol * bnorm;
     while (st.iters < max_iters && rz > tol2) {
-        A(ctx, p, Ap);
-        mask(n, free_mask, Ap);
+        A(actx, p, Ap);
         double pAp = dot(m, p, Ap);
         if (!(pAp > 0)) { /* not positive definite along p: stop with what we have */
             st.negative_curvature = 1;
@@ -129,11 +121,11 @@ sw_pcg_stats sw_pcg_solve(sw_linop_fn A, void *ctx, const double *b, const doubl
             x[i] += alpha * p[i];
         st.iters++;
         if (st.iters % 50 == 0)
-            residual(A, ctx, b, free_mask, ws, x);
+            residual(A, actx, b, m, r, Ap, x);
         else
             for (int64_t i = 0; i < m; ++i)
                 r[i] -= alpha * Ap[i];
-        apply_prec(n, Pinv, r, z);
+        P(pctx, r, z);
         double rz_new = dot(m, r, z);
         double beta = rz_new / rz;
         rz = rz_new;
@@ -143,4 +135,29 @@ sw_pcg_stats sw_pcg_solve(sw_linop_fn A, void *ctx, const double *b, const doubl
     st.rel_residual = sqrt(fmax(rz, 0) / bnorm);
     st.converged = rz <= tol2;
     return st;
+}
+
+/* The block-Jacobi preconditioner of sw_pcg_solve, masked. */
+typedef struct {
+    int32_t n;
+    const double *Pinv;
+    const unsigned char *free_mask;
+} block_jacobi;
+
+static void block_jacobi_apply(void *ctx, const double *r, double *z) {
+    const block_jacobi *bj = ctx;
+    apply_prec(bj->n, bj->Pinv, bj->free_mask, r, z);
+}
+
+/* Masked vertices' entries of x stay zero: the preconditioner zeroes them in every
+ * search direction, and x starts with them zeroed. */
+sw_pcg_stats sw_pcg_solve(sw_linop_fn A, void *ctx, const double *b, const double *Pinv,
+                          const unsigned char *free_mask, double rel_tol, int max_iters,
+                          sw_pcg_workspace *ws, double *x) {
+    for (int32_t v = 0; v < ws->n; ++v)
+        if (!free_mask[v]) x[3 * v] = x[3 * v + 1] = x[3 * v + 2] = 0;
+    block_jacobi bj = {ws->n, Pinv, free_mask};
+    sw_pcg_vectors vec = {ws->r, ws->z, ws->p, ws->Ap};
+    return sw_pcg_run(3 * (int64_t)ws->n, A, ctx, block_jacobi_apply, &bj, b, rel_tol, max_iters,
+                      &vec, x);
 }

@@ -13,6 +13,14 @@
  * (they are zero) and its output there is ignored. */
 typedef void (*sw_linop_fn)(void *ctx, const double *x, double *y);
 
+/* z = P^-1 r: a preconditioner. */
+typedef void (*sw_precond_fn)(void *ctx, const double *r, double *z);
+
+/* The four vectors of a solve (m doubles each, the caller's memory). */
+typedef struct sw_pcg_vectors {
+    double *r, *z, *p, *Ap;
+} sw_pcg_vectors;
+
 typedef struct sw_pcg_workspace {
     int32_t n; /* vertices */
     double *r, *z, *p, *Ap;
@@ -30,7 +38,7 @@ void sw_pcg_workspace_free(sw_pcg_workspace *ws);
 
 /* Inverts the 3x3 blocks diag (9*n) into Pinv (9*n); a block that is not safely
  * invertible (non-positive pivot) is replaced by the inverse of its diagonal, or
- * identity. Masked vertices get zero. */
+ * identity. Masked vertices get zero (free_mask NULL: none is masked). */
 void sw_block_jacobi_invert(int32_t n, const double *diag, const unsigned char *free_mask,
                             double *Pinv);
 
@@ -43,4 +51,10 @@ void sw_block_jacobi_invert(int32_t n, const double *diag, const unsigned char *
 sw_pcg_stats sw_pcg_solve(sw_linop_fn A, void *ctx, const double *b, const double *Pinv,
                           const unsigned char *free_mask, double rel_tol, int max_iters,
                           sw_pcg_workspace *ws, double *x);
+/* PCG on m doubles with the preconditioner P (the same stopping rule, restarts and
+ * truncation as sw_pcg_solve, which is this with masked block-Jacobi): solves A x = b
+ * from the guess in x. No allocation. */
+sw_pcg_stats sw_pcg_run(int64_t m, sw_linop_fn A, void *actx, sw_precond_fn P, void *pctx,
+                        const double *b, double rel_tol, int max_iters, const sw_pcg_vectors *ws,
+                        double *x);
 #endif

@@ -38,9 +38,7 @@ void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_pose_
     }
 }
 
-/* Factors H (the block-sparse Cholesky into s->L), shifting the diagonal if H is not
- * positive definite; 0 if no shift makes it so. */
-static int factor_hessian(sw_reduced *red, sw_solver *s) {
+int sw_solver_factor(sw_reduced *red, sw_solver *s) {
     int32_t R = red->R, nd = red->v->ndomains;
     double tr = 0;
     for (int32_t i = 0; i < R; ++i)
@@ -58,12 +56,16 @@ static int factor_hessian(sw_reduced *red, sw_solver *s) {
     return 0;
 }
 
+void sw_solver_factor_solve(const sw_reduced *red, const sw_solver *s, double *x) {
+    sw_block_cholesky_solve(s->L, red->R, red->v->ndomains, s->blk_off, s->blk_size, s->blk_order,
+                            s->blk_nz, x);
+}
+
 /* dq = -L^-T L^-1 g with the factor in s->L. */
 static void factored_direction(const sw_reduced *red, sw_solver *s) {
     for (int32_t i = 0; i < red->R; ++i)
         s->dq[i] = -red->g[i];
-    sw_block_cholesky_solve(s->L, red->R, red->v->ndomains, s->blk_off, s->blk_size, s->blk_order,
-                            s->blk_nz, s->dq);
+    sw_solver_factor_solve(red, s, s->dq);
 }
 
 /* Phi at q with its gradient, and its Hessian with want_hess; counted. */
@@ -115,7 +117,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
         }
         if (it == s->max_newton) break;
         if (have_h) {
-            if (!factor_hessian(red, s)) break;
+            if (!sw_solver_factor(red, s)) break;
             st->factorizations++;
             have_h = 0;
             fresh = 1;

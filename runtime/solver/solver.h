@@ -55,6 +55,13 @@ double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver
  * domains the contact pairs in use join (no scan of H's values). */
 void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_pose_space *ps);
 
+/* Factors red->H (the block-sparse Cholesky into s->L, the step's block pattern),
+ * shifting the diagonal if H is not positive definite; 0 if no shift makes it so. */
+int sw_solver_factor(sw_reduced *red, sw_solver *s);
+
+/* x = H^-1 x with the factor of sw_solver_factor. */
+void sw_solver_factor_solve(const sw_reduced *red, const sw_solver *s, double *x);
+
 /* Newton from s->q with the energy guard, into s->q; fills st's iterations, status
  * (CONVERGED, GUARD), residual, energy and potential_evals. A non-finite potential
  * restores q_n, sets FAILED and returns SINEW_ERROR_NOT_FINITE. */

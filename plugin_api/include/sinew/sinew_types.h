@@ -119,6 +119,19 @@ typedef struct sinew_instance_def {
      * step that finds more keeps those found first, drops the rest and flags
      * SINEW_STEP_BUDGET with SINEW_BUDGET_WORLD_CONTACTS. */
     uint32_t max_world_contacts;
+    /** Budget: the simulation vertices one step may simulate in full space (subspace
+     * condensation, thesis §4.3: a patch around world contact the subspace has never
+     * seen). 0 (the default) turns condensation off; otherwise every patch array is
+     * reserved at creation for this many vertices (sinew_instance_memory_size counts
+     * them). A step whose oracle asks for more keeps the vertices nearest the contacts,
+     * drops the rest and flags SINEW_STEP_BUDGET with SINEW_BUDGET_PATCH. Needs a blob
+     * with the tet mesh (sinew-bake writes it); INVALID_ARGUMENT otherwise. */
+    uint32_t max_patch_vertices;
+    /** The patch radius: the breadth-first growth from a contact vertex accepts the
+     * vertices within this rest-space distance of it, in units of the rest bounding-box
+     * diagonal (the thesis's radii, for a mesh normalised to a unit cube, are this times
+     * diagonal / longest side). 0 means 0.05; otherwise 0 < patch_radius <= 1. */
+    float patch_radius;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -135,6 +148,8 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.tasks.worker_count = 0;
     d.tasks.user = NULL;
     d.max_world_contacts = 0;
+    d.max_patch_vertices = 0;
+    d.patch_radius = 0.0f;
     return d;
 }
 
@@ -185,6 +200,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
 /** Budgets of an instance (sinew_step_stats.budget_exceeded bits). */
 #define SINEW_BUDGET_CONTACT_PAIRS 1u  /**< sinew_instance_def.max_contact_pairs */
 #define SINEW_BUDGET_WORLD_CONTACTS 2u /**< sinew_instance_def.max_world_contacts */
+#define SINEW_BUDGET_PATCH 4u          /**< sinew_instance_def.max_patch_vertices */
 
 /** Figures of an instance's last step. */
 typedef struct sinew_step_stats {
@@ -215,6 +231,12 @@ typedef struct sinew_step_stats {
     uint32_t world_rounds;           /**< detections: 2 when the solve ran into new contact */
     /** reduced Hessians factored (the other updates reuse the last factor) */
     uint32_t factorizations;
+    /* Subspace condensation (zero without a patch): */
+    uint32_t patch_vertices; /**< vertices simulated in full space this step */
+    uint32_t patch_tets;     /**< tets touching them (evaluated in full space) */
+    uint32_t patch_dropped;  /**< vertices the max_patch_vertices budget left out */
+    uint32_t pcg_iterations; /**< conjugate-gradient iterations of the coupled solves */
+    double ms_oracle;        /**< the partition oracle: seeds, growth, the patch's tets */
 } sinew_step_stats;
 
 #ifdef __cplusplus

@@ -1,0 +1,138 @@
+/* Subspace condensation (thesis §4.3-4.4, Algorithm 4; DESIGN.md §4.6): where the flesh
+ * meets a collider the subspace was never trained on, a small patch of simulation
+ * vertices is solved in full space, coupled both ways to the reduced coordinates of
+ * everything else, with no O(N) work a step.
+ *
+ * The partition oracle (oracle.c, thesis §4.4.2): the vertices of the world candidates
+ * that penetrate at the step's start state are this step's seeds; with the seeds of the
+ * two steps before, each grows breadth-first over the mesh's edges (through shared tets),
+ * accepting the vertices within the rest-space radius rho of that seed (a vertex another
+ * seed rejected can still be accepted from this one). The full tets are those touching a
+ * patch vertex; their corners outside the patch are "ring" copies, the subspace vertex
+ * copies of the tet's domain that carry the coupling. Over budget, the vertices nearest
+ * their seeds are kept.
+ *
+ * The coupled solve (coupled.c): one potential in z = (q, x_f), the reduced coordinates
+ * and the patch vertices' positions,
+ *   Phi(q, x_f) = sum_{t full} E_t(x_t)                        (ring corners at q)
+ *               + sum_{c cubature, not full} s_d w_c E_c(q)    (eq. 4.12's second sum)
+ *               + springs, pose-space contact, world contact of the subspace copies
+ *               + world contact of the patch vertices at x_f (the full block),
+ * whose gradient in q is eq. 4.12: the boundary tets' forces projected through the ring
+ * copies' rows, plus the cubature tets wholly in the subspace, their weights renormalised
+ * (s_d: the domain's cubature then stands for its volume outside the patch, the
+ * prototype's third flaw). Newton with the energy guard; each update solves eq. 4.11 by
+ * PCG preconditioned with 3x3 Jacobi blocks on x_f and the factored reduced block on q.
+ * The element Hessians are projected to PSD, so the coupled matrix is too. */
+#ifndef SW_CONDENSE_H
+#define SW_CONDENSE_H
+
+#include <stdint.h>
+
+#include "solver.h"
+
+/* The patch radius when the def leaves it 0, in units of the rest diagonal. */
+#define SW_COND_DEFAULT_RADIUS 0.05
+
+/* Sizes an instance reserves for a patch budget (all 0 when condensation is off). */
+typedef struct sw_cond_sizes {
+    int32_t max_verts; /* patch vertices */
+    int32_t max_tets;  /* full tets */
+    int32_t max_ring;  /* ring copies */
+    int32_t max_cand;  /* vertices the growth may accept before the budget's cut */
+    int32_t max_seeds; /* seeds of one step */
+    int32_t rmax;      /* the largest domain rank */
+} sw_cond_sizes;
+
+typedef struct sw_cond {
+    const sw_blob_view *v;
+    sw_cond_sizes z;
+    double rho; /* rest-space radius of the growth (world units) */
+    /* the oracle's memory: the seeds of this step and the two before (a ring buffer) */
+    int32_t *seeds;    /* 3 max_seeds */
+    int32_t nseeds[3]; /* seeds per slot */
+    int32_t slot;      /* this step's slot */
+    /* per simulation vertex (memory only: a step touches the patch's entries) */
+    uint32_t *vis;      /* growth visit stamp */
+    uint32_t *in_patch; /* patch stamp: == stamp when the vertex is a patch vertex */
+    int32_t *vloc;      /* its patch index, or (ring) -1 - its first ring copy */
+    uint32_t *in_ring;  /* ring stamp */
+    uint32_t *seeded;   /* seed stamp (a vertex seeded twice grows once) */
+    double *dev;        /* 3 per vertex: its last patch position minus its subspace one */
+    uint32_t *dev_at;   /* the stamp of the step that left dev */
+    uint32_t *tvis;     /* per tet: full-tet stamp */
+    int32_t *tet_cub;   /* per tet: its cubature index, or -1 */
+    double *dom_vol;    /* ndomains: rest volume of the domain's tets */
+    double *dom_wvol;   /* ndomains: sum of w_c vol_c over its cubature tets */
+    uint32_t stamp, vstamp;
+    /* the growth */
+    int32_t *queue; /* max_cand */
+    int32_t *cand;  /* max_cand accepted vertices */
+    double *cand_d; /* their rest distance to the seed that accepted them */
+    int32_t ncand;
+    int32_t dropped; /* vertices the budget left out this step */
+    /* the patch */
+    int32_t nf, nt, nring;
+    int32_t *fv;      /* nf: patch vertices (global ids) */
+    int32_t *ft;      /* nt: full tets */
+    int32_t *ft_slot; /* 4 per full tet: patch index >= 0, or -1 - ring copy */
+    int32_t *ring_v;  /* per ring copy: global vertex, domain, local index, next copy */
+    int32_t *ring_d, *ring_l, *ring_next;
+    double *ring_x0;         /* 3 per ring copy: R rest + t (its position at q = 0) */
+    double *ring_J;          /* 3 rmax per ring copy: J = R U (3 x r_d) */
+    double *ring_x;          /* 3 per ring copy: its position at the iterate */
+    double *ring_dx;         /* 3 per ring copy: scratch (J dq) */
+    double *dom_fv, *dom_fw; /* ndomains: the patch's tets' volume and cubature w vol */
+    /* the coupled Newton */
+    double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
+    double *gf;          /* 3 nf: gradient in x_f */
+    double *Kt;          /* 144 per full tet: its PSD element Hessian */
+    double *Dw;          /* 9 nf: world-contact 3x3 Hessians of the patch vertices */
+    double *Pf;          /* 9 nf: the inverted 3x3 diagonal blocks (preconditioner) */
+    double *cg_r, *cg_z, *cg_p, *cg_Ap, *rhs, *sol; /* R + 3 nf each */
+    double *cub_w;      /* ncub: the cubature weights in use (red->cub_w points here) */
+    uint32_t pcg_iters; /* of the last solve */
+} sw_cond;
+
+/* The sizes for a budget of max_verts patch vertices (0: off). */
+sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world);
+
+/* Creation (no allocation: the arrays are laid out by the instance): per-domain volumes,
+ * the tet -> cubature map, cleared stamps. rho in world units. */
+void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho);
+
+/* Forgets the seeds and the patch history (a reset or a teleport). */
+void sw_cond_forget(sw_cond *c);
+
+/* The partition oracle at the state q: seeds from the world's candidates penetrating at
+ * q (and those of the two steps before), the growth, the full tets and ring copies (their
+ * skinning and Jacobians), the patch's start positions (the subspace position plus the
+ * deviation the vertex had when it was last in a patch), and the world candidates tagged
+ * with their patch vertex. Returns the patch's vertex count. */
+int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, const double *q);
+
+/* Tags the world candidates whose vertex is in the patch (after new ones were added). */
+void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc);
+
+/* The coupled Newton (see above) from (s->q, c->x) into them; fills st like
+ * sw_newton_solve plus pcg_iterations. */
+sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                           const sw_dyn_coef *dc, sinew_step_stats *st);
+
+/* After a step: each patch vertex's deviation from its subspace position at q (the next
+ * patch's start); the patch stays readable until the next oracle. */
+void sw_cond_finish(sw_cond *c, const sw_reduced *red, const double *q);
+
+/* The patch position of simulation vertex gv, or NULL when it is not in the patch. */
+static inline const double *sw_cond_position(const sw_cond *c, int32_t gv) {
+    if (!c->in_patch || c->nf == 0 || c->in_patch[gv] != c->stamp) return 0;
+    return c->x + 3 * (int64_t)c->vloc[gv];
+}
+
+/* The subspace position of vertex gv's copy (domain d, local lv) at q, with the skinning
+ * of the current pose (red's bone dual quaternions): R (rest + U q_d) + t; J = R U
+ * (3 x r_d) when J is not NULL. */
+void sw_cond_copy_position(const sw_reduced *red, int32_t gv, int32_t d, int32_t lv,
+                           const double *q, double x[3], double *J);
+
+#endif

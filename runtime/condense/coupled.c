@@ -1,0 +1,335 @@
+/* The coupled solve of subspace condensation (condense.h; thesis eqs. 4.9-4.12,
+ * Algorithm 4): the potential in (q, x_f), its gradient and Hessian, and Newton whose
+ * updates solve eq. 4.11 by PCG. The Hessian is never assembled: the reduced block is
+ * red->H (the reduced potential's, plus the ring copies' J^T K J), the patch block and
+ * the coupling are applied tet by tet from each full tet's 12x12 K. */
+#include <math.h>
+#include <string.h>
+
+#include "condense.h"
+#include "dense.h"
+#include "fem_corot.h"
+#include "pcg.h"
+
+/* ---- the cubature weights of eq. 4.12 --------------------------------------------- */
+
+/* Cubature tets in full tets drop out (their tets are evaluated exactly); the rest of
+ * each domain the patch reaches is scaled so that its cubature stands for the domain's
+ * volume outside the patch: s_d = (V_d - V_fd) / V_d * W_d / (W_d - W_fd), W the
+ * cubature's represented volume sum w_c vol_c. The cached cubature Jacobians of those
+ * domains are refilled by the next gradient pass. */
+static void weights_apply(sw_cond *c, sw_reduced *red) {
+    const sw_blob_view *v = c->v;
+    for (int32_t k = 0; k < v->ndomains; ++k)
+        c->dom_fv[k] = c->dom_fw[k] = 0;
+    for (int32_t e = 0; e < c->nt; ++e) {
+        int32_t t = c->ft[e], d = v->tet_domain[t], ci = c->tet_cub[t];
+        c->dom_fv[d] += v->tet_vol[t];
+        if (ci < 0) continue;
+        c->dom_fw[d] += v->cub_weight[ci] * v->cub_vol[ci];
+        c->cub_w[ci] = 0;
+    }
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        if (c->dom_fv[k] == 0) continue;
+        const sw_blob_domain *D = &v->domains[k];
+        double rest = c->dom_wvol[k] - c->dom_fw[k];
+        double s = rest > 0 && c->dom_vol[k] > 0
+                       ? (c->dom_vol[k] - c->dom_fv[k]) / c->dom_vol[k] * c->dom_wvol[k] / rest
+                       : 0;
+        if (!(s > 0)) s = 0;
+        for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
+            if (c->cub_w[i] != 0) c->cub_w[i] = s * v->cub_weight[i];
+        red->Jcub_ok[k] = 0;
+    }
+}
+
+static void weights_restore(sw_cond *c, sw_reduced *red) {
+    const sw_blob_view *v = c->v;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        if (c->dom_fv[k] == 0) continue;
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
+            c->cub_w[i] = v->cub_weight[i];
+        red->Jcub_ok[k] = 0;
+    }
+}
+
+/* ---- the potential ---------------------------------------------------------------- */
+
+static const double *ring_J(const sw_cond *c, int32_t k) {
+    return c->ring_J + (int64_t)3 * c->z.rmax * k;
+}
+
+/* The 12 corner positions of full tet e. */
+static void tet_positions(const sw_cond *c, const double *x, int32_t e, double x12[12]) {
+    const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+    for (int k = 0; k < 4; ++k) {
+        const double *p = slot[k] >= 0 ? x + 3 * (int64_t)slot[k] : c->ring_x + 3 * (-1 - slot[k]);
+        memcpy(x12 + 3 * k, p, 3 * sizeof(double));
+    }
+}
+
+/* red->H's domain block of ring copies a and b (both of domain d) += J_a^T K_ab J_b. */
+static void add_ring_block(const sw_cond *c, sw_reduced *red, int32_t a, int32_t b, const double *K,
+                           int ka, int kb) {
+    const sw_blob_domain *D = &c->v->domains[c->ring_d[a]];
+    int32_t r = D->rank, o = D->q_offset;
+    const double *Ja = ring_J(c, a), *Jb = ring_J(c, b);
+    double KJ[3 * 64], *kj = r <= 64 ? KJ : NULL; /* K_ab J_b, 3 x r */
+    for (int i = 0; i < 3; ++i)
+        for (int32_t j = 0; j < r; ++j) {
+            double acc = 0;
+            for (int l = 0; l < 3; ++l)
+                acc += K[(3 * ka + i) * 12 + 3 * kb + l] * Jb[l * r + j];
+            if (kj)
+                kj[i * r + j] = acc;
+            else /* a rank above 64: straight into H (slower, same sums) */
+                for (int32_t m = 0; m < r; ++m)
+                    red->H[(int64_t)(o + m) * red->R + o + j] += Ja[i * r + m] * acc;
+        }
+    if (!kj) return;
+    for (int32_t m = 0; m < r; ++m)
+        for (int32_t j = 0; j < r; ++j)
+            red->H[(int64_t)(o + m) * red->R + o + j] +=
+                Ja[m] * kj[j] + Ja[r + m] * kj[r + j] + Ja[2 * r + m] * kj[2 * r + j];
+}
+
+/* Phi(q, x) (condense.h) with its gradient into (red->g, c->gf) and with want_hess the
+ * Hessian's parts (red->H with the ring blocks, Kt, Dw). */
+static double cond_eval(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
+                        const double *q, const double *x, const sw_dyn_coef *dc, int want_hess) {
+    const sw_blob_view *v = c->v;
+    double phi = sw_potential(red, ct, s, q, dc, 1, want_hess);
+    for (int32_t k = 0; k < c->nring; ++k) {
+        const sw_blob_domain *D = &v->domains[c->ring_d[k]];
+        int32_t r = D->rank;
+        const double *J = ring_J(c, k), *qd = q + D->q_offset;
+        for (int i = 0; i < 3; ++i) {
+            double acc = c->ring_x0[3 * k + i];
+            for (int32_t j = 0; j < r; ++j)
+                acc += J[i * r + j] * qd[j];
+            c->ring_x[3 * k + i] = acc;
+        }
+    }
+    memset(c->gf, 0, 3 * (size_t)c->nf * sizeof(double));
+    if (want_hess) memset(c->Dw, 0, 9 * (size_t)c->nf * sizeof(double));
+    for (int32_t e = 0; e < c->nt; ++e) {
+        int32_t t = c->ft[e];
+        const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+        double x12[12], f[12], *K = c->Kt + 144 * (int64_t)e;
+        tet_positions(c, x, e, x12);
+        phi += sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, f,
+                             want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
+        for (int k = 0; k < 4; ++k) {
+            if (slot[k] >= 0) {
+                for (int i = 0; i < 3; ++i)
+                    c->gf[3 * (int64_t)slot[k] + i] -= f[3 * k + i];
+                continue;
+            }
+            int32_t a = -1 - slot[k];
+            const sw_blob_domain *D = &v->domains[c->ring_d[a]];
+            const double *J = ring_J(c, a);
+            for (int32_t j = 0; j < D->rank; ++j)
+                red->g[D->q_offset + j] -= J[j] * f[3 * k] + J[D->rank + j] * f[3 * k + 1] +
+                                           J[2 * D->rank + j] * f[3 * k + 2];
+            for (int l = 0; want_hess && l < 4; ++l)
+                if (slot[l] < 0) add_ring_block(c, red, a, -1 - slot[l], K, k, l);
+        }
+    }
+    const sw_world_contacts *wc = ct->wc;
+    for (int32_t j = 0; wc && j < wc->ncand; ++j) {
+        const sw_world_cand *cd = &wc->cand[j];
+        if (cd->patch < 0) continue;
+        double f[3], H3[9];
+        phi += sw_world_penalty(&cd->law, x + 3 * (int64_t)cd->patch, f, want_hess ? H3 : NULL);
+        for (int i = 0; i < 3; ++i)
+            c->gf[3 * (int64_t)cd->patch + i] -= f[i];
+        for (int i = 0; want_hess && i < 9; ++i)
+            c->Dw[9 * (int64_t)cd->patch + i] += H3[i];
+    }
+    return phi;
+}
+
+/* ---- the linear system of eq. 4.11 ------------------------------------------------- */
+
+typedef struct {
+    sw_cond *c;
+    sw_reduced *red;
+    const sw_solver *s;
+} cond_sys;
+
+/* y = H z, z = (dq, dx): the reduced block, the world's 3x3 blocks, and each full tet's K
+ * on its corners (the ring rows through J^T, leaving out the ring-ring part red->H has). */
+static void sys_apply(void *ctx, const double *z, double *y) {
+    const cond_sys *S = ctx;
+    sw_cond *c = S->c;
+    const sw_blob_view *v = c->v;
+    int32_t R = S->red->R;
+    const double *dq = z, *dx = z + R;
+    double *yq = y, *yx = y + R;
+    sw_matvec(S->red->H, R, dq, yq);
+    for (int32_t i = 0; i < c->nf; ++i) {
+        const double *D = c->Dw + 9 * (int64_t)i, *a = dx + 3 * (int64_t)i;
+        for (int k = 0; k < 3; ++k)
+            yx[3 * i + k] = D[3 * k] * a[0] + D[3 * k + 1] * a[1] + D[3 * k + 2] * a[2];
+    }
+    for (int32_t k = 0; k < c->nring; ++k) {
+        const sw_blob_domain *D = &v->domains[c->ring_d[k]];
+        const double *J = ring_J(c, k), *qd = dq + D->q_offset;
+        for (int i = 0; i < 3; ++i) {
+            double acc = 0;
+            for (int32_t j = 0; j < D->rank; ++j)
+                acc += J[i * D->rank + j] * qd[j];
+            c->ring_dx[3 * k + i] = acc;
+        }
+    }
+    for (int32_t e = 0; e < c->nt; ++e) {
+        const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+        const double *K = c->Kt + 144 * (int64_t)e;
+        double zp[12], zr[12];
+        for (int k = 0; k < 4; ++k)
+            for (int i = 0; i < 3; ++i) {
+                zp[3 * k + i] = slot[k] >= 0 ? dx[3 * (int64_t)slot[k] + i] : 0;
+                zr[3 * k + i] = slot[k] >= 0 ? 0 : c->ring_dx[3 * (-1 - slot[k]) + i];
+            }
+        for (int k = 0; k < 4; ++k) {
+            double out[3];
+            for (int i = 0; i < 3; ++i) {
+                const double *Kr = K + 12 * (3 * k + i);
+                double acc = 0;
+                for (int l = 0; l < 12; ++l)
+                    acc += Kr[l] * (slot[k] >= 0 ? zp[l] + zr[l] : zp[l]);
+                out[i] = acc;
+            }
+            if (slot[k] >= 0) {
+                for (int i = 0; i < 3; ++i)
+                    yx[3 * (int64_t)slot[k] + i] += out[i];
+                continue;
+            }
+            int32_t a = -1 - slot[k];
+            const sw_blob_domain *D = &v->domains[c->ring_d[a]];
+            const double *J = ring_J(c, a);
+            for (int32_t j = 0; j < D->rank; ++j)
+                yq[D->q_offset + j] +=
+                    J[j] * out[0] + J[D->rank + j] * out[1] + J[2 * D->rank + j] * out[2];
+        }
+    }
+}
+
+/* z = P^-1 r: the factored reduced block on q, the inverted 3x3 diagonal blocks on x_f. */
+static void sys_prec(void *ctx, const double *r, double *z) {
+    const cond_sys *S = ctx;
+    const sw_cond *c = S->c;
+    int32_t R = S->red->R;
+    memcpy(z, r, (size_t)R * sizeof(double));
+    sw_solver_factor_solve(S->red, S->s, z);
+    for (int32_t i = 0; i < c->nf; ++i) {
+        const double *P = c->Pf + 9 * (int64_t)i, *a = r + R + 3 * (int64_t)i;
+        for (int k = 0; k < 3; ++k)
+            z[R + 3 * i + k] = P[3 * k] * a[0] + P[3 * k + 1] * a[1] + P[3 * k + 2] * a[2];
+    }
+}
+
+/* The patch block's 3x3 diagonal blocks (tets and world) inverted into Pf. */
+static void patch_preconditioner(sw_cond *c) {
+    double *Dg = c->Pf; /* assembled in place of their inverses, then inverted */
+    memcpy(Dg, c->Dw, 9 * (size_t)c->nf * sizeof(double));
+    for (int32_t e = 0; e < c->nt; ++e) {
+        const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+        const double *K = c->Kt + 144 * (int64_t)e;
+        for (int k = 0; k < 4; ++k)
+            if (slot[k] >= 0)
+                for (int i = 0; i < 3; ++i)
+                    for (int l = 0; l < 3; ++l)
+                        Dg[9 * (int64_t)slot[k] + 3 * i + l] += K[(3 * k + i) * 12 + 3 * k + l];
+    }
+    /* inverted in place: each block is read before its inverse is written */
+    for (int32_t i = 0; i < c->nf; ++i) {
+        double blk[9];
+        memcpy(blk, Dg + 9 * (int64_t)i, sizeof blk);
+        sw_block_jacobi_invert(1, blk, NULL, Dg + 9 * (int64_t)i);
+    }
+}
+
+/* ---- Newton ------------------------------------------------------------------------ */
+
+/* Coupled solves take at least this many Newton updates (a patch starts far from its
+ * solution: the flesh inside a collider). */
+#define SW_COND_MIN_NEWTON 8
+/* PCG's relative tolerance and iteration cap for one update (thesis: "typically fewer
+ * than 100 iterations"). */
+#define SW_COND_PCG_TOL 1e-3
+#define SW_COND_PCG_MAX 200
+
+static double grad_norm(const sw_cond *c, const sw_reduced *red) {
+    return sqrt(sw_dot(red->g, red->g, red->R) + sw_dot(c->gf, c->gf, 3 * c->nf));
+}
+
+sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                           const sw_dyn_coef *dc, sinew_step_stats *st) {
+    int32_t R = red->R, nx = 3 * c->nf;
+    int64_t m = R + nx;
+    weights_apply(c, red);
+    cond_sys S = {c, red, s};
+    sw_pcg_vectors vec = {c->cg_r, c->cg_z, c->cg_p, c->cg_Ap};
+    double phi = cond_eval(c, red, ct, s, s->q, c->x, dc, 1);
+    st->potential_evals++;
+    double gn = grad_norm(c, red), g0 = gn;
+    uint32_t max_it = s->max_newton > SW_COND_MIN_NEWTON ? s->max_newton : SW_COND_MIN_NEWTON;
+    sinew_result res = SINEW_OK;
+    for (uint32_t it = 0;; ++it) {
+        if (!isfinite(phi) || !isfinite(gn)) {
+            memcpy(s->q, s->qn, (size_t)R * sizeof(double));
+            st->status |= SINEW_STEP_FAILED;
+            res = SINEW_ERROR_NOT_FINITE;
+            break;
+        }
+        if (gn <= 1e-5 * g0 || gn == 0) {
+            st->status |= SINEW_STEP_CONVERGED;
+            break;
+        }
+        if (it == max_it) break;
+        if (!sw_solver_factor(red, s)) break;
+        st->factorizations++;
+        patch_preconditioner(c);
+        for (int32_t i = 0; i < R; ++i)
+            c->rhs[i] = -red->g[i];
+        for (int32_t i = 0; i < nx; ++i)
+            c->rhs[R + i] = -c->gf[i];
+        memset(c->sol, 0, (size_t)m * sizeof(double));
+        sw_pcg_stats ps = sw_pcg_run(m, sys_apply, &S, sys_prec, &S, c->rhs, SW_COND_PCG_TOL,
+                                     SW_COND_PCG_MAX, &vec, c->sol);
+        c->pcg_iters += (uint32_t)ps.iters;
+        /* the update: q and x from the iterate kept in qtrial and xt */
+        memcpy(s->qtrial, s->q, (size_t)R * sizeof(double));
+        memcpy(c->xt, c->x, (size_t)nx * sizeof(double));
+        double phi0 = phi, gn0 = gn, step = 1.0;
+        int accepted = 0;
+        for (int ls = 0; ls < 5; ++ls, step *= 0.5) {
+            for (int32_t i = 0; i < R; ++i)
+                s->q[i] = s->qtrial[i] + step * c->sol[i];
+            for (int32_t i = 0; i < nx; ++i)
+                c->x[i] = c->xt[i] + step * c->sol[R + i];
+            phi = cond_eval(c, red, ct, s, s->q, c->x, dc, 1);
+            st->potential_evals++;
+            if (isfinite(phi) && phi <= phi0 + 1e-12 * fabs(phi0)) {
+                accepted = 1;
+                break;
+            }
+        }
+        if (!accepted) { /* keep the best iterate */
+            memcpy(s->q, s->qtrial, (size_t)R * sizeof(double));
+            memcpy(c->x, c->xt, (size_t)nx * sizeof(double));
+            phi = phi0;
+            gn = gn0;
+            st->status |= SINEW_STEP_GUARD;
+            break;
+        }
+        gn = grad_norm(c, red);
+        st->newton_iterations++;
+    }
+    weights_restore(c, red);
+    st->residual = g0 > 0 ? gn / g0 : 0;
+    st->energy = phi;
+    return res;
+}

@@ -1,0 +1,327 @@
+/* The partition oracle of subspace condensation (condense.h; thesis §4.4.2, DESIGN.md
+ * §4.6 and §8): seeds, the breadth-first growth within rho of each seed, the budget's cut,
+ * the full tets and their ring copies. Its cost follows the seeds' neighbourhoods, never
+ * the mesh: the per-vertex arrays are read and written only at the vertices it visits,
+ * and stamps stand in for clearing them. */
+#include <math.h>
+#include <string.h>
+
+#include "condense.h"
+#include "dqs.h"
+
+/* Seeds persist this many steps after the one that found them (the thesis's "two more
+ * frames": a patch outlives its contact while the flesh recovers from it). */
+#define SEED_STEPS 3
+
+/* Largest number of tets at one vertex. */
+static int32_t max_valence(const sw_blob_view *v) {
+    int32_t m = 0;
+    for (int32_t gv = 0; gv < v->nverts; ++gv) {
+        int32_t n = v->vert_tet_ptr[gv + 1] - v->vert_tet_ptr[gv];
+        if (n > m) m = n;
+    }
+    return m;
+}
+
+static int32_t min32(int64_t a, int64_t b) {
+    return (int32_t)(a < b ? a : b);
+}
+
+sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world) {
+    sw_cond_sizes z;
+    memset(&z, 0, sizeof z);
+    if (max_verts == 0 || v->ntets == 0) return z;
+    z.max_verts = min32(max_verts, v->nverts);
+    z.max_tets = min32((int64_t)z.max_verts * max_valence(v), v->ntets);
+    z.max_ring = min32(4 * (int64_t)z.max_tets, v->ndomain_verts);
+    z.max_cand = min32(4 * (int64_t)z.max_verts + 64, v->nverts);
+    z.max_seeds = max_world > 0 ? max_world : 1;
+    for (int32_t k = 0; k < v->ndomains; ++k)
+        if (v->domains[k].rank > z.rmax) z.rmax = v->domains[k].rank;
+    return z;
+}
+
+void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
+    c->v = v;
+    c->rho = rho;
+    memset(c->vis, 0, (size_t)v->nverts * sizeof *c->vis);
+    memset(c->in_patch, 0, (size_t)v->nverts * sizeof *c->in_patch);
+    memset(c->in_ring, 0, (size_t)v->nverts * sizeof *c->in_ring);
+    memset(c->seeded, 0, (size_t)v->nverts * sizeof *c->seeded);
+    memset(c->dev_at, 0, (size_t)v->nverts * sizeof *c->dev_at);
+    memset(c->tvis, 0, (size_t)v->ntets * sizeof *c->tvis);
+    for (int32_t t = 0; t < v->ntets; ++t)
+        c->tet_cub[t] = -1;
+    for (int32_t k = 0; k < v->ndomains; ++k)
+        c->dom_vol[k] = c->dom_wvol[k] = 0;
+    for (int32_t t = 0; t < v->ntets; ++t)
+        c->dom_vol[v->tet_domain[t]] += v->tet_vol[t];
+    for (int32_t i = 0; i < v->ncub; ++i) {
+        c->tet_cub[v->cub_tet_id[i]] = i;
+        c->cub_w[i] = v->cub_weight[i];
+    }
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
+            c->dom_wvol[k] += v->cub_weight[i] * v->cub_vol[i];
+    }
+    c->stamp = c->vstamp = 0;
+    sw_cond_forget(c);
+}
+
+void sw_cond_forget(sw_cond *c) {
+    c->nseeds[0] = c->nseeds[1] = c->nseeds[2] = 0;
+    c->slot = 0;
+    c->nf = c->nt = c->nring = 0;
+    c->stamp++; /* every deviation is older than any later step */
+    c->stamp++;
+}
+
+/* A fresh stamp for the per-vertex visit marks (wrapping to 1 after clearing them, so
+ * that a stale mark never equals a live one). */
+static uint32_t next_visit(sw_cond *c) {
+    if (++c->vstamp == 0) {
+        memset(c->vis, 0, (size_t)c->v->nverts * sizeof *c->vis);
+        c->vstamp = 1;
+    }
+    return c->vstamp;
+}
+
+static double dist2(const double *a, const double *b) {
+    double d0 = a[0] - b[0], d1 = a[1] - b[1], d2 = a[2] - b[2];
+    return d0 * d0 + d1 * d1 + d2 * d2;
+}
+
+/* Accepts vertex gv at rest distance d (the growth's candidates: a vertex accepted twice
+ * keeps its nearer distance). Returns 0 when the candidate list is full. */
+static int accept(sw_cond *c, int32_t gv, double d) {
+    if (c->in_patch[gv] == c->stamp) {
+        double *cd = c->cand_d + c->vloc[gv];
+        if (d < *cd) *cd = d;
+        return 1;
+    }
+    if (c->ncand == c->z.max_cand) return 0;
+    c->in_patch[gv] = c->stamp;
+    c->vloc[gv] = c->ncand;
+    c->cand[c->ncand] = gv;
+    c->cand_d[c->ncand++] = d;
+    return 1;
+}
+
+/* The breadth-first growth from seed s over the mesh's edges (the corners of the tets at
+ * a vertex), accepting vertices within rho of s in rest space. */
+static void grow(sw_cond *c, int32_t s) {
+    const sw_blob_view *v = c->v;
+    uint32_t mark = next_visit(c);
+    const double *X0 = v->rest + 3 * (int64_t)s, rho2 = c->rho * c->rho;
+    int32_t head = 0, tail = 0;
+    c->vis[s] = mark;
+    c->queue[tail++] = s;
+    while (head < tail) {
+        int32_t a = c->queue[head++];
+        if (!accept(c, a, sqrt(dist2(v->rest + 3 * (int64_t)a, X0)))) {
+            c->dropped++;
+            continue;
+        }
+        for (int32_t e = v->vert_tet_ptr[a]; e < v->vert_tet_ptr[a + 1]; ++e) {
+            const int32_t *tv = v->tets + 4 * (int64_t)v->vert_tets[e];
+            for (int k = 0; k < 4; ++k) {
+                int32_t b = tv[k];
+                if (c->vis[b] == mark) continue;
+                c->vis[b] = mark;
+                if (dist2(v->rest + 3 * (int64_t)b, X0) > rho2) continue;
+                if (tail == c->z.max_cand) { /* the growth's queue is full: cut here */
+                    c->dropped++;
+                    continue;
+                }
+                c->queue[tail++] = b;
+            }
+        }
+    }
+}
+
+/* Keeps the max_verts candidates nearest their seeds (quickselect on the distance, in
+ * place; ties by vertex id, so the cut is a function of the candidates alone). */
+static int before(const sw_cond *c, int32_t i, int32_t j) {
+    return c->cand_d[i] < c->cand_d[j] || (c->cand_d[i] == c->cand_d[j] && c->cand[i] < c->cand[j]);
+}
+static void swap_cand(sw_cond *c, int32_t i, int32_t j) {
+    int32_t g = c->cand[i];
+    double d = c->cand_d[i];
+    c->cand[i] = c->cand[j];
+    c->cand_d[i] = c->cand_d[j];
+    c->cand[j] = g;
+    c->cand_d[j] = d;
+}
+static void keep_nearest(sw_cond *c, int32_t k) {
+    int32_t n = c->ncand;
+    int32_t lo = 0, hi = c->ncand - 1;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2, i = lo;
+        swap_cand(c, mid, hi);
+        for (int32_t p = lo; p < hi; ++p)
+            if (before(c, p, hi)) swap_cand(c, p, i++);
+        swap_cand(c, i, hi);
+        if (i == k) break;
+        if (i < k)
+            lo = i + 1;
+        else
+            hi = i - 1;
+    }
+    for (int32_t i = k; i < n; ++i) /* out of the patch again */
+        c->in_patch[c->cand[i]] = 0;
+    c->dropped += n - k;
+    c->ncand = k;
+}
+
+/* This step's seeds: the vertices of the candidates penetrating at q (their copies'
+ * positions at q). */
+static void find_seeds(sw_cond *c, const sw_reduced *red, const sw_world_contacts *wc,
+                       const double *q) {
+    const sw_blob_view *v = c->v;
+    int32_t *seeds = c->seeds + (int64_t)c->slot * c->z.max_seeds, n = 0;
+    for (int32_t j = 0; j < wc->ncand && n < c->z.max_seeds; ++j) {
+        const sw_world_cand *cd = &wc->cand[j];
+        int32_t d = v->surf_copies[2 * cd->copy], lv = v->surf_copies[2 * cd->copy + 1];
+        int32_t gv = v->domain_verts[v->domains[d].vert_begin + lv];
+        double x[3];
+        sw_cond_copy_position(red, gv, d, lv, q, x, NULL);
+        double g[3] = {cd->law.a[0] - x[0], cd->law.a[1] - x[1], cd->law.a[2] - x[2]};
+        if (g[0] * cd->law.n[0] + g[1] * cd->law.n[1] + g[2] * cd->law.n[2] > 0) seeds[n++] = gv;
+    }
+    c->nseeds[c->slot] = n;
+}
+
+/* The ring copy of (gv, domain d, local lv), added on first sight. */
+static int32_t ring_copy(sw_cond *c, const sw_reduced *red, int32_t gv, int32_t d, int32_t lv) {
+    int32_t i = c->in_ring[gv] == c->stamp ? -1 - c->vloc[gv] : -1;
+    for (int32_t k = i; k >= 0; k = c->ring_next[k])
+        if (c->ring_d[k] == d) return k;
+    int32_t k = c->nring++;
+    c->ring_v[k] = gv;
+    c->ring_d[k] = d;
+    c->ring_l[k] = lv;
+    c->ring_next[k] = i;
+    c->in_ring[gv] = c->stamp;
+    c->vloc[gv] = -1 - k;
+    double *J = c->ring_J + (int64_t)3 * c->z.rmax * k;
+    sw_cond_copy_position(red, gv, d, lv, NULL, c->ring_x0 + 3 * k, J);
+    return k;
+}
+
+/* The full tets (those touching a patch vertex) and their corners' slots. */
+static void full_tets(sw_cond *c, const sw_reduced *red) {
+    const sw_blob_view *v = c->v;
+    c->nt = c->nring = 0;
+    for (int32_t i = 0; i < c->nf; ++i) {
+        int32_t a = c->fv[i];
+        for (int32_t e = v->vert_tet_ptr[a]; e < v->vert_tet_ptr[a + 1]; ++e) {
+            int32_t t = v->vert_tets[e];
+            if (c->tvis[t] == c->stamp || c->nt == c->z.max_tets) continue;
+            c->tvis[t] = c->stamp;
+            c->ft[c->nt] = t;
+            int32_t *slot = c->ft_slot + 4 * (int64_t)c->nt++;
+            for (int k = 0; k < 4; ++k) {
+                int32_t b = v->tets[4 * (int64_t)t + k];
+                slot[k] = c->in_patch[b] == c->stamp ? c->vloc[b]
+                                                     : -1 - ring_copy(c, red, b, v->tet_domain[t],
+                                                                      v->tet_local[4 * t + k]);
+            }
+        }
+    }
+}
+
+/* The patch's start: each vertex at its subspace position at q (the copy of its first
+ * tet's domain) plus the deviation it had when last in a patch, if it was in the last
+ * step's. */
+static void start_positions(sw_cond *c, const sw_reduced *red, const double *q) {
+    const sw_blob_view *v = c->v;
+    for (int32_t i = 0; i < c->nf; ++i) {
+        int32_t gv = c->fv[i], t = v->vert_tets[v->vert_tet_ptr[gv]];
+        int k = 0;
+        while (v->tets[4 * (int64_t)t + k] != gv)
+            ++k;
+        double *x = c->x + 3 * (int64_t)i;
+        sw_cond_copy_position(red, gv, v->tet_domain[t], v->tet_local[4 * t + k], q, x, NULL);
+        if (c->dev_at[gv] == c->stamp - 1)
+            for (int j = 0; j < 3; ++j)
+                x[j] += c->dev[3 * (int64_t)gv + j];
+    }
+}
+
+void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc) {
+    const sw_blob_view *v = c->v;
+    for (int32_t j = 0; j < wc->ncand; ++j) {
+        sw_world_cand *cd = &wc->cand[j];
+        int32_t d = v->surf_copies[2 * cd->copy], lv = v->surf_copies[2 * cd->copy + 1];
+        int32_t gv = v->domain_verts[v->domains[d].vert_begin + lv];
+        cd->patch = c->nf > 0 && c->in_patch[gv] == c->stamp ? c->vloc[gv] : -1;
+    }
+    wc->patch_x = c->nf > 0 ? c->x : NULL;
+}
+
+int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, const double *q) {
+    c->stamp++;
+    c->slot = (c->slot + 1) % SEED_STEPS;
+    c->ncand = c->dropped = 0;
+    c->nf = c->nt = c->nring = 0;
+    find_seeds(c, red, wc, q);
+    /* the oldest seeds first, this step's last; a vertex seeded twice grows once */
+    for (int32_t k = 0; k < SEED_STEPS; ++k)
+        for (int32_t i = 0, sl = (c->slot + 1 + k) % SEED_STEPS; i < c->nseeds[sl]; ++i) {
+            int32_t s = c->seeds[(int64_t)sl * c->z.max_seeds + i];
+            if (c->seeded[s] == c->stamp) continue;
+            c->seeded[s] = c->stamp;
+            grow(c, s);
+        }
+    if (c->ncand > c->z.max_verts) /* over budget: the nearest stay in the patch */
+        keep_nearest(c, c->z.max_verts);
+    c->nf = c->ncand;
+    for (int32_t i = 0; i < c->nf; ++i) {
+        c->fv[i] = c->cand[i];
+        c->vloc[c->cand[i]] = i;
+    }
+    full_tets(c, red);
+    start_positions(c, red, q);
+    sw_cond_tag_candidates(c, wc);
+    return c->nf;
+}
+
+void sw_cond_finish(sw_cond *c, const sw_reduced *red, const double *q) {
+    const sw_blob_view *v = c->v;
+    for (int32_t i = 0; i < c->nf; ++i) {
+        int32_t gv = c->fv[i], t = v->vert_tets[v->vert_tet_ptr[gv]];
+        int k = 0;
+        while (v->tets[4 * (int64_t)t + k] != gv)
+            ++k;
+        double y[3];
+        sw_cond_copy_position(red, gv, v->tet_domain[t], v->tet_local[4 * t + k], q, y, NULL);
+        for (int j = 0; j < 3; ++j)
+            c->dev[3 * (int64_t)gv + j] = c->x[3 * (int64_t)i + j] - y[j];
+        c->dev_at[gv] = c->stamp;
+    }
+}
+
+void sw_cond_copy_position(const sw_reduced *red, int32_t gv, int32_t d, int32_t lv,
+                           const double *q, double x[3], double *J) {
+    const sw_blob_view *v = red->v;
+    const sw_blob_domain *D = &v->domains[d];
+    int32_t r = D->rank;
+    double R[9], t[3];
+    sw_dqs_blend(red->bone_dq, v->skin_bone + 4 * (int64_t)gv, v->skin_weight + 4 * (int64_t)gv, 4,
+                 R, t);
+    const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r,
+                 *X = v->rest + 3 * (int64_t)gv;
+    double y[3] = {X[0], X[1], X[2]};
+    if (q)
+        for (int i = 0; i < 3; ++i)
+            for (int32_t j = 0; j < r; ++j)
+                y[i] += U[i * r + j] * q[D->q_offset + j];
+    for (int i = 0; i < 3; ++i)
+        x[i] = R[3 * i] * y[0] + R[3 * i + 1] * y[1] + R[3 * i + 2] * y[2] + t[i];
+    if (J)
+        for (int i = 0; i < 3; ++i)
+            for (int32_t j = 0; j < r; ++j)
+                J[i * r + j] =
+                    R[3 * i] * U[j] + R[3 * i + 1] * U[r + j] + R[3 * i + 2] * U[2 * r + j];
+}

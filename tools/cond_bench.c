@@ -1,0 +1,119 @@
+/* sinew-bench --world: the condensed runtime (a patch budget) against the reference of the
+ * same scene, frame by frame (cond_bench.h). */
+#include "cond_bench.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "blob_load.h"
+#include "clock.h"
+#include "instance.h"
+#include "tool_common.h"
+
+/* Passes of the scene timed; a frame's time is its fastest pass (the least disturbed by
+ * the machine's other work: the per-frame ratios are what the figures are made of). */
+#define COND_PASSES 3
+
+/* The largest one-frame move of an output vertex between a and b (3 n each). */
+static double max_jump(const double *a, const double *b, int32_t n) {
+    double m = 0;
+    for (int32_t i = 0; i < n; ++i)
+        m = fmax(m, sqrt((a[3 * i] - b[3 * i]) * (a[3 * i] - b[3 * i]) +
+                         (a[3 * i + 1] - b[3 * i + 1]) * (a[3 * i + 1] - b[3 * i + 1]) +
+                         (a[3 * i + 2] - b[3 * i + 2]) * (a[3 * i + 2] - b[3 * i + 2])));
+    return m;
+}
+
+sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const double *T, int nf,
+                               const double *x_full, const double *ref_ms,
+                               const unsigned char *touch, const double *mass,
+                               const sw_cond_bench_params *cp, sw_cond_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    int32_t n = v->nverts, ns = sw_blob_output_verts(v);
+    sinew_instance_def d = sinew_instance_def_default();
+    d.max_patch_vertices = cp->budget > 0 ? cp->budget : (uint32_t)(n / 4 > 0 ? n / 4 : 1);
+    d.patch_radius = (float)cp->rho;
+    out->budget = d.max_patch_vertices;
+    out->rho = d.patch_radius > 0 ? d.patch_radius : 0.05;
+    sinew_instance *inst;
+    sinew_result r = sinew_instance_create(blob, &d, &inst);
+    if (r != SINEW_OK)
+        return sw_error_set(err, r,
+                            "cannot create a condensed instance (a blob without the tet "
+                            "mesh? bake it again)");
+    sinew_instance_set_world(inst, ws->world);
+    double *ms = malloc(sizeof(double) * nf), *sorted = malloc(sizeof(double) * nf);
+    double *xs = malloc(sizeof(double) * 3 * n), *cnt = malloc(sizeof(double) * n),
+           *xd = malloc(sizeof(double) * 3 * n);
+    double *prev = malloc(sizeof(double) * 3 * ns), *ref_prev = malloc(sizeof(double) * 3 * ns),
+           *ref_out = malloc(sizeof(double) * 3 * ns);
+    float *pos = malloc(sizeof(float) * 3 * ns), *nrm = malloc(sizeof(float) * 3 * ns);
+    if (!ms || !sorted || !xs || !cnt || !xd || !prev || !ref_prev || !ref_out || !pos || !nrm) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the condensed run");
+        goto done;
+    }
+    for (int f = 0; f < nf; ++f)
+        ms[f] = INFINITY;
+    double num = 0, den = 0;
+    for (int pass = 0; pass < COND_PASSES; ++pass) {
+        sinew_instance_reset(inst);
+        uint32_t last_patch = 0;
+        for (int f = 0; f < nf; ++f) {
+            if ((r = sw_world_scene_at(ws, f, err)) != SINEW_OK) goto done;
+            double t0 = sw_now_seconds();
+            sw_instance_set_pose_d(inst, T + (size_t)f * 12 * v->nbones);
+            sinew_result sr = sinew_instance_step(inst, 1.0f / 30);
+            sinew_instance_read_surface(inst, pos, nrm, (uint32_t)ns);
+            ms[f] = fmin(ms[f], 1e3 * (sw_now_seconds() - t0));
+            if (pass > 0) continue; /* the figures of the state: the first pass */
+            out->failed += sr != SINEW_OK;
+            sinew_step_stats st = {.struct_size = sizeof st};
+            sinew_instance_get_stats(inst, &st);
+            double frac = st.patch_vertices / (double)n;
+            out->patch_frac_mean += frac / nf;
+            out->patch_frac_max = fmax(out->patch_frac_max, frac);
+            out->truncated_frames += (st.budget_exceeded & SINEW_BUDGET_PATCH) != 0;
+            out->pcg_iters_max =
+                st.pcg_iterations > out->pcg_iters_max ? st.pcg_iterations : out->pcg_iters_max;
+            const double *xo = sw_instance_surface(inst), *xf = x_full + (size_t)f * 3 * n;
+            sw_output_from_full(v, xf, ref_out);
+            /* a pop: the frame a patch appears or vanishes, its largest surface jump
+               against the reference's largest jump at that frame */
+            if (f > 0 && (st.patch_vertices > 0) != (last_patch > 0)) {
+                double ref_jump = max_jump(ref_out, ref_prev, ns);
+                double jump = max_jump(xo, prev, ns);
+                if (ref_jump > 0) out->pop_max = fmax(out->pop_max, jump / ref_jump);
+            }
+            last_patch = st.patch_vertices;
+            memcpy(prev, xo, sizeof(double) * 3 * ns);
+            memcpy(ref_prev, ref_out, sizeof(double) * 3 * ns);
+            if (!touch[f]) continue;
+            sw_instance_full_positions(inst, xs, cnt);
+            sw_instance_dqs_positions(inst, xd);
+            for (int32_t i = 0; i < n; ++i)
+                for (int k = 0; k < 3; ++k) {
+                    double a = xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - xd[3 * i + k];
+                    num += mass[i] * a * a;
+                    den += mass[i] * b * b;
+                }
+        }
+    }
+    out->err_world_cond = den > 0 ? sqrt(num / den) : 0;
+    out->speedup_worst = INFINITY;
+    for (int f = 0; f < nf; ++f) {
+        double s = ref_ms[f] / ms[f];
+        out->speedup_mean += s / nf;
+        out->speedup_worst = fmin(out->speedup_worst, s);
+        out->ms_max = fmax(out->ms_max, ms[f]);
+        sorted[f] = ms[f];
+    }
+    out->ms_median = sw_median(sorted, nf);
+    out->p100_over_p50 = out->ms_median > 0 ? out->ms_max / out->ms_median : 0;
+done:
+    free(ms), free(sorted), free(xs), free(cnt), free(xd), free(prev), free(ref_prev);
+    free(ref_out), free(pos), free(nrm);
+    sinew_instance_destroy(inst);
+    return r;
+}
