@@ -331,7 +331,7 @@ TEST(the_loader_rejects_a_damaged_render_mesh) {
     entry(b, SINEW_SECTION_RENDER_WELD)->id = 200;
     ENSURE(rejects(b, SINEW_ERROR_CORRUPT, "RENDER_WELD", "all or none"));
     FRESH(); /* all eight unknown: a blob of the tet boundary, as an older writer's */
-    for (uint32_t id = SINEW_SECTION_RENDER_FIRST; id <= SINEW_SECTION_ID_MAX; ++id)
+    for (uint32_t id = SINEW_SECTION_RENDER_FIRST; id <= SINEW_SECTION_RENDER_LAST; ++id)
         entry(b, id)->id = 100 + id;
     fix_checksum(b, fx.size);
     sw_blob_view plain;
@@ -356,7 +356,7 @@ TEST(the_synthetic_render_blob_round_trips_and_seeds_the_fuzzer) {
     sw_blob_view v;
     char msg[512];
     ENSUREF(sw_blob_parse(b, size, &v, msg, sizeof msg) == SINEW_OK, "%s", msg);
-    ENSURE(hdr(b)->section_count == SINEW_SECTION_ID_MAX);
+    ENSURE(hdr(b)->section_count == SINEW_SECTION_RENDER_LAST);
     ENSURE(v.nrender_verts == NRV && sw_blob_output_verts(&v) == NRV &&
            sw_blob_output_ntris(&v) == NRT);
     ENSURE(memcmp(v.render_bary, r.render_bary, sizeof r.render_bary) == 0 &&

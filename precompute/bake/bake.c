@@ -441,13 +441,15 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     t0 = t1;
     if ((r = sw_bake_contacts(&s, err)) != SINEW_OK ||
         (r = sw_bake_reduce(&s, out, err)) != SINEW_OK ||
-        (r = sw_bake_render(&s, out, err)) != SINEW_OK)
+        (r = sw_bake_render(&s, out, err)) != SINEW_OK ||
+        (r = sw_bake_cond(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;
     {
         char msg[96];
-        snprintf(msg, sizeof msg, "springs, mass, inertia, surface, %d pose-space contact pairs",
+        snprintf(msg, sizeof msg,
+                 "springs, mass, inertia, surface, %d pose-space contact pairs, the tet mesh",
                  s.ncontacts);
         progress(&p, "reduce", t1 - t0, msg);
     }

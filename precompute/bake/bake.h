@@ -78,7 +78,7 @@ sw_bake_params sw_bake_params_default(void);
 /* What the bake made, plus the arrays the view points into (owned). */
 typedef struct sw_bake_result {
     sw_blob_view view;
-    void *storage[48]; /* owned arrays (freed by sw_bake_result_free) */
+    void *storage[64]; /* owned arrays (freed by sw_bake_result_free) */
     int nstorage;
     /* report */
     double stage_seconds[8]; /* prepare, domains, poses+simulate, basis, cubature, reduce */

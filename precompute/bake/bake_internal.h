@@ -97,6 +97,9 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
 /* The render mesh's sections of the view from s->embed (nothing without a render mesh);
  * after sw_bake_reduce (bake_render.c). */
 sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* The condensation tet mesh's sections of the view (the whole tet mesh, its incidences and
+ * lumped masses, the cubature tets' ids); after sw_bake_reduce (bake_cond.c). */
+sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 
 /* Records an owned allocation in the result (freed with it); returns p. */
 void *sw_bake_own(sw_bake_result *out, void *p);

@@ -1,7 +1,8 @@
-/* Blob layout: header (64 bytes), section table (26 entries, 34 with a render mesh), then
- * the sections in id order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum
- * (FNV-1a 64) covers everything after the header. A view without a render mesh writes
- * exactly the 26 sections it always did, byte for byte. */
+/* Blob layout: header (64 bytes), section table (26 entries, 8 more with a render mesh, 10
+ * more with the condensation tet mesh), then the sections in id order, each starting at a
+ * multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers everything after the
+ * header. A view without the optional groups writes exactly the 26 sections it always did,
+ * byte for byte. */
 #include "blob_write.h"
 
 #include <errno.h>
@@ -27,23 +28,37 @@ static uint64_t round_up(uint64_t x) {
 #define SOURCE(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
     {id, elem_size, v->field, count},
 
-/* The sections of a validated view, in id order, into s; returns their number (26, or 34
- * with a render mesh). `meta` and `rmeta` must outlive the result. */
-static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta,
-                         const sinew_blob_render_meta *rmeta, section_src s[SINEW_SECTION_ID_MAX]) {
+/* The metas of the optional groups, filled from the view's counts. */
+typedef struct group_metas {
+    sinew_blob_render_meta render;
+    sinew_blob_cond_meta cond;
+} group_metas;
+
+/* The sections of a validated view, in id order, into s; returns their number (26, plus 8
+ * with a render mesh, plus 10 with the condensation tet mesh). `meta` and `g` must outlive
+ * the result. */
+static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
+                         section_src s[SINEW_SECTION_ID_MAX]) {
     SW_BLOB_COUNT_LOCALS(v);
     const section_src list[SINEW_SECTION_COUNT_V1] = {{SINEW_SECTION_META, sizeof *meta, meta, 1},
                                                       SINEW_BLOB_ARRAY_SECTIONS(SOURCE)};
     memcpy(s, list, sizeof list);
-    if (v->nrender_verts == 0) return SINEW_SECTION_COUNT_V1;
-#define RENDER_COUNT_LOCAL(name) const uint64_t name = (uint64_t)v->name;
-    SINEW_BLOB_RENDER_COUNTS(RENDER_COUNT_LOCAL)
-#undef RENDER_COUNT_LOCAL
-    const section_src render[SINEW_SECTION_ID_MAX - SINEW_SECTION_COUNT_V1] = {
-        {SINEW_SECTION_RENDER_META, sizeof *rmeta, rmeta, 1},
-        SINEW_BLOB_RENDER_ARRAY_SECTIONS(SOURCE)};
-    memcpy(s + SINEW_SECTION_COUNT_V1, render, sizeof render);
-    return SINEW_SECTION_ID_MAX;
+    int n = SINEW_SECTION_COUNT_V1;
+    if (v->nrender_verts > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_RENDER_COUNTS);
+        const section_src render[] = {{SINEW_SECTION_RENDER_META, sizeof g->render, &g->render, 1},
+                                      SINEW_BLOB_RENDER_ARRAY_SECTIONS(SOURCE)};
+        memcpy(s + n, render, sizeof render);
+        n += (int)(sizeof render / sizeof render[0]);
+    }
+    if (v->ntets > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_COND_COUNTS);
+        const section_src cond[] = {{SINEW_SECTION_COND_META, sizeof g->cond, &g->cond, 1},
+                                    SINEW_BLOB_COND_ARRAY_SECTIONS(SOURCE)};
+        memcpy(s + n, cond, sizeof cond);
+        n += (int)(sizeof cond / sizeof cond[0]);
+    }
+    return n;
 }
 #undef SOURCE
 
@@ -64,15 +79,18 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     SW_BLOB_META_FIELDS(TO_META)
 #undef TO_META
 
-    sinew_blob_render_meta rmeta;
-    memset(&rmeta, 0, sizeof rmeta);
-#define TO_RENDER_META(field) rmeta.field = view->field;
+    group_metas g;
+    memset(&g, 0, sizeof g);
+#define TO_RENDER_META(field) g.render.field = view->field;
     SINEW_BLOB_RENDER_COUNTS(TO_RENDER_META)
 #undef TO_RENDER_META
+#define TO_COND_META(field) g.cond.field = view->field;
+    SINEW_BLOB_COND_COUNTS(TO_COND_META)
+#undef TO_COND_META
 
     section_src src[SINEW_SECTION_ID_MAX];
     sinew_blob_section table[SINEW_SECTION_ID_MAX];
-    const int nsec = list_sections(view, &meta, &rmeta, src);
+    const int nsec = list_sections(view, &meta, &g, src);
     /* Validated counts are bounded (blob_load.h limits), so no sum below overflows. */
     uint64_t at = round_up(sizeof(sinew_blob_header) + (uint64_t)nsec * sizeof table[0]);
     for (int i = 0; i < nsec; ++i) {

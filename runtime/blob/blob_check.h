@@ -1,7 +1,8 @@
-/* What the blob loader's files share (blob_load.c, blob_render.c): the message writer and
- * the checks of a "vertex = mean of its domain copies" list, which the tet boundary
- * (SURF_COPY_PTR / SURF_COPIES) and the render nodes (RENDER_NODE_PTR / _COPIES) both are.
- * Private to runtime/blob. */
+/* What the blob loader's files share (blob_load.c, blob_render.c, blob_cond.c): the message
+ * writer, the layer-1 reading of an optional group of sections (its meta section, presence
+ * all or none, counts), the value checks, and the checks of a "vertex = mean of its domain
+ * copies" list, which the tet boundary (SURF_COPY_PTR / SURF_COPIES) and the render nodes
+ * (RENDER_NODE_PTR / _COPIES) both are. Private to runtime/blob. */
 #ifndef SW_BLOB_CHECK_H
 #define SW_BLOB_CHECK_H
 
@@ -17,22 +18,65 @@ sinew_result sw_blob_fail(char *msg, size_t msg_size, sinew_result code, const c
 #endif
     ;
 
-/* Every index of a (n elements of k indices each: triangles, tets, one a vertex) lies in
- * [0, bound); messages name the section, the `elem` (and its corner when k > 1) and the
- * `what` it indexes. */
-sinew_result sw_blob_check_indices(uint32_t id, const char *elem, int k, const int32_t *a,
-                                   int64_t n, const char *what, int32_t bound, char *msg,
-                                   size_t msg_size);
+/* A section's expected count for sw_blob_check_counts: a row of a section table
+ * (sinew_blob_format.h) expands to one with SW_BLOB_EXPECT_ROW, in a scope that holds its
+ * count names (SW_BLOB_COUNT_LOCALS, SW_BLOB_GROUP_COUNT_LOCALS). */
+typedef struct sw_blob_count_expect {
+    uint32_t id;
+    int by_meta; /* 0: not checked (a count the section's own size gives) */
+    uint64_t count;
+    const char *formula;
+} sw_blob_count_expect;
+#define SW_BLOB_EXPECT_ROW(id, NAME, elem_size, type, field, by_meta, count, formula)              \
+    {id, by_meta, count, formula},
+
+/* Every section of e (by_meta) present in the table s (at found[id]) with its expected
+ * count; messages say which meta section (`meta`, e.g. "META") needs it. */
+sinew_result sw_blob_check_counts(const sinew_blob_section *s, const int found[],
+                                  const sw_blob_count_expect *e, size_t n, const char *meta,
+                                  char *msg, size_t msg_size);
+
+/* Points the view `v`'s field at its section: a table row expanded in a scope holding
+ * `bytes`, the table `s` and `found` (every row's section present). */
+#define SW_BLOB_POINT_ROW(id, NAME, elem_size, type, field, ...)                                   \
+    v->field = (const type *)(const void *)(bytes + s[found[id]].offset);
+
+/* The optional group of sections with ids first .. last, the first its meta section of one
+ * element (meta_size bytes, its last nreserved int32 words reserved, zero): *present is 0
+ * when none of them is in the table, and 1, with the meta section read into `meta`, when
+ * all are. Errors: some present but not all (the first missing one named, with `what`,
+ * e.g. "the render mesh's"), the meta section's count, a reserved word. */
+sinew_result sw_blob_group_meta(const uint8_t *bytes, const sinew_blob_section *s,
+                                const int found[], uint32_t first, uint32_t last, const char *what,
+                                void *meta, size_t meta_size, size_t nreserved, int *present,
+                                char *msg, size_t msg_size);
+
+/* Every element of a (n doubles) finite (SINEW_ERROR_NOT_FINITE naming the section `id`). */
+sinew_result sw_blob_check_finite(uint32_t id, const double *a, int64_t n, char *msg,
+                                  size_t msg_size);
+
+/* a[i * stride] > 0 for i < n (stride > 1: a matrix's diagonal). */
+sinew_result sw_blob_check_positive(uint32_t id, const double *a, int64_t n, int64_t stride,
+                                    char *msg, size_t msg_size);
 
 /* A view's array and the section it holds, for sw_blob_check_arrays. */
 typedef struct sw_blob_array_ref {
     const void *p;
     uint32_t id;
 } sw_blob_array_ref;
+/* A table row's sw_blob_array_ref in a scope holding the view `v`. */
+#define SW_BLOB_ARRAY_REF_ROW(id, NAME, elem_size, type, field, ...) {v->field, id},
 
 /* Every array of the list is non-NULL (SINEW_ERROR_INVALID_ARGUMENT naming the first that
  * is not: a writer's view that lacks one). */
 sinew_result sw_blob_check_arrays(const sw_blob_array_ref *a, size_t n, char *msg, size_t msg_size);
+
+/* Every index of a (n elements of k indices each: triangles, tets, one a vertex) lies in
+ * [0, bound); messages name the section, the `elem` (and its corner when k > 1) and the
+ * `what` it indexes. */
+sinew_result sw_blob_check_indices(uint32_t id, const char *elem, int k, const int32_t *a,
+                                   int64_t n, const char *what, int32_t bound, char *msg,
+                                   size_t msg_size);
 
 /* ptr (n + 1 entries) starts at 0, rises strictly (every `item` has a copy) and ends at
  * ncopies, which is in [1, SW_BLOB_MAX_COPIES]. */
@@ -53,5 +97,17 @@ sinew_result sw_blob_render_fill(const uint8_t *bytes, const sinew_blob_section 
 
 /* Layer 2 of the render mesh: counts, indices and values (nothing when nrender_verts is 0). */
 sinew_result sw_blob_render_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 1 of the condensation tet mesh (blob_cond.c): the ten optional sections all present
+ * or all absent, COND_META's counts (ntets in [1, SW_BLOB_MAX_COUNT], nvert_tets = 4 ntets)
+ * and reserved words, every section's count against them and META's; points the view's
+ * fields at them (left 0 / NULL when absent). After META has been read into v. */
+sinew_result sw_blob_cond_fill(const uint8_t *bytes, const sinew_blob_section *s, const int found[],
+                               sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 2 of the condensation tet mesh: counts, indices, incidences, the cubature tets'
+ * agreement and values (nothing when ntets is 0); after the domains and cubature tets have
+ * been checked. */
+sinew_result sw_blob_cond_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
 #endif

@@ -22,7 +22,12 @@ _Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
     _Static_assert(sizeof(type) == elem_size, #NAME " elements are " #elem_size " bytes");
 SINEW_BLOB_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_RENDER_SECTIONS(SIZE_MATCHES)
+SINEW_BLOB_COND_SECTIONS(SIZE_MATCHES)
 #undef SIZE_MATCHES
+/* The optional groups follow the version-1 sections with no gap (the all-or-none loops). */
+_Static_assert(SINEW_SECTION_RENDER_FIRST == SINEW_SECTION_COUNT_V1 + 1 &&
+                   SINEW_SECTION_COND_FIRST == SINEW_SECTION_RENDER_LAST + 1,
+               "section ids run on without gaps");
 /* SW_BLOB_META_FIELDS covers every byte of META: no field is left uncopied. */
 #define META_FIELD_SIZE(field) +sizeof(((sinew_blob_meta *)0)->field)
 _Static_assert(0 SW_BLOB_META_FIELDS(META_FIELD_SIZE) == sizeof(sinew_blob_meta),
@@ -41,7 +46,8 @@ static const struct {
     uint32_t elem_size;
 } k_sections[SINEW_SECTION_ID_MAX + 1] = {[0] = {"unknown", 0},
                                           SINEW_BLOB_SECTIONS(SECTION_INFO)
-                                              SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)};
+                                              SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)
+                                                  SINEW_BLOB_COND_SECTIONS(SECTION_INFO)};
 #undef SECTION_INFO
 
 /* Not instrumented for fuzzing coverage: its loop has no branch worth a fuzzer's
@@ -160,11 +166,7 @@ sinew_result sw_blob_check_indices(uint32_t id, const char *elem, int k, const i
 }
 
 static sinew_result check_pointers(const sw_blob_view *v, char *msg, size_t ms) {
-    const sw_blob_array_ref arrays[] = {
-#define ARRAY(id, NAME, elem_size, type, field, ...) {v->field, id},
-        SINEW_BLOB_ARRAY_SECTIONS(ARRAY)
-#undef ARRAY
-    };
+    const sw_blob_array_ref arrays[] = {SINEW_BLOB_ARRAY_SECTIONS(SW_BLOB_ARRAY_REF_ROW)};
     return sw_blob_check_arrays(arrays, sizeof arrays / sizeof arrays[0], msg, ms);
 }
 
@@ -285,7 +287,7 @@ sinew_result sw_blob_check_copies(uint32_t id, const sw_blob_view *v, const int3
     return SINEW_OK;
 }
 
-static sinew_result check_finite(uint32_t id, const double *a, int64_t n, char *msg, size_t ms) {
+sinew_result sw_blob_check_finite(uint32_t id, const double *a, int64_t n, char *msg, size_t ms) {
     for (int64_t i = 0; i < n; ++i)
         if (!isfinite(a[i]))
             return fail(msg, ms, SINEW_ERROR_NOT_FINITE, "blob section %s: element %lld is %g",
@@ -309,7 +311,8 @@ static sinew_result check_all_finite(const sw_blob_view *v, char *msg, size_t ms
     };
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i) {
         if (!arrays[i].a) continue;
-        sinew_result r = check_finite(arrays[i].id, arrays[i].a, (int64_t)arrays[i].n, msg, ms);
+        sinew_result r =
+            sw_blob_check_finite(arrays[i].id, arrays[i].a, (int64_t)arrays[i].n, msg, ms);
         if (r != SINEW_OK) return r;
     }
     return SINEW_OK;
@@ -398,8 +401,8 @@ static sinew_result check_surface(const sw_blob_view *v, char *msg, size_t ms) {
                                 ms);
 }
 
-static sinew_result check_positive(uint32_t id, const double *a, int64_t n, int64_t stride,
-                                   char *msg, size_t ms) {
+sinew_result sw_blob_check_positive(uint32_t id, const double *a, int64_t n, int64_t stride,
+                                    char *msg, size_t ms) {
     for (int64_t i = 0; i < n; ++i)
         if (!(a[i * stride] > 0.0))
             return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section %s: %s %lld is %g, must be > 0",
@@ -457,11 +460,15 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
     if ((r = check_surface(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_contacts(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_render_validate(v, msg, ms)) != SINEW_OK) return r;
-    if ((r = check_positive(SINEW_SECTION_CUB_WEIGHT, v->cub_weight, v->ncub, 1, msg, ms)))
+    if ((r = sw_blob_check_positive(SINEW_SECTION_CUB_WEIGHT, v->cub_weight, v->ncub, 1, msg,
+                                    ms)) ||
+        (r = sw_blob_check_positive(SINEW_SECTION_CUB_VOL, v->cub_vol, v->ncub, 1, msg, ms)))
         return r;
-    if ((r = check_positive(SINEW_SECTION_CUB_VOL, v->cub_vol, v->ncub, 1, msg, ms))) return r;
     /* Lumped mass projected on the basis: its diagonal is sum_v m_v |U_v col i|^2 > 0. */
-    return check_positive(SINEW_SECTION_MASS, v->mass, v->rank_total, v->rank_total + 1, msg, ms);
+    if ((r = sw_blob_check_positive(SINEW_SECTION_MASS, v->mass, v->rank_total, v->rank_total + 1,
+                                    msg, ms)))
+        return r;
+    return sw_blob_cond_validate(v, msg, ms);
 }
 
 /* ---- layer 1: bytes --------------------------------------------------------------- */
@@ -565,29 +572,46 @@ static sinew_result check_overlaps(const sinew_blob_section *s, uint32_t n, cons
     return SINEW_OK;
 }
 
-/* Counts of the sections whose size follows from META alone (by_meta). The other rows'
- * counts read nbasis, ninertia_u and nsurf_copies, still 0 here, and go unused. */
-static sinew_result check_meta_counts(const sw_blob_view *v, const sinew_blob_section *s,
-                                      const int found[], char *msg, size_t ms) {
-    SW_BLOB_COUNT_LOCALS(v);
-    const struct {
-        uint32_t id;
-        int by_meta;
-        uint64_t count;
-        const char *formula;
-    } expect[] = {
-#define EXPECT(id, NAME, elem_size, type, field, by_meta, count, formula)                          \
-    {id, by_meta, count, formula},
-        SINEW_BLOB_ARRAY_SECTIONS(EXPECT)
-#undef EXPECT
-    };
-    for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i) {
-        const sinew_blob_section *e = &s[found[expect[i].id]];
-        if (expect[i].by_meta && e->count != expect[i].count)
+sinew_result sw_blob_check_counts(const sinew_blob_section *s, const int found[],
+                                  const sw_blob_count_expect *e, size_t n, const char *meta,
+                                  char *msg, size_t ms) {
+    for (size_t i = 0; i < n; ++i) {
+        const sinew_blob_section *at = &s[found[e[i].id]];
+        if (e[i].by_meta && at->count != e[i].count)
             return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section %s: %llu elements, META needs %s = %llu",
-                        sw_blob_section_name(expect[i].id), (unsigned long long)e->count,
-                        expect[i].formula, (unsigned long long)expect[i].count);
+                        "blob section %s: %llu elements, %s needs %s = %llu",
+                        sw_blob_section_name(e[i].id), (unsigned long long)at->count, meta,
+                        e[i].formula, (unsigned long long)e[i].count);
+    }
+    return SINEW_OK;
+}
+
+sinew_result sw_blob_group_meta(const uint8_t *bytes, const sinew_blob_section *s,
+                                const int found[], uint32_t first, uint32_t last, const char *what,
+                                void *meta, size_t meta_size, size_t nreserved, int *present,
+                                char *msg, size_t ms) {
+    uint32_t n = 0;
+    for (uint32_t id = first; id <= last; ++id)
+        n += found[id] >= 0;
+    *present = n > 0;
+    if (n == 0) return SINEW_OK;
+    for (uint32_t id = first; id <= last; ++id)
+        if (found[id] < 0)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s: missing (%s sections come all or none)",
+                        sw_blob_section_name(id), what);
+    const sinew_blob_section *m = &s[found[first]];
+    if (m->count != 1)
+        return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob section %s: %llu elements, expected 1",
+                    sw_blob_section_name(first), (unsigned long long)m->count);
+    memcpy(meta, bytes + m->offset, meta_size);
+    for (size_t i = 0; i < nreserved; ++i) {
+        int32_t w;
+        memcpy(&w, (const uint8_t *)meta + meta_size - 4 * (nreserved - i), sizeof w);
+        if (w != 0)
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section %s: reserved word %zu is %d, not 0",
+                        sw_blob_section_name(first), i, w);
     }
     return SINEW_OK;
 }
@@ -608,7 +632,15 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
 #undef FROM_META
     sinew_result r = check_meta(v, msg, ms);
     if (r != SINEW_OK) return r;
-    if ((r = check_meta_counts(v, s, found, msg, ms)) != SINEW_OK) return r;
+    {
+        /* The sections whose size follows from META alone (by_meta); the other rows' counts
+         * read nbasis, ninertia_u and nsurf_copies, still 0 here, and go unused. */
+        SW_BLOB_COUNT_LOCALS(v);
+        const sw_blob_count_expect expect[] = {SINEW_BLOB_ARRAY_SECTIONS(SW_BLOB_EXPECT_ROW)};
+        if ((r = sw_blob_check_counts(s, found, expect, sizeof expect / sizeof expect[0], "META",
+                                      msg, ms)) != SINEW_OK)
+            return r;
+    }
 
     /* Sizes that depend on the domain records: recorded here, checked against the
      * records by the view validator. Each count is bounded by the file size. */
@@ -621,10 +653,7 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     v->ninertia_u = (int64_t)s[found[SINEW_SECTION_INERTIA_U]].count;
     v->nsurf_copies = (int32_t)(copies->count / 2);
 
-#define AT(id, NAME, elem_size, type, field, ...)                                                  \
-    v->field = (const type *)(const void *)(bytes + s[found[id]].offset);
-    SINEW_BLOB_ARRAY_SECTIONS(AT)
-#undef AT
+    SINEW_BLOB_ARRAY_SECTIONS(SW_BLOB_POINT_ROW)
     return SINEW_OK;
 }
 
@@ -671,7 +700,9 @@ sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, ch
 
     sw_blob_view v;
     if ((r = fill_view(bytes, s, found, &v, msg, ms)) != SINEW_OK) return r;
-    if ((r = sw_blob_render_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_render_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
+        (r = sw_blob_cond_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK)
+        return r;
     if ((r = sw_blob_validate_view(&v, msg, ms)) != SINEW_OK) return r;
     *view = v;
     return SINEW_OK;

@@ -10,12 +10,6 @@
 
 _Static_assert(sizeof(sinew_blob_render_meta) == 32, "RENDER_META is 32 bytes");
 
-/* Declares a `const uint64_t` local for every render count of the view `v`, for the count
- * expressions of SINEW_BLOB_RENDER_SECTIONS. */
-#define RENDER_COUNT_LOCAL(name)                                                                   \
-    const uint64_t name = (uint64_t)v->name;                                                       \
-    (void)name;
-
 static sinew_result check_counts(const sw_blob_view *v, char *msg, size_t ms) {
     const struct {
         const char *name;
@@ -35,54 +29,22 @@ static sinew_result check_counts(const sw_blob_view *v, char *msg, size_t ms) {
 
 sinew_result sw_blob_render_fill(const uint8_t *bytes, const sinew_blob_section *s,
                                  const int found[], sw_blob_view *v, char *msg, size_t ms) {
-    int present = 0;
-    for (uint32_t id = SINEW_SECTION_RENDER_FIRST; id <= SINEW_SECTION_ID_MAX; ++id)
-        present += found[id] >= 0;
-    if (present == 0) return SINEW_OK; /* no render mesh: the view's fields stay 0 / NULL */
-    for (uint32_t id = SINEW_SECTION_RENDER_FIRST; id <= SINEW_SECTION_ID_MAX; ++id)
-        if (found[id] < 0)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section %s: missing (the render mesh's sections come all or none)",
-                        sw_blob_section_name(id));
-    const sinew_blob_section *meta = &s[found[SINEW_SECTION_RENDER_META]];
-    if (meta->count != 1)
-        return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                    "blob section RENDER_META: %llu elements, expected 1",
-                    (unsigned long long)meta->count);
     sinew_blob_render_meta m;
-    memcpy(&m, bytes + meta->offset, sizeof m);
-    for (size_t i = 0; i < sizeof m.reserved / sizeof m.reserved[0]; ++i)
-        if (m.reserved[i] != 0)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section RENDER_META: reserved word %zu is %d, not 0", i,
-                        m.reserved[i]);
+    int present;
+    sinew_result r = sw_blob_group_meta(
+        bytes, s, found, SINEW_SECTION_RENDER_FIRST, SINEW_SECTION_RENDER_LAST, "the render mesh's",
+        &m, sizeof m, sizeof m.reserved / sizeof m.reserved[0], &present, msg, ms);
+    if (r != SINEW_OK || !present) return r; /* none: the view's fields stay 0 / NULL */
 #define FROM_META(name) v->name = m.name;
     SINEW_BLOB_RENDER_COUNTS(FROM_META)
 #undef FROM_META
-    sinew_result r = check_counts(v, msg, ms);
-    if (r != SINEW_OK) return r;
-    SINEW_BLOB_RENDER_COUNTS(RENDER_COUNT_LOCAL)
-    const struct {
-        uint32_t id;
-        uint64_t count;
-        const char *formula;
-    } expect[] = {
-#define EXPECT(id, NAME, elem_size, type, field, by_meta, count, formula) {id, count, formula},
-        SINEW_BLOB_RENDER_ARRAY_SECTIONS(EXPECT)
-#undef EXPECT
-    };
-    for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i) {
-        const sinew_blob_section *e = &s[found[expect[i].id]];
-        if (e->count != expect[i].count)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section %s: %llu elements, RENDER_META needs %s = %llu",
-                        sw_blob_section_name(expect[i].id), (unsigned long long)e->count,
-                        expect[i].formula, (unsigned long long)expect[i].count);
-    }
-#define AT(id, NAME, elem_size, type, field, ...)                                                  \
-    v->field = (const type *)(const void *)(bytes + s[found[id]].offset);
-    SINEW_BLOB_RENDER_ARRAY_SECTIONS(AT)
-#undef AT
+    if ((r = check_counts(v, msg, ms)) != SINEW_OK) return r;
+    SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_RENDER_COUNTS);
+    const sw_blob_count_expect expect[] = {SINEW_BLOB_RENDER_ARRAY_SECTIONS(SW_BLOB_EXPECT_ROW)};
+    if ((r = sw_blob_check_counts(s, found, expect, sizeof expect / sizeof expect[0], "RENDER_META",
+                                  msg, ms)) != SINEW_OK)
+        return r;
+    SINEW_BLOB_RENDER_ARRAY_SECTIONS(SW_BLOB_POINT_ROW)
     return SINEW_OK;
 }
 
@@ -174,11 +136,7 @@ sinew_result sw_blob_render_validate(const sw_blob_view *v, char *msg, size_t ms
     }
     sinew_result r = check_counts(v, msg, ms);
     if (r != SINEW_OK) return r;
-    const sw_blob_array_ref arrays[] = {
-#define ARRAY(id, NAME, elem_size, type, field, ...) {v->field, id},
-        SINEW_BLOB_RENDER_ARRAY_SECTIONS(ARRAY)
-#undef ARRAY
-    };
+    const sw_blob_array_ref arrays[] = {SINEW_BLOB_RENDER_ARRAY_SECTIONS(SW_BLOB_ARRAY_REF_ROW)};
     if ((r = sw_blob_check_arrays(arrays, sizeof arrays / sizeof arrays[0], msg, ms)) ||
         (r = sw_blob_check_indices(SINEW_SECTION_RENDER_TRIS, "triangle", 3, v->render_tris,
                                    v->nrender_tris, "vertex", v->nrender_verts, msg, ms)) ||

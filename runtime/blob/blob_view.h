@@ -33,6 +33,15 @@
     const uint64_t name = (uint64_t)sw_blob_counts_of_->name;                                      \
     (void)name;
 
+/* The same for the counts of an optional group of sections (COUNTS: e.g.
+ * SINEW_BLOB_RENDER_COUNTS), which may share a scope with SW_BLOB_COUNT_LOCALS. */
+#define SW_BLOB_GROUP_COUNT_LOCALS(view, COUNTS)                                                   \
+    const sw_blob_view *const sw_blob_group_counts_of_ = (view);                                   \
+    COUNTS(SW_BLOB_GROUP_COUNT_LOCAL_)
+#define SW_BLOB_GROUP_COUNT_LOCAL_(name)                                                           \
+    const uint64_t name = (uint64_t)sw_blob_group_counts_of_->name;                                \
+    (void)name;
+
 /* One domain (the on-disk record itself, used in place):
  *   bone            the bone this domain rides with (inertial frame)
  *   vert_begin/count  its vertex copies are domain_verts[vert_begin .. +vert_count)
@@ -136,17 +145,21 @@ typedef struct sw_blob_view {
     const int32_t *render_node_copies; /* 2 * nrender_copies: (domain, local vertex) */
 
     /* the whole tet mesh for condensation's full-space patches (issue 12; ntets 0: none,
-     * every field below 0 / NULL) */
+     * every field below 0 / NULL). Tet t lies in domain tet_domain[t]: its corner k is
+     * domain_verts[domains[tet_domain[t]].vert_begin + tet_local[4t+k]] == tets[4t+k]. */
     int32_t ntets, nvert_tets;
-    const int32_t *tets;         /* 4 ntets: global simulation vertex ids */
-    const int32_t *tet_domain;   /* ntets: the domain whose copies are the tet's corners */
-    const int32_t *tet_local;    /* 4 ntets: the corners' domain-local indices */
-    const double *tet_dminv;     /* 9 ntets: rest Dm^-1, row-major (as cub_dminv) */
-    const double *tet_vol;       /* ntets: rest volume > 0 (as cub_vol) */
-    const int32_t *vert_tet_ptr; /* nverts + 1: vertex v's tets are vert_tets[ptr[v] ..) */
-    const int32_t *vert_tets;    /* nvert_tets (= 4 ntets): tet ids, ascending per vertex */
-    const double *vert_mass;     /* nverts: lumped mass (> 0) */
-    const int32_t *cub_tet_id;   /* ncub: the global tet id of each cubature tet */
+    const int32_t *tets;       /* 4 ntets: global simulation vertex ids */
+    const int32_t *tet_domain; /* ntets: the domain whose copies are the tet's corners */
+    const int32_t *tet_local;  /* 4 ntets: the corners' domain-local indices (see above) */
+    const double *tet_dminv;   /* 9 ntets: rest Dm^-1, row-major (as cub_dminv) */
+    const double *tet_vol;     /* ntets: rest volume > 0 (as cub_vol) */
+    /* nverts + 1: vertex v's incident tets are vert_tets[ptr[v] .. ptr[v+1]) */
+    const int32_t *vert_tet_ptr;
+    const int32_t *vert_tets; /* nvert_tets (= 4 ntets): tet ids, ascending per vertex */
+    /* nverts: lumped mass, the same masses the bake's reduced mass/inertia used (> 0; 0
+     * only for a vertex in no tet, which no patch reaches) */
+    const double *vert_mass;
+    const int32_t *cub_tet_id; /* ncub: the global tet id of each cubature tet */
 } sw_blob_view;
 
 /* The output surface a host reads (sinew_instance_read_surface): the render mesh when the

@@ -69,6 +69,13 @@ SW_ABI_ASSERT(SINEW_SECTION_COUNT_V1 == 26, section_count_v1);
 #define SW_ABI_ELEM_SIZE(id, NAME, elem_size, type, ...)                                           \
     SW_ABI_ASSERT(sizeof(type) == elem_size, elem_size_##NAME);
 SINEW_BLOB_SECTIONS(SW_ABI_ELEM_SIZE)
+/* The optional groups: the render mesh's and the condensation tet mesh's ids, in order. */
+SW_ABI_ASSERT(SINEW_SECTION_RENDER_FIRST == 27 && SINEW_SECTION_RENDER_LAST == 34, render_ids);
+SW_ABI_ASSERT(SINEW_SECTION_COND_FIRST == 35 && SINEW_SECTION_COND_LAST == 44 &&
+                  SINEW_SECTION_ID_MAX == SINEW_SECTION_COND_LAST,
+              cond_ids);
+SINEW_BLOB_RENDER_SECTIONS(SW_ABI_ELEM_SIZE)
+SINEW_BLOB_COND_SECTIONS(SW_ABI_ELEM_SIZE)
 
 /* Every public function, with the exact signature a host binary was built against. */
 typedef uint32_t (*sw_abi_version_fn)(void);

@@ -3,8 +3,9 @@
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/blob -Iruntime/math \
- *     tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c runtime/blob/blob_render.c -lm -o
- * build-fuzz-blob mkdir -p /tmp/blob-corpus && ./build-fuzz-blob -max_len=65536 /tmp/blob-corpus
+ *     tests/fuzz/fuzz_blob.c runtime/blob/blob_load.c runtime/blob/blob_render.c \
+ *     runtime/blob/blob_cond.c -lm -o build-fuzz-blob
+ *   mkdir -p /tmp/blob-corpus && ./build-fuzz-blob -max_len=65536 /tmp/blob-corpus
  *
  * Two flavours, chosen at compile time:
  *   fuzz_blob        the parser alone, on the bytes as given: random bytes almost never

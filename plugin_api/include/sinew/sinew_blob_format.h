@@ -44,6 +44,24 @@
  *   RENDER_TETS        4 render nodes a tet: the simulation tets the mesh is embedded in
  *   RENDER_NODE_PTR    render node n (a simulation vertex) owns copies [ptr[n], ptr[n+1])
  *   RENDER_NODE_COPIES (domain, local vertex) of each copy; a node is the mean of them
+ *
+ * Optional sections (SINEW_BLOB_COND_SECTIONS, ids 35..44): the whole simulation tet mesh,
+ * for subspace condensation's full-space patches (issue 12), all ten present or none. A
+ * blob without them is byte for byte what it was before they existed; a runtime that
+ * predates them skips them as unknown ids. Every tet lies in one domain (the domain the
+ * bake gave it: all four corners have copies there), as a cubature tet does. Their counts
+ * are in COND_META (sinew_blob_cond_meta) and META (nverts, ncub), their rows:
+ *   COND_TETS         4 global simulation vertex ids a tet, all distinct
+ *   COND_TET_DOMAIN   per tet, the domain whose copies are its corners
+ *   COND_TET_LOCAL    4 a tet: its corners' local vertex indices in that domain
+ *                     (domain_verts[vert_begin + local] is the COND_TETS corner)
+ *   COND_TET_DMINV    9 a tet: rest Dm^-1, row-major (as CUB_DMINV)
+ *   COND_TET_VOL      per tet, its rest volume > 0 (as CUB_VOL)
+ *   COND_VERT_TET_PTR vertex v's incident tets are COND_VERT_TETS [ptr[v], ptr[v+1])
+ *   COND_VERT_TETS    tet ids, ascending per vertex: every (vertex, tet) incidence once
+ *   COND_VERT_MASS    per vertex, its lumped mass (> 0; 0 only for a vertex in no tet)
+ *   COND_CUB_TET_ID   per cubature tet (ncub), its tet id: the tet's domain, corners,
+ *                     Dm^-1 and volume are the cubature tet's
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -146,18 +164,43 @@ typedef struct sinew_blob_section {
     X(34, RENDER_NODE_COPIES, 4, int32_t, render_node_copies, 1, 2 * nrender_copies,               \
       "2 nrender_copies")
 
+/* The optional tet mesh for condensation (see above): counts named by SINEW_BLOB_COND_COUNTS
+ * from COND_META, with META's nverts and ncub; rows as in SINEW_BLOB_SECTIONS. */
+#define SINEW_BLOB_COND_COUNTS(X) X(ntets) X(nvert_tets)
+#define SINEW_BLOB_COND_SECTIONS(X)                                                                \
+    X(35, COND_META,         32, sinew_blob_cond_meta, cond_meta, 1, 1, "1")                       \
+    SINEW_BLOB_COND_ARRAY_SECTIONS(X)
+#define SINEW_BLOB_COND_ARRAY_SECTIONS(X)                                                          \
+    X(36, COND_TETS,          4, int32_t, tets,         1, 4 * ntets,  "4 ntets")                  \
+    X(37, COND_TET_DOMAIN,    4, int32_t, tet_domain,   1, ntets,      "ntets")                    \
+    X(38, COND_TET_LOCAL,     4, int32_t, tet_local,    1, 4 * ntets,  "4 ntets")                  \
+    X(39, COND_TET_DMINV,     8, double,  tet_dminv,    1, 9 * ntets,  "9 ntets")                  \
+    X(40, COND_TET_VOL,       8, double,  tet_vol,      1, ntets,      "ntets")                    \
+    X(41, COND_VERT_TET_PTR,  4, int32_t, vert_tet_ptr, 1, nverts + 1, "nverts + 1")               \
+    X(42, COND_VERT_TETS,     4, int32_t, vert_tets,    1, nvert_tets, "nvert_tets")               \
+    X(43, COND_VERT_MASS,     8, double,  vert_mass,    1, nverts,     "nverts")                   \
+    X(44, COND_CUB_TET_ID,    4, int32_t, cub_tet_id,   1, ncub,       "ncub")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
 #define SINEW_BLOB_PLUS_ONE_(id, NAME, elem_size, type, field, by_meta, count, formula) +1
 /** Section ids; SINEW_SECTION_COUNT_V1 (26) is the number of sections every version-1 blob
- * has; SINEW_SECTION_RENDER_FIRST .. SINEW_SECTION_ID_MAX are the optional render mesh's. */
+ * has; SINEW_SECTION_RENDER_FIRST .. _RENDER_LAST are the optional render mesh's,
+ * SINEW_SECTION_COND_FIRST .. _COND_LAST the optional condensation tet mesh's;
+ * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
     SINEW_SECTION_COUNT_V1 = 0 SINEW_BLOB_SECTIONS(SINEW_BLOB_PLUS_ONE_),
     SINEW_BLOB_RENDER_SECTIONS(SINEW_BLOB_ENUM_ROW_)
     SINEW_SECTION_RENDER_FIRST = SINEW_SECTION_RENDER_META,
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_COUNT_V1 SINEW_BLOB_RENDER_SECTIONS(SINEW_BLOB_PLUS_ONE_)
+    SINEW_SECTION_RENDER_LAST =
+        SINEW_SECTION_COUNT_V1 SINEW_BLOB_RENDER_SECTIONS(SINEW_BLOB_PLUS_ONE_),
+    SINEW_BLOB_COND_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_COND_FIRST = SINEW_SECTION_COND_META,
+    SINEW_SECTION_COND_LAST =
+        SINEW_SECTION_RENDER_LAST SINEW_BLOB_COND_SECTIONS(SINEW_BLOB_PLUS_ONE_),
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_COND_LAST
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
@@ -181,6 +224,13 @@ typedef struct sinew_blob_render_meta {
     int32_t nrender_copies; /**< domain copies of those vertices */
     int32_t reserved[3];    /**< zero */
 } sinew_blob_render_meta;
+
+/** Section COND_META: the condensation tet mesh's counts (32 bytes). */
+typedef struct sinew_blob_cond_meta {
+    int32_t ntets;       /**< simulation tets (>= 1) */
+    int32_t nvert_tets;  /**< (vertex, incident tet) pairs: 4 ntets */
+    int32_t reserved[6]; /**< zero */
+} sinew_blob_cond_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
 typedef struct sinew_blob_domain_record {
