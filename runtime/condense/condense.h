@@ -119,6 +119,22 @@ void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc);
 sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
                            const sw_dyn_coef *dc, sinew_step_stats *st);
 
+/* The pieces of the solve, for tests: the patch's cubature weights (eq. 4.12's
+ * renormalisation) applied and restored; Phi(q, x) with its gradient into (red->g, c->gf)
+ * and with want_hess the Hessian's parts; y = H z for z = (dq, dx) (R + 3 nf) with the
+ * parts of the last evaluation, ctx an sw_cond_system. */
+typedef struct sw_cond_system {
+    sw_cond *c;
+    sw_reduced *red;
+    const sw_solver *s;
+} sw_cond_system;
+void sw_cond_weights_apply(sw_cond *c, sw_reduced *red);
+void sw_cond_weights_restore(sw_cond *c, sw_reduced *red);
+double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
+                         const sw_solver *s, const double *q, const double *x,
+                         const sw_dyn_coef *dc, int want_hess);
+void sw_cond_hessian_apply(void *ctx, const double *z, double *y);
+
 /* After a step: each patch vertex's deviation from its subspace position at q (the next
  * patch's start); the patch stays readable until the next oracle. */
 void sw_cond_finish(sw_cond *c, const sw_reduced *red, const double *q);

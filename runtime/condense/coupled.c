@@ -18,7 +18,7 @@
  * volume outside the patch: s_d = (V_d - V_fd) / V_d * W_d / (W_d - W_fd), W the
  * cubature's represented volume sum w_c vol_c. The cached cubature Jacobians of those
  * domains are refilled by the next gradient pass. */
-static void weights_apply(sw_cond *c, sw_reduced *red) {
+void sw_cond_weights_apply(sw_cond *c, sw_reduced *red) {
     const sw_blob_view *v = c->v;
     for (int32_t k = 0; k < v->ndomains; ++k)
         c->dom_fv[k] = c->dom_fw[k] = 0;
@@ -43,7 +43,7 @@ static void weights_apply(sw_cond *c, sw_reduced *red) {
     }
 }
 
-static void weights_restore(sw_cond *c, sw_reduced *red) {
+void sw_cond_weights_restore(sw_cond *c, sw_reduced *red) {
     const sw_blob_view *v = c->v;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         if (c->dom_fv[k] == 0) continue;
@@ -94,10 +94,11 @@ static void add_ring_block(const sw_cond *c, sw_reduced *red, int32_t a, int32_t
                 Ja[m] * kj[j] + Ja[r + m] * kj[r + j] + Ja[2 * r + m] * kj[2 * r + j];
 }
 
-/* Phi(q, x) (condense.h) with its gradient into (red->g, c->gf) and with want_hess the
- * Hessian's parts (red->H with the ring blocks, Kt, Dw). */
-static double cond_eval(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
-                        const double *q, const double *x, const sw_dyn_coef *dc, int want_hess) {
+/* Phi(q, x) (condense.h): the gradient into (red->g, c->gf), the Hessian's parts (red->H
+ * with the ring blocks, Kt, Dw) with want_hess. */
+double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
+                         const sw_solver *s, const double *q, const double *x,
+                         const sw_dyn_coef *dc, int want_hess) {
     const sw_blob_view *v = c->v;
     double phi = sw_potential(red, ct, s, q, dc, 1, want_hess);
     for (int32_t k = 0; k < c->nring; ++k) {
@@ -152,16 +153,10 @@ static double cond_eval(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
 
 /* ---- the linear system of eq. 4.11 ------------------------------------------------- */
 
-typedef struct {
-    sw_cond *c;
-    sw_reduced *red;
-    const sw_solver *s;
-} cond_sys;
-
 /* y = H z, z = (dq, dx): the reduced block, the world's 3x3 blocks, and each full tet's K
  * on its corners (the ring rows through J^T, leaving out the ring-ring part red->H has). */
-static void sys_apply(void *ctx, const double *z, double *y) {
-    const cond_sys *S = ctx;
+void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
+    const sw_cond_system *S = ctx;
     sw_cond *c = S->c;
     const sw_blob_view *v = c->v;
     int32_t R = S->red->R;
@@ -218,7 +213,7 @@ static void sys_apply(void *ctx, const double *z, double *y) {
 
 /* z = P^-1 r: the factored reduced block on q, the inverted 3x3 diagonal blocks on x_f. */
 static void sys_prec(void *ctx, const double *r, double *z) {
-    const cond_sys *S = ctx;
+    const sw_cond_system *S = ctx;
     const sw_cond *c = S->c;
     int32_t R = S->red->R;
     memcpy(z, r, (size_t)R * sizeof(double));
@@ -269,10 +264,10 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
                            const sw_dyn_coef *dc, sinew_step_stats *st) {
     int32_t R = red->R, nx = 3 * c->nf;
     int64_t m = R + nx;
-    weights_apply(c, red);
-    cond_sys S = {c, red, s};
+    sw_cond_weights_apply(c, red);
+    sw_cond_system S = {c, red, s};
     sw_pcg_vectors vec = {c->cg_r, c->cg_z, c->cg_p, c->cg_Ap};
-    double phi = cond_eval(c, red, ct, s, s->q, c->x, dc, 1);
+    double phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
     st->potential_evals++;
     double gn = grad_norm(c, red), g0 = gn;
     uint32_t max_it = s->max_newton > SW_COND_MIN_NEWTON ? s->max_newton : SW_COND_MIN_NEWTON;
@@ -297,8 +292,8 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         for (int32_t i = 0; i < nx; ++i)
             c->rhs[R + i] = -c->gf[i];
         memset(c->sol, 0, (size_t)m * sizeof(double));
-        sw_pcg_stats ps = sw_pcg_run(m, sys_apply, &S, sys_prec, &S, c->rhs, SW_COND_PCG_TOL,
-                                     SW_COND_PCG_MAX, &vec, c->sol);
+        sw_pcg_stats ps = sw_pcg_run(m, sw_cond_hessian_apply, &S, sys_prec, &S, c->rhs,
+                                     SW_COND_PCG_TOL, SW_COND_PCG_MAX, &vec, c->sol);
         c->pcg_iters += (uint32_t)ps.iters;
         /* the update: q and x from the iterate kept in qtrial and xt */
         memcpy(s->qtrial, s->q, (size_t)R * sizeof(double));
@@ -310,7 +305,7 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
                 s->q[i] = s->qtrial[i] + step * c->sol[i];
             for (int32_t i = 0; i < nx; ++i)
                 c->x[i] = c->xt[i] + step * c->sol[R + i];
-            phi = cond_eval(c, red, ct, s, s->q, c->x, dc, 1);
+            phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
             st->potential_evals++;
             if (isfinite(phi) && phi <= phi0 + 1e-12 * fabs(phi0)) {
                 accepted = 1;
@@ -328,7 +323,7 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         gn = grad_norm(c, red);
         st->newton_iterations++;
     }
-    weights_restore(c, red);
+    sw_cond_weights_restore(c, red);
     st->residual = g0 > 0 ? gn / g0 : 0;
     st->energy = phi;
     return res;

@@ -1,0 +1,340 @@
+/* Subspace condensation (runtime/condense, issue 12): the coupled potential's gradient
+ * against finite differences and its Hessian symmetric and PSD; the partition oracle
+ * against a brute-force growth; the budget's cut; the flesh denting where the subspace
+ * locks, closer to the reference; bitwise the subspace without contact; the real-time
+ * contract; the def's checks. The finger of world_fixture.h pressed into a table. */
+#include <math.h>
+#include <stdint.h>
+
+#include "collision.h"
+#include "condense.h"
+#include "fullsim.h"
+#include "instance.h"
+#include "instance_internal.h"
+#include "rt_interpose.h"
+#include "sw_test.h"
+#include "world_fixture.h"
+
+#define RHO 0.08 /* of the diagonal: about 0.3 on the 3.6-long finger */
+
+static float *rest_pose(int nb) {
+    float *p = calloc((size_t)12 * nb, sizeof(float));
+    for (int b = 0; b < nb; ++b)
+        p[12 * b] = p[12 * b + 4] = p[12 * b + 8] = 1;
+    return p;
+}
+
+/* A condensed instance of the fixture on world w at the rest pose, stepped `steps` times. */
+static sinew_instance *pressed(const bake_fixture *f, sinew_world *w, uint32_t budget, int steps) {
+    sinew_instance_def d = sinew_instance_def_default();
+    d.max_patch_vertices = budget;
+    d.patch_radius = (float)RHO;
+    sinew_instance *inst;
+    if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return NULL;
+    if (w) sinew_instance_set_world(inst, w);
+    float *pose = rest_pose(f->ch.skel.nbones);
+    sinew_instance_set_pose(inst, pose, (uint32_t)f->ch.skel.nbones);
+    for (int k = 0; k < steps; ++k)
+        if (sinew_instance_step(inst, 1.0f / 30) != SINEW_OK) break;
+    free(pose);
+    return inst;
+}
+
+TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(0.08, 0.3f, &id);
+    sinew_instance *in = pressed(f, w, 2000, 1);
+    ENSURE(in);
+    sw_instance_step_prepare(in, 1.0f / 30);
+    sw_cond *c = &in->cond;
+    ENSURE(c->nf > 10 && c->nt > c->nf && c->nring > 0);
+    int32_t R = in->red.R, nx = 3 * c->nf;
+    sw_step_contacts ct = {&in->ps, &in->wc};
+    sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
+    sw_cond_weights_apply(c, &in->red);
+    double *q = malloc(sizeof(double) * R), *x = malloc(sizeof(double) * nx);
+    double *g = malloc(sizeof(double) * (R + nx));
+    memcpy(q, in->solver.q, sizeof(double) * R);
+    for (int32_t i = 0; i < nx; ++i) /* off the start: some tets stretched, some contact */
+        x[i] = c->x[i] + 0.01 * sin(1.7 * i);
+    sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 1);
+    memcpy(g, in->red.g, sizeof(double) * R);
+    memcpy(g + R, c->gf, sizeof(double) * nx);
+    double gmax = 0;
+    for (int32_t i = 0; i < R + nx; ++i)
+        gmax = fmax(gmax, fabs(g[i]));
+    int checked = 0;
+    for (int32_t i = 0; i < R + nx; i += (i < R ? 1 : 1 + nx / 40)) {
+        double *p = i < R ? q + i : x + (i - R), keep = *p, h = 1e-6;
+        *p = keep + h;
+        double ep = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
+        *p = keep - h;
+        double em = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
+        *p = keep;
+        ENSURE_NEAR((ep - em) / (2 * h), g[i], 1e-5 * gmax + 1e-4 * fabs(g[i]));
+        checked++;
+    }
+    ENSURE(checked > R + 20);
+    /* the Hessian of the last evaluation with Hessian: symmetric, positive semi-definite */
+    sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 1);
+    sw_cond_system S = {c, &in->red, &in->solver};
+    double *a = malloc(sizeof(double) * (R + nx)), *b = malloc(sizeof(double) * (R + nx));
+    double *Ha = malloc(sizeof(double) * (R + nx)), *Hb = malloc(sizeof(double) * (R + nx));
+    for (int32_t i = 0; i < R + nx; ++i) {
+        a[i] = cos(0.3 * i + 1);
+        b[i] = sin(0.7 * i);
+    }
+    sw_cond_hessian_apply(&S, a, Ha);
+    sw_cond_hessian_apply(&S, b, Hb);
+    double bHa = 0, aHb = 0, aHa = 0, scale = 0;
+    for (int32_t i = 0; i < R + nx; ++i) {
+        bHa += b[i] * Ha[i];
+        aHb += a[i] * Hb[i];
+        aHa += a[i] * Ha[i];
+        scale += fabs(a[i] * Ha[i]) + fabs(b[i] * Hb[i]);
+    }
+    fprintf(stderr,
+            "    patch %d vertices, %d tets, %d ring copies; b'Ha %.6g a'Hb %.6g a'Ha %.6g\n",
+            c->nf, c->nt, c->nring, bHa, aHb, aHa);
+    ENSURE_NEAR(bHa, aHb, 1e-10 * scale);
+    ENSURE(aHa > 0);
+    sw_cond_weights_restore(c, &in->red);
+    free(q), free(x), free(g), free(a), free(b), free(Ha), free(Hb);
+    sinew_instance_destroy(in);
+    sinew_world_destroy(w);
+}
+
+/* Brute force: the vertices a breadth-first growth over the whole mesh reaches from seed s
+ * through vertices within rho of s, marked in m. */
+static void brute_grow(const sw_blob_view *v, int32_t s, double rho, unsigned char *m,
+                       int32_t *queue) {
+    unsigned char *seen = calloc((size_t)v->nverts, 1);
+    int32_t head = 0, tail = 0;
+    queue[tail++] = s;
+    seen[s] = 1;
+    while (head < tail) {
+        int32_t a = queue[head++];
+        m[a] = 1;
+        for (int32_t t = 0; t < v->ntets; ++t) {
+            const int32_t *tv = v->tets + 4 * (int64_t)t;
+            if (tv[0] != a && tv[1] != a && tv[2] != a && tv[3] != a) continue;
+            for (int k = 0; k < 4; ++k) {
+                int32_t b = tv[k];
+                double d2 = 0;
+                for (int i = 0; i < 3; ++i)
+                    d2 += (v->rest[3 * b + i] - v->rest[3 * s + i]) *
+                          (v->rest[3 * b + i] - v->rest[3 * s + i]);
+                if (seen[b] || d2 > rho * rho) continue;
+                seen[b] = 1;
+                queue[tail++] = b;
+            }
+        }
+    }
+    free(seen);
+}
+
+TEST(oracle_patch_is_the_growth_of_its_seeds_and_the_budget_keeps_the_nearest) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(0.08, 0.3f, &id);
+    sinew_instance *in = pressed(f, w, 5000, 1); /* one step: only its own seeds */
+    ENSURE(in);
+    const sw_cond *c = &in->cond;
+    const sw_blob_view *v = in->v;
+    int32_t n = v->nverts, ns = c->nseeds[c->slot];
+    ENSURE(ns > 0 && c->nf > ns);
+    unsigned char *m = calloc((size_t)n, 1);
+    int32_t *queue = malloc(sizeof(int32_t) * n);
+    for (int32_t i = 0; i < ns; ++i)
+        brute_grow(v, c->seeds[(int64_t)c->slot * c->z.max_seeds + i], c->rho, m, queue);
+    int32_t nm = 0;
+    for (int32_t gv = 0; gv < n; ++gv) {
+        nm += m[gv];
+        ENSURE((sw_cond_position(c, gv) != NULL) == m[gv]);
+    }
+    ENSURE(nm == c->nf);
+    /* the full tets: exactly those with a patch corner */
+    int32_t nfull = 0;
+    for (int32_t t = 0; t < v->ntets; ++t) {
+        const int32_t *tv = v->tets + 4 * (int64_t)t;
+        nfull += m[tv[0]] || m[tv[1]] || m[tv[2]] || m[tv[3]];
+    }
+    ENSURE(nfull == c->nt);
+    fprintf(stderr, "    %d seeds, %d patch vertices, %d full tets, %d ring copies\n", ns, c->nf,
+            c->nt, c->nring);
+    int32_t nf_all = c->nf;
+    sinew_instance_destroy(in);
+    /* a budget of a fifth: the nearest stay, the step flags it and stays finite */
+    uint32_t budget = (uint32_t)(nf_all / 5);
+    in = pressed(f, w, budget, 1);
+    ENSURE(in);
+    sinew_step_stats st = {.struct_size = sizeof st};
+    sinew_instance_get_stats(in, &st);
+    ENSURE(st.patch_vertices == budget);
+    ENSURE(st.patch_dropped == (uint32_t)(nf_all - (int32_t)budget));
+    ENSURE((st.status & SINEW_STEP_BUDGET) && (st.budget_exceeded & SINEW_BUDGET_PATCH));
+    const double *xs = sw_instance_surface(in);
+    for (int32_t i = 0; i < 3 * v->nsurf_verts; ++i)
+        ENSURE(isfinite(xs[i]));
+    /* nearest: no kept vertex is further from every seed than a dropped one */
+    c = &in->cond;
+    double kept_max = 0, dropped_min = INFINITY;
+    for (int32_t gv = 0; gv < n; ++gv) {
+        if (!m[gv]) continue;
+        double d = INFINITY;
+        for (int32_t i = 0; i < ns; ++i) {
+            int32_t s = c->seeds[(int64_t)c->slot * c->z.max_seeds + i];
+            double d2 = 0;
+            for (int k = 0; k < 3; ++k)
+                d2 += (v->rest[3 * gv + k] - v->rest[3 * s + k]) *
+                      (v->rest[3 * gv + k] - v->rest[3 * s + k]);
+            d = fmin(d, sqrt(d2));
+        }
+        if (sw_cond_position(c, gv))
+            kept_max = fmax(kept_max, d);
+        else
+            dropped_min = fmin(dropped_min, d);
+    }
+    ENSURE(kept_max <= dropped_min + 1e-12);
+    free(m), free(queue);
+    sinew_instance_destroy(in);
+    sinew_world_destroy(w);
+}
+
+/* Mass-weighted correction error of x against the reference xr (skinned xd). */
+static double correction_error(const sinew_instance *in, const double *xr, const double *mass) {
+    const sw_blob_view *v = in->v;
+    double *x = malloc(sizeof(double) * 3 * v->nverts), *cnt = malloc(sizeof(double) * v->nverts),
+           *xd = malloc(sizeof(double) * 3 * v->nverts);
+    sw_instance_full_positions(in, x, cnt);
+    sw_instance_dqs_positions(in, xd);
+    double num = 0, den = 0;
+    for (int32_t i = 0; i < 3 * v->nverts; ++i) {
+        num += mass[i / 3] * (x[i] - xr[i]) * (x[i] - xr[i]);
+        den += mass[i / 3] * (xr[i] - xd[i]) * (xr[i] - xd[i]);
+    }
+    free(x), free(cnt), free(xd);
+    return sqrt(num / den);
+}
+
+TEST(condensation_dents_where_the_subspace_locks_closer_to_the_reference) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(0.08, 0.0f, &id);
+    sinew_instance *sub = pressed(f, w, 0, 3), *cond = pressed(f, w, 3000, 3);
+    ENSURE(sub && cond);
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.world = w;
+    sw_fullsim *sim;
+    sw_error err;
+    ENSURE(sw_fullsim_create(&f->ch, &p, &sim, &err) == SINEW_OK);
+    int nb = f->ch.skel.nbones;
+    double *T = calloc((size_t)12 * nb, sizeof(double));
+    for (int b = 0; b < nb; ++b)
+        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    sw_fullsim_stats fs;
+    ENSURE(sw_fullsim_step(sim, T, &fs) == SINEW_OK);
+    const double *xr = sw_fullsim_positions(sim), *mass = sw_fullsim_masses(sim);
+    double e_sub = correction_error(sub, xr, mass), e_cond = correction_error(cond, xr, mass);
+    int32_t ns = sub->v->nsurf_verts;
+    double pen_sub = sw_world_max_penetration(w, ns, sw_instance_surface(sub), NULL, NULL, NULL),
+           pen_cond = sw_world_max_penetration(w, ns, sw_instance_surface(cond), NULL, NULL, NULL);
+    sinew_step_stats st = {.struct_size = sizeof st};
+    sinew_instance_get_stats(cond, &st);
+    fprintf(stderr,
+            "    error vs reference: subspace %.3f, condensed %.3f; penetration %.4f -> %.4f "
+            "(reference %.4f); patch %u vertices, %u PCG iterations\n",
+            e_sub, e_cond, pen_sub, pen_cond, fs.world_penetration, st.patch_vertices,
+            st.pcg_iterations);
+    ENSURE(st.patch_vertices > 0 && st.pcg_iterations > 0);
+    ENSURE(e_cond < 0.6 * e_sub);
+    ENSURE(pen_cond < 0.3 * pen_sub);
+    free(T);
+    sw_fullsim_destroy(sim);
+    sinew_instance_destroy(sub);
+    sinew_instance_destroy(cond);
+    sinew_world_destroy(w);
+}
+
+TEST(without_contact_a_condensed_instance_is_bitwise_the_subspace) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(-1.0, 0.3f, &id); /* a table far below */
+    sinew_instance *sub = pressed(f, w, 0, 0), *cond = pressed(f, w, 500, 0);
+    ENSURE(sub && cond);
+    int nb = f->ch.skel.nbones;
+    for (int fr = 0; fr < f->ch.clip.nframes; ++fr) {
+        const double *T = f->ch.clip.T + (size_t)fr * 12 * nb;
+        sw_instance_set_pose_d(sub, T);
+        sw_instance_set_pose_d(cond, T);
+        ENSURE(sinew_instance_step(sub, 1.0f / 30) == SINEW_OK);
+        ENSURE(sinew_instance_step(cond, 1.0f / 30) == SINEW_OK);
+        ENSURE(memcmp(sw_instance_surface(sub), sw_instance_surface(cond),
+                      sizeof(double) * 3 * sub->v->nsurf_verts) == 0);
+        ENSURE(cond->stats.patch_vertices == 0);
+    }
+    sinew_instance_destroy(sub);
+    sinew_instance_destroy(cond);
+    sinew_world_destroy(w);
+}
+
+TEST(condensed_steps_allocate_and_lock_nothing_while_the_patch_moves) {
+    moving_scene ms;
+    ENSURE(moving_scene_make(&ms));
+    sinew_instance *in = pressed(ms.f, ms.w, 800, 0);
+    ENSURE(in);
+    int nb = ms.f->ch.skel.nbones, nfr = ms.f->ch.clip.nframes;
+    unsigned active = sw_rt_interpose_active();
+    uint32_t with_patch = 0, without = 0;
+    sw_rt_count_begin();
+    for (int s = 0; s < 60; ++s) {
+        sinew_transform t;
+        ball_at(s, &t);
+        sinew_world_set_collider_transform(ms.w, ms.ball, &t);
+        sw_instance_set_pose_d(in, ms.f->ch.clip.T + (size_t)(s % nfr) * 12 * nb);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+        with_patch += in->stats.patch_vertices > 0;
+        without += in->stats.patch_vertices == 0;
+    }
+    sw_rt_counts cnt = sw_rt_count_end();
+    fprintf(stderr, "    %u steps with a patch, %u without; allocs %lu locks %lu\n", with_patch,
+            without, (unsigned long)cnt.allocs, (unsigned long)cnt.locks);
+    ENSURE(with_patch > 10);
+    if (active & SW_RT_CAT_ALLOCS) ENSURE(cnt.allocs == 0 && cnt.frees == 0);
+    if (active & SW_RT_CAT_LOCKS) ENSURE(cnt.locks == 0);
+    sinew_instance_destroy(in);
+    sinew_world_destroy(ms.w);
+}
+
+TEST(patch_def_is_checked_and_sized) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_instance_def d = sinew_instance_def_default();
+    size_t off = 0, on = 0;
+    ENSURE(sinew_instance_memory_size(f->blob, &d, &off) == SINEW_OK);
+    d.max_patch_vertices = 100;
+    ENSURE(sinew_instance_memory_size(f->blob, &d, &on) == SINEW_OK);
+    ENSURE(on > off);
+    sinew_instance *in;
+    float bad[] = {-0.1f, 1.5f, NAN, INFINITY};
+    for (int i = 0; i < 4; ++i) {
+        d.patch_radius = bad[i];
+        ENSURE(sinew_instance_create(f->blob, &d, &in) == SINEW_ERROR_INVALID_ARGUMENT);
+    }
+}
+
+TEST(release_fixture) {
+    if (fx_ok > 0) bake_fixture_free(&fx);
+}
+
+SW_TEST_MAIN(CASE(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd),
+             CASE(oracle_patch_is_the_growth_of_its_seeds_and_the_budget_keeps_the_nearest),
+             CASE(condensation_dents_where_the_subspace_locks_closer_to_the_reference),
+             CASE(without_contact_a_condensed_instance_is_bitwise_the_subspace),
+             CASE(condensed_steps_allocate_and_lock_nothing_while_the_patch_moves),
+             CASE(patch_def_is_checked_and_sized), CASE(release_fixture))
