@@ -1,8 +1,9 @@
 /* The blob tests' synthetic character: a small, complete, consistent view (4 bones, 3
- * domains, 2 training poses with 2 contact pairs) written by the real writer, and the
- * helpers that forge its bytes (table entries, sections, checksum fix-up) and walk an
- * accepted view along every index chain a runtime follows. Shared by test_blob.c and
- * test_blob_forged.c; everything is static inline (a test uses what it needs). */
+ * domains, 2 training poses with 2 contact pairs; optionally a render mesh and the
+ * condensation tet mesh) written by the real writer, and the helpers that forge its bytes
+ * (table entries, sections, checksum fix-up) and walk an accepted view along every index
+ * chain a runtime follows. Shared by the blob tests; everything is static inline (a test
+ * uses what it needs). */
 #ifndef SW_BLOB_SYNTH_H
 #define SW_BLOB_SYNTH_H
 
@@ -14,6 +15,7 @@
 #include "blob_load.h"
 #include "blob_write.h"
 #include "sinew/sinew.h"
+#include "sw_test.h"
 
 /* ---- a small, complete, consistent synthetic character -------------------------- */
 
@@ -212,10 +214,70 @@ static inline void fixture_add_render(fixture *f, render_fixture *r) {
 #undef POINT
 }
 
+/* ---- the optional condensation tet mesh (sinew_blob_format.h, ids 35..44) --------- */
+
+enum {
+    NCT = NCUB + 2 /* tets: two of their own, then the cubature tets in reverse order */
+};
+
+typedef struct cond_fixture {
+    int32_t tets[4 * NCT], tet_domain[NCT], tet_local[4 * NCT];
+    double tet_dminv[9 * NCT], tet_vol[NCT];
+    int32_t vert_tet_ptr[NV + 1], vert_tets[4 * NCT];
+    double vert_mass[NV];
+    int32_t cub_tet_id[NCUB];
+} cond_fixture;
+
+/* Gives f's view the tet mesh held in c: tet 0 on domain 0's local vertices 0..3, tet 1 on
+ * domain 2's 0, 1, 2, 4 (vertices 8, 9, 10, 0), and cubature tet k as tet NCT - 1 - k; the
+ * vertices in no tet have mass 0. */
+static inline void fixture_add_cond(fixture *f, cond_fixture *c) {
+    static const int32_t own_domain[2] = {0, 2}, own_local[2][4] = {{0, 1, 2, 3}, {0, 1, 2, 4}};
+    sw_blob_view *v = &f->v;
+    memset(c, 0, sizeof *c);
+    for (int32_t t = 0; t < NCT; ++t) {
+        const int32_t k = NCT - 1 - t; /* its cubature tet (when t >= 2) */
+        int32_t d = 0;
+        if (t < 2) {
+            d = own_domain[t];
+            memcpy(&c->tet_local[4 * t], own_local[t], sizeof own_local[t]);
+            for (int i = 0; i < 9; ++i)
+                c->tet_dminv[9 * t + i] = i % 4 == 0 ? 2.0 + t : 0.25 * (i - 4);
+            c->tet_vol[t] = 0.5 / (1 + t);
+        } else {
+            while (k >= f->domains[d].cub_begin + f->domains[d].cub_count)
+                ++d;
+            memcpy(&c->tet_local[4 * t], &f->cub_tets[4 * k], 4 * sizeof(int32_t));
+            memcpy(&c->tet_dminv[9 * t], &f->cub_dminv[9 * k], 9 * sizeof(double));
+            c->tet_vol[t] = f->cub_vol[k];
+            c->cub_tet_id[k] = t;
+        }
+        c->tet_domain[t] = d;
+        for (int i = 0; i < 4; ++i) {
+            c->tets[4 * t + i] =
+                f->domain_verts[f->domains[d].vert_begin + c->tet_local[4 * t + i]];
+            c->vert_tet_ptr[c->tets[4 * t + i] + 1]++;
+        }
+    }
+    for (int32_t x = 0; x < NV; ++x) {
+        c->vert_mass[x] = c->vert_tet_ptr[x + 1] > 0 ? 1.0 + 0.125 * x : 0.0;
+        c->vert_tet_ptr[x + 1] += c->vert_tet_ptr[x];
+    }
+    int32_t fill[NV];
+    memcpy(fill, c->vert_tet_ptr, sizeof fill);
+    for (int32_t t = 0; t < NCT; ++t)
+        for (int i = 0; i < 4; ++i)
+            c->vert_tets[fill[c->tets[4 * t + i]]++] = t;
+    v->ntets = NCT, v->nvert_tets = 4 * NCT;
+#define POINT(id, NAME, elem_size, type, field, ...) v->field = c->field;
+    SINEW_BLOB_COND_ARRAY_SECTIONS(POINT)
+#undef POINT
+}
+
 /* ---- helpers --------------------------------------------------------------------- */
 
-/* First field in which two views differ (counts, scalars bitwise, arrays bitwise), or
- * NULL when they are identical. */
+/* First field in which two views differ (counts, scalars bitwise, arrays bitwise, the
+ * optional groups' too), or NULL when they are identical. */
 static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b) {
 #define SAME_BITS(f)                                                                               \
     if (memcmp(&a->f, &b->f, sizeof a->f) != 0) return #f;
@@ -223,11 +285,21 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     SAME_BITS(nbasis)
     SAME_BITS(ninertia_u)
     SAME_BITS(nsurf_copies)
+    SINEW_BLOB_RENDER_COUNTS(SAME_BITS)
+    SINEW_BLOB_COND_COUNTS(SAME_BITS)
 #undef SAME_BITS
     SW_BLOB_COUNT_LOCALS(a);
 #define SAME_ARRAY(id, NAME, elem_size, type, field, by_meta, count, formula)                      \
     if (memcmp(a->field, b->field, (size_t)(count) * sizeof a->field[0]) != 0) return #field;
     SINEW_BLOB_ARRAY_SECTIONS(SAME_ARRAY)
+    if (a->nrender_verts > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_RENDER_COUNTS);
+        SINEW_BLOB_RENDER_ARRAY_SECTIONS(SAME_ARRAY)
+    }
+    if (a->ntets > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_COND_COUNTS);
+        SINEW_BLOB_COND_ARRAY_SECTIONS(SAME_ARRAY)
+    }
 #undef SAME_ARRAY
     return NULL;
 }
@@ -363,6 +435,40 @@ static inline int contains(const char *haystack, const char *needle) {
     return strstr(haystack, needle) != NULL;
 }
 
+/* Parses the forged blob b (size bytes) after fixing its checksum up: 1 when sw_blob_parse
+ * refuses it with `code` and a message (printed) holding a and, unless NULL, c. */
+static inline int parse_refuses(uint8_t *b, size_t size, sinew_result code, const char *a,
+                                const char *c) {
+    fix_checksum(b, size);
+    sw_blob_view v;
+    char msg[512];
+    sinew_result r = sw_blob_parse(b, size, &v, msg, sizeof msg);
+    fprintf(stderr, "    %s\n", msg);
+    return r == code && strstr(msg, a) && (!c || strstr(msg, c));
+}
+
+/* Whether the fuzz seed tests/fuzz/corpus/blob_fixed/<name> holds exactly the n bytes b
+ * (1), or not (0, saying so); SINEW_WRITE_SEEDS=1 in the environment (re)writes it first. */
+static inline int seed_is(const char *name, const uint8_t *b, size_t n) {
+    char path[1024];
+    snprintf(path, sizeof path, "%s/tests/fuzz/corpus/blob_fixed/%s", SINEW_SOURCE_DIR, name);
+    const char *write = getenv("SINEW_WRITE_SEEDS");
+    if (write && strcmp(write, "1") == 0) {
+        FILE *o = fopen(path, "wb");
+        int ok = o && fwrite(b, 1, n, o) == n;
+        if (o && fclose(o) != 0) ok = 0;
+        if (!ok) fprintf(stderr, "  cannot write %s\n", path);
+    }
+    size_t got = 0;
+    char *seed = sw_test_read_file(path, &got);
+    const int same = seed && got == n && memcmp(seed, b, n) == 0;
+    if (!same)
+        fprintf(stderr, "  %s %s the blob written (SINEW_WRITE_SEEDS=1 rewrites it)\n", path,
+                seed ? "is not" : "is missing, not");
+    free(seed);
+    return same;
+}
+
 /* The fixture written to memory (64-aligned buffer, caller frees). */
 static inline uint8_t *write_fixture(const fixture *f, size_t *size) {
     void *data = NULL;
@@ -373,6 +479,19 @@ static inline uint8_t *write_fixture(const fixture *f, size_t *size) {
         return NULL;
     }
     return data;
+}
+
+/* write_fixture, parsed back into *v: NULL (the message printed) unless the parse accepts
+ * the bytes. */
+static inline uint8_t *write_parsed(const fixture *f, size_t *size, sw_blob_view *v) {
+    uint8_t *b = write_fixture(f, size);
+    char msg[512];
+    if (b && sw_blob_parse(b, *size, v, msg, sizeof msg) != SINEW_OK) {
+        fprintf(stderr, "  parse failed: %s\n", msg);
+        free(b);
+        b = NULL;
+    }
+    return b;
 }
 
 #endif

@@ -272,12 +272,7 @@ TEST(welded_duplicates_move_and_shade_as_one) {
 
 /* Parses the forged copy (checksum fixed) and checks the code and the message's words. */
 static int rejects(uint8_t *b, sinew_result code, const char *a, const char *c) {
-    fix_checksum(b, fx.size);
-    sw_blob_view v;
-    char msg[512];
-    sinew_result r = sw_blob_parse(b, fx.size, &v, msg, sizeof msg);
-    fprintf(stderr, "    %s\n", msg);
-    return r == code && strstr(msg, a) && (!c || strstr(msg, c));
+    return parse_refuses(b, fx.size, code, a, c);
 }
 
 TEST(the_loader_rejects_a_damaged_render_mesh) {
@@ -351,11 +346,9 @@ TEST(the_synthetic_render_blob_round_trips_and_seeds_the_fuzzer) {
     fixture_init(&f, 7);
     fixture_add_render(&f, &r);
     size_t size = 0;
-    uint8_t *b = write_fixture(&f, &size);
-    ENSURE(b);
     sw_blob_view v;
-    char msg[512];
-    ENSUREF(sw_blob_parse(b, size, &v, msg, sizeof msg) == SINEW_OK, "%s", msg);
+    uint8_t *b = write_parsed(&f, &size, &v);
+    ENSURE(b);
     ENSURE(hdr(b)->section_count == SINEW_SECTION_RENDER_LAST);
     ENSURE(v.nrender_verts == NRV && sw_blob_output_verts(&v) == NRV &&
            sw_blob_output_ntris(&v) == NRT);
@@ -368,20 +361,7 @@ TEST(the_synthetic_render_blob_round_trips_and_seeds_the_fuzzer) {
     uint8_t *p = write_fixture(&plain, &psize);
     ENSURE(p && hdr(p)->section_count == SINEW_SECTION_COUNT_V1 && psize < size);
     free(p);
-    const char *path = SINEW_SOURCE_DIR "/tests/fuzz/corpus/blob_fixed/synth_render.blob";
-    const char *write = getenv("SINEW_WRITE_SEEDS");
-    if (write && strcmp(write, "1") == 0) {
-        FILE *o = fopen(path, "wb");
-        ENSURE(o && fwrite(b, 1, size, o) == size && fclose(o) == 0);
-    }
-    FILE *in = fopen(path, "rb");
-    ENSUREF(in, "no seed %s (SINEW_WRITE_SEEDS=1 writes it)", path);
-    uint8_t *seed = malloc(size + 1);
-    size_t got = fread(seed, 1, size + 1, in);
-    fclose(in);
-    ENSUREF(got == size && memcmp(seed, b, size) == 0,
-            "%s is not the synthetic render blob (SINEW_WRITE_SEEDS=1 rewrites it)", path);
-    free(seed);
+    ENSURE(seed_is("synth_render.blob", b, size));
     free(b);
 }
 

@@ -164,7 +164,7 @@ static sinew_result check_cubature(const sw_blob_view *v, char *msg, size_t ms) 
             if (what)
                 return fail(msg, ms, SINEW_ERROR_CORRUPT,
                             "blob section COND_CUB_TET_ID: cubature tet %d (domain %d) is tet %d "
-                            "(domain %d), whose %s differs",
+                            "(domain %d), which differs from it in its %s",
                             c, d, t, v->tet_domain[t], what);
         }
     }

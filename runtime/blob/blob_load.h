@@ -14,6 +14,7 @@
  *     domain, rank_total <= SW_BLOB_MAX_RANK_TOTAL, surface copies <= SW_BLOB_MAX_COPIES;
  *   - the optional render mesh: its counts <= SW_BLOB_MAX_COUNT, |barycentric| <=
  *     SW_BLOB_MAX_BARY (blob_render.c);
+ *   - the optional condensation tet mesh: ntets <= SW_BLOB_MAX_COUNT (blob_cond.c);
  *   - domain d's ranges are the prefix sums of the previous domains' sizes in domain
  *     order (vertex copies, q, cubature, basis, inertia_u), every domain has at least
  *     one vertex copy and one cubature tet, every surface vertex at least one copy.

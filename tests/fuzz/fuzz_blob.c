@@ -22,8 +22,9 @@
  *
  * Every input is copied into a 64-byte aligned buffer of exactly its size, so that ASan
  * reports a read one byte past it. An accepted blob is re-validated and every index
- * chain a runtime follows is walked, the contact references with explicit bounds checks
- * (a wrong index into one buffer mostly lands inside another section, unseen by ASan). */
+ * chain a runtime follows is walked (the optional render mesh's and condensation tet
+ * mesh's too), the contact references and the tets' incidences with explicit checks (a
+ * wrong index into one buffer mostly lands inside another section, unseen by ASan). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -84,6 +85,24 @@ static double walk(const sw_blob_view *v) {
             }
         }
     }
+    /* the condensation tet mesh: every tet's corners through its domain's copies, every
+       vertex's tets, every cubature tet's tet */
+    for (int64_t t = 0; t < v->ntets; ++t) {
+        const sw_blob_domain *dom = &v->domains[v->tet_domain[t]];
+        for (int k = 0; k < 4; ++k) {
+            int32_t gv = v->domain_verts[dom->vert_begin + v->tet_local[4 * t + k]];
+            if (gv != v->tets[4 * t + k]) abort();
+            s += v->rest[3 * (int64_t)gv] * v->vert_mass[gv];
+        }
+        s += v->tet_dminv[9 * t + 8] * v->tet_vol[t];
+    }
+    for (int32_t x = 0; x < v->nverts && v->ntets > 0; ++x)
+        for (int32_t i = v->vert_tet_ptr[x]; i < v->vert_tet_ptr[x + 1]; ++i) {
+            const int32_t *c = v->tets + 4 * (int64_t)v->vert_tets[i];
+            if (c[0] != x && c[1] != x && c[2] != x && c[3] != x) abort();
+        }
+    for (int32_t c = 0; c < v->ncub && v->ntets > 0; ++c)
+        if (v->tet_vol[v->cub_tet_id[c]] != v->cub_vol[c]) abort();
     /* the pose-space contacts: every training pose's range, every reference of its pairs */
     if (v->contact_ptr[0] != 0 || v->contact_ptr[v->ntrain] != v->ncontacts) abort();
     for (int32_t t = 0; t < v->ntrain; ++t) {
