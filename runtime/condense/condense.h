@@ -23,7 +23,9 @@
  * (s_d: the domain's cubature then stands for its volume outside the patch, the
  * prototype's third flaw). Newton with the energy guard; each update solves eq. 4.11 by
  * PCG preconditioned with 3x3 Jacobi blocks on x_f and the factored reduced block on q.
- * The element Hessians are projected to PSD, so the coupled matrix is too. */
+ * The element Hessians are projected to PSD, so the coupled matrix is too. The reduced
+ * block of the preconditioner (the factor) holds the full tets' ring-ring terms J^T K J
+ * too; the matrix-vector product applies them tet by tet instead. */
 #ifndef SW_CONDENSE_H
 #define SW_CONDENSE_H
 
@@ -82,6 +84,8 @@ typedef struct sw_cond {
     double *ring_J;          /* 3 rmax per ring copy: J = R U (3 x r_d) */
     double *ring_x;          /* 3 per ring copy: its position at the iterate */
     double *ring_dx;         /* 3 per ring copy: scratch (J dq) */
+    double *ring_tmp;        /* 12 rmax: scratch (a tet's K J over its ring corners) */
+    double *Hq;              /* R x R: the reduced potential's Hessian (without the ring blocks) */
     double *dom_fv, *dom_fw; /* ndomains: the patch's tets' volume and cubature w vol */
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */

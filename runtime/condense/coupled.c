@@ -69,29 +69,44 @@ static void tet_positions(const sw_cond *c, const double *x, int32_t e, double x
     }
 }
 
-/* red->H's domain block of ring copies a and b (both of domain d) += J_a^T K_ab J_b. */
-static void add_ring_block(const sw_cond *c, sw_reduced *red, int32_t a, int32_t b, const double *K,
-                           int ka, int kb) {
-    const sw_blob_domain *D = &c->v->domains[c->ring_d[a]];
+/* red->H's domain block += J^T K_rr J over full tet e's ring corners (all copies of the
+ * tet's domain): their stacked Jacobians J (3m x r), KJ = K_rr J first, then J^T KJ. */
+static void add_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const double *K) {
+    const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+    int rk[4], m = 0;
+    for (int k = 0; k < 4; ++k)
+        if (slot[k] < 0) rk[m++] = k;
+    if (m == 0) return;
+    const sw_blob_domain *D = &c->v->domains[c->ring_d[-1 - slot[rk[0]]]];
     int32_t r = D->rank, o = D->q_offset;
-    const double *Ja = ring_J(c, a), *Jb = ring_J(c, b);
-    double KJ[3 * 64], *kj = r <= 64 ? KJ : NULL; /* K_ab J_b, 3 x r */
-    for (int i = 0; i < 3; ++i)
-        for (int32_t j = 0; j < r; ++j) {
-            double acc = 0;
-            for (int l = 0; l < 3; ++l)
-                acc += K[(3 * ka + i) * 12 + 3 * kb + l] * Jb[l * r + j];
-            if (kj)
-                kj[i * r + j] = acc;
-            else /* a rank above 64: straight into H (slower, same sums) */
-                for (int32_t m = 0; m < r; ++m)
-                    red->H[(int64_t)(o + m) * red->R + o + j] += Ja[i * r + m] * acc;
+    double *KJ = c->ring_tmp; /* 3m x r */
+    for (int a = 0; a < m; ++a)
+        for (int i = 0; i < 3; ++i) {
+            double *row = KJ + (3 * a + i) * r;
+            const double *Krow = K + (3 * rk[a] + i) * 12;
+            for (int32_t j = 0; j < r; ++j)
+                row[j] = 0;
+            for (int b = 0; b < m; ++b) {
+                const double *Jb = ring_J(c, -1 - slot[rk[b]]);
+                for (int l = 0; l < 3; ++l) {
+                    double kv = Krow[3 * rk[b] + l];
+                    const double *Jl = Jb + l * r;
+                    for (int32_t j = 0; j < r; ++j)
+                        row[j] += kv * Jl[j];
+                }
+            }
         }
-    if (!kj) return;
-    for (int32_t m = 0; m < r; ++m)
-        for (int32_t j = 0; j < r; ++j)
-            red->H[(int64_t)(o + m) * red->R + o + j] +=
-                Ja[m] * kj[j] + Ja[r + m] * kj[r + j] + Ja[2 * r + m] * kj[2 * r + j];
+    for (int a = 0; a < m; ++a) {
+        const double *Ja = ring_J(c, -1 - slot[rk[a]]);
+        for (int i = 0; i < 3; ++i) {
+            const double *Jai = Ja + i * r, *row = KJ + (3 * a + i) * r;
+            for (int32_t p = 0; p < r; ++p) {
+                double jp = Jai[p], *Hp = red->H + (int64_t)(o + p) * red->R + o;
+                for (int32_t j = 0; j < r; ++j)
+                    Hp[j] += jp * row[j];
+            }
+        }
+    }
 }
 
 /* Phi(q, x) (condense.h): the gradient into (red->g, c->gf), the Hessian's parts (red->H
@@ -101,6 +116,8 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
                          const sw_dyn_coef *dc, int want_hess) {
     const sw_blob_view *v = c->v;
     double phi = sw_potential(red, ct, s, q, dc, 1, want_hess);
+    int32_t R = red->R;
+    if (want_hess) memcpy(c->Hq, red->H, (size_t)R * R * sizeof(double));
     for (int32_t k = 0; k < c->nring; ++k) {
         const sw_blob_domain *D = &v->domains[c->ring_d[k]];
         int32_t r = D->rank;
@@ -133,9 +150,8 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
             for (int32_t j = 0; j < D->rank; ++j)
                 red->g[D->q_offset + j] -= J[j] * f[3 * k] + J[D->rank + j] * f[3 * k + 1] +
                                            J[2 * D->rank + j] * f[3 * k + 2];
-            for (int l = 0; want_hess && l < 4; ++l)
-                if (slot[l] < 0) add_ring_block(c, red, a, -1 - slot[l], K, k, l);
         }
+        if (want_hess) add_ring_blocks(c, red, e, K);
     }
     const sw_world_contacts *wc = ct->wc;
     for (int32_t j = 0; wc && j < wc->ncand; ++j) {
@@ -153,8 +169,8 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
 
 /* ---- the linear system of eq. 4.11 ------------------------------------------------- */
 
-/* y = H z, z = (dq, dx): the reduced block, the world's 3x3 blocks, and each full tet's K
- * on its corners (the ring rows through J^T, leaving out the ring-ring part red->H has). */
+/* y = H z, z = (dq, dx): the reduced potential's block Hq, the world's 3x3 blocks, and
+ * each full tet's K on its corners (ring corners at J dq, their rows back through J^T). */
 void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
     const sw_cond_system *S = ctx;
     sw_cond *c = S->c;
@@ -162,7 +178,7 @@ void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
     int32_t R = S->red->R;
     const double *dq = z, *dx = z + R;
     double *yq = y, *yx = y + R;
-    sw_matvec(S->red->H, R, dq, yq);
+    sw_matvec(c->Hq, R, dq, yq);
     for (int32_t i = 0; i < c->nf; ++i) {
         const double *D = c->Dw + 9 * (int64_t)i, *a = dx + 3 * (int64_t)i;
         for (int k = 0; k < 3; ++k)
@@ -181,32 +197,33 @@ void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
     for (int32_t e = 0; e < c->nt; ++e) {
         const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
         const double *K = c->Kt + 144 * (int64_t)e;
-        double zp[12], zr[12];
-        for (int k = 0; k < 4; ++k)
-            for (int i = 0; i < 3; ++i) {
-                zp[3 * k + i] = slot[k] >= 0 ? dx[3 * (int64_t)slot[k] + i] : 0;
-                zr[3 * k + i] = slot[k] >= 0 ? 0 : c->ring_dx[3 * (-1 - slot[k]) + i];
-            }
+        double z12[12], y12[12];
         for (int k = 0; k < 4; ++k) {
-            double out[3];
-            for (int i = 0; i < 3; ++i) {
-                const double *Kr = K + 12 * (3 * k + i);
-                double acc = 0;
-                for (int l = 0; l < 12; ++l)
-                    acc += Kr[l] * (slot[k] >= 0 ? zp[l] + zr[l] : zp[l]);
-                out[i] = acc;
-            }
+            const double *src =
+                slot[k] >= 0 ? dx + 3 * (int64_t)slot[k] : c->ring_dx + 3 * (-1 - slot[k]);
+            z12[3 * k] = src[0];
+            z12[3 * k + 1] = src[1];
+            z12[3 * k + 2] = src[2];
+        }
+        for (int i = 0; i < 12; ++i) {
+            const double *Ki = K + 12 * i;
+            double acc = 0;
+            for (int l = 0; l < 12; ++l)
+                acc += Ki[l] * z12[l];
+            y12[i] = acc;
+        }
+        for (int k = 0; k < 4; ++k) {
             if (slot[k] >= 0) {
                 for (int i = 0; i < 3; ++i)
-                    yx[3 * (int64_t)slot[k] + i] += out[i];
+                    yx[3 * (int64_t)slot[k] + i] += y12[3 * k + i];
                 continue;
             }
             int32_t a = -1 - slot[k];
             const sw_blob_domain *D = &v->domains[c->ring_d[a]];
             const double *J = ring_J(c, a);
             for (int32_t j = 0; j < D->rank; ++j)
-                yq[D->q_offset + j] +=
-                    J[j] * out[0] + J[D->rank + j] * out[1] + J[2 * D->rank + j] * out[2];
+                yq[D->q_offset + j] += J[j] * y12[3 * k] + J[D->rank + j] * y12[3 * k + 1] +
+                                       J[2 * D->rank + j] * y12[3 * k + 2];
         }
     }
 }
