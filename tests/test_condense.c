@@ -108,15 +108,15 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
 
 /* Brute force: the vertices a breadth-first growth over the whole mesh reaches from seed s
  * through vertices within rho of s, marked in m. */
-static void brute_grow(const sw_blob_view *v, int32_t s, double rho, unsigned char *m,
-                       int32_t *queue) {
+static void brute_grow(const sw_blob_view *v, const unsigned char *pinned, int32_t s, double rho,
+                       unsigned char *m, int32_t *queue) {
     unsigned char *seen = calloc((size_t)v->nverts, 1);
     int32_t head = 0, tail = 0;
     queue[tail++] = s;
     seen[s] = 1;
     while (head < tail) {
         int32_t a = queue[head++];
-        m[a] = 1;
+        if (!pinned[a]) m[a] = 1; /* a bone vertex is passed through, never freed */
         for (int32_t t = 0; t < v->ntets; ++t) {
             const int32_t *tv = v->tets + 4 * (int64_t)t;
             if (tv[0] != a && tv[1] != a && tv[2] != a && tv[3] != a) continue;
@@ -149,13 +149,19 @@ TEST(oracle_patch_is_the_growth_of_its_seeds_and_the_budget_keeps_the_nearest) {
     unsigned char *m = calloc((size_t)n, 1);
     int32_t *queue = malloc(sizeof(int32_t) * n);
     for (int32_t i = 0; i < ns; ++i)
-        brute_grow(v, c->seeds[(int64_t)c->slot * c->z.max_seeds + i], c->rho, m, queue);
+        brute_grow(v, c->pinned, c->seeds[(int64_t)c->slot * c->z.max_seeds + i], c->rho, m, queue);
     int32_t nm = 0;
     for (int32_t gv = 0; gv < n; ++gv) {
         nm += m[gv];
         ENSURE((sw_cond_position(c, gv) != NULL) == m[gv]);
     }
     ENSURE(nm == c->nf);
+    int32_t npinned = 0; /* the fixture's bone vertices: the kinematic ones */
+    for (int32_t gv = 0; gv < n; ++gv) {
+        npinned += c->pinned[gv];
+        ENSURE(c->pinned[gv] == (f->ch.bone_of_vertex[gv] >= 0));
+    }
+    ENSURE(npinned > 0);
     /* the full tets: exactly those with a patch corner */
     int32_t nfull = 0;
     for (int32_t t = 0; t < v->ntets; ++t) {

@@ -28,13 +28,14 @@ static double max_jump(const double *a, const double *b, int32_t n) {
 sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const double *T, int nf,
                                const double *x_full, const double *ref_ms,
                                const unsigned char *touch, const double *mass,
-                               const sw_cond_bench_params *cp, sw_cond_bench *out, sw_error *err) {
+                               const sw_cond_bench_params *cp, double rho, sw_cond_bench *out,
+                               sw_error *err) {
     memset(out, 0, sizeof *out);
     const sw_blob_view *v = sw_blob_get_view(blob);
     int32_t n = v->nverts, ns = sw_blob_output_verts(v);
     sinew_instance_def d = sinew_instance_def_default();
     d.max_patch_vertices = cp->budget > 0 ? cp->budget : (uint32_t)(n / 4 > 0 ? n / 4 : 1);
-    d.patch_radius = (float)cp->rho;
+    d.patch_radius = (float)rho;
     out->budget = d.max_patch_vertices;
     out->rho = d.patch_radius > 0 ? d.patch_radius : 0.05;
     sinew_instance *inst;

@@ -7,9 +7,12 @@
 #include "sw_error.h"
 #include "world_scene.h"
 
+#define SW_COND_MAX_RHO 8
+
 typedef struct sw_cond_bench_params {
-    double rho;      /* patch radius in units of the rest diagonal (0: the default) */
-    uint32_t budget; /* max_patch_vertices (0: a quarter of the vertices) */
+    double rho[SW_COND_MAX_RHO]; /* patch radii in units of the rest diagonal */
+    int nrho;                    /* 0: the default radius alone */
+    uint32_t budget;             /* max_patch_vertices (0: a quarter of the vertices) */
 } sw_cond_bench_params;
 
 typedef struct sw_cond_bench {
@@ -28,12 +31,14 @@ typedef struct sw_cond_bench {
     int failed;
 } sw_cond_bench;
 
-/* Steps a condensed instance of blob over the scene's nf frames (poses T), compares each
- * frame with the reference's x_full (its frame times ref_ms, contact frames touch, masses
- * mass for the error's weights). */
+/* Steps a condensed instance of blob with patch radius rho (0: the default) and budget
+ * cp->budget over the scene's nf frames (poses T), compares each frame with the
+ * reference's x_full (its frame times ref_ms, contact frames touch, masses mass for the
+ * error's weights). */
 sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const double *T, int nf,
                                const double *x_full, const double *ref_ms,
                                const unsigned char *touch, const double *mass,
-                               const sw_cond_bench_params *cp, sw_cond_bench *out, sw_error *err);
+                               const sw_cond_bench_params *cp, double rho, sw_cond_bench *out,
+                               sw_error *err);
 
 #endif

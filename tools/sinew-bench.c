@@ -161,8 +161,11 @@ static void usage(FILE *f) {
             "                      schema 1, samples/worlds/README.md) and report its figures;\n"
             "                      with a blob holding the tet mesh, also a condensed runtime\n"
             "                      (full-space patches at novel contact) and its figures\n"
-            "  --rho R             with --world: the patch radius in units of the rest\n"
-            "                      bounding-box diagonal, 0 < R <= 1 (default 0.05)\n"
+            "  --rho R[,R...]      with --world: the patch radius in units of the rest\n"
+            "                      bounding-box diagonal, 0 < R <= 1 (default 0.05); several\n"
+            "                      (at most 8) run one condensed instance each against the\n"
+            "                      same reference run (the first in the top-level figures,\n"
+            "                      the others in cond_sweep)\n"
             "  --patch-budget N    with --world: max_patch_vertices (default a quarter of\n"
             "                      the vertices)\n"
             "  --dynamic           also run the runtime in dynamic mode against the reference's\n"
@@ -281,6 +284,24 @@ done:
     return r;
 }
 
+/* --rho R[,R...]: patch radii in (0, 1], at most SW_COND_MAX_RHO. */
+static int parse_rhos(const char *tool, const char *s, sw_cond_bench_params *cp) {
+    char buf[256];
+    if (strlen(s) >= sizeof buf) return sw_tool_real(tool, "--rho", "", 0, 1, "in (0, 1]", NULL);
+    strcpy(buf, s);
+    cp->nrho = 0;
+    for (char *tok = strtok(buf, ","); tok; tok = strtok(NULL, ",")) {
+        if (cp->nrho == SW_COND_MAX_RHO) {
+            fprintf(stderr, "%s: --rho takes at most %d radii\n", tool, SW_COND_MAX_RHO);
+            return 0;
+        }
+        if (!sw_tool_real(tool, "--rho", tok, 0, 1.0000001, "in (0, 1]", &cp->rho[cp->nrho]))
+            return 0;
+        cp->nrho++;
+    }
+    return cp->nrho > 0 || sw_tool_real(tool, "--rho", s, 0, 1, "in (0, 1]", NULL);
+}
+
 int main(int argc, char **argv) {
     static const char *tool = "sinew-bench";
     sw_character_args ca;
@@ -288,7 +309,7 @@ int main(int argc, char **argv) {
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     int dynamic = 0, hold_frames = 0, instances = 0, patch_budget = 0;
-    sw_cond_bench_params cond = {0, 0};
+    sw_cond_bench_params cond = {{0}, 0, 0};
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -304,7 +325,7 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--world") && next)
             world_path = argv[++i];
         else if (!strcmp(a, "--rho") && next)
-            ok = sw_tool_real(tool, a, argv[++i], 0, 1.0000001, "in (0, 1]", &cond.rho);
+            ok = parse_rhos(tool, argv[++i], &cond);
         else if (!strcmp(a, "--patch-budget") && next)
             ok = sw_tool_int(tool, a, argv[++i], 1, 100000000, &patch_budget);
         else if (!strcmp(a, "--full-frames") && next)
@@ -339,7 +360,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "%s: --hold-frames applies only with --dynamic\n", tool);
         return 2;
     }
-    if ((cond.rho > 0 || patch_budget > 0) && !world_path) {
+    if ((cond.nrho > 0 || patch_budget > 0) && !world_path) {
         fprintf(stderr, "%s: --rho and --patch-budget apply only with --world\n", tool);
         return 2;
     }
@@ -572,9 +593,9 @@ int main(int argc, char **argv) {
                 world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
                 wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.allocs,
                 wb.locks);
-        const sw_cond_bench *cb = &wb.cond;
-        failed_steps += cb->failed;
-        if (wb.cond_ran)
+        for (int k = 0; k < wb.ncond; ++k) {
+            const sw_cond_bench *cb = &wb.cond[k];
+            failed_steps += cb->failed;
             fprintf(stderr,
                     "sinew-bench: condensed (rho %.4g of the diagonal, budget %u): err_world_cond "
                     "%.4f (subspace %.4f); speedup mean %.1f worst %.1f; patch %.2f%% mean, "
@@ -582,6 +603,7 @@ int main(int argc, char **argv) {
                     cb->rho, cb->budget, cb->err_world_cond, wb.err_world_sub, cb->speedup_mean,
                     cb->speedup_worst, 100 * cb->patch_frac_mean, 100 * cb->patch_frac_max,
                     cb->p100_over_p50, cb->truncated_frames, cb->pop_max);
+        }
     }
     /* 8. dynamics against the reference's backward Euler, when asked */
     sw_dyn_bench db;
@@ -681,16 +703,28 @@ int main(int argc, char **argv) {
                world_path, wb.frames, wb.world_contact_frames, wb.err_world_sub, wb.pen_world_full,
                wb.pen_world_sub, wb.world_query_ms, wb.world_queries, wb.world_contacts, wb.full_ms,
                wb.sub_ms, wb.ref_unsettled, wb.allocs, wb.locks);
-    if (json && wb.cond_ran)
+    for (int k = 0; json && k < wb.ncond; ++k) {
+        const sw_cond_bench *cb = &wb.cond[k];
+        if (k == 1) printf(",\"cond_sweep\":[");
+        if (k >= 1)
+            printf("%s{\"rho\":%.5g,\"err_world_cond\":%.5f,\"speedup_cond_mean\":%.2f,"
+                   "\"speedup_cond_worst\":%.2f,\"patch_frac_mean\":%.5f,\"patch_frac_max\":%.5f,"
+                   "\"cond_ms_max\":%.4f}%s",
+                   k > 1 ? "," : "", cb->rho, cb->err_world_cond, cb->speedup_mean,
+                   cb->speedup_worst, cb->patch_frac_mean, cb->patch_frac_max, cb->ms_max,
+                   k == wb.ncond - 1 ? "]" : "");
+    }
+    if (json && wb.ncond > 0)
         printf(",\"rho\":%.5g,\"patch_budget\":%u,\"err_world_cond\":%.5f,"
                "\"speedup_cond_mean\":%.2f,\"speedup_cond_worst\":%.2f,\"patch_frac_mean\":%.5f,"
                "\"patch_frac_max\":%.5f,\"frame_p100_over_p50\":%.3f,"
                "\"patch_truncated_frames\":%d,\"pop_max\":%.3f,\"cond_ms_median\":%.4f,"
                "\"cond_ms_max\":%.4f,\"pcg_iters_max\":%u",
-               wb.cond.rho, wb.cond.budget, wb.cond.err_world_cond, wb.cond.speedup_mean,
-               wb.cond.speedup_worst, wb.cond.patch_frac_mean, wb.cond.patch_frac_max,
-               wb.cond.p100_over_p50, wb.cond.truncated_frames, wb.cond.pop_max, wb.cond.ms_median,
-               wb.cond.ms_max, wb.cond.pcg_iters_max);
+               wb.cond[0].rho, wb.cond[0].budget, wb.cond[0].err_world_cond,
+               wb.cond[0].speedup_mean, wb.cond[0].speedup_worst, wb.cond[0].patch_frac_mean,
+               wb.cond[0].patch_frac_max, wb.cond[0].p100_over_p50, wb.cond[0].truncated_frames,
+               wb.cond[0].pop_max, wb.cond[0].ms_median, wb.cond[0].ms_max,
+               wb.cond[0].pcg_iters_max);
     char ratio[32] = "null"; /* no reference overshoot: no ratio */
     if (isfinite(db.overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db.overshoot_ratio);
     char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */

@@ -165,9 +165,12 @@ sinew_result sw_world_bench_run(const sw_character *ch, const sinew_blob *blob, 
     if ((r = run_reference(ch, ws, fp, T, nf, x_full, touch, mass, ref_ms, out, err)) != SINEW_OK)
         goto done;
     if ((r = run_subspace(blob, ws, T, nf, x_full, touch, mass, out, err)) != SINEW_OK) goto done;
-    if (cp && sw_blob_get_view(blob)->ntets > 0) {
-        r = sw_cond_bench_run(blob, ws, T, nf, x_full, ref_ms, touch, mass, cp, &out->cond, err);
-        out->cond_ran = r == SINEW_OK;
+    for (int k = 0; cp && sw_blob_get_view(blob)->ntets > 0 && k < (cp->nrho ? cp->nrho : 1); ++k) {
+        double rho = cp->nrho ? cp->rho[k] : 0;
+        r = sw_cond_bench_run(blob, ws, T, nf, x_full, ref_ms, touch, mass, cp, rho, &out->cond[k],
+                              err);
+        if (r != SINEW_OK) break;
+        out->ncond = k + 1;
     }
 done:
     free(T), free(x_full), free(mass), free(touch), free(ref_ms);

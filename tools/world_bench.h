@@ -21,8 +21,8 @@ typedef struct sw_world_bench {
     int ref_unsettled, ref_failed, sub_failed;
     long allocs, locks; /* in contract_steps steps with world contact; -1: not observable */
     int contract_steps;
-    sw_cond_bench cond; /* the condensed run (cond_ran: it ran) */
-    int cond_ran;
+    sw_cond_bench cond[SW_COND_MAX_RHO]; /* the condensed runs, one a radius */
+    int ncond;
 } sw_world_bench;
 
 /* Runs the scene `ws` on the character (its clip or rest pose, as the file says; at

@@ -60,6 +60,8 @@ typedef struct sw_cond {
     int32_t *vloc;      /* its patch index, or (ring) -1 - its first ring copy */
     uint32_t *in_ring;  /* ring stamp */
     uint32_t *seeded;   /* seed stamp (a vertex seeded twice grows once) */
+    unsigned char *pinned; /* kinematic (a bone vertex): never in a patch */
+    int32_t *surf_of;      /* its boundary surface vertex, or -1 */
     double *dev;        /* 3 per vertex: its last patch position minus its subspace one */
     uint32_t *dev_at;   /* the stamp of the step that left dev */
     uint32_t *tvis;     /* per tet: full-tet stamp */
@@ -114,6 +116,11 @@ void sw_cond_forget(sw_cond *c);
  * deviation the vertex had when it was last in a patch), and the world candidates tagged
  * with their patch vertex. Returns the patch's vertex count. */
 int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, const double *q);
+
+/* The world's candidates of the patch's surface vertices at their patch positions: the
+ * laws taken again there, new colliders within the detection radius (penetrating_only:
+ * only those entered) added. Returns how many were added; tag them afterwards. */
+int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, int penetrating_only);
 
 /* Tags the world candidates whose vertex is in the patch (after new ones were added). */
 void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc);

@@ -52,10 +52,32 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     memset(c->tvis, 0, (size_t)v->ntets * sizeof *c->tvis);
     for (int32_t t = 0; t < v->ntets; ++t)
         c->tet_cub[t] = -1;
+    for (int32_t gv = 0; gv < v->nverts; ++gv)
+        c->surf_of[gv] = -1;
+    for (int32_t s = 0; s < v->nsurf_verts; ++s) {
+        int32_t i = v->surf_copy_ptr[s], d = v->surf_copies[2 * i];
+        c->surf_of[v->domain_verts[v->domains[d].vert_begin + v->surf_copies[2 * i + 1]]] = s;
+    }
     for (int32_t k = 0; k < v->ndomains; ++k)
         c->dom_vol[k] = c->dom_wvol[k] = 0;
     for (int32_t t = 0; t < v->ntets; ++t)
         c->dom_vol[v->tet_domain[t]] += v->tet_vol[t];
+    /* Kinematic vertices: the bake's bone vertices follow their bone rigidly (one-hot
+     * weights, no training displacement: bake_basis.c), so every basis row of theirs is
+     * exactly zero; the reference holds them too. A patch never frees them: they stay
+     * ring copies at their skinned positions. */
+    memset(c->pinned, 1, (size_t)v->nverts);
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+            const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * D->rank;
+            for (int32_t j = 0; j < 3 * D->rank; ++j)
+                if (U[j] != 0) {
+                    c->pinned[v->domain_verts[D->vert_begin + lv]] = 0;
+                    break;
+                }
+        }
+    }
     for (int32_t i = 0; i < v->ncub; ++i) {
         c->tet_cub[v->cub_tet_id[i]] = i;
         c->cub_w[i] = v->cub_weight[i];
@@ -119,7 +141,8 @@ static void grow(sw_cond *c, int32_t s) {
     c->queue[tail++] = s;
     while (head < tail) {
         int32_t a = c->queue[head++];
-        if (!accept(c, a, sqrt(dist2(v->rest + 3 * (int64_t)a, X0)))) {
+        /* a kinematic vertex is passed through, never freed */
+        if (!c->pinned[a] && !accept(c, a, sqrt(dist2(v->rest + 3 * (int64_t)a, X0)))) {
             c->dropped++;
             continue;
         }
@@ -249,6 +272,24 @@ static void start_positions(sw_cond *c, const sw_reduced *red, const double *q) 
     }
 }
 
+/* The world's candidates of the patch's surface vertices taken at their patch positions
+ * (their subspace positions, where the step's detection ran, can be a dent away: a law
+ * frozen there would anchor friction and the contact plane in the wrong place), new
+ * ones added within the detection radius (penetrating_only: inside). Returns how many
+ * were added. */
+int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, int penetrating_only) {
+    const sw_blob_view *v = c->v;
+    int32_t added = 0;
+    for (int32_t i = 0; i < c->nf; ++i) {
+        int32_t s = c->surf_of[c->fv[i]];
+        if (s < 0) continue;
+        for (int32_t k = v->surf_copy_ptr[s]; k < v->surf_copy_ptr[s + 1]; ++k)
+            added += sw_world_contacts_at(wc, k, c->x + 3 * (int64_t)i, v->contact_k,
+                                          penetrating_only);
+    }
+    return added;
+}
+
 void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc) {
     const sw_blob_view *v = c->v;
     for (int32_t j = 0; j < wc->ncand; ++j) {
@@ -283,6 +324,7 @@ int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
     }
     full_tets(c, red);
     start_positions(c, red, q);
+    sw_cond_detect(c, wc, 0);
     sw_cond_tag_candidates(c, wc);
     return c->nf;
 }

@@ -362,6 +362,40 @@ int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *re
     return wc->ncand - before;
 }
 
+/* Candidate j's law taken again at x (closest point, normal, friction cap); a collider
+ * no longer within four detection radii leaves the law without stiffness. */
+static void refresh_candidate(sw_world_contacts *wc, int32_t j, const double x[3]) {
+    sw_world_cand *cd = &wc->cand[j];
+    const sw_collider *c = sw_world_slot(wc->world, (uint32_t)cd->slot);
+    sw_collider_hit hit;
+    wc->queries++;
+    if (!c || !sw_collider_query(c, x, 4 * wc->radius, &hit)) {
+        cd->law.k = 0;
+        cd->law.cap = 0;
+        return;
+    }
+    for (int k = 0; k < 3; ++k) {
+        cd->law.a[k] = hit.point[k];
+        cd->law.n[k] = hit.normal[k];
+    }
+    cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
+}
+
+int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double x[3], double blob_k,
+                             int penetrating_only) {
+    int32_t before = wc->ncand;
+    for (int32_t j = wc->copy_first[i]; !penetrating_only && j >= 0; j = wc->cand[j].next)
+        refresh_candidate(wc, j, x);
+    uint32_t ns = sw_world_slot_count(wc->world);
+    for (uint32_t s = 0; s < ns; ++s) {
+        double cb[6];
+        if (collider_box(wc, s, cb) && sw_box_contains(cb, cb + 3, x) &&
+            !is_candidate(wc, i, (int32_t)s))
+            try_candidate(wc, i, x, s, blob_k, penetrating_only);
+    }
+    return wc->ncand - before;
+}
+
 /* ---- energy, gradient, Hessian --------------------------------------------------- */
 
 double sw_world_contact_eval(sw_reduced *red, const sw_world_contacts *wc, const double *q,

@@ -84,6 +84,14 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
  * output wrote them); returns how many were added. */
 int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red, const double *q);
 
+/* Surface copy i sitting at x instead of its subspace position (a condensation patch's
+ * vertex, condense.h): its candidates' laws taken again at x, and the colliders whose
+ * box holds x and that it is within the detection radius of added as candidates; with
+ * penetrating_only (after a solve), only the colliders it entered are added and the laws
+ * stay. Returns how many were added. */
+int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double x[3], double blob_k,
+                             int penetrating_only);
+
 /* The world contact energy at q of the candidates outside a condensation patch (those
  * in one are the patch's, condense.h); with want_grad its gradient into red->g, with
  * want_hess its (domain-diagonal) Hessian blocks into red->H. */

@@ -112,6 +112,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->vloc, nv);
         TAKE(c->in_ring, nv);
         TAKE(c->seeded, nv);
+        TAKE(c->pinned, nv);
+        TAKE(c->surf_of, nv);
         TAKE(c->dev, 3 * nv);
         TAKE(c->dev_at, nv);
         TAKE(c->tvis, nt);

@@ -199,6 +199,7 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         write_output(c);
         double t = sw_now_seconds();
         int32_t added = sw_world_contacts_add_missed(wc, &in->red, in->solver.q);
+        if (in->cond.nf > 0) added += sw_cond_detect(&in->cond, wc, 1);
         double ms_missed = 1e3 * (sw_now_seconds() - t);
         c->st.ms_world += ms_missed;
         if (added > 0) { /* (a failed second solve leaves the first round's surface) */
