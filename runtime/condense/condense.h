@@ -40,6 +40,7 @@
 typedef struct sw_cond_sizes {
     int32_t max_verts; /* patch vertices */
     int32_t max_tets;  /* full tets */
+    int32_t max_pairs; /* pose-space contact pairs a step may use */
     int32_t max_ring;  /* ring copies */
     int32_t max_cand;  /* vertices the growth may accept before the budget's cut */
     int32_t max_seeds; /* seeds of one step */
@@ -77,6 +78,10 @@ typedef struct sw_cond {
     int32_t dropped; /* vertices the budget left out this step */
     /* the patch */
     int32_t nf, nt, nring;
+    int32_t np;        /* pose-space contact pairs with a patch corner (elements nt ..) */
+    int32_t *pp_id;    /* max_pairs: their contact ids */
+    double *pp_w;      /* max_pairs: their pose-space blend weights */
+    unsigned char *pp_skip; /* max_pairs: per ps->pairs entry, the patch evaluates it */
     int32_t *fv;      /* nf: patch vertices (global ids) */
     int32_t *ft;      /* nt: full tets */
     int32_t *ft_slot; /* 4 per full tet: patch index >= 0, or -1 - ring copy */
@@ -92,7 +97,7 @@ typedef struct sw_cond {
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
     double *gf;          /* 3 nf: gradient in x_f */
-    double *Kt;          /* 144 per full tet: its PSD element Hessian */
+    double *Kt;          /* 144 per element: its PSD Hessian */
     double *Dw;          /* 9 nf: world-contact 3x3 Hessians of the patch vertices */
     double *Pf;          /* 9 nf: the inverted 3x3 diagonal blocks (preconditioner) */
     double *cg_r, *cg_z, *cg_p, *cg_Ap, *rhs, *sol; /* R + 3 nf each */
@@ -101,7 +106,8 @@ typedef struct sw_cond {
 } sw_cond;
 
 /* The sizes for a budget of max_verts patch vertices (0: off). */
-sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world);
+sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world,
+                           int32_t max_pairs);
 
 /* Creation (no allocation: the arrays are laid out by the instance): per-domain volumes,
  * the tet -> cubature map, cleared stamps. rho in world units. */
@@ -115,7 +121,8 @@ void sw_cond_forget(sw_cond *c);
  * skinning and Jacobians), the patch's start positions (the subspace position plus the
  * deviation the vertex had when it was last in a patch), and the world candidates tagged
  * with their patch vertex. Returns the patch's vertex count. */
-int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, const double *q);
+int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
+                       sw_pose_space *ps, const double *q);
 
 /* The world's candidates of the patch's surface vertices at their patch positions: the
  * laws taken again there, new colliders within the detection radius (penetrating_only:

@@ -10,6 +10,7 @@
 #include "dense.h"
 #include "fem_corot.h"
 #include "pcg.h"
+#include "penalty.h"
 
 /* ---- the cubature weights of eq. 4.12 --------------------------------------------- */
 
@@ -109,6 +110,65 @@ static void add_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const double
     }
 }
 
+/* Pose-space contact pair j of the patch (a trained pair with a corner in the patch, the
+ * law of pose_contact.c at the corners' patch or subspace positions x12: p, t0, t1, t2):
+ * E = 1/2 kk d^T N d while it collides, d = sum b_m x_tm - x_p. Its forces into f, its
+ * Hessian kk (c c^T kron N) into K (12 x 12) when not NULL. */
+static double patch_pair(const sw_cond *c, const sw_reduced *red, int32_t j, const double x12[12],
+                         double f[12], double *K) {
+    const sw_blob_view *v = c->v;
+    int32_t id = c->pp_id[j];
+    const double *cd = v->contact_data + 7 * (int64_t)id;
+    const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
+    const double *Rp = red->act_R + 9 * red->contact_act[4 * id];
+    double d[3] = {0, 0, 0}, n[3], Nd[3], N[9];
+    for (int m = 0; m < 4; ++m)
+        for (int i = 0; i < 3; ++i)
+            d[i] += coef[m] * x12[3 * m + i];
+    for (int i = 0; i < 3; ++i)
+        n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
+    memset(f, 0, 12 * sizeof(double));
+    if (K) memset(K, 0, 144 * sizeof(double));
+    if (!(sw_penalty_gap(n, d) > 0)) return 0;
+    double kk = c->pp_w[j] * v->contact_k * cd[6];
+    sw_penalty_apply_N(n, SW_CONTACT_ALPHA, d, Nd);
+    for (int m = 0; m < 4; ++m)
+        for (int i = 0; i < 3; ++i)
+            f[3 * m + i] = -kk * coef[m] * Nd[i];
+    if (K) {
+        sw_penalty_N(n, SW_CONTACT_ALPHA, N);
+        for (int m = 0; m < 4; ++m)
+            for (int l = 0; l < 4; ++l)
+                for (int i = 0; i < 3; ++i)
+                    for (int k = 0; k < 3; ++k)
+                        K[(3 * m + i) * 12 + 3 * l + k] = kk * coef[m] * coef[l] * N[3 * i + k];
+    }
+    return sw_penalty_energy(kk, d, Nd);
+}
+
+/* red->H += J_a^T K_ab J_b over a pair element's ring corners a, b (their domains may
+ * differ: the block the pose-space pair couples, in the step's pattern already). */
+static void add_pair_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const double *K) {
+    const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+    for (int a = 0; a < 4; ++a)
+        for (int b = 0; b < 4; ++b) {
+            if (slot[a] >= 0 || slot[b] >= 0) continue;
+            int32_t ka = -1 - slot[a], kb = -1 - slot[b];
+            const sw_blob_domain *Da = &c->v->domains[c->ring_d[ka]],
+                                 *Db = &c->v->domains[c->ring_d[kb]];
+            const double *Ja = ring_J(c, ka), *Jb = ring_J(c, kb);
+            for (int32_t p = 0; p < Da->rank; ++p)
+                for (int32_t q = 0; q < Db->rank; ++q) {
+                    double acc = 0;
+                    for (int i = 0; i < 3; ++i)
+                        for (int k = 0; k < 3; ++k)
+                            acc += Ja[i * Da->rank + p] * K[(3 * a + i) * 12 + 3 * b + k] *
+                                   Jb[k * Db->rank + q];
+                    red->H[(int64_t)(Da->q_offset + p) * red->R + Db->q_offset + q] += acc;
+                }
+        }
+}
+
 /* Phi(q, x) (condense.h): the gradient into (red->g, c->gf), the Hessian's parts (red->H
  * with the ring blocks, Kt, Dw) with want_hess. */
 double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
@@ -131,13 +191,17 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
     }
     memset(c->gf, 0, 3 * (size_t)c->nf * sizeof(double));
     if (want_hess) memset(c->Dw, 0, 9 * (size_t)c->nf * sizeof(double));
-    for (int32_t e = 0; e < c->nt; ++e) {
-        int32_t t = c->ft[e];
+    for (int32_t e = 0; e < c->nt + c->np; ++e) {
         const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
         double x12[12], f[12], *K = c->Kt + 144 * (int64_t)e;
         tet_positions(c, x, e, x12);
-        phi += sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, f,
-                             want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
+        if (e < c->nt) {
+            int32_t t = c->ft[e];
+            phi += sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu,
+                                 v->lambda, f, want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
+        } else {
+            phi += patch_pair(c, red, e - c->nt, x12, f, want_hess ? K : NULL);
+        }
         for (int k = 0; k < 4; ++k) {
             if (slot[k] >= 0) {
                 for (int i = 0; i < 3; ++i)
@@ -151,7 +215,8 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
                 red->g[D->q_offset + j] -= J[j] * f[3 * k] + J[D->rank + j] * f[3 * k + 1] +
                                            J[2 * D->rank + j] * f[3 * k + 2];
         }
-        if (want_hess) add_ring_blocks(c, red, e, K);
+        if (want_hess && e < c->nt) add_ring_blocks(c, red, e, K);
+        if (want_hess && e >= c->nt) add_pair_ring_blocks(c, red, e, K);
     }
     const sw_world_contacts *wc = ct->wc;
     for (int32_t j = 0; wc && j < wc->ncand; ++j) {
@@ -194,7 +259,7 @@ void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
             c->ring_dx[3 * k + i] = acc;
         }
     }
-    for (int32_t e = 0; e < c->nt; ++e) {
+    for (int32_t e = 0; e < c->nt + c->np; ++e) {
         const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
         const double *K = c->Kt + 144 * (int64_t)e;
         double z12[12], y12[12];
@@ -246,7 +311,7 @@ static void sys_prec(void *ctx, const double *r, double *z) {
 static void patch_preconditioner(sw_cond *c) {
     double *Dg = c->Pf; /* assembled in place of their inverses, then inverted */
     memcpy(Dg, c->Dw, 9 * (size_t)c->nf * sizeof(double));
-    for (int32_t e = 0; e < c->nt; ++e) {
+    for (int32_t e = 0; e < c->nt + c->np; ++e) {
         const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
         const double *K = c->Kt + 144 * (int64_t)e;
         for (int k = 0; k < 4; ++k)

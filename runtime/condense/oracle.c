@@ -27,13 +27,15 @@ static int32_t min32(int64_t a, int64_t b) {
     return (int32_t)(a < b ? a : b);
 }
 
-sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world) {
+sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world,
+                           int32_t max_pairs) {
     sw_cond_sizes z;
     memset(&z, 0, sizeof z);
     if (max_verts == 0 || v->ntets == 0) return z;
     z.max_verts = min32(max_verts, v->nverts);
     z.max_tets = min32((int64_t)z.max_verts * max_valence(v), v->ntets);
-    z.max_ring = min32(4 * (int64_t)z.max_tets, v->ndomain_verts);
+    z.max_pairs = max_pairs;
+    z.max_ring = min32(4 * ((int64_t)z.max_tets + max_pairs), v->ndomain_verts);
     z.max_cand = min32(4 * (int64_t)z.max_verts + 64, v->nverts);
     z.max_seeds = max_world > 0 ? max_world : 1;
     for (int32_t k = 0; k < v->ndomains; ++k)
@@ -94,7 +96,7 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
 void sw_cond_forget(sw_cond *c) {
     c->nseeds[0] = c->nseeds[1] = c->nseeds[2] = 0;
     c->slot = 0;
-    c->nf = c->nt = c->nring = 0;
+    c->nf = c->nt = c->nring = c->np = 0;
     c->stamp++; /* every deviation is older than any later step */
     c->stamp++;
 }
@@ -301,11 +303,40 @@ void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc) {
     wc->patch_x = c->nf > 0 ? c->x : NULL;
 }
 
-int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, const double *q) {
+/* The pose-space contact pairs in use with a corner in the patch: elements after the full
+ * tets, evaluated at the patch's positions (the rest stay reduced; ps->in_patch says
+ * which). */
+static void patch_pairs(sw_cond *c, const sw_reduced *red, sw_pose_space *ps) {
+    const sw_blob_view *v = c->v;
+    c->np = 0;
+    ps->in_patch = NULL;
+    for (int32_t p = 0; p < ps->npairs; ++p) {
+        const int32_t *cv = v->contact_verts + 8 * (int64_t)ps->pairs[p];
+        int32_t gv[4], any = 0;
+        for (int m = 0; m < 4; ++m) {
+            gv[m] = v->domain_verts[v->domains[cv[2 * m]].vert_begin + cv[2 * m + 1]];
+            any |= c->in_patch[gv[m]] == c->stamp;
+        }
+        c->pp_skip[p] = (unsigned char)any;
+        if (!any) continue;
+        int32_t *slot = c->ft_slot + 4 * ((int64_t)c->nt + c->np);
+        for (int m = 0; m < 4; ++m)
+            slot[m] = c->in_patch[gv[m]] == c->stamp
+                          ? c->vloc[gv[m]]
+                          : -1 - ring_copy(c, red, gv[m], cv[2 * m], cv[2 * m + 1]);
+        c->pp_id[c->np] = ps->pairs[p];
+        c->pp_w[c->np++] = p < ps->npairs_nearest ? 1 - ps->blend : ps->blend;
+    }
+    if (c->np > 0) ps->in_patch = c->pp_skip;
+}
+
+int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
+                       sw_pose_space *ps, const double *q) {
     c->stamp++;
     c->slot = (c->slot + 1) % SEED_STEPS;
     c->ncand = c->dropped = 0;
-    c->nf = c->nt = c->nring = 0;
+    c->nf = c->nt = c->nring = c->np = 0;
+    ps->in_patch = NULL;
     find_seeds(c, red, wc, q);
     /* the oldest seeds first, this step's last; a vertex seeded twice grows once */
     for (int32_t k = 0; k < SEED_STEPS; ++k)
@@ -323,6 +354,7 @@ int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
         c->vloc[c->cand[i]] = i;
     }
     full_tets(c, red);
+    patch_pairs(c, red, ps);
     start_positions(c, red, q);
     sw_cond_detect(c, wc, 0);
     sw_cond_tag_candidates(c, wc);

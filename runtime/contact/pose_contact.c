@@ -12,12 +12,14 @@
  * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
  * couple two domains. Added after the cubature so it lands on the full (mirrored)
  * matrix. */
-static double contact_pairs(sw_reduced *red, const int32_t *pairs, int32_t npairs, double weight,
-                            const double *q, int want_grad, int want_hess) {
+static double contact_pairs(sw_reduced *red, const int32_t *pairs, const unsigned char *skip,
+                            int32_t npairs, double weight, const double *q, int want_grad,
+                            int want_hess) {
     const sw_blob_view *v = red->v;
     double E = 0, k = weight * v->contact_k, al = SW_CONTACT_ALPHA;
     int32_t rm = red->rmax;
     for (int32_t p = 0; p < npairs; ++p) {
+        if (skip && skip[p]) continue; /* a condensation patch's (condense.h) */
         const int32_t c = pairs[p];
         const int32_t *cv = v->contact_verts + 8 * (int64_t)c;
         const double *cd = v->contact_data + 7 * (int64_t)c;
@@ -98,10 +100,12 @@ static double contact_pairs(sw_reduced *red, const int32_t *pairs, int32_t npair
 double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,
                             int want_grad, int want_hess) {
     if (ps->nearest < 0) return 0;
-    double E =
-        contact_pairs(red, ps->pairs, ps->npairs_nearest, 1 - ps->blend, q, want_grad, want_hess);
+    const unsigned char *skip = ps->in_patch;
+    double E = contact_pairs(red, ps->pairs, skip, ps->npairs_nearest, 1 - ps->blend, q, want_grad,
+                             want_hess);
     if (ps->blend > 0)
-        E += contact_pairs(red, ps->pairs + ps->npairs_nearest, ps->npairs - ps->npairs_nearest,
-                           ps->blend, q, want_grad, want_hess);
+        E += contact_pairs(red, ps->pairs + ps->npairs_nearest,
+                           skip ? skip + ps->npairs_nearest : NULL,
+                           ps->npairs - ps->npairs_nearest, ps->blend, q, want_grad, want_hess);
     return E;
 }

@@ -25,6 +25,9 @@ typedef struct sw_pose_space {
     int32_t max_pairs; /* the budget: at most this many pairs a step */
     int32_t npairs_nearest, npairs;
     int32_t dropped; /* pairs the budget left out this step */
+    /* per pairs[] entry: 1 when a condensation patch evaluates the pair with its full-space
+       positions instead (condense.h); NULL: none does */
+    const unsigned char *in_patch;
 } sw_pose_space;
 
 /* Links the training poses stored more than once into cycles (twin_next, ntrain). */

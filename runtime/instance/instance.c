@@ -104,7 +104,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     const sw_cond_sizes *cz = &z->cond;
     if (cz->max_verts > 0) {
         const uint64_t nv = (uint64_t)v->nverts, nt = (uint64_t)v->ntets,
-                       nf = (uint64_t)cz->max_verts, ntf = (uint64_t)cz->max_tets,
+                       nf = (uint64_t)cz->max_verts, np = (uint64_t)cz->max_pairs,
+                       ntf = (uint64_t)cz->max_tets + np,
                        nr = (uint64_t)cz->max_ring, m = R + 3 * nf;
         TAKE(c->seeds, 3 * (uint64_t)cz->max_seeds);
         TAKE(c->vis, nv);
@@ -126,6 +127,9 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->cand, (uint64_t)cz->max_cand);
         TAKE(c->cand_d, (uint64_t)cz->max_cand);
         TAKE(c->fv, nf);
+        TAKE(c->pp_id, np);
+        TAKE(c->pp_w, np);
+        TAKE(c->pp_skip, np);
         TAKE(c->ft, ntf);
         TAKE(c->ft_slot, 4 * ntf);
         TAKE(c->ring_v, nr);
@@ -301,7 +305,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->max_world = d->max_world_contacts == 0          ? (int32_t)wneed
                    : d->max_world_contacts > 4 * wneed ? (int32_t)(4 * wneed)
                                                        : (int32_t)d->max_world_contacts;
-    z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world);
+    z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs);
     z->rho = d->patch_radius > 0 ? d->patch_radius : SW_COND_DEFAULT_RADIUS;
     return SINEW_OK;
 }
@@ -460,6 +464,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);
     if (inst->cond.z.max_verts > 0) sw_cond_forget(&inst->cond);
+    inst->ps.in_patch = NULL;
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;
         memset(V, 0, 9 * sizeof(double));

@@ -155,11 +155,12 @@ static void phase_oracle(sw_step_ctx *c) {
     if (cd->z.max_verts == 0) return;
     if (c->st.status & SINEW_STEP_TELEPORT) sw_cond_forget(cd);
     if (!in->wc.world) {
-        cd->nf = 0;
+        cd->nf = cd->np = 0;
+        in->ps.in_patch = NULL;
         return;
     }
     cd->pcg_iters = 0;
-    sw_cond_oracle(cd, &in->red, &in->wc, in->solver.q);
+    sw_cond_oracle(cd, &in->red, &in->wc, &in->ps, in->solver.q);
     c->st.patch_vertices = (uint32_t)cd->nf;
     c->st.patch_tets = (uint32_t)cd->nt;
     if (cd->dropped > 0) {
@@ -292,7 +293,8 @@ static sinew_result check_output(sw_step_ctx *c) {
         if (!(fabs(in->surf_x[i]) <= FLT_MAX) || !(fabs(in->surf_n[i]) <= FLT_MAX)) {
             memcpy(in->solver.q, in->solver.qn, (size_t)in->red.R * sizeof(double));
             memset(in->solver.qdot, 0, (size_t)in->red.R * sizeof(double));
-            in->cond.nf = 0; /* no patch: the subspace state alone */
+            in->cond.nf = in->cond.np = 0; /* no patch: the subspace state alone */
+            in->ps.in_patch = NULL;
             sw_instance_write_surface(in);
             c->st.status |= SINEW_STEP_FAILED;
             return SINEW_ERROR_NOT_FINITE;
