@@ -9,6 +9,7 @@
 #include "blob_load.h"
 #include "clock.h"
 #include "instance.h"
+#include "instance_internal.h"
 #include "tool_common.h"
 
 /* Passes of the scene timed; a frame's time is its fastest pass (the least disturbed by
@@ -93,12 +94,19 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
             if (!touch[f]) continue;
             sw_instance_full_positions(inst, xs, cnt);
             sw_instance_dqs_positions(inst, xd);
+            double fn = 0, fd = 0, fin = 0;
             for (int32_t i = 0; i < n; ++i)
                 for (int k = 0; k < 3; ++k) {
                     double a = xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - xd[3 * i + k];
                     num += mass[i] * a * a;
                     den += mass[i] * b * b;
+                    fn += mass[i] * a * a;
+                    fd += mass[i] * b * b;
+                    if (sw_cond_position(&inst->cond, i)) fin += mass[i] * a * a;
                 }
+            if (getenv("SW_COND_DEBUG"))
+                fprintf(stderr, "frame %d: patch %u, err num %.3g (in patch %.3g) den %.3g\n", f,
+                        st.patch_vertices, fn, fin, fd);
         }
     }
     out->err_world_cond = den > 0 ? sqrt(num / den) : 0;

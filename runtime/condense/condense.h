@@ -56,19 +56,19 @@ typedef struct sw_cond {
     int32_t nseeds[3]; /* seeds per slot */
     int32_t slot;      /* this step's slot */
     /* per simulation vertex (memory only: a step touches the patch's entries) */
-    uint32_t *vis;      /* growth visit stamp */
-    uint32_t *in_patch; /* patch stamp: == stamp when the vertex is a patch vertex */
-    int32_t *vloc;      /* its patch index, or (ring) -1 - its first ring copy */
-    uint32_t *in_ring;  /* ring stamp */
-    uint32_t *seeded;   /* seed stamp (a vertex seeded twice grows once) */
+    uint32_t *vis;         /* growth visit stamp */
+    uint32_t *in_patch;    /* patch stamp: == stamp when the vertex is a patch vertex */
+    int32_t *vloc;         /* its patch index, or (ring) -1 - its first ring copy */
+    uint32_t *in_ring;     /* ring stamp */
+    uint32_t *seeded;      /* seed stamp (a vertex seeded twice grows once) */
     unsigned char *pinned; /* kinematic (a bone vertex): never in a patch */
     int32_t *surf_of;      /* its boundary surface vertex, or -1 */
-    double *dev;        /* 3 per vertex: its last patch position minus its subspace one */
-    uint32_t *dev_at;   /* the stamp of the step that left dev */
-    uint32_t *tvis;     /* per tet: full-tet stamp */
-    int32_t *tet_cub;   /* per tet: its cubature index, or -1 */
-    double *dom_vol;    /* ndomains: rest volume of the domain's tets */
-    double *dom_wvol;   /* ndomains: sum of w_c vol_c over its cubature tets */
+    double *dev;           /* 3 per vertex: its last patch position minus its subspace one */
+    uint32_t *dev_at;      /* the stamp of the step that left dev */
+    uint32_t *tvis;        /* per tet: full-tet stamp */
+    int32_t *tet_cub;      /* per tet: its cubature index, or -1 */
+    double *dom_vol;       /* ndomains: rest volume of the domain's tets */
+    double *dom_wvol;      /* ndomains: sum of w_c vol_c over its cubature tets */
     uint32_t stamp, vstamp;
     /* the growth */
     int32_t *queue; /* max_cand */
@@ -78,14 +78,14 @@ typedef struct sw_cond {
     int32_t dropped; /* vertices the budget left out this step */
     /* the patch */
     int32_t nf, nt, nring;
-    int32_t np;        /* pose-space contact pairs with a patch corner (elements nt ..) */
-    int32_t *pp_id;    /* max_pairs: their contact ids */
-    double *pp_w;      /* max_pairs: their pose-space blend weights */
+    int32_t np;             /* pose-space contact pairs with a patch corner (elements nt ..) */
+    int32_t *pp_id;         /* max_pairs: their contact ids */
+    double *pp_w;           /* max_pairs: their pose-space blend weights */
     unsigned char *pp_skip; /* max_pairs: per ps->pairs entry, the patch evaluates it */
-    int32_t *fv;      /* nf: patch vertices (global ids) */
-    int32_t *ft;      /* nt: full tets */
-    int32_t *ft_slot; /* 4 per full tet: patch index >= 0, or -1 - ring copy */
-    int32_t *ring_v;  /* per ring copy: global vertex, domain, local index, next copy */
+    int32_t *fv;            /* nf: patch vertices (global ids) */
+    int32_t *ft;            /* nt: full tets */
+    int32_t *ft_slot;       /* 4 per full tet: patch index >= 0, or -1 - ring copy */
+    int32_t *ring_v;        /* per ring copy: global vertex, domain, local index, next copy */
     int32_t *ring_d, *ring_l, *ring_next;
     double *ring_x0;         /* 3 per ring copy: R rest + t (its position at q = 0) */
     double *ring_J;          /* 3 rmax per ring copy: J = R U (3 x r_d) */
@@ -103,6 +103,16 @@ typedef struct sw_cond {
     double *cg_r, *cg_z, *cg_p, *cg_Ap, *rhs, *sol; /* R + 3 nf each */
     double *cub_w;      /* ncub: the cubature weights in use (red->cub_w points here) */
     uint32_t pcg_iters; /* of the last solve */
+    /* dynamics (patch_dynamics.c): per vertex its last patch step's position, velocity,
+       deviation from the subspace and that deviation's rate (3 each), stamped dyn_at */
+    double *px, *pv, *pdev, *prate;
+    uint32_t *dyn_at;
+    double *xn, *vn, *dev_n, *rate_n; /* 3 nf: the patch vertices' start state */
+    double *mass;                     /* nf: their lumped masses */
+    double *q_prev;                   /* R: q one step before q_n */
+    sw_dualquat *dq_prev, *dq_prev2;  /* nbones each: the two poses before (scratch) */
+    int32_t *keep_v;                  /* max_verts: the last patch, kept while unsettled */
+    int32_t nkeep, keep;
 } sw_cond;
 
 /* The sizes for a budget of max_verts patch vertices (0: off). */
@@ -117,12 +127,13 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho);
 void sw_cond_forget(sw_cond *c);
 
 /* The partition oracle at the state q: seeds from the world's candidates penetrating at
- * q (and those of the two steps before), the growth, the full tets and ring copies (their
- * skinning and Jacobians), the patch's start positions (the subspace position plus the
- * deviation the vertex had when it was last in a patch), and the world candidates tagged
- * with their patch vertex. Returns the patch's vertex count. */
-int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
-                       sw_pose_space *ps, const double *q);
+ * q (and those of the two steps before, and in a dynamic step the last patch while it
+ * has not settled), the growth, the full tets and ring copies (their skinning and
+ * Jacobians), the pose-space pairs the patch touches, and the patch's start positions
+ * (the subspace position plus the deviation the vertex had when it was last in a patch).
+ * Returns the patch's vertex count; then sw_cond_detect and sw_cond_tag_candidates. */
+int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, sw_pose_space *ps,
+                       const double *q);
 
 /* The world's candidates of the patch's surface vertices at their patch positions: the
  * laws taken again there, new colliders within the detection radius (penetrating_only:
@@ -152,6 +163,20 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
                          const sw_solver *s, const double *q, const double *x,
                          const sw_dyn_coef *dc, int want_hess);
 void sw_cond_hessian_apply(void *ctx, const double *z, double *y);
+
+/* Dynamic steps (patch_dynamics.c): the patch vertices' start state x_n, v_n (their own
+ * from the last step when they were in its patch, else the subspace's motion under the
+ * two poses before, dq_prev2 NULL: at rest, dq_prev NULL: no pose history) and their
+ * start at x_n + h v_n; the backward-Euler terms of Phi, sum m/2 (cm |x - x_n - h v_n|^2
+ * + cd alpha |x - x_n|^2), with their gradient into c->gf and Hessian into c->Dw (the
+ * Rayleigh stiffness part is left to the reduced coordinates); after the step the state
+ * kept and the dynamics oracle (keep: the patch stays while it moves). */
+void sw_cond_dynamics_start(sw_cond *c, const sw_reduced *red, const sw_solver *s,
+                            const sw_dyn_coef *dc, const sw_dualquat *dq_prev,
+                            const sw_dualquat *dq_prev2);
+double sw_cond_inertia(sw_cond *c, const sw_dyn_coef *dc, const double *x, int want_hess);
+void sw_cond_dynamics_finish(sw_cond *c, const sw_reduced *red, const double *q,
+                             const sw_dyn_coef *dc, double size);
 
 /* After a step: each patch vertex's deviation from its subspace position at q (the next
  * patch's start); the patch stays readable until the next oracle. */

@@ -5,8 +5,6 @@
  * the coupling are applied tet by tet from each full tet's 12x12 K. */
 #include <math.h>
 #include <string.h>
-#include <stdio.h>
-#include <stdlib.h>
 
 #include "condense.h"
 #include "dense.h"
@@ -231,6 +229,7 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
         for (int i = 0; want_hess && i < 9; ++i)
             c->Dw[9 * (int64_t)cd->patch + i] += H3[i];
     }
+    if (dc->dynamic) phi += sw_cond_inertia(c, dc, x, want_hess);
     return phi;
 }
 
@@ -413,9 +412,6 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         st->newton_iterations++;
     }
     sw_cond_weights_restore(c, red);
-    if (getenv("SW_COND_DEBUG"))
-        fprintf(stderr, "cond: nf %d nt %d np %d newton %u evals %u pcg %u res %.2g\n", c->nf, c->nt,
-                c->np, st->newton_iterations, st->potential_evals, c->pcg_iters, g0 > 0 ? gn / g0 : 0);
     st->residual = g0 > 0 ? gn / g0 : 0;
     st->energy = phi;
     return res;

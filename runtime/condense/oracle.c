@@ -51,6 +51,7 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     memset(c->in_ring, 0, (size_t)v->nverts * sizeof *c->in_ring);
     memset(c->seeded, 0, (size_t)v->nverts * sizeof *c->seeded);
     memset(c->dev_at, 0, (size_t)v->nverts * sizeof *c->dev_at);
+    memset(c->dyn_at, 0, (size_t)v->nverts * sizeof *c->dyn_at);
     memset(c->tvis, 0, (size_t)v->ntets * sizeof *c->tvis);
     for (int32_t t = 0; t < v->ntets; ++t)
         c->tet_cub[t] = -1;
@@ -97,6 +98,7 @@ void sw_cond_forget(sw_cond *c) {
     c->nseeds[0] = c->nseeds[1] = c->nseeds[2] = 0;
     c->slot = 0;
     c->nf = c->nt = c->nring = c->np = 0;
+    c->keep = c->nkeep = 0;
     c->stamp++; /* every deviation is older than any later step */
     c->stamp++;
 }
@@ -286,8 +288,8 @@ int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, int penetrating_
         int32_t s = c->surf_of[c->fv[i]];
         if (s < 0) continue;
         for (int32_t k = v->surf_copy_ptr[s]; k < v->surf_copy_ptr[s + 1]; ++k)
-            added += sw_world_contacts_at(wc, k, c->x + 3 * (int64_t)i, v->contact_k,
-                                          penetrating_only);
+            added +=
+                sw_world_contacts_at(wc, k, c->x + 3 * (int64_t)i, v->contact_k, penetrating_only);
     }
     return added;
 }
@@ -330,8 +332,8 @@ static void patch_pairs(sw_cond *c, const sw_reduced *red, sw_pose_space *ps) {
     if (c->np > 0) ps->in_patch = c->pp_skip;
 }
 
-int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
-                       sw_pose_space *ps, const double *q) {
+int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, sw_pose_space *ps,
+                       const double *q) {
     c->stamp++;
     c->slot = (c->slot + 1) % SEED_STEPS;
     c->ncand = c->dropped = 0;
@@ -346,6 +348,10 @@ int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
             c->seeded[s] = c->stamp;
             grow(c, s);
         }
+    /* the dynamics oracle's: the last patch while its flesh still moves */
+    for (int32_t i = 0; c->keep && i < c->nkeep; ++i)
+        if (!c->pinned[c->keep_v[i]] && !accept(c, c->keep_v[i], 0)) c->dropped++;
+    c->keep = 0;
     if (c->ncand > c->z.max_verts) /* over budget: the nearest stay in the patch */
         keep_nearest(c, c->z.max_verts);
     c->nf = c->ncand;
@@ -356,8 +362,6 @@ int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
     full_tets(c, red);
     patch_pairs(c, red, ps);
     start_positions(c, red, q);
-    sw_cond_detect(c, wc, 0);
-    sw_cond_tag_candidates(c, wc);
     return c->nf;
 }
 

@@ -105,8 +105,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     if (cz->max_verts > 0) {
         const uint64_t nv = (uint64_t)v->nverts, nt = (uint64_t)v->ntets,
                        nf = (uint64_t)cz->max_verts, np = (uint64_t)cz->max_pairs,
-                       ntf = (uint64_t)cz->max_tets + np,
-                       nr = (uint64_t)cz->max_ring, m = R + 3 * nf;
+                       ntf = (uint64_t)cz->max_tets + np, nr = (uint64_t)cz->max_ring,
+                       m = R + 3 * nf;
         TAKE(c->seeds, 3 * (uint64_t)cz->max_seeds);
         TAKE(c->vis, nv);
         TAKE(c->in_patch, nv);
@@ -156,6 +156,20 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->rhs, m);
         TAKE(c->sol, m);
         TAKE(c->cub_w, (uint64_t)v->ncub);
+        TAKE(c->px, 3 * nv);
+        TAKE(c->pv, 3 * nv);
+        TAKE(c->pdev, 3 * nv);
+        TAKE(c->prate, 3 * nv);
+        TAKE(c->dyn_at, nv);
+        TAKE(c->xn, 3 * nf);
+        TAKE(c->vn, 3 * nf);
+        TAKE(c->dev_n, 3 * nf);
+        TAKE(c->rate_n, 3 * nf);
+        TAKE(c->mass, nf);
+        TAKE(c->q_prev, R);
+        TAKE(c->dq_prev, nb);
+        TAKE(c->dq_prev2, nb);
+        TAKE(c->keep_v, nf);
     }
     /* the output */
     TAKE(in->surf_x, 3 * ns);

@@ -160,7 +160,20 @@ static void phase_oracle(sw_step_ctx *c) {
         return;
     }
     cd->pcg_iters = 0;
-    sw_cond_oracle(cd, &in->red, &in->wc, &in->ps, in->solver.q);
+    if (sw_cond_oracle(cd, &in->red, &in->wc, &in->ps, in->solver.q) > 0) {
+        if (c->dc.dynamic) {
+            const sw_pose_history *ph = &in->pose;
+            for (int32_t b = 0; b < in->v->nbones; ++b) {
+                sw_dq_from_transform(ph->T_prev + 12 * b, &cd->dq_prev[b]);
+                sw_dq_from_transform(ph->T_prev2 + 12 * b, &cd->dq_prev2[b]);
+            }
+            sw_cond_dynamics_start(cd, &in->red, &in->solver, &c->dc,
+                                   ph->history >= 1 ? cd->dq_prev : NULL,
+                                   ph->history >= 2 ? cd->dq_prev2 : NULL);
+        }
+        sw_cond_detect(cd, &in->wc, 0);
+    }
+    sw_cond_tag_candidates(cd, &in->wc);
     c->st.patch_vertices = (uint32_t)cd->nf;
     c->st.patch_tets = (uint32_t)cd->nt;
     if (cd->dropped > 0) {
@@ -224,6 +237,8 @@ static sinew_result phase_solve(sw_step_ctx *c) {
     c->st.cubature_tets = (uint32_t)in->v->ncub;
     if (in->cond.nf > 0) {
         if (r == SINEW_OK) sw_cond_finish(&in->cond, &in->red, in->solver.q);
+        if (r == SINEW_OK && c->dc.dynamic)
+            sw_cond_dynamics_finish(&in->cond, &in->red, in->solver.q, &c->dc, in->size);
         c->st.pcg_iterations = in->cond.pcg_iters;
     }
     c->st.ms_solve = lap(c) - ms_aside;
