@@ -10,11 +10,39 @@
 #include "clock.h"
 #include "instance.h"
 #include "instance_internal.h"
+#include "mesh_io.h"
 #include "tool_common.h"
 
 /* Passes of the scene timed; a frame's time is its fastest pass (the least disturbed by
  * the machine's other work: the per-frame ratios are what the figures are made of). */
 #define COND_PASSES 3
+
+/* The output surface's vertex colours: skin, turning red with the share of a vertex's
+ * position that comes from patch vertices (its own, or its embedding tet's corners'). */
+static void patch_colors(const sinew_instance *inst, double *C) {
+    const sw_blob_view *v = inst->v;
+    const double skin[3] = {0.80, 0.45, 0.36}, red[3] = {0.85, 0.05, 0.05};
+    for (int32_t i = 0; i < sw_blob_output_verts(v); ++i) {
+        double w = 0;
+        if (v->nrender_verts > 0) {
+            int32_t t = v->render_tet[v->render_weld[i]];
+            for (int k = 0; k < 4; ++k)
+                if (sw_cond_position(&inst->cond,
+                                     sw_render_node_vertex(v, v->render_tets[4 * t + k])))
+                    w += fabs(v->render_bary[4 * (int64_t)v->render_weld[i] + k]);
+            w = w > 1 ? 1 : w;
+        } else {
+            int32_t c0 = v->surf_copy_ptr[i], d = v->surf_copies[2 * c0];
+            w = sw_cond_position(
+                    &inst->cond,
+                    v->domain_verts[v->domains[d].vert_begin + v->surf_copies[2 * c0 + 1]])
+                    ? 1
+                    : 0;
+        }
+        for (int k = 0; k < 3; ++k)
+            C[3 * i + k] = (1 - w) * skin[k] + w * red[k];
+    }
+}
 
 /* The largest one-frame move of an output vertex between a and b (3 n each). */
 static double max_jump(const double *a, const double *b, int32_t n) {
@@ -52,7 +80,17 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
     double *prev = malloc(sizeof(double) * 3 * ns), *ref_prev = malloc(sizeof(double) * 3 * ns),
            *ref_out = malloc(sizeof(double) * 3 * ns);
     float *pos = malloc(sizeof(float) * 3 * ns), *nrm = malloc(sizeof(float) * 3 * ns);
-    if (!ms || !sorted || !xs || !cnt || !xd || !prev || !ref_prev || !ref_out || !pos || !nrm) {
+    double *col = malloc(sizeof(double) * 3 * ns);
+    char dir[4096] = "";
+    if (cp->out_dir && rho == (cp->nrho ? cp->rho[0] : 0)) {
+        snprintf(dir, sizeof dir, "%s/condensed", cp->out_dir);
+        if (!sw_tool_make_dirs(dir)) {
+            r = sw_error_set(err, SINEW_ERROR_IO, "%s: cannot create the folder", dir);
+            goto done;
+        }
+    }
+    if (!ms || !sorted || !xs || !cnt || !xd || !prev || !ref_prev || !ref_out || !pos || !nrm ||
+        !col) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the condensed run");
         goto done;
     }
@@ -89,6 +127,14 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
                 if (ref_jump > 0) out->pop_max = fmax(out->pop_max, jump / ref_jump);
             }
             last_patch = st.patch_vertices;
+            if (dir[0]) { /* the frame, its patch in red (sinew-render --frames DIR) */
+                char path[4200];
+                snprintf(path, sizeof path, "%s/frame_%04d.obj", dir, f);
+                patch_colors(inst, col);
+                if ((r = sw_write_obj_colors(path, ns, xo, col, sw_blob_output_ntris(v),
+                                             sw_blob_output_tris(v), err)) != SINEW_OK)
+                    goto done;
+            }
             memcpy(prev, xo, sizeof(double) * 3 * ns);
             memcpy(ref_prev, ref_out, sizeof(double) * 3 * ns);
             if (!touch[f]) continue;
@@ -122,7 +168,7 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
     out->p100_over_p50 = out->ms_median > 0 ? out->ms_max / out->ms_median : 0;
 done:
     free(ms), free(sorted), free(xs), free(cnt), free(xd), free(prev), free(ref_prev);
-    free(ref_out), free(pos), free(nrm);
+    free(ref_out), free(pos), free(nrm), free(col);
     sinew_instance_destroy(inst);
     return r;
 }

@@ -13,6 +13,8 @@ typedef struct sw_cond_bench_params {
     double rho[SW_COND_MAX_RHO]; /* patch radii in units of the rest diagonal */
     int nrho;                    /* 0: the default radius alone */
     uint32_t budget;             /* max_patch_vertices (0: a quarter of the vertices) */
+    const char *out_dir;         /* NULL, or where the first radius's frames go as OBJ files
+                                    (DIR/condensed/frame_NNNN.obj), patch vertices coloured */
 } sw_cond_bench_params;
 
 typedef struct sw_cond_bench {

@@ -156,7 +156,9 @@ static void usage(FILE *f) {
             "                      (default 10000)\n"
             "  --threads T         0..256 (default 0: all cores); also the crowd's threads\n"
             "  --out DIR           write the subspace surface of every clip frame as\n"
-            "                      DIR/frame_NNNN.obj\n"
+            "                      DIR/frame_NNNN.obj; with --world, the condensed run's\n"
+            "                      (the first radius) as DIR/condensed/frame_NNNN.obj, the\n"
+            "                      patch in red (sinew-render --frames DIR/condensed)\n"
             "  --world F           also run reference and runtime against world file F (.json,\n"
             "                      schema 1, samples/worlds/README.md) and report its figures;\n"
             "                      with a blob holding the tet mesh, also a condensed runtime\n"
@@ -309,7 +311,7 @@ int main(int argc, char **argv) {
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     int dynamic = 0, hold_frames = 0, instances = 0, patch_budget = 0;
-    sw_cond_bench_params cond = {{0}, 0, 0};
+    sw_cond_bench_params cond = {{0}, 0, 0, NULL};
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
@@ -365,6 +367,7 @@ int main(int argc, char **argv) {
         return 2;
     }
     cond.budget = (uint32_t)patch_budget;
+    cond.out_dir = out_dir;
     if (world_path && !sw_tool_format(tool, "--world", world_path, "json", ".json (world file)"))
         return 2;
     /* the output folder before the long run: an unwritable one is an error now */

@@ -37,7 +37,9 @@ static void usage(FILE *f) {
     fprintf(f,
             "usage: sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [options]\n"
             "       sinew-render --frames DIR --out IMAGE.png [--grid N] [options]\n"
-            "  --obj FILE      a Wavefront OBJ surface; several make a contact sheet\n"
+            "  --obj FILE      a Wavefront OBJ surface; several make a contact sheet (vertex\n"
+            "                  colours, v x y z r g b, colour its triangles: sinew-bench\n"
+            "                  --world --out marks the full-space patch so)\n"
             "  --frames DIR    every DIR/frame_NNNN.obj (as written by sinew-fullsim --out)\n"
             "  --grid N        with --frames: at most N x N evenly spaced frames, 1..64\n"
             "                  (default 4)\n"
@@ -212,22 +214,38 @@ static void progress_bar(uint8_t *tile, int w, int h, double frac) {
         }
 }
 
+/* Each triangle's colour, the mean of its corners' vertex colours, or NULL (the
+ * renderer's skin tone) for a file without colours. */
+static float *triangle_colors(const sw_trimesh *m, const double *C) {
+    float *tc = C ? malloc(sizeof(float) * 3 * (size_t)(m->ntris ? m->ntris : 1)) : NULL;
+    for (int32_t t = 0; tc && t < m->ntris; ++t)
+        for (int k = 0; k < 3; ++k)
+            tc[3 * t + k] = (float)((C[3 * m->tris[3 * t] + k] + C[3 * m->tris[3 * t + 1] + k] +
+                                     C[3 * m->tris[3 * t + 2] + k]) /
+                                    3);
+    return tc;
+}
+
 static int render_all(const options *o, const char **paths, int n) {
     sw_trimesh *m = calloc((size_t)n, sizeof *m);
+    float **tc = calloc((size_t)n, sizeof *tc);
     uint8_t *tile = NULL, *sheet = NULL;
-    int ok = m != NULL;
+    int ok = m != NULL && tc != NULL;
     sw_error err;
     sw_error_clear(&err);
     double bmin[3] = {INFINITY, INFINITY, INFINITY}, bmax[3] = {-INFINITY, -INFINITY, -INFINITY};
     long long total_tris = 0;
     for (int i = 0; ok && i < n; ++i) {
         double lo[3], hi[3];
-        if (sw_read_obj(paths[i], &m[i], &err) ||
+        double *C = NULL; /* vertex colours (sinew-bench --world --out: the patch) */
+        if (sw_read_obj_colors(paths[i], &m[i], &C, &err) ||
             sw_render_bbox(m[i].nverts, m[i].X, lo, hi, &err)) {
             fprintf(stderr, "sinew-render: %s\n", err.msg);
             ok = 0;
             break;
         }
+        tc[i] = triangle_colors(&m[i], C);
+        free(C);
         total_tris += m[i].ntris;
         for (int k = 0; k < 3; ++k) {
             if (lo[k] < bmin[k]) bmin[k] = lo[k];
@@ -265,7 +283,7 @@ static int render_all(const options *o, const char **paths, int n) {
     clock_gettime(CLOCK_MONOTONIC, &t0);
     if (ok) memset(sheet, 64, (size_t)W * H * 3); /* dark grey gutters */
     for (int i = 0; ok && i < n; ++i) {
-        if (sw_render_surface(&p, m[i].nverts, m[i].X, m[i].ntris, m[i].tris, NULL, tile, &err)) {
+        if (sw_render_surface(&p, m[i].nverts, m[i].X, m[i].ntris, m[i].tris, tc[i], tile, &err)) {
             fprintf(stderr, "sinew-render: %s: %s\n", paths[i], err.msg);
             ok = 0;
             break;
@@ -292,7 +310,10 @@ static int render_all(const options *o, const char **paths, int n) {
     }
     for (int i = 0; m && i < n; ++i)
         sw_trimesh_free(&m[i]);
+    for (int i = 0; tc && i < n; ++i)
+        free(tc[i]);
     free(m);
+    free(tc);
     free(tile);
     free(sheet);
     return ok;

@@ -43,6 +43,13 @@ sinew_result sw_parse_obj(const char *text, size_t len, const char *name_for_err
                           sw_trimesh *out, sw_error *err);
 sinew_result sw_write_obj(const char *path, int32_t nverts, const double *X, int32_t ntris,
                           const int32_t *tris, sw_error *err);
+/* The same with vertex colours: sw_read_obj_colors gives the file's "v x y z r g b"
+ * colours (3 per vertex, clamped to [0, 1], the caller frees them) in *colors, NULL when
+ * not every vertex has one; sw_write_obj_colors writes C (3 per vertex) so, or none when
+ * C is NULL (sinew-render colours a triangle by its corners' mean). */
+sinew_result sw_read_obj_colors(const char *path, sw_trimesh *out, double **colors, sw_error *err);
+sinew_result sw_write_obj_colors(const char *path, int32_t nverts, const double *X, const double *C,
+                                 int32_t ntris, const int32_t *tris, sw_error *err);
 
 /* libigl .tgf: joint lines "index x y z", a "#" separator, edge lines "a b [flags...]"
  * (1-based). Bones keep file order; parents are derived from shared joints. */

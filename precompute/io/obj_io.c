@@ -71,6 +71,10 @@ typedef struct obj_state {
     double *X;
     int32_t *tris;
     size_t nv, cap_v, nt, cap_t;
+    double *C; /* 3 per vertex: its "v x y z r g b" colour (want_colors only) */
+    size_t cap_c;
+    int colored; /* every vertex so far had a colour */
+    int want_colors;
 } obj_state;
 
 static sinew_result read_vertex(sw_text_reader *r, obj_state *s) {
@@ -81,12 +85,22 @@ static sinew_result read_vertex(sw_text_reader *r, obj_state *s) {
         return sw_text_fail(r, r->tline, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     for (int k = 0; k < 3; ++k)
         if ((rc = sw_text_double(r, 1, "vertex coordinate", s->X + 3 * s->nv + k))) return rc;
+    double extra[4];
+    int nextra = 0;
     for (int k = 0; k < 4; ++k) { /* optional w or vertex colour */
         const char *t;
         size_t save = r->pos;
         if (sw_text_word(r, &t) == 0) break;
         r->pos = save;
-        if ((rc = sw_text_number(r, 1, "vertex weight or colour"))) return rc;
+        if ((rc = sw_text_double(r, 1, "vertex weight or colour", extra + nextra))) return rc;
+        nextra++;
+    }
+    s->colored = s->colored && nextra == 3;
+    if (s->want_colors && s->colored) {
+        if (!sw_grow((void **)&s->C, &s->cap_c, 3 * (s->nv + 1), sizeof(double)))
+            return sw_text_fail(r, r->tline, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+        for (int k = 0; k < 3; ++k) /* a colour outside [0, 1] is clamped into it */
+            s->C[3 * s->nv + k] = extra[k] > 1 ? 1 : extra[k] > 0 ? extra[k] : 0;
     }
     if ((rc = sw_text_expect_eol(r, "the vertex"))) return rc;
     s->nv++;
@@ -122,10 +136,12 @@ static sinew_result read_face(sw_text_reader *r, obj_state *s) {
 }
 
 /* Parses the opened reader `r` into *out (zeroed by the caller) and closes it. */
-static sinew_result read_obj(sw_text_reader *r, sw_trimesh *out) {
+static sinew_result read_obj(sw_text_reader *r, sw_trimesh *out, double **colors) {
     sinew_result rc = SINEW_OK;
     obj_state s;
     memset(&s, 0, sizeof s);
+    s.colored = 1;
+    s.want_colors = colors != NULL;
     while (!rc && sw_text_skip_blank_lines(r)) {
         const char *t;
         size_t n = sw_text_word(r, &t);
@@ -143,11 +159,13 @@ static sinew_result read_obj(sw_text_reader *r, sw_trimesh *out) {
         rc = sw_text_fail(r, sw_text_eof_line(r), SINEW_ERROR_PARSE, "no %s in the file",
                           s.nv == 0 ? "vertices" : "faces");
     sw_text_close(r);
+    if (rc || !s.colored || !colors) free(s.C);
     if (rc) {
         free(s.X);
         free(s.tris);
         return rc;
     }
+    if (colors) *colors = s.colored ? s.C : NULL;
     out->nverts = (int32_t)s.nv;
     out->ntris = (int32_t)s.nt;
     out->X = s.X;
@@ -160,7 +178,17 @@ sinew_result sw_read_obj(const char *path, sw_trimesh *out, sw_error *err) {
     if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_obj: no output");
     sw_text_reader r;
     sinew_result rc = sw_text_open(&r, path, '#', err);
-    return rc ? rc : read_obj(&r, out);
+    return rc ? rc : read_obj(&r, out, NULL);
+}
+
+sinew_result sw_read_obj_colors(const char *path, sw_trimesh *out, double **colors, sw_error *err) {
+    if (out) memset(out, 0, sizeof *out);
+    if (colors) *colors = NULL;
+    if (!out || !colors)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_read_obj_colors: no output");
+    sw_text_reader r;
+    sinew_result rc = sw_text_open(&r, path, '#', err);
+    return rc ? rc : read_obj(&r, out, colors);
 }
 
 sinew_result sw_parse_obj(const char *text, size_t len, const char *name_for_errors,
@@ -169,11 +197,16 @@ sinew_result sw_parse_obj(const char *text, size_t len, const char *name_for_err
     if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_parse_obj: no output");
     sw_text_reader r;
     sinew_result rc = sw_text_open_mem(&r, name_for_errors, text, len, '#', err);
-    return rc ? rc : read_obj(&r, out);
+    return rc ? rc : read_obj(&r, out, NULL);
 }
 
 sinew_result sw_write_obj(const char *path, int32_t nverts, const double *X, int32_t ntris,
                           const int32_t *tris, sw_error *err) {
+    return sw_write_obj_colors(path, nverts, X, NULL, ntris, tris, err);
+}
+
+sinew_result sw_write_obj_colors(const char *path, int32_t nverts, const double *X, const double *C,
+                                 int32_t ntris, const int32_t *tris, sw_error *err) {
     if (!path || nverts < 0 || ntris < 0 || (nverts && !X) || (ntris && !tris))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_write_obj: bad arguments");
     for (int64_t i = 0; i < 3 * (int64_t)ntris; ++i)
@@ -183,8 +216,11 @@ sinew_result sw_write_obj(const char *path, int32_t nverts, const double *X, int
                                 (long long)(i / 3), tris[i], nverts);
     FILE *f = fopen(path, "w");
     if (!f) return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot open for writing", path);
-    for (int32_t v = 0; v < nverts; ++v)
-        fprintf(f, "v %.17g %.17g %.17g\n", X[3 * v], X[3 * v + 1], X[3 * v + 2]);
+    for (int32_t v = 0; v < nverts; ++v) {
+        fprintf(f, "v %.17g %.17g %.17g", X[3 * v], X[3 * v + 1], X[3 * v + 2]);
+        if (C) fprintf(f, " %.4g %.4g %.4g", C[3 * v], C[3 * v + 1], C[3 * v + 2]);
+        fputc('\n', f);
+    }
     for (int32_t t = 0; t < ntris; ++t)
         fprintf(f, "f %d %d %d\n", tris[3 * t] + 1, tris[3 * t + 1] + 1, tris[3 * t + 2] + 1);
     int bad = ferror(f);
