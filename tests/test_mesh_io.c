@@ -382,6 +382,36 @@ TEST(obj_reads_polygons_and_relative_indices) {
     sw_trimesh_free(&m);
 }
 
+TEST(obj_vertex_colours_round_trip) {
+    const double X[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0}, C[9] = {1, 0, 0, 0.5, 0.25, 0, 0, 0, 1};
+    const int32_t tri[3] = {0, 1, 2};
+    sw_error e;
+    ENSURE(sw_write_obj_colors(tmp_path("c.obj"), 3, X, C, 1, tri, &e) == SINEW_OK);
+    sw_trimesh m;
+    double *col = NULL;
+    ENSURE(sw_read_obj_colors(tmp_path("c.obj"), &m, &col, &e) == SINEW_OK);
+    ENSURE(col && m.nverts == 3);
+    for (int i = 0; i < 9; ++i)
+        ENSURE(col[i] == C[i] && m.X[i] == X[i]);
+    free(col);
+    sw_trimesh_free(&m);
+    /* a vertex without a colour: none; a colour outside [0, 1]: clamped */
+    ENSURE(sw_read_obj_colors(write_text("c2.obj", "v 0 0 0 1 0 0\nv 1 0 0\nv 0 1 0 0 0 1\n"
+                                                   "f 1 2 3\n"),
+                              &m, &col, &e) == SINEW_OK);
+    ENSURE(col == NULL);
+    sw_trimesh_free(&m);
+    ENSURE(sw_read_obj_colors(write_text("c3.obj", "v 0 0 0 2 -1 0.5\nv 1 0 0 0 0 0\n"
+                                                   "v 0 1 0 0 0 1\nf 1 2 3\n"),
+                              &m, &col, &e) == SINEW_OK);
+    ENSURE(col && col[0] == 1 && col[1] == 0 && col[2] == 0.5);
+    free(col);
+    sw_trimesh_free(&m);
+    /* plain reading ignores them */
+    ENSURE(sw_read_obj(tmp_path("c.obj"), &m, &e) == SINEW_OK && m.nverts == 3);
+    sw_trimesh_free(&m);
+}
+
 TEST(obj_rejects_malformed) {
     static const bad_case cases[] = {
         {"f 1/1/1 2/1/1 3/1/1 4/1/1", "f 1 2 0", SINEW_ERROR_PARSE, 13, "1-based"},
@@ -1093,11 +1123,11 @@ TEST(byte_flips_never_crash) {
 SW_TEST_MAIN(CASE(medit_reads_small_mesh), CASE(medit_reorients_negative_tets),
              CASE(medit_rejects_malformed), CASE(medit_rejects_truncated_and_missing),
              CASE(tetgen_reads_both_bases), CASE(tetgen_rejects_malformed),
-             CASE(obj_reads_polygons_and_relative_indices), CASE(obj_rejects_malformed),
-             CASE(tgf_reads_and_derives_parents), CASE(tgf_rejects_malformed),
-             CASE(dmat_round_trips_ascii_and_binary), CASE(dmat_rejects_malformed),
-             CASE(weights_are_checked_and_normalised), CASE(parse_from_memory_matches_files),
-             CASE(medit_and_obj_round_trip), CASE(surface_of_small_meshes),
-             CASE(quality_of_known_tets), CASE(real_tet_meshes),
+             CASE(obj_reads_polygons_and_relative_indices), CASE(obj_vertex_colours_round_trip),
+             CASE(obj_rejects_malformed), CASE(tgf_reads_and_derives_parents),
+             CASE(tgf_rejects_malformed), CASE(dmat_round_trips_ascii_and_binary),
+             CASE(dmat_rejects_malformed), CASE(weights_are_checked_and_normalised),
+             CASE(parse_from_memory_matches_files), CASE(medit_and_obj_round_trip),
+             CASE(surface_of_small_meshes), CASE(quality_of_known_tets), CASE(real_tet_meshes),
              CASE(real_surfaces_skeletons_and_matrices), CASE(real_every_asset_reads),
              CASE(real_truncation_sweep), CASE(byte_flips_never_crash))

@@ -182,6 +182,11 @@ void sw_cond_dynamics_finish(sw_cond *c, const sw_reduced *red, const double *q,
  * patch's start); the patch stays readable until the next oracle. */
 void sw_cond_finish(sw_cond *c, const sw_reduced *red, const double *q);
 
+/* Patch vertex i's subspace position at q (its first tet's domain copy), skinned by the
+ * pose dq (NULL: the step's). */
+void sw_cond_subspace_position(const sw_cond *c, const sw_reduced *red, int32_t i,
+                               const sw_dualquat *dq, const double *q, double x[3]);
+
 /* The patch position of simulation vertex gv, or NULL when it is not in the patch. */
 static inline const double *sw_cond_position(const sw_cond *c, int32_t gv) {
     if (!c->in_patch || c->nf == 0 || c->in_patch[gv] != c->stamp) return 0;

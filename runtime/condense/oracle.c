@@ -262,14 +262,10 @@ static void full_tets(sw_cond *c, const sw_reduced *red) {
  * tet's domain) plus the deviation it had when last in a patch, if it was in the last
  * step's. */
 static void start_positions(sw_cond *c, const sw_reduced *red, const double *q) {
-    const sw_blob_view *v = c->v;
     for (int32_t i = 0; i < c->nf; ++i) {
-        int32_t gv = c->fv[i], t = v->vert_tets[v->vert_tet_ptr[gv]];
-        int k = 0;
-        while (v->tets[4 * (int64_t)t + k] != gv)
-            ++k;
+        int32_t gv = c->fv[i];
         double *x = c->x + 3 * (int64_t)i;
-        sw_cond_copy_position(red, gv, v->tet_domain[t], v->tet_local[4 * t + k], q, x, NULL);
+        sw_cond_subspace_position(c, red, i, NULL, q, x);
         if (c->dev_at[gv] == c->stamp - 1)
             for (int j = 0; j < 3; ++j)
                 x[j] += c->dev[3 * (int64_t)gv + j];
@@ -366,18 +362,26 @@ int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
 }
 
 void sw_cond_finish(sw_cond *c, const sw_reduced *red, const double *q) {
-    const sw_blob_view *v = c->v;
     for (int32_t i = 0; i < c->nf; ++i) {
-        int32_t gv = c->fv[i], t = v->vert_tets[v->vert_tet_ptr[gv]];
-        int k = 0;
-        while (v->tets[4 * (int64_t)t + k] != gv)
-            ++k;
+        int32_t gv = c->fv[i];
         double y[3];
-        sw_cond_copy_position(red, gv, v->tet_domain[t], v->tet_local[4 * t + k], q, y, NULL);
+        sw_cond_subspace_position(c, red, i, NULL, q, y);
         for (int j = 0; j < 3; ++j)
             c->dev[3 * (int64_t)gv + j] = c->x[3 * (int64_t)i + j] - y[j];
         c->dev_at[gv] = c->stamp;
     }
+}
+
+void sw_cond_subspace_position(const sw_cond *c, const sw_reduced *red, int32_t i,
+                               const sw_dualquat *dq, const double *q, double x[3]) {
+    const sw_blob_view *v = c->v;
+    int32_t gv = c->fv[i], t = v->vert_tets[v->vert_tet_ptr[gv]];
+    int k = 0;
+    while (v->tets[4 * (int64_t)t + k] != gv)
+        ++k;
+    sw_reduced pose = *red; /* the same map, skinned by dq */
+    if (dq) pose.bone_dq = dq;
+    sw_cond_copy_position(&pose, gv, v->tet_domain[t], v->tet_local[4 * t + k], q, x, NULL);
 }
 
 void sw_cond_copy_position(const sw_reduced *red, int32_t gv, int32_t d, int32_t lv,

@@ -8,19 +8,6 @@
 #include "condense.h"
 #include "dqs.h"
 
-/* The subspace position of patch vertex i's first copy at state qv under the pose dq. */
-static void position_under(const sw_cond *c, const sw_reduced *red, int32_t i,
-                           const sw_dualquat *dq, const double *qv, double x[3]) {
-    const sw_blob_view *v = c->v;
-    int32_t gv = c->fv[i], t = v->vert_tets[v->vert_tet_ptr[gv]];
-    int k = 0;
-    while (v->tets[4 * (int64_t)t + k] != gv)
-        ++k;
-    sw_reduced pose = *red; /* the same map, skinned by dq */
-    pose.bone_dq = dq;
-    sw_cond_copy_position(&pose, gv, v->tet_domain[t], v->tet_local[4 * t + k], qv, x, NULL);
-}
-
 void sw_cond_dynamics_start(sw_cond *c, const sw_reduced *red, const sw_solver *s,
                             const sw_dyn_coef *dc, const sw_dualquat *dq_prev,
                             const sw_dualquat *dq_prev2) {
@@ -42,16 +29,16 @@ void sw_cond_dynamics_start(sw_cond *c, const sw_reduced *red, const sw_solver *
             memcpy(vn, c->pv + 3 * (int64_t)gv, 3 * sizeof(double));
         } else if (dq_prev) { /* entering: where and how fast the subspace carried it */
             double x1[3];
-            position_under(c, red, i, dq_prev, s->qn, xn);
+            sw_cond_subspace_position(c, red, i, dq_prev, s->qn, xn);
             if (dq_prev2) {
-                position_under(c, red, i, dq_prev2, c->q_prev, x1);
+                sw_cond_subspace_position(c, red, i, dq_prev2, c->q_prev, x1);
                 for (int k = 0; k < 3; ++k)
                     vn[k] = (xn[k] - x1[k]) / dc->h;
             } else {
                 vn[0] = vn[1] = vn[2] = 0;
             }
         } else { /* no pose history: at rest where the subspace has it now */
-            position_under(c, red, i, red->bone_dq, s->qn, xn);
+            sw_cond_subspace_position(c, red, i, NULL, s->qn, xn);
             vn[0] = vn[1] = vn[2] = 0;
         }
         for (int k = 0; k < 3; ++k) /* the start: the inertial prediction */
@@ -92,7 +79,7 @@ void sw_cond_dynamics_finish(sw_cond *c, const sw_reduced *red, const double *q,
         const double *x = c->x + 3 * (int64_t)i, *xn = c->xn + 3 * (int64_t)i,
                      *vn = c->vn + 3 * (int64_t)i;
         double sp = 0, ac = 0, y[3];
-        position_under(c, red, i, red->bone_dq, q, y);
+        sw_cond_subspace_position(c, red, i, NULL, q, y);
         for (int k = 0; k < 3; ++k) {
             /* relative to the subspace (the bones' own motion is no reason to keep a
                patch): the deviation's rate and the rate's change */
