@@ -82,6 +82,7 @@ typedef struct sw_cond {
     int32_t *pp_id;         /* max_pairs: their contact ids */
     double *pp_w;           /* max_pairs: their pose-space blend weights */
     unsigned char *pp_skip; /* max_pairs: per ps->pairs entry, the patch evaluates it */
+    signed char *pp_active; /* max_pairs: in contact for this solve (-1: not decided yet) */
     int32_t *fv;            /* nf: patch vertices (global ids) */
     int32_t *ft;            /* nt: full tets */
     int32_t *ft_slot;       /* 4 per full tet: patch index >= 0, or -1 - ring copy */

@@ -260,15 +260,18 @@ static void full_tets(sw_cond *c, const sw_reduced *red) {
 
 /* The patch's start: each vertex at its subspace position at q (the copy of its first
  * tet's domain) plus the deviation it had when last in a patch, if it was in the last
- * step's. */
+ * step's (kept in its skinning frame, so that it turns with the bones). */
 static void start_positions(sw_cond *c, const sw_reduced *red, const double *q) {
     for (int32_t i = 0; i < c->nf; ++i) {
         int32_t gv = c->fv[i];
         double *x = c->x + 3 * (int64_t)i;
         sw_cond_subspace_position(c, red, i, NULL, q, x);
-        if (c->dev_at[gv] == c->stamp - 1)
-            for (int j = 0; j < 3; ++j)
-                x[j] += c->dev[3 * (int64_t)gv + j];
+        if (c->dev_at[gv] != c->stamp - 1) continue;
+        double R[9], t[3], *d = c->dev + 3 * (int64_t)gv; /* the deviation, in the skin frame */
+        sw_dqs_blend(red->bone_dq, c->v->skin_bone + 4 * (int64_t)gv,
+                     c->v->skin_weight + 4 * (int64_t)gv, 4, R, t);
+        for (int j = 0; j < 3; ++j)
+            x[j] += R[3 * j] * d[0] + R[3 * j + 1] * d[1] + R[3 * j + 2] * d[2];
     }
 }
 
@@ -322,6 +325,7 @@ static void patch_pairs(sw_cond *c, const sw_reduced *red, sw_pose_space *ps) {
             slot[m] = c->in_patch[gv[m]] == c->stamp
                           ? c->vloc[gv[m]]
                           : -1 - ring_copy(c, red, gv[m], cv[2 * m], cv[2 * m + 1]);
+        c->pp_active[c->np] = -1;
         c->pp_id[c->np] = ps->pairs[p];
         c->pp_w[c->np++] = p < ps->npairs_nearest ? 1 - ps->blend : ps->blend;
     }
@@ -366,8 +370,13 @@ void sw_cond_finish(sw_cond *c, const sw_reduced *red, const double *q) {
         int32_t gv = c->fv[i];
         double y[3];
         sw_cond_subspace_position(c, red, i, NULL, q, y);
+        double R[9], t[3], e[3]; /* kept in the vertex's skin frame: it turns with the bones */
+        sw_dqs_blend(red->bone_dq, c->v->skin_bone + 4 * (int64_t)gv,
+                     c->v->skin_weight + 4 * (int64_t)gv, 4, R, t);
         for (int j = 0; j < 3; ++j)
-            c->dev[3 * (int64_t)gv + j] = c->x[3 * (int64_t)i + j] - y[j];
+            e[j] = c->x[3 * (int64_t)i + j] - y[j];
+        for (int j = 0; j < 3; ++j)
+            c->dev[3 * (int64_t)gv + j] = R[j] * e[0] + R[3 + j] * e[1] + R[6 + j] * e[2];
         c->dev_at[gv] = c->stamp;
     }
 }

@@ -130,6 +130,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->pp_id, np);
         TAKE(c->pp_w, np);
         TAKE(c->pp_skip, np);
+        TAKE(c->pp_active, np);
         TAKE(c->ft, ntf);
         TAKE(c->ft_slot, 4 * ntf);
         TAKE(c->ring_v, nr);
