@@ -339,13 +339,13 @@ static void patch_preconditioner(sw_cond *c) {
 
 /* Coupled solves take at least this many Newton updates (a patch starts far from its
  * solution: the flesh inside a collider). */
-#define SW_COND_MIN_NEWTON 10
+#define SW_COND_MIN_NEWTON 8
 /* PCG's relative tolerance and iteration cap for one update (thesis: "typically fewer
  * than 100 iterations"). */
 #define SW_COND_GTOL 1e-4
 #define SW_COND_PCG_TOL 1e-3
 #define SW_COND_PCG_TOL_FAR 1e-1
-#define SW_COND_PCG_MAX 300
+#define SW_COND_PCG_MAX 200
 
 static double grad_norm(const sw_cond *c, const sw_reduced *red) {
     return sqrt(sw_dot(red->g, red->g, red->R) + sw_dot(c->gf, c->gf, 3 * c->nf));
@@ -364,9 +364,17 @@ static int line_search(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, 
             s->q[i] = s->qtrial[i] + step * c->sol[i];
         for (int32_t i = 0; i < nx; ++i)
             c->x[i] = c->xt[i] + step * c->sol[R + i];
-        *phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
+        /* the full step usually passes: evaluated with the Hessian the next update
+           needs; shorter ones without it, and again with it once one passes */
+        *phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, ls == 0);
         st->potential_evals++;
-        if (isfinite(*phi) && *phi <= phi0 + 1e-12 * fabs(phi0)) return 1;
+        if (isfinite(*phi) && *phi <= phi0 + 1e-12 * fabs(phi0)) {
+            if (ls > 0) {
+                *phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
+                st->potential_evals++;
+            }
+            return 1;
+        }
     }
     return 0;
 }
