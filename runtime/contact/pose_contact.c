@@ -105,7 +105,7 @@ double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const doub
                              want_hess);
     if (ps->blend > 0)
         E += contact_pairs(red, ps->pairs + ps->npairs_nearest,
-                           skip ? skip + ps->npairs_nearest : NULL,
-                           ps->npairs - ps->npairs_nearest, ps->blend, q, want_grad, want_hess);
+                           skip ? skip + ps->npairs_nearest : NULL, ps->npairs - ps->npairs_nearest,
+                           ps->blend, q, want_grad, want_hess);
     return E;
 }
