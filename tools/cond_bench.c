@@ -153,9 +153,9 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
             if (getenv("SW_COND_DEBUG"))
                 fprintf(stderr,
                         "frame %d: patch %u, err num %.3g (in patch %.3g) den %.3g; status %u, "
-                        "%u Newton, %u PCG, residual %.2g\n",
+                        "%u Newton, %u PCG, residual %.2g, %d pose-space pairs in the patch\n",
                         f, st.patch_vertices, fn, fin, fd, st.status, st.newton_iterations,
-                        st.pcg_iterations, st.residual);
+                        st.pcg_iterations, st.residual, inst->cond.np);
         }
     }
     out->err_world_cond = den > 0 ? sqrt(num / den) : 0;

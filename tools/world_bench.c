@@ -37,8 +37,11 @@ static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
         memcpy(x_full + (size_t)f * nv3, sw_fullsim_positions(sim), nv3 * sizeof(double));
         fprintf(stderr,
                 "sinew-bench: world reference frame %d/%d: %.1f ms, %d in contact, "
-                "penetration %.4g\n",
-                f + 1, nf, ms[f], st.world_contacts, st.world_penetration);
+                "penetration %.4g; %d Newton, converged %d, residual %.2g, %d self-contacts, "
+                "unsettled %d\n",
+                f + 1, nf, ms[f], st.world_contacts, st.world_penetration, st.newton_iters,
+                st.converged, st.grad_norm0 > 0 ? st.grad_norm / st.grad_norm0 : 0, st.contacts,
+                st.contacts_unsettled);
     }
     double *sorted = malloc(sizeof(double) * nf);
     if (sorted) memcpy(sorted, ms, sizeof(double) * nf);

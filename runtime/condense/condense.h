@@ -66,9 +66,7 @@ typedef struct sw_cond {
     double *dev;           /* 3 per vertex: its last patch position minus its subspace one */
     uint32_t *dev_at;      /* the stamp of the step that left dev */
     uint32_t *tvis;        /* per tet: full-tet stamp */
-    int32_t *tet_cub;      /* per tet: its cubature index, or -1 */
     double *dom_vol;       /* ndomains: rest volume of the domain's tets */
-    double *dom_wvol;      /* ndomains: sum of w_c vol_c over its cubature tets */
     uint32_t stamp, vstamp;
     /* the growth */
     int32_t *queue; /* max_cand */
@@ -88,13 +86,13 @@ typedef struct sw_cond {
     int32_t *ft_slot;       /* 4 per full tet: patch index >= 0, or -1 - ring copy */
     int32_t *ring_v;        /* per ring copy: global vertex, domain, local index, next copy */
     int32_t *ring_d, *ring_l, *ring_next;
-    double *ring_x0;         /* 3 per ring copy: R rest + t (its position at q = 0) */
-    double *ring_J;          /* 3 rmax per ring copy: J = R U (3 x r_d) */
-    double *ring_x;          /* 3 per ring copy: its position at the iterate */
-    double *ring_dx;         /* 3 per ring copy: scratch (J dq) */
-    double *ring_tmp;        /* 12 rmax: scratch (a tet's K J over its ring corners) */
-    double *Hq;              /* R x R: the reduced potential's Hessian (without the ring blocks) */
-    double *dom_fv, *dom_fw; /* ndomains: the patch's tets' volume and cubature w vol */
+    double *ring_x0;  /* 3 per ring copy: R rest + t (its position at q = 0) */
+    double *ring_J;   /* 3 rmax per ring copy: J = R U (3 x r_d) */
+    double *ring_x;   /* 3 per ring copy: its position at the iterate */
+    double *ring_dx;  /* 3 per ring copy: scratch (J dq) */
+    double *ring_tmp; /* 12 rmax: scratch (a tet's K J over its ring corners) */
+    double *Hq;       /* R x R: the reduced potential's Hessian (without the ring blocks) */
+    double *dom_fv;   /* ndomains: the patch's tets' volume */
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
     double *gf;          /* 3 nf: gradient in x_f */

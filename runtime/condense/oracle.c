@@ -53,8 +53,6 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     memset(c->dev_at, 0, (size_t)v->nverts * sizeof *c->dev_at);
     memset(c->dyn_at, 0, (size_t)v->nverts * sizeof *c->dyn_at);
     memset(c->tvis, 0, (size_t)v->ntets * sizeof *c->tvis);
-    for (int32_t t = 0; t < v->ntets; ++t)
-        c->tet_cub[t] = -1;
     for (int32_t gv = 0; gv < v->nverts; ++gv)
         c->surf_of[gv] = -1;
     for (int32_t s = 0; s < v->nsurf_verts; ++s) {
@@ -62,7 +60,7 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
         c->surf_of[v->domain_verts[v->domains[d].vert_begin + v->surf_copies[2 * i + 1]]] = s;
     }
     for (int32_t k = 0; k < v->ndomains; ++k)
-        c->dom_vol[k] = c->dom_wvol[k] = 0;
+        c->dom_vol[k] = 0;
     for (int32_t t = 0; t < v->ntets; ++t)
         c->dom_vol[v->tet_domain[t]] += v->tet_vol[t];
     /* Kinematic vertices: the bake's bone vertices follow their bone rigidly (one-hot
@@ -81,15 +79,8 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
                 }
         }
     }
-    for (int32_t i = 0; i < v->ncub; ++i) {
-        c->tet_cub[v->cub_tet_id[i]] = i;
+    for (int32_t i = 0; i < v->ncub; ++i)
         c->cub_w[i] = v->cub_weight[i];
-    }
-    for (int32_t k = 0; k < v->ndomains; ++k) {
-        const sw_blob_domain *D = &v->domains[k];
-        for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
-            c->dom_wvol[k] += v->cub_weight[i] * v->cub_vol[i];
-    }
     c->stamp = c->vstamp = 0;
     sw_cond_forget(c);
 }

@@ -118,11 +118,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->dev, 3 * nv);
         TAKE(c->dev_at, nv);
         TAKE(c->tvis, nt);
-        TAKE(c->tet_cub, nt);
         TAKE(c->dom_vol, nd);
-        TAKE(c->dom_wvol, nd);
         TAKE(c->dom_fv, nd);
-        TAKE(c->dom_fw, nd);
         TAKE(c->queue, (uint64_t)cz->max_cand);
         TAKE(c->cand, (uint64_t)cz->max_cand);
         TAKE(c->cand_d, (uint64_t)cz->max_cand);
