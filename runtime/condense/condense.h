@@ -93,6 +93,9 @@ typedef struct sw_cond {
     double *ring_tmp; /* 12 rmax: scratch (a tet's K J over its ring corners) */
     double *Hq;       /* R x R: the reduced potential's Hessian (without the ring blocks) */
     double *dom_fv;   /* ndomains: the patch's tets' volume */
+    sw_world_contacts *wc_refresh; /* the step's world contacts: the solve refreshes the
+                                      patch's laws (NULL: never) */
+    double g0_step; /* |grad| at the step's first coupled iterate (0: not solved yet) */
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
     double *gf;          /* 3 nf: gradient in x_f */

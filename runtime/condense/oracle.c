@@ -46,6 +46,8 @@ sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t ma
 void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     c->v = v;
     c->rho = rho;
+    c->wc_refresh = NULL;
+    c->g0_step = 0;
     memset(c->vis, 0, (size_t)v->nverts * sizeof *c->vis);
     memset(c->in_patch, 0, (size_t)v->nverts * sizeof *c->in_patch);
     memset(c->in_ring, 0, (size_t)v->nverts * sizeof *c->in_ring);

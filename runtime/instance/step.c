@@ -160,6 +160,8 @@ static void phase_oracle(sw_step_ctx *c) {
         return;
     }
     cd->pcg_iters = 0;
+    cd->g0_step = 0;
+    cd->wc_refresh = &in->wc;
     if (sw_cond_oracle(cd, &in->red, &in->wc, &in->ps, in->solver.q) > 0) {
         if (c->dc.dynamic) {
             const sw_pose_history *ph = &in->pose;
