@@ -110,7 +110,8 @@ static void add_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const double
 /* Pose-space contact pair j of the patch (a trained pair with a corner in the patch, the
  * law of pose_contact.c at the corners' patch or subspace positions x12: p, t0, t1, t2):
  * E = 1/2 kk d^T N d, d = sum b_m x_tm - x_p, for a pair that collides at the solve's
- * start. The set is frozen for the solve (as the reference's contact rounds do): the law
+ * start, or at one of the solve's law refreshes (sw_cond_solve). Between those the set is
+ * frozen (as within one of the reference's contact rounds): the law
  * jumps where a pair starts to collide (E = 1/2 kk alpha |d_t|^2 there, eq. 3.12's
  * Heaviside), and measured, a set re-decided at every iterate left the energy guard no
  * decrease (capsule 20K, rho 0.45: 5 of 5 contact frames stopped at 4-6% of the first
@@ -447,9 +448,12 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
             /* the patch's world contact laws again at the iterate (the reference's
                contact rounds, fullsim.h): taken at the start state, deep inside the
                collider, a curved collider's plane is the wrong one (capsule 20K in the
-               pipe, rho 0.0754: err_world_cond 0.133 -> 0.126, no extra update) */
+               pipe, rho 0.0754: err_world_cond 0.133 -> 0.126, no extra update); the
+               pose-space pairs' set grows as the reference's does between rounds */
             sw_cond_detect(c, c->wc_refresh, 0);
             sw_cond_tag_candidates(c, c->wc_refresh);
+            for (int32_t j = 0; j < c->np; ++j) /* and a pair now colliding joins */
+                if (c->pp_active[j] == 0) c->pp_active[j] = -1;
             phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
             st->potential_evals++;
         }
