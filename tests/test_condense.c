@@ -106,6 +106,47 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
     sinew_world_destroy(w);
 }
 
+/* Eq. 4.12's subspace part: each domain the patch reaches keeps its cubature scaled to
+ * its volume outside the patch (the tets touching a patch vertex, found here by a scan
+ * of every tet), the others keep theirs, and the solve's end restores them. */
+TEST(cubature_weights_follow_each_domains_volume_outside_the_patch) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(0.08, 0.3f, &id);
+    sinew_instance *in = pressed(f, w, 2000, 1);
+    ENSURE(in);
+    sw_instance_step_prepare(in, 1.0f / 30);
+    sw_cond *c = &in->cond;
+    const sw_blob_view *v = c->v;
+    ENSURE(c->nf > 0);
+    double *vol = calloc((size_t)v->ndomains, sizeof(double));
+    double *in_vol = calloc((size_t)v->ndomains, sizeof(double));
+    for (int32_t t = 0; t < v->ntets; ++t) {
+        int touches = 0;
+        for (int k = 0; k < 4; ++k)
+            touches |= sw_cond_position(c, v->tets[4 * t + k]) != NULL;
+        vol[v->tet_domain[t]] += v->tet_vol[t];
+        if (touches) in_vol[v->tet_domain[t]] += v->tet_vol[t];
+    }
+    sw_cond_weights_apply(c, &in->red);
+    int reached = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        double s = in_vol[k] > 0 ? (vol[k] - in_vol[k]) / vol[k] : 1;
+        reached += in_vol[k] > 0;
+        for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
+            ENSURE_NEAR(c->cub_w[i], s * v->cub_weight[i], 1e-12 * v->cub_weight[i]);
+    }
+    ENSURE(reached > 0);
+    sw_cond_weights_restore(c, &in->red);
+    for (int32_t i = 0; i < v->ncub; ++i)
+        ENSURE(c->cub_w[i] == v->cub_weight[i]);
+    free(vol), free(in_vol);
+    sinew_instance_destroy(in);
+    sinew_world_destroy(w);
+}
+
 /* Brute force: the vertices a breadth-first growth over the whole mesh reaches from seed s
  * through vertices within rho of s, marked in m. */
 static void brute_grow(const sw_blob_view *v, const unsigned char *pinned, int32_t s, double rho,
@@ -414,6 +455,7 @@ TEST(release_fixture) {
 }
 
 SW_TEST_MAIN(CASE(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd),
+             CASE(cubature_weights_follow_each_domains_volume_outside_the_patch),
              CASE(oracle_patch_is_the_growth_of_its_seeds_and_the_budget_keeps_the_nearest),
              CASE(condensation_dents_where_the_subspace_locks_closer_to_the_reference),
              CASE(without_contact_a_condensed_instance_is_bitwise_the_subspace),
