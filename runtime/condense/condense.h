@@ -137,10 +137,10 @@ void sw_cond_forget(sw_cond *c);
 int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, sw_pose_space *ps,
                        const double *q);
 
-/* The world's candidates of the patch's surface vertices at their patch positions: the
- * laws taken again there, new colliders within the detection radius (penetrating_only:
- * only those entered) added. Returns how many were added; tag them afterwards. */
-int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, int penetrating_only);
+/* The world's candidates of the patch's surface vertices at their patch positions, as
+ * sw_world_contacts_at's mode says (world_contact.h). Returns how many were added; tag
+ * them afterwards. */
+int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, sw_wc_at_mode mode);
 
 /* Tags the world candidates whose vertex is in the patch (after new ones were added). */
 void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc);

@@ -445,12 +445,12 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         }
         st->newton_iterations++;
         if (c->wc_refresh && it < SW_COND_LAW_REFRESHES) {
-            /* the patch's world contact laws again at the iterate (the reference's
-               contact rounds, fullsim.h): taken at the start state, deep inside the
-               collider, a curved collider's plane is the wrong one (capsule 20K in the
-               pipe, rho 0.0754: err_world_cond 0.133 -> 0.126, no extra update); the
-               pose-space pairs' set grows as the reference's does between rounds */
-            sw_cond_detect(c, c->wc_refresh, 0);
+            /* the patch's world contact laws again at the iterate: taken at the start
+               state, where the subspace went deep into the collider (the reference takes
+               its own at its last solution, near the surface), their friction caps held
+               the flesh (world_contact.c, replane_candidate); no extra update. The
+               pose-space pairs' set grows as the reference's does between rounds. */
+            sw_cond_detect(c, c->wc_refresh, SW_WC_AT_REPLANE);
             sw_cond_tag_candidates(c, c->wc_refresh);
             for (int32_t j = 0; j < c->np; ++j) /* and a pair now colliding joins */
                 if (c->pp_active[j] == 0) c->pp_active[j] = -1;

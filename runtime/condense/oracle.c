@@ -273,15 +273,14 @@ static void start_positions(sw_cond *c, const sw_reduced *red, const double *q) 
  * frozen there would anchor friction and the contact plane in the wrong place), new
  * ones added within the detection radius (penetrating_only: inside). Returns how many
  * were added. */
-int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, int penetrating_only) {
+int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, sw_wc_at_mode mode) {
     const sw_blob_view *v = c->v;
     int32_t added = 0;
     for (int32_t i = 0; i < c->nf; ++i) {
         int32_t s = c->surf_of[c->fv[i]];
         if (s < 0) continue;
         for (int32_t k = v->surf_copy_ptr[s]; k < v->surf_copy_ptr[s + 1]; ++k)
-            added +=
-                sw_world_contacts_at(wc, k, c->x + 3 * (int64_t)i, v->contact_k, penetrating_only);
+            added += sw_world_contacts_at(wc, k, c->x + 3 * (int64_t)i, v->contact_k, mode);
     }
     return added;
 }

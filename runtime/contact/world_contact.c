@@ -381,11 +381,39 @@ static void refresh_candidate(sw_world_contacts *wc, int32_t j, const double x[3
     cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
 }
 
+/* Candidate j's plane turned to the collider's normal at x's closest point, through its
+ * anchor (the friction's stick point) projected onto it, and its friction cap taken from
+ * the normal force at x: a law taken at a patch's start state, deep inside a collider the
+ * subspace went through, has a cap from that depth that holds the flesh where the
+ * reference's slides (capsule 20K in the pipe, rho 0.0754: err_world_cond 0.133 ->
+ * 0.127). The stick point stays, so a resting contact keeps its friction history
+ * (finger 5K on the table with a patch of the whole mesh: 0.0004 of the reference's
+ * correction missed; taking the anchor again too made it 0.025). */
+static void replane_candidate(sw_world_contacts *wc, int32_t j, const double x[3]) {
+    sw_world_cand *cd = &wc->cand[j];
+    const sw_collider *c = sw_world_slot(wc->world, (uint32_t)cd->slot);
+    sw_collider_hit hit;
+    wc->queries++;
+    if (!c || !sw_collider_query(c, x, 4 * wc->radius, &hit)) return;
+    double e = 0;
+    for (int k = 0; k < 3; ++k)
+        e += (cd->law.a[k] - hit.point[k]) * hit.normal[k];
+    for (int k = 0; k < 3; ++k) {
+        cd->law.a[k] -= e * hit.normal[k];
+        cd->law.n[k] = hit.normal[k];
+    }
+    cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
+}
+
 int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double x[3], double blob_k,
-                             int penetrating_only) {
+                             sw_wc_at_mode mode) {
     int32_t before = wc->ncand;
-    for (int32_t j = wc->copy_first[i]; !penetrating_only && j >= 0; j = wc->cand[j].next)
-        refresh_candidate(wc, j, x);
+    for (int32_t j = wc->copy_first[i]; mode != SW_WC_AT_MISSED && j >= 0; j = wc->cand[j].next)
+        if (mode == SW_WC_AT_DETECT)
+            refresh_candidate(wc, j, x);
+        else
+            replane_candidate(wc, j, x);
+    int penetrating_only = mode == SW_WC_AT_MISSED;
     uint32_t ns = sw_world_slot_count(wc->world);
     for (uint32_t s = 0; s < ns; ++s) {
         double cb[6];

@@ -84,13 +84,23 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
  * output wrote them); returns how many were added. */
 int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *red, const double *q);
 
+/* What sw_world_contacts_at does with a copy's candidates. */
+typedef enum sw_wc_at_mode {
+    SW_WC_AT_DETECT = 0, /* laws taken again at x (closest point, normal, friction cap), and
+                            the colliders x is within the detection radius of added */
+    SW_WC_AT_MISSED = 1, /* after a solve: only the colliders x entered are added, the laws
+                            stay */
+    SW_WC_AT_REPLANE = 2 /* within a solve: each law's plane turned to the collider's normal
+                            at x's closest point, its anchor (the friction's stick point)
+                            projected onto it, its friction cap from the normal force at
+                            x; colliders within the radius added */
+} sw_wc_at_mode;
+
 /* Surface copy i sitting at x instead of its subspace position (a condensation patch's
- * vertex, condense.h): its candidates' laws taken again at x, and the colliders whose
- * box holds x and that it is within the detection radius of added as candidates; with
- * penetrating_only (after a solve), only the colliders it entered are added and the laws
- * stay. Returns how many were added. */
+ * vertex, condense.h): its candidates and laws as mode says. Returns how many were
+ * added. */
 int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double x[3], double blob_k,
-                             int penetrating_only);
+                             sw_wc_at_mode mode);
 
 /* The world contact energy at q of the candidates outside a condensation patch (those
  * in one are the patch's, condense.h); with want_grad its gradient into red->g, with

@@ -173,7 +173,7 @@ static void phase_oracle(sw_step_ctx *c) {
                                    ph->history >= 1 ? cd->dq_prev : NULL,
                                    ph->history >= 2 ? cd->dq_prev2 : NULL);
         }
-        sw_cond_detect(cd, &in->wc, 0);
+        sw_cond_detect(cd, &in->wc, SW_WC_AT_DETECT);
     }
     sw_cond_tag_candidates(cd, &in->wc);
     c->st.patch_vertices = (uint32_t)cd->nf;
@@ -215,7 +215,7 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         write_output(c);
         double t = sw_now_seconds();
         int32_t added = sw_world_contacts_add_missed(wc, &in->red, in->solver.q);
-        if (in->cond.nf > 0) added += sw_cond_detect(&in->cond, wc, 1);
+        if (in->cond.nf > 0) added += sw_cond_detect(&in->cond, wc, SW_WC_AT_MISSED);
         double ms_missed = 1e3 * (sw_now_seconds() - t);
         c->st.ms_world += ms_missed;
         if (added > 0) { /* (a failed second solve leaves the first round's surface) */
