@@ -162,6 +162,9 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
     out->speedup_worst = INFINITY;
     for (int f = 0; f < nf; ++f) {
         double s = ref_ms[f] / ms[f];
+        if (getenv("SW_COND_DEBUG") && s < 50)
+            fprintf(stderr, "frame %d: %.1f ms, reference %.1f ms: %.1fx\n", f, ms[f], ref_ms[f],
+                    s);
         out->speedup_mean += s / nf;
         out->speedup_worst = fmin(out->speedup_worst, s);
         out->ms_max = fmax(out->ms_max, ms[f]);
