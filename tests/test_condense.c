@@ -40,14 +40,22 @@ static sinew_instance *pressed(const bake_fixture *f, sinew_world *w, uint32_t b
     return inst;
 }
 
-TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
+/* An instance pressed onto the table for one step and prepared for the next, its patch
+ * set (the world into *w). */
+static sinew_instance *prepared_on_table(sinew_world **w) {
     const bake_fixture *f = fixture();
-    ENSURE(f);
+    if (!f) return NULL;
     sinew_collider_id id;
-    sinew_world *w = table_world(0.08, 0.3f, &id);
-    sinew_instance *in = pressed(f, w, 2000, 1);
+    *w = table_world(0.08, 0.3f, &id);
+    sinew_instance *in = *w ? pressed(f, *w, 2000, 1) : NULL;
+    if (in) sw_instance_step_prepare(in, 1.0f / 30);
+    return in;
+}
+
+TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
+    sinew_world *w = NULL;
+    sinew_instance *in = prepared_on_table(&w);
     ENSURE(in);
-    sw_instance_step_prepare(in, 1.0f / 30);
     sw_cond *c = &in->cond;
     ENSURE(c->nf > 10 && c->nt > c->nf && c->nring > 0);
     int32_t R = in->red.R, nx = 3 * c->nf;
@@ -110,13 +118,9 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
  * its volume outside the patch (the tets touching a patch vertex, found here by a scan
  * of every tet), the others keep theirs, and the solve's end restores them. */
 TEST(cubature_weights_follow_each_domains_volume_outside_the_patch) {
-    const bake_fixture *f = fixture();
-    ENSURE(f);
-    sinew_collider_id id;
-    sinew_world *w = table_world(0.08, 0.3f, &id);
-    sinew_instance *in = pressed(f, w, 2000, 1);
+    sinew_world *w = NULL;
+    sinew_instance *in = prepared_on_table(&w);
     ENSURE(in);
-    sw_instance_step_prepare(in, 1.0f / 30);
     sw_cond *c = &in->cond;
     const sw_blob_view *v = c->v;
     ENSURE(c->nf > 0);
