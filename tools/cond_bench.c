@@ -81,6 +81,7 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
            *ref_out = malloc(sizeof(double) * 3 * ns);
     float *pos = malloc(sizeof(float) * 3 * ns), *nrm = malloc(sizeof(float) * 3 * ns);
     double *col = malloc(sizeof(double) * 3 * ns);
+    double *patch_size = calloc(2 * (size_t)nf, sizeof(double)); /* vertices, tets a frame */
     char dir[4096] = "";
     if (cp->out_dir && rho == (cp->nrho ? cp->rho[0] : 0)) {
         snprintf(dir, sizeof dir, "%s/condensed", cp->out_dir);
@@ -90,7 +91,7 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
         }
     }
     if (!ms || !sorted || !xs || !cnt || !xd || !prev || !ref_prev || !ref_out || !pos || !nrm ||
-        !col) {
+        !col || !patch_size) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the condensed run");
         goto done;
     }
@@ -112,6 +113,8 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
             sinew_step_stats st = {.struct_size = sizeof st};
             sinew_instance_get_stats(inst, &st);
             double frac = st.patch_vertices / (double)n;
+            patch_size[2 * f] = st.patch_vertices;
+            patch_size[2 * f + 1] = st.patch_tets;
             out->patch_frac_mean += frac / nf;
             out->patch_frac_max = fmax(out->patch_frac_max, frac);
             out->truncated_frames += (st.budget_exceeded & SINEW_BUDGET_PATCH) != 0;
@@ -170,11 +173,24 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
         out->ms_max = fmax(out->ms_max, ms[f]);
         sorted[f] = ms[f];
     }
+    int patch_frames = 0;
+    for (int f = 0; f < nf; ++f) {
+        if (patch_size[2 * f] == 0) continue;
+        patch_frames++;
+        out->patch_ms_mean += ms[f];
+        out->patch_verts_mean += patch_size[2 * f];
+        out->patch_tets_mean += patch_size[2 * f + 1];
+    }
+    if (patch_frames > 0) {
+        out->patch_ms_mean /= patch_frames;
+        out->patch_verts_mean /= patch_frames;
+        out->patch_tets_mean /= patch_frames;
+    }
     out->ms_median = sw_median(sorted, nf);
     out->p100_over_p50 = out->ms_median > 0 ? out->ms_max / out->ms_median : 0;
 done:
     free(ms), free(sorted), free(xs), free(cnt), free(xd), free(prev), free(ref_prev);
-    free(ref_out), free(pos), free(nrm), free(col);
+    free(ref_out), free(pos), free(nrm), free(col), free(patch_size);
     sinew_instance_destroy(inst);
     return r;
 }

@@ -30,6 +30,9 @@ typedef struct sw_cond_bench {
     double pop_max; /* largest surface jump at a patch's activation or release over the
                        reference's largest jump at that frame */
     uint32_t pcg_iters_max;
+    /* over the frames with a patch: mean condensed step time and patch size (the step's
+       cost at a patch size, compared across mesh resolutions) */
+    double patch_ms_mean, patch_verts_mean, patch_tets_mean;
     int failed;
 } sw_cond_bench;
 

@@ -602,10 +602,12 @@ int main(int argc, char **argv) {
             fprintf(stderr,
                     "sinew-bench: condensed (rho %.4g of the diagonal, budget %u): err_world_cond "
                     "%.4f (subspace %.4f); speedup mean %.1f worst %.1f; patch %.2f%% mean, "
-                    "%.2f%% max; frame p100/p50 %.2f; %d frames truncated; pop %.2f\n",
+                    "%.2f%% max; frame p100/p50 %.2f; %d frames truncated; pop %.2f; frames with a "
+                    "patch %.1f ms at %.0f vertices, %.0f tets (means)\n",
                     cb->rho, cb->budget, cb->err_world_cond, wb.err_world_sub, cb->speedup_mean,
                     cb->speedup_worst, 100 * cb->patch_frac_mean, 100 * cb->patch_frac_max,
-                    cb->p100_over_p50, cb->truncated_frames, cb->pop_max);
+                    cb->p100_over_p50, cb->truncated_frames, cb->pop_max, cb->patch_ms_mean,
+                    cb->patch_verts_mean, cb->patch_tets_mean);
         }
     }
     /* 8. dynamics against the reference's backward Euler, when asked */
@@ -712,9 +714,11 @@ int main(int argc, char **argv) {
         if (k >= 1)
             printf("%s{\"rho\":%.5g,\"err_world_cond\":%.5f,\"speedup_cond_mean\":%.2f,"
                    "\"speedup_cond_worst\":%.2f,\"patch_frac_mean\":%.5f,\"patch_frac_max\":%.5f,"
-                   "\"cond_ms_max\":%.4f}%s",
+                   "\"cond_ms_max\":%.4f,\"patch_ms_mean\":%.4f,\"patch_verts_mean\":%.1f,"
+                   "\"patch_tets_mean\":%.1f}%s",
                    k > 1 ? "," : "", cb->rho, cb->err_world_cond, cb->speedup_mean,
                    cb->speedup_worst, cb->patch_frac_mean, cb->patch_frac_max, cb->ms_max,
+                   cb->patch_ms_mean, cb->patch_verts_mean, cb->patch_tets_mean,
                    k == wb.ncond - 1 ? "]" : "");
     }
     if (json && wb.ncond > 0)
@@ -722,12 +726,14 @@ int main(int argc, char **argv) {
                "\"speedup_cond_mean\":%.2f,\"speedup_cond_worst\":%.2f,\"patch_frac_mean\":%.5f,"
                "\"patch_frac_max\":%.5f,\"frame_p100_over_p50\":%.3f,"
                "\"patch_truncated_frames\":%d,\"pop_max\":%.3f,\"cond_ms_median\":%.4f,"
-               "\"cond_ms_max\":%.4f,\"pcg_iters_max\":%u",
+               "\"cond_ms_max\":%.4f,\"pcg_iters_max\":%u,\"patch_ms_mean\":%.4f,"
+               "\"patch_verts_mean\":%.1f,\"patch_tets_mean\":%.1f",
                wb.cond[0].rho, wb.cond[0].budget, wb.cond[0].err_world_cond,
                wb.cond[0].speedup_mean, wb.cond[0].speedup_worst, wb.cond[0].patch_frac_mean,
                wb.cond[0].patch_frac_max, wb.cond[0].p100_over_p50, wb.cond[0].truncated_frames,
                wb.cond[0].pop_max, wb.cond[0].ms_median, wb.cond[0].ms_max,
-               wb.cond[0].pcg_iters_max);
+               wb.cond[0].pcg_iters_max, wb.cond[0].patch_ms_mean, wb.cond[0].patch_verts_mean,
+               wb.cond[0].patch_tets_mean);
     char ratio[32] = "null"; /* no reference overshoot: no ratio */
     if (isfinite(db.overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db.overshoot_ratio);
     char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */
