@@ -351,6 +351,17 @@ static double grad_norm(const sw_cond *c, const sw_reduced *red) {
     return sqrt(sw_dot(red->g, red->g, red->R) + sw_dot(c->gf, c->gf, 3 * c->nf));
 }
 
+/* A patch candidate's gap along the ray x + t dx (world_penalty.h's g = n . (a - x)):
+ * g + t s. */
+static void gap_along(const sw_cond *c, const sw_world_cand *cd, int32_t R, double *g, double *s) {
+    const double *x = c->x + 3 * (int64_t)cd->patch, *dx = c->sol + R + 3 * (int64_t)cd->patch;
+    *g = *s = 0;
+    for (int i = 0; i < 3; ++i) {
+        *g += cd->law.n[i] * (cd->law.a[i] - x[i]);
+        *s -= cd->law.n[i] * dx[i];
+    }
+}
+
 /* The first step of a line search along c->sol from the patch positions c->x: the
  * minimiser in (0, 1] of the update's quadratic model, phi0 + t d0 + t^2 |d0| / 2 (PCG's
  * solve of H sol = -g gives sol^T H sol = -d0), plus the world laws of the patch's
@@ -363,14 +374,10 @@ static double contact_step(const sw_cond *c, const sw_world_contacts *wc, int32_
     int crossed = 0;
     for (int32_t j = 0; j < wc->ncand && !crossed; ++j) {
         const sw_world_cand *cd = &wc->cand[j];
-        if (cd->patch < 0) continue;
-        const double *x = c->x + 3 * (int64_t)cd->patch, *dx = c->sol + R + 3 * (int64_t)cd->patch;
-        double g = 0, sl = 0;
-        for (int i = 0; i < 3; ++i) {
-            g += cd->law.n[i] * (cd->law.a[i] - x[i]);
-            sl -= cd->law.n[i] * dx[i];
-        }
-        crossed = g <= 0 && g + sl > 0 && cd->law.k > 0;
+        if (cd->patch < 0 || !(cd->law.k > 0)) continue;
+        double g, sl;
+        gap_along(c, cd, R, &g, &sl);
+        crossed = g <= 0 && g + sl > 0;
     }
     if (!crossed) return 1.0;
     /* the model's slope is increasing in t (a convex model): bisect its root */
@@ -380,13 +387,8 @@ static double contact_step(const sw_cond *c, const sw_world_contacts *wc, int32_
         for (int32_t j = 0; j < wc->ncand; ++j) {
             const sw_world_cand *cd = &wc->cand[j];
             if (cd->patch < 0) continue;
-            const double *x = c->x + 3 * (int64_t)cd->patch,
-                         *dx = c->sol + R + 3 * (int64_t)cd->patch;
-            double g = 0, sl = 0;
-            for (int i = 0; i < 3; ++i) {
-                g += cd->law.n[i] * (cd->law.a[i] - x[i]);
-                sl -= cd->law.n[i] * dx[i];
-            }
+            double g, sl;
+            gap_along(c, cd, R, &g, &sl);
             if (g <= 0 && g + t * sl > 0) slope += cd->law.k * sl * (g + t * sl);
         }
         if (slope > 0)
