@@ -93,9 +93,7 @@ typedef struct sw_cond {
     double *ring_tmp; /* 12 rmax: scratch (a tet's K J over its ring corners) */
     double *Hq;       /* R x R: the reduced potential's Hessian (without the ring blocks) */
     double *dom_fv;   /* ndomains: the patch's tets' volume */
-    sw_world_contacts *wc_refresh; /* the step's world contacts: the solve refreshes the
-                                      patch's laws (NULL: never) */
-    double g0_step; /* |grad| at the step's first coupled iterate (0: not solved yet) */
+    double g0_step;   /* |grad| at the step's first coupled iterate (0: not solved yet) */
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
     double *gf;          /* 3 nf: gradient in x_f */
@@ -146,9 +144,11 @@ int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, sw_wc_at_mode mo
 void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc);
 
 /* The coupled Newton (see above) from (s->q, c->x) into them; fills st like
- * sw_newton_solve plus pcg_iterations. */
-sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
-                           const sw_dyn_coef *dc, sinew_step_stats *st);
+ * sw_newton_solve plus pcg_iterations. wc (ct's world contacts, or NULL without a world)
+ * gets the patch's laws taken again at the iterate after the first updates. */
+sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
+                           sw_world_contacts *wc, sw_solver *s, const sw_dyn_coef *dc,
+                           sinew_step_stats *st);
 
 /* The pieces of the solve, for tests: the patch's cubature weights (eq. 4.12's
  * renormalisation) applied and restored; Phi(q, x) with its gradient into (red->g, c->gf)

@@ -436,8 +436,9 @@ static int line_search(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, 
     return 0;
 }
 
-sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
-                           const sw_dyn_coef *dc, sinew_step_stats *st) {
+sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
+                           sw_world_contacts *wc, sw_solver *s, const sw_dyn_coef *dc,
+                           sinew_step_stats *st) {
     int32_t R = red->R, nx = 3 * c->nf;
     int64_t m = R + nx;
     sw_cond_weights_apply(c, red);
@@ -503,14 +504,14 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
             break;
         }
         st->newton_iterations++;
-        if (c->wc_refresh && it < SW_COND_LAW_REFRESHES) {
+        if (wc && it < SW_COND_LAW_REFRESHES) {
             /* the patch's world contact laws again at the iterate: taken at the start
                state, where the subspace went deep into the collider (the reference takes
                its own at its last solution, near the surface), their friction caps held
-               the flesh (world_contact.c, replane_candidate); no extra update. The
+               the flesh (world_contact.c, refresh_candidate); no extra update. The
                pose-space pairs' set grows as the reference's does between rounds. */
-            sw_cond_detect(c, c->wc_refresh, SW_WC_AT_REPLANE);
-            sw_cond_tag_candidates(c, c->wc_refresh);
+            sw_cond_detect(c, wc, SW_WC_AT_REPLANE);
+            sw_cond_tag_candidates(c, wc);
             for (int32_t j = 0; j < c->np; ++j) /* and a pair now colliding joins */
                 if (c->pp_active[j] == 0) c->pp_active[j] = -1;
             phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);

@@ -46,7 +46,6 @@ sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t ma
 void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     c->v = v;
     c->rho = rho;
-    c->wc_refresh = NULL;
     c->g0_step = 0;
     memset(c->vis, 0, (size_t)v->nverts * sizeof *c->vis);
     memset(c->in_patch, 0, (size_t)v->nverts * sizeof *c->in_patch);
@@ -271,8 +270,7 @@ static void start_positions(sw_cond *c, const sw_reduced *red, const double *q) 
 /* The world's candidates of the patch's surface vertices taken at their patch positions
  * (their subspace positions, where the step's detection ran, can be a dent away: a law
  * frozen there would anchor friction and the contact plane in the wrong place), new
- * ones added within the detection radius (penetrating_only: inside). Returns how many
- * were added. */
+ * ones added, as mode says (world_contact.h). Returns how many were added. */
 int32_t sw_cond_detect(const sw_cond *c, sw_world_contacts *wc, sw_wc_at_mode mode) {
     const sw_blob_view *v = c->v;
     int32_t added = 0;

@@ -362,44 +362,35 @@ int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *re
     return wc->ncand - before;
 }
 
-/* Candidate j's law taken again at x (closest point, normal, friction cap); a collider
- * no longer within four detection radii leaves the law without stiffness. */
-static void refresh_candidate(sw_world_contacts *wc, int32_t j, const double x[3]) {
+/* Candidate j's law taken again at x: the collider's normal at x's closest point, the
+ * friction cap from the normal force there, and the anchor (the friction's stick point)
+ * either that closest point or, with keep_anchor, the old anchor projected onto the new
+ * plane. A collider no longer within four detection radii leaves the law without
+ * stiffness (with keep_anchor, as it was).
+ *
+ * keep_anchor is the in-solve refresh of a patch (SW_WC_AT_REPLANE): a law taken at the
+ * patch's start state, deep inside a collider the subspace went through, has a cap from
+ * that depth that holds the flesh where the reference's slides (capsule 20K in the pipe,
+ * rho 0.0754: err_world_cond 0.133 -> 0.127), while keeping the stick point keeps a
+ * resting contact's friction history (finger 5K on the table with a patch of the whole
+ * mesh: 0.0004 of the reference's correction missed; a new anchor made it 0.025). */
+static void refresh_candidate(sw_world_contacts *wc, int32_t j, const double x[3],
+                              int keep_anchor) {
     sw_world_cand *cd = &wc->cand[j];
     const sw_collider *c = sw_world_slot(wc->world, (uint32_t)cd->slot);
     sw_collider_hit hit;
     wc->queries++;
     if (!c || !sw_collider_query(c, x, 4 * wc->radius, &hit)) {
+        if (keep_anchor) return;
         cd->law.k = 0;
         cd->law.cap = 0;
         return;
     }
-    for (int k = 0; k < 3; ++k) {
-        cd->law.a[k] = hit.point[k];
-        cd->law.n[k] = hit.normal[k];
-    }
-    cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
-}
-
-/* Candidate j's plane turned to the collider's normal at x's closest point, through its
- * anchor (the friction's stick point) projected onto it, and its friction cap taken from
- * the normal force at x: a law taken at a patch's start state, deep inside a collider the
- * subspace went through, has a cap from that depth that holds the flesh where the
- * reference's slides (capsule 20K in the pipe, rho 0.0754: err_world_cond 0.133 ->
- * 0.127). The stick point stays, so a resting contact keeps its friction history
- * (finger 5K on the table with a patch of the whole mesh: 0.0004 of the reference's
- * correction missed; taking the anchor again too made it 0.025). */
-static void replane_candidate(sw_world_contacts *wc, int32_t j, const double x[3]) {
-    sw_world_cand *cd = &wc->cand[j];
-    const sw_collider *c = sw_world_slot(wc->world, (uint32_t)cd->slot);
-    sw_collider_hit hit;
-    wc->queries++;
-    if (!c || !sw_collider_query(c, x, 4 * wc->radius, &hit)) return;
-    double e = 0;
+    double e = 0; /* the old anchor's height over the new plane */
     for (int k = 0; k < 3; ++k)
         e += (cd->law.a[k] - hit.point[k]) * hit.normal[k];
     for (int k = 0; k < 3; ++k) {
-        cd->law.a[k] -= e * hit.normal[k];
+        cd->law.a[k] = keep_anchor ? cd->law.a[k] - e * hit.normal[k] : hit.point[k];
         cd->law.n[k] = hit.normal[k];
     }
     cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
@@ -409,10 +400,7 @@ int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double x[3]
                              sw_wc_at_mode mode) {
     int32_t before = wc->ncand;
     for (int32_t j = wc->copy_first[i]; mode != SW_WC_AT_MISSED && j >= 0; j = wc->cand[j].next)
-        if (mode == SW_WC_AT_DETECT)
-            refresh_candidate(wc, j, x);
-        else
-            replane_candidate(wc, j, x);
+        refresh_candidate(wc, j, x, mode == SW_WC_AT_REPLANE);
     int penetrating_only = mode == SW_WC_AT_MISSED;
     uint32_t ns = sw_world_slot_count(wc->world);
     for (uint32_t s = 0; s < ns; ++s) {

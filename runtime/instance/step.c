@@ -161,7 +161,6 @@ static void phase_oracle(sw_step_ctx *c) {
     }
     cd->pcg_iters = 0;
     cd->g0_step = 0;
-    cd->wc_refresh = &in->wc;
     if (sw_cond_oracle(cd, &in->red, &in->wc, &in->ps, in->solver.q) > 0) {
         if (c->dc.dynamic) {
             const sw_pose_history *ph = &in->pose;
@@ -189,7 +188,9 @@ static void phase_oracle(sw_step_ctx *c) {
 /* Newton on the step's potential: reduced, or coupled to the patch. */
 static sinew_result solve(sw_step_ctx *c, const sw_step_contacts *ct) {
     sinew_instance *in = c->in;
-    if (in->cond.nf > 0) return sw_cond_solve(&in->cond, &in->red, ct, &in->solver, &c->dc, &c->st);
+    if (in->cond.nf > 0)
+        return sw_cond_solve(&in->cond, &in->red, ct, ct->wc ? &in->wc : NULL, &in->solver, &c->dc,
+                             &c->st);
     return sw_newton_solve(&in->red, ct, &in->solver, &c->dc, &c->st);
 }
 
