@@ -8,6 +8,7 @@
 
 #include "collision.h"
 #include "condense.h"
+#include "fem_corot.h"
 #include "fullsim.h"
 #include "instance.h"
 #include "instance_internal.h"
@@ -16,6 +17,8 @@
 #include "world_fixture.h"
 
 #define RHO 0.08 /* of the diagonal: about 0.3 on the 3.6-long finger */
+/* A radius whose patch covers most of a domain: its other tets are evaluated at q */
+#define RHO_WIDE 0.35
 
 static float *rest_pose(int nb) {
     float *p = calloc((size_t)12 * nb, sizeof(float));
@@ -24,11 +27,13 @@ static float *rest_pose(int nb) {
     return p;
 }
 
-/* A condensed instance of the fixture on world w at the rest pose, stepped `steps` times. */
-static sinew_instance *pressed(const bake_fixture *f, sinew_world *w, uint32_t budget, int steps) {
+/* A condensed instance of the fixture on world w at the rest pose, patch radius rho,
+ * stepped `steps` times. */
+static sinew_instance *pressed_rho(const bake_fixture *f, sinew_world *w, uint32_t budget,
+                                   int steps, double rho) {
     sinew_instance_def d = sinew_instance_def_default();
     d.max_patch_vertices = budget;
-    d.patch_radius = (float)RHO;
+    d.patch_radius = (float)rho;
     sinew_instance *inst;
     if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return NULL;
     if (w) sinew_instance_set_world(inst, w);
@@ -40,115 +45,177 @@ static sinew_instance *pressed(const bake_fixture *f, sinew_world *w, uint32_t b
     return inst;
 }
 
+static sinew_instance *pressed(const bake_fixture *f, sinew_world *w, uint32_t budget, int steps) {
+    return pressed_rho(f, w, budget, steps, RHO);
+}
+
 /* An instance pressed onto the table for one step and prepared for the next, its patch
- * set (the world into *w). */
-static sinew_instance *prepared_on_table(sinew_world **w) {
+ * of radius rho set (the world into *w). */
+static sinew_instance *prepared_on_table(sinew_world **w, double rho) {
     const bake_fixture *f = fixture();
     if (!f) return NULL;
     sinew_collider_id id;
     *w = table_world(0.08, 0.3f, &id);
-    sinew_instance *in = *w ? pressed(f, *w, 2000, 1) : NULL;
+    sinew_instance *in = *w ? pressed_rho(f, *w, 2000, 1, rho) : NULL;
     if (in) sw_instance_step_prepare(in, 1.0f / 30);
     return in;
 }
 
+/* At both radii: with a wide patch, the rest of the domains it mostly covers is part of
+ * the potential (at q), and its Hessian is in the reduced block of the product. */
 TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
-    sinew_world *w = NULL;
-    sinew_instance *in = prepared_on_table(&w);
-    ENSURE(in);
-    sw_cond *c = &in->cond;
-    ENSURE(c->nf > 10 && c->nt > c->nf && c->nring > 0);
-    int32_t R = in->red.R, nx = 3 * c->nf;
-    sw_step_contacts ct = {&in->ps, &in->wc};
-    sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
-    sw_cond_weights_apply(c, &in->red);
-    double *q = malloc(sizeof(double) * R), *x = malloc(sizeof(double) * nx);
-    double *g = malloc(sizeof(double) * (R + nx));
-    memcpy(q, in->solver.q, sizeof(double) * R);
-    for (int32_t i = 0; i < nx; ++i) /* off the start: some tets stretched, some contact */
-        x[i] = c->x[i] + 0.01 * sin(1.7 * i);
-    sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 1);
-    memcpy(g, in->red.g, sizeof(double) * R);
-    memcpy(g + R, c->gf, sizeof(double) * nx);
-    double gmax = 0;
-    for (int32_t i = 0; i < R + nx; ++i)
-        gmax = fmax(gmax, fabs(g[i]));
-    int checked = 0;
-    for (int32_t i = 0; i < R + nx; i += (i < R ? 1 : 1 + nx / 40)) {
-        double *p = i < R ? q + i : x + (i - R), keep = *p, h = 1e-6;
-        *p = keep + h;
-        double ep = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
-        *p = keep - h;
-        double em = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
-        *p = keep;
-        ENSURE_NEAR((ep - em) / (2 * h), g[i], 1e-5 * gmax + 1e-4 * fabs(g[i]));
-        checked++;
+    for (int wide = 0; wide < 2; ++wide) {
+        sinew_world *w = NULL;
+        sinew_instance *in = prepared_on_table(&w, wide ? RHO_WIDE : RHO);
+        ENSURE(in);
+        sw_cond *c = &in->cond;
+        ENSURE(c->nf > 10 && c->nt > c->nf && c->nring > 0);
+        ENSURE((c->nrest > 0) == wide);
+        int32_t R = in->red.R, nx = 3 * c->nf;
+        sw_step_contacts ct = {&in->ps, &in->wc};
+        sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
+        sw_cond_weights_apply(c, &in->red);
+        double *q = malloc(sizeof(double) * R), *x = malloc(sizeof(double) * nx);
+        double *g = malloc(sizeof(double) * (R + nx));
+        memcpy(q, in->solver.q, sizeof(double) * R);
+        for (int32_t i = 0; wide && i < R; ++i) /* the rest strained (at the step's q it rests) */
+            q[i] += 0.05 * cos(2.3 * i);
+        for (int32_t i = 0; i < nx; ++i) /* off the start: some tets stretched, some contact */
+            x[i] = c->x[i] + 0.01 * sin(1.7 * i);
+        sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 1);
+        memcpy(g, in->red.g, sizeof(double) * R);
+        memcpy(g + R, c->gf, sizeof(double) * nx);
+        double gmax = 0;
+        for (int32_t i = 0; i < R + nx; ++i)
+            gmax = fmax(gmax, fabs(g[i]));
+        int checked = 0;
+        for (int32_t i = 0; i < R + nx; i += (i < R ? 1 : 1 + nx / 40)) {
+            double *p = i < R ? q + i : x + (i - R), keep = *p, h = 1e-6;
+            *p = keep + h;
+            double ep = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
+            *p = keep - h;
+            double em = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
+            *p = keep;
+            ENSURE_NEAR((ep - em) / (2 * h), g[i], 1e-5 * gmax + 1e-4 * fabs(g[i]));
+            checked++;
+        }
+        ENSURE(checked > R + 20);
+        if (wide) { /* the rest's part of Phi: its tets' energies at their subspace positions */
+            const sw_blob_view *v = c->v;
+            double with = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
+            int32_t nrest = c->nrest;
+            c->nrest = 0;
+            double without = sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 0);
+            c->nrest = nrest;
+            double brute = 0;
+            for (int32_t e = c->nt + c->np; e < c->nt + c->np + nrest; ++e) {
+                int32_t t = c->ft[e];
+                double x12[12], f12[12];
+                for (int k = 0; k < 4; ++k)
+                    sw_cond_copy_position(&in->red, v->tets[4 * t + k], v->tet_domain[t],
+                                          v->tet_local[4 * t + k], q, x12 + 3 * k, NULL);
+                brute += sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu,
+                                       v->lambda, f12, NULL, SW_COROT_PROJECT_PSD);
+            }
+            fprintf(stderr, "    Phi %.9g, of it the rest's %d tets %.9g (by brute force %.9g)\n",
+                    with, nrest, with - without, brute);
+            ENSURE(brute > 0);
+            ENSURE_NEAR(with - without, brute, 1e-9 * (fabs(with) + brute));
+        }
+        /* the Hessian of the last evaluation with Hessian: symmetric, positive semi-definite */
+        sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 1);
+        sw_cond_system S = {c, &in->red, &in->solver};
+        double *a = malloc(sizeof(double) * (R + nx)), *b = malloc(sizeof(double) * (R + nx));
+        double *Ha = malloc(sizeof(double) * (R + nx)), *Hb = malloc(sizeof(double) * (R + nx));
+        for (int32_t i = 0; i < R + nx; ++i) {
+            a[i] = cos(0.3 * i + 1);
+            b[i] = sin(0.7 * i);
+        }
+        sw_cond_hessian_apply(&S, a, Ha);
+        sw_cond_hessian_apply(&S, b, Hb);
+        double bHa = 0, aHb = 0, aHa = 0, scale = 0;
+        for (int32_t i = 0; i < R + nx; ++i) {
+            bHa += b[i] * Ha[i];
+            aHb += a[i] * Hb[i];
+            aHa += a[i] * Ha[i];
+            scale += fabs(a[i] * Ha[i]) + fabs(b[i] * Hb[i]);
+        }
+        fprintf(
+            stderr,
+            "    patch %d vertices, %d tets (%d more at q), %d ring copies; b'Ha %.6g a'Hb %.6g "
+            "a'Ha %.6g\n",
+            c->nf, c->nt, c->nrest, c->nring, bHa, aHb, aHa);
+        ENSURE_NEAR(bHa, aHb, 1e-10 * scale);
+        ENSURE(aHa > 0);
+        sw_cond_weights_restore(c, &in->red);
+        free(q), free(x), free(g), free(a), free(b), free(Ha), free(Hb);
+        sinew_instance_destroy(in);
+        sinew_world_destroy(w);
     }
-    ENSURE(checked > R + 20);
-    /* the Hessian of the last evaluation with Hessian: symmetric, positive semi-definite */
-    sw_cond_potential(c, &in->red, &ct, &in->solver, q, x, &dc, 1);
-    sw_cond_system S = {c, &in->red, &in->solver};
-    double *a = malloc(sizeof(double) * (R + nx)), *b = malloc(sizeof(double) * (R + nx));
-    double *Ha = malloc(sizeof(double) * (R + nx)), *Hb = malloc(sizeof(double) * (R + nx));
-    for (int32_t i = 0; i < R + nx; ++i) {
-        a[i] = cos(0.3 * i + 1);
-        b[i] = sin(0.7 * i);
-    }
-    sw_cond_hessian_apply(&S, a, Ha);
-    sw_cond_hessian_apply(&S, b, Hb);
-    double bHa = 0, aHb = 0, aHa = 0, scale = 0;
-    for (int32_t i = 0; i < R + nx; ++i) {
-        bHa += b[i] * Ha[i];
-        aHb += a[i] * Hb[i];
-        aHa += a[i] * Ha[i];
-        scale += fabs(a[i] * Ha[i]) + fabs(b[i] * Hb[i]);
-    }
-    fprintf(stderr,
-            "    patch %d vertices, %d tets, %d ring copies; b'Ha %.6g a'Hb %.6g a'Ha %.6g\n",
-            c->nf, c->nt, c->nring, bHa, aHb, aHa);
-    ENSURE_NEAR(bHa, aHb, 1e-10 * scale);
-    ENSURE(aHa > 0);
-    sw_cond_weights_restore(c, &in->red);
-    free(q), free(x), free(g), free(a), free(b), free(Ha), free(Hb);
-    sinew_instance_destroy(in);
-    sinew_world_destroy(w);
 }
 
 /* Eq. 4.12's subspace part: each domain the patch reaches keeps its cubature scaled to
  * its volume outside the patch (the tets touching a patch vertex, found here by a scan
  * of every tet), the others keep theirs, and the solve's end restores them. */
 TEST(cubature_weights_follow_each_domains_volume_outside_the_patch) {
-    sinew_world *w = NULL;
-    sinew_instance *in = prepared_on_table(&w);
-    ENSURE(in);
-    sw_cond *c = &in->cond;
-    const sw_blob_view *v = c->v;
-    ENSURE(c->nf > 0);
-    double *vol = calloc((size_t)v->ndomains, sizeof(double));
-    double *in_vol = calloc((size_t)v->ndomains, sizeof(double));
-    for (int32_t t = 0; t < v->ntets; ++t) {
-        int touches = 0;
-        for (int k = 0; k < 4; ++k)
-            touches |= sw_cond_position(c, v->tets[4 * t + k]) != NULL;
-        vol[v->tet_domain[t]] += v->tet_vol[t];
-        if (touches) in_vol[v->tet_domain[t]] += v->tet_vol[t];
+    for (int wide = 0; wide < 2; ++wide) {
+        sinew_world *w = NULL;
+        sinew_instance *in = prepared_on_table(&w, wide ? RHO_WIDE : RHO);
+        ENSURE(in);
+        sw_cond *c = &in->cond;
+        const sw_blob_view *v = c->v;
+        ENSURE(c->nf > 0);
+        double *vol = calloc((size_t)v->ndomains, sizeof(double));
+        double *in_vol = calloc((size_t)v->ndomains, sizeof(double));
+        unsigned char *touches = calloc((size_t)v->ntets, 1);
+        for (int32_t t = 0; t < v->ntets; ++t) {
+            for (int k = 0; k < 4; ++k)
+                touches[t] |= sw_cond_position(c, v->tets[4 * t + k]) != NULL;
+            vol[v->tet_domain[t]] += v->tet_vol[t];
+            if (touches[t]) in_vol[v->tet_domain[t]] += v->tet_vol[t];
+        }
+        /* a domain more than SW_COND_EXACT_SHARE in the patch: each of its other tets is a
+           rest element once, its four corners the ring copies of its own vertices */
+        int32_t *seen = calloc((size_t)v->ntets, sizeof(int32_t)), nexact = 0, nrest = 0;
+        for (int32_t e = c->nt + c->np; e < c->nt + c->np + c->nrest; ++e) {
+            int32_t t = c->ft[e];
+            seen[t]++;
+            for (int k = 0; k < 4; ++k) {
+                int32_t slot = c->ft_slot[4 * e + k];
+                ENSURE(slot < 0 && c->ring_v[-1 - slot] == v->tets[4 * t + k] &&
+                       c->ring_d[-1 - slot] == v->tet_domain[t]);
+            }
+        }
+        for (int32_t k = 0; k < v->ndomains; ++k)
+            nexact += in_vol[k] > SW_COND_EXACT_SHARE * vol[k];
+        for (int32_t t = 0; t < v->ntets; ++t) {
+            int32_t k = v->tet_domain[t];
+            int rest = !touches[t] && in_vol[k] > SW_COND_EXACT_SHARE * vol[k];
+            ENSURE(seen[t] == rest);
+            nrest += rest;
+        }
+        ENSURE(nrest == c->nrest && (nexact > 0) == wide);
+        /* the cubature of the others scaled to their volume outside, of these none */
+        sw_cond_weights_apply(c, &in->red);
+        int reached = 0;
+        for (int32_t k = 0; k < v->ndomains; ++k) {
+            const sw_blob_domain *D = &v->domains[k];
+            double s = in_vol[k] > 0 ? (vol[k] - in_vol[k]) / vol[k] : 1;
+            if (in_vol[k] > SW_COND_EXACT_SHARE * vol[k]) s = 0;
+            reached += in_vol[k] > 0;
+            for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
+                ENSURE_NEAR(c->cub_w[i], s * v->cub_weight[i], 1e-12 * v->cub_weight[i]);
+        }
+        fprintf(stderr, "    radius %g: %d of %d domains reached, %d evaluated at q (%d tets)\n",
+                wide ? RHO_WIDE : RHO, reached, v->ndomains, nexact, nrest);
+        ENSURE(reached > 0);
+        sw_cond_weights_restore(c, &in->red);
+        for (int32_t i = 0; i < v->ncub; ++i)
+            ENSURE(c->cub_w[i] == v->cub_weight[i]);
+        free(vol), free(in_vol), free(touches), free(seen);
+        sinew_instance_destroy(in);
+        sinew_world_destroy(w);
     }
-    sw_cond_weights_apply(c, &in->red);
-    int reached = 0;
-    for (int32_t k = 0; k < v->ndomains; ++k) {
-        const sw_blob_domain *D = &v->domains[k];
-        double s = in_vol[k] > 0 ? (vol[k] - in_vol[k]) / vol[k] : 1;
-        reached += in_vol[k] > 0;
-        for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
-            ENSURE_NEAR(c->cub_w[i], s * v->cub_weight[i], 1e-12 * v->cub_weight[i]);
-    }
-    ENSURE(reached > 0);
-    sw_cond_weights_restore(c, &in->red);
-    for (int32_t i = 0; i < v->ncub; ++i)
-        ENSURE(c->cub_w[i] == v->cub_weight[i]);
-    free(vol), free(in_vol);
-    sinew_instance_destroy(in);
-    sinew_world_destroy(w);
 }
 
 /* Brute force: the vertices a breadth-first growth over the whole mesh reaches from seed s

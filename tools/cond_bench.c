@@ -140,7 +140,16 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
             }
             memcpy(prev, xo, sizeof(double) * 3 * ns);
             memcpy(ref_prev, ref_out, sizeof(double) * 3 * ns);
-            if (!touch[f]) continue;
+            if (!touch[f]) {
+                if (getenv("SW_COND_DEBUG") && st.patch_vertices > 0)
+                    fprintf(
+                        stderr,
+                        "frame %d: patch %u, no contact in the reference; status %u, %u Newton, "
+                        "%u PCG, residual %.2g\n",
+                        f, st.patch_vertices, st.status, st.newton_iterations, st.pcg_iterations,
+                        st.residual);
+                continue;
+            }
             sw_instance_full_positions(inst, xs, cnt);
             sw_instance_dqs_positions(inst, xd);
             double fn = 0, fd = 0, fin = 0;

@@ -16,6 +16,7 @@
  * and the patch vertices' positions,
  *   Phi(q, x_f) = sum_{t full} E_t(x_t)                        (ring corners at q)
  *               + sum_{c cubature, not full} s_d w_c E_c(q)    (eq. 4.12's second sum)
+ *               + sum_{t rest} E_t(q)   (the other tets of a domain the patch mostly covers)
  *               + springs, pose-space contact, world contact of the subspace copies
  *               + world contact of the patch vertices at x_f (the full block),
  * whose gradient in q is eq. 4.12: the boundary tets' forces projected through the ring
@@ -35,6 +36,9 @@
 
 /* The patch radius when the def leaves it 0, in units of the rest diagonal. */
 #define SW_COND_DEFAULT_RADIUS 0.05
+/* The share of a domain's rest volume in the patch past which the domain's other tets are
+ * evaluated exactly at q instead of by its scaled cubature (oracle.c, exact_domains). */
+#define SW_COND_EXACT_SHARE 0.5
 
 /* Sizes an instance reserves for a patch budget (all 0 when condensation is off). */
 typedef struct sw_cond_sizes {
@@ -67,6 +71,8 @@ typedef struct sw_cond {
     uint32_t *dev_at;      /* the stamp of the step that left dev */
     uint32_t *tvis;        /* per tet: full-tet stamp */
     double *dom_vol;       /* ndomains: rest volume of the domain's tets */
+    int32_t *dom_tet_ptr;  /* ndomains + 1: each domain's tets are dom_tets[ptr[d] .. ptr[d+1]) */
+    int32_t *dom_tets;     /* ntets */
     uint32_t stamp, vstamp;
     /* the growth */
     int32_t *queue; /* max_cand */
@@ -77,13 +83,17 @@ typedef struct sw_cond {
     /* the patch */
     int32_t nf, nt, nring;
     int32_t np;             /* pose-space contact pairs with a patch corner (elements nt ..) */
+    int32_t nrest;          /* the other tets of the domains the patch mostly covers, all four
+                               corners ring copies, evaluated at q (elements nt + np ..) */
+    int32_t nring_patch;    /* ring copies [0, nring_patch) are those of the patch's tets and
+                               pairs; the rest's own come after */
     int32_t *pp_id;         /* max_pairs: their contact ids */
     double *pp_w;           /* max_pairs: their pose-space blend weights */
     unsigned char *pp_skip; /* max_pairs: per ps->pairs entry, the patch evaluates it */
     signed char *pp_active; /* max_pairs: in contact for this solve (-1: not decided yet) */
     int32_t *fv;            /* nf: patch vertices (global ids) */
-    int32_t *ft;            /* nt: full tets */
-    int32_t *ft_slot;       /* 4 per full tet: patch index >= 0, or -1 - ring copy */
+    int32_t *ft;            /* nt full tets, then (from nt + np) the rest's nrest tets */
+    int32_t *ft_slot;       /* 4 per element: patch index >= 0, or -1 - ring copy */
     int32_t *ring_v;        /* per ring copy: global vertex, domain, local index, next copy */
     int32_t *ring_d, *ring_l, *ring_next;
     double *ring_x0;  /* 3 per ring copy: R rest + t (its position at q = 0) */
@@ -91,7 +101,8 @@ typedef struct sw_cond {
     double *ring_x;   /* 3 per ring copy: its position at the iterate */
     double *ring_dx;  /* 3 per ring copy: scratch (J dq) */
     double *ring_tmp; /* 12 rmax: scratch (a tet's K J over its ring corners) */
-    double *Hq;       /* R x R: the reduced potential's Hessian (without the ring blocks) */
+    double *Hq;       /* R x R: the reduced potential's Hessian and the rest's ring blocks
+                         (without the patch's: the product applies those tet by tet) */
     double *dom_fv;   /* ndomains: the patch's tets' volume */
     double g0_step;   /* |grad| at the step's first coupled iterate (0: not solved yet) */
     /* the coupled Newton */

@@ -26,15 +26,15 @@ void sw_cond_weights_apply(sw_cond *c, sw_reduced *red) {
     const sw_blob_view *v = c->v;
     for (int32_t k = 0; k < v->ndomains; ++k)
         c->dom_fv[k] = 0;
-    for (int32_t e = 0; e < c->nt; ++e) {
-        int32_t t = c->ft[e];
-        c->dom_fv[v->tet_domain[t]] += v->tet_vol[t];
-    }
+    for (int32_t e = 0; e < c->nt; ++e)
+        c->dom_fv[v->tet_domain[c->ft[e]]] += v->tet_vol[c->ft[e]];
+    for (int32_t e = c->nt + c->np; e < c->nt + c->np + c->nrest; ++e) /* (after the pairs) */
+        c->dom_fv[v->tet_domain[c->ft[e]]] += v->tet_vol[c->ft[e]];
     for (int32_t k = 0; k < v->ndomains; ++k) {
         if (c->dom_fv[k] == 0) continue;
         const sw_blob_domain *D = &v->domains[k];
         double s = c->dom_vol[k] > 0 ? (c->dom_vol[k] - c->dom_fv[k]) / c->dom_vol[k] : 0;
-        if (!(s > 0)) s = 0;
+        if (!(s > 1e-9)) s = 0; /* every tet full (exact_domains): 0 up to the sums' rounding */
         for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
             c->cub_w[i] = s * v->cub_weight[i];
         red->Jcub_ok[k] = 0;
@@ -173,17 +173,49 @@ static void add_pair_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const d
         }
 }
 
+/* Element e's energy (a full tet's, or a pose-space pair's); its forces into c->gf and,
+ * through its ring corners' rows, red->g; with want_hess its Hessian into Kt and its ring
+ * blocks into red->H. */
+static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t e, int want_hess) {
+    const sw_blob_view *v = c->v;
+    const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
+    int is_pair = e >= c->nt && e < c->nt + c->np;
+    double x12[12], f[12], *K = c->Kt + 144 * (int64_t)e, phi;
+    tet_positions(c, x, e, x12);
+    if (!is_pair) {
+        int32_t t = c->ft[e];
+        phi = sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, f,
+                            want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
+    } else {
+        phi = patch_pair(c, red, e - c->nt, x12, f, want_hess ? K : NULL);
+    }
+    for (int k = 0; k < 4; ++k) {
+        if (slot[k] >= 0) {
+            for (int i = 0; i < 3; ++i)
+                c->gf[3 * (int64_t)slot[k] + i] -= f[3 * k + i];
+            continue;
+        }
+        int32_t a = -1 - slot[k];
+        const sw_blob_domain *D = &v->domains[c->ring_d[a]];
+        const double *J = ring_J(c, a);
+        for (int32_t j = 0; j < D->rank; ++j)
+            red->g[D->q_offset + j] -=
+                J[j] * f[3 * k] + J[D->rank + j] * f[3 * k + 1] + J[2 * D->rank + j] * f[3 * k + 2];
+    }
+    if (want_hess && !is_pair) add_ring_blocks(c, red, e, K);
+    if (want_hess && is_pair) add_pair_ring_blocks(c, red, e, K);
+    return phi;
+}
+
 /* Phi(q, x) (condense.h): the gradient into (red->g, c->gf), the Hessian's parts (red->H
  * with the ring blocks, Kt, Dw) with want_hess. */
 double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
                          const sw_solver *s, const double *q, const double *x,
                          const sw_dyn_coef *dc, int want_hess) {
-    const sw_blob_view *v = c->v;
     double phi = sw_potential(red, ct, s, q, dc, 1, want_hess);
     int32_t R = red->R;
-    if (want_hess) memcpy(c->Hq, red->H, (size_t)R * R * sizeof(double));
     for (int32_t k = 0; k < c->nring; ++k) {
-        const sw_blob_domain *D = &v->domains[c->ring_d[k]];
+        const sw_blob_domain *D = &c->v->domains[c->ring_d[k]];
         int32_t r = D->rank;
         const double *J = ring_J(c, k), *qd = q + D->q_offset;
         for (int i = 0; i < 3; ++i) {
@@ -195,33 +227,14 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
     }
     memset(c->gf, 0, 3 * (size_t)c->nf * sizeof(double));
     if (want_hess) memset(c->Dw, 0, 9 * (size_t)c->nf * sizeof(double));
-    for (int32_t e = 0; e < c->nt + c->np; ++e) {
-        const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
-        double x12[12], f[12], *K = c->Kt + 144 * (int64_t)e;
-        tet_positions(c, x, e, x12);
-        if (e < c->nt) {
-            int32_t t = c->ft[e];
-            phi += sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu,
-                                 v->lambda, f, want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
-        } else {
-            phi += patch_pair(c, red, e - c->nt, x12, f, want_hess ? K : NULL);
-        }
-        for (int k = 0; k < 4; ++k) {
-            if (slot[k] >= 0) {
-                for (int i = 0; i < 3; ++i)
-                    c->gf[3 * (int64_t)slot[k] + i] -= f[3 * k + i];
-                continue;
-            }
-            int32_t a = -1 - slot[k];
-            const sw_blob_domain *D = &v->domains[c->ring_d[a]];
-            const double *J = ring_J(c, a);
-            for (int32_t j = 0; j < D->rank; ++j)
-                red->g[D->q_offset + j] -= J[j] * f[3 * k] + J[D->rank + j] * f[3 * k + 1] +
-                                           J[2 * D->rank + j] * f[3 * k + 2];
-        }
-        if (want_hess && e < c->nt) add_ring_blocks(c, red, e, K);
-        if (want_hess && e >= c->nt) add_pair_ring_blocks(c, red, e, K);
-    }
+    /* the rest of the domains the patch mostly covers first: wholly at q, their J^T K J
+       belong to the reduced block the matrix-vector product applies as a whole (Hq) */
+    int32_t ne = c->nt + c->np;
+    for (int32_t e = ne; e < ne + c->nrest; ++e)
+        phi += add_element(c, red, x, e, want_hess);
+    if (want_hess) memcpy(c->Hq, red->H, (size_t)R * R * sizeof(double));
+    for (int32_t e = 0; e < ne; ++e)
+        phi += add_element(c, red, x, e, want_hess);
     const sw_world_contacts *wc = ct->wc;
     for (int32_t j = 0; wc && j < wc->ncand; ++j) {
         const sw_world_cand *cd = &wc->cand[j];
@@ -254,7 +267,7 @@ void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
         for (int k = 0; k < 3; ++k)
             yx[3 * i + k] = D[3 * k] * a[0] + D[3 * k + 1] * a[1] + D[3 * k + 2] * a[2];
     }
-    for (int32_t k = 0; k < c->nring; ++k) {
+    for (int32_t k = 0; k < c->nring_patch; ++k) { /* the rest's elements are in Hq */
         const sw_blob_domain *D = &v->domains[c->ring_d[k]];
         const double *J = ring_J(c, k), *qd = dq + D->q_offset;
         for (int i = 0; i < 3; ++i) {

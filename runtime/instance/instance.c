@@ -120,6 +120,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->tvis, nt);
         TAKE(c->dom_vol, nd);
         TAKE(c->dom_fv, nd);
+        TAKE(c->dom_tet_ptr, nd + 1);
+        TAKE(c->dom_tets, nt);
         TAKE(c->queue, (uint64_t)cz->max_cand);
         TAKE(c->cand, (uint64_t)cz->max_cand);
         TAKE(c->cand_d, (uint64_t)cz->max_cand);
