@@ -142,12 +142,11 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
             memcpy(ref_prev, ref_out, sizeof(double) * 3 * ns);
             if (!touch[f]) {
                 if (getenv("SW_COND_DEBUG") && st.patch_vertices > 0)
-                    fprintf(
-                        stderr,
-                        "frame %d: patch %u, no contact in the reference; status %u, %u Newton, "
-                        "%u PCG, residual %.2g\n",
-                        f, st.patch_vertices, st.status, st.newton_iterations, st.pcg_iterations,
-                        st.residual);
+                    fprintf(stderr,
+                            "frame %d: patch %u (%d tets more at q), no contact in the reference; "
+                            "status %u, %u Newton, %u PCG, %u evaluations, residual %.2g\n",
+                            f, st.patch_vertices, inst->cond.nrest, st.status, st.newton_iterations,
+                            st.pcg_iterations, st.potential_evals, st.residual);
                 continue;
             }
             sw_instance_full_positions(inst, xs, cnt);
@@ -164,10 +163,12 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
                 }
             if (getenv("SW_COND_DEBUG"))
                 fprintf(stderr,
-                        "frame %d: patch %u, err num %.3g (in patch %.3g) den %.3g; status %u, "
-                        "%u Newton, %u PCG, residual %.2g, %d pose-space pairs in the patch\n",
-                        f, st.patch_vertices, fn, fin, fd, st.status, st.newton_iterations,
-                        st.pcg_iterations, st.residual, inst->cond.np);
+                        "frame %d: patch %u (%d tets more at q), err num %.3g (in patch %.3g) den "
+                        "%.3g; status %u, %u Newton, %u PCG, %u evaluations, residual %.2g, %d "
+                        "pose-space pairs in the patch\n",
+                        f, st.patch_vertices, inst->cond.nrest, fn, fin, fd, st.status,
+                        st.newton_iterations, st.pcg_iterations, st.potential_evals, st.residual,
+                        inst->cond.np);
         }
     }
     out->err_world_cond = den > 0 ? sqrt(num / den) : 0;

@@ -100,7 +100,7 @@ typedef struct sw_cond {
     double *ring_J;   /* 3 rmax per ring copy: J = R U (3 x r_d) */
     double *ring_x;   /* 3 per ring copy: its position at the iterate */
     double *ring_dx;  /* 3 per ring copy: scratch (J dq) */
-    double *ring_tmp; /* 12 rmax: scratch (a tet's K J over its ring corners) */
+    double *ring_M;   /* 3 rmax per ring copy: its tets' K J gathered (coupled.c; kept 0) */
     double *Hq;       /* R x R: the reduced potential's Hessian and the rest's ring blocks
                          (without the patch's: the product applies those tet by tet) */
     double *dom_fv;   /* ndomains: the patch's tets' volume */

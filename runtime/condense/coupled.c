@@ -67,43 +67,51 @@ static void tet_positions(const sw_cond *c, const double *x, int32_t e, double x
     }
 }
 
-/* red->H's domain block += J^T K_rr J over full tet e's ring corners (all copies of the
- * tet's domain): their stacked Jacobians J (3m x r), KJ = K_rr J first, then J^T KJ. */
-static void add_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const double *K) {
+/* The full tets' ring blocks, J^T K_rr J summed over their ring corners' pairs, gathered
+ * per ring copy a: M_a += sum_b K_ab J_b over the tet's ring corners b (3 x r_d), then
+ * H_dd += J_a^T M_a once per copy. Tet by tet, J_a^T (K J) cost 12 r^2 a tet; per copy it
+ * costs 3 r^2, and a copy has about five tets (the rest of a domain is all ring copies). */
+static void ring_blocks_gather(sw_cond *c, int32_t e, const double *K) {
     const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
-    int rk[4], m = 0;
-    for (int k = 0; k < 4; ++k)
-        if (slot[k] < 0) rk[m++] = k;
-    if (m == 0) return;
-    const sw_blob_domain *D = &c->v->domains[c->ring_d[-1 - slot[rk[0]]]];
-    int32_t r = D->rank, o = D->q_offset;
-    double *KJ = c->ring_tmp; /* 3m x r */
-    for (int a = 0; a < m; ++a)
-        for (int i = 0; i < 3; ++i) {
-            double *row = KJ + (3 * a + i) * r;
-            const double *Krow = K + (3 * rk[a] + i) * 12;
-            for (int32_t j = 0; j < r; ++j)
-                row[j] = 0;
-            for (int b = 0; b < m; ++b) {
-                const double *Jb = ring_J(c, -1 - slot[rk[b]]);
+    for (int a = 0; a < 4; ++a) {
+        if (slot[a] >= 0) continue;
+        int32_t ka = -1 - slot[a];
+        int32_t r = c->v->domains[c->ring_d[ka]].rank;
+        double *M = c->ring_M + (int64_t)3 * c->z.rmax * ka;
+        for (int b = 0; b < 4; ++b) {
+            if (slot[b] >= 0) continue;
+            const double *Jb = ring_J(c, -1 - slot[b]);
+            for (int i = 0; i < 3; ++i) {
+                const double *Krow = K + (3 * a + i) * 12 + 3 * b;
+                double *Mi = M + i * r;
                 for (int l = 0; l < 3; ++l) {
-                    double kv = Krow[3 * rk[b] + l];
+                    double kv = Krow[l];
                     const double *Jl = Jb + l * r;
                     for (int32_t j = 0; j < r; ++j)
-                        row[j] += kv * Jl[j];
+                        Mi[j] += kv * Jl[j];
                 }
             }
         }
-    for (int a = 0; a < m; ++a) {
-        const double *Ja = ring_J(c, -1 - slot[rk[a]]);
+    }
+}
+
+/* red->H's domain blocks += J_a^T M_a for the ring copies a in [k0, k1), their M cleared
+ * for the next gathering. */
+static void ring_blocks_flush(sw_cond *c, sw_reduced *red, int32_t k0, int32_t k1) {
+    for (int32_t ka = k0; ka < k1; ++ka) {
+        const sw_blob_domain *D = &c->v->domains[c->ring_d[ka]];
+        int32_t r = D->rank, o = D->q_offset;
+        const double *Ja = ring_J(c, ka);
+        double *M = c->ring_M + (int64_t)3 * c->z.rmax * ka;
         for (int i = 0; i < 3; ++i) {
-            const double *Jai = Ja + i * r, *row = KJ + (3 * a + i) * r;
+            const double *Jai = Ja + i * r, *Mi = M + i * r;
             for (int32_t p = 0; p < r; ++p) {
                 double jp = Jai[p], *Hp = red->H + (int64_t)(o + p) * red->R + o;
                 for (int32_t j = 0; j < r; ++j)
-                    Hp[j] += jp * row[j];
+                    Hp[j] += jp * Mi[j];
             }
         }
+        memset(M, 0, 3 * (size_t)r * sizeof(double));
     }
 }
 
@@ -175,7 +183,7 @@ static void add_pair_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const d
 
 /* Element e's energy (a full tet's, or a pose-space pair's); its forces into c->gf and,
  * through its ring corners' rows, red->g; with want_hess its Hessian into Kt and its ring
- * blocks into red->H. */
+ * blocks into red->H (a tet's gathered, for ring_blocks_flush). */
 static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t e, int want_hess) {
     const sw_blob_view *v = c->v;
     const int32_t *slot = c->ft_slot + 4 * (int64_t)e;
@@ -202,7 +210,7 @@ static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t 
             red->g[D->q_offset + j] -=
                 J[j] * f[3 * k] + J[D->rank + j] * f[3 * k + 1] + J[2 * D->rank + j] * f[3 * k + 2];
     }
-    if (want_hess && !is_pair) add_ring_blocks(c, red, e, K);
+    if (want_hess && !is_pair) ring_blocks_gather(c, e, K);
     if (want_hess && is_pair) add_pair_ring_blocks(c, red, e, K);
     return phi;
 }
@@ -232,9 +240,13 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
     int32_t ne = c->nt + c->np;
     for (int32_t e = ne; e < ne + c->nrest; ++e)
         phi += add_element(c, red, x, e, want_hess);
-    if (want_hess) memcpy(c->Hq, red->H, (size_t)R * R * sizeof(double));
+    if (want_hess) {
+        ring_blocks_flush(c, red, 0, c->nring);
+        memcpy(c->Hq, red->H, (size_t)R * R * sizeof(double));
+    }
     for (int32_t e = 0; e < ne; ++e)
         phi += add_element(c, red, x, e, want_hess);
+    if (want_hess) ring_blocks_flush(c, red, 0, c->nring_patch);
     const sw_world_contacts *wc = ct->wc;
     for (int32_t j = 0; wc && j < wc->ncand; ++j) {
         const sw_world_cand *cd = &wc->cand[j];

@@ -54,6 +54,7 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     memset(c->dev_at, 0, (size_t)v->nverts * sizeof *c->dev_at);
     memset(c->dyn_at, 0, (size_t)v->nverts * sizeof *c->dyn_at);
     memset(c->tvis, 0, (size_t)v->ntets * sizeof *c->tvis);
+    memset(c->ring_M, 0, (size_t)3 * c->z.rmax * c->z.max_ring * sizeof *c->ring_M);
     for (int32_t gv = 0; gv < v->nverts; ++gv)
         c->surf_of[gv] = -1;
     for (int32_t s = 0; s < v->nsurf_verts; ++s) {

@@ -140,7 +140,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->ring_J, 3 * (uint64_t)cz->rmax * nr);
         TAKE(c->ring_x, 3 * nr);
         TAKE(c->ring_dx, 3 * nr);
-        TAKE(c->ring_tmp, 12 * (uint64_t)cz->rmax);
+        TAKE(c->ring_M, 3 * (uint64_t)cz->rmax * nr);
         TAKE(c->Hq, R * R);
         TAKE(c->x, 3 * nf);
         TAKE(c->xt, 3 * nf);
