@@ -404,28 +404,34 @@ TEST(without_contact_a_condensed_instance_is_bitwise_the_subspace) {
 TEST(condensed_steps_allocate_and_lock_nothing_while_the_patch_moves) {
     moving_scene ms;
     ENSURE(moving_scene_make(&ms));
-    sinew_instance *in = pressed(ms.f, ms.w, 800, 0);
-    ENSURE(in);
-    int nb = ms.f->ch.skel.nbones, nfr = ms.f->ch.clip.nframes;
-    unsigned active = sw_rt_interpose_active();
-    uint32_t with_patch = 0, without = 0;
-    sw_rt_count_begin();
-    for (int s = 0; s < 60; ++s) {
-        sinew_transform t;
-        ball_at(s, &t);
-        sinew_world_set_collider_transform(ms.w, ms.ball, &t);
-        sw_instance_set_pose_d(in, ms.f->ch.clip.T + (size_t)(s % nfr) * 12 * nb);
-        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
-        with_patch += in->stats.patch_vertices > 0;
-        without += in->stats.patch_vertices == 0;
+    for (int wide = 0; wide < 2; ++wide) { /* wide: with the rest of mostly covered domains */
+        sinew_instance *in = pressed_rho(ms.f, ms.w, 800, 0, wide ? RHO_WIDE : RHO);
+        ENSURE(in);
+        int nb = ms.f->ch.skel.nbones, nfr = ms.f->ch.clip.nframes;
+        unsigned active = sw_rt_interpose_active();
+        uint32_t with_patch = 0, without = 0, with_rest = 0;
+        sw_rt_count_begin();
+        for (int s = 0; s < 60; ++s) {
+            sinew_transform t;
+            ball_at(s, &t);
+            sinew_world_set_collider_transform(ms.w, ms.ball, &t);
+            sw_instance_set_pose_d(in, ms.f->ch.clip.T + (size_t)(s % nfr) * 12 * nb);
+            ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+            with_patch += in->stats.patch_vertices > 0;
+            without += in->stats.patch_vertices == 0;
+            with_rest += in->cond.nrest > 0;
+        }
+        sw_rt_counts cnt = sw_rt_count_end();
+        fprintf(stderr,
+                "    radius %g: %u steps with a patch (%u with tets at q), %u without; allocs %lu "
+                "locks %lu\n",
+                wide ? RHO_WIDE : RHO, with_patch, with_rest, without, (unsigned long)cnt.allocs,
+                (unsigned long)cnt.locks);
+        ENSURE(with_patch > 10 && (with_rest > 0) == wide);
+        if (active & SW_RT_CAT_ALLOCS) ENSURE(cnt.allocs == 0 && cnt.frees == 0);
+        if (active & SW_RT_CAT_LOCKS) ENSURE(cnt.locks == 0);
+        sinew_instance_destroy(in);
     }
-    sw_rt_counts cnt = sw_rt_count_end();
-    fprintf(stderr, "    %u steps with a patch, %u without; allocs %lu locks %lu\n", with_patch,
-            without, (unsigned long)cnt.allocs, (unsigned long)cnt.locks);
-    ENSURE(with_patch > 10);
-    if (active & SW_RT_CAT_ALLOCS) ENSURE(cnt.allocs == 0 && cnt.frees == 0);
-    if (active & SW_RT_CAT_LOCKS) ENSURE(cnt.locks == 0);
-    sinew_instance_destroy(in);
     sinew_world_destroy(ms.w);
 }
 
