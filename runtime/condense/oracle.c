@@ -61,21 +61,17 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
         int32_t i = v->surf_copy_ptr[s], d = v->surf_copies[2 * i];
         c->surf_of[v->domain_verts[v->domains[d].vert_begin + v->surf_copies[2 * i + 1]]] = s;
     }
-    for (int32_t k = 0; k <= v->ndomains; ++k)
-        c->dom_tet_ptr[k] = 0;
     for (int32_t k = 0; k < v->ndomains; ++k)
-        c->dom_vol[k] = 0;
+        c->dom_vol[k] = c->dom_tet_ptr[k] = 0;
     for (int32_t t = 0; t < v->ntets; ++t) {
         c->dom_vol[v->tet_domain[t]] += v->tet_vol[t];
-        c->dom_tet_ptr[v->tet_domain[t] + 1]++;
+        c->dom_tet_ptr[v->tet_domain[t]]++;
     }
-    for (int32_t k = 0; k < v->ndomains; ++k)
-        c->dom_tet_ptr[k + 1] += c->dom_tet_ptr[k];
-    for (int32_t t = 0; t < v->ntets; ++t) /* dom_tet_ptr[d] runs ahead, then shifts back */
-        c->dom_tets[c->dom_tet_ptr[v->tet_domain[t]]++] = t;
-    for (int32_t k = v->ndomains; k > 0; --k)
-        c->dom_tet_ptr[k] = c->dom_tet_ptr[k - 1];
-    c->dom_tet_ptr[0] = 0;
+    for (int32_t k = 1; k < v->ndomains; ++k) /* each domain's end ... */
+        c->dom_tet_ptr[k] += c->dom_tet_ptr[k - 1];
+    c->dom_tet_ptr[v->ndomains] = v->ntets;
+    for (int32_t t = v->ntets - 1; t >= 0; --t) /* ... counted down to its start */
+        c->dom_tets[--c->dom_tet_ptr[v->tet_domain[t]]] = t;
     /* Kinematic vertices: the bake's bone vertices follow their bone rigidly (one-hot
      * weights, no training displacement: bake_basis.c), so every basis row of theirs is
      * exactly zero; the reference holds them too. A patch never frees them: they stay
