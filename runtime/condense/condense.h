@@ -103,7 +103,8 @@ typedef struct sw_cond {
     double *ring_M;  /* 3 rmax per ring copy: its tets' K J gathered (coupled.c; kept 0) */
     double *Hq;      /* R x R: the reduced potential's Hessian and the rest's ring blocks
                         (without the patch's: the product applies those tet by tet) */
-    double *dom_fv;  /* ndomains: the patch's tets' volume */
+    double *dom_fv;  /* ndomains: the patch's tets' volume (the oracle's), all of the
+                        domain's when its rest is evaluated at q */
     double g0_step;  /* |grad| at the step's first coupled iterate (0: not solved yet) */
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */

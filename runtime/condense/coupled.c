@@ -24,17 +24,11 @@
  * cached cubature Jacobians of those domains are refilled by the next gradient pass. */
 void sw_cond_weights_apply(sw_cond *c, sw_reduced *red) {
     const sw_blob_view *v = c->v;
-    for (int32_t k = 0; k < v->ndomains; ++k)
-        c->dom_fv[k] = 0;
-    for (int32_t e = 0; e < c->nt; ++e)
-        c->dom_fv[v->tet_domain[c->ft[e]]] += v->tet_vol[c->ft[e]];
-    for (int32_t e = c->nt + c->np; e < c->nt + c->np + c->nrest; ++e) /* (after the pairs) */
-        c->dom_fv[v->tet_domain[c->ft[e]]] += v->tet_vol[c->ft[e]];
-    for (int32_t k = 0; k < v->ndomains; ++k) {
+    for (int32_t k = 0; k < v->ndomains; ++k) { /* dom_fv: the oracle's (exact_domains) */
         if (c->dom_fv[k] == 0) continue;
         const sw_blob_domain *D = &v->domains[k];
         double s = c->dom_vol[k] > 0 ? (c->dom_vol[k] - c->dom_fv[k]) / c->dom_vol[k] : 0;
-        if (!(s > 1e-9)) s = 0; /* every tet full (exact_domains): 0 up to the sums' rounding */
+        if (!(s > 0)) s = 0;
         for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
             c->cub_w[i] = s * v->cub_weight[i];
         red->Jcub_ok[k] = 0;
@@ -241,7 +235,7 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
     for (int32_t e = ne; e < ne + c->nrest; ++e)
         phi += add_element(c, red, x, e, want_hess);
     if (want_hess) {
-        ring_blocks_flush(c, red, 0, c->nring);
+        if (c->nrest > 0) ring_blocks_flush(c, red, 0, c->nring);
         memcpy(c->Hq, red->H, (size_t)R * R * sizeof(double));
     }
     for (int32_t e = 0; e < ne; ++e)

@@ -98,6 +98,8 @@ void sw_cond_forget(sw_cond *c) {
     c->nseeds[0] = c->nseeds[1] = c->nseeds[2] = 0;
     c->slot = 0;
     c->nf = c->nt = c->nring = c->np = c->nrest = c->nring_patch = 0;
+    for (int32_t k = 0; k < c->v->ndomains; ++k)
+        c->dom_fv[k] = 0;
     c->keep = c->nkeep = 0;
     c->stamp++; /* every deviation is older than any later step */
     c->stamp++;
@@ -265,7 +267,8 @@ static void full_tets(sw_cond *c, const sw_reduced *red) {
  * volume in the patch, the domain's other tets become elements whose four corners are all
  * ring copies, evaluated exactly at q (its cubature's weights go to 0 with its volume
  * outside): no more tets than the patch holds of that domain, so no O(N) work. A domain
- * the budget's arrays cannot hold keeps its scaled cubature. */
+ * the budget's arrays cannot hold keeps its scaled cubature. Leaves each domain's volume
+ * in the patch in dom_fv (all of it for these), the scale sw_cond_weights_apply reads. */
 static void exact_domains(sw_cond *c, const sw_reduced *red) {
     const sw_blob_view *v = c->v;
     c->nring_patch = c->nring;
@@ -284,6 +287,7 @@ static void exact_domains(sw_cond *c, const sw_reduced *red) {
         for (int32_t i = 0; i < c->nring; ++i)
             copies -= c->ring_d[i] == k;
         if (c->nrest + tets > room || c->nring + copies > c->z.max_ring) continue;
+        c->dom_fv[k] = c->dom_vol[k]; /* all of it full or at q: no cubature (exactly 0) */
         for (int32_t i = b; i < b + n; ++i) {
             int32_t t = c->dom_tets[i];
             if (c->tvis[t] == c->stamp) continue; /* a patch tet */
