@@ -303,7 +303,51 @@ TEST(warm_start_gives_the_same_decomposition) {
     }
 }
 
-SW_TEST_MAIN(CASE(warm_start_gives_the_same_decomposition), CASE(random_matrices),
+/* The Newton polar iteration gives sw_polar3's rotation wherever it accepts a matrix:
+ * random ones, stretches up to 20x, near-rotations with clustered singular values; it
+ * declines inverted, flat, non-finite and hugely stretched matrices (the caller then
+ * takes the SVD), and leaves R untouched when it does. */
+TEST(polar_newton_matches_the_svd_polar_factor) {
+    int accepted = 0, declined = 0;
+    for (int t = 0; t < 6000; ++t) {
+        double A[9], R[9], R0[9];
+        if (t % 3 == 0) {
+            for (int i = 0; i < 9; ++i)
+                A[i] = urand();
+        } else if (t % 3 == 1) { /* strain up to 20x either way */
+            double d[3];
+            for (int i = 0; i < 3; ++i)
+                d[i] = pow(20.0, urand());
+            compose(d, A);
+        } else { /* near rest: a rotation times I + 1e-3 noise (clustered) */
+            double d[3] = {1.0 + 1e-3 * urand(), 1.0 + 1e-3 * urand(), 1.0 + 1e-3 * urand()};
+            compose(d, A);
+        }
+        sw_polar3(A, R0, NULL);
+        for (int i = 0; i < 9; ++i)
+            R[i] = 7.0;
+        if (!sw_polar3_newton(A, R)) {
+            ENSURE(det3(A) <= 1e-6 * pow(fro(A) / sqrt(3.0), 3.0) * (1 + 1e-12) || t % 3 != 2);
+            for (int i = 0; i < 9; ++i)
+                ENSURE(R[i] == 7.0);
+            ++declined;
+            continue;
+        }
+        ++accepted;
+        ENSURE(det3(A) > 0.0);
+        for (int i = 0; i < 9; ++i)
+            ENSURE_NEAR(R[i], R0[i], 1e-13);
+    }
+    ENSURE(accepted > 3000 && declined > 500); /* both branches were exercised */
+    double flat[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1e-9}, inv[9] = {1, 0, 0, 0, 1, 0, 0, 0, -0.5};
+    double nan_m[9] = {1, 0, 0, 0, NAN, 0, 0, 0, 1}, R[9];
+    ENSURE(!sw_polar3_newton(flat, R));
+    ENSURE(!sw_polar3_newton(inv, R));
+    ENSURE(!sw_polar3_newton(nan_m, R));
+}
+
+SW_TEST_MAIN(CASE(polar_newton_matches_the_svd_polar_factor),
+             CASE(warm_start_gives_the_same_decomposition), CASE(random_matrices),
              CASE(inverted_matrices_flip_only_the_smallest), CASE(rank_deficient_matrices),
              CASE(repeated_singular_values), CASE(near_degenerate_and_extreme_scales),
              CASE(zero_and_non_finite), CASE(polar_decomposition))

@@ -146,6 +146,33 @@ static void corot_hessian(const double U[9], const double s[3], const double V[9
     }
 }
 
+/* Energy and forces alone, from the polar rotation R of F (no SVD): psi = mu |F - R|^2 +
+ * lambda/2 tr^2(R^T F - I) (eq. 2.3) and P = 2 mu (F - R) + lambda tr(R^T F - I) R, the
+ * same function as the singular-value form below. Returns 0 when F is nearly flat or
+ * inverted (sw_polar3_newton declines): the rotation-variant SVD decides there. */
+static int corot_eval_polar(const double F[9], const double D[12], double vol, double mu,
+                            double lambda, double f[12], double *psi) {
+    double R[9];
+    if (!sw_polar3_newton(F, R)) return 0;
+    double dev2 = 0.0, tr = 0.0;
+    for (int i = 0; i < 9; ++i) {
+        double d = F[i] - R[i];
+        dev2 += d * d;
+        tr += R[i] * F[i]; /* tr(R^T F) */
+    }
+    double e = tr - 3.0;
+    *psi = mu * dev2 + 0.5 * lambda * e * e;
+    if (f) {
+        double P[9], g[12];
+        for (int i = 0; i < 9; ++i)
+            P[i] = 2.0 * mu * (F[i] - R[i]) + lambda * e * R[i];
+        pull_to_nodes(P, D, g); /* dE/dx = vol B^T vec(P) */
+        for (int i = 0; i < 12; ++i)
+            f[i] = -vol * g[i];
+    }
+    return 1;
+}
+
 static double corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
                          double lambda, double f[12], double K[144], double *modes_w,
                          double *modes_g, double *V_cache, uint32_t flags) {
@@ -154,6 +181,12 @@ static double corot_eval(const double x[12], const double DmInv[9], double vol, 
         for (int k = 0; k < 3; ++k)
             Ds[3 * a + k] = x[3 * (k + 1) + a] - x[a];
     sw_m3_mul(Ds, DmInv, F); /* F = Ds Dm^-1 */
+    shape_gradients(DmInv, D);
+    /* Without the Hessian (line-search trials, forces) the rotation alone is needed: the
+     * polar Newton iteration costs a fraction of the Jacobi SVD. */
+    double psi_polar;
+    if (!K && !modes_w && corot_eval_polar(F, D, vol, mu, lambda, f, &psi_polar))
+        return vol * psi_polar;
     if (V_cache) {
         sw_svd3_warm(F, V_cache, U, s, V);
         memcpy(V_cache, V, sizeof V);
@@ -163,7 +196,6 @@ static double corot_eval(const double x[12], const double DmInv[9], double vol, 
     double e = s[0] + s[1] + s[2] - 3.0;
     double d0 = s[0] - 1.0, d1 = s[1] - 1.0, d2 = s[2] - 1.0;
     double psi = mu * (d0 * d0 + d1 * d1 + d2 * d2) + 0.5 * lambda * e * e; /* eq. 2.3 */
-    shape_gradients(DmInv, D);
     if (f) {
         /* P = U diag(dPsi/ds) V^T = 2mu (F - R) + lambda tr(R^T F - I) R. */
         double dpsi[3] = {2.0 * mu * d0 + lambda * e, 2.0 * mu * d1 + lambda * e,

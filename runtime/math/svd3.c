@@ -11,6 +11,7 @@
 
 #include "mat3.h"
 
+#include <float.h>
 #include <math.h>
 #include <stddef.h>
 
@@ -19,6 +20,19 @@ enum { SVD3_MAX_SWEEPS = 40 };
 /* Columns of the (prescaled, max |entry| = 1) matrix shorter than this carry no usable
  * direction: their squares underflow. Their singular value is <= 1e-150 * max|A|. */
 static const double SVD3_TINY = 1e-150;
+
+/* Columns p, q of W and of V rotated by (c, s). */
+static void rotate_columns(double W[9], double V[9], int p, int q, double c, double s) {
+    for (int r = 0; r < 3; ++r) {
+        double a = W[3 * r + p], b = W[3 * r + q];
+        W[3 * r + p] = c * a - s * b;
+        W[3 * r + q] = s * a + c * b;
+        a = V[3 * r + p];
+        b = V[3 * r + q];
+        V[3 * r + p] = c * a - s * b;
+        V[3 * r + q] = s * a + c * b;
+    }
+}
 
 /* Rotates columns p, q of W (and V alike) so that w_p . w_q = 0. Returns 1 when a
  * rotation was applied, 0 when the pair was already orthogonal to working precision. */
@@ -38,16 +52,50 @@ static int orthogonalize_pair(double W[9], double V[9], int p, int q) {
                    ? 0.5 / zeta
                    : (zeta >= 0.0 ? 1.0 : -1.0) / (fabs(zeta) + sqrt(1.0 + zeta * zeta));
     double c = 1.0 / sqrt(1.0 + t * t), s = c * t;
+    rotate_columns(W, V, p, q, c, s);
+    return 1;
+}
+
+/* Off-orthogonality below which the warm Jacobi leaves a pair alone: |w_p . w_q| <=
+ * 1e-15 |w_p| |w_q|, compared in squares. */
+static const double SVD3_WARM_TOL2 = 1e-30;
+/* A warm sweep whose pairs were all this close to orthogonal (relative |w_p . w_q|)
+ * before their rotation ends the iteration: cyclic Jacobi converges quadratically, so
+ * what is left after it is ~1e-16, below what another (checking) sweep would act on;
+ * and where singular values cluster and it is not, R = U V^T is off by the residual
+ * itself (its polar correction divides by s_i + s_j, not s_i - s_j), ~1e-8 at worst. */
+static const double SVD3_WARM_LAST_SWEEP_TOL2 = 1e-16;
+
+/* orthogonalize_pair for the warm start (the runtime's per-step elements, where the
+ * SVD was a quarter of the step): no square root in the test and two, with one
+ * division, in the rotation. Returns the squared relative off-orthogonality
+ * gamma^2 / (alpha beta) the pair had, 0 when no rotation was applied. The cold SVD
+ * (the full-space reference, the bake's training solves) keeps the textbook form above:
+ * the bake's training set is sensitive to the last bits of its solves (a rounding-level
+ * change moved the 20K finger's held-out error by 2-14%), so its bits stay as they were. */
+static double orthogonalize_pair_warm(double W[9], double V[9], int p, int q) {
+    double alpha = 0.0, beta = 0.0, gamma = 0.0;
     for (int r = 0; r < 3; ++r) {
         double a = W[3 * r + p], b = W[3 * r + q];
-        W[3 * r + p] = c * a - s * b;
-        W[3 * r + q] = s * a + c * b;
-        a = V[3 * r + p];
-        b = V[3 * r + q];
-        V[3 * r + p] = c * a - s * b;
-        V[3 * r + q] = s * a + c * b;
+        alpha += a * a;
+        beta += b * b;
+        gamma += a * b;
     }
-    return 1;
+    double ab = alpha * beta, g2 = gamma * gamma;
+    if (!(g2 > SVD3_WARM_TOL2 * ab)) return 0.0;
+    /* tan = t the smaller root of gamma t^2 + d t - gamma = 0 (d = beta - alpha): with
+     * h = sqrt(d^2 + 4 gamma^2) and u = |d| + h, t = 2 gamma sgn(d) / u, so
+     * c = u / sqrt(u^2 + 4 gamma^2) and s = 2 gamma sgn(d) / sqrt(..), where
+     * u^2 + 4 gamma^2 = 2 h u. After the prescaling d, gamma <= 3 in magnitude: no
+     * overflow. Columns so short (< 1e-75) that 2 h u underflows hold singular values of
+     * no consequence: left as they are. */
+    double d = beta - alpha;
+    double h = sqrt(d * d + 4.0 * gamma * gamma), u = fabs(d) + h;
+    double hu2 = 2.0 * h * u;
+    if (!(hu2 >= DBL_MIN)) return 0.0;
+    double inv = 1.0 / sqrt(hu2);
+    rotate_columns(W, V, p, q, u * inv, (d >= 0.0 ? 2.0 : -2.0) * gamma * inv);
+    return ab > 0.0 ? g2 / ab : 1.0;
 }
 
 static void swap_columns(double M[9], int p, int q) {
@@ -98,10 +146,17 @@ static void svd3(const double A[9], const double *V0, double U[9], double s[3], 
             W[i] = Am[i];
     }
     for (int sweep = 0; sweep < SVD3_MAX_SWEEPS; ++sweep) {
-        int rotated = orthogonalize_pair(W, V, 0, 1);
-        rotated += orthogonalize_pair(W, V, 0, 2);
-        rotated += orthogonalize_pair(W, V, 1, 2);
-        if (!rotated) break;
+        if (V0) { /* three statements: the pairs must rotate in this order */
+            double off = orthogonalize_pair_warm(W, V, 0, 1);
+            off = fmax(off, orthogonalize_pair_warm(W, V, 0, 2));
+            off = fmax(off, orthogonalize_pair_warm(W, V, 1, 2));
+            if (off < SVD3_WARM_LAST_SWEEP_TOL2) break;
+        } else {
+            int rotated = orthogonalize_pair(W, V, 0, 1);
+            rotated += orthogonalize_pair(W, V, 0, 2);
+            rotated += orthogonalize_pair(W, V, 1, 2);
+            if (!rotated) break;
+        }
     }
     double n[3];
     for (int j = 0; j < 3; ++j)
@@ -175,4 +230,45 @@ void sw_polar3(const double A[9], double R[9], double S[9]) {
                 S[3 * i + j] = s[0] * (V[3 * i] * V[3 * j]) + s[1] * (V[3 * i + 1] * V[3 * j + 1]) +
                                s[2] * (V[3 * i + 2] * V[3 * j + 2]);
     }
+}
+
+enum { POLAR_MAX_ITERS = 16 };
+
+int sw_polar3_newton(const double A[9], double R[9]) {
+    double n2 = 0.0;
+    for (int i = 0; i < 9; ++i)
+        n2 += A[i] * A[i];
+    /* det of a matrix with |A|_F^2 = n2 is at most (n2 / 3)^(3/2) (all singular values
+     * equal): below 1e-6 of that the element is nearly flat or inverted */
+    double det = sw_m3_det(A), dmax = (n2 / 3.0) * sqrt(n2 / 3.0);
+    if (!isfinite(det) || !isfinite(dmax) || !(det > 1e-6 * dmax)) return 0;
+    double X[9];
+    for (int i = 0; i < 9; ++i)
+        X[i] = A[i];
+    for (int it = 0; it < POLAR_MAX_ITERS; ++it) {
+        /* X^-T = cofactor(X) / det X */
+        double C[9] = {
+            X[4] * X[8] - X[5] * X[7], X[5] * X[6] - X[3] * X[8], X[3] * X[7] - X[4] * X[6],
+            X[2] * X[7] - X[1] * X[8], X[0] * X[8] - X[2] * X[6], X[1] * X[6] - X[0] * X[7],
+            X[1] * X[5] - X[2] * X[4], X[2] * X[3] - X[0] * X[5], X[0] * X[4] - X[1] * X[3],
+        };
+        double dx = X[0] * C[0] + X[1] * C[1] + X[2] * C[2];
+        if (!(dx > 0.0)) return 0;
+        double inv = 1.0 / dx, change = 0.0, size = 0.0;
+        for (int i = 0; i < 9; ++i) {
+            double xn = 0.5 * (X[i] + C[i] * inv);
+            double dlt = xn - X[i];
+            change += dlt * dlt;
+            size += xn * xn;
+            X[i] = xn;
+        }
+        /* the error after an update is about half its square: a change below 1e-8 of
+         * |X| (= sqrt 3 at convergence) leaves ~1e-16, so this update was the last */
+        if (change <= 1e-16 * size) {
+            for (int i = 0; i < 9; ++i)
+                R[i] = X[i];
+            return 1;
+        }
+    }
+    return 0;
 }

@@ -17,4 +17,13 @@ void sw_svd3_warm(const double A[9], const double V0[9], double U[9], double s[3
 /* Polar decomposition A = R S with R a proper rotation, R = U V^T from sw_svd3
  * (so for inverted A, S is symmetric but indefinite). S may be NULL. */
 void sw_polar3(const double A[9], double R[9], double S[9]);
+
+/* The rotation R of A = R S (S symmetric positive definite) by Newton's iteration
+ * X <- (X + X^-T) / 2 from X = A (Higham 1986): no SVD, a handful of 3x3 inverses,
+ * quadratic convergence. Only for A safely non-inverted: returns 0 (R untouched) when
+ * det A <= 1e-6 |A|_F^3 / (3 sqrt 3) or A is not finite, or the iteration has not converged
+ * in its budget (stretches beyond ~100x); the caller then takes sw_svd3. Where it
+ * returns 1, R equals sw_polar3's R to working precision (both are the unique polar
+ * factor), not bitwise. */
+int sw_polar3_newton(const double A[9], double R[9]);
 #endif
