@@ -68,6 +68,20 @@ static void add_mode_products(double *H, int32_t R, int32_t r, const double *hm,
     }
 }
 
+/* x = x0 + J q for a cubature tet's four corners: twelve independent sums over the
+ * domain's r coordinates, along J's contiguous rows (four corners' three add chains
+ * each, then a rotation, before). */
+static void corners_at(const double x0[12], const double *J, int32_t r, const double *qd,
+                       double x[12]) {
+    for (int i = 0; i < 12; ++i) {
+        const double *Ji = J + (int64_t)i * r;
+        double acc = 0.0;
+        for (int32_t j = 0; j < r; ++j)
+            acc += Ji[j] * qd[j];
+        x[i] = x0[i] + acc;
+    }
+}
+
 /* One cubature pass over some domains, by one worker. */
 typedef struct {
     sw_reduced *m;
@@ -90,18 +104,22 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         int32_t r = D->rank, o = D->q_offset;
         const double *qd = p->q + o;
         /* the tets' Jacobians: computed by the step's first gradient pass, then read */
-        int fill_J = want_grad && !m->Jcub_ok[k];
+        int fill_J = !m->Jcub_ok[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12], wm[9], gm[108];
-            double *Jc = m->Jcub + m->Jcub_off[k] + (int64_t)12 * r * (c - D->cub_begin);
+            /* x0 (12: the corners at q = 0), then J (12 x r) */
+            double *x0 = m->Jcub + m->Jcub_off[k] + (int64_t)12 * (r + 1) * (c - D->cub_begin);
+            double *Jc = x0 + 12;
+            if (fill_J)
+                for (int j = 0; j < 4; ++j)
+                    sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], NULL,
+                                        x0 + 3 * j, Jc + 3 * j * r);
             double w = m->cub_w[c];
             if (w == 0.0) { /* in a condensation patch: its tet is evaluated in full space */
                 m->ecub[c] = 0;
                 continue;
             }
-            for (int j = 0; j < 4; ++j)
-                sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], qd,
-                                    x + 3 * j, fill_J ? Jc + 3 * j * r : NULL);
+            corners_at(x0, Jc, r, qd, x);
             m->ecub[c] =
                 w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
                                         want_grad ? f : NULL, want_hess ? wm : NULL, gm,

@@ -34,7 +34,7 @@ void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t l
      * after another (each row still sums in j order, so the result is bitwise the same) */
     const double *U0 = U, *U1 = U + r, *U2 = U + 2 * r;
     double y[3] = {X[0], X[1], X[2]};
-    for (int32_t j = 0; j < r; ++j) {
+    for (int32_t j = 0; qd && j < r; ++j) { /* qd NULL: q = 0 */
         y[0] += U0[j] * qd[j];
         y[1] += U1[j] * qd[j];
         y[2] += U2[j] * qd[j];

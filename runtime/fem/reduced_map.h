@@ -36,9 +36,10 @@ typedef struct sw_reduced {
     const sinew_task_callbacks *tasks; /* the host's job system, NULL: serial */
     double *Jc, *hc;                   /* 4 x 3 x rmax each: one contact's Jacobians and N G */
     double *svd_V;                     /* 9 per cubature tet: its last SVD rotation (warm start) */
-    /* The cubature tets' Jacobians J = R U (12 x r_d each, domain k's from Jcub +
-     * Jcub_off[k]): they depend on the skinning alone, not on q, so the step's first
-     * gradient pass over a domain fills them (Jcub_ok[k] = 1) and its later passes read
+    /* The cubature tets' corners as affine maps of q, x = x0 + J q (x0: 12, the corners
+     * at q = 0, then J = R U: 12 x r_d, per tet; domain k's from Jcub + Jcub_off[k]):
+     * they depend on the skinning alone, not on q, so the step's first pass over a
+     * domain fills them (Jcub_ok[k] = 1) and its later passes read
      * them; skinning clears the flags. */
     double *Jcub;
     int64_t *Jcub_off;          /* ndomains */
@@ -54,8 +55,8 @@ typedef struct sw_reduced {
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 
 /* Position x of copy (domain D, local vertex lv, active index a) for the domain's
- * reduced coordinates qd, and its Jacobian J = R U (3 x r_d, row-major) when J is not
- * NULL. */
+ * reduced coordinates qd (NULL: q = 0), and its Jacobian J = R U (3 x r_d, row-major)
+ * when J is not NULL. */
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J);
 

@@ -19,7 +19,7 @@ typedef struct {
     int32_t max_pairs;  /* the contact pair budget */
     int32_t max_world;  /* the world candidate budget */
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
-    uint64_t njcub;     /* the cubature tets' Jacobians: 12 r_d each */
+    uint64_t njcub;     /* the cubature tets' corners and Jacobians: 12 (r_d + 1) each */
     sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
     double rho;         /* its radius, in units of the rest diagonal */
 } layout_sizes;
@@ -306,7 +306,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->njcub = 0;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         if (v->domains[k].rank > z->rmax) z->rmax = v->domains[k].rank;
-        z->njcub += 12 * (uint64_t)v->domains[k].cub_count * (uint64_t)v->domains[k].rank;
+        z->njcub += 12 * (uint64_t)v->domains[k].cub_count * ((uint64_t)v->domains[k].rank + 1);
     }
     /* a budget above what the blob can ever need is what it needs */
     int32_t need = sw_pose_space_default_max_pairs(v);
@@ -423,7 +423,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.nworkers = z.nworkers;
     for (int64_t k = 0, off = 0; k < v->ndomains; ++k) {
         in->red.Jcub_off[k] = off;
-        off += 12 * (int64_t)v->domains[k].cub_count * v->domains[k].rank;
+        off += 12 * (int64_t)v->domains[k].cub_count * (v->domains[k].rank + 1);
     }
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
