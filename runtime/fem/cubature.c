@@ -103,7 +103,7 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
         const double *qd = p->q + o;
-        /* the tets' Jacobians: computed by the step's first gradient pass, then read */
+        /* the tets' corners x0 and Jacobians J: filled by the step's first pass, then read */
         int fill_J = !m->Jcub_ok[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12], wm[9], gm[108];

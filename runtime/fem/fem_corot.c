@@ -36,13 +36,11 @@ int sw_tet_rest(const double X[12], double DmInv[9], double *vol) {
             Dm[3 * a + k] = X[3 * (k + 1) + a] - X[a];
     double det = sw_m3_det(Dm);
     if (!isfinite(det) || !(fabs(det) >= 1e-300)) return 0;
-    double inv[9] = {
-        (Dm[4] * Dm[8] - Dm[5] * Dm[7]) / det, (Dm[2] * Dm[7] - Dm[1] * Dm[8]) / det,
-        (Dm[1] * Dm[5] - Dm[2] * Dm[4]) / det, (Dm[5] * Dm[6] - Dm[3] * Dm[8]) / det,
-        (Dm[0] * Dm[8] - Dm[2] * Dm[6]) / det, (Dm[2] * Dm[3] - Dm[0] * Dm[5]) / det,
-        (Dm[3] * Dm[7] - Dm[4] * Dm[6]) / det, (Dm[1] * Dm[6] - Dm[0] * Dm[7]) / det,
-        (Dm[0] * Dm[4] - Dm[1] * Dm[3]) / det,
-    };
+    double C[9], inv[9];
+    sw_m3_cofactor(Dm, C);
+    for (int i = 0; i < 3; ++i) /* Dm^-1 = C^T / det */
+        for (int j = 0; j < 3; ++j)
+            inv[3 * i + j] = C[3 * j + i] / det;
     for (int i = 0; i < 9; ++i)
         if (!isfinite(inv[i])) return 0;
     for (int i = 0; i < 9; ++i)

@@ -33,6 +33,20 @@ static inline double sw_m3_det(const double A[9]) {
            A[2] * (A[3] * A[7] - A[4] * A[6]);
 }
 
+/* The cofactor matrix C of A: A^-1 = C^T / det A, and det A = A[0] C[0] + A[1] C[1] +
+ * A[2] C[2]. */
+static inline void sw_m3_cofactor(const double A[9], double C[9]) {
+    C[0] = A[4] * A[8] - A[5] * A[7];
+    C[1] = A[5] * A[6] - A[3] * A[8];
+    C[2] = A[3] * A[7] - A[4] * A[6];
+    C[3] = A[2] * A[7] - A[1] * A[8];
+    C[4] = A[0] * A[8] - A[2] * A[6];
+    C[5] = A[1] * A[6] - A[0] * A[7];
+    C[6] = A[1] * A[5] - A[2] * A[4];
+    C[7] = A[2] * A[3] - A[0] * A[5];
+    C[8] = A[0] * A[4] - A[1] * A[3];
+}
+
 static inline void sw_m3_identity(double A[9]) {
     for (int i = 0; i < 9; ++i)
         A[i] = (i % 4 == 0) ? 1.0 : 0.0;

@@ -2,6 +2,8 @@
  * summation order (deterministic); the operator itself may run in parallel. */
 #include "pcg.h"
 
+#include "mat3.h"
+
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -33,22 +35,16 @@ void sw_block_jacobi_invert(int32_t n, const double *diag, const unsigned char *
         double *o = Pinv + 9 * v;
         memset(o, 0, 9 * sizeof(double));
         if (free_mask && !free_mask[v]) continue;
-        double c00 = a[4] * a[8] - a[5] * a[7], c01 = a[5] * a[6] - a[3] * a[8],
-               c02 = a[3] * a[7] - a[4] * a[6];
-        double det = a[0] * c00 + a[1] * c01 + a[2] * c02;
+        double C[9];
+        sw_m3_cofactor(a, C);
+        double det = a[0] * C[0] + a[1] * C[1] + a[2] * C[2];
         double scale = fabs(a[0]) + fabs(a[4]) + fabs(a[8]);
         /* SPD blocks have positive leading minors; anything else falls back. */
         if (a[0] > 0 && a[0] * a[4] - a[1] * a[3] > 0 && det > 1e-14 * scale * scale * scale) {
             double inv = 1.0 / det;
-            o[0] = c00 * inv;
-            o[1] = (a[2] * a[7] - a[1] * a[8]) * inv;
-            o[2] = (a[1] * a[5] - a[2] * a[4]) * inv;
-            o[3] = c01 * inv;
-            o[4] = (a[0] * a[8] - a[2] * a[6]) * inv;
-            o[5] = (a[2] * a[3] - a[0] * a[5]) * inv;
-            o[6] = c02 * inv;
-            o[7] = (a[1] * a[6] - a[0] * a[7]) * inv;
-            o[8] = (a[0] * a[4] - a[1] * a[3]) * inv;
+            for (int i = 0; i < 3; ++i) /* A^-1 = C^T / det */
+                for (int j = 0; j < 3; ++j)
+                    o[3 * i + j] = C[3 * j + i] * inv;
         } else {
             for (int i = 0; i < 3; ++i)
                 o[4 * i] = a[4 * i] > 0 ? 1.0 / a[4 * i] : 1.0;

@@ -34,16 +34,26 @@ static void rotate_columns(double W[9], double V[9], int p, int q, double c, dou
     }
 }
 
+/* |w_p|^2, |w_q|^2 and w_p . w_q of columns p, q of W. */
+static void column_products(const double W[9], int p, int q, double *alpha, double *beta,
+                            double *gamma) {
+    double aa = 0.0, bb = 0.0, ab = 0.0;
+    for (int r = 0; r < 3; ++r) {
+        double a = W[3 * r + p], b = W[3 * r + q];
+        aa += a * a;
+        bb += b * b;
+        ab += a * b;
+    }
+    *alpha = aa;
+    *beta = bb;
+    *gamma = ab;
+}
+
 /* Rotates columns p, q of W (and V alike) so that w_p . w_q = 0. Returns 1 when a
  * rotation was applied, 0 when the pair was already orthogonal to working precision. */
 static int orthogonalize_pair(double W[9], double V[9], int p, int q) {
-    double alpha = 0.0, beta = 0.0, gamma = 0.0;
-    for (int r = 0; r < 3; ++r) {
-        double a = W[3 * r + p], b = W[3 * r + q];
-        alpha += a * a;
-        beta += b * b;
-        gamma += a * b;
-    }
+    double alpha, beta, gamma;
+    column_products(W, p, q, &alpha, &beta, &gamma);
     /* sqrt(alpha)*sqrt(beta), not sqrt(alpha*beta): the product may underflow. */
     if (!(fabs(gamma) > 1e-15 * sqrt(alpha) * sqrt(beta))) return 0;
     /* Smaller root of t^2 + 2 zeta t - 1 = 0: a rotation of at most 45 degrees. */
@@ -74,13 +84,8 @@ static const double SVD3_WARM_LAST_SWEEP_TOL2 = 1e-16;
  * the bake's training set is sensitive to the last bits of its solves (a rounding-level
  * change moved the 20K finger's held-out error by 2-14%), so its bits stay as they were. */
 static double orthogonalize_pair_warm(double W[9], double V[9], int p, int q) {
-    double alpha = 0.0, beta = 0.0, gamma = 0.0;
-    for (int r = 0; r < 3; ++r) {
-        double a = W[3 * r + p], b = W[3 * r + q];
-        alpha += a * a;
-        beta += b * b;
-        gamma += a * b;
-    }
+    double alpha, beta, gamma;
+    column_products(W, p, q, &alpha, &beta, &gamma);
     double ab = alpha * beta, g2 = gamma * gamma;
     if (!(g2 > SVD3_WARM_TOL2 * ab)) return 0.0;
     /* tan = t the smaller root of gamma t^2 + d t - gamma = 0 (d = beta - alpha): with
@@ -246,12 +251,8 @@ int sw_polar3_newton(const double A[9], double R[9]) {
     for (int i = 0; i < 9; ++i)
         X[i] = A[i];
     for (int it = 0; it < POLAR_MAX_ITERS; ++it) {
-        /* X^-T = cofactor(X) / det X */
-        double C[9] = {
-            X[4] * X[8] - X[5] * X[7], X[5] * X[6] - X[3] * X[8], X[3] * X[7] - X[4] * X[6],
-            X[2] * X[7] - X[1] * X[8], X[0] * X[8] - X[2] * X[6], X[1] * X[6] - X[0] * X[7],
-            X[1] * X[5] - X[2] * X[4], X[2] * X[3] - X[0] * X[5], X[0] * X[4] - X[1] * X[3],
-        };
+        double C[9]; /* X^-T = cofactor(X) / det X */
+        sw_m3_cofactor(X, C);
         double dx = X[0] * C[0] + X[1] * C[1] + X[2] * C[2];
         if (!(dx > 0.0)) return 0;
         double inv = 1.0 / dx, change = 0.0, size = 0.0;

@@ -10,8 +10,11 @@
 void sw_svd3(const double A[9], double U[9], double s[3], double V[9]);
 
 /* sw_svd3 with the Jacobi iteration started from V0, a proper rotation (e.g. the V of
- * the same element's previous evaluation): the result is the same decomposition to
- * working precision, reached in fewer sweeps when V0 is close. V may alias V0. */
+ * the same element's previous evaluation): the same decomposition, reached in fewer
+ * sweeps when V0 is close. It stops after a sweep whose pairs were all within 1e-8 of
+ * orthogonal (sw_svd3 sweeps on until none rotates): singular values to working
+ * precision; U V^T to working precision where the singular values are apart, within
+ * ~1e-8 where they cluster. V may alias V0. */
 void sw_svd3_warm(const double A[9], const double V0[9], double U[9], double s[3], double V[9]);
 
 /* Polar decomposition A = R S with R a proper rotation, R = U V^T from sw_svd3
