@@ -701,7 +701,11 @@ TEST(outputs_are_optional_and_consistent) {
         ENSURE(K1[i] == K2[i]);
 }
 
-/* The Hessian as nine rank-one modes reproduces the assembled K (projected or not). */
+/* The element through its SVD (sw_corot_eval_svd) and the modes in the singular frame
+ * (sw_corot_modes_dot), as the step's cubature uses them: for every node coordinate,
+ * E = dF/dx_(n,c) = e_c D_n^T in the singular frame gives g_k[3n + c] = <E, U M_k V^T> and
+ * f[3n + c] = -vol <E, U diag(dPsi/ds) V^T>; sum_k w_k g_k g_k^T reproduces the assembled
+ * K and f the forces (projected or not, with and without a warm start). */
 TEST(hessian_modes_reproduce_K) {
     uint64_t seed = 77;
     for (int trial = 0; trial < 200; ++trial) {
@@ -713,13 +717,28 @@ TEST(hessian_modes_reproduce_K) {
             x[i] = X[i] * (trial % 3 ? 1.0 : -0.5) +
                    0.3 * ((double)((seed = seed * 6364136223846793005ull + 1) >> 11) * 0x1.0p-53 -
                           0.5);
+        double D[12];
+        sw_tet_shape_gradients(Dm, D);
         for (uint32_t flags = 0; flags <= SW_COROT_PROJECT_PSD; ++flags) {
-            double K[144], f1[12], f2[12], w[9], g[108];
+            double K[144], f1[12], f2[12], w[9], g[108], U[9], s[3], V[9], dpsi[3];
             double e1 = sw_corot_eval(x, Dm, vol, 1.0, 3.0, f1, K, flags);
             double Vc[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
-            double e2 =
-                sw_corot_eval_modes(x, Dm, vol, 1.0, 3.0, f2, w, g, trial % 2 ? Vc : NULL, flags);
+            double e2 = sw_corot_eval_svd(x, Dm, vol, 1.0, 3.0, trial % 2 ? Vc : NULL, flags, U, s,
+                                          V, dpsi, w);
             ENSURE_NEAR(e1, e2, 1e-12 * (fabs(e1) + 1e-300));
+            for (int n = 0; n < 4; ++n)
+                for (int c = 0; c < 3; ++c) {
+                    double Es[9], h[9]; /* U^T (e_c D_n^T) V: row c of U, D_n V */
+                    for (int i = 0; i < 3; ++i)
+                        for (int l = 0; l < 3; ++l)
+                            Es[3 * i + l] =
+                                U[3 * c + i] * (D[3 * n] * V[l] + D[3 * n + 1] * V[3 + l] +
+                                                D[3 * n + 2] * V[6 + l]);
+                    sw_corot_modes_dot(Es, h);
+                    for (int k = 0; k < 9; ++k)
+                        g[12 * k + 3 * n + c] = h[k];
+                    f2[3 * n + c] = -vol * (dpsi[0] * Es[0] + dpsi[1] * Es[4] + dpsi[2] * Es[8]);
+                }
             for (int i = 0; i < 12; ++i)
                 ENSURE_NEAR(f1[i], f2[i], 1e-10 * (fabs(f1[i]) + 1.0));
             double scale = 0;

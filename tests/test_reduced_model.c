@@ -9,6 +9,7 @@
 #include "bake_fixture.h"
 #include "dqs.h"
 #include "instance.h"
+#include "solver.h"
 #include "subspace_eval.h"
 #include "sw_test.h"
 
@@ -166,9 +167,10 @@ TEST(chord_updates_end_at_a_newton_stationary_point) {
         }
         dq = sqrt(dq);
         qn = sqrt(qn);
-        /* the solve's own test is 3e-3 |q| on its last update; one more Newton update
-         * from there is far smaller when the iterate is near the stationary point */
-        ENSUREF(dq <= 3e-3 * qn + 1e-9,
+        /* the solve's own test is SW_NEWTON_LAST_UPDATE |q| on its last update; one more
+         * Newton update from there is smaller when the iterate is near the stationary
+         * point */
+        ENSUREF(dq <= SW_NEWTON_LAST_UPDATE * qn + 1e-9,
                 "frame %d: a Newton update from the solution moves %g of %g", k, dq, qn);
     }
     ENSUREF(2 * converged >= f->ch.clip.nframes, "%d of %d steps converged", converged,

@@ -82,6 +82,41 @@ static void corners_at(const double x0[12], const double *J, int32_t r, const do
     }
 }
 
+/* The projections of one tet evaluated with its Hessian, through the singular frame of
+ * its SVD F = U diag(s) V^T: column j of J moves F by G_j = sum_n J_n,j D_n^T (corner n's
+ * three rows of J, shape gradient D_n), and in that frame Gs_j = U^T G_j V =
+ * sum_n (U^T J_n,j)(V^T D_n)^T, against which the nine modes U M_k V^T and the stress
+ * U diag(dpsi) V^T are sparse (sw_corot_modes_dot): out[j] = fscale <Gs_j, diag(dpsi)>
+ * (J^T f with fscale = -vol), then out[(1 + i) r + j] = <Gs_j, M_mode[i]> for the n modes
+ * listed. About 100 products a column instead of 12 for each of ten 12-vectors, and no
+ * mode directions or pulls to the nodes. */
+static void singular_frame_projections(const double *J, int32_t r, const double DmInv[9],
+                                       const double U[9], const double V[9], const double dpsi[3],
+                                       double fscale, const int *mode, int n, double *out) {
+    double D[12], b[12];
+    sw_tet_shape_gradients(DmInv, D);
+    for (int c = 0; c < 4; ++c) /* b_n = V^T D_n */
+        for (int i = 0; i < 3; ++i)
+            b[3 * c + i] = V[i] * D[3 * c] + V[3 + i] * D[3 * c + 1] + V[6 + i] * D[3 * c + 2];
+    for (int32_t j = 0; j < r; ++j) {
+        double Gs[9] = {0}, h[9];
+        for (int c = 0; c < 4; ++c) {
+            double j0 = J[(3 * c) * r + j], j1 = J[(3 * c + 1) * r + j],
+                   j2 = J[(3 * c + 2) * r + j];
+            for (int i = 0; i < 3; ++i) {
+                double ai = U[i] * j0 + U[3 + i] * j1 + U[6 + i] * j2; /* (U^T J_n,j)_i */
+                Gs[3 * i] += ai * b[3 * c];
+                Gs[3 * i + 1] += ai * b[3 * c + 1];
+                Gs[3 * i + 2] += ai * b[3 * c + 2];
+            }
+        }
+        out[j] = fscale * (dpsi[0] * Gs[0] + dpsi[1] * Gs[4] + dpsi[2] * Gs[8]);
+        sw_corot_modes_dot(Gs, h);
+        for (int i = 0; i < n; ++i)
+            out[(int64_t)(1 + i) * r + j] = h[mode[i]];
+    }
+}
+
 /* One cubature pass over some domains, by one worker. */
 typedef struct {
     sw_reduced *m;
@@ -106,7 +141,7 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         /* the tets' corners x0 and Jacobians J: filled by the step's first pass, then read */
         int fill_J = !m->Jcub_ok[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
-            double x[12], f[12], wm[9], gm[108];
+            double x[12], f[12];
             /* x0 (12: the corners at q = 0), then J (12 x r) */
             double *x0 = m->Jcub + m->Jcub_off[k] + (int64_t)12 * (r + 1) * (c - D->cub_begin);
             double *Jc = x0 + 12;
@@ -120,25 +155,34 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
                 continue;
             }
             corners_at(x0, Jc, r, qd, x);
+            const double *dminv = v->cub_dminv + 9 * c;
+            if (!want_hess) { /* energy, and J^T f (the polar rotation: no SVD) */
+                m->ecub[c] = w * sw_corot_eval(x, dminv, v->cub_vol[c], v->mu, v->lambda,
+                                               want_grad ? f : NULL, NULL, project);
+                if (!want_grad) continue;
+                const double *vs[1] = {f};
+                project_rows(Jc, r, vs, 1, hm);
+                for (int32_t j = 0; j < r; ++j)
+                    m->g[o + j] -= w * hm[j];
+                continue;
+            }
+            /* With the Hessian: J^T f and J^T g_k of the element's nonzero modes in the
+             * singular frame (eq. 2.12 through the modes, J^T K J = sum_k w_k (J^T g_k)
+             * (J^T g_k)^T) */
+            double U[9], sv[3], V[9], dpsi[3], wm[9], a[9];
             m->ecub[c] =
-                w * sw_corot_eval_modes(x, v->cub_dminv + 9 * c, v->cub_vol[c], v->mu, v->lambda,
-                                        want_grad ? f : NULL, want_hess ? wm : NULL, gm,
-                                        m->svd_V + 9 * (int64_t)c, project);
-            if (!want_grad) continue;
-            /* J^T f, and J^T g_k of the element's nonzero modes: eq. 2.12 through the
-             * modes, J^T K J = sum_k w_k (J^T g_k)(J^T g_k)^T */
-            const double *vs[10] = {f};
-            double a[9];
-            int n = 1;
-            for (int mk = 0; want_hess && mk < 9; ++mk)
+                w * sw_corot_eval_svd(x, dminv, v->cub_vol[c], v->mu, v->lambda,
+                                      m->svd_V + 9 * (int64_t)c, project, U, sv, V, dpsi, wm);
+            int mode[9], n = 0;
+            for (int mk = 0; mk < 9; ++mk)
                 if (wm[mk] != 0.0) {
-                    a[n - 1] = w * wm[mk];
-                    vs[n++] = gm + 12 * mk;
+                    a[n] = w * wm[mk];
+                    mode[n++] = mk;
                 }
-            project_rows(Jc, r, vs, n, hm);
+            singular_frame_projections(Jc, r, dminv, U, V, dpsi, -v->cub_vol[c], mode, n, hm);
             for (int32_t j = 0; j < r; ++j)
                 m->g[o + j] -= w * hm[j];
-            if (n > 1) add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, hm + r, a, n - 1);
+            if (n > 0) add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, hm + r, a, n);
         }
         if (fill_J) m->Jcub_ok[k] = 1;
         if (want_hess) /* the block was filled in its upper triangle: mirror */

@@ -57,7 +57,7 @@ void sw_lumped_mass_add(const int32_t tet[4], double density, double vol, double
 
 /* dF/dx as a 4x3 table D: F = sum_n x_n D[n]^T, so d(F_cb)/d(x_n)_c = D[n][b]. Row 0 is
  * minus the sum of the others (translations leave F unchanged). */
-static void shape_gradients(const double DmInv[9], double D[12]) {
+void sw_tet_shape_gradients(const double DmInv[9], double D[12]) {
     for (int b = 0; b < 3; ++b) {
         D[3 + b] = DmInv[b];
         D[6 + b] = DmInv[3 + b];
@@ -74,41 +74,41 @@ static void pull_to_nodes(const double Q[9], const double D[12], double g[12]) {
                 Q[3 * c] * D[3 * n] + Q[3 * c + 1] * D[3 * n + 1] + Q[3 * c + 2] * D[3 * n + 2];
 }
 
-/* Mode k of the element Hessian: weight w (vol * eigenvalue) and direction
- * g = B^T vec(U M V^T) (12). */
-static void mode_direction(const double U[9], const double M[9], const double V[9],
-                           const double D[12], double g[12]) {
-    double UM[9], Q[9];
-    sw_m3_mul(U, M, UM);
-    sw_m3_mul_nt(UM, V, Q);
-    pull_to_nodes(Q, D, g);
+/* Mode k's matrix M_k (fem_corot.h); the pairs (i, j) in mode order. */
+static const int mode_pair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
+
+static void mode_matrix(int k, double M[9]) {
+    static const double dirs[3][3] = {{SW_COROT_R3, SW_COROT_R3, SW_COROT_R3},
+                                      {SW_COROT_R2, -SW_COROT_R2, 0.0},
+                                      {SW_COROT_R6, SW_COROT_R6, -2.0 * SW_COROT_R6}};
+    for (int i = 0; i < 9; ++i)
+        M[i] = 0.0;
+    if (k < 3) {
+        M[0] = dirs[k][0];
+        M[4] = dirs[k][1];
+        M[8] = dirs[k][2];
+        return;
+    }
+    int i = mode_pair[(k - 3) / 2][0], j = mode_pair[(k - 3) / 2][1];
+    M[3 * i + j] = SW_COROT_R2;
+    M[3 * j + i] = (k - 3) % 2 ? SW_COROT_R2 : -SW_COROT_R2; /* flip : twist */
 }
 
-/* The element Hessian vol B^T (dP/dF) B as nine rank-one modes K = sum_k w_k g_k g_k^T,
- * through the analytic eigen system of dP/dF (w: 9, g: 9 x 12). */
-static void corot_modes(const double U[9], const double s[3], const double V[9], const double D[12],
-                        double vol, double mu, double lambda, uint32_t flags, double w[9],
-                        double g[108]) {
+/* The nine modes' weights vol * lambda_k (clamped at 0 with SW_COROT_PROJECT_PSD). */
+static void corot_mode_weights(const double s[3], double vol, double mu, double lambda,
+                               uint32_t flags, double w[9]) {
     int project = (flags & SW_COROT_PROJECT_PSD) != 0;
     double e = s[0] + s[1] + s[2] - 3.0;
     /* Scaling block d2Psi/ds2 = 2 mu I + lambda 1 1^T: eigenvalue 2mu + 3lambda along
      * (1,1,1)/sqrt(3), 2mu on its orthogonal complement. */
-    static const double r3 = 0.57735026918962576451, r2 = 0.70710678118654752440,
-                        r6 = 0.40824829046386301637;
-    const double dirs[3][3] = {{r3, r3, r3}, {r2, -r2, 0.0}, {r6, r6, -2.0 * r6}};
     double lam_scale[3] = {2.0 * mu + 3.0 * lambda, 2.0 * mu, 2.0 * mu};
-    for (int k = 0; k < 3; ++k) {
-        double lam = project && lam_scale[k] < 0.0 ? 0.0 : lam_scale[k];
-        double M[9] = {dirs[k][0], 0, 0, 0, dirs[k][1], 0, 0, 0, dirs[k][2]};
-        w[k] = vol * lam;
-        mode_direction(U, M, V, D, g + 12 * k);
-    }
+    for (int k = 0; k < 3; ++k)
+        w[k] = vol * (project && lam_scale[k] < 0.0 ? 0.0 : lam_scale[k]);
     /* Pair (i, j): flip eigenvalue (psi_i - psi_j)/(s_i - s_j) = 2mu exactly (no division,
      * so equal singular values are harmless); twist eigenvalue (psi_i + psi_j)/(s_i + s_j)
      * = 2mu + (2 lambda e - 4 mu)/(s_i + s_j), zero at any rotation of the rest state. */
-    static const int pair[3][2] = {{0, 1}, {0, 2}, {1, 2}};
-    for (int k = 0; k < 3; ++k) {
-        int i = pair[k][0], j = pair[k][1];
+    for (int p = 0; p < 3; ++p) {
+        int i = mode_pair[p][0], j = mode_pair[p][1];
         double sum = fmax(s[i] + s[j], COROT_MIN_PAIR_SUM);
         double lam_twist = 2.0 * mu + (2.0 * lambda * e - 4.0 * mu) / sum;
         double lam_flip = 2.0 * mu;
@@ -116,14 +116,23 @@ static void corot_modes(const double U[9], const double s[3], const double V[9],
             lam_twist = fmax(lam_twist, 0.0);
             lam_flip = fmax(lam_flip, 0.0);
         }
-        double M[9] = {0};
-        M[3 * i + j] = r2;
-        M[3 * j + i] = -r2;
-        w[3 + 2 * k] = vol * lam_twist;
-        mode_direction(U, M, V, D, g + 12 * (3 + 2 * k));
-        M[3 * j + i] = r2;
-        w[4 + 2 * k] = vol * lam_flip;
-        mode_direction(U, M, V, D, g + 12 * (4 + 2 * k));
+        w[3 + 2 * p] = vol * lam_twist;
+        w[4 + 2 * p] = vol * lam_flip;
+    }
+}
+
+/* The element Hessian vol B^T (dP/dF) B as nine rank-one modes K = sum_k w_k g_k g_k^T,
+ * g_k = B^T vec(U M_k V^T) (w: 9, g: 9 x 12). */
+static void corot_modes(const double U[9], const double s[3], const double V[9], const double D[12],
+                        double vol, double mu, double lambda, uint32_t flags, double w[9],
+                        double g[108]) {
+    corot_mode_weights(s, vol, mu, lambda, flags, w);
+    for (int k = 0; k < 9; ++k) {
+        double M[9], UM[9], Q[9];
+        mode_matrix(k, M);
+        sw_m3_mul(U, M, UM);
+        sw_m3_mul_nt(UM, V, Q);
+        pull_to_nodes(Q, D, g + 12 * k);
     }
 }
 
@@ -171,33 +180,46 @@ static int corot_eval_polar(const double F[9], const double D[12], double vol, d
     return 1;
 }
 
-static double corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
-                         double lambda, double f[12], double K[144], double *modes_w,
-                         double *modes_g, double *V_cache, uint32_t flags) {
-    double Ds[9], F[9], U[9], s[3], V[9], D[12];
+/* F = Ds Dm^-1 of the element at x, and its shape gradients D. */
+static void deformation_gradient(const double x[12], const double DmInv[9], double F[9],
+                                 double D[12]) {
+    double Ds[9];
     for (int a = 0; a < 3; ++a)
         for (int k = 0; k < 3; ++k)
             Ds[3 * a + k] = x[3 * (k + 1) + a] - x[a];
-    sw_m3_mul(Ds, DmInv, F); /* F = Ds Dm^-1 */
-    shape_gradients(DmInv, D);
-    /* Without the Hessian (line-search trials, forces) the rotation alone is needed: the
-     * polar Newton iteration costs a fraction of the Jacobi SVD. */
-    double psi_polar;
-    if (!K && !modes_w && corot_eval_polar(F, D, vol, mu, lambda, f, &psi_polar))
-        return vol * psi_polar;
+    sw_m3_mul(Ds, DmInv, F);
+    sw_tet_shape_gradients(DmInv, D);
+}
+
+/* Psi and dPsi/ds (dpsi) through the rotation-variant SVD F = U diag(s) V^T,
+ * warm-started from V_cache (stored back) when given. */
+static double svd_psi(const double F[9], double *V_cache, double mu, double lambda, double U[9],
+                      double s[3], double V[9], double dpsi[3]) {
     if (V_cache) {
         sw_svd3_warm(F, V_cache, U, s, V);
-        memcpy(V_cache, V, sizeof V);
+        memcpy(V_cache, V, 9 * sizeof *V);
     } else {
         sw_svd3(F, U, s, V);
     }
     double e = s[0] + s[1] + s[2] - 3.0;
     double d0 = s[0] - 1.0, d1 = s[1] - 1.0, d2 = s[2] - 1.0;
-    double psi = mu * (d0 * d0 + d1 * d1 + d2 * d2) + 0.5 * lambda * e * e; /* eq. 2.3 */
+    dpsi[0] = 2.0 * mu * d0 + lambda * e;
+    dpsi[1] = 2.0 * mu * d1 + lambda * e;
+    dpsi[2] = 2.0 * mu * d2 + lambda * e;
+    return mu * (d0 * d0 + d1 * d1 + d2 * d2) + 0.5 * lambda * e * e; /* eq. 2.3 */
+}
+
+static double corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
+                         double lambda, double f[12], double K[144], uint32_t flags) {
+    double F[9], U[9], s[3], V[9], D[12], dpsi[3];
+    deformation_gradient(x, DmInv, F, D);
+    /* Without the Hessian (line-search trials, forces) the rotation alone is needed: the
+     * polar Newton iteration costs a fraction of the Jacobi SVD. */
+    double psi_polar;
+    if (!K && corot_eval_polar(F, D, vol, mu, lambda, f, &psi_polar)) return vol * psi_polar;
+    double psi = svd_psi(F, NULL, mu, lambda, U, s, V, dpsi);
     if (f) {
         /* P = U diag(dPsi/ds) V^T = 2mu (F - R) + lambda tr(R^T F - I) R. */
-        double dpsi[3] = {2.0 * mu * d0 + lambda * e, 2.0 * mu * d1 + lambda * e,
-                          2.0 * mu * d2 + lambda * e};
         double UP[9], P[9], g[12];
         for (int r = 0; r < 3; ++r)
             for (int c = 0; c < 3; ++c)
@@ -208,17 +230,20 @@ static double corot_eval(const double x[12], const double DmInv[9], double vol, 
             f[i] = -vol * g[i];
     }
     if (K) corot_hessian(U, s, V, D, vol, mu, lambda, flags, K);
-    if (modes_w) corot_modes(U, s, V, D, vol, mu, lambda, flags, modes_w, modes_g);
     return vol * psi;
 }
 
 double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
                      double lambda, double f[12], double K[144], uint32_t flags) {
-    return corot_eval(x, DmInv, vol, mu, lambda, f, K, NULL, NULL, NULL, flags);
+    return corot_eval(x, DmInv, vol, mu, lambda, f, K, flags);
 }
 
-double sw_corot_eval_modes(const double x[12], const double DmInv[9], double vol, double mu,
-                           double lambda, double f[12], double w[9], double g[108],
-                           double V_cache[9], uint32_t flags) {
-    return corot_eval(x, DmInv, vol, mu, lambda, f, NULL, w, g, V_cache, flags);
+double sw_corot_eval_svd(const double x[12], const double DmInv[9], double vol, double mu,
+                         double lambda, double V_cache[9], uint32_t flags, double U[9], double s[3],
+                         double V[9], double dpsi[3], double w[9]) {
+    double F[9], D[12];
+    deformation_gradient(x, DmInv, F, D);
+    double psi = svd_psi(F, V_cache, mu, lambda, U, s, V, dpsi);
+    corot_mode_weights(s, vol, mu, lambda, flags, w);
+    return vol * psi;
 }

@@ -39,14 +39,41 @@ enum {
 double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
                      double lambda, double f[12], double K[144], uint32_t flags);
 
-/* As sw_corot_eval, but the Hessian as its nine rank-one modes: K = sum_k w[k] g_k g_k^T
- * with g_k = g[12k .. 12k+11]. A caller projecting K onto a basis J (12 x r) gets
- * J^T K J = sum_k w[k] (J^T g_k)(J^T g_k)^T without forming K (the step's cubature).
- * V_cache (may be NULL) holds a proper rotation from this element's previous call: the
- * SVD starts from it and stores its new V there (fewer Jacobi sweeps frame to frame). */
-double sw_corot_eval_modes(const double x[12], const double DmInv[9], double vol, double mu,
-                           double lambda, double f[12], double w[9], double g[108],
-                           double V_cache[9], uint32_t flags);
+/* The element at x through its SVD, for a caller that projects the Hessian's modes
+ * itself (the step's cubature): returns vol Psi; writes the rotation-variant SVD
+ * F = U diag(s) V^T (warm-started from V_cache when it is not NULL, and the new V stored
+ * there: fewer Jacobi sweeps frame to frame), dpsi = dPsi/ds (P = U diag(dpsi) V^T), and
+ * the weights w (9) of the Hessian's modes: vol d2Psi/dF2 = sum_k w[k] vec(Q_k)
+ * vec(Q_k)^T with Q_k = U M_k V^T (clamped at 0 with SW_COROT_PROJECT_PSD). */
+double sw_corot_eval_svd(const double x[12], const double DmInv[9], double vol, double mu,
+                         double lambda, double V_cache[9], uint32_t flags, double U[9], double s[3],
+                         double V[9], double dpsi[3], double w[9]);
+
+/* The nine modes of dP/dF are U M_k V^T (Teran et al. 2005): three scalings
+ * M = diag(d) along (1,1,1)/sqrt(3), (1,-1,0)/sqrt(2), (1,1,-2)/sqrt(6), then per
+ * singular-value pair (i, j) = (0,1), (0,2), (1,2) a twist (e_i e_j^T - e_j e_i^T)/sqrt(2)
+ * and a flip (e_i e_j^T + e_j e_i^T)/sqrt(2). */
+#define SW_COROT_R3 0.57735026918962576451
+#define SW_COROT_R2 0.70710678118654752440
+#define SW_COROT_R6 0.40824829046386301637
+
+/* h[k] = <A, U M_k V^T> for the nine modes, from A written in the singular frame,
+ * As = U^T A V (row-major): the M_k are sparse, so one to three products each. Inline:
+ * the step's cubature calls it once per reduced coordinate of every tet. */
+static inline void sw_corot_modes_dot(const double As[9], double h[9]) {
+    h[0] = SW_COROT_R3 * As[0] + SW_COROT_R3 * As[4] + SW_COROT_R3 * As[8];
+    h[1] = SW_COROT_R2 * As[0] - SW_COROT_R2 * As[4];
+    h[2] = SW_COROT_R6 * As[0] + SW_COROT_R6 * As[4] - 2.0 * SW_COROT_R6 * As[8];
+    h[3] = SW_COROT_R2 * As[1] - SW_COROT_R2 * As[3]; /* pair (0, 1) */
+    h[4] = SW_COROT_R2 * As[1] + SW_COROT_R2 * As[3];
+    h[5] = SW_COROT_R2 * As[2] - SW_COROT_R2 * As[6]; /* pair (0, 2) */
+    h[6] = SW_COROT_R2 * As[2] + SW_COROT_R2 * As[6];
+    h[7] = SW_COROT_R2 * As[5] - SW_COROT_R2 * As[7]; /* pair (1, 2) */
+    h[8] = SW_COROT_R2 * As[5] + SW_COROT_R2 * As[7];
+}
+
+/* dF/dx of a tet as its 4 x 3 shape gradients: F = sum_n x_n D[3n .. 3n+2]^T. */
+void sw_tet_shape_gradients(const double DmInv[9], double D[12]);
 
 /* Lumped mass: adds density*vol/4 to each of the tet's four vertices' entry of mass. */
 void sw_lumped_mass_add(const int32_t tet[4], double density, double vol, double *mass);

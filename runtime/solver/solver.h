@@ -11,6 +11,10 @@
 #include "world_contact.h"
 #include "sinew/sinew.h"
 
+/* A Newton update that moves the shape by less than this share of its correction |q| is
+ * the step's last (newton.c says why 2%). */
+#define SW_NEWTON_LAST_UPDATE 2e-2
+
 typedef struct sw_solver {
     double *q, *qn, *qdot; /* R each: the state, its value at step start, its velocity */
     double *fin;           /* R: inertial forces of the step (inertia.h) */
