@@ -5,34 +5,30 @@
 #include "blob_load.h"
 #include "fem_corot.h"
 
-/* out[k r + j] = J^T v_k for the n vectors v_k (12 each, at vs[k]): each sum over the 12
- * rows of J (12 x r) in row order from +0, in a register. */
-static void project_rows(const double *J, int32_t r, const double *const *vs, int n, double *out) {
-    for (int k = 0; k < n; ++k) {
-        const double *vk = vs[k];
-        double *o = out + (int64_t)k * r;
-        int32_t j = 0;
-        for (; j + 4 <= r; j += 4) { /* four independent chains, each in row order */
-            double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
-            for (int row = 0; row < 12; ++row) {
-                const double *Jr = J + row * r + j;
-                double c = vk[row];
-                a0 += Jr[0] * c;
-                a1 += Jr[1] * c;
-                a2 += Jr[2] * c;
-                a3 += Jr[3] * c;
-            }
-            o[j] = a0;
-            o[j + 1] = a1;
-            o[j + 2] = a2;
-            o[j + 3] = a3;
+/* out = J^T v (J: 12 x r, v: 12): each sum over the 12 rows of J in row order from +0, in
+ * a register, four columns side by side. */
+static void project_row(const double *J, int32_t r, const double v[12], double *out) {
+    int32_t j = 0;
+    for (; j + 4 <= r; j += 4) { /* four independent chains, each in row order */
+        double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
+        for (int row = 0; row < 12; ++row) {
+            const double *Jr = J + row * r + j;
+            double c = v[row];
+            a0 += Jr[0] * c;
+            a1 += Jr[1] * c;
+            a2 += Jr[2] * c;
+            a3 += Jr[3] * c;
         }
-        for (; j < r; ++j) {
-            double acc = 0;
-            for (int row = 0; row < 12; ++row)
-                acc += J[row * r + j] * vk[row];
-            o[j] = acc;
-        }
+        out[j] = a0;
+        out[j + 1] = a1;
+        out[j + 2] = a2;
+        out[j + 3] = a3;
+    }
+    for (; j < r; ++j) {
+        double acc = 0;
+        for (int row = 0; row < 12; ++row)
+            acc += J[row * r + j] * v[row];
+        out[j] = acc;
     }
 }
 
@@ -160,8 +156,7 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
                 m->ecub[c] = w * sw_corot_eval(x, dminv, v->cub_vol[c], v->mu, v->lambda,
                                                want_grad ? f : NULL, NULL, project);
                 if (!want_grad) continue;
-                const double *vs[1] = {f};
-                project_rows(Jc, r, vs, 1, hm);
+                project_row(Jc, r, f, hm);
                 for (int32_t j = 0; j < r; ++j)
                     m->g[o + j] -= w * hm[j];
                 continue;
