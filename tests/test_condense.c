@@ -74,7 +74,7 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
         int32_t R = in->red.R, nx = 3 * c->nf;
         sw_step_contacts ct = {&in->ps, &in->wc};
         sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
-        sw_cond_weights_apply(c, &in->red);
+        sw_cond_weights_apply(c);
         double *q = malloc(sizeof(double) * R), *x = malloc(sizeof(double) * nx);
         double *g = malloc(sizeof(double) * (R + nx));
         memcpy(q, in->solver.q, sizeof(double) * R);
@@ -147,7 +147,7 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
             c->nf, c->nt, c->nrest, c->nring, bHa, aHb, aHa);
         ENSURE_NEAR(bHa, aHb, 1e-10 * scale);
         ENSURE(aHa > 0);
-        sw_cond_weights_restore(c, &in->red);
+        sw_cond_weights_restore(c);
         free(q), free(x), free(g), free(a), free(b), free(Ha), free(Hb);
         sinew_instance_destroy(in);
         sinew_world_destroy(w);
@@ -196,7 +196,7 @@ TEST(cubature_weights_follow_each_domains_volume_outside_the_patch) {
         }
         ENSURE(nrest == c->nrest && (nexact > 0) == wide);
         /* the cubature of the others scaled to their volume outside, of these none */
-        sw_cond_weights_apply(c, &in->red);
+        sw_cond_weights_apply(c);
         int reached = 0;
         for (int32_t k = 0; k < v->ndomains; ++k) {
             const sw_blob_domain *D = &v->domains[k];
@@ -209,7 +209,7 @@ TEST(cubature_weights_follow_each_domains_volume_outside_the_patch) {
         fprintf(stderr, "    radius %g: %d of %d domains reached, %d evaluated at q (%d tets)\n",
                 wide ? RHO_WIDE : RHO, reached, v->ndomains, nexact, nrest);
         ENSURE(reached > 0);
-        sw_cond_weights_restore(c, &in->red);
+        sw_cond_weights_restore(c);
         for (int32_t i = 0; i < v->ncub; ++i)
             ENSURE(c->cub_w[i] == v->cub_weight[i]);
         free(vol), free(in_vol), free(touches), free(seen);
@@ -460,7 +460,7 @@ TEST(dynamic_patch_gradient_and_the_dynamics_oracle) {
     sw_step_contacts ct = {&in->ps, &in->wc};
     sw_dyn_coef dc = {
         h, 1.0 / ((double)h * h), 1.0 / h, in->v->rayleigh_alpha, in->v->rayleigh_beta, 1};
-    sw_cond_weights_apply(c, &in->red);
+    sw_cond_weights_apply(c);
     double *q = malloc(sizeof(double) * R), *x = malloc(sizeof(double) * nx),
            *g = malloc(sizeof(double) * (R + nx));
     memcpy(q, in->solver.q, sizeof(double) * R);
@@ -481,7 +481,7 @@ TEST(dynamic_patch_gradient_and_the_dynamics_oracle) {
         *p = keep;
         ENSURE_NEAR((ep - em) / (2 * e), g[i], 1e-5 * gmax + 1e-4 * fabs(g[i]));
     }
-    sw_cond_weights_restore(c, &in->red);
+    sw_cond_weights_restore(c);
     free(q), free(x), free(g);
     /* the table drops away: no seed after three steps, but the patch stays while its
        flesh springs back, and folds back once settled */

@@ -171,8 +171,8 @@ typedef struct sw_cond_system {
     sw_reduced *red;
     const sw_solver *s;
 } sw_cond_system;
-void sw_cond_weights_apply(sw_cond *c, sw_reduced *red);
-void sw_cond_weights_restore(sw_cond *c, sw_reduced *red);
+void sw_cond_weights_apply(sw_cond *c);
+void sw_cond_weights_restore(sw_cond *c);
 double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
                          const sw_solver *s, const double *q, const double *x,
                          const sw_dyn_coef *dc, int want_hess);

@@ -22,7 +22,7 @@
  * the bent domain's volume but 97% of its cubature weight, and the 2 tets left, scaled
  * 7.8x, stood for the rest (err_world_cond 0.201; 0.144 with this rule, README). The
  * cached cubature Jacobians of those domains are refilled by the next gradient pass. */
-void sw_cond_weights_apply(sw_cond *c, sw_reduced *red) {
+void sw_cond_weights_apply(sw_cond *c) {
     const sw_blob_view *v = c->v;
     for (int32_t k = 0; k < v->ndomains; ++k) { /* dom_fv: the oracle's (exact_domains) */
         if (c->dom_fv[k] == 0) continue;
@@ -31,18 +31,16 @@ void sw_cond_weights_apply(sw_cond *c, sw_reduced *red) {
         if (!(s > 0)) s = 0;
         for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
             c->cub_w[i] = s * v->cub_weight[i];
-        red->Jcub_ok[k] = 0;
     }
 }
 
-void sw_cond_weights_restore(sw_cond *c, sw_reduced *red) {
+void sw_cond_weights_restore(sw_cond *c) {
     const sw_blob_view *v = c->v;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         if (c->dom_fv[k] == 0) continue;
         const sw_blob_domain *D = &v->domains[k];
         for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
             c->cub_w[i] = v->cub_weight[i];
-        red->Jcub_ok[k] = 0;
     }
 }
 
@@ -460,7 +458,7 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
                            sinew_step_stats *st) {
     int32_t R = red->R, nx = 3 * c->nf;
     int64_t m = R + nx;
-    sw_cond_weights_apply(c, red);
+    sw_cond_weights_apply(c);
     for (int32_t j = 0; j < c->np; ++j) /* undecided: the first evaluation decides */
         c->pp_active[j] = -1;
     sw_cond_system S = {c, red, s};
@@ -538,7 +536,7 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         }
         gn = grad_norm(c, red);
     }
-    sw_cond_weights_restore(c, red);
+    sw_cond_weights_restore(c);
     st->residual = g0 > 0 ? gn / g0 : 0;
     st->energy = phi;
     return res;

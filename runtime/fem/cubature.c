@@ -5,19 +5,35 @@
 #include "blob_load.h"
 #include "fem_corot.h"
 
-/* out = J^T v (J: 12 x r, v: 12): each sum over the 12 rows of J in row order from +0, in
- * a register, four columns side by side. */
-static void project_row(const double *J, int32_t r, const double v[12], double *out) {
+/* A cubature tet's corners in the subspace map (reduced_map.h): corner n's rows of the
+ * domain's basis U_n (3 x r) and its skinning rotation R_n, so that its Jacobian is
+ * J_n = R_n U_n without being formed. (A per-step cache of x0 and J = R U, 12 (r + 1)
+ * doubles a tet, cost more to fill than it saved: W_n = U^T R_n costs a pass what J costs
+ * a column, and most steps make one or two passes. Without it, callgrind over 4 finger 50K
+ * instances' steps: 2.316G -> 2.206G instructions, the elephant's instance 7.18 -> 5.89 MB.) */
+typedef struct {
+    const double *U[4];
+    const double *R[4];
+} tet_map;
+
+/* out = J^T v = sum_n U_n^T (R_n^T v_n) (v: 12): each sum over the corners' 12 basis rows
+ * in row order, four columns side by side. */
+static void project_corners(const tet_map *tm, int32_t r, const double v[12], double *out) {
+    double w[12];
+    for (int n = 0; n < 4; ++n) /* R_n^T v_n */
+        for (int k = 0; k < 3; ++k)
+            w[3 * n + k] = tm->R[n][k] * v[3 * n] + tm->R[n][3 + k] * v[3 * n + 1] +
+                           tm->R[n][6 + k] * v[3 * n + 2];
     int32_t j = 0;
     for (; j + 4 <= r; j += 4) { /* four independent chains, each in row order */
         double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
         for (int row = 0; row < 12; ++row) {
-            const double *Jr = J + row * r + j;
-            double c = v[row];
-            a0 += Jr[0] * c;
-            a1 += Jr[1] * c;
-            a2 += Jr[2] * c;
-            a3 += Jr[3] * c;
+            const double *Ur = tm->U[row / 3] + (row % 3) * r + j;
+            double c = w[row];
+            a0 += Ur[0] * c;
+            a1 += Ur[1] * c;
+            a2 += Ur[2] * c;
+            a3 += Ur[3] * c;
         }
         out[j] = a0;
         out[j + 1] = a1;
@@ -27,7 +43,7 @@ static void project_row(const double *J, int32_t r, const double v[12], double *
     for (; j < r; ++j) {
         double acc = 0;
         for (int row = 0; row < 12; ++row)
-            acc += J[row * r + j] * v[row];
+            acc += tm->U[row / 3][(row % 3) * r + j] * w[row];
         out[j] = acc;
     }
 }
@@ -64,43 +80,35 @@ static void add_mode_products(double *H, int32_t R, int32_t r, const double *hm,
     }
 }
 
-/* x = x0 + J q for a cubature tet's four corners: twelve independent sums over the
- * domain's r coordinates, along J's contiguous rows (four corners' three add chains
- * each, then a rotation, before). */
-static void corners_at(const double x0[12], const double *J, int32_t r, const double *qd,
-                       double x[12]) {
-    for (int i = 0; i < 12; ++i) {
-        const double *Ji = J + (int64_t)i * r;
-        double acc = 0.0;
-        for (int32_t j = 0; j < r; ++j)
-            acc += Ji[j] * qd[j];
-        x[i] = x0[i] + acc;
-    }
-}
-
 /* The projections of one tet evaluated with its Hessian, through the singular frame of
  * its SVD F = U diag(s) V^T: column j of J moves F by G_j = sum_n J_n,j D_n^T (corner n's
- * three rows of J, shape gradient D_n), and in that frame Gs_j = U^T G_j V =
- * sum_n (U^T J_n,j)(V^T D_n)^T, against which the nine modes U M_k V^T and the stress
- * U diag(dpsi) V^T are sparse (sw_corot_modes_dot): out[j] = fscale <Gs_j, diag(dpsi)>
- * (J^T f with fscale = -vol), then out[(1 + i) r + j] = <Gs_j, M_mode[i]> for the n modes
- * listed. About 100 products a column instead of 12 for each of ten 12-vectors, and no
- * mode directions or pulls to the nodes. */
-static void singular_frame_projections(const double *J, int32_t r, const double DmInv[9],
+ * Jacobian J_n = R_n U_n, shape gradient D_n), and in that frame Gs_j = U^T G_j V =
+ * sum_n (W_n U_n,j)(V^T D_n)^T with W_n = U^T R_n formed once a tet, against which the nine modes U
+ * M_k V^T and the stress U diag(dpsi) V^T are sparse (sw_corot_modes_dot): out[j] = fscale <Gs_j,
+ * diag(dpsi)> (J^T f with fscale = -vol), then out[(1 + i) r + j] = <Gs_j, M_mode[i]> for the n
+ * modes listed. About 100 products a column instead of 12 for each of ten 12-vectors, and no mode
+ * directions or pulls to the nodes. */
+static void singular_frame_projections(const tet_map *tm, int32_t r, const double DmInv[9],
                                        const double U[9], const double V[9], const double dpsi[3],
                                        double fscale, const int *mode, int n, double *out) {
-    double D[12], b[12];
+    double D[12], b[12], W[4][9];
     sw_tet_shape_gradients(DmInv, D);
+    for (int c = 0; c < 4; ++c) /* W_n = U^T R_n */
+        for (int i = 0; i < 3; ++i)
+            for (int k = 0; k < 3; ++k)
+                W[c][3 * i + k] =
+                    U[i] * tm->R[c][k] + U[3 + i] * tm->R[c][3 + k] + U[6 + i] * tm->R[c][6 + k];
     for (int c = 0; c < 4; ++c) /* b_n = V^T D_n */
         for (int i = 0; i < 3; ++i)
             b[3 * c + i] = V[i] * D[3 * c] + V[3 + i] * D[3 * c + 1] + V[6 + i] * D[3 * c + 2];
     for (int32_t j = 0; j < r; ++j) {
         double Gs[9] = {0}, h[9];
         for (int c = 0; c < 4; ++c) {
-            double j0 = J[(3 * c) * r + j], j1 = J[(3 * c + 1) * r + j],
-                   j2 = J[(3 * c + 2) * r + j];
+            const double *Un = tm->U[c];
+            double u0 = Un[j], u1 = Un[r + j], u2 = Un[2 * r + j];
             for (int i = 0; i < 3; ++i) {
-                double ai = U[i] * j0 + U[3 + i] * j1 + U[6 + i] * j2; /* (U^T J_n,j)_i */
+                const double *Wi = W[c] + 3 * i;
+                double ai = Wi[0] * u0 + Wi[1] * u1 + Wi[2] * u2; /* (U^T R_n U_n,j)_i */
                 Gs[3 * i] += ai * b[3 * c];
                 Gs[3 * i + 1] += ai * b[3 * c + 1];
                 Gs[3 * i + 2] += ai * b[3 * c + 2];
@@ -134,29 +142,26 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
         const double *qd = p->q + o;
-        /* the tets' corners x0 and Jacobians J: filled by the step's first pass, then read */
-        int fill_J = !m->Jcub_ok[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12];
-            /* x0 (12: the corners at q = 0), then J (12 x r) */
-            double *x0 = m->Jcub + m->Jcub_off[k] + (int64_t)12 * (r + 1) * (c - D->cub_begin);
-            double *Jc = x0 + 12;
-            if (fill_J)
-                for (int j = 0; j < 4; ++j)
-                    sw_reduced_position(m, D, v->cub_tets[4 * c + j], m->cub_act[4 * c + j], NULL,
-                                        x0 + 3 * j, Jc + 3 * j * r);
             double w = m->cub_w[c];
             if (w == 0.0) { /* in a condensation patch: its tet is evaluated in full space */
                 m->ecub[c] = 0;
                 continue;
             }
-            corners_at(x0, Jc, r, qd, x);
+            tet_map tm;
+            for (int n = 0; n < 4; ++n) {
+                int32_t lv = v->cub_tets[4 * c + n], a = m->cub_act[4 * c + n];
+                tm.U[n] = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+                tm.R[n] = m->act_R + 9 * a;
+                sw_reduced_position(m, D, lv, a, qd, x + 3 * n, NULL);
+            }
             const double *dminv = v->cub_dminv + 9 * c;
             if (!want_hess) { /* energy, and J^T f (the polar rotation: no SVD) */
                 m->ecub[c] = w * sw_corot_eval(x, dminv, v->cub_vol[c], v->mu, v->lambda,
                                                want_grad ? f : NULL, NULL, project);
                 if (!want_grad) continue;
-                project_row(Jc, r, f, hm);
+                project_corners(&tm, r, f, hm);
                 for (int32_t j = 0; j < r; ++j)
                     m->g[o + j] -= w * hm[j];
                 continue;
@@ -174,12 +179,11 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
                     a[n] = w * wm[mk];
                     mode[n++] = mk;
                 }
-            singular_frame_projections(Jc, r, dminv, U, V, dpsi, -v->cub_vol[c], mode, n, hm);
+            singular_frame_projections(&tm, r, dminv, U, V, dpsi, -v->cub_vol[c], mode, n, hm);
             for (int32_t j = 0; j < r; ++j)
                 m->g[o + j] -= w * hm[j];
             if (n > 0) add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, hm + r, a, n);
         }
-        if (fill_J) m->Jcub_ok[k] = 1;
         if (want_hess) /* the block was filled in its upper triangle: mirror */
             for (int32_t i = 0; i < r; ++i)
                 for (int32_t j = i + 1; j < r; ++j)

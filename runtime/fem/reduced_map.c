@@ -1,10 +1,7 @@
 #include "reduced_map.h"
 
-#include <string.h>
-
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq) {
     const sw_blob_view *v = m->v;
-    memset(m->Jcub_ok, 0, (size_t)v->ndomains);
     m->bone_dq = bone_dq;
     for (int32_t a = 0; a < m->nact; ++a) {
         int32_t gv = m->act_vert[a];

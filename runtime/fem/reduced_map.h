@@ -36,22 +36,14 @@ typedef struct sw_reduced {
     const sinew_task_callbacks *tasks; /* the host's job system, NULL: serial */
     double *Jc, *hc;                   /* 4 x 3 x rmax each: one contact's Jacobians and N G */
     double *svd_V;                     /* 9 per cubature tet: its last SVD rotation (warm start) */
-    /* The cubature tets' corners as affine maps of q, x = x0 + J q (x0: 12, the corners
-     * at q = 0, then J = R U: 12 x r_d, per tet; domain k's from Jcub + Jcub_off[k]):
-     * they depend on the skinning alone, not on q, so the step's first pass over a
-     * domain fills them (Jcub_ok[k] = 1) and its later passes read
-     * them; skinning clears the flags. */
-    double *Jcub;
-    int64_t *Jcub_off;          /* ndomains */
-    unsigned char *Jcub_ok;     /* ndomains */
-    const sw_dualquat *bone_dq; /* the pose of the last sw_reduced_skin */
+    const sw_dualquat *bone_dq;        /* the pose of the last sw_reduced_skin */
     /* The cubature weights in use (ncub): the blob's, except while a condensation patch
      * holds some tets (0 there, the rest of their domain renormalised, condense.h). */
     const double *cub_w;
 } sw_reduced;
 
 /* Skins every active vertex with the bones' dual quaternions (act_R, act_t), which m keeps
- * (bone_dq) for vertices skinned on demand; the cached cubature Jacobians become stale. */
+ * (bone_dq) for vertices skinned on demand. */
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 
 /* Position x of copy (domain D, local vertex lv, active index a) for the domain's

@@ -19,7 +19,6 @@ typedef struct {
     int32_t max_pairs;  /* the contact pair budget */
     int32_t max_world;  /* the world candidate budget */
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
-    uint64_t njcub;     /* the cubature tets' corners and Jacobians: 12 (r_d + 1) each */
     sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
     double rho;         /* its radius, in units of the rest diagonal */
 } layout_sizes;
@@ -55,9 +54,6 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->Jc, 12 * rm);
     TAKE(m->hc, 12 * rm);
     TAKE(m->svd_V, 9 * (uint64_t)v->ncub);
-    TAKE(m->Jcub, z->njcub);
-    TAKE(m->Jcub_off, nd);
-    TAKE(m->Jcub_ok, nd);
     /* the pose space */
     sw_pose_space *ps = &in->ps;
     TAKE(ps->feature, 4 * nb);
@@ -303,11 +299,8 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     if (!d->allocator.alloc) d->allocator = blob->allocator;
     z->nact = active_vertices(v, NULL);
     z->rmax = 0;
-    z->njcub = 0;
-    for (int32_t k = 0; k < v->ndomains; ++k) {
+    for (int32_t k = 0; k < v->ndomains; ++k)
         if (v->domains[k].rank > z->rmax) z->rmax = v->domains[k].rank;
-        z->njcub += 12 * (uint64_t)v->domains[k].cub_count * ((uint64_t)v->domains[k].rank + 1);
-    }
     /* a budget above what the blob can ever need is what it needs */
     int32_t need = sw_pose_space_default_max_pairs(v);
     z->max_pairs = d->max_contact_pairs == 0 || d->max_contact_pairs > (uint32_t)need
@@ -421,10 +414,6 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.rmax = z.rmax;
     in->red.nact = z.nact; /* counted for the layout; now listed */
     in->red.nworkers = z.nworkers;
-    for (int64_t k = 0, off = 0; k < v->ndomains; ++k) {
-        in->red.Jcub_off[k] = off;
-        off += 12 * (int64_t)v->domains[k].cub_count * (v->domains[k].rank + 1);
-    }
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
     (void)active_vertices(v, in->red.act_vert);

@@ -12,8 +12,8 @@
 #include "sinew/sinew.h"
 
 /* A Newton update that moves the shape by less than this share of its correction |q| is
- * the step's last (newton.c says why 2%). */
-#define SW_NEWTON_LAST_UPDATE 2e-2
+ * the step's last (newton.c says why 5%). */
+#define SW_NEWTON_LAST_UPDATE 5e-2
 
 typedef struct sw_solver {
     double *q, *qn, *qdot; /* R each: the state, its value at step start, its velocity */

@@ -174,7 +174,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
  * shear) or is a reflection gives SINEW_ERROR_INVALID_ARGUMENT; either way the pose and
  * the state stay as they were. */
 /** Newton stopped at a solution: its gradient fell below 1e-5 of the step's first (or
- * was zero), the last update moved the shape by less than 0.3% of its correction, or the
+ * was zero), the last update moved the shape by less than 5% of its correction, or the
  * predicted decrease of a further update is below the energy's rounding (a state already
  * at its minimum, e.g. a step at rest, converges with 0 iterations). */
 #define SINEW_STEP_CONVERGED 1u
