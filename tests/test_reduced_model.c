@@ -9,6 +9,7 @@
 #include "bake_fixture.h"
 #include "dqs.h"
 #include "instance.h"
+#include "instance_internal.h"
 #include "solver.h"
 #include "subspace_eval.h"
 #include "sw_test.h"
@@ -82,6 +83,104 @@ TEST(gradient_matches_finite_differences_with_contact_pairs) {
     free(q);
     free(g);
     free(H);
+    sinew_instance_destroy(inst);
+}
+
+/* Halfway between poses A and B (12 per bone): each bone's rotation the normalised
+ * mean of its two quaternions, its translation the mean. */
+static void halfway_pose(const double *A, const double *B, int32_t nbones, double *T) {
+    for (int32_t b = 0; b < nbones; ++b) {
+        sw_dualquat qa, qb;
+        sw_dq_from_transform(A + 12 * b, &qa);
+        sw_dq_from_transform(B + 12 * b, &qb);
+        double s = qa.r[0] * qb.r[0] + qa.r[1] * qb.r[1] + qa.r[2] * qb.r[2] + qa.r[3] * qb.r[3],
+               r[4], n = 0;
+        for (int i = 0; i < 4; ++i) {
+            r[i] = qa.r[i] + (s < 0 ? -qb.r[i] : qb.r[i]);
+            n += r[i] * r[i];
+        }
+        for (int i = 0; i < 4; ++i)
+            r[i] /= sqrt(n);
+        sw_quat_to_matrix(r, T + 12 * b);
+        for (int i = 0; i < 3; ++i)
+            T[12 * b + 9 + i] = 0.5 * (A[12 * b + 9 + i] + B[12 * b + 9 + i]);
+    }
+}
+
+/* The pairs' tangential term (pose_space.c): the reference's whole law at a training
+ * pose, a share of it between two, none far from every sample; the gradient stays the
+ * energy's at a share in between. */
+TEST(contact_tangential_share_fades_from_the_training_poses) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    int32_t R = v->rank_total, nb = v->nbones;
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    double *q = malloc(sizeof(double) * R), *g = malloc(sizeof(double) * R),
+           *T = malloc(sizeof(double) * 12 * nb);
+    int checked = 0;
+    for (int32_t t = 0; t + 1 < v->ntrain; ++t) {
+        const double *Ta = f->res.train_T + (size_t)t * 12 * nb, *Tb = Ta + 12 * nb;
+        if (v->contact_ptr[t + 1] - v->contact_ptr[t] < 3) continue;
+        ENSURE(sw_instance_set_pose_d(inst, Ta) == SINEW_OK);
+        ENSURE(isfinite(sw_instance_potential(inst, v->train_q + (size_t)t * R, NULL, NULL)));
+        ENSUREF(inst->ps.tangent[0] == 1.0, "training pose %d: share %g", t, inst->ps.tangent[0]);
+        halfway_pose(Ta, Tb, nb, T);
+        ENSURE(sw_instance_set_pose_d(inst, T) == SINEW_OK);
+        for (int32_t i = 0; i < R; ++i)
+            q[i] = v->train_q[(size_t)t * R + i];
+        double e = sw_instance_potential(inst, q, g, NULL);
+        ENSURE(isfinite(e));
+        if (inst->ps.npairs == 0) continue;
+        double share = inst->ps.tangent[0];
+        if (!(share > 0 && share < 1)) continue; /* a pose stored twice, or far apart */
+        double gmax = 0;
+        for (int32_t i = 0; i < R; ++i)
+            gmax = fmax(gmax, fabs(g[i]));
+        for (int32_t i = 0; i < R; ++i) {
+            double h = 1e-6, qi = q[i];
+            q[i] = qi + h;
+            double ep = sw_instance_potential(inst, q, NULL, NULL);
+            q[i] = qi - h;
+            double em = sw_instance_potential(inst, q, NULL, NULL);
+            q[i] = qi;
+            ENSUREF(fabs((ep - em) / (2 * h) - g[i]) <= 1e-5 * gmax + 1e-8,
+                    "halfway after pose %d (share %g) coordinate %d: finite difference %.9g, "
+                    "gradient %.9g",
+                    t, share, i, (ep - em) / (2 * h), g[i]);
+        }
+        checked++;
+    }
+    ENSUREF(checked > 0, "no pose between two training poses with pairs in use");
+    /* the first training pose with its bones turned 2 rad about x, alternately either
+     * way: beyond every sample's reach */
+    for (int32_t b = 0; b < nb; ++b) {
+        const double *A = f->res.train_T + 12 * b;
+        double a = b % 2 ? 2.0 : -2.0, c = cos(a), sn = sin(a);
+        for (int i = 0; i < 3; ++i) { /* A R_x(a) */
+            T[12 * b + 3 * i] = A[3 * i];
+            T[12 * b + 3 * i + 1] = A[3 * i + 1] * c + A[3 * i + 2] * sn;
+            T[12 * b + 3 * i + 2] = -A[3 * i + 1] * sn + A[3 * i + 2] * c;
+        }
+        for (int i = 9; i < 12; ++i)
+            T[12 * b + i] = A[i];
+    }
+    double *feat = malloc(sizeof(double) * 4 * nb), far = INFINITY, reach = 0;
+    sw_pose_feature(T, v->bone_parent, nb, feat);
+    for (int32_t t = 0; t < v->ntrain; ++t) {
+        far = fmin(far, sqrt(sw_pose_distance(feat, v->train_pose + (size_t)4 * nb * t, nb)));
+        reach = fmax(reach, inst->ps.reach[t]);
+    }
+    free(feat);
+    ENSUREF(far > reach, "the turned pose is %g from a sample, within reach %g", far, reach);
+    ENSURE(sw_instance_set_pose_d(inst, T) == SINEW_OK);
+    ENSURE(isfinite(sw_instance_potential(inst, v->train_q, NULL, NULL)));
+    ENSUREF(inst->ps.tangent[0] == 0 && inst->ps.tangent[1] == 0, "far pose: shares %g %g",
+            inst->ps.tangent[0], inst->ps.tangent[1]);
+    free(q);
+    free(g);
+    free(T);
     sinew_instance_destroy(inst);
 }
 
@@ -259,6 +358,7 @@ TEST(release_fixture) {
 }
 
 SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
+             CASE(contact_tangential_share_fades_from_the_training_poses),
              CASE(chord_updates_end_at_a_newton_stationary_point),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
              CASE(branches_follow_the_motion), CASE(training_poses_are_reproduced),

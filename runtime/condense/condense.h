@@ -89,6 +89,7 @@ typedef struct sw_cond {
                                pairs; the rest's own come after */
     int32_t *pp_id;         /* max_pairs: their contact ids */
     double *pp_w;           /* max_pairs: their pose-space blend weights */
+    double *pp_alpha;       /* max_pairs: their law's anisotropy (pose_contact.c) */
     unsigned char *pp_skip; /* max_pairs: per ps->pairs entry, the patch evaluates it */
     signed char *pp_active; /* max_pairs: in contact for this solve (-1: not decided yet) */
     int32_t *fv;            /* nf: patch vertices (global ids) */

@@ -135,12 +135,12 @@ static double patch_pair(sw_cond *c, const sw_reduced *red, int32_t j, const dou
     if (c->pp_active[j] < 0) c->pp_active[j] = sw_penalty_gap(n, d) > 0; /* the solve's start */
     if (!c->pp_active[j]) return 0;
     double kk = c->pp_w[j] * v->contact_k * cd[6];
-    sw_penalty_apply_N(n, SW_CONTACT_ALPHA, d, Nd);
+    sw_penalty_apply_N(n, c->pp_alpha[j], d, Nd);
     for (int m = 0; m < 4; ++m)
         for (int i = 0; i < 3; ++i)
             f[3 * m + i] = -kk * coef[m] * Nd[i];
     if (K) {
-        sw_penalty_N(n, SW_CONTACT_ALPHA, N);
+        sw_penalty_N(n, c->pp_alpha[j], N);
         for (int m = 0; m < 4; ++m)
             for (int l = 0; l < 4; ++l)
                 for (int i = 0; i < 3; ++i)

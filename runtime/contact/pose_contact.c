@@ -6,17 +6,18 @@
 
 /* Pose-space self-contact (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
  * training pose's pairs, each the reference's penalty E = 1/2 k ka d^T N d with
- * d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and n = R_p n_rest, applied
+ * d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and n = R_p n_rest (alpha:
+ * SW_CONTACT_ALPHA times the pose's tangential share, pose_space.c), applied
  * while the pair collides (the Heaviside of eq. 3.12: p behind the triangle along n).
  * Per pair the slots of one domain are summed into G_d = sum coef_m J_m (3 x r_d), so
  * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
  * couple two domains. Added after the cubature so it lands on the full (mirrored)
  * matrix. */
 static double contact_pairs(sw_reduced *red, const int32_t *pairs, const unsigned char *skip,
-                            int32_t npairs, double weight, const double *q, int want_grad,
-                            int want_hess) {
+                            int32_t npairs, double weight, double tangent, const double *q,
+                            int want_grad, int want_hess) {
     const sw_blob_view *v = red->v;
-    double E = 0, k = weight * v->contact_k, al = SW_CONTACT_ALPHA;
+    double E = 0, k = weight * v->contact_k, al = tangent * SW_CONTACT_ALPHA;
     int32_t rm = red->rmax;
     for (int32_t p = 0; p < npairs; ++p) {
         if (skip && skip[p]) continue; /* a condensation patch's (condense.h) */
@@ -101,11 +102,11 @@ double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const doub
                             int want_grad, int want_hess) {
     if (ps->nearest < 0) return 0;
     const unsigned char *skip = ps->in_patch;
-    double E = contact_pairs(red, ps->pairs, skip, ps->npairs_nearest, 1 - ps->blend, q, want_grad,
-                             want_hess);
+    double E = contact_pairs(red, ps->pairs, skip, ps->npairs_nearest, 1 - ps->blend,
+                             ps->tangent[0], q, want_grad, want_hess);
     if (ps->blend > 0)
         E += contact_pairs(red, ps->pairs + ps->npairs_nearest,
                            skip ? skip + ps->npairs_nearest : NULL, ps->npairs - ps->npairs_nearest,
-                           ps->blend, q, want_grad, want_hess);
+                           ps->blend, ps->tangent[1], q, want_grad, want_hess);
     return E;
 }

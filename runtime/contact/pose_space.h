@@ -15,10 +15,16 @@ typedef struct sw_pose_space {
     double *motion;       /* 4 nbones: the last change of pose between two lookups */
     int32_t *twin_next;   /* ntrain: the next training pose storing the same pose (a
                              cycle over its branches; itself when it has one) */
+    double *reach;        /* ntrain: each training pose's feature distance (its root) to the
+                             nearest other pose (INFINITY when there is none) */
     int looked_up;        /* feature_last holds a pose */
     int32_t nearest;      /* training pose nearest to the current pose, or -1 */
     int32_t second;       /* the second nearest, or -1 */
     double blend;         /* pose-space weight of `second` (0: `nearest` alone) */
+    /* the share of the contact law's tangential term (SW_CONTACT_ALPHA) that the pairs of
+       `nearest` [0] and of `second` [1] carry: 1 at their own training pose, falling
+       linearly to 0 at the distance of its nearest other pose (sw_pose_space_lookup) */
+    double tangent[2];
     /* the contact pairs in use: pairs[0, npairs_nearest) are the nearest pose's,
        pairs[npairs_nearest, npairs) the second's (when blended) */
     int32_t *pairs;    /* max_pairs contact ids */
@@ -33,12 +39,16 @@ typedef struct sw_pose_space {
 /* Links the training poses stored more than once into cycles (twin_next, ntrain). */
 void sw_pose_space_link_twins(const sw_blob_view *v, int32_t *twin_next);
 
+/* Fills reach (ntrain) for the training poses of v (a pose's twins do not count).
+ * O(ntrain^2 nbones), once at creation. */
+void sw_pose_space_reach(const sw_blob_view *v, double *reach);
+
 /* Forgets the pose history: no motion, no nearest pose. */
 void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);
 
 /* Finds the two nearest training poses of the pose T (12 per bone) and the blend
- * weight, and updates the pose motion. Sets nearest (-1 without training poses), second
- * and blend. O(ntrain nbones). */
+ * weight, and updates the pose motion. Sets nearest (-1 without training poses), second,
+ * blend and tangent. O(ntrain nbones). */
 void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T);
 
 /* Collects the contact pairs of the poses the lookup found into ps->pairs, the nearest

@@ -60,6 +60,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(ps->feature_last, 4 * nb);
     TAKE(ps->motion, 4 * nb);
     TAKE(ps->twin_next, (uint64_t)v->ntrain);
+    TAKE(ps->reach, (uint64_t)v->ntrain);
     TAKE(ps->pairs, (uint64_t)z->max_pairs);
     /* the solver */
     sw_solver *s = &in->solver;
@@ -124,6 +125,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->fv, nf);
         TAKE(c->pp_id, np);
         TAKE(c->pp_w, np);
+        TAKE(c->pp_alpha, np);
         TAKE(c->pp_skip, np);
         TAKE(c->pp_active, np);
         TAKE(c->ft, ntf);
@@ -425,6 +427,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     /* 2% of the character's size: what a surface vertex can travel in one step */
     in->wc.radius = 0.01 * in->size;
     sw_pose_space_link_twins(v, in->ps.twin_next);
+    sw_pose_space_reach(v, in->ps.reach);
     in->cond.z = z.cond;
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
     in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
