@@ -53,6 +53,44 @@ TEST(solutions_match_the_bake) {
     ENSURE(same);
 }
 
+/* Bones carrying little flesh fold into their parents' domains (bake_domains.c): the
+ * finger's three bones own tets and are three domains with folding off; at a share above
+ * the tip bone's (a third of the finger at most) it joins its parent, whose domain then
+ * rides the parent's bone; a share out of range is an error that names it. */
+TEST(small_bones_fold_into_their_parents) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 5, &c, &err) == SINEW_OK);
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 2;
+    p.threads = 2;
+    int32_t nd[2];
+    for (int k = 0; k < 2; ++k) {
+        p.fold_share = k == 0 ? 0 : 0.45;
+        sw_bake_result r;
+        ENSUREF(sw_bake(&c, &p, &r, &err) == SINEW_OK, "%s", err.msg);
+        nd[k] = r.view.ndomains;
+        int tip = 0; /* the bone no other bone hangs from */
+        for (int32_t b = 0; b < c.skel.nbones; ++b) {
+            int leaf = 1;
+            for (int32_t o = 0; o < c.skel.nbones; ++o)
+                leaf = leaf && c.skel.parent[o] != b;
+            if (!leaf) continue;
+            for (int32_t d = 0; d < r.view.ndomains; ++d)
+                tip += r.view.domains[d].bone == b;
+        }
+        ENSUREF(tip == (k == 0), "fold share %g: %d domains ride the tip bone", p.fold_share, tip);
+        sw_bake_result_free(&r);
+    }
+    ENSUREF(nd[0] == c.skel.nbones && nd[1] < nd[0], "domains %d unfolded, %d folded", nd[0],
+            nd[1]);
+    p.fold_share = 0.5;
+    sw_bake_result r;
+    ENSURE(sw_bake(&c, &p, &r, &err) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(err.msg, "fold share 0.5"), "%s", err.msg);
+    sw_character_free(&c);
+}
+
 /* What the progress callback saw: per stage, its calls, the last done and total, and
  * whether done ever fell or the elapsed time went back. */
 typedef struct {
@@ -105,4 +143,4 @@ TEST(progress_counts_every_pose_and_domain) {
 }
 
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
-             CASE(progress_counts_every_pose_and_domain))
+             CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain))

@@ -36,36 +36,39 @@
 #include "subspace_eval.h"
 
 static void usage(FILE *f) {
-    fprintf(f,
-            "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
-            "                   [--fps F] [--height H] |\n"
-            "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-            "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-            "                   [--clip FILE [--frames F]])\n"
-            "                  --out FILE.blob [--report DIR]\n"
-            "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
-            "                  [--max-rank R] [--spring-k K] [--compare-cubature]\n"
-            "                  [--no-self-contact] [--return-path] [--inertia-modes]\n"
-            "                  [--threads T] [--force] [--json]\n"
-            "character:\n" SW_CHARACTER_USAGE "bake:\n"
-            "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
-            "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
-            "                   frame's error, ranks, cubature, stage times, a contact sheet of\n"
-            "                   held-out frames) and DIR/report.json (the same figures)\n"
-            "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
-            "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
-            "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
-            "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
-            "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
-            "                   bones' accelerations (static responses to them), so that the\n"
-            "                   flesh lags and overshoots as the reference does; a higher rank\n"
-            "  --threads T      0..256 (default 0: all cores)\n"
-            "  --force          write the blob even when its training error is %.2f or more\n"
-            "                   (the share of the physics correction it misses on its own\n"
-            "                   training poses; without --force that is an error)\n"
-            "  --json           one JSON object with the figures as the last stdout line\n"
-            "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
-            SW_BAKE_MAX_TRAIN_ERROR);
+    fprintf(
+        f,
+        "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
+        "                   [--fps F] [--height H] |\n"
+        "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+        "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+        "                   [--clip FILE [--frames F]])\n"
+        "                  --out FILE.blob [--report DIR]\n"
+        "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
+        "                  [--max-rank R] [--fold-share S] [--spring-k K] [--compare-cubature]\n"
+        "                  [--no-self-contact] [--return-path] [--inertia-modes]\n"
+        "                  [--threads T] [--force] [--json]\n"
+        "character:\n" SW_CHARACTER_USAGE "bake:\n"
+        "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
+        "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
+        "                   frame's error, ranks, cubature, stage times, a contact sheet of\n"
+        "                   held-out frames) and DIR/report.json (the same figures)\n"
+        "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
+        "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
+        "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
+        "  --fold-share S   a bone whose tets hold less than S of the mesh's volume\n"
+        "                   joins its parent's domain, 0..0.5 (default 0.03; 0: off)\n"
+        "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
+        "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
+        "                   bones' accelerations (static responses to them), so that the\n"
+        "                   flesh lags and overshoots as the reference does; a higher rank\n"
+        "  --threads T      0..256 (default 0: all cores)\n"
+        "  --force          write the blob even when its training error is %.2f or more\n"
+        "                   (the share of the physics correction it misses on its own\n"
+        "                   training poses; without --force that is an error)\n"
+        "  --json           one JSON object with the figures as the last stdout line\n"
+        "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
+        SW_BAKE_MAX_TRAIN_ERROR);
 }
 
 int main(int argc, char **argv) {
@@ -106,6 +109,13 @@ int main(int argc, char **argv) {
             else {
                 fprintf(stderr, "%s: --selector wants greedy | importance | nnhtp, got '%s'\n",
                         tool, s);
+                ok = 0;
+            }
+        } else if (!strcmp(a, "--fold-share") && next) {
+            ok = sw_tool_real(tool, a, argv[++i], -1, 0.5, "in 0..0.5", &p.fold_share);
+            if (ok && p.fold_share < 0) {
+                fprintf(stderr, "%s: --fold-share wants a number in 0..0.5, got '%s'\n", tool,
+                        argv[i]);
                 ok = 0;
             }
         } else if (!strcmp(a, "--spring-k") && next)

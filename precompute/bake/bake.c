@@ -17,6 +17,7 @@ sw_bake_params sw_bake_params_default(void) {
     sw_bake_params p;
     memset(&p, 0, sizeof p);
     p.max_rank = 30;
+    p.fold_share = 0.03;
     p.pca_energy = 0.9999;
     p.cubature_tol = 0.05;
     p.cubature_max = 1000;
@@ -253,12 +254,13 @@ static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
         !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 || p.sweep_samples < 1 ||
         p.sweep_samples > 1000 || p.max_train_frames < 1 ||
         !(p.heldout_fraction >= 0 && p.heldout_fraction < 1) || !(p.spring_k >= 0) ||
-        !isfinite(p.spring_k))
+        !isfinite(p.spring_k) || !(p.fold_share >= 0 && p.fold_share < 0.5))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "bake parameters out of range (rank %d, energy %g, cubature tol %g, "
-                            "max %d, sweep %d, frames %d, held-out %g, spring %g)",
+                            "max %d, sweep %d, frames %d, held-out %g, spring %g, fold share %g)",
                             p.max_rank, p.pca_energy, p.cubature_tol, p.cubature_max,
-                            p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k);
+                            p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k,
+                            p.fold_share);
     if (p.ntrain_clips < 0 || p.nheldout_clips < 0 || (p.ntrain_clips > 0 && !p.train_clips) ||
         (p.nheldout_clips > 0 && !p.heldout_clips) || (p.nheldout_clips > 0 && !p.ntrain_clips))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
