@@ -28,13 +28,20 @@ TEST(too_few_frames_rejected) {
     }
 }
 
+/* The defaults with two poses a joint sweep, on 2 threads: a bake of the 1K finger in
+ * about a second. */
+static sw_bake_params quick_params(void) {
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 2;
+    p.threads = 2;
+    return p;
+}
+
 TEST(solutions_match_the_bake) {
     sw_character c;
     sw_error err;
     ENSURE(sw_sample_make("finger", 1000, 5, &c, &err) == SINEW_OK);
-    sw_bake_params p = sw_bake_params_default();
-    p.sweep_samples = 2;
-    p.threads = 2;
+    sw_bake_params p = quick_params();
     sw_bake_result a, b;
     ENSUREF(sw_bake(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
     ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
@@ -61,9 +68,7 @@ TEST(small_bones_fold_into_their_parents) {
     sw_character c;
     sw_error err;
     ENSURE(sw_sample_make("finger", 1000, 5, &c, &err) == SINEW_OK);
-    sw_bake_params p = sw_bake_params_default();
-    p.sweep_samples = 2;
-    p.threads = 2;
+    sw_bake_params p = quick_params();
     int32_t nd[2];
     for (int k = 0; k < 2; ++k) {
         p.fold_share = k == 0 ? 0 : 0.45;
@@ -123,9 +128,7 @@ TEST(progress_counts_every_pose_and_domain) {
     sw_character c;
     sw_error err;
     ENSURE(sw_sample_make("finger", 1000, 6, &c, &err) == SINEW_OK);
-    sw_bake_params p = sw_bake_params_default();
-    p.sweep_samples = 2;
-    p.threads = 2;
+    sw_bake_params p = quick_params();
     progress_log g;
     memset(&g, 0, sizeof g);
     p.on_progress = record_progress;
