@@ -75,9 +75,7 @@ static int fold_bones(const sw_bake_state *s, int32_t *bone_of_tet) {
     }
     for (int32_t b = 0; b < nb; ++b) {
         to[b] = b;
-        depth[b] = 0;
-        for (int32_t c = b; sk->parent[c] >= 0; c = sk->parent[c])
-            depth[b]++;
+        depth[b] = sw_bone_depth(sk, b);
         if (depth[b] > maxdepth) maxdepth = depth[b];
     }
     for (int32_t d = maxdepth; d > 0; --d)

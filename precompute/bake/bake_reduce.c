@@ -30,14 +30,6 @@ static double mean_edge(const sw_tetmesh *m) {
     return m->ntets > 0 ? sum / (6.0 * m->ntets) : 0;
 }
 
-/* Depth of bone b in the skeleton (0: a root; the hierarchy has no cycles). */
-static int32_t bone_depth(const sw_skeleton *sk, int32_t b) {
-    int32_t d = 0;
-    while (sk->parent[b] >= 0)
-        b = sk->parent[b], d++;
-    return d;
-}
-
 /* Interface springs (eq. 4.20) into the R x R spring Hessian: a vertex with copies in
  * several domains ties each to its hub, the copy in the domain whose bone is nearest the
  * skeleton's root (the lower domain on a tie), by k/2 |U_i q_i - U_j q_j|^2. Every pair
@@ -55,7 +47,7 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
     for (int32_t gv = 0; gv < s->nv; ++gv) {
         int32_t hub = copy_ptr_v[gv], hub_depth = INT32_MAX;
         for (int32_t a = copy_ptr_v[gv]; a < copy_ptr_v[gv + 1]; ++a) {
-            int32_t d = bone_depth(&s->ch.skel, s->domain_bone[copy_list[2 * a]]);
+            int32_t d = sw_bone_depth(&s->ch.skel, s->domain_bone[copy_list[2 * a]]);
             if (d < hub_depth) hub_depth = d, hub = a; /* copies are in domain order */
         }
         for (int32_t b = copy_ptr_v[gv]; b < copy_ptr_v[gv + 1]; ++b) {

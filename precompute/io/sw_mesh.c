@@ -128,6 +128,13 @@ void sw_transform_point(const double *T, const double *p, double *out) {
     out[2] = r2;
 }
 
+int32_t sw_bone_depth(const sw_skeleton *s, int32_t b) {
+    int32_t d = 0;
+    while (s->parent[b] >= 0)
+        b = s->parent[b], d++;
+    return d;
+}
+
 sinew_result sw_skeleton_validate(const sw_skeleton *s, sw_error *err) {
     if (!s || s->nbones < 1 || s->njoints < 2 || !s->joints || !s->bones || !s->parent)
         return sw_error_set(err, SINEW_ERROR_DEGENERATE, "skeleton has no bones");

@@ -114,6 +114,9 @@ void sw_forward_kinematics(const sw_skeleton *s, const double *local,
  * most SW_MAX_BONES bones. */
 sinew_result sw_skeleton_validate(const sw_skeleton *s, sw_error *err);
 
+/* Depth of bone b: 0 for a root, its parent's plus 1 otherwise (a validated skeleton). */
+int32_t sw_bone_depth(const sw_skeleton *s, int32_t b);
+
 /* Linear blend skinning of rest positions X (3*n) with weights W (n x nbones) and
  * bone transforms T (12*nbones) into x (3*n). */
 void sw_lbs(int32_t n, const double *X, const sw_weights *W, const double *T, double *x);
