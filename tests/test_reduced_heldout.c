@@ -20,11 +20,11 @@
  * 24 held-out frames (0.980 on its 36 training frames). Since issue 13's fourth round
  * (the pairs' tangential term fading away from their training pose, springs tied to
  * hubs, a 5% last Newton update): finger 0.108 (0.019), dynamic 0.281 (0.255); elephant
- * 0.143 (0.007), dynamic 1.111 (0.983); and with bones under 3% of the volume folded into
- * their parents (bake_domains.c: 11 domains instead of 24, rank 195 instead of 329 with
- * this test's few training poses) elephant 0.171 (0.007), dynamic 1.050 (1.018). Folding
- * costs this sparse training set accuracy (0.155 at a 1% share, 0.168 at 2%) that the
- * default one does not lose (sinew-bake: 0.0886 -> 0.0900 held-out). The elephant's dynamic figure
+ * 0.143 (0.007), dynamic 1.111 (0.983). (Folding the bones under 3% of the volume into
+ * their parents, sw_bake_params.fold_share, costs this sparse training set accuracy:
+ * 0.171 with 11 domains instead of 24; 0.155 at a 1% share, 0.168 at 2%; the default
+ * training set loses almost none: sinew-bake 0.0886 -> 0.0900 held-out.) The elephant's
+ * dynamic figure
  * is a known gap, not a held-out effect: its dynamic instance misses the reference's
  * backward-Euler correction as much on the training frames as on the held-out ones (no
  * better than skinning); its bound only guards against it getting worse. */

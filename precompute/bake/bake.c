@@ -17,7 +17,7 @@ sw_bake_params sw_bake_params_default(void) {
     sw_bake_params p;
     memset(&p, 0, sizeof p);
     p.max_rank = 30;
-    p.fold_share = 0.03;
+    p.fold_share = 0;
     p.pca_energy = 0.9999;
     p.cubature_tol = 0.05;
     p.cubature_max = 1000;

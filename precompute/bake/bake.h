@@ -33,8 +33,8 @@
 typedef struct sw_bake_params {
     int32_t max_rank;              /* per domain (default 30) */
     double fold_share;             /* a bone whose tets hold less than this share of the
-                                      mesh's volume joins its parent's domain (default 0.03;
-                                      0: every bone that owns tets is a domain; bake_domains.c) */
+                                      mesh's volume joins its parent's domain (default 0: every
+                                      bone that owns tets is a domain; bake_domains.c) */
     double pca_energy;             /* fraction of snapshot energy kept (default 0.9999) */
     double cubature_tol;           /* default 0.05 */
     int32_t cubature_max;          /* per domain (default 1000) */
