@@ -209,8 +209,8 @@ static double svd_psi(const double F[9], double *V_cache, double mu, double lamb
     return mu * (d0 * d0 + d1 * d1 + d2 * d2) + 0.5 * lambda * e * e; /* eq. 2.3 */
 }
 
-static double corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
-                         double lambda, double f[12], double K[144], uint32_t flags) {
+double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
+                     double lambda, double f[12], double K[144], uint32_t flags) {
     double F[9], U[9], s[3], V[9], D[12], dpsi[3];
     deformation_gradient(x, DmInv, F, D);
     /* Without the Hessian (line-search trials, forces) the rotation alone is needed: the
@@ -231,11 +231,6 @@ static double corot_eval(const double x[12], const double DmInv[9], double vol, 
     }
     if (K) corot_hessian(U, s, V, D, vol, mu, lambda, flags, K);
     return vol * psi;
-}
-
-double sw_corot_eval(const double x[12], const double DmInv[9], double vol, double mu,
-                     double lambda, double f[12], double K[144], uint32_t flags) {
-    return corot_eval(x, DmInv, vol, mu, lambda, f, K, flags);
 }
 
 double sw_corot_eval_svd(const double x[12], const double DmInv[9], double vol, double mu,
