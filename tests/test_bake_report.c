@@ -113,9 +113,10 @@ TEST(clips_of_their_own_and_the_report) {
     ENSURE(sinew_blob_load(&bd, &blob) == SINEW_OK);
     double *fe = malloc(sizeof(double) * (size_t)(res.ntrain + res.nheldout));
     sw_eval_result et, eh;
-    ENSURE(sw_bake_errors_frames(blob, &res, &et, &eh, fe, fe + res.ntrain, &e) == SINEW_OK);
+    ENSURE(sw_bake_errors_frames(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, &et, &eh, fe,
+                                 fe + res.ntrain, &e) == SINEW_OK);
     sw_eval_result et2, eh2; /* the aggregate is sw_bake_errors' */
-    ENSURE(sw_bake_errors(blob, &res, &et2, &eh2, &e) == SINEW_OK);
+    ENSURE(sw_bake_errors(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, &et2, &eh2, &e) == SINEW_OK);
     ENSURE(et.correction_error == et2.correction_error);
     ENSURE(eh.correction_error == eh2.correction_error);
     static const char tn[1][64] = {"Bend"}, hn[1][64] = {"Return"};

@@ -72,7 +72,7 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
         ENSURE(c->nf > 10 && c->nt > c->nf && c->nring > 0);
         ENSURE((c->nrest > 0) == wide);
         int32_t R = in->red.R, nx = 3 * c->nf;
-        sw_step_contacts ct = {&in->ps, &in->wc};
+        sw_step_contacts ct = {&in->ps, &in->wc, NULL, NULL};
         sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
         sw_cond_weights_apply(c);
         double *q = malloc(sizeof(double) * R), *x = malloc(sizeof(double) * nx);
@@ -457,7 +457,7 @@ TEST(dynamic_patch_gradient_and_the_dynamics_oracle) {
     sw_cond *c = &in->cond;
     ENSURE(c->nf > 10);
     int32_t R = in->red.R, nx = 3 * c->nf;
-    sw_step_contacts ct = {&in->ps, &in->wc};
+    sw_step_contacts ct = {&in->ps, &in->wc, NULL, NULL};
     sw_dyn_coef dc = {
         h, 1.0 / ((double)h * h), 1.0 / h, in->v->rayleigh_alpha, in->v->rayleigh_beta, 1};
     sw_cond_weights_apply(c);

@@ -33,7 +33,9 @@ static int run(int inertia_modes, variant *o) {
     p.inertia_modes = inertia_modes;
     if (!bake_fixture_make_params(&o->f, "finger", 1000, 30, &p)) return 0;
     sw_eval_result tr, ho;
-    if (sw_bake_errors(o->f.blob, &o->f.res, &tr, &ho, &err) != SINEW_OK) return 0;
+    if (sw_bake_errors(o->f.blob, &o->f.res, SINEW_SELF_CONTACT_POSE_SPACE, &tr, &ho, &err) !=
+        SINEW_OK)
+        return 0;
     o->err_train = tr.correction_error;
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.threads = 2;

@@ -85,7 +85,9 @@ static void compare(baked *b, const char *name, double qs_bound, double dyn_boun
     const sw_blob_view *v = sw_blob_get_view(b->blob);
     sw_eval_result et, eh;
     sw_error err;
-    ENSUREF(sw_bake_errors(b->blob, &b->res, &et, &eh, &err) == SINEW_OK, "%s", err.msg);
+    ENSUREF(sw_bake_errors(b->blob, &b->res, SINEW_SELF_CONTACT_POSE_SPACE, &et, &eh, &err) ==
+                SINEW_OK,
+            "%s", err.msg);
     fprintf(stderr,
             "  %s (%d tets, rank %d): quasistatic correction error, %d training poses %.4f, "
             "%d held-out poses %.4f\n",
@@ -117,7 +119,8 @@ static void compare(baked *b, const char *name, double qs_bound, double dyn_boun
     sw_fullsim_destroy(sim);
     /* the training frames too, for the record: a dynamic step never starts from a stored
        solution, so they are not much easier than the held-out ones */
-    sw_eval_options o = {SINEW_STEP_DYNAMIC, dt, SW_BAKE_EVAL_NEWTON, 0};
+    sw_eval_options o = {SINEW_STEP_DYNAMIC, dt, SW_BAKE_EVAL_NEWTON, 0,
+                         SINEW_SELF_CONTACT_POSE_SPACE};
     sw_eval_result ed, edt;
     sinew_result r =
         sw_eval_correction_opts(b->blob, b->res.mass, b->ch.clip.T, xref, first, &o, &edt, &err);

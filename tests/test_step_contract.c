@@ -183,12 +183,13 @@ enum {
     P_PAIR_BUDGET,  /* max_contact_pairs = 1 (BUDGET) */
     P_WORLD,        /* quasistatic and dynamic against a table and a moving ball */
     P_WORLD_BUDGET, /* the same, max_world_contacts = 1 (BUDGET) */
+    P_EXHAUSTIVE,   /* the clip, quasistatic and dynamic, exhaustive self-contact */
     P_COUNT
 };
 static const char *const path_names[P_COUNT] = {
     "quasistatic", "dynamic", "translate jump", "rotation snap", "dt spikes",
     "cut",         "limited", "guard",          "failed",        "reset",
-    "pair budget", "world",   "world budget"};
+    "pair budget", "world",   "world budget",   "exhaustive"};
 
 typedef struct {
     int steps, failed;         /* steps made; of them, returning an error */
@@ -196,6 +197,7 @@ typedef struct {
     uint32_t iters, min_iters; /* Newton iterations: total, fewest in one step */
     uint32_t pairs_dropped, world_dropped, world_contacts, world_rounds;
     uint32_t budget_bits;
+    uint32_t self_contacts; /* self-contact pairs in the solves, summed */
 } path_record;
 
 typedef struct {
@@ -238,6 +240,7 @@ static sinew_result step_path(contract_run *cr, int p, sinew_instance *inst, con
     r->world_contacts += st.world_contacts;
     if (st.world_rounds > r->world_rounds) r->world_rounds = st.world_rounds;
     r->budget_bits |= st.budget_exceeded;
+    r->self_contacts += st.self_contacts;
     return res;
 }
 
@@ -293,7 +296,7 @@ static sinew_transform ball_at(int s) {
     return t;
 }
 
-enum { I_Q, I_D, I_PAIRS, I_WQ, I_WD, I_WBUDGET, I_LIMIT, I_GUARD, I_FRESH, I_COUNT };
+enum { I_Q, I_D, I_PAIRS, I_WQ, I_WD, I_WBUDGET, I_LIMIT, I_GUARD, I_FRESH, I_XQ, I_XD, I_COUNT };
 
 TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     const contract_fixture *f = fixture();
@@ -308,8 +311,10 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     for (int i = 0; i < I_COUNT; ++i) {
         sinew_instance_def d = sinew_instance_def_default();
         d.allocator = (sinew_allocator){host_alloc, host_free, &heap};
-        d.mode = (i == I_D || i == I_WD || i == I_WBUDGET || i == I_LIMIT) ? SINEW_STEP_DYNAMIC
-                                                                           : SINEW_STEP_QUASISTATIC;
+        d.mode = (i == I_D || i == I_WD || i == I_WBUDGET || i == I_LIMIT || i == I_XD)
+                     ? SINEW_STEP_DYNAMIC
+                     : SINEW_STEP_QUASISTATIC;
+        if (i == I_XQ || i == I_XD) d.self_contact = SINEW_SELF_CONTACT_EXHAUSTIVE;
         if (i == I_PAIRS) d.max_contact_pairs = 1;
         if (i == I_WBUDGET) d.max_world_contacts = 1;
         size_t bytes = 0;
@@ -368,6 +373,8 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         step_path(&cr, P_QUASISTATIC, in[I_Q], clip_pose(f, s), 1.0f / 30);
         step_path(&cr, P_DYNAMIC, in[I_D], clip_pose(f, s), 1.0f / 30);
         step_path(&cr, P_PAIR_BUDGET, in[I_PAIRS], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_EXHAUSTIVE, in[I_XQ], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_EXHAUSTIVE, in[I_XD], clip_pose(f, s), 1.0f / 30);
     }
     /* teleports: away and back, then a half turn of the whole character */
     moved_pose(f, 0, I3, far, pose);
@@ -471,7 +478,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         /* a quasistatic step starts from the pose space, a dynamic one never */
         int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET;
         if (quasi) ENSUREF(r->all & SINEW_STEP_POSE_SPACE, "path %s", path_names[p]);
-        if (!quasi && p != P_RESET && p != P_WORLD)
+        if (!quasi && p != P_RESET && p != P_WORLD && p != P_EXHAUSTIVE)
             ENSUREF(!(r->any & SINEW_STEP_POSE_SPACE), "path %s", path_names[p]);
     }
     const path_record *rec = cr.rec;
@@ -512,6 +519,8 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     /* the world with its moving ball */
     ENSURE(rec[P_WORLD].world_contacts > 0 && rec[P_WORLD].world_rounds >= 1);
     ENSURE(!(rec[P_WORLD].any & SINEW_STEP_BUDGET));
+    /* exhaustive self-contact found the fold's contacts itself */
+    ENSUREF(rec[P_EXHAUSTIVE].self_contacts > 0, "the exhaustive mode found no self-contact");
 
     /* ---- memory: the host allocator, once per instance at creation, never in a step */
     ENSUREF(heap_in_run == 0 && heap_frees_in_run == 0,

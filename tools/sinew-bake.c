@@ -191,8 +191,8 @@ int main(int argc, char **argv) {
         fprintf(stderr, "%s: out of memory\n", tool);
         goto done;
     }
-    if ((r = sw_bake_errors_frames(blob, &res, &et, &eh, frame_err, frame_err + res.ntrain,
-                                   &err)) != SINEW_OK) {
+    if ((r = sw_bake_errors_frames(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, &et, &eh, frame_err,
+                                   frame_err + res.ntrain, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         goto done;
     }

@@ -125,6 +125,7 @@
 #include "world_bench.h"
 #include "dyn_bench.h"
 #include "crowd_bench.h"
+#include "sc_bench.h"
 
 /* The step's phases as sinew_step_stats reports them. */
 enum { NPHASES = 5 };
@@ -137,7 +138,8 @@ static void usage(FILE *f) {
                "                   [--full-frames K] [--contract-steps S] [--threads T]\n"
                "                   [reference options] [--out DIR]\n"
                "                   [--world FILE.json [--rho R] [--patch-budget N]]\n"
-               "                   [--dynamic [--hold-frames H]] [--instances N] [--json]\n"
+               "                   [--dynamic [--hold-frames H]] [--instances N]\n"
+               "                   [--self-contact pose-space|exhaustive] [--sc-compare] [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
             "bench:\n"
@@ -170,6 +172,9 @@ static void usage(FILE *f) {
             "                      the others in cond_sweep)\n"
             "  --patch-budget N    with --world: max_patch_vertices (default a quarter of\n"
             "                      the vertices)\n"
+            "  --self-contact M    pose-space (default) or exhaustive: the runtime's mode\n"
+            "                      (sinew_instance_def.self_contact) for the timing and errors\n"
+            "  --sc-compare        also time self-contact in both modes over the clip: sc_*\n"
             "  --dynamic           also run the runtime in dynamic mode against the reference's\n"
             "                      backward-Euler run of the clip (same dt, damping, masses)\n"
             "                      and report err_dynamic and the overshoot after the clip\n"
@@ -311,6 +316,8 @@ int main(int argc, char **argv) {
     const char *blob_path = NULL, *out_dir = NULL, *world_path = NULL;
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     int dynamic = 0, hold_frames = 0, instances = 0, patch_budget = 0;
+    sinew_self_contact self_mode = SINEW_SELF_CONTACT_POSE_SPACE;
+    int sc_compare = 0;
     sw_cond_bench_params cond = {{0}, 0, 0, NULL};
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
@@ -340,6 +347,13 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 1, 4096, &instances);
         else if (!strcmp(a, "--hold-frames") && next)
             ok = sw_tool_int(tool, a, argv[++i], 2, 100000, &hold_frames);
+        else if (!strcmp(a, "--self-contact") && next) {
+            int k = sw_tool_choice(argv[++i], (const char *const[]){"pose-space", "exhaustive", 0});
+            if (!(ok = k >= 0))
+                fprintf(stderr, "%s: --self-contact: pose-space or exhaustive\n", tool);
+            self_mode = k > 0 ? SINEW_SELF_CONTACT_EXHAUSTIVE : SINEW_SELF_CONTACT_POSE_SPACE;
+        } else if (!strcmp(a, "--sc-compare"))
+            sc_compare = 1;
         else if (!strcmp(a, "--dynamic"))
             dynamic = 1;
         else if (!strcmp(a, "--bake-errors"))
@@ -480,7 +494,9 @@ int main(int argc, char **argv) {
 
     /* 3. subspace: step + read over the clip */
     sinew_instance *inst;
-    if ((r = sinew_instance_create(blob, NULL, &inst)) != SINEW_OK) {
+    sinew_instance_def idef = sinew_instance_def_default();
+    idef.self_contact = self_mode;
+    if ((r = sinew_instance_create(blob, &idef, &inst)) != SINEW_OK) {
         fprintf(stderr, "sinew-bench: cannot create an instance: %s\n", sinew_result_string(r));
         return 1;
     }
@@ -545,13 +561,13 @@ int main(int argc, char **argv) {
         clip.nheldout = kf - ntr;
         clip.heldout_T = ch.clip.T + ntr * pt;
         clip.heldout_x = full_x + ntr * px;
-        if ((r = sw_bake_errors(blob, &clip, &et, &eh, &err)) != SINEW_OK)
+        if ((r = sw_bake_errors(blob, &clip, self_mode, &et, &eh, &err)) != SINEW_OK)
             return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         ref_unsettled = full_unsettled;
     } else {
         if (blob_path && (r = sw_bake_solutions(&ch, &bp, &res, &err)) != SINEW_OK)
             return sw_tool_failed(r, &err, "%s: the bake's reference solutions: ", tool);
-        if ((r = sw_bake_errors(blob, &res, &et, &eh, &err)) != SINEW_OK)
+        if ((r = sw_bake_errors(blob, &res, self_mode, &et, &eh, &err)) != SINEW_OK)
             return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         ref_unsettled = res.train_unsettled + res.heldout_unsettled;
     }
@@ -641,6 +657,16 @@ int main(int argc, char **argv) {
                 cb.instances, cb.threads, cb.frames, cb.warmup_frames, cb.ms, cb.us_per_instance,
                 cb.ms_1thread, cb.scaling, cb.lone_ms, cb.vs_lone);
     }
+    /* 10. self-contact, pose-space against exhaustive, when asked */
+    sw_sc_bench scb;
+    memset(&scb, 0, sizeof scb);
+    if (sc_compare) {
+        float dt = 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30);
+        if ((r = sw_sc_bench_run(blob, ch.clip.T, nf, dt, 3, &scb, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "sinew-bench: self-contact comparison failed: ");
+        failed_steps += scb.failed;
+        sw_sc_bench_print(&scb, stderr, 0);
+    }
     /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
     char e_tr[32] = "null", e_ho[32] = "null";
     if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
@@ -696,6 +722,10 @@ int main(int argc, char **argv) {
                "\"crowd_lone_median_ms\":%.4f",
                cb.instances, cb.threads, cb.frames, cb.ms, cb.us_per_instance, cb.scaling,
                cb.vs_lone, cb.ms_1thread, cb.lone_ms, cb.lone_median_ms);
+    if (json)
+        printf(",\"self_contact\":\"%s\"",
+               self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive" : "pose_space");
+    if (json && sc_compare) sw_sc_bench_print(&scb, stdout, 1);
     if (json && clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
                et.frames + et.failed, eh.frames + eh.failed);

@@ -328,16 +328,18 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *para
 }
 
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
-                            sw_eval_result *train, sw_eval_result *heldout, sw_error *err) {
-    return sw_bake_errors_frames(blob, res, train, heldout, NULL, NULL, err);
+                            sinew_self_contact sc, sw_eval_result *train, sw_eval_result *heldout,
+                            sw_error *err) {
+    return sw_bake_errors_frames(blob, res, sc, train, heldout, NULL, NULL, err);
 }
 
 sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
-                                   sw_eval_result *train, sw_eval_result *heldout,
-                                   double *train_frames, double *heldout_frames, sw_error *err) {
+                                   sinew_self_contact sc, sw_eval_result *train,
+                                   sw_eval_result *heldout, double *train_frames,
+                                   double *heldout_frames, sw_error *err) {
     memset(train, 0, sizeof *train);
     memset(heldout, 0, sizeof *heldout);
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0};
+    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0, sc};
     sinew_result r = sw_eval_correction_frames(blob, res->mass, res->train_T, res->train_x,
                                                res->ntrain, &o, train_frames, train, err);
     if (r == SINEW_OK)

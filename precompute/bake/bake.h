@@ -141,16 +141,19 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *p, s
  * sinew-bench report these): sw_eval_correction of `blob` over res's training poses (the
  * clip's training frames, then the return path when baked, then every joint sweep, in
  * that order, one quasistatic instance stepped through them all) and, separately, over
- * its held-out poses, SW_BAKE_EVAL_NEWTON Newton iterations a step. */
+ * its held-out poses, SW_BAKE_EVAL_NEWTON Newton iterations a step, the instance in
+ * self-contact mode `sc` (the pose-space mode is the bake's figure). */
 #define SW_BAKE_EVAL_NEWTON 20
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
-                            sw_eval_result *train, sw_eval_result *heldout, sw_error *err);
+                            sinew_self_contact sc, sw_eval_result *train, sw_eval_result *heldout,
+                            sw_error *err);
 
 /* sw_bake_errors, also writing every pose's own correction error (res->ntrain and
  * res->nheldout doubles; sw_eval_correction_frames) when the arrays are not NULL. */
 sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
-                                   sw_eval_result *train, sw_eval_result *heldout,
-                                   double *train_frames, double *heldout_frames, sw_error *err);
+                                   sinew_self_contact sc, sw_eval_result *train,
+                                   sw_eval_result *heldout, double *train_frames,
+                                   double *heldout_frames, sw_error *err);
 
 /* A training error at or above this share of the correction missed is no usable bake:
  * the subspace misses half of the physics correction on the very poses it was built

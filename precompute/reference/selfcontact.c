@@ -11,26 +11,13 @@
 #include "penalty.h"
 #include "vec3.h"
 
-/* A vertex counts as inside a tet when all its barycentrics are >= -this. */
-#define SC_BARY_TOL 1e-12
-/* Rest depths below this fraction of the triangle's longest edge are touching, not
- * penetration: a vertex lying on the other surface up to round-off has no normal. */
-#define SC_TOUCH_TOL 1e-10
-
 struct sw_selfcontact {
-    int32_t nverts, ntets, ntris, nsurf;
-    double *X;        /* 3*nverts rest positions (copy) */
-    int32_t *tets;    /* 4*ntets (copy) */
-    int32_t *tris;    /* 3*ntris (copy) */
-    int32_t *surf;    /* nsurf surface vertex ids, ascending (copy) */
-    double *ring;     /* nsurf: rest area of the surface triangles around the vertex */
-    double *tri_area; /* ntris rest areas */
-    double *tri_edge; /* ntris longest rest edges */
-    double rest_diag; /* rest bounding-box diagonal: finite radius of the rest query */
-    double neighbour_factor;
+    sw_self_mesh m; /* over the arrays below */
+    double *X;      /* 3*nverts rest positions (copy) */
+    int32_t *tets;  /* 4*ntets (copy) */
+    int32_t *tris;  /* 3*ntris (copy) */
+    int32_t *surf;  /* nsurf surface vertex ids, ascending (copy) */
     int32_t max_contacts;
-    sw_bvh tri_bvh;                   /* static: rest surface triangles */
-    sw_bvh tet_bvh;                   /* topology from the rest pose, refit per detect */
     sw_contact *list;                 /* nsurf: per-range slices during detect, then the list */
     int32_t *range_count, *range_end; /* nsurf, indexed by the first item of a range */
     int32_t count, dropped;
@@ -48,28 +35,15 @@ void sw_selfcontact_destroy(sw_selfcontact *sc) {
     free(sc->tets);
     free(sc->tris);
     free(sc->surf);
-    free(sc->ring);
-    free(sc->tri_area);
-    free(sc->tri_edge);
-    sw_bvh_free(&sc->tri_bvh);
-    sw_bvh_free(&sc->tet_bvh);
+    free(sc->m.ring);
+    free(sc->m.tri_area);
+    free(sc->m.tri_edge);
+    sw_bvh_free(&sc->m.tri_bvh);
+    sw_bvh_free(&sc->m.tet_bvh);
     free(sc->list);
     free(sc->range_count);
     free(sc->range_end);
     free(sc);
-}
-
-/* Index of vertex v in the ascending surface vertex list, or -1. */
-static int32_t surf_index(const int32_t *surf, int32_t n, int32_t v) {
-    int32_t lo = 0, hi = n;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (surf[mid] < v)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return (lo < n && surf[lo] == v) ? lo : -1;
 }
 
 static sinew_result validate(const sw_tetmesh *m, const sw_surface *s, double factor,
@@ -117,7 +91,7 @@ static sinew_result validate(const sw_tetmesh *m, const sw_surface *s, double fa
     for (int32_t t = 0; t < s->ntris; ++t) {
         const int32_t *v = s->tris + 3 * (size_t)t;
         for (int k = 0; k < 3; ++k)
-            if (surf_index(s->verts, s->nverts, v[k]) < 0)
+            if (sw_self_surf_index(s->verts, s->nverts, v[k]) < 0)
                 return sw_error_set(
                     err, SINEW_ERROR_INVALID_ARGUMENT,
                     "sw_selfcontact_create: surface triangle %d vertex %d is not in the "
@@ -136,30 +110,6 @@ static sinew_result validate(const sw_tetmesh *m, const sw_surface *s, double fa
     return SINEW_OK;
 }
 
-/* Rest areas and edges of the surface: ka of eq. 3.4 needs the one-ring area of the
- * vertex and the area of the triangle; the neighbour rule the longest edge. */
-static void rest_measures(sw_selfcontact *sc) {
-    for (int32_t t = 0; t < sc->ntris; ++t) {
-        const int32_t *v = sc->tris + 3 * (size_t)t;
-        const double *a = sc->X + 3 * (size_t)v[0], *b = sc->X + 3 * (size_t)v[1],
-                     *c = sc->X + 3 * (size_t)v[2];
-        double e[3][3], nrm[3];
-        sw_v3_sub(b, a, e[0]);
-        sw_v3_sub(c, b, e[1]);
-        sw_v3_sub(a, c, e[2]);
-        sw_v3_cross(e[0], e[2], nrm);
-        double area = 0.5 * sw_v3_norm(nrm), longest = 0;
-        for (int k = 0; k < 3; ++k) {
-            double l = sw_v3_norm(e[k]);
-            if (l > longest) longest = l;
-        }
-        sc->tri_area[t] = area;
-        sc->tri_edge[t] = longest;
-        for (int k = 0; k < 3; ++k)
-            sc->ring[surf_index(sc->surf, sc->nsurf, v[k])] += area;
-    }
-}
-
 sinew_result sw_selfcontact_create(const sw_tetmesh *mesh, const sw_surface *surf,
                                    double neighbour_factor, int32_t max_contacts,
                                    sw_selfcontact **out, sw_error *err) {
@@ -172,28 +122,29 @@ sinew_result sw_selfcontact_create(const sw_tetmesh *mesh, const sw_surface *sur
     sw_selfcontact *sc = calloc(1, sizeof *sc);
     if (!sc)
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "sw_selfcontact_create: out of memory");
-    sc->nverts = mesh->nverts;
-    sc->ntets = mesh->ntets;
-    sc->ntris = surf->ntris;
-    sc->nsurf = surf->nverts;
-    sc->neighbour_factor = neighbour_factor;
+    sw_self_mesh *m = &sc->m;
+    m->nverts = mesh->nverts;
+    m->ntets = mesh->ntets;
+    m->ntris = surf->ntris;
+    m->nsurf = surf->nverts;
+    m->neighbour_factor = neighbour_factor;
     sc->max_contacts = max_contacts;
-    size_t nv = (size_t)sc->nverts, nt = (size_t)sc->ntets, nf = (size_t)sc->ntris,
-           ns = (size_t)sc->nsurf;
+    size_t nv = (size_t)m->nverts, nt = (size_t)m->ntets, nf = (size_t)m->ntris,
+           ns = (size_t)m->nsurf;
     sc->X = malloc(3 * nv * sizeof(double));
     sc->tets = malloc(4 * nt * sizeof(int32_t));
     sc->tris = malloc(3 * nf * sizeof(int32_t));
     sc->surf = malloc(ns * sizeof(int32_t));
-    sc->ring = calloc(ns, sizeof(double));
-    sc->tri_area = malloc(nf * sizeof(double));
-    sc->tri_edge = malloc(nf * sizeof(double));
+    m->ring = calloc(ns, sizeof(double));
+    m->tri_area = malloc(nf * sizeof(double));
+    m->tri_edge = malloc(nf * sizeof(double));
     sc->list = malloc(ns * sizeof(sw_contact));
     sc->range_count = calloc(ns, sizeof(int32_t));
     sc->range_end = calloc(ns, sizeof(int32_t));
     /* build-time boxes: triangles, then (reused) tets */
     double *box = malloc(6 * (nf > nt ? nf : nt) * sizeof(double));
-    if (!sc->X || !sc->tets || !sc->tris || !sc->surf || !sc->ring || !sc->tri_area ||
-        !sc->tri_edge || !sc->list || !sc->range_count || !sc->range_end || !box) {
+    if (!sc->X || !sc->tets || !sc->tris || !sc->surf || !m->ring || !m->tri_area || !m->tri_edge ||
+        !sc->list || !sc->range_count || !sc->range_end || !box) {
         free(box);
         sw_selfcontact_destroy(sc);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "sw_selfcontact_create: out of memory");
@@ -202,23 +153,17 @@ sinew_result sw_selfcontact_create(const sw_tetmesh *mesh, const sw_surface *sur
     memcpy(sc->tets, mesh->tets, 4 * nt * sizeof(int32_t));
     memcpy(sc->tris, surf->tris, 3 * nf * sizeof(int32_t));
     memcpy(sc->surf, surf->verts, ns * sizeof(int32_t));
-    rest_measures(sc);
+    m->X = sc->X;
+    m->tets = sc->tets;
+    m->tris = sc->tris;
+    m->surf = sc->surf;
+    sw_self_mesh_measures(m);
 
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (size_t i = 0; i < nv; ++i)
-        for (int k = 0; k < 3; ++k) {
-            if (sc->X[3 * i + k] < lo[k]) lo[k] = sc->X[3 * i + k];
-            if (sc->X[3 * i + k] > hi[k]) hi[k] = sc->X[3 * i + k];
-        }
-    /* Every rest point lies in the bounding box, so this radius always finds the
-     * closest surface triangle, yet it is finite (STYLE.md §6). */
-    sc->rest_diag = 1.01 * sw_v3_dist(hi, lo) + 1e-300;
-
-    sw_bvh_element_boxes(sc->tris, 3, sc->X, 0, sc->ntris, box);
-    r = sw_bvh_build(sc->ntris, box, &sc->tri_bvh, err);
+    sw_bvh_element_boxes(sc->tris, 3, sc->X, 0, m->ntris, box);
+    r = sw_bvh_build(m->ntris, box, &m->tri_bvh, err);
     if (r == SINEW_OK) {
-        sw_bvh_element_boxes(sc->tets, 4, sc->X, 0, sc->ntets, box);
-        r = sw_bvh_build(sc->ntets, box, &sc->tet_bvh, err);
+        sw_bvh_element_boxes(sc->tets, 4, sc->X, 0, m->ntets, box);
+        r = sw_bvh_build(m->ntets, box, &m->tet_bvh, err);
     }
     free(box);
     if (r != SINEW_OK) {
@@ -229,120 +174,6 @@ sinew_result sw_selfcontact_create(const sw_tetmesh *mesh, const sw_surface *sur
     return SINEW_OK;
 }
 
-/* ---- detection ---------------------------------------------------------------- */
-
-typedef struct {
-    const sw_selfcontact *sc;
-    const double *x;
-    int32_t p;        /* the surface vertex */
-    const double *xp; /* its deformed position */
-    /* best candidate so far: deepest rest point, ties to the lowest tet id */
-    int32_t tet;
-    double rest_depth;
-    sw_bvh_closest hit;
-} vertex_query;
-
-/* Barycentrics of p in the deformed tet t; 0 when the tet is flat. */
-static int tet_barycentrics(const double *x, const int32_t *v, const double *p, double b[4]) {
-    const double *x0 = x + 3 * (size_t)v[0], *x1 = x + 3 * (size_t)v[1], *x2 = x + 3 * (size_t)v[2],
-                 *x3 = x + 3 * (size_t)v[3];
-    double e1[3], e2[3], e3[3], q0[3], q1[3], q2[3], q3[3];
-    sw_v3_sub(x1, x0, e1);
-    sw_v3_sub(x2, x0, e2);
-    sw_v3_sub(x3, x0, e3);
-    double vol = sw_v3_triple(e1, e2, e3);
-    if (!(vol != 0) || !isfinite(vol)) return 0;
-    sw_v3_sub(x0, p, q0);
-    sw_v3_sub(x1, p, q1);
-    sw_v3_sub(x2, p, q2);
-    sw_v3_sub(x3, p, q3);
-    /* Each weight is the signed volume of the tet with its vertex replaced by p. */
-    b[0] = sw_v3_triple(q1, q2, q3) / vol;
-    b[1] = -sw_v3_triple(q0, q2, q3) / vol;
-    b[2] = sw_v3_triple(q0, q1, q3) / vol;
-    b[3] = -sw_v3_triple(q0, q1, q2) / vol;
-    return 1;
-}
-
-static int visit_tet(void *ctx, int32_t t) {
-    vertex_query *q = ctx;
-    const sw_selfcontact *sc = q->sc;
-    const int32_t *v = sc->tets + 4 * (size_t)t;
-    /* Tets incident to p always contain it; they are its own flesh, not a contact. */
-    if (v[0] == q->p || v[1] == q->p || v[2] == q->p || v[3] == q->p) return 0;
-    double b[4];
-    if (!tet_barycentrics(q->x, v, q->xp, b)) return 0;
-    for (int k = 0; k < 4; ++k)
-        if (!(b[k] >= -SC_BARY_TOL)) return 0;
-    /* §3.3.1: the penetrating vertex's rest position, by barycentric interpolation in
-     * the rest pose of the tet it entered, then its closest rest-surface point. */
-    double Xr[3] = {0, 0, 0};
-    for (int k = 0; k < 4; ++k)
-        for (int c = 0; c < 3; ++c)
-            Xr[c] += b[k] * sc->X[3 * (size_t)v[k] + c];
-    sw_bvh_closest hit;
-    if (!sw_bvh_closest_triangle(&sc->tri_bvh, sc->X, sc->tris, Xr, sc->rest_diag, &hit)) return 0;
-    const int32_t *tv = sc->tris + 3 * (size_t)hit.tri;
-    if (tv[0] == q->p || tv[1] == q->p || tv[2] == q->p) return 0;
-    double edge = sc->tri_edge[hit.tri];
-    if (hit.dist <= SC_TOUCH_TOL * edge) return 0;
-    /* Neighbour rule (DESIGN.md §8): a triangle close to p in rest space is p's own
-     * neighbourhood folding, not a contact. */
-    double beta[3], Q[3];
-    const double *Xp = sc->X + 3 * (size_t)q->p;
-    sw_closest_point_triangle(Xp, sc->X + 3 * (size_t)tv[0], sc->X + 3 * (size_t)tv[1],
-                              sc->X + 3 * (size_t)tv[2], beta, Q);
-    double dQ[3];
-    sw_v3_sub(Q, Xp, dQ);
-    if (sw_v3_norm(dQ) < sc->neighbour_factor * edge) return 0;
-    if (q->tet < 0 || hit.dist > q->rest_depth || (hit.dist == q->rest_depth && t < q->tet)) {
-        q->tet = t;
-        q->rest_depth = hit.dist;
-        q->hit = hit;
-    }
-    return 0;
-}
-
-/* Fills c from the chosen triangle: v_s, d, n, depth, ka (eqs. 3.4-3.5). */
-static void make_contact(const sw_selfcontact *sc, const double *x, int32_t si,
-                         const vertex_query *q, sw_contact *c) {
-    const int32_t *tv = sc->tris + 3 * (size_t)q->hit.tri;
-    memset(c, 0, sizeof *c);
-    c->p = q->p;
-    double vs[3] = {0, 0, 0};
-    for (int k = 0; k < 3; ++k) {
-        c->tri[k] = tv[k];
-        c->beta[k] = q->hit.beta[k];
-        for (int j = 0; j < 3; ++j)
-            vs[j] += c->beta[k] * x[3 * (size_t)tv[k] + j];
-    }
-    c->ka = 0.25 * (sc->ring[si] + sc->tri_area[q->hit.tri]);
-    double d[3];
-    sw_v3_sub(vs, q->xp, d);
-    double len = sw_v3_norm(d);
-    c->depth = len;
-    if (len > 0 && isfinite(len)) {
-        for (int j = 0; j < 3; ++j)
-            c->n[j] = d[j] / len;
-        return;
-    }
-    /* v_s == v_p: the direction is undefined; the triangle's outward normal is where
-     * v_s - v_p points for any nearby penetration (deformed, else rest). */
-    double e1[3], e2[3], nrm[3];
-    for (int pass = 0; pass < 2; ++pass) {
-        const double *P = pass == 0 ? x : sc->X;
-        sw_v3_sub(P + 3 * (size_t)tv[1], P + 3 * (size_t)tv[0], e1);
-        sw_v3_sub(P + 3 * (size_t)tv[2], P + 3 * (size_t)tv[0], e2);
-        sw_v3_cross(e1, e2, nrm);
-        double l = sw_v3_norm(nrm);
-        if (l > 0 && isfinite(l)) {
-            for (int j = 0; j < 3; ++j)
-                c->n[j] = nrm[j] / l;
-            return;
-        }
-    }
-}
-
 typedef struct {
     sw_selfcontact *sc;
     const double *x;
@@ -351,7 +182,7 @@ typedef struct {
 static void boxes_range(void *ctx, int64_t begin, int64_t end, int worker) {
     (void)worker;
     detect_ctx *d = ctx;
-    sw_bvh_refit_elements(&d->sc->tet_bvh, d->sc->tets, 4, d->x, (int32_t)begin, (int32_t)end);
+    sw_bvh_refit_elements(&d->sc->m.tet_bvh, d->sc->tets, 4, d->x, (int32_t)begin, (int32_t)end);
 }
 
 /* One range of surface vertices writes its contacts compactly from list[begin]: the
@@ -361,17 +192,8 @@ static void detect_range(void *ctx, int64_t begin, int64_t end, int worker) {
     detect_ctx *d = ctx;
     sw_selfcontact *sc = d->sc;
     int32_t n = 0;
-    for (int64_t i = begin; i < end; ++i) {
-        vertex_query q;
-        q.sc = sc;
-        q.x = d->x;
-        q.p = sc->surf[i];
-        q.xp = d->x + 3 * (size_t)q.p;
-        q.tet = -1;
-        q.rest_depth = 0;
-        sw_bvh_query_point(&sc->tet_bvh, q.xp, visit_tet, &q);
-        if (q.tet >= 0) make_contact(sc, d->x, (int32_t)i, &q, &sc->list[begin + n++]);
-    }
+    for (int64_t i = begin; i < end; ++i)
+        n += sw_self_detect_vertex(&sc->m, d->x, (int32_t)i, &sc->list[begin + n], NULL);
     sc->range_count[begin] = n;
     sc->range_end[begin] = (int32_t)end;
 }
@@ -417,19 +239,19 @@ int32_t sw_selfcontact_detect(sw_selfcontact *sc, const double *x, sw_pool *pool
     sc->max_depth = 0;
     if (!x) return 0;
     detect_ctx d = {sc, x};
-    sw_pool_parallel_for(pool, sc->ntets, boxes_range, &d);
-    sw_bvh_refit_nodes(&sc->tet_bvh);
-    sw_pool_parallel_for(pool, sc->nsurf, detect_range, &d);
+    sw_pool_parallel_for(pool, sc->m.ntets, boxes_range, &d);
+    sw_bvh_refit_nodes(&sc->m.tet_bvh);
+    sw_pool_parallel_for(pool, sc->m.nsurf, detect_range, &d);
     /* Concatenate the ranges in order; the result is the list in surface vertex
      * order whatever the partition (hence the thread count) was. */
     int32_t n = 0;
-    for (int32_t pos = 0; pos < sc->nsurf; pos = sc->range_end[pos]) {
+    for (int32_t pos = 0; pos < sc->m.nsurf; pos = sc->range_end[pos]) {
         int32_t c = sc->range_count[pos];
         if (c > 0 && n != pos)
             memmove(sc->list + n, sc->list + pos, (size_t)c * sizeof(sw_contact));
         n += c;
     }
-    int32_t cap = sc->max_contacts > 0 ? sc->max_contacts : sc->nsurf;
+    int32_t cap = sc->max_contacts > 0 ? sc->max_contacts : sc->m.nsurf;
     if (n > cap) {
         /* Over budget: keep the deepest (ties by vertex id), back in vertex order. */
         heap_sort(sc->list, n, deeper);

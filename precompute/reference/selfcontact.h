@@ -22,17 +22,9 @@
 
 #include <stdint.h>
 
+#include "self_detect.h"
 #include "sw_mesh.h"
 #include "thread_pool.h"
-
-typedef struct sw_contact {
-    int32_t p;      /* penetrating vertex (tet-mesh vertex id) */
-    int32_t tri[3]; /* tet-mesh vertex ids of the surface triangle */
-    double beta[3]; /* barycentrics of the contact point on that triangle */
-    double ka;      /* area weight k_a (rest units^2) */
-    double n[3];    /* unit normal (v_s - v_p) / |v_s - v_p| at detection */
-    double depth;   /* |v_s - v_p| at detection (world units) */
-} sw_contact;
 
 typedef struct sw_selfcontact sw_selfcontact;
 

@@ -60,7 +60,8 @@ void sw_eval_acc_free(sw_eval_acc *a) {
 sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,
                                 const double *x_full, int32_t npose, uint32_t max_newton,
                                 sw_eval_result *out, sw_error *err) {
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, max_newton, 0};
+    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, max_newton, 0,
+                         SINEW_SELF_CONTACT_POSE_SPACE};
     return sw_eval_correction_opts(blob, mass, T, x_full, npose, &o, out, err);
 }
 
@@ -82,6 +83,7 @@ sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mas
     sinew_instance_def def = sinew_instance_def_default();
     def.mode = o->mode;
     def.max_newton_iters = o->max_newton;
+    def.self_contact = o->self_contact;
     sinew_instance *inst;
     sinew_result r = sinew_instance_create(blob, &def, &inst);
     if (r != SINEW_OK)

@@ -43,13 +43,15 @@ sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, cons
                                 sw_eval_result *out, sw_error *err);
 
 /* How sw_eval_correction_opts steps: the instance's mode, the step's dt, Newton's
- * iterations a step, and `skip` leading poses stepped but not compared (a dynamic path's
- * lead-in: its held-out frames depend on the frames before them). */
+ * iterations a step, `skip` leading poses stepped but not compared (a dynamic path's
+ * lead-in: its held-out frames depend on the frames before them), and the instance's
+ * self-contact mode (0: pose-space, the default). */
 typedef struct sw_eval_options {
     sinew_step_mode mode;
     float dt;
     uint32_t max_newton;
     int32_t skip;
+    sinew_self_contact self_contact;
 } sw_eval_options;
 
 /* As sw_eval_correction with options: steps through all npose poses and compares the

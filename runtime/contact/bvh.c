@@ -84,9 +84,8 @@ static int32_t build_range(builder *B, int32_t lo, int32_t hi, int depth) {
     return node;
 }
 
-sinew_result sw_bvh_build(int32_t n, const double *boxes, sw_bvh *out, sw_error *err) {
-    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_bvh_build: out is NULL");
-    memset(out, 0, sizeof *out);
+/* The checks of a build's input (n and every box). */
+static sinew_result check_boxes(int32_t n, const double *boxes, sw_error *err) {
     if (n < 1 || !boxes)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "sw_bvh_build: need at least one primitive box (n = %d)", (int)n);
@@ -105,40 +104,74 @@ sinew_result sw_bvh_build(int32_t n, const double *boxes, sw_bvh *out, sw_error 
                                     "sw_bvh_build: box of primitive %d has min > max on axis %d",
                                     (int)i, k);
     }
-    /* A binary tree whose leaves hold >= 1 primitive has at most 2n - 1 nodes. */
-    size_t maxnodes = 2 * (size_t)n - 1;
-    sw_bvh t = {0};
-    t.nprims = n;
-    t.box = malloc(6 * maxnodes * sizeof(double));
-    t.node = malloc(2 * maxnodes * sizeof(int32_t));
-    t.prims = malloc((size_t)n * sizeof(int32_t));
-    t.pbox = malloc(6 * (size_t)n * sizeof(double));
-    double *centroid = malloc(3 * (size_t)n * sizeof(double));
-    sort_key *keys = malloc((size_t)n * sizeof(sort_key));
-    if (!t.box || !t.node || !t.prims || !t.pbox || !centroid || !keys) {
-        free(centroid);
-        free(keys);
-        sw_bvh_free(&t);
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
-                            "sw_bvh_build: out of memory (%d primitives)", (int)n);
-    }
+    return SINEW_OK;
+}
+
+/* A binary tree whose leaves hold >= 1 primitive has at most 2n - 1 nodes. */
+static size_t max_nodes(int32_t n) {
+    return n > 0 ? 2 * (size_t)n - 1 : 0;
+}
+
+size_t sw_bvh_scratch_size(int32_t n) {
+    return (size_t)(n > 0 ? n : 0) * (3 * sizeof(double) + sizeof(sort_key));
+}
+
+void sw_bvh_take(sw_mem_plan *p, int32_t n, sw_bvh *out) {
+    memset(out, 0, sizeof *out);
+    size_t maxnodes = max_nodes(n);
+    out->box = sw_plan_take(p, 6 * maxnodes, sizeof(double));
+    out->node = sw_plan_take(p, 2 * maxnodes, sizeof(int32_t));
+    out->prims = sw_plan_take(p, (uint64_t)n, sizeof(int32_t));
+    out->pbox = sw_plan_take(p, 6 * (uint64_t)n, sizeof(double));
+}
+
+sinew_result sw_bvh_build_in(int32_t n, const double *boxes, sw_bvh *t, void *scratch,
+                             sw_error *err) {
+    sinew_result r = check_boxes(n, boxes, err);
+    if (r != SINEW_OK) return r;
+    double *centroid = scratch;
+    sort_key *keys = (sort_key *)(centroid + 3 * (size_t)n);
+    t->nprims = n;
     for (int32_t i = 0; i < n; ++i) {
-        t.prims[i] = i;
+        t->prims[i] = i;
         for (int k = 0; k < 3; ++k)
             centroid[3 * (size_t)i + k] =
                 0.5 * (boxes[6 * (size_t)i + k] + boxes[6 * (size_t)i + 3 + k]);
     }
-    builder B = {boxes, centroid, keys, &t, 0, 0};
+    builder B = {boxes, centroid, keys, t, 0, 0};
     build_range(&B, 0, n, 0);
-    t.nnodes = B.next;
+    t->nnodes = B.next;
     for (int32_t j = 0; j < n; ++j)
-        memcpy(t.pbox + 6 * (size_t)j, boxes + 6 * (size_t)t.prims[j], 6 * sizeof(double));
-    free(centroid);
-    free(keys);
-    if (B.depth + 2 > SW_BVH_STACK) { /* cannot happen with median splits; guard the stack */
-        sw_bvh_free(&t);
+        memcpy(t->pbox + 6 * (size_t)j, boxes + 6 * (size_t)t->prims[j], 6 * sizeof(double));
+    if (B.depth + 2 > SW_BVH_STACK) /* cannot happen with median splits; guard the stack */
         return sw_error_set(err, SINEW_ERROR_CAPACITY,
                             "sw_bvh_build: tree depth %d exceeds the stack", B.depth);
+    return SINEW_OK;
+}
+
+sinew_result sw_bvh_build(int32_t n, const double *boxes, sw_bvh *out, sw_error *err) {
+    if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sw_bvh_build: out is NULL");
+    memset(out, 0, sizeof *out);
+    sinew_result r = check_boxes(n, boxes, err);
+    if (r != SINEW_OK) return r;
+    size_t maxnodes = max_nodes(n);
+    sw_bvh t = {0};
+    t.box = malloc(6 * maxnodes * sizeof(double));
+    t.node = malloc(2 * maxnodes * sizeof(int32_t));
+    t.prims = malloc((size_t)n * sizeof(int32_t));
+    t.pbox = malloc(6 * (size_t)n * sizeof(double));
+    void *scratch = malloc(sw_bvh_scratch_size(n));
+    if (!t.box || !t.node || !t.prims || !t.pbox || !scratch) {
+        free(scratch);
+        sw_bvh_free(&t);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                            "sw_bvh_build: out of memory (%d primitives)", (int)n);
+    }
+    r = sw_bvh_build_in(n, boxes, &t, scratch, err);
+    free(scratch);
+    if (r != SINEW_OK) {
+        sw_bvh_free(&t);
+        return r;
     }
     *out = t;
     return SINEW_OK;

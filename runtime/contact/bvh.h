@@ -17,6 +17,7 @@
 
 #include <stdint.h>
 
+#include "mem_plan.h"
 #include "sw_error.h"
 
 /* Primitives per leaf at most. */
@@ -35,6 +36,15 @@ typedef struct sw_bvh {
 /* Builds the tree over boxes[6*n] (n >= 1, finite, min <= max). On error `out` is
  * left zeroed. */
 sinew_result sw_bvh_build(int32_t n, const double *boxes, sw_bvh *out, sw_error *err);
+/* The same build into memory laid out by a memory plan (an instance's block):
+ * sw_bvh_take places the arrays of a tree of n primitives in p; sw_bvh_build_in builds
+ * into them with sw_bvh_scratch_size(n) bytes of scratch (8-byte aligned, free again
+ * after the build) and no allocation of its own (the median splits' qsort may allocate:
+ * creation only). The tree is then used as any other, but never passed to sw_bvh_free. */
+size_t sw_bvh_scratch_size(int32_t n);
+void sw_bvh_take(sw_mem_plan *p, int32_t n, sw_bvh *out);
+sinew_result sw_bvh_build_in(int32_t n, const double *boxes, sw_bvh *t, void *scratch,
+                             sw_error *err);
 /* Releases the arrays and zeroes the struct; a zeroed struct is a no-op. */
 void sw_bvh_free(sw_bvh *bvh);
 

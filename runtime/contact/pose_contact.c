@@ -4,37 +4,39 @@
 
 #include "penalty.h"
 
-/* Pose-space self-contact (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
- * training pose's pairs, each the reference's penalty E = 1/2 k ka d^T N d with
- * d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and n = R_p n_rest (alpha:
+/* Self-contact pairs (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
+ * training poses' pairs or the exhaustive mode's, each the reference's penalty E = 1/2 k ka d^T N d
+ * with d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and n = R_p n_rest (alpha:
  * SW_CONTACT_ALPHA times the pose's tangential share, pose_space.c), applied
  * while the pair collides (the Heaviside of eq. 3.12: p behind the triangle along n).
  * Per pair the slots of one domain are summed into G_d = sum coef_m J_m (3 x r_d), so
  * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
  * couple two domains. Added after the cubature so it lands on the full (mirrored)
  * matrix. */
-static double contact_pairs(sw_reduced *red, const int32_t *pairs, const unsigned char *skip,
-                            int32_t npairs, double weight, double tangent, const double *q,
-                            int want_grad, int want_hess) {
+static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32_t *pairs,
+                            const unsigned char *skip, int32_t npairs, double weight,
+                            double tangent, const double *q, int want_grad, int want_hess) {
     const sw_blob_view *v = red->v;
     double E = 0, k = weight * v->contact_k, al = tangent * SW_CONTACT_ALPHA;
     int32_t rm = red->rmax;
+    sw_reduced map = *red; /* the same map with the set's skinning transforms */
+    map.act_R = (double *)set->act_R;
+    map.act_t = (double *)set->act_t;
     for (int32_t p = 0; p < npairs; ++p) {
         if (skip && skip[p]) continue; /* a condensation patch's (condense.h) */
-        const int32_t c = pairs[p];
-        const int32_t *cv = v->contact_verts + 8 * (int64_t)c;
-        const double *cd = v->contact_data + 7 * (int64_t)c;
+        const int32_t c = pairs ? pairs[p] : p;
+        const int32_t *cv = set->verts + 8 * (int64_t)c, *ca = set->act + 4 * (int64_t)c;
+        const double *cd = set->data + 7 * (int64_t)c;
         const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
         const sw_blob_domain *D[4];
         double x[4][3], d[3] = {0, 0, 0};
         for (int m = 0; m < 4; ++m) {
             D[m] = &v->domains[cv[2 * m]];
-            sw_reduced_position(red, D[m], cv[2 * m + 1], red->contact_act[4 * c + m],
-                                q + D[m]->q_offset, x[m], NULL);
+            sw_reduced_position(&map, D[m], cv[2 * m + 1], ca[m], q + D[m]->q_offset, x[m], NULL);
             for (int i = 0; i < 3; ++i)
                 d[i] += coef[m] * x[m][i];
         }
-        const double *Rp = red->act_R + 9 * red->contact_act[4 * c];
+        const double *Rp = set->act_R + 9 * (int64_t)ca[0];
         double n[3];
         for (int i = 0; i < 3; ++i)
             n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
@@ -45,8 +47,7 @@ static double contact_pairs(sw_reduced *red, const int32_t *pairs, const unsigne
         if (!want_grad) continue;
         /* the Jacobians of a pair in contact only (most pairs of a pose are apart) */
         for (int m = 0; m < 4; ++m)
-            sw_reduced_jacobian(red, D[m], cv[2 * m + 1], red->contact_act[4 * c + m],
-                                red->Jc + 3 * m * rm);
+            sw_reduced_jacobian(&map, D[m], cv[2 * m + 1], ca[m], red->Jc + 3 * m * rm);
         /* G per distinct domain (slot `lead[m]` holds the sum of its domain's slots) */
         int lead[4], nlead = 0, leads[4];
         for (int m = 0; m < 4; ++m) {
@@ -96,16 +97,29 @@ static double contact_pairs(sw_reduced *red, const int32_t *pairs, const unsigne
     return E;
 }
 
+sw_pair_set sw_pose_pair_set(const sw_reduced *red) {
+    const sw_blob_view *v = red->v;
+    sw_pair_set set = {v->contact_verts, v->contact_data, red->contact_act, red->act_R, red->act_t};
+    return set;
+}
+
+double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids, int32_t n,
+                             double weight, double tangent, const double *q, int want_grad,
+                             int want_hess) {
+    return contact_pairs(red, set, ids, NULL, n, weight, tangent, q, want_grad, want_hess);
+}
+
 /* The two nearest training poses' pairs with their pose-space blend weights (DESIGN.md
  * §8, thesis §3.2.3: the two schemes' forces interpolated). */
 double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,
                             int want_grad, int want_hess) {
     if (ps->nearest < 0) return 0;
     const unsigned char *skip = ps->in_patch;
-    double E = contact_pairs(red, ps->pairs, skip, ps->npairs_nearest, 1 - ps->blend,
+    sw_pair_set set = sw_pose_pair_set(red);
+    double E = contact_pairs(red, &set, ps->pairs, skip, ps->npairs_nearest, 1 - ps->blend,
                              ps->tangent[0], q, want_grad, want_hess);
     if (ps->blend > 0)
-        E += contact_pairs(red, ps->pairs + ps->npairs_nearest,
+        E += contact_pairs(red, &set, ps->pairs + ps->npairs_nearest,
                            skip ? skip + ps->npairs_nearest : NULL, ps->npairs - ps->npairs_nearest,
                            ps->blend, ps->tangent[1], q, want_grad, want_hess);
     return E;

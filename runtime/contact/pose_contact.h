@@ -1,16 +1,40 @@
-/* Pose-space self-contact in the step (thesis §3.2.3 with the penalty of eqs. 3.4-3.6,
- * penalty.h): the reference's converged contact pairs of the two nearest training
- * poses (pose_space.h), each applied while it collides, their forces blended by the
- * pose-space weight. Cost: the pairs in use, not the mesh. */
+/* Self-contact pairs in the step (thesis §3.2.3 with the penalty of eqs. 3.4-3.6,
+ * penalty.h): the pose-space mode applies the reference's converged contact pairs of the
+ * two nearest training poses (pose_space.h), each while it collides, their forces blended
+ * by the pose-space weight; the exhaustive mode (self_contact.h) the pairs it detected.
+ * Cost: the pairs in use, not the mesh. */
 #ifndef SW_POSE_CONTACT_H
 #define SW_POSE_CONTACT_H
 
 #include "pose_space.h"
 #include "reduced_map.h"
 
-/* Contact energy at q of the pairs ps gathered; with want_grad it adds the gradient to
- * red->g, with want_hess the Hessian blocks (which may couple two domains) to red->H.
- * Call after the cubature, so the blocks land on the full (mirrored) matrix. */
+/* A list of contact pairs as the blob stores the training poses': pair c is vertex p and
+ * triangle (t0, t1, t2) as (domain, local vertex) pairs verts[8c..], the triangle
+ * barycentrics, the normal in p's un-skinned frame (R_p^T n) and the area weight ka in
+ * data[7c..], and the slots' indices into the skinning transforms act_R/act_t in
+ * act[4c..]. */
+typedef struct sw_pair_set {
+    const int32_t *verts;
+    const double *data;
+    const int32_t *act;
+    const double *act_R, *act_t;
+} sw_pair_set;
+
+/* The blob's training-pose pairs, with the active vertices' transforms of red. */
+sw_pair_set sw_pose_pair_set(const sw_reduced *red);
+
+/* Contact energy at q of the pairs ids[0..n) of set (ids NULL: pairs 0..n-1), each
+ * scaled by weight, the tangential term at share `tangent` of SW_CONTACT_ALPHA; with
+ * want_grad it adds the gradient to red->g, with want_hess the Hessian blocks (which may
+ * couple two domains) to red->H. Call after the cubature, so the blocks land on the full
+ * (mirrored) matrix. */
+double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids, int32_t n,
+                             double weight, double tangent, const double *q, int want_grad,
+                             int want_hess);
+
+/* Contact energy at q of the pairs ps gathered (sw_contact_pairs_eval of the blob's
+ * pairs, the two nearest poses' blended). */
 double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,
                             int want_grad, int want_hess);
 

@@ -21,6 +21,7 @@ typedef struct {
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
     sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
     double rho;         /* its radius, in units of the rest diagonal */
+    int exhaustive;     /* SINEW_SELF_CONTACT_EXHAUSTIVE: its detection's arrays */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -62,6 +63,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(ps->twin_next, (uint64_t)v->ntrain);
     TAKE(ps->reach, (uint64_t)v->ntrain);
     TAKE(ps->pairs, (uint64_t)z->max_pairs);
+    if (z->exhaustive) sw_self_contacts_take(p, v, &in->sc);
     /* the solver */
     sw_solver *s = &in->solver;
     TAKE(s->q, R);
@@ -291,6 +293,11 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
             ? "patch_radius must be 0 (the default) or in (0, 1]"
         : d->max_patch_vertices > 0 && v->ntets == 0
             ? "max_patch_vertices needs a blob with the tet mesh (bake it again)"
+        : d->self_contact != SINEW_SELF_CONTACT_POSE_SPACE &&
+                d->self_contact != SINEW_SELF_CONTACT_EXHAUSTIVE
+            ? "self_contact is neither pose-space nor exhaustive"
+        : d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE && v->ntets == 0
+            ? "exhaustive self-contact needs a blob with the tet mesh (bake it again)"
             : NULL;
     if (bad) {
         sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
@@ -316,6 +323,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
                                                        : (int32_t)d->max_world_contacts;
     z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs);
     z->rho = d->patch_radius > 0 ? d->patch_radius : SW_COND_DEFAULT_RADIUS;
+    z->exhaustive = d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE;
     return SINEW_OK;
 }
 
@@ -431,6 +439,16 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->cond.z = z.cond;
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
     in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
+    in->self_mode = d.self_contact;
+    if (z.exhaustive) {
+        sw_error e;
+        if (sw_self_contacts_build(&in->sc, v, &e) != SINEW_OK) {
+            sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
+                   "sinew_instance_create: %s", e.msg);
+            sw_free(&d.allocator, block);
+            return SINEW_ERROR_INVALID_ARGUMENT;
+        }
+    }
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
     sw_solver_order_blocks(&in->solver, v);
@@ -470,6 +488,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);
     if (inst->cond.z.max_verts > 0) sw_cond_forget(&inst->cond);
+    if (inst->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE) sw_self_contacts_clear(&inst->sc);
     inst->ps.in_patch = NULL;
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;

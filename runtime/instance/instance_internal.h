@@ -15,21 +15,23 @@ struct sinew_instance {
     const sw_blob_view *v;
     sinew_allocator allocator; /* frees the block */
     sinew_step_mode mode;
-    double size;             /* rest bounding-box diagonal */
-    double *bone_ball;       /* 4 nbones: the ball of the rest vertices each bone skins
-                                (centre, radius; radius -1: none), sw_pose_jump's */
-    double *q_bound;         /* ndomains: the largest |q_k| a step may leave (step.c) */
-    double *u_max;           /* ndomains: the largest |U_v|_F of a domain's vertex */
-    sw_dualquat *bone_dq;    /* nbones: the current pose */
-    sw_pose_history pose;    /* the current pose and the two before */
-    sw_reduced red;          /* the subspace map and the evaluation accumulators */
-    sw_pose_space ps;        /* training poses near the current one, contact pairs */
-    sw_solver solver;        /* state and Newton */
-    sw_world_contacts wc;    /* the collision world's candidates of the step */
-    sw_cond cond;            /* subspace condensation (cond.z.max_verts 0: off) */
-    double *surf_x, *surf_n; /* 3 per output surface vertex each (sw_blob_output_verts) */
-    double *node_x;          /* 3 per render node: the mean of its copies (render mesh only) */
-    int32_t *weld_tris;      /* 3 per render triangle: its corners' weld representatives */
+    double size;                  /* rest bounding-box diagonal */
+    double *bone_ball;            /* 4 nbones: the ball of the rest vertices each bone skins
+                                     (centre, radius; radius -1: none), sw_pose_jump's */
+    double *q_bound;              /* ndomains: the largest |q_k| a step may leave (step.c) */
+    double *u_max;                /* ndomains: the largest |U_v|_F of a domain's vertex */
+    sw_dualquat *bone_dq;         /* nbones: the current pose */
+    sw_pose_history pose;         /* the current pose and the two before */
+    sw_reduced red;               /* the subspace map and the evaluation accumulators */
+    sw_pose_space ps;             /* training poses near the current one, contact pairs */
+    sw_solver solver;             /* state and Newton */
+    sw_world_contacts wc;         /* the collision world's candidates of the step */
+    sw_cond cond;                 /* subspace condensation (cond.z.max_verts 0: off) */
+    sinew_self_contact self_mode; /* the def's self_contact */
+    sw_self_contacts sc;          /* the exhaustive mode's detection (unused arrays otherwise) */
+    double *surf_x, *surf_n;      /* 3 per output surface vertex each (sw_blob_output_verts) */
+    double *node_x;               /* 3 per render node: the mean of its copies (render mesh only) */
+    int32_t *weld_tris;           /* 3 per render triangle: its corners' weld representatives */
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
 };
@@ -44,6 +46,10 @@ struct sinew_instance {
  * SW_LIMIT_SIZE L); and (dynamic) |qdot_k| u_k <= SW_JUMP_MAX_SPIN L. */
 #define SW_LIMIT_TRAIN 4.0
 #define SW_LIMIT_SIZE 0.25
+
+/* The contact terms of the instance's step (the world's when it has one); self_seconds
+ * as sw_step_contacts. */
+sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds);
 
 /* The output surface (positions and normals) of the state q (output.c). */
 void sw_instance_write_surface(sinew_instance *in);

@@ -140,7 +140,7 @@ double sw_instance_potential(sinew_instance *inst, const double *q, double *g, d
     sw_reduced_skin(&inst->red, inst->bone_dq);
     sw_pose_space_lookup(&inst->ps, inst->v, inst->pose.T_cur);
     sw_pose_space_gather_pairs(&inst->ps, inst->v);
-    sw_step_contacts ct = {&inst->ps, inst->wc.world ? &inst->wc : NULL};
+    sw_step_contacts ct = sw_instance_contacts(inst, NULL);
     double phi = sw_potential(&inst->red, &ct, &inst->solver, q, &dc, g || H, H != NULL);
     if (g) memcpy(g, inst->red.g, R * sizeof(double));
     if (H) memcpy(H, inst->red.H, R * R * sizeof(double));

@@ -3,13 +3,15 @@
  *   skin      dual-quaternion skinning of the active vertices (eq. 4.13)
  *   contact   the training poses nearest to the pose, their contact pairs (§3.2.3)
  *   dynamics  teleports, inertial forces, the start state, the frozen damping Hessian
+ *   self      exhaustive self-contact: the pairs touching at the start state
+ *             (self_contact.h); either mode: the Hessian's block pattern
  *   world     the surface copies near colliders at the start state (world_contact.h)
  *   oracle    with a patch budget: the full-space patch around the novel contact
  *             (condense.h, thesis §4.4.2)
  *   solve     Newton on the step's potential (eqs. 2.11-2.12, 3.4-3.6, 4.20), coupled to
  *             the patch when there is one (eqs. 4.11-4.12); when it ran into colliders
- *             the start state did not touch, one more detection round and solve from
- *             there
+ *             (or, exhaustive, into flesh) the start state did not touch, one more
+ *             detection round and solve from there
  *   advance   the velocity and the pose history
  *   output    the output surface and its normals
  * Nothing here allocates, locks or touches a vertex that is not active: the cost follows
@@ -66,20 +68,50 @@ static void phase_skin(sw_step_ctx *c) {
     c->st.ms_skin = lap(c);
 }
 
-/* The pairs in use fix the Hessian's block pattern for the step (the factorisations add
- * their fill to it). */
+static int exhaustive(const sinew_instance *in) {
+    return in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE;
+}
+
+sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) {
+    sw_step_contacts ct = {&in->ps, in->wc.world ? &in->wc : NULL, exhaustive(in) ? &in->sc : NULL,
+                           self_seconds};
+    return ct;
+}
+
+/* The training poses near the pose (the quasistatic start, either mode) and, pose-space
+ * mode, their pairs. */
 static void phase_contact(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_pose_space_lookup(&in->ps, in->v, in->pose.T_cur);
-    sw_pose_space_gather_pairs(&in->ps, in->v);
+    if (exhaustive(in)) {
+        in->ps.npairs = in->ps.npairs_nearest = in->ps.dropped = 0;
+    } else {
+        sw_pose_space_gather_pairs(&in->ps, in->v);
+        c->st.self_contact_tests = c->st.self_contacts = (uint32_t)in->ps.npairs;
+    }
     if (in->ps.dropped > 0) {
         c->st.status |= SINEW_STEP_BUDGET;
         c->st.budget_exceeded |= SINEW_BUDGET_CONTACT_PAIRS;
         c->st.contact_pairs_dropped = (uint32_t)in->ps.dropped;
     }
     c->st.contact_pairs = (uint32_t)in->ps.npairs;
-    sw_solver_block_pattern(&in->solver, in->v, &in->ps);
     c->st.ms_contact = lap(c);
+    c->st.ms_self_contact = c->st.ms_contact;
+}
+
+/* Exhaustive mode: the pairs touching at the start state. Either mode: the pairs in use
+ * fix the Hessian's block pattern for the step (the factorisations add their fill). */
+static void phase_self(sw_step_ctx *c) {
+    sinew_instance *in = c->in;
+    if (exhaustive(in)) {
+        sw_self_contacts_detect(&in->sc, &in->red, in->solver.q);
+        c->st.self_contact_tests = (uint32_t)in->sc.tests;
+    }
+    sw_step_contacts ct = sw_instance_contacts(in, NULL);
+    sw_solver_block_pattern(&in->solver, in->v, &ct);
+    double ms = lap(c);
+    c->st.ms_contact += ms;
+    c->st.ms_self_contact += ms;
 }
 
 /* Pose-space start of a quasistatic step: q = the blend of the two nearest training
@@ -124,7 +156,9 @@ static void phase_dynamics(sw_step_ctx *c) {
         sw_inertial_forces(in->v, &in->pose, s, c->dc.h);
         sw_dyn_coef statics = c->dc;
         statics.dynamic = 0;
-        sw_step_contacts self = {&in->ps, NULL}; /* H_n: the material and self-contact */
+        /* H_n: the material and pose-space self-contact (the exhaustive mode's pairs are
+           detected after the start state, phase_self) */
+        sw_step_contacts self = {&in->ps, NULL, NULL, NULL};
         sw_potential(&in->red, &self, s, s->q, &statics, 1, 1);
         c->st.potential_evals++;
         memcpy(s->Hn, in->red.H, (size_t)R * R * sizeof(double));
@@ -209,8 +243,19 @@ static void write_output(sw_step_ctx *c) {
 static sinew_result phase_solve(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_world_contacts *wc = &in->wc;
-    sw_step_contacts ct = {&in->ps, wc->world ? wc : NULL};
+    double self_s = 0; /* the self-contact terms' share of the evaluations */
+    sw_step_contacts ct = sw_instance_contacts(in, &self_s);
     sinew_result r = solve(c, &ct);
+    if (r == SINEW_OK && exhaustive(in)) { /* the solution pressed into flesh it did not touch */
+        double t = sw_now_seconds();
+        int32_t fresh = sw_self_contacts_detect(&in->sc, &in->red, in->solver.q);
+        c->st.self_contact_tests += (uint32_t)in->sc.tests;
+        self_s += sw_now_seconds() - t;
+        if (fresh > 0) {
+            sw_solver_block_pattern(&in->solver, in->v, &ct);
+            r = solve(c, &ct);
+        }
+    }
     double ms_aside = 0; /* the second detection and the output, counted as theirs */
     if (r == SINEW_OK && wc->world) {
         write_output(c);
@@ -245,6 +290,8 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         c->st.pcg_iterations = in->cond.pcg_iters;
     }
     c->st.ms_solve = lap(c) - ms_aside;
+    c->st.ms_self_contact += 1e3 * self_s;
+    if (exhaustive(in)) c->st.self_contacts = (uint32_t)in->sc.npairs;
     return r;
 }
 
@@ -326,6 +373,7 @@ static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
     phase_skin(c);
     phase_contact(c);
     phase_dynamics(c);
+    phase_self(c);
     phase_world(c);
     phase_oracle(c);
 }
@@ -353,7 +401,7 @@ double sw_instance_step_potential(sinew_instance *inst, float dt, const double *
                                   double *H, int exact_hessian) {
     sw_dyn_coef dc = step_coef(inst, dt);
     size_t R = (size_t)inst->red.R;
-    sw_step_contacts ct = {&inst->ps, inst->wc.world ? &inst->wc : NULL};
+    sw_step_contacts ct = sw_instance_contacts(inst, NULL);
     int want_hess = H ? (exact_hessian ? SW_CUB_HESSIAN_EXACT : 1) : 0;
     double phi = sw_potential(&inst->red, &ct, &inst->solver, q, &dc, g || H, want_hess);
     if (g) memcpy(g, inst->red.g, R * sizeof(double));

@@ -23,19 +23,25 @@ void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v) {
         s->blk_pos[s->blk_order[e]] = e;
 }
 
-void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_pose_space *ps) {
+/* The blocks a contact pair's four copies (cv: (domain, local) each) couple. */
+static void couple_pair(sw_solver *s, int32_t nd, const int32_t *cv) {
+    for (int m = 0; m < 4; ++m)
+        for (int k = 0; k < 4; ++k) {
+            int32_t a = s->blk_pos[cv[2 * m]], b = s->blk_pos[cv[2 * k]];
+            if (a > b) s->blk_nz[a * nd + b] = 1;
+        }
+}
+
+void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_step_contacts *ct) {
     int32_t nd = v->ndomains;
     for (int32_t a = 0; a < nd; ++a)
         for (int32_t b = 0; b < a; ++b)
             s->blk_nz[a * nd + b] = s->blk_adj[s->blk_order[a] * nd + s->blk_order[b]];
-    for (int32_t p = 0; p < ps->npairs; ++p) {
-        const int32_t *cv = v->contact_verts + 8 * (int64_t)ps->pairs[p];
-        for (int m = 0; m < 4; ++m)
-            for (int k = 0; k < 4; ++k) {
-                int32_t a = s->blk_pos[cv[2 * m]], b = s->blk_pos[cv[2 * k]];
-                if (a > b) s->blk_nz[a * nd + b] = 1;
-            }
-    }
+    for (int32_t p = 0; p < ct->ps->npairs; ++p)
+        couple_pair(s, nd, v->contact_verts + 8 * (int64_t)ct->ps->pairs[p]);
+    if (ct->sc)
+        for (int32_t p = 0; p < ct->sc->npairs; ++p)
+            couple_pair(s, nd, ct->sc->verts + 8 * (int64_t)p);
 }
 
 int sw_solver_factor(sw_reduced *red, sw_solver *s) {

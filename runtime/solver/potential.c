@@ -7,6 +7,7 @@
 
 #include "cubature.h"
 #include "dense.h"
+#include "clock.h"
 #include "pose_contact.h"
 #include "solver.h"
 
@@ -35,7 +36,14 @@ double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver
     if (want_grad) memset(red->g, 0, (size_t)R * sizeof(double));
     if (want_hess) memcpy(red->H, v->spring_hessian, (size_t)R * R * sizeof(double));
     double phi = sw_cubature_eval(red, q, want_grad, want_hess);
+    double t0 = ct->self_seconds ? sw_now_seconds() : 0;
     phi += sw_pose_contact_eval(red, ct->ps, q, want_grad, want_hess);
+    if (ct->sc) {
+        sw_pair_set set = sw_self_contacts_pairs(ct->sc);
+        phi +=
+            sw_contact_pairs_eval(red, &set, NULL, ct->sc->npairs, 1, 1, q, want_grad, want_hess);
+    }
+    if (ct->self_seconds) *ct->self_seconds += sw_now_seconds() - t0;
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
     spring_matvec(v, s, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);

@@ -8,6 +8,7 @@
 
 #include "pose_space.h"
 #include "reduced_map.h"
+#include "self_contact.h"
 #include "world_contact.h"
 #include "sinew/sinew.h"
 
@@ -41,11 +42,14 @@ typedef struct sw_dyn_coef {
 /* The block layout of H and its minimum-degree elimination order, once at creation. */
 void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v);
 
-/* The contact terms of a step: pose-space self-contact pairs and world candidates
- * (either may be empty; wc may be NULL). */
+/* The contact terms of a step: pose-space self-contact pairs, the exhaustive mode's
+ * detected pairs and world candidates (any may be empty; sc and wc may be NULL). With
+ * self_seconds, every evaluation adds the wall time of its self-contact terms there. */
 typedef struct sw_step_contacts {
     const sw_pose_space *ps;
     const sw_world_contacts *wc;
+    const sw_self_contacts *sc;
+    double *self_seconds;
 } sw_step_contacts;
 
 /* Phi(q): cubature + contact (self and world) + springs [+ inertia, damping and inertial
@@ -56,8 +60,8 @@ double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver
                     const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess);
 
 /* The structural block pattern of H for this step: spring-coupled domains and the
- * domains the contact pairs in use join (no scan of H's values). */
-void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_pose_space *ps);
+ * domains the self-contact pairs in use join (no scan of H's values). */
+void sw_solver_block_pattern(sw_solver *s, const sw_blob_view *v, const sw_step_contacts *ct);
 
 /* Factors red->H (the block-sparse Cholesky into s->L, the step's block pattern),
  * shifting the diagonal if H is not positive definite; 0 if no shift makes it so. */

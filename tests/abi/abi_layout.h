@@ -35,6 +35,8 @@
     X(offsetof(sinew_instance_def, logger))                                                        \
     X(offsetof(sinew_instance_def, max_contact_pairs))                                             \
     X(offsetof(sinew_instance_def, tasks))                                                         \
+    X(offsetof(sinew_instance_def, self_contact))                                                  \
+    X(sizeof(sinew_self_contact))                                                                  \
     X(sizeof(sinew_task_callbacks))                                                                \
     X(offsetof(sinew_task_callbacks, enqueue))                                                     \
     X(offsetof(sinew_task_callbacks, finish))                                                      \
@@ -46,7 +48,8 @@
     X(offsetof(sinew_step_stats, ms_skin))                                                         \
     X(offsetof(sinew_step_stats, ms_output))                                                       \
     X(offsetof(sinew_step_stats, active_vertices))                                                 \
-    X(offsetof(sinew_step_stats, budget_exceeded))
+    X(offsetof(sinew_step_stats, budget_exceeded))                                                 \
+    X(offsetof(sinew_step_stats, ms_self_contact))
 
 #ifdef __cplusplus
 extern "C" {

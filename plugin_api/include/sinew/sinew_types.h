@@ -97,6 +97,19 @@ typedef enum sinew_step_mode {
     SINEW_STEP_DYNAMIC = 1      /**< implicit dynamics: flesh lags, jiggles and settles */
 } sinew_step_mode;
 
+/** Self-contact of an instance (sinew_instance_def.self_contact). */
+typedef enum sinew_self_contact {
+    /** the reference's contact pairs at the two nearest training poses, blended (thesis
+     * §3.2.3): a cost that follows those pairs, contacts only where the bake saw them */
+    SINEW_SELF_CONTACT_POSE_SPACE = 0,
+    /** every boundary vertex tested against the whole deformed mesh at the step's start
+     * state, and again at its solution (a second solve when that found new contact), with
+     * the reference's detection rule: contacts the bake never saw, at a cost that follows
+     * the mesh (every vertex mapped, every tet's box refit). Needs a blob with the tet
+     * mesh (sinew-bake writes it); INVALID_ARGUMENT otherwise */
+    SINEW_SELF_CONTACT_EXHAUSTIVE = 1
+} sinew_self_contact;
+
 /** How to create an instance of a blob. All memory is reserved at creation. */
 typedef struct sinew_instance_def {
     uint32_t struct_size;      /**< sizeof(sinew_instance_def), set by the default */
@@ -132,6 +145,9 @@ typedef struct sinew_instance_def {
      * diagonal (the thesis's radii, for a mesh normalised to a unit cube, are this times
      * diagonal / longest side). 0 means 0.05; otherwise 0 < patch_radius <= 1. */
     float patch_radius;
+    /** Self-contact detection: SINEW_SELF_CONTACT_POSE_SPACE (the default) or
+     * SINEW_SELF_CONTACT_EXHAUSTIVE (see there). */
+    sinew_self_contact self_contact;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -150,6 +166,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.max_world_contacts = 0;
     d.max_patch_vertices = 0;
     d.patch_radius = 0.0f;
+    d.self_contact = SINEW_SELF_CONTACT_POSE_SPACE;
     return d;
 }
 
@@ -237,6 +254,16 @@ typedef struct sinew_step_stats {
     uint32_t patch_dropped;  /**< vertices the max_patch_vertices budget left out */
     uint32_t pcg_iterations; /**< conjugate-gradient iterations of the coupled solves */
     double ms_oracle;        /**< the partition oracle: seeds, growth, the patch's tets */
+    /** Self-contact, wall-clock milliseconds: the pose-space lookup and pair gathering
+     * or the exhaustive detections, plus the contact terms' share of every potential
+     * evaluation (inside ms_contact and ms_solve, which include it) */
+    double ms_self_contact;
+    /** self-contact candidates tested this step: the pose-space pairs in use, or the
+     * exhaustive detections' (vertex, tet) candidates whose boxes overlap */
+    uint32_t self_contact_tests;
+    /** self-contact pairs in the solve: the pose-space pairs in use, or the exhaustive
+     * detection's pairs at the end of the step */
+    uint32_t self_contacts;
 } sinew_step_stats;
 
 #ifdef __cplusplus

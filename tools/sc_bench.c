@@ -1,0 +1,101 @@
+/* sinew-bench --sc-compare (sc_bench.h). */
+#include "sc_bench.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "instance.h"
+#include "rt_interpose.h"
+
+/* One mode's pass: the figures of its timed steps. */
+static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, const double *T,
+                             int nframes, float dt, int reps, int count_rt, sw_sc_bench *out,
+                             sw_error *err) {
+    sinew_instance_def def = sinew_instance_def_default();
+    def.self_contact = mode;
+    sinew_instance *inst;
+    sinew_result r = sinew_instance_create(blob, &def, &inst);
+    if (r != SINEW_OK)
+        return sw_error_set(err, r, "cannot create a %s instance: %s",
+                            mode == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive" : "pose-space",
+                            sinew_result_string(r));
+    int nb = (int)sinew_blob_bone_count(blob), k = mode == SINEW_SELF_CONTACT_EXHAUSTIVE;
+    double sc_sum = 0, step_sum = 0;
+    out->ms_mean[k] = out->ms_max[k] = out->tests_mean[k] = out->pairs_mean[k] = 0;
+    for (int f = 0; f < nframes; ++f) { /* untimed pass: the instance settles on the clip */
+        sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
+        out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
+    }
+    if (count_rt) sw_rt_count_begin();
+    int steps = 0;
+    for (int rep = 0; rep < reps; ++rep)
+        for (int f = 0; f < nframes; ++f, ++steps) {
+            sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
+            out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
+            sinew_step_stats st = {.struct_size = sizeof st};
+            sinew_instance_get_stats(inst, &st);
+            double step = st.ms_skin + st.ms_contact + st.ms_dynamics + st.ms_world + st.ms_oracle +
+                          st.ms_solve + st.ms_output;
+            sc_sum += st.ms_self_contact;
+            step_sum += step;
+            out->ms_max[k] = fmax(out->ms_max[k], st.ms_self_contact);
+            out->tests_mean[k] += st.self_contact_tests;
+            out->pairs_mean[k] += st.self_contacts;
+        }
+    if (count_rt) {
+        sw_rt_counts c = sw_rt_count_end();
+        unsigned active = sw_rt_interpose_active();
+        out->allocs = active & SW_RT_CAT_ALLOCS
+                          ? (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0))
+                          : -1;
+        out->locks = active & SW_RT_CAT_LOCKS ? (long)c.locks : -1;
+    }
+    out->steps = steps;
+    out->ms_mean[k] = sc_sum / steps;
+    out->step_mean[k] = step_sum / steps;
+    out->tests_mean[k] /= steps;
+    out->pairs_mean[k] /= steps;
+    if (!k) out->frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
+    sinew_instance_destroy(inst);
+    return SINEW_OK;
+}
+
+sinew_result sw_sc_bench_run(const sinew_blob *blob, const double *T, int nframes, float dt,
+                             int reps, sw_sc_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    if (!blob || !T || nframes < 1 || reps < 1 || !(dt > 0))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "sc bench: bad arguments");
+    sinew_result r =
+        run_mode(blob, SINEW_SELF_CONTACT_POSE_SPACE, T, nframes, dt, reps, 0, out, err);
+    if (r == SINEW_OK)
+        r = run_mode(blob, SINEW_SELF_CONTACT_EXHAUSTIVE, T, nframes, dt, reps, 1, out, err);
+    if (r != SINEW_OK) return r;
+    out->speedup_mean = out->ms_mean[0] > 0 ? out->ms_mean[1] / out->ms_mean[0] : INFINITY;
+    out->speedup_max = out->ms_max[0] > 0 ? out->ms_max[1] / out->ms_max[0] : INFINITY;
+    return SINEW_OK;
+}
+
+void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
+    if (!json) {
+        fprintf(f,
+                "sinew-bench: self-contact over %d steps: pose-space %.4f ms mean, %.4f max "
+                "(%.1f pairs, %.3f of the step); exhaustive %.4f ms mean, %.4f max (%.0f "
+                "candidates, %.1f pairs); speedup %.1fx mean, %.1fx max; exhaustive allocs %ld, "
+                "locks %ld\n",
+                b->steps, b->ms_mean[0], b->ms_max[0], b->tests_mean[0], b->frame_share,
+                b->ms_mean[1], b->ms_max[1], b->tests_mean[1], b->pairs_mean[1], b->speedup_mean,
+                b->speedup_max, b->allocs, b->locks);
+        return;
+    }
+    fprintf(f,
+            ",\"sc_steps\":%d,\"sc_ms_mean\":%.5f,\"sc_ms_max\":%.5f,\"sc_exh_ms_mean\":%.5f,"
+            "\"sc_exh_ms_max\":%.5f,\"sc_speedup_mean\":%.2f,\"sc_speedup_max\":%.2f,"
+            "\"sc_frame_share\":%.4f,\"sc_exh_frame_share\":%.4f,\"sc_pairs\":%.1f,"
+            "\"sc_exh_pairs\":%.1f,\"sc_exh_contacts\":%.1f,\"sc_step_ms\":%.4f,"
+            "\"sc_exh_step_ms\":%.4f,\"sc_exh_allocs_in_step\":%ld,\"sc_exh_locks_in_step\":%ld",
+            b->steps, b->ms_mean[0], b->ms_max[0], b->ms_mean[1], b->ms_max[1], b->speedup_mean,
+            b->speedup_max, b->frame_share,
+            b->step_mean[1] > 0 ? b->ms_mean[1] / b->step_mean[1] : 0, b->tests_mean[0],
+            b->tests_mean[1], b->pairs_mean[1], b->step_mean[0], b->step_mean[1], b->allocs,
+            b->locks);
+}

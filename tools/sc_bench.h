@@ -1,0 +1,43 @@
+/* sinew-bench --sc-compare: self-contact in the two modes of the runtime, on the same
+ * blob and clip in one run (issue 16, thesis Table 3.2): a pose-space instance and an
+ * exhaustive one (sinew_instance_def.self_contact) each step every clip frame, `reps`
+ * passes over the clip after one untimed pass, and the step's own figures give
+ *   ms_mean, ms_max      self-contact ms a step (sinew_step_stats.ms_self_contact)
+ *   step_mean            the whole step's ms
+ *   tests_mean           candidates tested a step (self_contact_tests: the pose-space
+ *                        pairs in use, or the exhaustive (vertex, tet) candidates)
+ *   pairs_mean           pairs in the solve a step (self_contacts)
+ * for each mode ([0] pose-space, [1] exhaustive), and
+ *   speedup_mean = ms_mean[1] / ms_mean[0], speedup_max = ms_max[1] / ms_max[0],
+ *   frame_share = the pose-space mode's self-contact time over its steps' time,
+ * plus the allocations and locks the interposer counted in the exhaustive steps (-1 when
+ * this build cannot observe them). */
+#ifndef SW_SC_BENCH_H
+#define SW_SC_BENCH_H
+
+#include <stdio.h>
+
+#include "sinew/sinew.h"
+#include "sw_error.h"
+
+typedef struct sw_sc_bench {
+    int steps; /* timed steps of each mode */
+    double ms_mean[2], ms_max[2], step_mean[2], tests_mean[2], pairs_mean[2];
+    double speedup_mean, speedup_max, frame_share;
+    long failed;        /* steps that did not return SINEW_OK (both modes) */
+    long allocs, locks; /* in the exhaustive mode's timed steps */
+} sw_sc_bench;
+
+/* Runs both modes over the clip's nframes poses T (12 doubles a bone each) at dt. */
+sinew_result sw_sc_bench_run(const sinew_blob *blob, const double *T, int nframes, float dt,
+                             int reps, sw_sc_bench *out, sw_error *err);
+
+/* The figures as a line for people (json 0) or as JSON members, each preceded by a
+ * comma, for sinew-bench's object: sc_steps, sc_ms_mean, sc_ms_max, sc_exh_ms_mean,
+ * sc_exh_ms_max, sc_speedup_mean, sc_speedup_max, sc_frame_share, sc_exh_frame_share,
+ * sc_pairs (pose-space pairs tested), sc_exh_pairs (exhaustive candidates tested),
+ * sc_exh_contacts, sc_step_ms, sc_exh_step_ms, sc_exh_allocs_in_step,
+ * sc_exh_locks_in_step. */
+void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json);
+
+#endif
