@@ -265,6 +265,8 @@ expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$benc
 touch "$tmp/plain"
 expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"
+expect bake_cache_unwritable 1 "--cache '$tmp/plain/c': cannot create or write the folder" \
+    "$bake" "${small[@]}" --out "$tmp/a.blob" --cache "$tmp/plain/c"
 if [ -f "$fox" ]; then
     expect bake_unknown_clip 1 "--heldout-clips: no clip named 'Gallop' \(the file's clips: Survey, Walk, Run\)" \
         "$bake" "$fox" --tets 1000 --train-clips Survey --heldout-clips Gallop --out "$tmp/f.blob"

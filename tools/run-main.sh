@@ -53,6 +53,7 @@ else
     echo "== bake: finger (no shared assets at $data), ~${tets} tets, a ${frames}-frame folding clip"
 fi
 build/tools/sinew-bake "${character[@]}" --out "$out/$name.blob" --report "$out/report" \
+    --cache "$out/cache" \
     --json | tail -n 1 | tee "$out/bake.json"
 echo "== benchmark: full-space reference vs subspace runtime vs plain DQS, same mesh and motion"
 build/tools/sinew-bench "${character[@]}" --blob "$out/$name.blob" --out "$out/subspace" \

@@ -46,7 +46,8 @@ static void usage(FILE *f) {
             "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
             "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
             "                  [--compare-cubature] [--no-self-contact] [--return-path]\n"
-            "                  [--inertia-modes] [--threads T] [--force] [--json]\n"
+            "                  [--inertia-modes] [--cache DIR] [--threads T] [--force]\n"
+            "                  [--json]\n"
             "character:\n" SW_CHARACTER_USAGE "bake:\n"
             "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
             "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
@@ -62,6 +63,9 @@ static void usage(FILE *f) {
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
             "                   flesh lags and overshoots as the reference does; a higher rank\n"
+            "  --cache DIR      keep the full-space solutions in DIR and reuse them when a\n"
+            "                   later bake solves the same poses of the same character (a\n"
+            "                   re-bake that changes the cubature, rank or report only)\n"
             "  --threads T      0..256 (default 0: all cores)\n"
             "  --force          write the blob even when its training error is %.2f or more\n"
             "                   (the share of the physics correction it misses on its own\n"
@@ -120,6 +124,8 @@ int main(int argc, char **argv) {
             }
         } else if (!strcmp(a, "--spring-k") && next)
             ok = sw_tool_real(tool, a, argv[++i], 0, INFINITY, "above 0", &p.spring_k);
+        else if (!strcmp(a, "--cache") && next)
+            p.cache_dir = argv[++i];
         else if (!strcmp(a, "--compare-cubature"))
             p.compare_selectors = 1;
         else if (!strcmp(a, "--no-self-contact"))
@@ -143,11 +149,13 @@ int main(int argc, char **argv) {
     }
     if (!sw_character_args_valid(&ca)) return 2;
     /* the report's folder before the long run: an unwritable one is an error now */
-    if (report_dir && !sw_tool_make_dirs(report_dir)) {
-        fprintf(stderr, "%s: --report '%s': cannot create or write the folder: %s\n", tool,
-                report_dir, strerror(errno ? errno : EACCES));
-        return 1;
-    }
+    const char *dirs[2][2] = {{"--report", report_dir}, {"--cache", p.cache_dir}};
+    for (int k = 0; k < 2; ++k)
+        if (dirs[k][1] && !sw_tool_make_dirs(dirs[k][1])) {
+            fprintf(stderr, "%s: %s '%s': cannot create or write the folder: %s\n", tool,
+                    dirs[k][0], dirs[k][1], strerror(errno ? errno : EACCES));
+            return 1;
+        }
     sw_error err;
     sw_character ch;
     sw_clip_split clips;
@@ -309,7 +317,8 @@ int main(int argc, char **argv) {
                    res.selector_points[0], res.selector_seconds[0], res.selector_error[0],
                    res.selector_points[1], res.selector_seconds[1], res.selector_error[1],
                    res.selector_points[2], res.selector_seconds[2], res.selector_error[2]);
-        printf(",\"forced\":%s}\n", absurd ? "true" : "false");
+        printf(",\"simulate_cached\":%s,\"forced\":%s}\n", res.simulate_cached ? "true" : "false",
+               absurd ? "true" : "false");
     }
 done:
     sinew_blob_destroy(blob);

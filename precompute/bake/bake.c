@@ -30,6 +30,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.random_poses = 10;
     p.self_contact = 1;
     p.spring_k = 0;
+    p.cache_dir = NULL;
     p.threads = 0;
     p.seed = 0x5eed5eedULL;
     p.progress = 0;
@@ -273,7 +274,8 @@ static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
 /* The stages poses and simulate, and what the result keeps of them for evaluation. */
 static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sinew_result r;
-    if ((r = sw_bake_poses(s, err)) != SINEW_OK || (r = sw_bake_simulate(s, err)) != SINEW_OK)
+    if ((r = sw_bake_poses(s, err)) != SINEW_OK ||
+        (r = sw_bake_simulate_cached(s, &out->simulate_cached, err)) != SINEW_OK)
         return r;
     for (int32_t i = 0; i < s->ntrain_seq; ++i) {
         out->ntrain += s->train[i].npose;
@@ -404,8 +406,9 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
         char msg[160];
         snprintf(msg, sizeof msg,
                  "%d training and %d held-out full-space solutions (%d and %d with a contact set "
-                 "left unsettled by the round cap)",
-                 out->ntrain, out->nheldout, out->train_unsettled, out->heldout_unsettled);
+                 "left unsettled by the round cap)%s",
+                 out->ntrain, out->nheldout, out->train_unsettled, out->heldout_unsettled,
+                 out->simulate_cached ? ", read from the cache" : "");
         progress(&p, "simulate", t1 - t0, msg);
     }
 

@@ -51,6 +51,12 @@ typedef struct sw_bake_params {
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
     int32_t random_poses;          /* held-out poses when there is no clip (default 10) */
     int self_contact;              /* in the training simulations (default 1) */
+    /* A folder for the simulate stage's results (NULL, the default: none): a bake finds
+       there the full-space solutions of a bake with the same mesh, weights, material,
+       simulator and poses and skips solving them; otherwise it stores its own
+       (bake_cache.c). A re-bake that changes only the cubature, the rank or the report
+       then takes seconds, not minutes. */
+    const char *cache_dir;
     double spring_k; /* interface springs per copy pair; 0: 20 E h (h the mean rest edge) */
     int threads;     /* 0: all cores */
     uint64_t seed;
@@ -90,6 +96,7 @@ typedef struct sw_bake_result {
        while it still changed (sw_fullsim_stats.contacts_unsettled): their shape in the
        fold depends on the cap, and so does the error measured against them */
     int32_t train_unsettled, heldout_unsettled;
+    int simulate_cached;       /* the simulate stage read its solutions from the cache */
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     double cubature_error_max; /* worst per-domain relative cubature training error */

@@ -7,6 +7,7 @@
 #include "bake.h"
 #include "dqs.h"
 #include "embed.h"
+#include "fullsim.h"
 #include "selfcontact.h"
 #include "thread_pool.h"
 
@@ -90,6 +91,12 @@ void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R 
 sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err);
+/* The reference simulator's parameters of the simulate stage (threads aside). */
+sw_fullsim_params sw_bake_sim_params(const sw_bake_state *s);
+/* The simulate stage through the cache of sw_bake_params.cache_dir (bake_cache.c): the
+ * solutions read back when the cache holds this bake's, else solved and stored. Sets
+ * *cached when they were read back. */
+sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err);
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);

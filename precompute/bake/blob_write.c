@@ -141,7 +141,7 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
 static sinew_result io_error(sw_error *err, const char *what, const char *file, int e) {
     char why[128];
     if (strerror_r(e, why, sizeof why) != 0) snprintf(why, sizeof why, "errno %d", e);
-    return sw_error_set(err, SINEW_ERROR_IO, "blob write: cannot %s '%s': %s", what, file, why);
+    return sw_error_set(err, SINEW_ERROR_IO, "write: cannot %s '%s': %s", what, file, why);
 }
 
 static int write_all(int fd, const uint8_t *p, size_t n) {
@@ -174,11 +174,11 @@ static void sync_parent(const char *path) {
     close(fd);
 }
 
-static sinew_result write_file_atomic(const char *path, const uint8_t *data, size_t size,
-                                      sw_error *err) {
+sinew_result sw_write_file_atomic(const char *path, const uint8_t *data, size_t size,
+                                  sw_error *err) {
     size_t len = strlen(path);
     char *tmp = malloc(len + 5);
-    if (!tmp) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "blob write: out of memory");
+    if (!tmp) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "write: out of memory");
     memcpy(tmp, path, len);
     memcpy(tmp + len, ".tmp", 5);
     sinew_result r = SINEW_OK;
@@ -195,8 +195,7 @@ static sinew_result write_file_atomic(const char *path, const uint8_t *data, siz
     if (close(fd) != 0 && r == SINEW_OK) r = io_error(err, "close", tmp, errno);
     if (r == SINEW_OK && rename(tmp, path) != 0) {
         int e = errno;
-        r = sw_error_set(err, SINEW_ERROR_IO, "blob write: cannot rename '%s' to '%s': ", tmp,
-                         path);
+        r = sw_error_set(err, SINEW_ERROR_IO, "write: cannot rename '%s' to '%s': ", tmp, path);
         if (err) {
             size_t used = strlen(err->msg);
             if (strerror_r(e, err->msg + used, sizeof err->msg - used) != 0)
@@ -218,7 +217,7 @@ sinew_result sw_blob_write(const char *path, const sw_blob_view *view, sw_error 
     size_t size = 0;
     sinew_result r = sw_blob_write_memory(view, &data, &size, err);
     if (r != SINEW_OK) return r;
-    r = write_file_atomic(path, data, size, err);
+    r = sw_write_file_atomic(path, data, size, err);
     free(data);
     return r;
 }

@@ -25,4 +25,9 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
  * the system's reason; other codes as sw_blob_write_memory. */
 sinew_result sw_blob_write(const char *path, const sw_blob_view *view, sw_error *err);
 
+/* Writes size bytes to `path` atomically, as sw_blob_write does (path.tmp, fsync,
+ * rename, the folder fsynced). */
+sinew_result sw_write_file_atomic(const char *path, const uint8_t *data, size_t size,
+                                  sw_error *err);
+
 #endif
