@@ -265,6 +265,16 @@ expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$benc
 touch "$tmp/plain"
 expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"
+expect bench_self_contact_mode 2 "--self-contact: pose-space or exhaustive" \
+    "$bench" "${small[@]}" --self-contact brute
+expect bench_gap_needs_poses 2 "--error-gap needs the bake's poses" \
+    "$bench" "${small[@]}" --blob "$tmp/a.blob" --error-gap
+# issue 16's figures on a small bake: both self-contact modes timed in one run, the
+# runtime against its basis's projection (every figure present, no step failed)
+want=('"sc_speedup_max":[0-9.]+,' '"sc_frame_share":0\.[0-9]+,' '"sc_exh_pairs":[0-9.]+,'
+    '"gap_poses":[1-9][0-9]*,' '"gap_err_projection":[0-9.]+,' '"failed_steps":0,')
+expect_stdout bench_sc_gap "$bench" "${small[@]}" --frames 8 --full-frames 1 \
+    --contract-steps 0 --sc-compare --error-gap --json
 expect bake_cache_unwritable 1 "--cache '$tmp/plain/c': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --cache "$tmp/plain/c"
 if [ -f "$fox" ]; then

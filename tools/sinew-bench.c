@@ -126,6 +126,8 @@
 #include "dyn_bench.h"
 #include "crowd_bench.h"
 #include "sc_bench.h"
+#include "dqs_bench.h"
+#include "gap_bench.h"
 
 /* The step's phases as sinew_step_stats reports them. */
 enum { NPHASES = 5 };
@@ -139,7 +141,8 @@ static void usage(FILE *f) {
                "                   [reference options] [--out DIR]\n"
                "                   [--world FILE.json [--rho R] [--patch-budget N]]\n"
                "                   [--dynamic [--hold-frames H]] [--instances N]\n"
-               "                   [--self-contact pose-space|exhaustive] [--sc-compare] [--json]\n"
+               "                   [--self-contact pose-space|exhaustive] [--sc-compare]\n"
+               "                   [--error-gap] [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
             "bench:\n"
@@ -175,6 +178,8 @@ static void usage(FILE *f) {
             "  --self-contact M    pose-space (default) or exhaustive: the runtime's mode\n"
             "                      (sinew_instance_def.self_contact) for the timing and errors\n"
             "  --sc-compare        also time self-contact in both modes over the clip: sc_*\n"
+            "  --error-gap         also the runtime against its basis's projection on the\n"
+            "                      bake's held-out poses (not with --blob alone): gap_*\n"
             "  --dynamic           also run the runtime in dynamic mode against the reference's\n"
             "                      backward-Euler run of the clip (same dt, damping, masses)\n"
             "                      and report err_dynamic and the overshoot after the clip\n"
@@ -187,72 +192,6 @@ static void usage(FILE *f) {
             "  --json              one JSON object with the figures as the last stdout line\n"
             "reference options (the full-space run the bench times; a bake it runs uses the\n"
             "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
-}
-
-/* What plain skinning of the output surface reads: per output vertex its rest position
- * and 4 influences. The boundary's vertices are simulation vertices with their own; a
- * render mesh's rest positions are its embedding's, and its influences those of the
- * simulation vertex it weighs most (the blob keeps no render-vertex weights; the cost,
- * what dqs_ms times, is a 4-influence blend a vertex either way). */
-typedef struct dqs_surface {
-    int32_t n;
-    double *X, *w; /* 3 n rest positions, 4 n weights */
-    int32_t *bone; /* 4 n bone ids */
-} dqs_surface;
-
-static int dqs_surface_make(const sw_blob_view *v, dqs_surface *d) {
-    d->n = sw_blob_output_verts(v);
-    d->X = malloc(sizeof(double) * 3 * (size_t)d->n);
-    d->w = malloc(sizeof(double) * 4 * (size_t)d->n);
-    d->bone = malloc(sizeof(int32_t) * 4 * (size_t)d->n);
-    if (!d->X || !d->w || !d->bone) return 0;
-    sw_output_from_full(v, v->rest, d->X);
-    for (int32_t s = 0; s < d->n; ++s) {
-        int32_t gv;
-        if (v->nrender_verts > 0) {
-            const double *b = v->render_bary + 4 * (int64_t)s;
-            int k = 0;
-            for (int j = 1; j < 4; ++j)
-                k = b[j] > b[k] ? j : k;
-            gv = sw_render_node_vertex(v, v->render_tets[4 * (int64_t)v->render_tet[s] + k]);
-        } else {
-            const int32_t *c = v->surf_copies + 2 * (int64_t)v->surf_copy_ptr[s];
-            gv = v->domain_verts[v->domains[c[0]].vert_begin + c[1]];
-        }
-        memcpy(d->bone + 4 * s, v->skin_bone + 4 * (int64_t)gv, 4 * sizeof(int32_t));
-        memcpy(d->w + 4 * s, v->skin_weight + 4 * (int64_t)gv, 4 * sizeof(double));
-    }
-    return 1;
-}
-
-static void dqs_surface_free(dqs_surface *d) {
-    free(d->X), free(d->w), free(d->bone);
-}
-
-/* Plain DQS of the output surface (positions and area-weighted normals over its own
- * triangles): the cost a host pays today, timed per frame over the clip. */
-static double dqs_ms(const sw_blob_view *v, const dqs_surface *d, const sw_clip *clip, int frames,
-                     double *x, double *n) {
-    double *ms = malloc((size_t)frames * sizeof(double));
-    sw_dualquat dq[SW_MAX_BONES];
-    for (int f = 0; f < frames && ms; ++f) {
-        const double *T = clip->T + (size_t)f * 12 * clip->nbones;
-        double t0 = sw_now_seconds();
-        for (int32_t b = 0; b < v->nbones; ++b)
-            sw_dq_from_transform(T + 12 * b, &dq[b]);
-        for (int32_t s = 0; s < d->n; ++s) {
-            double R[9], t[3];
-            const double *X = d->X + 3 * s;
-            sw_dqs_blend(dq, d->bone + 4 * s, d->w + 4 * s, 4, R, t);
-            for (int i = 0; i < 3; ++i)
-                x[3 * s + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
-        }
-        sw_surface_normals(d->n, x, sw_blob_output_ntris(v), sw_blob_output_tris(v), n);
-        ms[f] = 1e3 * (sw_now_seconds() - t0);
-    }
-    double m = sw_median(ms, frames);
-    free(ms);
-    return m;
 }
 
 /* The subspace surface of every clip frame as DIR/frame_NNNN.obj (for sinew-render);
@@ -317,7 +256,7 @@ int main(int argc, char **argv) {
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     int dynamic = 0, hold_frames = 0, instances = 0, patch_budget = 0;
     sinew_self_contact self_mode = SINEW_SELF_CONTACT_POSE_SPACE;
-    int sc_compare = 0;
+    int sc_compare = 0, error_gap = 0;
     sw_cond_bench_params cond = {{0}, 0, 0, NULL};
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
@@ -354,6 +293,8 @@ int main(int argc, char **argv) {
             self_mode = k > 0 ? SINEW_SELF_CONTACT_EXHAUSTIVE : SINEW_SELF_CONTACT_POSE_SPACE;
         } else if (!strcmp(a, "--sc-compare"))
             sc_compare = 1;
+        else if (!strcmp(a, "--error-gap"))
+            error_gap = 1;
         else if (!strcmp(a, "--dynamic"))
             dynamic = 1;
         else if (!strcmp(a, "--bake-errors"))
@@ -365,6 +306,13 @@ int main(int argc, char **argv) {
         if (!ok) return 2; /* the value's message is out */
     }
     if (!sw_character_args_valid(&ca)) return 2;
+    if (error_gap && blob_path && !bake_errors) {
+        fprintf(stderr,
+                "%s: --error-gap needs the bake's poses: without --blob, or with "
+                "--bake-errors\n",
+                tool);
+        return 2;
+    }
     if (bake_errors && !blob_path) {
         fprintf(stderr,
                 "%s: --bake-errors applies only with --blob (without --blob the bench bakes and "
@@ -530,14 +478,11 @@ int main(int argc, char **argv) {
         return sw_tool_failed(r, &err, "%s: --out %s: ", tool, out_dir);
 
     /* 4. plain DQS of the same surface (the render mesh's own vertices when it has one) */
-    dqs_surface ds;
-    double *xs = malloc((size_t)ns * 3 * sizeof(double)),
-           *xn = malloc((size_t)ns * 3 * sizeof(double));
-    if (!dqs_surface_make(v, &ds) || !xs || !xn) {
+    double d_ms = sw_dqs_bench_ms(v, &ch.clip, nf);
+    if (!(d_ms >= 0)) {
         fprintf(stderr, "sinew-bench: out of memory\n");
         return 1;
     }
-    double d_ms = dqs_ms(v, &ds, &ch.clip, nf, xs, xn);
 
     /* 5. errors against full-space solutions, always by the bake's definition
        (sw_bake_errors): on the bake's poses when it baked here; a given blob on the clip
@@ -571,6 +516,11 @@ int main(int argc, char **argv) {
             return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         ref_unsettled = res.train_unsettled + res.heldout_unsettled;
     }
+
+    sw_gap_bench gap;
+    if (error_gap && (r = sw_gap_bench_run(blob, &res, self_mode, &gap, &err)) != SINEW_OK)
+        return sw_tool_failed(r, &err, "%s: ", tool);
+    if (error_gap) sw_gap_bench_print(&gap, stderr, 0);
 
     /* 6. the real-time contract: allocation and lock calls inside the step */
     long allocs = -1, locks = -1;
@@ -726,6 +676,7 @@ int main(int argc, char **argv) {
         printf(",\"self_contact\":\"%s\"",
                self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive" : "pose_space");
     if (json && sc_compare) sw_sc_bench_print(&scb, stdout, 1);
+    if (json && error_gap) sw_gap_bench_print(&gap, stdout, 1);
     if (json && clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
                et.frames + et.failed, eh.frames + eh.failed);
@@ -789,9 +740,6 @@ int main(int argc, char **argv) {
     free(sub);
     free(pos);
     free(nrm);
-    free(xs);
-    free(xn);
-    dqs_surface_free(&ds);
     sinew_instance_destroy(inst);
     sinew_blob_destroy(blob);
     free(mem);

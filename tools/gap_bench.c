@@ -1,0 +1,144 @@
+/* sinew-bench --error-gap (gap_bench.h). */
+#include "gap_bench.h"
+
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "condense.h"
+#include "cubature.h"
+#include "fem_corot.h"
+#include "instance.h"
+#include "instance_internal.h"
+#include "pose_contact.h"
+
+/* The terms of the step's energy at q (gap_bench.h's rt/proj order). */
+static void terms(sinew_instance *in, const double *q, double o[4]) {
+    const sw_blob_view *v = in->v;
+    o[0] = sw_cubature_eval(&in->red, q, 0, 0);
+    o[1] = 0;
+    for (int32_t t = 0; t < v->ntets; ++t) {
+        double x[12];
+        for (int k = 0; k < 4; ++k)
+            sw_cond_copy_position(&in->red, v->tets[4 * (int64_t)t + k], v->tet_domain[t],
+                                  v->tet_local[4 * (int64_t)t + k], q, x + 3 * k, NULL);
+        o[1] += sw_corot_eval(x, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda,
+                              NULL, NULL, 0);
+    }
+    o[2] = sw_pose_contact_eval(&in->red, &in->ps, q, 0, 0);
+    if (in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE) {
+        sw_pair_set set = sw_self_contacts_pairs(&in->sc);
+        o[2] += sw_contact_pairs_eval(&in->red, &set, NULL, in->sc.npairs, 1, 1, q, 0, 0);
+    }
+    int32_t R = v->rank_total;
+    o[3] = 0;
+    for (int32_t i = 0; i < R; ++i)
+        for (int32_t j = 0; j < R; ++j)
+            o[3] += 0.5 * q[i] * v->spring_hessian[(int64_t)i * R + j] * q[j];
+}
+
+/* q = U^T d per domain, d the un-skinned displacement of x (3 nverts) at the instance's
+ * pose (eq. 4.13 solved for the correction). */
+static void project(const sinew_instance *in, const double *x, double *q) {
+    const sw_blob_view *v = in->v;
+    memset(q, 0, (size_t)v->rank_total * sizeof(double));
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank;
+        for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+            int32_t gv = v->domain_verts[D->vert_begin + lv];
+            double R[9], t[3], e[3], d[3];
+            sw_dqs_blend(in->bone_dq, v->skin_bone + 4 * (int64_t)gv,
+                         v->skin_weight + 4 * (int64_t)gv, 4, R, t);
+            for (int i = 0; i < 3; ++i)
+                e[i] = x[3 * (int64_t)gv + i] - t[i];
+            for (int i = 0; i < 3; ++i)
+                d[i] =
+                    R[i] * e[0] + R[3 + i] * e[1] + R[6 + i] * e[2] - v->rest[3 * (int64_t)gv + i];
+            const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+            for (int i = 0; i < 3; ++i)
+                for (int32_t c = 0; c < r; ++c)
+                    q[D->q_offset + c] += U[i * r + c] * d[i];
+        }
+    }
+}
+
+sinew_result sw_gap_bench_run(const sinew_blob *blob, const sw_bake_result *res,
+                              sinew_self_contact sc, sw_gap_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    if (!v || v->ntets == 0)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "--error-gap needs a blob with the tet mesh (bake it again)");
+    sinew_instance_def d = sinew_instance_def_default();
+    d.max_newton_iters = SW_BAKE_EVAL_NEWTON;
+    d.self_contact = sc;
+    sinew_instance *in;
+    sinew_result r = sinew_instance_create(blob, &d, &in);
+    if (r != SINEW_OK) return sw_error_set(err, r, "--error-gap: cannot create an instance");
+    int32_t R = v->rank_total, nb = v->nbones, nv = v->nverts;
+    double *qp = malloc(sizeof(double) * R), *qr = malloc(sizeof(double) * R);
+    sw_eval_acc art, apr;
+    int acc = sw_eval_acc_init(&art, blob, res->mass, err) == SINEW_OK;
+    acc += sw_eval_acc_init(&apr, blob, res->mass, err) == SINEW_OK;
+    if (!qp || !qr || acc < 2) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "--error-gap: out of memory");
+        goto done;
+    }
+    for (int32_t j = 0; j < res->nheldout; ++j) {
+        const double *xf = res->heldout_x + (size_t)j * 3 * nv;
+        if (sw_instance_set_pose_d(in, res->heldout_T + (size_t)j * 12 * nb) != SINEW_OK ||
+            sinew_instance_step(in, 1.0f / 30) != SINEW_OK)
+            continue; /* a failed step: sinew-bench's failed_steps counts it already */
+        memcpy(qr, sw_instance_q(in), sizeof(double) * R);
+        sw_eval_acc_add(&art, in, xf);
+        project(in, xf, qp);
+        double er = sw_instance_step_potential(in, 1.0f / 30, qr, NULL, NULL, 0),
+               ep = sw_instance_step_potential(in, 1.0f / 30, qp, NULL, NULL, 0), tr[4], tp[4];
+        out->projection_higher += ep > er;
+        terms(in, qr, tr);
+        terms(in, qp, tp);
+        for (int k = 0; k < 4; ++k) {
+            out->rt[k] += tr[k];
+            out->proj[k] += tp[k];
+        }
+        sw_instance_set_q(in, qp);
+        sw_eval_acc_add(&apr, in, xf);
+        sw_instance_set_q(in, qr);
+        out->poses++;
+    }
+    sw_eval_result a, b;
+    sw_eval_acc_result(&art, &a);
+    sw_eval_acc_result(&apr, &b);
+    out->err_runtime = a.correction_error;
+    out->err_projection = b.correction_error;
+done: /* (a failed init leaves its sums zeroed: freeing them is a no-op) */
+    sw_eval_acc_free(&art);
+    sw_eval_acc_free(&apr);
+    free(qp);
+    free(qr);
+    sinew_instance_destroy(in);
+    return r;
+}
+
+void sw_gap_bench_print(const sw_gap_bench *g, FILE *f, int json) {
+    static const char *const name[4] = {"cubature", "exact", "contact", "springs"};
+    if (json) {
+        fprintf(f,
+                ",\"gap_poses\":%d,\"gap_err_runtime\":%.5f,\"gap_err_projection\":%.5f,"
+                "\"gap_projection_higher\":%d",
+                g->poses, g->err_runtime, g->err_projection, g->projection_higher);
+        for (int k = 0; k < 4; ++k)
+            fprintf(f, ",\"gap_rt_%s\":%.6g,\"gap_proj_%s\":%.6g", name[k], g->rt[k], name[k],
+                    g->proj[k]);
+        return;
+    }
+    fprintf(f,
+            "sinew-bench: error gap over %d held-out poses: runtime %.4f, projection %.4f; the "
+            "reduced energy is higher at the projection in %d; energy terms summed (runtime / "
+            "projection):",
+            g->poses, g->err_runtime, g->err_projection, g->projection_higher);
+    for (int k = 0; k < 4; ++k)
+        fprintf(f, " %s %.5g / %.5g%s", name[k], g->rt[k], g->proj[k], k < 3 ? "," : "\n");
+}
