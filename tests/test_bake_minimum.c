@@ -145,5 +145,56 @@ TEST(progress_counts_every_pose_and_domain) {
     sw_character_free(&c);
 }
 
+/* Bone b's rotation relative to its parent in pose T (12 per bone): L = R_p^T R_b. */
+static void local_of(const sw_skeleton *sk, const double *T, int32_t b, double L[9]) {
+    const double *Rb = T + 12 * b, *Rp = T + 12 * sk->parent[b];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
+}
+
+/* Pair sweeps (issue 16): the finger's tip joint swept together with its parent joint, a
+ * sequence of sweep_samples poses after the single sweeps, the last of them each joint at
+ * its own sweep's end; the held-out poses stay the same. */
+TEST(pair_sweeps_turn_a_joint_with_its_parent) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 6, &c, &err) == SINEW_OK);
+    sw_bake_params p = quick_params();
+    sw_bake_result a, b;
+    ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    p.pair_sweeps = 1;
+    ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
+    int32_t nb = c.skel.nbones, tip = -1, n = p.sweep_samples;
+    for (int32_t k = 0; k < nb; ++k) /* the finger: a chain root -> middle -> tip */
+        if (c.skel.parent[k] >= 0 && c.skel.parent[c.skel.parent[k]] >= 0) tip = k;
+    ENSURE(tip >= 0);
+    int32_t mid = c.skel.parent[tip];
+    ENSUREF(b.ntrain == a.ntrain + n, "%d training poses with pair sweeps, %d without", b.ntrain,
+            a.ntrain);
+    ENSURE(b.nheldout == a.nheldout &&
+           !memcmp(a.heldout_T, b.heldout_T, sizeof(double) * 12 * nb * a.nheldout));
+    /* the single sweeps end the training poses: the tip's last (a's last pose), the
+       middle's before it; the pair's last pose is b's last */
+    const double *pair = b.train_T + (size_t)12 * nb * (b.ntrain - 1),
+                 *tip_end = a.train_T + (size_t)12 * nb * (a.ntrain - 1),
+                 *mid_end = a.train_T + (size_t)12 * nb * (a.ntrain - 1 - n);
+    double L[9], Ls[9];
+    local_of(&c.skel, pair, tip, L);
+    local_of(&c.skel, tip_end, tip, Ls);
+    for (int i = 0; i < 9; ++i)
+        ENSURE_NEAR(L[i], Ls[i], 1e-12);
+    local_of(&c.skel, pair, mid, L);
+    local_of(&c.skel, mid_end, mid, Ls);
+    for (int i = 0; i < 9; ++i)
+        ENSURE_NEAR(L[i], Ls[i], 1e-12);
+    ENSUREF(fabs(Ls[0] - 1) + fabs(Ls[4] - 1) + fabs(Ls[8] - 1) > 1e-3,
+            "the middle joint's sweep does not turn it");
+    sw_bake_result_free(&a);
+    sw_bake_result_free(&b);
+    sw_character_free(&c);
+}
+
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
-             CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain))
+             CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain),
+             CASE(pair_sweeps_turn_a_joint_with_its_parent))

@@ -46,6 +46,7 @@ static void usage(FILE *f) {
             "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
             "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
             "                  [--compare-cubature] [--no-self-contact] [--return-path]\n"
+            "                  [--pair-sweeps]\n"
             "                  [--inertia-modes] [--cache DIR] [--threads T] [--force]\n"
             "                  [--json]\n"
             "character:\n" SW_CHARACTER_USAGE "bake:\n"
@@ -60,6 +61,8 @@ static void usage(FILE *f) {
             "                   joins its parent's domain, 0..0.5 (default 0: off; 0.03\n"
             "                   folds the elephant's 24 bones into 11 domains)\n"
             "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
+            "  --pair-sweeps    also train on every joint swept together with its parent\n"
+            "                   joint (combinations the single-joint sweeps never show)\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
             "                   flesh lags and overshoots as the reference does; a higher rank\n"
@@ -132,6 +135,8 @@ int main(int argc, char **argv) {
             p.self_contact = 0;
         else if (!strcmp(a, "--return-path"))
             p.return_path = 1;
+        else if (!strcmp(a, "--pair-sweeps"))
+            p.pair_sweeps = 1;
         else if (!strcmp(a, "--inertia-modes"))
             p.inertia_modes = 1;
         else if (!strcmp(a, "--force"))

@@ -23,6 +23,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.cubature_max = 1000;
     p.selector = SW_CUBATURE_NNHTP;
     p.sweep_samples = 6;
+    p.pair_sweeps = 0;
     p.max_train_frames = 40;
     p.return_path = 0;
     p.inertia_modes = 0;

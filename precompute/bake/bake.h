@@ -40,6 +40,9 @@ typedef struct sw_bake_params {
     int32_t cubature_max;          /* per domain (default 1000) */
     sw_cubature_selector selector; /* default NN-HTP */
     int32_t sweep_samples;         /* poses per joint sweep (default 6) */
+    int pair_sweeps;               /* also sweep every joint together with its parent joint
+                                      (default 0; issue 16: combinations the single sweeps
+                                      never show; measured in the README) */
     int32_t max_train_frames;      /* clip frames used for training at most (default 40) */
     int return_path;               /* also train on those frames played back from the last one
                                       (default 0; measured: finger held-out error 0.235 -> 0.164 at

@@ -209,13 +209,38 @@ static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld
 
 /* Training sequences: every training range (at most max_train_frames of it), the first
  * one's return path when asked, then a sweep per joint. Returns 0 when out of memory. */
+/* Sample i of n of the sweeps: every bone of `bones` (nsw of them) turned by i/n of its
+ * sweep angle, every other joint at rest. */
+static void sweep_pose(const sw_bake_state *s, const int32_t *bones, int nsw, int32_t i, int32_t n,
+                       const double *sweep_axis, const double *sweep_angle, double *local,
+                       double *T) {
+    for (int32_t k = 0; k < s->nb; ++k) {
+        double *L = local + 9 * k;
+        memset(L, 0, 9 * sizeof(double));
+        L[0] = L[4] = L[8] = 1;
+    }
+    for (int j = 0; j < nsw; ++j)
+        sw_m3_axis_angle(sweep_axis + 3 * bones[j], sweep_angle[bones[j]] * i / n,
+                         local + 9 * bones[j]);
+    sw_forward_kinematics(&s->ch.skel, local, NULL, T);
+}
+
+/* Whether the sweeps bend bone b's joint (b >= 0). A pair sweep turns a joint and its
+ * parent's together when both are (issue 16: the flesh between two domain boundaries
+ * depends on both joints, and the single sweeps never show them combined). */
+static int swept(const double *sweep_angle, int32_t b) {
+    return b >= 0 && sweep_angle[b] > 1e-3;
+}
+
 static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t njoint,
                           const double *sweep_axis, const double *sweep_angle, double *local) {
     const sw_skeleton *sk = &s->ch.skel;
     int32_t nb = s->nb, cap = s->p->max_train_frames;
     int32_t n0 = ntr > 0 ? (train[0].count < cap ? train[0].count : cap) : 0;
-    int32_t nreturn = s->p->return_path && n0 >= 2 ? n0 - 1 : 0;
-    s->ntrain_seq = ntr + (nreturn > 0) + njoint;
+    int32_t nreturn = s->p->return_path && n0 >= 2 ? n0 - 1 : 0, npair = 0;
+    for (int32_t b = 0; s->p->pair_sweeps && b < nb; ++b)
+        npair += swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b]);
+    s->ntrain_seq = ntr + (nreturn > 0) + njoint + npair;
     s->train = calloc((size_t)s->ntrain_seq + 1, sizeof(sw_pose_seq));
     if (!s->train) return 0;
     int32_t qi = 0;
@@ -233,21 +258,19 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
         s->train[qi].continues = 1;
         qi++;
     }
-    for (int32_t b = 0; b < nb; ++b) {
-        if (!(sweep_angle[b] > 1e-3)) continue;
-        int32_t n = s->p->sweep_samples;
-        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
-        for (int32_t i = 0; i < n; ++i) {
-            for (int32_t k = 0; k < nb; ++k) {
-                double *L = local + 9 * k;
-                memset(L, 0, 9 * sizeof(double));
-                L[0] = L[4] = L[8] = 1;
-            }
-            sw_m3_axis_angle(sweep_axis + 3 * b, sweep_angle[b] * (i + 1) / n, local + 9 * b);
-            sw_forward_kinematics(sk, local, NULL, s->train[qi].T + (size_t)i * 12 * nb);
+    /* a sweep per joint, then (pair_sweeps) a sweep of every joint with its parent joint */
+    for (int pass = 0; pass < 2; ++pass)
+        for (int32_t b = 0; b < nb; ++b) {
+            int32_t bones[2] = {b, sk->parent[b]}, n = s->p->sweep_samples;
+            if (!swept(sweep_angle, b) || (pass == 1 && !npair) ||
+                (pass == 1 && !swept(sweep_angle, bones[1])))
+                continue;
+            if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
+            for (int32_t i = 0; i < n; ++i)
+                sweep_pose(s, bones, pass + 1, i + 1, n, sweep_axis, sweep_angle, local,
+                           s->train[qi].T + (size_t)i * 12 * nb);
+            qi++;
         }
-        qi++;
-    }
     return 1;
 }
 

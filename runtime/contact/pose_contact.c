@@ -5,8 +5,9 @@
 #include "penalty.h"
 
 /* Self-contact pairs (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
- * training poses' pairs or the exhaustive mode's, each the reference's penalty E = 1/2 k ka d^T N d
- * with d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and n = R_p n_rest (alpha:
+ * training poses' pairs or the exhaustive mode's, each the reference's penalty
+ * E = 1/2 k ka d^T N d with d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and
+ * n = R_p n_rest (alpha:
  * SW_CONTACT_ALPHA times the pose's tangential share, pose_space.c), applied
  * while the pair collides (the Heaviside of eq. 3.12: p behind the triangle along n).
  * Per pair the slots of one domain are summed into G_d = sum coef_m J_m (3 x r_d), so

@@ -12,7 +12,7 @@ void sw_self_contacts_take(sw_mem_plan *p, const sw_blob_view *v, sw_self_contac
     const uint64_t nv = (uint64_t)v->nverts, ns = (uint64_t)v->nsurf_verts,
                    nf = (uint64_t)v->nsurf_tris;
     memset(sc, 0, sizeof *sc);
-#define TAKE(ptr, count) ((ptr) = sw_plan_take(p, (count), sizeof *(ptr)))
+#define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
     TAKE(sc->tris, 3 * nf);
     TAKE(sc->surf, ns);
     TAKE(sc->m.ring, ns);

@@ -29,6 +29,9 @@ static inline void *sw_plan_take(sw_mem_plan *p, uint64_t count, size_t elem) {
     return p->base && count ? p->base + at : NULL;
 }
 
+/* Places `ptr` (a typed pointer) as a region of `count` of what it points to. */
+#define SW_PLAN_TAKE(p, ptr, count) ((ptr) = sw_plan_take((p), (count), sizeof *(ptr)))
+
 /* The block's size: everything laid out, rounded up to the alignment (what sw_alloc
  * reserves). */
 static inline size_t sw_plan_size(const sw_mem_plan *p) {

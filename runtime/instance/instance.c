@@ -32,7 +32,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     const uint64_t R = (uint64_t)v->rank_total, nb = (uint64_t)v->nbones,
                    nd = (uint64_t)v->ndomains, na = (uint64_t)z->nact, rm = (uint64_t)z->rmax,
                    ns = (uint64_t)sw_blob_output_verts(v);
-#define TAKE(ptr, count) ((ptr) = sw_plan_take(p, (count), sizeof *(ptr)))
+#define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
     (void)sw_plan_take(p, 1, sizeof *in);
     TAKE(in->bone_dq, nb);
     TAKE(in->pose.T_cur, 12 * nb);
