@@ -295,15 +295,56 @@ TEST(bad_surfaces_are_rejected) {
     box.X[5] = NAN;
     ENSURE(sw_tetmesh_from_surface(&box, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
     box.X[5] = 0;
-    for (int32_t v = 0; v < box.nverts; ++v) /* flat: every z = 0 */
+    /* no area at all: every vertex at one point */
+    sw_trimesh dot = boxes(1, lo, 1, -1);
+    for (int32_t i = 0; i < 3 * dot.nverts; ++i)
+        dot.X[i] = 0;
+    ENSURE(sw_tetmesh_from_surface(&dot, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_DEGENERATE);
+    ENSURE(t.ntets == 0 && t.tets == NULL && t.X == NULL && strstr(e.msg, "no area"));
+    sw_trimesh_free(&dot);
+    sw_trimesh_free(&box);
+}
+
+/* Every tet's centre within the shell's half-thickness (plus a cube's half diagonal) of
+ * the plane z = 0, and the volume near the sheet's area times the thickness. */
+static void check_shell(const sw_tetmesh *t, const sw_lattice_report *rep, double area) {
+    double vol = 0;
+    for (int32_t k = 0; k < t->ntets; ++k) {
+        const int32_t *v = t->tets + 4 * k;
+        double z = 0;
+        for (int c = 0; c < 4; ++c)
+            z += 0.25 * t->X[3 * v[c] + 2];
+        ENSURE(fabs(z) <= 0.5 * rep->shell + 0.87 * rep->spacing);
+        vol += sw_tet_signed_volume(t->X + 3 * v[0], t->X + 3 * v[1], t->X + 3 * v[2],
+                                    t->X + 3 * v[3]);
+    }
+    ENSUREF(vol > 0.5 * area * rep->shell && vol < 2.5 * area * rep->shell,
+            "shell volume %g for area %g and thickness %g", vol, area, rep->shell);
+}
+
+/* A surface with no inside (issue 14: SimpleSkin is a flat strip) is meshed as a shell:
+ * a flat sheet (the unit box squashed to z = 0) and one tilted triangle. */
+TEST(a_surface_without_inside_becomes_a_shell) {
+    double lo[1][3] = {{0, 0, 0}};
+    sw_trimesh box = boxes(1, lo, 1, -1);
+    for (int32_t v = 0; v < box.nverts; ++v) /* flat: every z = 0 (both faces coincide) */
         box.X[3 * v + 2] = 0;
-    ENSURE(sw_tetmesh_from_surface(&box, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
-    /* one tilted triangle encloses nothing (winding number below 1/2 off its plane) */
+    sw_tetmesh t;
+    sw_lattice_report rep;
+    sw_error e;
+    ENSUREF(sw_tetmesh_from_surface(&box, 20000, NULL, &t, &rep, &e) == SINEW_OK, "%s", e.msg);
+    fprintf(stderr, "    flat sheet: %d tets, shell %.4f, spacing %.4f, %d piece(s)\n", t.ntets,
+            rep.shell, rep.spacing, rep.components);
+    ENSURE(rep.shell > 0 && fabs(rep.shell - 0.04 * sqrt(2.0)) < 1e-12);
+    ENSURE(t.ntets >= 20000 / 1.5 && t.ntets <= 1.5 * 20000 && rep.components == 1);
+    check_shell(&t, &rep, 1.0);
+    sw_tetmesh_free(&t);
     sw_trimesh tri = boxes(1, lo, 1, -1);
     tri.ntris = 1;
     tri.tris[0] = 0, tri.tris[1] = 3, tri.tris[2] = 5; /* (0,0,0), (1,1,0), (1,0,1) */
-    ENSURE(sw_tetmesh_from_surface(&tri, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_DEGENERATE);
-    ENSURE(t.ntets == 0 && t.tets == NULL && t.X == NULL);
+    ENSUREF(sw_tetmesh_from_surface(&tri, 1000, NULL, &t, &rep, &e) == SINEW_OK, "%s", e.msg);
+    ENSURE(rep.shell > 0 && t.ntets >= 1000 / 1.5 && rep.components == 1);
+    sw_tetmesh_free(&t);
     sw_trimesh_free(&tri);
     sw_trimesh_free(&box);
 }
@@ -312,4 +353,5 @@ SW_TEST_MAIN(CASE(winding_number_of_a_closed_and_an_open_box),
              CASE(winding_tree_matches_the_exact_sum),
              CASE(sphere_fills_to_its_volume_at_the_target_count),
              CASE(open_and_inside_out_surfaces_are_filled), CASE(separate_pieces_stay_separate),
-             CASE(real_render_surface), CASE(bad_surfaces_are_rejected))
+             CASE(real_render_surface), CASE(bad_surfaces_are_rejected),
+             CASE(a_surface_without_inside_becomes_a_shell))

@@ -6,8 +6,13 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bvh.h"
 #include "vec3.h"
 #include "winding.h"
+
+/* A surface that encloses no volume is meshed as a shell of this share of its bounding
+ * box's diagonal on each side. */
+#define SW_LATTICE_SHELL 0.02
 
 /* Lattices of more cubes than this are refused (memory: a byte and an index each). */
 #define SW_LATTICE_MAX_CELLS 100000000LL
@@ -183,6 +188,54 @@ static sinew_result build_tets(const lattice *L, int64_t kept, sw_tetmesh *out, 
     return SINEW_OK;
 }
 
+/* The cubes whose centre lies within r of the surface (a shell around a sheet), over the
+ * box [lo, hi] (the surface's, grown by r) at spacing h: each triangle marks the cubes of
+ * its own grown box. Returns the number kept, or -1 as classify. */
+static int64_t classify_shell(lattice *L, const sw_trimesh *surf, const double lo[3],
+                              const double hi[3], double h, double r) {
+    int64_t total = 1;
+    L->h = h;
+    for (int a = 0; a < 3; ++a) {
+        L->n[a] = (int32_t)ceil((hi[a] - lo[a]) / h) + 1;
+        L->origin[a] = 0.5 * (lo[a] + hi[a]) - 0.5 * L->n[a] * h;
+        total *= L->n[a];
+        if (total > SW_LATTICE_MAX_CELLS) return -1;
+    }
+    free(L->inside);
+    if (!(L->inside = calloc((size_t)total, 1))) return -1;
+    int64_t k = 0;
+    for (int32_t t = 0; t < surf->ntris; ++t) {
+        const double *A = surf->X + 3 * (size_t)surf->tris[3 * t],
+                     *B = surf->X + 3 * (size_t)surf->tris[3 * t + 1],
+                     *C = surf->X + 3 * (size_t)surf->tris[3 * t + 2];
+        double e1[3], e2[3], nrm[3];
+        sw_v3_sub(B, A, e1);
+        sw_v3_sub(C, A, e2);
+        sw_v3_cross(e1, e2, nrm);
+        if (!(sw_v3_dot(nrm, nrm) > 0)) continue; /* no area: its edges are others' */
+        int64_t c0[3], c1[3];
+        for (int a = 0; a < 3; ++a) {
+            double mn = fmin(A[a], fmin(B[a], C[a])) - r, mx = fmax(A[a], fmax(B[a], C[a])) + r;
+            c0[a] = (int64_t)floor((mn - L->origin[a]) / h - 0.5);
+            c1[a] = (int64_t)ceil((mx - L->origin[a]) / h - 0.5);
+            c0[a] = c0[a] < 0 ? 0 : c0[a];
+            c1[a] = c1[a] > L->n[a] - 1 ? L->n[a] - 1 : c1[a];
+        }
+        for (int64_t z = c0[2]; z <= c1[2]; ++z)
+            for (int64_t y = c0[1]; y <= c1[1]; ++y)
+                for (int64_t x = c0[0]; x <= c1[0]; ++x) {
+                    int64_t c = x + L->n[0] * (y + (int64_t)L->n[1] * z);
+                    if (L->inside[c]) continue;
+                    double p[3] = {L->origin[0] + (x + 0.5) * h, L->origin[1] + (y + 0.5) * h,
+                                   L->origin[2] + (z + 0.5) * h},
+                           beta[3], q[3];
+                    sw_closest_point_triangle(p, A, B, C, beta, q);
+                    if (sw_v3_dist(p, q) <= r) L->inside[c] = 1, ++k;
+                }
+    }
+    return k;
+}
+
 sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets, sw_pool *pool,
                                      sw_tetmesh *out, sw_lattice_report *report, sw_error *err) {
     double t0 = sw_now_seconds();
@@ -197,15 +250,17 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
             lo[a] = fmin(lo[a], surf->X[3 * (size_t)v + a]);
             hi[a] = fmax(hi[a], surf->X[3 * (size_t)v + a]);
         }
-    double box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]);
-    if (!(box > 0) || !isfinite(box))
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "tet lattice: the surface's bounding box is flat");
+    double box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]), area = 0;
     for (int32_t t = 0; t < surf->ntris; ++t) {
         const int32_t *f = surf->tris + 3 * t;
-        rep.surface_volume += sw_v3_triple(surf->X + 3 * (size_t)f[0], surf->X + 3 * (size_t)f[1],
-                                           surf->X + 3 * (size_t)f[2]) /
-                              6.0;
+        const double *A = surf->X + 3 * (size_t)f[0], *B = surf->X + 3 * (size_t)f[1],
+                     *C = surf->X + 3 * (size_t)f[2];
+        double e1[3], e2[3], nrm[3];
+        sw_v3_sub(B, A, e1);
+        sw_v3_sub(C, A, e2);
+        sw_v3_cross(e1, e2, nrm);
+        area += 0.5 * sw_v3_norm(nrm);
+        rep.surface_volume += sw_v3_triple(A, B, C) / 6.0;
     }
     lattice L = {.tree = sw_winding_tree_create(surf)};
     if (!L.tree) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "tet lattice: out of memory");
@@ -214,7 +269,7 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
        inside: a thin shape the coarse lattice missed) */
     double h = cbrt(6.0 * 0.5 * box / target_tets);
     int64_t kept = 0;
-    for (int pass = 0, halvings = 0; pass < 8; ++pass) {
+    for (int pass = 0, halvings = 0; box > 0 && pass < 8; ++pass) {
         kept = classify(&L, lo, hi, h, pool);
         if (kept < 0) break;
         double made = 6.0 * (double)kept;
@@ -227,17 +282,36 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
         h *= cbrt(made / target_tets);
     }
     sw_winding_tree_destroy(L.tree);
+    if (kept == 0 && area > 0) {
+        /* no inside (a flat sheet, an open strip): a shell of half-thickness r around the
+           surface, which bends as a plate of that thickness; at least two cubes through
+           it */
+        double rs = SW_LATTICE_SHELL * sw_v3_dist(lo, hi), glo[3], ghi[3];
+        for (int a = 0; a < 3; ++a)
+            glo[a] = lo[a] - rs, ghi[a] = hi[a] + rs;
+        h = fmin(rs, cbrt(6.0 * area * 2 * rs / target_tets));
+        for (int pass = 0; pass < 8; ++pass) {
+            kept = classify_shell(&L, surf, glo, ghi, h, rs);
+            if (kept <= 0) break;
+            double made = 6.0 * (double)kept;
+            if (fabs(made - target_tets) <= 0.2 * target_tets || (h >= rs && made > target_tets))
+                break;
+            h = fmin(rs, h * cbrt(made / target_tets));
+        }
+        rep.shell = 2 * rs;
+    }
     if (kept < 0) {
         free(L.inside);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
                             "tet lattice: a lattice of spacing %g is too large", h);
     }
     double made = 6.0 * (double)kept;
-    if (kept == 0 || made > 1.5 * target_tets || made < target_tets / 1.5) {
+    /* a shell as thin as two cubes may hold more than asked of a small target */
+    if (kept == 0 || (made > 1.5 * target_tets && !(rep.shell > 0)) || made < target_tets / 1.5) {
         free(L.inside);
         if (kept == 0)
             return sw_error_set(err, SINEW_ERROR_DEGENERATE,
-                                "tet lattice: the surface encloses no volume");
+                                "tet lattice: the surface encloses no volume and has no area");
         return sw_error_set(err, SINEW_ERROR_DEGENERATE,
                             "tet lattice: no spacing gives about %d tets (%.0f at best)",
                             target_tets, made);

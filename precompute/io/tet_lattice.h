@@ -29,14 +29,19 @@ typedef struct sw_lattice_report {
     double surface_volume; /* the surface's signed volume (divergence theorem; exact when
                               it is closed and consistently oriented) */
     int32_t components;    /* face-connected pieces of the tet mesh */
+    double shell;          /* > 0: the surface encloses no volume (a flat sheet, an open
+                              strip) and the mesh is a shell of this thickness around it
+                              (4% of its bounding-box diagonal), which bends as a plate */
     double seconds;
 } sw_lattice_report;
 
 /* Fills `surf` (triangles over its own vertices) with about `target_tets` tets
  * (100..5,000,000; the result is within a factor of 1.5 for any surface that
- * encloses volume). pool may be NULL. Errors: INVALID_ARGUMENT for an empty surface,
- * out-of-range indices, non-finite coordinates, a flat bounding box or a target out
- * of range; DEGENERATE when the surface encloses no lattice cube; OUT_OF_MEMORY. */
+ * encloses volume). A surface that encloses none (a flat sheet, a single open strip) is
+ * meshed as a shell around it instead (report->shell; at least two cubes through it, so
+ * a small target may get more). pool may be NULL. Errors: INVALID_ARGUMENT for an empty
+ * surface, out-of-range indices, non-finite coordinates or a target out of range;
+ * DEGENERATE when the surface has no area; OUT_OF_MEMORY. */
 sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets, sw_pool *pool,
                                      sw_tetmesh *out, sw_lattice_report *report, sw_error *err);
 
