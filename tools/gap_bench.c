@@ -64,13 +64,12 @@ static void project(const sinew_instance *in, const double *x, double *q) {
     }
 }
 
-sinew_result sw_gap_bench_run(const sinew_blob *blob, const sw_bake_result *res,
-                              sinew_self_contact sc, sw_gap_bench *out, sw_error *err) {
+/* One pose set (npose poses T, solutions X) stepped in order on a fresh instance. */
+static sinew_result run_set(const sinew_blob *blob, const double *mass, const double *T,
+                            const double *X, int32_t npose, sinew_self_contact sc, sw_gap_set *out,
+                            sw_error *err) {
     memset(out, 0, sizeof *out);
     const sw_blob_view *v = sw_blob_get_view(blob);
-    if (!v || v->ntets == 0)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "--error-gap needs a blob with the tet mesh (bake it again)");
     sinew_instance_def d = sinew_instance_def_default();
     d.max_newton_iters = SW_BAKE_EVAL_NEWTON;
     d.self_contact = sc;
@@ -80,15 +79,15 @@ sinew_result sw_gap_bench_run(const sinew_blob *blob, const sw_bake_result *res,
     int32_t R = v->rank_total, nb = v->nbones, nv = v->nverts;
     double *qp = malloc(sizeof(double) * R), *qr = malloc(sizeof(double) * R);
     sw_eval_acc art, apr;
-    int acc = sw_eval_acc_init(&art, blob, res->mass, err) == SINEW_OK;
-    acc += sw_eval_acc_init(&apr, blob, res->mass, err) == SINEW_OK;
+    int acc = sw_eval_acc_init(&art, blob, mass, err) == SINEW_OK;
+    acc += sw_eval_acc_init(&apr, blob, mass, err) == SINEW_OK;
     if (!qp || !qr || acc < 2) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "--error-gap: out of memory");
         goto done;
     }
-    for (int32_t j = 0; j < res->nheldout; ++j) {
-        const double *xf = res->heldout_x + (size_t)j * 3 * nv;
-        if (sw_instance_set_pose_d(in, res->heldout_T + (size_t)j * 12 * nb) != SINEW_OK ||
+    for (int32_t j = 0; j < npose; ++j) {
+        const double *xf = X + (size_t)j * 3 * nv;
+        if (sw_instance_set_pose_d(in, T + (size_t)j * 12 * nb) != SINEW_OK ||
             sinew_instance_step(in, 1.0f / 30) != SINEW_OK)
             continue; /* a failed step: sinew-bench's failed_steps counts it already */
         memcpy(qr, sw_instance_q(in), sizeof(double) * R);
@@ -122,23 +121,44 @@ done: /* (a failed init leaves its sums zeroed: freeing them is a no-op) */
     return r;
 }
 
+sinew_result sw_gap_bench_run(const sinew_blob *blob, const sw_bake_result *res,
+                              sinew_self_contact sc, sw_gap_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    if (!v || v->ntets == 0)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "--error-gap needs a blob with the tet mesh (bake it again)");
+    sinew_result r = run_set(blob, res->mass, res->heldout_T, res->heldout_x, res->nheldout, sc,
+                             &out->heldout, err);
+    if (r == SINEW_OK)
+        r = run_set(blob, res->mass, res->train_T, res->train_x, res->ntrain, sc, &out->train, err);
+    return r;
+}
+
 void sw_gap_bench_print(const sw_gap_bench *g, FILE *f, int json) {
     static const char *const name[4] = {"cubature", "exact", "contact", "springs"};
-    if (json) {
+    const sw_gap_set *set[2] = {&g->heldout, &g->train};
+    static const char *const tag[2] = {"", "train_"};
+    for (int k = 0; k < 2; ++k) {
+        const sw_gap_set *s = set[k];
+        if (json) {
+            fprintf(f,
+                    ",\"gap_%sposes\":%d,\"gap_%serr_runtime\":%.5f,\"gap_%serr_projection\":%.5f,"
+                    "\"gap_%sprojection_higher\":%d",
+                    tag[k], s->poses, tag[k], s->err_runtime, tag[k], s->err_projection, tag[k],
+                    s->projection_higher);
+            for (int t = 0; t < 4; ++t)
+                fprintf(f, ",\"gap_%srt_%s\":%.6g,\"gap_%sproj_%s\":%.6g", tag[k], name[t],
+                        s->rt[t], tag[k], name[t], s->proj[t]);
+            continue;
+        }
         fprintf(f,
-                ",\"gap_poses\":%d,\"gap_err_runtime\":%.5f,\"gap_err_projection\":%.5f,"
-                "\"gap_projection_higher\":%d",
-                g->poses, g->err_runtime, g->err_projection, g->projection_higher);
-        for (int k = 0; k < 4; ++k)
-            fprintf(f, ",\"gap_rt_%s\":%.6g,\"gap_proj_%s\":%.6g", name[k], g->rt[k], name[k],
-                    g->proj[k]);
-        return;
+                "sinew-bench: error gap over %d %s poses: runtime %.4f, projection %.4f; the "
+                "reduced energy is higher at the projection in %d; energy terms summed (runtime / "
+                "projection):",
+                s->poses, k ? "training" : "held-out", s->err_runtime, s->err_projection,
+                s->projection_higher);
+        for (int t = 0; t < 4; ++t)
+            fprintf(f, " %s %.5g / %.5g%s", name[t], s->rt[t], s->proj[t], t < 3 ? "," : "\n");
     }
-    fprintf(f,
-            "sinew-bench: error gap over %d held-out poses: runtime %.4f, projection %.4f; the "
-            "reduced energy is higher at the projection in %d; energy terms summed (runtime / "
-            "projection):",
-            g->poses, g->err_runtime, g->err_projection, g->projection_higher);
-    for (int k = 0; k < 4; ++k)
-        fprintf(f, " %s %.5g / %.5g%s", name[k], g->rt[k], g->proj[k], k < 3 ? "," : "\n");
 }

@@ -5,7 +5,12 @@
  *  - a skin without inverseBindMatrices (optional in glTF 2.0; assimp issue #3465),
  *  - an inverseBindMatrices accessor that is not MAT4 floats, one per joint (#6612),
  *  - a node graph that is not a forest (a node that is a child twice, a child and a scene
- *    root, or its own ancestor).
+ *    root, or its own ancestor),
+ *  - an index that points past its array (a node's mesh or skin, a skin's joint, a
+ *    primitive's accessor, an accessor's buffer view, a view's buffer, an animation
+ *    channel's sampler or target node, a sampler's accessors), or a channel without a
+ *    target (a node's skin naming a skin that is not there crashed it: fuzz_scene_import,
+ *    2026-12-03).
  * The bytes must also be what the name says (a .glb starts with "glTF", a .gltf with '{'):
  * otherwise assimp tries its other readers on them, some of which read past the buffer
  * (fuzz_scene_import: strlen over unterminated bytes) or allocate what a header claims.
@@ -28,6 +33,100 @@ static int index_of(const cJSON *o, const char *key, int n) {
         v->valuedouble != (double)(int)v->valuedouble)
         return -1;
     return (int)v->valuedouble;
+}
+
+/* The length of root's array `key` (0 when absent). */
+static int count_of(const cJSON *root, const char *key) {
+    const cJSON *a = cJSON_GetObjectItemCaseSensitive(root, key);
+    return cJSON_IsArray(a) ? cJSON_GetArraySize(a) : 0;
+}
+
+/* Item `key` of o is absent (and not required) or an index in [0, n). */
+static int ref_ok(const cJSON *o, const char *key, int n, int required) {
+    if (!cJSON_GetObjectItemCaseSensitive(o, key)) return !required;
+    return index_of(o, key, n) >= 0;
+}
+
+/* Every element of the array `key` of o is an index in [0, n). */
+static int refs_ok(const cJSON *o, const char *key, int n) {
+    const cJSON *e;
+    cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(o, key)) {
+        if (!cJSON_IsNumber(e) || e->valuedouble < 0 || e->valuedouble >= n ||
+            e->valuedouble != (double)(int)e->valuedouble)
+            return 0;
+    }
+    return 1;
+}
+
+#define BAD_REF(what, i)                                                                           \
+    sw_error_set(err, SINEW_ERROR_PARSE, "%s: %s %d: an index out of range or missing", name,      \
+                 what, (int)(i))
+
+/* Every index the document holds in range of the array it points into. */
+static sinew_result check_references(const cJSON *root, const char *name, sw_error *err) {
+    const int nnode = count_of(root, "nodes"), nmesh = count_of(root, "meshes"),
+              nskin = count_of(root, "skins"), nacc = count_of(root, "accessors"),
+              nview = count_of(root, "bufferViews"), nbuf = count_of(root, "buffers"),
+              nscene = count_of(root, "scenes"), nmat = count_of(root, "materials");
+    const cJSON *o, *p, *a;
+    int i = 0;
+    if (!ref_ok(root, "scene", nscene, 0)) return BAD_REF("scene", 0);
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "scenes")) {
+        if (!refs_ok(o, "nodes", nnode)) return BAD_REF("scene", i);
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "nodes")) {
+        if (!ref_ok(o, "mesh", nmesh, 0) || !ref_ok(o, "skin", nskin, 0)) return BAD_REF("node", i);
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "skins")) {
+        if (!refs_ok(o, "joints", nnode) || !ref_ok(o, "skeleton", nnode, 0))
+            return BAD_REF("skin", i);
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "meshes")) {
+        cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(o, "primitives")) {
+            const cJSON *attr = cJSON_GetObjectItemCaseSensitive(p, "attributes");
+            if (!cJSON_IsObject(attr) || !ref_ok(p, "indices", nacc, 0) ||
+                !ref_ok(p, "material", nmat, 0))
+                return BAD_REF("mesh", i);
+            cJSON_ArrayForEach(a, attr) {
+                if (!cJSON_IsNumber(a) || a->valuedouble < 0 || a->valuedouble >= nacc ||
+                    a->valuedouble != (double)(int)a->valuedouble)
+                    return BAD_REF("mesh", i);
+            }
+        }
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "accessors")) {
+        if (!ref_ok(o, "bufferView", nview, 0)) return BAD_REF("accessor", i);
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "bufferViews")) {
+        if (!ref_ok(o, "buffer", nbuf, 1)) return BAD_REF("buffer view", i);
+        i++;
+    }
+    i = 0;
+    cJSON_ArrayForEach(o, cJSON_GetObjectItemCaseSensitive(root, "animations")) {
+        int nsamp = count_of(o, "samplers");
+        cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(o, "channels")) {
+            const cJSON *target = cJSON_GetObjectItemCaseSensitive(p, "target");
+            if (!ref_ok(p, "sampler", nsamp, 1) || !cJSON_IsObject(target) ||
+                !ref_ok(target, "node", nnode, 0))
+                return BAD_REF("animation", i);
+        }
+        cJSON_ArrayForEach(p, cJSON_GetObjectItemCaseSensitive(o, "samplers")) {
+            if (!ref_ok(p, "input", nacc, 1) || !ref_ok(p, "output", nacc, 1))
+                return BAD_REF("animation", i);
+        }
+        i++;
+    }
+    return SINEW_OK;
 }
 
 static sinew_result check_skins(const cJSON *root, const char *name, sw_error *err) {
@@ -136,7 +235,8 @@ sinew_result sw_gltf_precheck(const void *data, size_t len, int binary, const ch
         cJSON_Delete(root);
         return sw_error_set(err, SINEW_ERROR_PARSE, "%s: the glTF JSON does not parse", name);
     }
-    sinew_result rc = check_skins(root, name, err);
+    sinew_result rc = check_references(root, name, err);
+    if (!rc) rc = check_skins(root, name, err);
     if (!rc) rc = check_nodes(root, name, err);
     cJSON_Delete(root);
     return rc;
