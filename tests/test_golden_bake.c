@@ -7,15 +7,8 @@
 #include <stdint.h>
 
 #include "bake_fixture.h"
+#include "hash.h"
 #include "sw_test.h"
-
-static uint64_t fnv1a(const void *data, size_t n) {
-    const unsigned char *p = data;
-    uint64_t h = 0xcbf29ce484222325ull;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
 
 TEST(blob_bytes_are_identical_on_1_2_3_bake_threads) {
     static const int threads[] = {1, 2, 3};
@@ -26,7 +19,7 @@ TEST(blob_bytes_are_identical_on_1_2_3_bake_threads) {
         ok = bake_fixture_make_threads(&f[t], "finger", 2000, 12, 1, threads[t]);
         if (!ok) break;
         fprintf(stderr, "  %d bake threads: blob %zu bytes, FNV-1a 0x%016llx\n", threads[t],
-                f[t].size, (unsigned long long)fnv1a(f[t].data, f[t].size));
+                f[t].size, (unsigned long long)sw_fnv1a(SW_FNV_START, f[t].data, f[t].size));
     }
     ENSUREF(ok, "a bake failed");
     ENSUREF(sw_blob_get_view(f[0].blob)->ncontacts > 0, "no contact pairs: the blob proves less");

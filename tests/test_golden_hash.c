@@ -41,19 +41,13 @@
 #include <stdint.h>
 
 #include "bake_fixture.h"
+#include "hash.h"
 #include "sw_test.h"
 
 enum { NINST = 4, STEPS = 24 };
 
 /* FNV-1a 64 of the four instances' surfaces, instance after instance. */
 #define GOLDEN_SURFACE_HASH 0xe9036879522188b8ull
-
-static uint64_t fnv1a(uint64_t h, const void *data, size_t n) {
-    const unsigned char *p = data;
-    for (size_t i = 0; i < n; ++i)
-        h = (h ^ p[i]) * 0x100000001b3ull;
-    return h;
-}
 
 typedef struct {
     const bake_fixture *f;
@@ -67,7 +61,7 @@ static int hash_instance(const bake_fixture *f, int i, uint64_t *h) {
     sinew_instance_def d = sinew_instance_def_default();
     d.mode = i % 2 ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
     sinew_instance *inst;
-    *h = 0xcbf29ce484222325ull;
+    *h = SW_FNV_START;
     if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
     uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
     float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 6 * ns);
@@ -77,7 +71,7 @@ static int hash_instance(const bake_fixture *f, int i, uint64_t *h) {
         ok = sinew_instance_set_pose(inst, pose, nb) == SINEW_OK &&
              sinew_instance_step(inst, 1.0f / 30) == SINEW_OK &&
              sinew_instance_read_surface(inst, x, x + 3 * ns, ns) == SINEW_OK;
-        if (ok) *h = fnv1a(*h, x, sizeof(float) * 6 * ns);
+        if (ok) *h = sw_fnv1a(*h, x, sizeof(float) * 6 * ns);
     }
     free(pose);
     free(x);
@@ -102,11 +96,11 @@ static uint64_t hash_on_threads(const bake_fixture *f, int nthreads) {
     }
     for (int t = 0; t < nthreads; ++t)
         pthread_join(th[t], NULL);
-    uint64_t h = 0xcbf29ce484222325ull;
+    uint64_t h = SW_FNV_START;
     for (int i = 0; i < NINST; ++i) {
         const job *j = &jobs[i % nthreads];
         if (!j->ok[i]) return 0;
-        h = fnv1a(h, &j->hash[i], sizeof j->hash[i]);
+        h = sw_fnv1a(h, &j->hash[i], sizeof j->hash[i]);
     }
     return h;
 }

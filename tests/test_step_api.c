@@ -8,6 +8,7 @@
 #include <stdint.h>
 
 #include "bake_fixture.h"
+#include "hash.h"
 #include "sw_test.h"
 
 static bake_fixture fx;
@@ -20,10 +21,7 @@ static const bake_fixture *fixture(void) {
 
 /* FNV-1a over float outputs: a bitwise fingerprint of a run. */
 static uint64_t hash_floats(uint64_t h, const float *x, size_t n) {
-    const unsigned char *p = (const unsigned char *)x;
-    for (size_t i = 0; i < n * sizeof(float); ++i)
-        h = (h ^ p[i]) * 0x100000001b3ULL;
-    return h;
+    return sw_fnv1a(h, x, n * sizeof(float));
 }
 
 static uint64_t run_hash(sinew_step_mode mode, int steps) {
@@ -35,7 +33,7 @@ static uint64_t run_hash(sinew_step_mode mode, int steps) {
     uint32_t ns = sinew_blob_surface_vertex_count(f->blob);
     float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones),
           *x = malloc(sizeof(float) * 3 * ns);
-    uint64_t h = 0xcbf29ce484222325ULL;
+    uint64_t h = SW_FNV_START;
     for (int s = 0; s < steps; ++s) {
         bake_fixture_pose(f, s, pose);
         sinew_instance_set_pose(inst, pose, (uint32_t)f->ch.skel.nbones);

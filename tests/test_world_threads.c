@@ -4,6 +4,7 @@
 #include <pthread.h>
 #include <stdint.h>
 
+#include "hash.h"
 #include "sw_test.h"
 #include "world_fixture.h"
 
@@ -16,10 +17,7 @@ typedef struct {
 } run_arg;
 
 static uint64_t hash_floats(uint64_t h, const float *x, size_t n) {
-    const unsigned char *p = (const unsigned char *)x;
-    for (size_t i = 0; i < n * sizeof(float); ++i)
-        h = (h ^ p[i]) * 0x100000001b3ULL;
-    return h;
+    return sw_fnv1a(h, x, n * sizeof(float));
 }
 
 /* Instance `offset` steps its clip from frame `offset` against the shared, fixed world. */
@@ -32,7 +30,7 @@ static void *run_instance(void *vp) {
     if (sinew_instance_create(f->blob, NULL, &inst) != SINEW_OK) return NULL;
     sinew_instance_set_world(inst, a->m->w);
     float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 3 * ns);
-    uint64_t h = 0xcbf29ce484222325ULL;
+    uint64_t h = SW_FNV_START;
     for (int s = 0; s < THREAD_STEPS; ++s) {
         bake_fixture_pose(f, s + a->offset, pose);
         sinew_instance_set_pose(inst, pose, nb);

@@ -8,15 +8,6 @@
 static const uint8_t MAGIC[8] = {'S', 'W', 'S', 'I', 'M', 'C', 0, 1};
 enum { HEAD = 8 + 8 + 4 + 4, SEQ_HEAD = 16, CONTACT = 16 + 64 };
 
-uint64_t sw_fnv1a(uint64_t h, const void *data, size_t n) {
-    const uint8_t *p = data;
-    for (size_t i = 0; i < n; ++i) {
-        h ^= p[i];
-        h *= 0x100000001b3ull;
-    }
-    return h;
-}
-
 void sw_sim_cache_free(sw_sim_cache *c) {
     if (!c) return;
     for (int32_t i = 0; c->seq && i < c->nseq; ++i) {

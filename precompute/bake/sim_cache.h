@@ -18,6 +18,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "hash.h"
 #include "self_detect.h"
 #include "sw_error.h"
 
@@ -44,9 +45,5 @@ sinew_result sw_sim_cache_parse(const uint8_t *b, size_t n, const char *name, ui
                                 sw_sim_cache *out, sw_error *err);
 
 void sw_sim_cache_free(sw_sim_cache *c);
-
-/* FNV-1a 64 of n bytes continued from h (start with SW_FNV_START). */
-#define SW_FNV_START 0xcbf29ce484222325ull
-uint64_t sw_fnv1a(uint64_t h, const void *data, size_t n);
 
 #endif

@@ -14,6 +14,7 @@
 #include <string.h>
 
 #include "blob_check.h"
+#include "hash.h"
 
 _Static_assert(sizeof(sinew_blob_header) == 64, "blob header is 64 bytes");
 _Static_assert(sizeof(sinew_blob_section) == 32, "section entry is 32 bytes");
@@ -59,13 +60,7 @@ static const struct {
 #define SW_NO_FUZZ_COVERAGE
 #endif
 SW_NO_FUZZ_COVERAGE uint64_t sw_blob_checksum(const void *data, size_t n) {
-    const uint8_t *p = data;
-    uint64_t h = 0xcbf29ce484222325ull; /* FNV-1a 64 offset basis */
-    for (size_t i = 0; i < n; ++i) {
-        h ^= p[i];
-        h *= 0x100000001b3ull; /* FNV 64 prime */
-    }
-    return h;
+    return sw_fnv1a(SW_FNV_START, data, n);
 }
 
 const char *sw_blob_section_name(uint32_t id) {

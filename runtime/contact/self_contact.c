@@ -99,29 +99,28 @@ void sw_self_contacts_clear(sw_self_contacts *sc) {
     sc->tests = 0;
 }
 
-/* Every vertex at the state q: x = R (X + U q) + t with its skinning (eq. 4.13), through
- * its home copy (copies differ by the interface springs' stretch only). */
+/* Every vertex at the state q: its skinning transform, then x = R (X + U q) + t
+ * (eq. 4.13, sw_reduced_position with these transforms) through its home copy (copies
+ * differ by the interface springs' stretch only); a vertex in no tet at its skinned rest. */
 static void map_vertices(sw_self_contacts *sc, const sw_reduced *red, const double *q) {
     const sw_blob_view *v = red->v;
+    sw_reduced map = *red; /* the same map, transforms indexed by vertex */
+    map.act_R = sc->vR;
+    map.act_t = sc->vt;
     for (int32_t gv = 0; gv < v->nverts; ++gv) {
-        double *R = sc->vR + 9 * (int64_t)gv, *t = sc->vt + 3 * (int64_t)gv;
+        double *R = sc->vR + 9 * (int64_t)gv, *t = sc->vt + 3 * (int64_t)gv,
+               *x = sc->x + 3 * (int64_t)gv;
         sw_dqs_blend(red->bone_dq, v->skin_bone + 4 * (int64_t)gv, v->skin_weight + 4 * (int64_t)gv,
                      4, R, t);
-        const double *X = v->rest + 3 * (int64_t)gv;
-        double y[3] = {X[0], X[1], X[2]};
         int32_t d = sc->home[2 * gv];
         if (d >= 0) {
             const sw_blob_domain *D = &v->domains[d];
-            int32_t r = D->rank;
-            const double *U = v->basis + D->basis_offset + (int64_t)3 * sc->home[2 * gv + 1] * r,
-                         *qd = q + D->q_offset;
-            for (int i = 0; i < 3; ++i)
-                for (int32_t j = 0; j < r; ++j)
-                    y[i] += U[i * r + j] * qd[j];
+            sw_reduced_position(&map, D, sc->home[2 * gv + 1], gv, q + D->q_offset, x, NULL);
+            continue;
         }
-        double *x = sc->x + 3 * (int64_t)gv;
+        const double *X = v->rest + 3 * (int64_t)gv;
         for (int i = 0; i < 3; ++i)
-            x[i] = R[3 * i] * y[0] + R[3 * i + 1] * y[1] + R[3 * i + 2] * y[2] + t[i];
+            x[i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
     }
 }
 
