@@ -322,7 +322,8 @@ int main(int argc, char **argv) {
                    res.selector_points[0], res.selector_seconds[0], res.selector_error[0],
                    res.selector_points[1], res.selector_seconds[1], res.selector_error[1],
                    res.selector_points[2], res.selector_seconds[2], res.selector_error[2]);
-        printf(",\"simulate_cached\":%s,\"forced\":%s}\n", res.simulate_cached ? "true" : "false",
+        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
+               res.simulate_cached ? "true" : "false", res.simulate_solved,
                absurd ? "true" : "false");
     }
 done:

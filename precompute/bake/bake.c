@@ -278,6 +278,7 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
     if ((r = sw_bake_poses(s, err)) != SINEW_OK ||
         (r = sw_bake_simulate_cached(s, &out->simulate_cached, err)) != SINEW_OK)
         return r;
+    out->simulate_solved = (int32_t)s->solved_poses;
     for (int32_t i = 0; i < s->ntrain_seq; ++i) {
         out->ntrain += s->train[i].npose;
         out->train_unsettled += s->train[i].unsettled;
@@ -404,12 +405,13 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     t1 = sw_now_seconds();
     out->stage_seconds[2] = t1 - t0;
     {
-        char msg[160];
+        char msg[224];
         snprintf(msg, sizeof msg,
                  "%d training and %d held-out full-space solutions (%d and %d with a contact set "
-                 "left unsettled by the round cap)%s",
+                 "left unsettled by the round cap), %d of them solved, the rest read from the "
+                 "cache",
                  out->ntrain, out->nheldout, out->train_unsettled, out->heldout_unsettled,
-                 out->simulate_cached ? ", read from the cache" : "");
+                 out->simulate_solved);
         progress(&p, "simulate", t1 - t0, msg);
     }
 

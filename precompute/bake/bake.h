@@ -99,7 +99,8 @@ typedef struct sw_bake_result {
        while it still changed (sw_fullsim_stats.contacts_unsettled): their shape in the
        fold depends on the cap, and so does the error measured against them */
     int32_t train_unsettled, heldout_unsettled;
-    int simulate_cached;       /* the simulate stage read its solutions from the cache */
+    int simulate_cached;       /* the simulate stage read all its solutions from the cache */
+    int32_t simulate_solved;   /* poses it solved (the others it read from the cache) */
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     double cubature_error_max; /* worst per-domain relative cubature training error */

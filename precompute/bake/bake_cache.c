@@ -18,19 +18,23 @@
 
 #define MIX(h, v) ((h) = sw_fnv1a((h), &(v), sizeof(v)))
 
-/* The sequences in the file's order: the training ones, then the held-out one. */
-static sw_pose_seq *seq_at(sw_bake_state *s, int32_t i) {
-    return i < s->ntrain_seq ? &s->train[i] : &s->heldout;
+/* A chain: a sequence solved from rest and the sequences that continue it (its then[]),
+ * in that order; the cache keeps one file per chain, so that a bake that adds or changes
+ * a clip, a sweep or the adaptive loop's poses solves only the chains that changed. */
+typedef struct chain {
+    sw_pose_seq *seq[3];
+    int32_t n;
+} chain;
+
+static chain chain_of(sw_pose_seq *root) {
+    chain c = {{root, NULL, NULL}, 1};
+    for (int k = 0; k < 2; ++k)
+        if (root->then[k]) c.seq[c.n++] = root->then[k];
+    return c;
 }
 
-/* The index of sequence q in that order (-1: none). */
-static int32_t seq_index(sw_bake_state *s, const sw_pose_seq *q) {
-    for (int32_t i = 0; q && i <= s->ntrain_seq; ++i)
-        if (seq_at(s, i) == q) return i;
-    return -1;
-}
-
-static uint64_t simulate_key(sw_bake_state *s) {
+/* Everything every solve depends on but its poses: mesh, weights, material, simulator. */
+static uint64_t character_key(sw_bake_state *s) {
     uint64_t h = SW_FNV_START;
     const char tag[] = "sinew simulate cache";
     h = sw_fnv1a(h, tag, sizeof tag);
@@ -56,13 +60,19 @@ static uint64_t simulate_key(sw_bake_state *s) {
         fp.ground_k,   fp.newton_rtol,    fp.pcg_rtol};
     h = sw_fnv1a(h, ints, sizeof ints);
     h = sw_fnv1a(h, reals, sizeof reals);
-    int32_t nseq = s->ntrain_seq + 1;
-    MIX(h, nseq);
-    for (int32_t i = 0; i < nseq; ++i) { /* the poses, and which path continues which */
-        const sw_pose_seq *q = seq_at(s, i);
-        int32_t links[3] = {q->npose, seq_index(s, q->then[0]), seq_index(s, q->then[1])};
+    return h;
+}
+
+/* The chain's key: the character's, then its sequences' poses in solving order. */
+static uint64_t chain_key(const sw_bake_state *s, uint64_t character, const chain *c) {
+    uint64_t h = character;
+    int32_t n = c->n;
+    MIX(h, n);
+    for (int32_t i = 0; i < c->n; ++i) {
+        const sw_pose_seq *q = c->seq[i];
+        int32_t links[3] = {q->npose, q->then[0] != NULL, q->then[1] != NULL};
         h = sw_fnv1a(h, links, sizeof links);
-        h = sw_fnv1a(h, q->T, (size_t)q->npose * 12 * nb * sizeof(double));
+        h = sw_fnv1a(h, q->T, (size_t)q->npose * 12 * s->nb * sizeof(double));
     }
     return h;
 }
@@ -83,10 +93,10 @@ static uint8_t *read_all(const char *path, size_t *n) {
     return b;
 }
 
-/* Hands the cache's arrays to the sequences. */
-static sinew_result adopt(sw_bake_state *s, sw_sim_cache *c, sw_error *err) {
+/* Hands the cache's arrays to the chain's sequences. */
+static sinew_result adopt(sw_bake_state *s, const chain *ch, sw_sim_cache *c, sw_error *err) {
     for (int32_t i = 0; i < c->nseq; ++i) {
-        sw_pose_seq *q = seq_at(s, i);
+        sw_pose_seq *q = ch->seq[i];
         sw_sim_cache_seq *e = &c->seq[i];
         memcpy(q->x, e->x, (size_t)q->npose * 3 * s->nv * sizeof(double));
         memcpy(q->contact_ptr, e->contact_ptr, (size_t)(q->npose + 1) * sizeof(int32_t));
@@ -96,35 +106,54 @@ static sinew_result adopt(sw_bake_state *s, sw_sim_cache *c, sw_error *err) {
         q->ncontacts = q->contact_cap = e->ncontacts;
         q->failed = e->failed;
         q->unsettled = e->unsettled;
+        q->from_cache = 1;
         if (q->failed)
             return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
-                                "%d training poses of sequence %d diverged (cached)", q->failed, i);
+                                "%d training poses of a cached sequence diverged", q->failed);
     }
     return SINEW_OK;
 }
 
-/* Stores the sequences' solutions under key (a failure is only reported: the bake
- * itself has what it needs). */
-static void store(sw_bake_state *s, uint64_t key, const char *path) {
-    int32_t nseq = s->ntrain_seq + 1;
-    sw_sim_cache c = {key, s->nv, nseq, calloc((size_t)nseq, sizeof(sw_sim_cache_seq))};
+/* Stores the chain's solutions under key (a failure is only reported: the bake itself
+ * has what it needs). */
+static void store(sw_bake_state *s, const chain *ch, uint64_t key, const char *path) {
+    sw_sim_cache_seq seq[3];
+    sw_sim_cache c = {key, s->nv, ch->n, seq};
     sw_error e;
     uint8_t *b = NULL;
     size_t n = 0;
-    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
-    if (c.seq) {
-        for (int32_t i = 0; i < nseq; ++i) {
-            sw_pose_seq *q = seq_at(s, i);
-            c.seq[i] = (sw_sim_cache_seq){q->npose, q->failed,      q->unsettled, q->ncontacts,
-                                          q->x,     q->contact_ptr, q->contacts};
-        }
-        r = sw_sim_cache_encode(&c, &b, &n, &e);
-        if (r == SINEW_OK) r = sw_write_file_atomic(path, b, n, &e);
+    for (int32_t i = 0; i < ch->n; ++i) {
+        sw_pose_seq *q = ch->seq[i];
+        seq[i] = (sw_sim_cache_seq){q->npose, q->failed,      q->unsettled, q->ncontacts,
+                                    q->x,     q->contact_ptr, q->contacts};
     }
+    sinew_result r = sw_sim_cache_encode(&c, &b, &n, &e);
+    if (r == SINEW_OK) r = sw_write_file_atomic(path, b, n, &e);
     if (r != SINEW_OK && s->p->progress)
         fprintf(stderr, "sinew-bake: simulate cache not stored: %s\n", e.msg);
+    free(b); /* the arrays are the sequences' */
+}
+
+/* Reads the chain's file when there is a usable one (1), reporting one that is not. */
+static int lookup(sw_bake_state *s, const chain *ch, uint64_t key, const char *path,
+                  sinew_result *r, sw_error *err) {
+    size_t n = 0;
+    uint8_t *b = read_all(path, &n);
+    if (!b) return 0;
+    int32_t npose[3];
+    for (int32_t i = 0; i < ch->n; ++i)
+        npose[i] = ch->seq[i]->npose;
+    sw_sim_cache c;
+    sw_error e;
+    sinew_result pr = sw_sim_cache_parse(b, n, path, key, s->nv, ch->n, npose, &c, &e);
     free(b);
-    free(c.seq); /* the arrays are the sequences' */
+    if (pr != SINEW_OK) {
+        if (s->p->progress) fprintf(stderr, "sinew-bake: simulate cache unused: %s\n", e.msg);
+        return 0;
+    }
+    *r = adopt(s, ch, &c, err);
+    sw_sim_cache_free(&c);
+    return 1;
 }
 
 sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err) {
@@ -137,32 +166,29 @@ sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *er
                             strerror(errno));
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
         return sw_error_set(err, SINEW_ERROR_IO, "cache folder '%s' is not a folder", dir);
-    uint64_t key = simulate_key(s);
+    uint64_t character = character_key(s);
+    int32_t nroot = 0, hits = 0;
+    sinew_result r = SINEW_OK;
     char path[4200];
-    snprintf(path, sizeof path, "%s/simulate-%016llx.bin", dir, (unsigned long long)key);
-    size_t n = 0;
-    uint8_t *b = read_all(path, &n);
-    if (b) {
-        int32_t nseq = s->ntrain_seq + 1, *npose = malloc((size_t)nseq * sizeof(int32_t));
-        sw_sim_cache c;
-        sw_error e;
-        sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
-        if (npose) {
-            for (int32_t i = 0; i < nseq; ++i)
-                npose[i] = seq_at(s, i)->npose;
-            r = sw_sim_cache_parse(b, n, path, key, s->nv, nseq, npose, &c, &e);
-        }
-        free(npose);
-        free(b);
-        if (r == SINEW_OK) {
-            r = adopt(s, &c, err);
-            sw_sim_cache_free(&c);
-            *cached = r == SINEW_OK;
-            return r;
-        }
-        if (s->p->progress) fprintf(stderr, "sinew-bake: simulate cache unused: %s\n", e.msg);
+    for (int32_t i = 0; i <= s->ntrain_seq && r == SINEW_OK; ++i) {
+        sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
+        if (q->continues || q->npose == 0) continue;
+        chain ch = chain_of(q);
+        snprintf(path, sizeof path, "%s/simulate-%016llx.bin", dir,
+                 (unsigned long long)chain_key(s, character, &ch));
+        nroot++;
+        hits += lookup(s, &ch, chain_key(s, character, &ch), path, &r, err);
     }
-    sinew_result r = sw_bake_simulate(s, err);
-    if (r == SINEW_OK) store(s, key, path);
-    return r;
+    if (r != SINEW_OK) return r;
+    if ((r = sw_bake_simulate(s, err)) != SINEW_OK) return r; /* the chains not found */
+    for (int32_t i = 0; i <= s->ntrain_seq; ++i) {
+        sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
+        if (q->continues || q->npose == 0 || q->from_cache) continue;
+        chain ch = chain_of(q);
+        uint64_t key = chain_key(s, character, &ch);
+        snprintf(path, sizeof path, "%s/simulate-%016llx.bin", dir, (unsigned long long)key);
+        store(s, &ch, key, path);
+    }
+    *cached = hits == nroot;
+    return SINEW_OK;
 }

@@ -29,7 +29,8 @@ typedef struct sw_pose_seq {
     /* solved after this sequence, each warm-started from its last solution: the clip's
        held-out frames and its return path continue the training frames' path */
     struct sw_pose_seq *then[2];
-    int continues; /* this sequence is another's `then`: not scheduled on its own */
+    int continues;  /* this sequence is another's `then`: not scheduled on its own */
+    int from_cache; /* its solutions were read from the simulate cache: not solved again */
 } sw_pose_seq;
 
 typedef struct sw_bake_state {
@@ -53,6 +54,7 @@ typedef struct sw_bake_state {
     /* poses */
     sw_pose_seq *train;
     int32_t ntrain_seq;
+    int64_t solved_poses; /* poses the simulate stage solved (not read from the cache) */
     sw_pose_seq heldout;
     /* basis: per domain 3 n_d x r_d, row-major */
     int32_t *rank;

@@ -412,8 +412,9 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     sw_pose_seq *seqs[4096];
     int32_t n = 0;
     for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
-        if (!s->train[i].continues) seqs[n++] = &s->train[i];
-    if (s->heldout.npose > 0 && !s->heldout.continues) seqs[n++] = &s->heldout;
+        if (!s->train[i].continues && !s->train[i].from_cache) seqs[n++] = &s->train[i];
+    if (s->heldout.npose > 0 && !s->heldout.continues && !s->heldout.from_cache)
+        seqs[n++] = &s->heldout;
     /* longest path first (stable): a long clip taken last by one worker would leave the
        others idle at the end (each path's results do not depend on the order) */
     for (int32_t i = 1; i < n; ++i)
@@ -428,9 +429,10 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     ctx.nseq = n;
     atomic_init(&ctx.next, 0);
     atomic_init(&ctx.failed, 0);
-    int64_t poses = s->heldout.npose;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        poses += s->train[i].npose;
+    int64_t poses = 0; /* the chains to solve (the others came from the cache) */
+    for (int32_t i = 0; i < n; ++i)
+        poses += path_poses(seqs[i]);
+    s->solved_poses = poses;
     sw_bake_progress_begin(s, "simulate", poses);
     /* one task per worker; each worker pulls sequences until none is left */
     sw_pool_parallel_for(s->pool, sw_pool_size(s->pool), simulate_worker, &ctx);
