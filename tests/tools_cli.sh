@@ -41,7 +41,7 @@ expect bake_frames_2 2 "--frames wants an integer in 4\.\.1000000, got '2'" \
     "$bake" "${small[@]}" --frames 2 --out "$tmp/a.blob"
 expect bench_frames_3 2 "--frames wants an integer in 4\.\.1000000" \
     "$bench" "${small[@]}" --frames 3
-"$bake" --help | grep -q "the bake trains on the first 60% and holds out" ||
+"$bake" --help | grep >/dev/null "the bake trains on the first 60% and holds out" ||
     { echo "FAIL bake_help_frames: --help does not say why --frames starts at 4" >&2; fails=$((fails + 1)); }
 
 # flags that do not apply to the input
@@ -67,6 +67,8 @@ expect bake_tol_range 2 "--tol wants a number in the open range 0\.\.1, got '2'"
     "$bake" "${small[@]}" --tol 2 --out "$tmp/a.blob"
 expect bake_rank_range 2 "--max-rank wants an integer in 1\.\.1024, got '0'" \
     "$bake" "${small[@]}" --max-rank 0 --out "$tmp/a.blob"
+expect bake_adaptive_range 2 "--adaptive wants an integer in 0\.\.32, got '40'" \
+    "$bake" "${small[@]}" --adaptive 40 --out "$tmp/a.blob"
 expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'" \
     "$bench" --scene finger --tets 10
 expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \
@@ -91,7 +93,7 @@ expect bench_world_format 2 "--world 'w\.yaml': not a format it reads; accepted:
     "$bench" "${small[@]}" --world w.yaml
 expect render_out_format 2 "--out '.*a\.jpg': not a format it reads; accepted: \.png" \
     "$render" --obj a.obj --out "$tmp/a.jpg"
-"$bake" --help | grep -q -- "^                   1000\.\.2000000 (default 20000)" ||
+"$bake" --help | grep >/dev/null -- "^                   1000\.\.2000000 (default 20000)" ||
     { echo "FAIL bake_help_ranges: --help does not state --tets's range" >&2; fails=$((fails + 1)); }
 
 # an absurd training error is an error (nothing written) unless --force
@@ -275,6 +277,11 @@ want=('"sc_speedup_max":[0-9.]+,' '"sc_frame_share":0\.[0-9]+,' '"sc_exh_pairs":
     '"gap_poses":[1-9][0-9]*,' '"gap_err_projection":[0-9.]+,' '"failed_steps":0,')
 expect_stdout bench_sc_gap "$bench" "${small[@]}" --frames 8 --full-frames 1 \
     --contract-steps 0 --sc-compare --error-gap --json
+# the adaptive loop: a round that adds 2 poses, both rounds in the JSON, the picks verified
+want=('"adaptive":\[\{"train_poses":[0-9]+,"added":0,.*"picks_error":[0-9.]+,' \
+    '\{"train_poses":[0-9]+,"added":2,.*"picks_error":-1\.0+,"solved":2,')
+expect_stdout bake_adaptive "$bake" "${small[@]}" --frames 8 --adaptive 1 --adaptive-add 2 \
+    --adaptive-candidates 4 --out "$tmp/adaptive.blob" --json
 expect bake_cache_unwritable 1 "--cache '$tmp/plain/c': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --cache "$tmp/plain/c"
 if [ -f "$fox" ]; then

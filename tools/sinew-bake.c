@@ -29,6 +29,7 @@
 #include "sw_mesh.h"
 
 #include "bake.h"
+#include "bake_adaptive.h"
 #include "bake_report.h"
 #include "blob_write.h"
 #include "character_io.h"
@@ -36,20 +37,23 @@
 #include "subspace_eval.h"
 
 static void usage(FILE *f) {
+    fprintf(f, "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
+               "                   [--fps F] [--height H] |\n"
+               "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+               "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+               "                   [--clip FILE [--frames F]])\n"
+               "                  --out FILE.blob [--report DIR]\n"
+               "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
+               "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
+               "                  [--compare-cubature] [--no-self-contact] [--return-path]\n"
+               "                  [--pair-sweeps] [--adaptive R [--adaptive-add K]\n"
+               "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
+               "                  [--adaptive-target E]]\n"
+               "                  [--inertia-modes] [--cache DIR] [--threads T] [--force]\n"
+               "                  [--json]\n"
+               "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
-            "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
-            "                   [--fps F] [--height H] |\n"
-            "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-            "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-            "                   [--clip FILE [--frames F]])\n"
-            "                  --out FILE.blob [--report DIR]\n"
-            "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
-            "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
-            "                  [--compare-cubature] [--no-self-contact] [--return-path]\n"
-            "                  [--pair-sweeps]\n"
-            "                  [--inertia-modes] [--cache DIR] [--threads T] [--force]\n"
-            "                  [--json]\n"
-            "character:\n" SW_CHARACTER_USAGE "bake:\n"
+            "bake:\n"
             "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
             "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
             "                   frame's error, ranks, cubature, stage times, a contact sheet of\n"
@@ -63,6 +67,11 @@ static void usage(FILE *f) {
             "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
             "  --pair-sweeps    also train on every joint swept together with its parent\n"
             "                   joint (combinations the single-joint sweeps never show)\n"
+            "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
+            "                   (default 64) random combined poses the blob steps worst (the\n"
+            "                   full-space force its state leaves over plain skinning's) to\n"
+            "                   the training poses and bake again, until B poses (default 32)\n"
+            "                   are added or the held-out error is at most E\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
             "                   flesh lags and overshoots as the reference does; a higher rank\n"
@@ -85,6 +94,9 @@ int main(int argc, char **argv) {
     const char *out_path = NULL, *report_dir = NULL;
     int json = 0, force = 0;
     sw_bake_params p = sw_bake_params_default();
+    sw_adaptive_params ad = sw_adaptive_params_default();
+    sw_adaptive_report arep;
+    ad.rounds = 0;
     p.progress = 1;
     sw_tool_progress bar;
     sw_tool_progress_init(&bar, tool);
@@ -137,6 +149,16 @@ int main(int argc, char **argv) {
             p.return_path = 1;
         else if (!strcmp(a, "--pair-sweeps"))
             p.pair_sweeps = 1;
+        else if (!strcmp(a, "--adaptive") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 0, SW_ADAPTIVE_MAX_ROUNDS, &ad.rounds);
+        else if (!strcmp(a, "--adaptive-add") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &ad.add);
+        else if (!strcmp(a, "--adaptive-candidates") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &ad.candidates);
+        else if (!strcmp(a, "--adaptive-budget") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 0, 1000000, &ad.budget);
+        else if (!strcmp(a, "--adaptive-target") && next)
+            ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in 0..1", &ad.target);
         else if (!strcmp(a, "--inertia-modes"))
             p.inertia_modes = 1;
         else if (!strcmp(a, "--force"))
@@ -175,7 +197,8 @@ int main(int argc, char **argv) {
     if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
     sw_tool_bake_clips(&ca, &clips, &p);
     sw_bake_result res;
-    r = sw_bake(&ch, &p, &res, &err);
+    r = ad.rounds > 0 ? sw_bake_adaptive(&ch, &p, &ad, &res, &arep, &err)
+                      : sw_bake(&ch, &p, &res, &err);
     if (r != SINEW_OK) {
         sw_character_free(&ch);
         sw_clip_split_free(&clips);
@@ -322,6 +345,17 @@ int main(int argc, char **argv) {
                    res.selector_points[0], res.selector_seconds[0], res.selector_error[0],
                    res.selector_points[1], res.selector_seconds[1], res.selector_error[1],
                    res.selector_points[2], res.selector_seconds[2], res.selector_error[2]);
+        for (int k = 0; ad.rounds > 0 && k < arep.nrounds; ++k) {
+            const sw_adaptive_round *a = &arep.round[k];
+            printf("%s{\"train_poses\":%d,\"added\":%d,\"rank\":%d,\"err_train\":%.5f,"
+                   "\"err_heldout\":%.5f,\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,"
+                   "\"score_mean\":%.4f,\"score_max\":%.4f,\"picks_score\":%.4f,"
+                   "\"picks_error\":%.5f,\"solved\":%d,\"seconds\":%.2f}%s",
+                   k == 0 ? ",\"adaptive\":[" : ",", a->ntrain, a->added, a->rank_total,
+                   a->err_train, a->err_heldout, a->proj_train, a->proj_heldout, a->score_mean,
+                   a->score_max, a->picks_score, a->picks_error, a->solved, a->seconds,
+                   k + 1 == arep.nrounds ? "]" : "");
+        }
         printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
                res.simulate_cached ? "true" : "false", res.simulate_solved,
                absurd ? "true" : "false");

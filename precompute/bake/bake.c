@@ -151,6 +151,8 @@ static sinew_result prepare(sw_bake_state *s, const sw_character *c, int heat, s
 static void free_state(sw_bake_state *s) {
     pthread_mutex_destroy(&s->progress_lock);
     free(s->weights);
+    free(s->sweep_axis);
+    free(s->sweep_angle);
     free(s->skin_bone);
     free(s->skin_weight);
     free(s->mass);
@@ -269,6 +271,12 @@ static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
                             "bake clips: %d training and %d held-out clips (held-out clips need "
                             "training clips)",
                             p.ntrain_clips, p.nheldout_clips);
+    int32_t chain = p.extra_chain > 0 ? p.extra_chain : p.nextra_poses;
+    if (p.nextra_poses < 0 || p.extra_chain < 0 || (p.nextra_poses > 0 && !p.extra_poses) ||
+        (p.nextra_poses > 0 && (p.nextra_poses + chain - 1) / chain > 1024))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "bake extra poses: %d poses in paths of %d (at most 1024 paths)",
+                            p.nextra_poses, p.extra_chain);
     return SINEW_OK;
 }
 
@@ -279,6 +287,12 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
         (r = sw_bake_simulate_cached(s, &out->simulate_cached, err)) != SINEW_OK)
         return r;
     out->simulate_solved = (int32_t)s->solved_poses;
+    size_t na = (size_t)s->nb * 3 * sizeof(double);
+    if (!(out->sweep_axis = sw_bake_own(out, malloc(na))) ||
+        !(out->sweep_angle = sw_bake_own(out, malloc(na / 3))))
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    memcpy(out->sweep_axis, s->sweep_axis, na);
+    memcpy(out->sweep_angle, s->sweep_angle, na / 3);
     for (int32_t i = 0; i < s->ntrain_seq; ++i) {
         out->ntrain += s->train[i].npose;
         out->train_unsettled += s->train[i].unsettled;
@@ -313,6 +327,11 @@ static sinew_result bake_begin(sw_bake_state *s, const sw_bake_params *p, const 
                              i < p->ntrain_clips ? i : i - p->ntrain_clips, k->nbones, k->nframes,
                              c->skel.nbones);
     }
+    for (int64_t i = 0; r == SINEW_OK && i < (int64_t)p->nextra_poses * 12 * c->skel.nbones; ++i)
+        if (!isfinite(p->extra_poses[i]))
+            r = sw_error_set(err, SINEW_ERROR_NOT_FINITE,
+                             "bake extra poses: pose %lld has a value that is not finite",
+                             (long long)(i / (12 * c->skel.nbones)));
     if (r == SINEW_OK) r = prepare(s, c, c->weights.w == NULL, err);
     if (r == SINEW_OK && !(s->pool = sw_pool_create(p->threads)))
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "cannot start threads");

@@ -81,6 +81,11 @@ typedef struct sw_bake_params {
     int32_t ntrain_clips;
     const sw_clip *heldout_clips;
     int32_t nheldout_clips;
+    /* Training poses of the caller's own (12 nbones each, as a clip's frames), solved
+       extra_chain at a time on a path from rest after the sweeps (0: all on one path);
+       the adaptive loop adds its poses here (bake_adaptive.h). NULL/0 (default): none. */
+    const double *extra_poses;
+    int32_t nextra_poses, extra_chain;
     int compare_selectors; /* also train the other two selectors on the same data and
                               report their sizes and times (the blob keeps `selector`) */
 } sw_bake_params;
@@ -126,7 +131,17 @@ typedef struct sw_bake_result {
        frame there; -1 for poses of no clip (joint sweeps, the return path, random poses) */
     int32_t *train_clip, *train_frame;     /* ntrain */
     int32_t *heldout_clip, *heldout_frame; /* nheldout */
+    /* every joint's sweep: its axis (3 per bone) and largest angle (per bone; 0 for a
+       joint the training poses do not bend), the range random combined poses span */
+    double *sweep_axis, *sweep_angle;
 } sw_bake_result;
+
+/* n random combined poses (12 nbones each into T): every joint turned about its sweep
+ * axis by a uniform share of its sweep angle, from `seed` (the held-out poses of a bake
+ * without a clip are these with sw_bake_params.seed). local: 9 nbones doubles scratch. */
+void sw_bake_random_poses(const sw_skeleton *sk, const double *sweep_axis,
+                          const double *sweep_angle, uint64_t seed, int32_t n, double *local,
+                          double *T);
 
 /* The fewest clip frames a bake can train on: it trains on the first
  * floor((1 - heldout_fraction) F) frames and holds out the rest, and learns its basis and

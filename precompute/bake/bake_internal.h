@@ -54,6 +54,7 @@ typedef struct sw_bake_state {
     /* poses */
     sw_pose_seq *train;
     int32_t ntrain_seq;
+    double *sweep_axis, *sweep_angle; /* per bone: each joint's sweep (bake_poses.c) */
     int64_t solved_poses; /* poses the simulate stage solved (not read from the cache) */
     sw_pose_seq heldout;
     /* basis: per domain 3 n_d x r_d, row-major */

@@ -191,10 +191,16 @@ static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld
     }
     if (s->p->random_poses <= 0) return 1;
     n = s->p->random_poses;
-    uint64_t seed = s->p->seed;
     if (!seq_alloc(&s->heldout, n, nb, s->nv)) return 0;
+    sw_bake_random_poses(&s->ch.skel, sweep_axis, sweep_angle, s->p->seed, n, local, s->heldout.T);
+    return 1;
+}
+
+void sw_bake_random_poses(const sw_skeleton *sk, const double *sweep_axis,
+                          const double *sweep_angle, uint64_t seed, int32_t n, double *local,
+                          double *T) {
     for (int32_t i = 0; i < n; ++i) {
-        for (int32_t k = 0; k < nb; ++k) {
+        for (int32_t k = 0; k < sk->nbones; ++k) {
             double u = (double)(splitmix(&seed) >> 11) * 0x1.0p-53;
             sw_m3_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
             if (!(sweep_angle[k] > 0)) {
@@ -202,9 +208,8 @@ static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld
                 local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;
             }
         }
-        sw_forward_kinematics(&s->ch.skel, local, NULL, s->heldout.T + (size_t)i * 12 * nb);
+        sw_forward_kinematics(sk, local, NULL, T + (size_t)i * 12 * sk->nbones);
     }
-    return 1;
 }
 
 /* Training sequences: every training range (at most max_train_frames of it), the first
@@ -240,7 +245,9 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
     int32_t nreturn = s->p->return_path && n0 >= 2 ? n0 - 1 : 0, npair = 0;
     for (int32_t b = 0; s->p->pair_sweeps && b < nb; ++b)
         npair += swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b]);
-    s->ntrain_seq = ntr + (nreturn > 0) + njoint + npair;
+    int32_t chain = s->p->extra_chain > 0 ? s->p->extra_chain : s->p->nextra_poses;
+    int32_t nextra = s->p->nextra_poses > 0 ? (s->p->nextra_poses + chain - 1) / chain : 0;
+    s->ntrain_seq = ntr + (nreturn > 0) + njoint + npair + nextra;
     s->train = calloc((size_t)s->ntrain_seq + 1, sizeof(sw_pose_seq));
     if (!s->train) return 0;
     int32_t qi = 0;
@@ -271,6 +278,13 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
                            s->train[qi].T + (size_t)i * 12 * nb);
             qi++;
         }
+    /* the caller's poses (the adaptive loop's), `chain` at a time on a path from rest */
+    for (int32_t at = 0; at < s->p->nextra_poses; at += chain, ++qi) {
+        int32_t n = s->p->nextra_poses - at < chain ? s->p->nextra_poses - at : chain;
+        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
+        memcpy(s->train[qi].T, s->p->extra_poses + (size_t)at * 12 * nb,
+               (size_t)n * 12 * nb * sizeof(double));
+    }
     return 1;
 }
 
@@ -319,8 +333,8 @@ oom:
 done:
     free(train);
     free(held);
-    free(sweep_axis);
-    free(sweep_angle);
+    s->sweep_axis = sweep_axis; /* the adaptive loop's candidates (sw_bake_result) */
+    s->sweep_angle = sweep_angle;
     free(local);
     return rc;
 }
