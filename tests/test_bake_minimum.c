@@ -156,6 +156,39 @@ static void local_of(const sw_skeleton *sk, const double *T, int32_t b, double L
 /* Pair sweeps (issue 16): the finger's tip joint swept together with its parent joint, a
  * sequence of sweep_samples poses after the single sweeps, the last of them each joint at
  * its own sweep's end; the held-out poses stay the same. */
+/* The held-out frames of the character's clip are solved after its training frames on
+ * one path, and measured on that path (sw_bake_heldout_path): the training frames first,
+ * unmeasured; held-out clips of their own start from rest. */
+TEST(heldout_frames_are_measured_on_the_reference_path) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 10, &c, &err) == SINEW_OK);
+    sw_bake_params p = quick_params();
+    sw_bake_result a;
+    ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    int32_t nb = c.skel.nbones, pre = -1, n = -1;
+    size_t pt = (size_t)12 * nb * sizeof(double);
+    ENSURE(a.heldout_after == 6 && a.nheldout == 4);
+    double *T = sw_bake_heldout_path(&a, nb, &pre, &n);
+    ENSURE(T && pre == 6 && n == 10);
+    for (int32_t f = 0; f < n; ++f) /* the clip itself, frame after frame */
+        ENSURE(!memcmp((char *)T + f * pt, (char *)c.clip.T + f * pt, pt));
+    free(T);
+    sw_bake_result_free(&a);
+    /* a held-out clip of its own: from rest */
+    p.train_clips = &c.clip;
+    p.ntrain_clips = 1;
+    p.heldout_clips = &c.clip;
+    p.nheldout_clips = 1;
+    ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    T = sw_bake_heldout_path(&a, nb, &pre, &n);
+    ENSURE(T && a.heldout_after == 0 && pre == 0 && n == a.nheldout &&
+           !memcmp(T, a.heldout_T, (size_t)n * pt));
+    free(T);
+    sw_bake_result_free(&a);
+    sw_character_free(&c);
+}
+
 TEST(pair_sweeps_turn_a_joint_with_its_parent) {
     sw_character c;
     sw_error err;
@@ -197,4 +230,5 @@ TEST(pair_sweeps_turn_a_joint_with_its_parent) {
 
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
              CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain),
-             CASE(pair_sweeps_turn_a_joint_with_its_parent))
+             CASE(pair_sweeps_turn_a_joint_with_its_parent),
+             CASE(heldout_frames_are_measured_on_the_reference_path))

@@ -19,8 +19,8 @@
 #define GAP 4
 
 /* The three surfaces (runtime, reference, skinning) of `rows` held-out poses, 3 nverts
- * doubles each, stepping a quasistatic instance through every held-out pose in order as
- * sw_bake_errors does. */
+ * doubles each, stepping a quasistatic instance along the held-out poses' path
+ * (sw_bake_heldout_path) as sw_bake_errors does. */
 static sinew_result capture(const sw_bake_result *res, const sinew_blob *blob, int32_t nv,
                             int32_t rows, double *X, sw_error *err) {
     sinew_instance_def def = sinew_instance_def_default();
@@ -36,9 +36,17 @@ static sinew_result capture(const sw_bake_result *res, const sinew_blob *blob, i
     }
     const sw_blob_view *v = sw_blob_get_view(blob);
     size_t n3 = 3 * (size_t)nv;
-    for (int32_t k = 0, row = 0; k < res->nheldout && row < rows; ++k) {
-        sw_instance_set_pose_d(inst, res->heldout_T + (size_t)k * 12 * v->nbones);
+    int32_t pre, n; /* the held-out poses on the reference's path */
+    double *T = sw_bake_heldout_path(res, v->nbones, &pre, &n);
+    if (!T) {
+        free(cnt);
+        sinew_instance_destroy(inst);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "contact sheet: out of memory");
+    }
+    for (int32_t k = -pre, row = 0; k < res->nheldout && row < rows; ++k) {
+        sw_instance_set_pose_d(inst, T + (size_t)(k + pre) * 12 * v->nbones);
         sinew_instance_step(inst, 1.0f / 30);
+        if (k < 0) continue;
         int32_t want = rows == 1 ? 0 : (int32_t)((int64_t)row * (res->nheldout - 1) / (rows - 1));
         if (k != want) continue;
         double *out = X + (size_t)row * 3 * n3;
@@ -47,6 +55,7 @@ static sinew_result capture(const sw_bake_result *res, const sinew_blob *blob, i
         sw_instance_dqs_positions(inst, out + 2 * n3);
         row++;
     }
+    free(T);
     free(cnt);
     sinew_instance_destroy(inst);
     return SINEW_OK;

@@ -64,10 +64,11 @@ static void project(const sinew_instance *in, const double *x, double *q) {
     }
 }
 
-/* One pose set (npose poses T, solutions X) stepped in order on a fresh instance. */
+/* One pose set (npose poses T, solutions X of the poses after the first `skip`, which
+ * are stepped but not measured) stepped in order on a fresh instance. */
 static sinew_result run_set(const sinew_blob *blob, const double *mass, const double *T,
-                            const double *X, int32_t npose, sinew_self_contact sc, sw_gap_set *out,
-                            sw_error *err) {
+                            const double *X, int32_t npose, int32_t skip, sinew_self_contact sc,
+                            sw_gap_set *out, sw_error *err) {
     memset(out, 0, sizeof *out);
     const sw_blob_view *v = sw_blob_get_view(blob);
     sinew_instance_def d = sinew_instance_def_default();
@@ -86,10 +87,10 @@ static sinew_result run_set(const sinew_blob *blob, const double *mass, const do
         goto done;
     }
     for (int32_t j = 0; j < npose; ++j) {
-        const double *xf = X + (size_t)j * 3 * nv;
         if (sw_instance_set_pose_d(in, T + (size_t)j * 12 * nb) != SINEW_OK ||
-            sinew_instance_step(in, 1.0f / 30) != SINEW_OK)
+            sinew_instance_step(in, 1.0f / 30) != SINEW_OK || j < skip)
             continue; /* a failed step: sinew-bench's failed_steps counts it already */
+        const double *xf = X + (size_t)(j - skip) * 3 * nv;
         memcpy(qr, sw_instance_q(in), sizeof(double) * R);
         sw_eval_acc_add(&art, in, xf);
         project(in, xf, qp);
@@ -128,10 +129,14 @@ sinew_result sw_gap_bench_run(const sinew_blob *blob, const sw_bake_result *res,
     if (!v || v->ntets == 0)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "--error-gap needs a blob with the tet mesh (bake it again)");
-    sinew_result r = run_set(blob, res->mass, res->heldout_T, res->heldout_x, res->nheldout, sc,
-                             &out->heldout, err);
+    int32_t pre, n; /* the held-out poses on the reference's path, as sw_bake_errors */
+    double *T = sw_bake_heldout_path(res, v->nbones, &pre, &n);
+    if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "--error-gap: out of memory");
+    sinew_result r = run_set(blob, res->mass, T, res->heldout_x, n, pre, sc, &out->heldout, err);
+    free(T);
     if (r == SINEW_OK)
-        r = run_set(blob, res->mass, res->train_T, res->train_x, res->ntrain, sc, &out->train, err);
+        r = run_set(blob, res->mass, res->train_T, res->train_x, res->ntrain, 0, sc, &out->train,
+                    err);
     return r;
 }
 

@@ -506,6 +506,7 @@ int main(int argc, char **argv) {
         clip.nheldout = kf - ntr;
         clip.heldout_T = ch.clip.T + ntr * pt;
         clip.heldout_x = full_x + ntr * px;
+        clip.heldout_after = ntr; /* the reference solved the clip on one path */
         if ((r = sw_bake_errors(blob, &clip, self_mode, &et, &eh, &err)) != SINEW_OK)
             return sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         ref_unsettled = full_unsettled;

@@ -10,6 +10,7 @@
 #include "sw_mesh.h"
 
 #include "bake_internal.h"
+#include "blob_load.h"
 #include "fem_corot.h"
 #include "weights_heat.h"
 
@@ -298,6 +299,7 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
         out->train_unsettled += s->train[i].unsettled;
     }
     out->nheldout = s->heldout.npose;
+    out->heldout_after = s->heldout.continues ? s->train[0].npose : 0;
     out->heldout_unsettled = s->heldout.unsettled;
     if ((r = keep_solutions(s, out, err)) != SINEW_OK) return r;
     if (!(out->mass = malloc((size_t)s->nv * sizeof(double))))
@@ -356,6 +358,18 @@ sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
     return sw_bake_errors_frames(blob, res, sc, train, heldout, NULL, NULL, err);
 }
 
+double *sw_bake_heldout_path(const sw_bake_result *res, int32_t nbones, int32_t *pre, int32_t *n) {
+    *pre = res->heldout_after > 0 && res->heldout_after <= res->ntrain ? res->heldout_after : 0;
+    *n = *pre + res->nheldout;
+    size_t pt = (size_t)12 * nbones * sizeof(double);
+    double *T = malloc((size_t)*n * pt + 1);
+    if (T) {
+        memcpy(T, res->train_T, (size_t)*pre * pt);
+        memcpy((char *)T + (size_t)*pre * pt, res->heldout_T, (size_t)res->nheldout * pt);
+    }
+    return T;
+}
+
 sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
                                    sinew_self_contact sc, sw_eval_result *train,
                                    sw_eval_result *heldout, double *train_frames,
@@ -365,9 +379,14 @@ sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result 
     sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0, sc};
     sinew_result r = sw_eval_correction_frames(blob, res->mass, res->train_T, res->train_x,
                                                res->ntrain, &o, train_frames, train, err);
-    if (r == SINEW_OK)
-        r = sw_eval_correction_frames(blob, res->mass, res->heldout_T, res->heldout_x,
-                                      res->nheldout, &o, heldout_frames, heldout, err);
+    if (r != SINEW_OK) return r;
+    int32_t pre, n;
+    double *T = sw_bake_heldout_path(res, sw_blob_get_view(blob)->nbones, &pre, &n);
+    if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    o.skip = pre;
+    r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, &o, heldout_frames,
+                                  heldout, err);
+    free(T);
     return r;
 }
 

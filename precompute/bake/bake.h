@@ -124,6 +124,11 @@ typedef struct sw_bake_result {
     /* full-space solutions of the held-out poses, for evaluation (3 nverts each) */
     double *heldout_x;
     double *heldout_T; /* 12 nbones per held-out pose */
+    /* the reference solved the held-out poses on the path of the first heldout_after
+       training poses, after them (the character's clip: its training frames, then the
+       held-out ones, as a host plays the clip); 0: from rest (held-out clips of their
+       own, random poses). sw_bake_errors steps the runtime along the same path. */
+    int32_t heldout_after;
     double *train_x;
     double *train_T;
     /* where each pose came from (the report's per-clip plots): the index of its clip (in
@@ -173,6 +178,12 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *p, s
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
                             sinew_self_contact sc, sw_eval_result *train, sw_eval_result *heldout,
                             sw_error *err);
+
+/* The held-out poses on the path the reference solved them on (malloc'd, 12 nbones
+ * each): the first *pre = res->heldout_after training poses, then the held-out ones,
+ * *n in all. sw_bake_errors, the error gap and the report's contact sheet step one
+ * instance along it and measure the poses after the first *pre. NULL: out of memory. */
+double *sw_bake_heldout_path(const sw_bake_result *res, int32_t nbones, int32_t *pre, int32_t *n);
 
 /* sw_bake_errors, also writing every pose's own correction error (res->ntrain and
  * res->nheldout doubles; sw_eval_correction_frames) when the arrays are not NULL. */
