@@ -189,6 +189,28 @@ TEST(heldout_frames_are_measured_on_the_reference_path) {
     sw_character_free(&c);
 }
 
+/* Self-contact force modes (sw_bake_params.contact_modes, thesis §3.3.1) only add to
+ * each domain's basis: the rank grows and no snapshot projects worse. */
+TEST(contact_modes_extend_the_basis) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 3000, 12, &c, &err) == SINEW_OK);
+    sw_bake_params p = quick_params();
+    sw_bake_result a, b;
+    ENSUREF(sw_bake(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    p.contact_modes = 1;
+    ENSUREF(sw_bake(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
+    fprintf(stderr, "    rank %d -> %d, projection error %.5f -> %.5f, held-out %.5f -> %.5f\n",
+            a.view.rank_total, b.view.rank_total, a.train_proj_error, b.train_proj_error,
+            a.heldout_proj_error, b.heldout_proj_error);
+    ENSURE(b.view.rank_total > a.view.rank_total);
+    ENSURE(b.train_proj_error <= a.train_proj_error + 1e-12 &&
+           b.heldout_proj_error <= a.heldout_proj_error + 1e-12);
+    sw_bake_result_free(&a);
+    sw_bake_result_free(&b);
+    sw_character_free(&c);
+}
+
 TEST(pair_sweeps_turn_a_joint_with_its_parent) {
     sw_character c;
     sw_error err;
@@ -231,4 +253,5 @@ TEST(pair_sweeps_turn_a_joint_with_its_parent) {
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
              CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain),
              CASE(pair_sweeps_turn_a_joint_with_its_parent),
-             CASE(heldout_frames_are_measured_on_the_reference_path))
+             CASE(heldout_frames_are_measured_on_the_reference_path),
+             CASE(contact_modes_extend_the_basis))

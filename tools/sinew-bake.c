@@ -49,7 +49,8 @@ static void usage(FILE *f) {
                "                  [--pair-sweeps] [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]]\n"
-               "                  [--inertia-modes] [--cache DIR] [--threads T] [--force]\n"
+               "                  [--inertia-modes] [--contact-modes] [--cache DIR] [--threads T] "
+               "[--force]\n"
                "                  [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
@@ -72,6 +73,8 @@ static void usage(FILE *f) {
             "                   full-space force its state leaves over plain skinning's) to\n"
             "                   the training poses and bake again, until B poses (default 32)\n"
             "                   are added or the held-out error is at most E\n"
+            "  --contact-modes  also the static responses to the training poses' self-contact\n"
+            "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
             "                   flesh lags and overshoots as the reference does; a higher rank\n"
@@ -161,6 +164,8 @@ int main(int argc, char **argv) {
             ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in 0..1", &ad.target);
         else if (!strcmp(a, "--inertia-modes"))
             p.inertia_modes = 1;
+        else if (!strcmp(a, "--contact-modes"))
+            p.contact_modes = 1;
         else if (!strcmp(a, "--force"))
             force = 1;
         else if (!strcmp(a, "--json"))

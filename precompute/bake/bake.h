@@ -47,6 +47,9 @@ typedef struct sw_bake_params {
     int return_path;               /* also train on those frames played back from the last one
                                       (default 0; measured: finger held-out error 0.235 -> 0.164 at
                                       20K tets, unchanged at 50K where the rank grows 41 -> 63) */
+    int contact_modes;             /* self-contact force modes (thesis §3.3.1): the static
+                                      responses to the training poses' contact forces join
+                                      the basis (bake_basis.c; default 0) */
     int inertia_modes;             /* for the dynamic step: basis modes for the inertia of the
                                       bones' accelerations and the cubature trained on them
                                       (bake_basis.c; default 0: they raise the rank, 33 -> 73

@@ -12,6 +12,7 @@
 
 #include "bake_internal.h"
 #include "fullsim.h"
+#include "penalty.h"
 #include "vec3.h"
 
 /* Un-skinned displacements of one pose: d (3 nv) from positions x and transforms T. */
@@ -214,8 +215,12 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * norm (a far domain's sliver of a response is no mode of its own), largest first, at
  * most max_rank of them a domain. */
 #define SW_INERTIA_MODE_TOL 0.05
-static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
-    int32_t nd = s->nd, nl = 6 * nd;
+
+/* The static responses of the rest shape to nl loads F (3 nverts each), every domain
+ * taking the restriction of every response as far as it lies outside its basis by `tol`
+ * of the response's whole norm, largest first, at most max_rank of them a domain. */
+static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F, double tol,
+                                  sw_error *err) {
     int64_t n3 = 3 * (int64_t)s->nv;
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.self_contact = 0;
@@ -223,11 +228,49 @@ static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
     fp.pcg_max = 100000;
     fp.threads = sw_pool_size(s->pool);
     sw_fullsim *sim = NULL;
-    double *F = calloc((size_t)nl * n3, sizeof(double)),
-           *Uf = malloc((size_t)nl * n3 * sizeof(double));
-    double *C = NULL, *gnorm = NULL;
+    double *Uf = malloc((size_t)nl * n3 * sizeof(double)), *C = NULL, *gnorm = NULL;
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
-    if (!F || !Uf) goto done;
+    if (!Uf) goto done;
+    if ((r = sw_fullsim_create(&s->ch, &fp, &sim, err)) != SINEW_OK ||
+        (r = sw_fullsim_rest_response(sim, nl, F, Uf, err)) != SINEW_OK)
+        goto done;
+    r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!(gnorm = malloc((size_t)nl * sizeof(double)))) goto done;
+    for (int32_t j = 0; j < nl; ++j) {
+        double g = 0;
+        for (int64_t i = 0; i < n3; ++i)
+            g += Uf[(size_t)j * n3 + i] * Uf[(size_t)j * n3 + i];
+        gnorm[j] = sqrt(g);
+    }
+    for (int32_t d = 0; d < s->nd; ++d) {
+        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base;
+        int64_t m = 3 * (int64_t)n;
+        free(C);
+        if (!(C = malloc((size_t)nl * m * sizeof(double)))) goto done;
+        for (int32_t j = 0; j < nl; ++j)
+            for (int32_t k = 0; k < n; ++k)
+                memcpy(C + (size_t)j * m + 3 * k, Uf + (size_t)j * n3 + 3 * s->dom_verts[base + k],
+                       3 * sizeof(double));
+        double *W = append_columns(s->basis[d], m, &s->rank[d], C, nl, gnorm, tol, s->p->max_rank);
+        if (!W) goto done;
+        free(s->basis[d]);
+        s->basis[d] = W;
+    }
+    r = SINEW_OK;
+done:
+    if (r == SINEW_ERROR_OUT_OF_MEMORY) sw_error_set(err, r, "out of memory for response modes");
+    sw_fullsim_destroy(sim);
+    free(Uf);
+    free(C);
+    free(gnorm);
+    return r;
+}
+
+static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
+    int32_t nd = s->nd, nl = 6 * nd;
+    int64_t n3 = 3 * (int64_t)s->nv;
+    double *F = calloc((size_t)nl * n3, sizeof(double));
+    if (!F) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for inertia modes");
     for (int32_t d = 0; d < nd; ++d) {
         int32_t b = s->dom_vert_ptr[d], e = s->dom_vert_ptr[d + 1];
         double c[3] = {0, 0, 0}, mt = 0;
@@ -256,40 +299,79 @@ static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
             }
         }
     }
-    if ((r = sw_fullsim_create(&s->ch, &fp, &sim, err)) != SINEW_OK ||
-        (r = sw_fullsim_rest_response(sim, nl, F, Uf, err)) != SINEW_OK)
-        goto done;
-    r = SINEW_ERROR_OUT_OF_MEMORY;
-    if (!(gnorm = malloc((size_t)nl * sizeof(double)))) goto done;
-    for (int32_t j = 0; j < nl; ++j) {
-        double g = 0;
-        for (int64_t i = 0; i < n3; ++i)
-            g += Uf[(size_t)j * n3 + i] * Uf[(size_t)j * n3 + i];
-        gnorm[j] = sqrt(g);
-    }
-    for (int32_t d = 0; d < nd; ++d) {
-        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base;
-        int64_t m = 3 * (int64_t)n;
-        free(C);
-        if (!(C = malloc((size_t)nl * m * sizeof(double)))) goto done;
-        for (int32_t j = 0; j < nl; ++j)
-            for (int32_t k = 0; k < n; ++k)
-                memcpy(C + (size_t)j * m + 3 * k, Uf + (size_t)j * n3 + 3 * s->dom_verts[base + k],
-                       3 * sizeof(double));
-        double *W = append_columns(s->basis[d], m, &s->rank[d], C, nl, gnorm, SW_INERTIA_MODE_TOL,
-                                   s->p->max_rank);
-        if (!W) goto done;
-        free(s->basis[d]);
-        s->basis[d] = W;
-    }
-    r = SINEW_OK;
-done:
-    if (r == SINEW_ERROR_OUT_OF_MEMORY) sw_error_set(err, r, "out of memory for inertia modes");
-    sw_fullsim_destroy(sim);
+    sinew_result r = add_responses(s, nl, F, SW_INERTIA_MODE_TOL, err);
     free(F);
-    free(Uf);
-    free(C);
-    free(gnorm);
+    return r;
+}
+
+/* Self-contact force modes (thesis §3.3.1; sw_bake_params.contact_modes): the flesh
+ * pressed by flesh deforms locally, in shapes the snapshots show only at the training
+ * poses; between them the contact forces of the runtime push the subspace where it has
+ * no such shape. The loads are the training solutions' contact forces (eqs. 3.4-3.6 at
+ * unit stiffness, each vertex's force pulled back to the rest frame by its skinning
+ * rotation), reduced to their SW_CONTACT_LOADS principal loads (uncentred PCA, 99.99% of
+ * their energy); their static responses of the rest shape join every domain's basis as
+ * the inertia modes do. */
+#define SW_CONTACT_LOADS 12
+#define SW_CONTACT_MODE_TOL 0.05
+static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
+    int64_t n3 = 3 * (int64_t)s->nv;
+    int32_t T = 0, nl = 0;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->train[i].npose; ++j)
+            T += s->train[i].contact_ptr[j + 1] > s->train[i].contact_ptr[j];
+    if (T == 0) return SINEW_OK; /* no training pose touches itself */
+    double *L = calloc((size_t)T * n3, sizeof(double)), *f = malloc((size_t)n3 * sizeof(double));
+    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->nv * 3 * sizeof(double)), *P = NULL, *F = NULL, kept;
+    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!L || !f || !R || !t) goto done;
+    int32_t k = 0;
+    for (int32_t i = 0; i < s->ntrain_seq; ++i) {
+        const sw_pose_seq *q = &s->train[i];
+        for (int32_t j = 0; j < q->npose; ++j) {
+            if (q->contact_ptr[j + 1] == q->contact_ptr[j]) continue;
+            const double *x = q->x + (size_t)j * n3;
+            memset(f, 0, (size_t)n3 * sizeof(double));
+            for (int32_t c = q->contact_ptr[j]; c < q->contact_ptr[j + 1]; ++c) {
+                const sw_contact *ct = &q->contacts[c];
+                double d[3], Nd[3];
+                for (int a = 0; a < 3; ++a)
+                    d[a] = ct->beta[0] * x[3 * ct->tri[0] + a] +
+                           ct->beta[1] * x[3 * ct->tri[1] + a] +
+                           ct->beta[2] * x[3 * ct->tri[2] + a] - x[3 * ct->p + a];
+                if (!(sw_penalty_gap(ct->n, d) > 0)) continue;
+                sw_penalty_apply_N(ct->n, SW_CONTACT_ALPHA, d, Nd);
+                for (int a = 0; a < 3; ++a) {
+                    f[3 * ct->p + a] += ct->ka * Nd[a];
+                    for (int e = 0; e < 3; ++e)
+                        f[3 * ct->tri[e] + a] -= ct->beta[e] * ct->ka * Nd[a];
+                }
+            }
+            sw_bake_skin_transforms(s, q->T + (size_t)j * 12 * s->nb, R, t);
+            double *g = L + (size_t)k++ * n3;
+            for (int32_t v = 0; v < s->nv; ++v) {
+                if (s->ch.bone_of_vertex[v] >= 0) continue; /* held by its bone */
+                const double *Rv = R + 9 * v, *fv = f + 3 * v;
+                for (int a = 0; a < 3; ++a)
+                    g[3 * v + a] = Rv[a] * fv[0] + Rv[3 + a] * fv[1] + Rv[6 + a] * fv[2];
+            }
+        }
+    }
+    if (!(P = domain_pca(L, T, n3, SW_CONTACT_LOADS, 0.9999, 0, &nl, &kept))) goto done;
+    if (nl > 0 && !(F = malloc((size_t)nl * n3 * sizeof(double)))) goto done;
+    for (int32_t j = 0; j < nl; ++j) /* P is n3 x nl, row-major: load j is its column */
+        for (int64_t e = 0; e < n3; ++e)
+            F[(size_t)j * n3 + e] = P[e * nl + j];
+    r = nl > 0 ? add_responses(s, nl, F, SW_CONTACT_MODE_TOL, err) : SINEW_OK;
+done:
+    if (r == SINEW_ERROR_OUT_OF_MEMORY) sw_error_set(err, r, "out of memory for contact modes");
+    free(L);
+    free(f);
+    free(R);
+    free(t);
+    free(P);
+    free(F);
     return r;
 }
 
@@ -330,7 +412,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         free(D);
         if (!s->basis[dm]) goto oom;
     }
-    r = s->p->inertia_modes ? add_inertia_modes(s, err) : SINEW_OK;
+    r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
+    if (r == SINEW_OK && s->p->inertia_modes) r = add_inertia_modes(s, err);
     if (r != SINEW_OK) goto done;
     for (int32_t dm = 0; dm < s->nd; ++dm)
         s->rank_total += s->rank[dm];
