@@ -67,6 +67,16 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == 6);
     const cJSON *sheet = cJSON_GetObjectItemCaseSensitive(j, "contact_sheet");
     ENSURE(cJSON_IsString(sheet));
+    /* the adaptive loop's rounds, as given (the second not verified: null) */
+    const cJSON *ad = cJSON_GetObjectItemCaseSensitive(j, "adaptive");
+    ENSURE(cJSON_GetArraySize(ad) == 2);
+    if (cJSON_GetArraySize(ad) == 2) {
+        const cJSON *a0 = cJSON_GetArrayItem(ad, 0), *a1 = cJSON_GetArrayItem(ad, 1);
+        ENSURE(num(a0, "train_poses") == 10 && num(a1, "added") == 4 && num(a1, "rank") == 24);
+        ENSURE_NEAR(num(a0, "err_heldout"), 0.25, 1e-12);
+        ENSURE_NEAR(num(a0, "picks_error"), 0.5, 1e-12);
+        ENSURE(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(a1, "picks_error")));
+    }
     cJSON_Delete(j);
     free(text);
 }
@@ -120,6 +130,12 @@ TEST(clips_of_their_own_and_the_report) {
     ENSURE(et.correction_error == et2.correction_error);
     ENSURE(eh.correction_error == eh2.correction_error);
     static const char tn[1][64] = {"Bend"}, hn[1][64] = {"Return"};
+    sw_adaptive_report arep;
+    memset(&arep, 0, sizeof arep);
+    arep.nrounds = 2;
+    arep.round[0] =
+        (sw_adaptive_round){10, 0, 20, 0.02, 0.25, 0.01, 0.1, 0.3, 0.9, 0.6, 0.5, 10, 1.0};
+    arep.round[1] = (sw_adaptive_round){14, 4, 24, 0.02, 0.2, 0.01, 0.08, 0, 0, 0, -1, 4, 1.0};
     sw_bake_report_input in = {"finger",
                                &ch,
                                &res,
@@ -135,7 +151,8 @@ TEST(clips_of_their_own_and_the_report) {
                                0,
                                1.0,
                                0.5,
-                               1};
+                               1,
+                               &arep};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
@@ -145,7 +162,7 @@ TEST(clips_of_their_own_and_the_report) {
     snprintf(path, sizeof path, "%.1000s/report.html", dir);
     char *html = read_text(path);
     ENSURE(html && strstr(html, "<svg") && strstr(html, "heldout_sheet.png") &&
-           strstr(html, "Return"));
+           strstr(html, "Return") && strstr(html, "Adaptive training rounds"));
     free(html);
     struct stat st;
     snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);

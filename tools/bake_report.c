@@ -10,6 +10,9 @@
  *   clips [{name, split "train" | "heldout", frames [clip frame], error [per frame]}]
  *   sweeps {poses, mean_error}: the training poses of no clip (joint sweeps, return path)
  *   domains [{bone, rank, energy, cubature}]
+ *   adaptive [{train_poses, added, rank, err_train, err_heldout, proj_err_train,
+ *              proj_err_heldout, picks_error (null: not verified), seconds}]: one per
+ *              bake of the adaptive loop (bake_adaptive.h), or null without it
  *   contact_sheet: the PNG's file name, or null */
 #include "bake_report.h"
 
@@ -152,6 +155,28 @@ static cJSON *json_domains(const sw_bake_report_input *in) {
     return a;
 }
 
+static cJSON *json_adaptive(const sw_adaptive_report *a) {
+    if (!a || a->nrounds < 1) return cJSON_CreateNull();
+    cJSON *arr = cJSON_CreateArray();
+    for (int32_t k = 0; k < a->nrounds; ++k) {
+        const sw_adaptive_round *rd = &a->round[k];
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "train_poses", rd->ntrain);
+        cJSON_AddNumberToObject(o, "added", rd->added);
+        cJSON_AddNumberToObject(o, "rank", rd->rank_total);
+        cJSON_AddItemToObject(o, "err_train", json_number(rd->err_train));
+        cJSON_AddItemToObject(o, "err_heldout", json_number(rd->err_heldout));
+        cJSON_AddItemToObject(o, "proj_err_train", json_number(rd->proj_train));
+        cJSON_AddItemToObject(o, "proj_err_heldout", json_number(rd->proj_heldout));
+        cJSON_AddItemToObject(o, "picks_error",
+                              rd->picks_error >= 0 ? json_number(rd->picks_error)
+                                                   : cJSON_CreateNull());
+        cJSON_AddNumberToObject(o, "seconds", rd->seconds);
+        cJSON_AddItemToArray(arr, o);
+    }
+    return arr;
+}
+
 static char *report_json(const sw_bake_report_input *in, const report *r, int sheet) {
     const sw_bake_result *res = in->res;
     cJSON *j = cJSON_CreateObject();
@@ -178,6 +203,7 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddNumberToObject(sw, "poses", r->sweep_poses);
     cJSON_AddNumberToObject(sw, "mean_error", r->sweep_mean);
     cJSON_AddItemToObject(j, "domains", json_domains(in));
+    cJSON_AddItemToObject(j, "adaptive", json_adaptive(in->adaptive));
     if (sheet)
         cJSON_AddStringToObject(j, "contact_sheet", SHEET_NAME);
     else
@@ -212,9 +238,10 @@ static void html_text(FILE *f, const char *s) {
 #define PLOT_H 150
 #define PAD 34
 
-/* A line plot of y over x (n points; NaN points skipped) with y from 0 to ymax. */
-static void svg_line(FILE *f, const char *title, const int32_t *x, const double *y, int32_t n,
-                     double ymax, const char *colour) {
+/* A line plot of y over x (n points; NaN points skipped) with y from 0 to ymax, the x axis
+ * named xname. */
+static void svg_line(FILE *f, const char *title, const char *xname, const int32_t *x,
+                     const double *y, int32_t n, double ymax, const char *colour) {
     fprintf(f, "<figure><figcaption>");
     html_text(f, title);
     fprintf(f, "</figcaption><svg width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">", PLOT_W,
@@ -228,9 +255,9 @@ static void svg_line(FILE *f, const char *title, const int32_t *x, const double 
             PAD, PLOT_H - PAD, PLOT_W - PAD, PLOT_H - PAD, PAD, PAD, PAD, PLOT_H - PAD);
     fprintf(f,
             "<text x=\"2\" y=\"%d\" font-size=\"10\">%.2g</text><text x=\"2\" y=\"%d\" "
-            "font-size=\"10\">0</text><text x=\"%d\" y=\"%d\" font-size=\"10\">frame %d</text>"
+            "font-size=\"10\">0</text><text x=\"%d\" y=\"%d\" font-size=\"10\">%s %d</text>"
             "<text x=\"%d\" y=\"%d\" font-size=\"10\" text-anchor=\"end\">%d</text>",
-            PAD + 4, ymax, PLOT_H - PAD, PAD, PLOT_H - PAD + 14, xmin, PLOT_W - PAD,
+            PAD + 4, ymax, PLOT_H - PAD, PAD, PLOT_H - PAD + 14, xname, xmin, PLOT_W - PAD,
             PLOT_H - PAD + 14, xmax);
     fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", colour);
     for (int32_t k = 0; k < n; ++k)
@@ -305,7 +332,7 @@ static void html_clips(FILE *f, const report *r) {
         char title[160];
         snprintf(title, sizeof title, "%s (%s, %d frames)", r->clips[i].name,
                  r->clips[i].heldout ? "held out" : "training", r->clips[i].n);
-        svg_line(f, title, r->clips[i].frame, r->clips[i].error, r->clips[i].n, ymax,
+        svg_line(f, title, "frame", r->clips[i].frame, r->clips[i].error, r->clips[i].n, ymax,
                  r->clips[i].heldout ? "#d2691e" : "#1f77b4");
     }
     fprintf(f,
@@ -333,6 +360,37 @@ static int html_domains(FILE *f, const sw_bake_report_input *in) {
     return 1;
 }
 
+/* The adaptive loop's rounds: a table and the held-out error per round. */
+static void html_adaptive(FILE *f, const sw_adaptive_report *a) {
+    if (!a || a->nrounds < 1) return;
+    fprintf(f, "<h2>Adaptive training rounds</h2><p>Each round adds the random combined poses "
+               "the blob steps worst to the training poses and bakes again; the picked poses' "
+               "error is the blob's own on them, checked against the reference the round "
+               "after.</p><table><tr><th>round</th><th>training poses (added)</th><th>rank</th>"
+               "<th>error train / held-out</th><th>projection train / held-out</th>"
+               "<th>picked poses' error</th><th>seconds</th></tr>");
+    int32_t x[SW_ADAPTIVE_MAX_ROUNDS + 1];
+    double y[SW_ADAPTIVE_MAX_ROUNDS + 1], ymax = 0.05;
+    for (int32_t k = 0; k < a->nrounds; ++k) {
+        const sw_adaptive_round *rd = &a->round[k];
+        fprintf(f,
+                "<tr><td>%d</td><td>%d (%d)</td><td>%d</td><td>%.4f / %.4f</td><td>%.4f / "
+                "%.4f</td><td>",
+                k, rd->ntrain, rd->added, rd->rank_total, rd->err_train, rd->err_heldout,
+                rd->proj_train, rd->proj_heldout);
+        if (rd->picks_error >= 0)
+            fprintf(f, "%.4f", rd->picks_error);
+        else
+            fprintf(f, "&ndash;");
+        fprintf(f, "</td><td>%.1f</td></tr>", rd->seconds);
+        x[k] = k;
+        y[k] = rd->err_heldout;
+        if (isfinite(y[k])) ymax = fmax(ymax, y[k]);
+    }
+    fprintf(f, "</table>");
+    svg_line(f, "held-out correction error per round", "round", x, y, a->nrounds, ymax, "#d2691e");
+}
+
 static int write_html(const char *path, const sw_bake_report_input *in, const report *r,
                       int sheet) {
     FILE *f = fopen(path, "w");
@@ -345,6 +403,7 @@ static int write_html(const char *path, const sw_bake_report_input *in, const re
     html_summary(f, in);
     html_clips(f, r);
     int ok = html_domains(f, in);
+    html_adaptive(f, in->adaptive);
     fprintf(f, "<h2>Stage times</h2>");
     svg_bars(f, "seconds per stage", in->res->stage_seconds, SW_BAKE_REPORT_STAGES, stage_names,
              "#7f7f7f");

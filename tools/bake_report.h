@@ -12,6 +12,7 @@
 #define SW_BAKE_REPORT_H
 
 #include "bake.h"
+#include "bake_adaptive.h"
 #include "sinew/sinew.h"
 #include "sw_mesh.h"
 
@@ -36,6 +37,8 @@ typedef struct sw_bake_report_input {
     int32_t failed_steps;
     double bake_seconds, eval_seconds;
     int contact_sheet; /* render DIR/heldout_sheet.png (Embree; a few seconds) */
+    /* the adaptive loop's rounds (sinew-bake --adaptive; NULL or 0 rounds: none) */
+    const sw_adaptive_report *adaptive;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

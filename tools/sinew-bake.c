@@ -269,7 +269,8 @@ int main(int argc, char **argv) {
                                    et.failed + eh.failed,
                                    bake_seconds,
                                    eval_seconds,
-                                   1};
+                                   1,
+                                   ad.rounds > 0 ? &arep : NULL};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
