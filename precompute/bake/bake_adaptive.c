@@ -114,10 +114,11 @@ static double score(scorer *s, const double *T) {
     return skin > 0 ? sqrt(left / skin) : 0;
 }
 
-/* Scores n candidates from `seed` and appends the `add` highest to *extra (12 nb each). */
+/* Scores n candidates from `seed` and appends the `add` highest to *extra (12 nb each),
+ * fewer when fewer step (*npicked). */
 static sinew_result pick(const sinew_blob *blob, const sw_bake_result *res, const sw_skeleton *sk,
                          const sw_adaptive_params *a, uint64_t seed, double **extra,
-                         int32_t *nextra, sw_adaptive_round *rd, sw_error *err) {
+                         int32_t *nextra, int32_t *npicked, sw_adaptive_round *rd, sw_error *err) {
     int32_t nb = sk->nbones, n = a->candidates;
     size_t pose = (size_t)12 * nb;
     double *T = malloc((size_t)n * pose * sizeof(double)), *sc = malloc((size_t)n * sizeof(double));
@@ -142,14 +143,18 @@ static sinew_result pick(const sinew_blob *blob, const sw_bake_result *res, cons
         if (sc[i] > rd->score_max) rd->score_max = sc[i];
     }
     rd->picks_score = 0;
-    for (int32_t k = 0; k < a->add; ++k) { /* the add highest, highest first */
+    int32_t added = 0;
+    for (; added < a->add; ++added) { /* the add highest, highest first */
         int32_t best = 0;
         for (int32_t i = 1; i < n; ++i)
             if (sc[i] > sc[best]) best = i;
+        if (sc[best] < 0) break; /* the rest failed to step: no pose to learn from */
         memcpy(*extra + (size_t)(*nextra)++ * pose, T + best * pose, pose * sizeof(double));
-        rd->picks_score += sc[best] / a->add;
+        rd->picks_score += sc[best];
         sc[best] = -2;
     }
+    rd->picks_score = added > 0 ? rd->picks_score / added : 0;
+    *npicked = added;
     scorer_free(&s);
     free(T);
     free(sc);
@@ -257,14 +262,15 @@ sinew_result sw_bake_adaptive(const sw_character *c, const sw_bake_params *param
         if ((r = sw_bake(c, &p, &res, err)) != SINEW_OK) break;
         rep->nrounds = round + 1;
         if ((r = load_blob(&res, &mem, &blob, err)) == SINEW_OK &&
-            (r = measure(blob, &res, nextra, rd, err)) == SINEW_OK && prev)
+            (r = measure(blob, &res, nextra, rd, err)) == SINEW_OK && prev && picked > 0)
             r = verify(prev, &res, picked, &rep->round[round - 1].picks_error, err);
         int last = round == a.rounds || nextra + a.add > a.budget ||
                    (a.target > 0 && rd->err_heldout <= a.target);
+        picked = 0;
         if (r == SINEW_OK && !last)
             r = pick(blob, &res, &c->skel, &a, p.seed ^ (0xada9713e5eedULL + (uint64_t)round),
-                     &extra, &nextra, rd, err);
-        picked = a.add;
+                     &extra, &nextra, &picked, rd, err);
+        last = last || picked == 0; /* no candidate stepped: nothing to add */
         rd->seconds = sw_now_seconds() - t0;
         if (p.progress)
             fprintf(stderr,
