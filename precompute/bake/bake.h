@@ -4,9 +4,11 @@
  *             made rigid (one-hot weights), surface, lumped masses
  *   domains   each tet to the strongest bone of the majority of its vertices (§2.3)
  *   poses     training = per-joint sweeps over the range the training clip uses plus
- *             the clip's first (1 - heldout) frames; held-out = the clip's last frames
+ *             the clip's first (1 - heldout) frames, and the caller's extra poses (the
+ *             adaptive loop's, bake_adaptive.h); held-out = the clip's last frames
  *             (or random combined poses with a fixed seed when there is no clip)
- *   simulate  full-space quasistatic solutions with self-contact, all cores; the
+ *   simulate  full-space quasistatic solutions with self-contact, all cores (each chain
+ *             of poses read from the cache when it holds it, bake_cache.c); the
  *             clip's held-out frames continue its training frames' path (the solution
  *             depends on the path through contact and buckling), and every training
  *             solution's contact set is kept for the runtime (pose-space contact)

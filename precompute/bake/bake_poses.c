@@ -4,8 +4,9 @@
  * them as its own path from rest, with
  * return_path the same frames played back from the last one (the return path: a fold
  * that buckled on the way in can stay buckled on the way out, and the runtime picks
- * the branch by the direction the pose arrives from), and, per joint, a sweep from
- * rest to the largest rotation the training frames give it.
+ * the branch by the direction the pose arrives from), per joint, a sweep from rest to
+ * the largest rotation the training frames give it, and the caller's extra poses
+ * (sw_bake_params.extra_poses: the adaptive loop's) in paths from rest.
  * Held-out: the clip's remaining frames, or the held-out clips one after the other on
  * one path from rest, never used to build the basis or cubature; without a clip, random combined
  * poses with a fixed seed. Each sequence is solved in order (every solve warm-starts the next);
