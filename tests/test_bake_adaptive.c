@@ -92,6 +92,10 @@ TEST(bad_loop_parameters_and_extra_poses_are_named) {
     p.extra_poses = NULL;
     ENSURE(sw_bake(&c, &p, &res, &err) == SINEW_ERROR_INVALID_ARGUMENT &&
            strstr(err.msg, "extra poses"));
+    /* the loop does not take them: it adds poses of its own there */
+    sw_adaptive_params a2 = sw_adaptive_params_default();
+    ENSURE(sw_bake_adaptive(&c, &p, &a2, &res, &rep, &err) == SINEW_ERROR_INVALID_ARGUMENT &&
+           strstr(err.msg, "extra poses"));
     /* and two good ones train: two more training poses on a path of their own */
     T[12 * nb + 5] = c.clip.T[(size_t)12 * nb * 3 + 5];
     p.extra_poses = T;

@@ -243,6 +243,11 @@ sinew_result sw_bake_adaptive(const sw_character *c, const sw_bake_params *param
     sw_bake_params p = params ? *params : sw_bake_params_default();
     sinew_result r = check(&a, err);
     if (r != SINEW_OK || !c) return c ? r : sw_error_set(err, r, "no character");
+    if (p.nextra_poses > 0) /* the loop's own poses go there: the caller's would be lost */
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "adaptive bake: the loop adds its own extra poses; bake with %d extra "
+                            "poses of your own without it",
+                            p.nextra_poses);
     char *tmp = NULL;
     if (!p.cache_dir && !(p.cache_dir = tmp = temp_cache()))
         return sw_error_set(err, SINEW_ERROR_IO, "adaptive bake: cannot make a cache folder");
