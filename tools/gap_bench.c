@@ -89,7 +89,8 @@ static sinew_result run_set(const sinew_blob *blob, const double *mass, const do
     for (int32_t j = 0; j < npose; ++j) {
         if (sw_instance_set_pose_d(in, T + (size_t)j * 12 * nb) != SINEW_OK ||
             sinew_instance_step(in, 1.0f / 30) != SINEW_OK || j < skip)
-            continue; /* a failed step: sinew-bench's failed_steps counts it already */
+            continue; /* the path before the measured poses, or a failed step (sinew-bench's
+                         failed_steps counts it already) */
         const double *xf = X + (size_t)(j - skip) * 3 * nv;
         memcpy(qr, sw_instance_q(in), sizeof(double) * R);
         sw_eval_acc_add(&art, in, xf);

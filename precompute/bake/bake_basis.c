@@ -13,6 +13,7 @@
 #include "bake_internal.h"
 #include "fullsim.h"
 #include "penalty.h"
+#include "selfcontact.h"
 #include "vec3.h"
 
 /* Un-skinned displacements of one pose: d (3 nv) from positions x and transforms T. */
@@ -307,11 +308,11 @@ static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
 /* Self-contact force modes (thesis §3.3.1; sw_bake_params.contact_modes): the flesh
  * pressed by flesh deforms locally, in shapes the snapshots show only at the training
  * poses; between them the contact forces of the runtime push the subspace where it has
- * no such shape. The loads are the training solutions' contact forces (eqs. 3.4-3.6 at
- * unit stiffness, each vertex's force pulled back to the rest frame by its skinning
- * rotation), reduced to their SW_CONTACT_LOADS principal loads (uncentred PCA, 99.99% of
- * their energy); their static responses of the rest shape join every domain's basis as
- * the inertia modes do. */
+ * no such shape. The loads are the training solutions' contact forces (the reference's
+ * own, sw_contact_add_forces: eqs. 3.4-3.6 at unit stiffness, each vertex's force pulled
+ * back to the rest frame by its skinning rotation), reduced to their SW_CONTACT_LOADS
+ * principal loads (uncentred PCA, 99.99% of their energy); their static responses of the
+ * rest shape join every domain's basis as the inertia modes do. */
 #define SW_CONTACT_LOADS 12
 #define SW_CONTACT_MODE_TOL 0.05
 static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
@@ -333,21 +334,9 @@ static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
             if (q->contact_ptr[j + 1] == q->contact_ptr[j]) continue;
             const double *x = q->x + (size_t)j * n3;
             memset(f, 0, (size_t)n3 * sizeof(double));
-            for (int32_t c = q->contact_ptr[j]; c < q->contact_ptr[j + 1]; ++c) {
-                const sw_contact *ct = &q->contacts[c];
-                double d[3], Nd[3];
-                for (int a = 0; a < 3; ++a)
-                    d[a] = ct->beta[0] * x[3 * ct->tri[0] + a] +
-                           ct->beta[1] * x[3 * ct->tri[1] + a] +
-                           ct->beta[2] * x[3 * ct->tri[2] + a] - x[3 * ct->p + a];
-                if (!(sw_penalty_gap(ct->n, d) > 0)) continue;
-                sw_penalty_apply_N(ct->n, SW_CONTACT_ALPHA, d, Nd);
-                for (int a = 0; a < 3; ++a) {
-                    f[3 * ct->p + a] += ct->ka * Nd[a];
-                    for (int e = 0; e < 3; ++e)
-                        f[3 * ct->tri[e] + a] -= ct->beta[e] * ct->ka * Nd[a];
-                }
-            }
+            sw_contact_add_forces(q->contacts + q->contact_ptr[j],
+                                  q->contact_ptr[j + 1] - q->contact_ptr[j], x, 1.0,
+                                  SW_CONTACT_ALPHA, f);
             sw_bake_skin_transforms(s, q->T + (size_t)j * 12 * s->nb, R, t);
             double *g = L + (size_t)k++ * n3;
             for (int32_t v = 0; v < s->nv; ++v) {

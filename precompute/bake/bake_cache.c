@@ -156,6 +156,18 @@ static int lookup(sw_bake_state *s, const chain *ch, uint64_t key, const char *p
     return 1;
 }
 
+/* Sequence i (the training ones, then the held-out one) when it starts a chain: the
+ * chain, its key and its file under dir (0: it continues another, or is empty). */
+static int chain_file(sw_bake_state *s, int32_t i, uint64_t character, const char *dir, chain *ch,
+                      uint64_t *key, char *path, size_t size) {
+    sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
+    if (q->continues || q->npose == 0) return 0;
+    *ch = chain_of(q);
+    *key = chain_key(s, character, ch);
+    snprintf(path, size, "%s/simulate-%016llx.bin", dir, (unsigned long long)*key);
+    return 1;
+}
+
 sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err) {
     *cached = 0;
     const char *dir = s->p->cache_dir;
@@ -166,29 +178,22 @@ sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *er
                             strerror(errno));
     if (stat(dir, &st) != 0 || !S_ISDIR(st.st_mode))
         return sw_error_set(err, SINEW_ERROR_IO, "cache folder '%s' is not a folder", dir);
-    uint64_t character = character_key(s);
+    uint64_t character = character_key(s), key;
     int32_t nroot = 0, hits = 0;
     sinew_result r = SINEW_OK;
     char path[4200];
-    for (int32_t i = 0; i <= s->ntrain_seq && r == SINEW_OK; ++i) {
-        sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
-        if (q->continues || q->npose == 0) continue;
-        chain ch = chain_of(q);
-        snprintf(path, sizeof path, "%s/simulate-%016llx.bin", dir,
-                 (unsigned long long)chain_key(s, character, &ch));
-        nroot++;
-        hits += lookup(s, &ch, chain_key(s, character, &ch), path, &r, err);
-    }
+    chain ch;
+    for (int32_t i = 0; i <= s->ntrain_seq && r == SINEW_OK; ++i)
+        if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path)) {
+            nroot++;
+            hits += lookup(s, &ch, key, path, &r, err);
+        }
     if (r != SINEW_OK) return r;
     if ((r = sw_bake_simulate(s, err)) != SINEW_OK) return r; /* the chains not found */
-    for (int32_t i = 0; i <= s->ntrain_seq; ++i) {
-        sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
-        if (q->continues || q->npose == 0 || q->from_cache) continue;
-        chain ch = chain_of(q);
-        uint64_t key = chain_key(s, character, &ch);
-        snprintf(path, sizeof path, "%s/simulate-%016llx.bin", dir, (unsigned long long)key);
-        store(s, &ch, key, path);
-    }
+    for (int32_t i = 0; i <= s->ntrain_seq; ++i)
+        if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path) &&
+            !ch.seq[0]->from_cache)
+            store(s, &ch, key, path);
     *cached = hits == nroot;
     return SINEW_OK;
 }
