@@ -11,6 +11,7 @@
 
 /* The condensation sections: all ten, in id order. */
 #define NCOND (SINEW_SECTION_COND_LAST - SINEW_SECTION_COND_FIRST + 1)
+#define NPAIR (SINEW_SECTION_PAIR_LAST - SINEW_SECTION_PAIR_FIRST + 1)
 
 static int fx_ok = -1; /* -1 not made yet, 0 failed, 1 made */
 static bake_fixture fx;
@@ -36,7 +37,8 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     ENSURE(capsule_fixture());
     const sw_blob_view *v = sw_blob_get_view(fx.blob);
     const sw_tetmesh *m = &fx.ch.mesh;
-    ENSURE(hdr(fx.data)->section_count == SINEW_SECTION_COUNT_V1 + NCOND);
+    ENSURE(hdr(fx.data)->section_count ==
+           SINEW_SECTION_COUNT_V1 + NCOND + (v->npair_groups > 0 ? NPAIR : 0));
     ENSURE(v->ntets == m->ntets && v->nvert_tets == 4 * m->ntets && v->nverts == m->nverts);
     ENSURE(v->ndomains >= 2); /* tets in more than one domain, vertices with several copies */
     ENSURE(memcmp(v->tets, m->tets, 4 * sizeof(int32_t) * (size_t)m->ntets) == 0);
@@ -123,15 +125,16 @@ TEST(the_masses_are_the_reduced_masses) {
     ENSUREF(err <= 1e-10 * scale, "the reduced mass is %g from the tets' (scale %g)", err, scale);
 }
 
-/* Without the tet mesh, a view writes the 26 sections it always did, the very bytes they
- * are in the blob with it; the synthetic character's seed, written before the tet mesh
- * existed, is still what the writer writes. */
+/* Without the tet mesh (and the per-pair sections), a view writes the 26 sections it
+ * always did, the very bytes they are in the blob with it; the synthetic character's seed,
+ * written before the tet mesh existed, is still what the writer writes. */
 TEST(a_view_without_the_tet_mesh_writes_the_blob_of_before) {
     ENSURE(capsule_fixture());
     sw_blob_view plain = fx.res.view;
-    plain.ntets = plain.nvert_tets = 0;
+    plain.ntets = plain.nvert_tets = plain.npair_groups = 0;
 #define CLEAR(id, NAME, elem_size, type, field, ...) plain.field = NULL;
     SINEW_BLOB_COND_ARRAY_SECTIONS(CLEAR)
+    SINEW_BLOB_PAIR_ARRAY_SECTIONS(CLEAR)
 #undef CLEAR
     size_t size = 0;
     void *data = NULL;
@@ -302,7 +305,7 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     sw_blob_view v;
     uint8_t *b = write_parsed(&f, &size, &v);
     ENSURE(b);
-    ENSURE(hdr(b)->section_count == SINEW_SECTION_ID_MAX);
+    ENSURE(hdr(b)->section_count == SINEW_SECTION_COND_LAST);
     const char *diff = view_diff(&v, &f.v);
     ENSUREF(!diff, "the parsed view differs in %s", diff);
     int32_t lone = -1; /* a vertex in no tet, of mass 0 */

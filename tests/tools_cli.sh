@@ -267,7 +267,7 @@ expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$benc
 touch "$tmp/plain"
 expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"
-expect bench_self_contact_mode 2 "--self-contact: pose-space or exhaustive" \
+expect bench_self_contact_mode 2 "--self-contact: pose-space, exhaustive or pose-pairs" \
     "$bench" "${small[@]}" --self-contact brute
 expect bench_gap_needs_poses 2 "--error-gap needs the bake's poses" \
     "$bench" "${small[@]}" --blob "$tmp/a.blob" --error-gap

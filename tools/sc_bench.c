@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "blob_load.h"
 #include "instance.h"
 #include "rt_interpose.h"
 
@@ -15,11 +16,12 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
     def.self_contact = mode;
     sinew_instance *inst;
     sinew_result r = sinew_instance_create(blob, &def, &inst);
+    const int k = (int)mode; /* 0 pose-space, 1 exhaustive, 2 pose-pairs */
+    static const char *const names[3] = {"pose-space", "exhaustive", "pose-pairs"};
     if (r != SINEW_OK)
-        return sw_error_set(err, r, "cannot create a %s instance: %s",
-                            mode == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive" : "pose-space",
+        return sw_error_set(err, r, "cannot create a %s instance: %s", names[k],
                             sinew_result_string(r));
-    int nb = (int)sinew_blob_bone_count(blob), k = mode == SINEW_SELF_CONTACT_EXHAUSTIVE;
+    int nb = (int)sinew_blob_bone_count(blob);
     double sc_sum = 0, step_sum = 0;
     out->ms_mean[k] = out->ms_max[k] = out->tests_mean[k] = out->pairs_mean[k] = 0;
     for (int f = 0; f < nframes; ++f) { /* untimed pass: the instance settles on the clip */
@@ -41,21 +43,24 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
             out->ms_max[k] = fmax(out->ms_max[k], st.ms_self_contact);
             out->tests_mean[k] += st.self_contact_tests;
             out->pairs_mean[k] += st.self_contacts;
+            out->novel_mean[k] += st.self_contact_novel;
         }
     if (count_rt) {
         sw_rt_counts c = sw_rt_count_end();
         unsigned active = sw_rt_interpose_active();
-        out->allocs = active & SW_RT_CAT_ALLOCS
-                          ? (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0))
-                          : -1;
-        out->locks = active & SW_RT_CAT_LOCKS ? (long)c.locks : -1;
+        out->allocs[k] = active & SW_RT_CAT_ALLOCS
+                             ? (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0))
+                             : -1;
+        out->locks[k] = active & SW_RT_CAT_LOCKS ? (long)c.locks : -1;
     }
     out->steps = steps;
     out->ms_mean[k] = sc_sum / steps;
     out->step_mean[k] = step_sum / steps;
     out->tests_mean[k] /= steps;
     out->pairs_mean[k] /= steps;
-    if (!k) out->frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
+    out->novel_mean[k] /= steps;
+    if (k == 0) out->frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
+    if (k == 2) out->pp_frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
     sinew_instance_destroy(inst);
     return SINEW_OK;
 }
@@ -72,7 +77,12 @@ sinew_result sw_sc_bench_run(const sinew_blob *blob, const double *T, int nframe
     if (r != SINEW_OK) return r;
     out->speedup_mean = out->ms_mean[0] > 0 ? out->ms_mean[1] / out->ms_mean[0] : INFINITY;
     out->speedup_max = out->ms_max[0] > 0 ? out->ms_max[1] / out->ms_max[0] : INFINITY;
-    return SINEW_OK;
+    out->pairs_mode = sw_blob_get_view(blob)->npair_groups > 0;
+    if (!out->pairs_mode) return SINEW_OK;
+    r = run_mode(blob, SINEW_SELF_CONTACT_POSE_PAIRS, T, nframes, dt, reps, 1, out, err);
+    out->pp_speedup_mean = out->ms_mean[2] > 0 ? out->ms_mean[1] / out->ms_mean[2] : INFINITY;
+    out->pp_speedup_max = out->ms_max[2] > 0 ? out->ms_max[1] / out->ms_max[2] : INFINITY;
+    return r;
 }
 
 void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
@@ -84,7 +94,15 @@ void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
                 "locks %ld\n",
                 b->steps, b->ms_mean[0], b->ms_max[0], b->tests_mean[0], b->frame_share,
                 b->ms_mean[1], b->ms_max[1], b->tests_mean[1], b->pairs_mean[1], b->speedup_mean,
-                b->speedup_max, b->allocs, b->locks);
+                b->speedup_max, b->allocs[1], b->locks[1]);
+        if (b->pairs_mode)
+            fprintf(f,
+                    "sinew-bench: pose-pairs %.4f ms mean, %.4f max (%.1f pairs, %.3f of the "
+                    "step, %.2f novel pairs of domains); speedup over exhaustive %.1fx mean, "
+                    "%.1fx max; allocs %ld, locks %ld\n",
+                    b->ms_mean[2], b->ms_max[2], b->tests_mean[2], b->pp_frame_share,
+                    b->novel_mean[2], b->pp_speedup_mean, b->pp_speedup_max, b->allocs[2],
+                    b->locks[2]);
         return;
     }
     fprintf(f,
@@ -96,6 +114,13 @@ void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
             b->steps, b->ms_mean[0], b->ms_max[0], b->ms_mean[1], b->ms_max[1], b->speedup_mean,
             b->speedup_max, b->frame_share,
             b->step_mean[1] > 0 ? b->ms_mean[1] / b->step_mean[1] : 0, b->tests_mean[0],
-            b->tests_mean[1], b->pairs_mean[1], b->step_mean[0], b->step_mean[1], b->allocs,
-            b->locks);
+            b->tests_mean[1], b->pairs_mean[1], b->step_mean[0], b->step_mean[1], b->allocs[1],
+            b->locks[1]);
+    if (b->pairs_mode)
+        fprintf(f,
+                ",\"sc_pp_ms_mean\":%.5f,\"sc_pp_ms_max\":%.5f,\"sc_pp_speedup_mean\":%.2f,"
+                "\"sc_pp_speedup_max\":%.2f,\"sc_pp_frame_share\":%.4f,\"sc_pp_pairs\":%.1f,"
+                "\"sc_pp_novel\":%.2f,\"sc_pp_allocs_in_step\":%ld,\"sc_pp_locks_in_step\":%ld",
+                b->ms_mean[2], b->ms_max[2], b->pp_speedup_mean, b->pp_speedup_max,
+                b->pp_frame_share, b->tests_mean[2], b->novel_mean[2], b->allocs[2], b->locks[2]);
 }

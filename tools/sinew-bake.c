@@ -49,8 +49,9 @@ static void usage(FILE *f) {
                "                  [--pair-sweeps] [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]]\n"
-               "                  [--inertia-modes] [--contact-modes] [--cache DIR] [--threads T] "
-               "[--force]\n"
+               "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
+               "                  [--eval-self-contact pose-space|pose-pairs]\n"
+               "                  [--cache DIR] [--threads T] [--force]\n"
                "                  [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
@@ -75,6 +76,11 @@ static void usage(FILE *f) {
             "                   are added or the held-out error is at most E\n"
             "  --contact-modes  also the static responses to the training poses' self-contact\n"
             "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
+            "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
+            "                   cut to a cubature that keeps their reduced force to T,\n"
+            "                   0 <= T < 1 (default 0.05; 0: every pair kept)\n"
+            "  --eval-self-contact M  the runtime's self-contact mode the bake's errors are\n"
+            "                   measured in: pose-space (default) or pose-pairs\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
             "                   flesh lags and overshoots as the reference does; a higher rank\n"
@@ -96,6 +102,7 @@ int main(int argc, char **argv) {
     sw_character_args_init(&ca, tool);
     const char *out_path = NULL, *report_dir = NULL;
     int json = 0, force = 0;
+    sinew_self_contact eval_mode = SINEW_SELF_CONTACT_POSE_SPACE;
     sw_bake_params p = sw_bake_params_default();
     sw_adaptive_params ad = sw_adaptive_params_default();
     sw_adaptive_report arep;
@@ -166,6 +173,15 @@ int main(int argc, char **argv) {
             p.inertia_modes = 1;
         else if (!strcmp(a, "--contact-modes"))
             p.contact_modes = 1;
+        else if (!strcmp(a, "--contact-tol") && next)
+            ok = sw_tool_real(tool, a, argv[++i], -1e-300, 1, "in 0 <= T < 1",
+                              &p.contact_cubature_tol);
+        else if (!strcmp(a, "--eval-self-contact") && next) {
+            int k = sw_tool_choice(argv[++i], (const char *const[]){"pose-space", "pose-pairs", 0});
+            if (!(ok = k >= 0))
+                fprintf(stderr, "%s: --eval-self-contact: pose-space or pose-pairs\n", tool);
+            eval_mode = k == 1 ? SINEW_SELF_CONTACT_POSE_PAIRS : SINEW_SELF_CONTACT_POSE_SPACE;
+        }
         else if (!strcmp(a, "--force"))
             force = 1;
         else if (!strcmp(a, "--json"))
@@ -232,7 +248,7 @@ int main(int argc, char **argv) {
         fprintf(stderr, "%s: out of memory\n", tool);
         goto done;
     }
-    if ((r = sw_bake_errors_frames(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, &et, &eh, frame_err,
+    if ((r = sw_bake_errors_frames(blob, &res, eval_mode, &et, &eh, frame_err,
                                    frame_err + res.ntrain, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         goto done;

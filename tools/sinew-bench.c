@@ -287,10 +287,13 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--hold-frames") && next)
             ok = sw_tool_int(tool, a, argv[++i], 2, 100000, &hold_frames);
         else if (!strcmp(a, "--self-contact") && next) {
-            int k = sw_tool_choice(argv[++i], (const char *const[]){"pose-space", "exhaustive", 0});
+            int k = sw_tool_choice(argv[++i],
+                                   (const char *const[]){"pose-space", "exhaustive", "pose-pairs", 0});
             if (!(ok = k >= 0))
-                fprintf(stderr, "%s: --self-contact: pose-space or exhaustive\n", tool);
-            self_mode = k > 0 ? SINEW_SELF_CONTACT_EXHAUSTIVE : SINEW_SELF_CONTACT_POSE_SPACE;
+                fprintf(stderr, "%s: --self-contact: pose-space, exhaustive or pose-pairs\n", tool);
+            self_mode = k == 1   ? SINEW_SELF_CONTACT_EXHAUSTIVE
+                        : k == 2 ? SINEW_SELF_CONTACT_POSE_PAIRS
+                                 : SINEW_SELF_CONTACT_POSE_SPACE;
         } else if (!strcmp(a, "--sc-compare"))
             sc_compare = 1;
         else if (!strcmp(a, "--error-gap"))
@@ -675,7 +678,9 @@ int main(int argc, char **argv) {
                cb.vs_lone, cb.ms_1thread, cb.lone_ms, cb.lone_median_ms);
     if (json)
         printf(",\"self_contact\":\"%s\"",
-               self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive" : "pose_space");
+               self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE    ? "exhaustive"
+               : self_mode == SINEW_SELF_CONTACT_POSE_PAIRS ? "pose_pairs"
+                                                            : "pose_space");
     if (json && sc_compare) sw_sc_bench_print(&scb, stdout, 1);
     if (json && error_gap) sw_gap_bench_print(&gap, stdout, 1);
     if (json && clip_errors)

@@ -43,6 +43,13 @@ static inline int sw_tool_int(const char *tool, const char *flag, const char *s,
     return 0;
 }
 
+/* The index of v in the NULL-terminated names, or -1. */
+static inline int sw_tool_choice(const char *v, const char *const *names) {
+    for (int k = 0; names[k]; ++k)
+        if (!strcmp(v, names[k])) return k;
+    return -1;
+}
+
 /* Parses flag's value s as a finite number with lo < value < hi (open bounds) into *out;
  * otherwise names the flag, its range and the value on stderr and returns 0. */
 static inline int sw_tool_real(const char *tool, const char *flag, const char *s, double lo,
@@ -518,12 +525,6 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
 
 /* When argv[*i] is a reference option, consumes it and its value and returns 1, with
  * *ok = 0 (and a message) for a bad value; returns 0 for any other argument. */
-/* The index of v in the NULL-terminated names, or -1. */
-static inline int sw_tool_choice(const char *v, const char *const *names) {
-    for (int k = 0; names[k]; ++k)
-        if (!strcmp(v, names[k])) return k;
-    return -1;
-}
 
 static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **argv, int *i,
                                          int *ok) {

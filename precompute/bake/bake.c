@@ -28,6 +28,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.max_train_frames = 40;
     p.return_path = 0;
     p.inertia_modes = 0;
+    p.contact_cubature_tol = 0.05;
     p.heldout_fraction = 0.4;
     p.random_poses = 10;
     p.self_contact = 1;
@@ -259,13 +260,15 @@ static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
         !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 || p.sweep_samples < 1 ||
         p.sweep_samples > 1000 || p.max_train_frames < 1 ||
         !(p.heldout_fraction >= 0 && p.heldout_fraction < 1) || !(p.spring_k >= 0) ||
-        !isfinite(p.spring_k) || !(p.fold_share >= 0 && p.fold_share < 0.5))
+        !isfinite(p.spring_k) || !(p.fold_share >= 0 && p.fold_share < 0.5) ||
+        !(p.contact_cubature_tol >= 0 && p.contact_cubature_tol < 1))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "bake parameters out of range (rank %d, energy %g, cubature tol %g, "
-                            "max %d, sweep %d, frames %d, held-out %g, spring %g, fold share %g)",
+                            "max %d, sweep %d, frames %d, held-out %g, spring %g, fold share %g, "
+                            "contact cubature tol %g)",
                             p.max_rank, p.pca_energy, p.cubature_tol, p.cubature_max,
                             p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k,
-                            p.fold_share);
+                            p.fold_share, p.contact_cubature_tol);
     if (p.ntrain_clips < 0 || p.nheldout_clips < 0 || (p.ntrain_clips > 0 && !p.train_clips) ||
         (p.nheldout_clips > 0 && !p.heldout_clips) || (p.nheldout_clips > 0 && !p.ntrain_clips))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
@@ -490,7 +493,8 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     if ((r = sw_bake_contacts(&s, err)) != SINEW_OK ||
         (r = sw_bake_reduce(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_render(&s, out, err)) != SINEW_OK ||
-        (r = sw_bake_cond(&s, out, err)) != SINEW_OK)
+        (r = sw_bake_cond(&s, out, err)) != SINEW_OK ||
+        (r = sw_bake_pairs(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;

@@ -52,6 +52,11 @@ typedef struct sw_bake_params {
     int contact_modes;             /* self-contact force modes (thesis §3.3.1): the static
                                       responses to the training poses' contact forces join
                                       the basis (bake_basis.c; default 0) */
+    double contact_cubature_tol;   /* pose-space pairs per pair of domains (bake_pairs.c): each
+                                      training pose's pairs of a pair of domains reduced to
+                                      a cubature that reproduces their reduced contact force
+                                      to this tolerance (default 0.05; 0: every pair kept at
+                                      weight 1) */
     int inertia_modes;             /* for the dynamic step: basis modes for the inertia of the
                                       bones' accelerations and the cubature trained on them
                                       (bake_basis.c; default 0: they raise the rank, 33 -> 73

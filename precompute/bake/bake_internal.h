@@ -111,6 +111,10 @@ sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err
  * lumped masses, the cubature tets' ids); after sw_bake_reduce (bake_cond.c). */
 sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 
+/* The per-pair self-contact sections of the view (groups of domains, pose features, each
+ * pose's pairs sorted by group with their cubature weights); after sw_bake_cond
+ * (bake_pairs.c). */
+sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* Records an owned allocation in the result (freed with it); returns p. */
 void *sw_bake_own(sw_bake_result *out, void *p);
 

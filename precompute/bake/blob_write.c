@@ -1,5 +1,5 @@
 /* Blob layout: header (64 bytes), section table (26 entries, 8 more with a render mesh, 10
- * more with the condensation tet mesh), then the sections in id order, each starting at a
+ * more with the condensation tet mesh, 6 more with per-pair self-contact), then the sections in id order, each starting at a
  * multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers everything after the
  * header. A view without the optional groups writes exactly the 26 sections it always did,
  * byte for byte. */
@@ -32,10 +32,12 @@ static uint64_t round_up(uint64_t x) {
 typedef struct group_metas {
     sinew_blob_render_meta render;
     sinew_blob_cond_meta cond;
+    sinew_blob_pair_meta pair;
 } group_metas;
 
 /* The sections of a validated view, in id order, into s; returns their number (26, plus 8
- * with a render mesh, plus 10 with the condensation tet mesh). `meta` and `g` must outlive
+ * with a render mesh, plus 10 with the condensation tet mesh, plus 6 with per-pair
+ * self-contact). `meta` and `g` must outlive
  * the result. */
 static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
                          section_src s[SINEW_SECTION_ID_MAX]) {
@@ -57,6 +59,13 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
                                     SINEW_BLOB_COND_ARRAY_SECTIONS(SOURCE)};
         memcpy(s + n, cond, sizeof cond);
         n += (int)(sizeof cond / sizeof cond[0]);
+    }
+    if (v->npair_groups > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_PAIR_COUNTS);
+        const section_src pair[] = {{SINEW_SECTION_PAIR_META, sizeof g->pair, &g->pair, 1},
+                                    SINEW_BLOB_PAIR_ARRAY_SECTIONS(SOURCE)};
+        memcpy(s + n, pair, sizeof pair);
+        n += (int)(sizeof pair / sizeof pair[0]);
     }
     return n;
 }
@@ -87,6 +96,9 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
 #define TO_COND_META(field) g.cond.field = view->field;
     SINEW_BLOB_COND_COUNTS(TO_COND_META)
 #undef TO_COND_META
+#define TO_PAIR_META(field) g.pair.field = view->field;
+    SINEW_BLOB_PAIR_COUNTS(TO_PAIR_META)
+#undef TO_PAIR_META
 
     section_src src[SINEW_SECTION_ID_MAX];
     sinew_blob_section table[SINEW_SECTION_ID_MAX];

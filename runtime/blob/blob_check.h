@@ -110,4 +110,16 @@ sinew_result sw_blob_cond_fill(const uint8_t *bytes, const sinew_blob_section *s
  * been checked. */
 sinew_result sw_blob_cond_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
+/* Layer 1 of the per-pair self-contact (blob_pair.c): the six optional sections all present
+ * or all absent, PAIR_META's count (npair_groups in [1, ndomains^2], npair_groups ntrain <=
+ * SW_BLOB_MAX_COUNT) and reserved words, every section's count against them and META's;
+ * points the view's fields at them (left 0 / NULL when absent). After META. */
+sinew_result sw_blob_pair_fill(const uint8_t *bytes, const sinew_blob_section *s, const int found[],
+                               sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 2 of the per-pair self-contact: domains, ascending groups, the pointer table against
+ * CONTACT_PTR and every contact's domains, finite maps and features, weights >= 0 (nothing
+ * when npair_groups is 0); after the contacts have been checked. */
+sinew_result sw_blob_pair_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
 #endif

@@ -15,6 +15,8 @@
  *   - the optional render mesh: its counts <= SW_BLOB_MAX_COUNT, |barycentric| <=
  *     SW_BLOB_MAX_BARY (blob_render.c);
  *   - the optional condensation tet mesh: ntets <= SW_BLOB_MAX_COUNT (blob_cond.c);
+ *   - the optional per-pair self-contact: npair_groups ntrain <= SW_BLOB_MAX_COUNT
+ *     (blob_pair.c);
  *   - domain d's ranges are the prefix sums of the previous domains' sizes in domain
  *     order (vertex copies, q, cubature, basis, inertia_u), every domain has at least
  *     one vertex copy and one cubature tet, every surface vertex at least one copy.

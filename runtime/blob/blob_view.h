@@ -160,6 +160,20 @@ typedef struct sw_blob_view {
      * only for a vertex in no tet, which no patch reaches) */
     const double *vert_mass;
     const int32_t *cub_tet_id; /* ncub: the global tet id of each cubature tet */
+
+    /* the optional per-pair self-contact (thesis §3.2.3; npair_groups 0: none, every field
+     * below NULL). Group g pairs domain pair_domains[2g] (the contacts' vertex p) with
+     * pair_domains[2g+1] (their triangle); its feature is pair_map[72 g ..] (6 x 12) times
+     * the relative transform [vec(R); t] of the second domain's bone in the first's frame,
+     * pair_feature[6 (g ntrain + t) ..] at training pose t, whose contacts of the group are
+     * [pair_ptr[t npair_groups + g], pair_ptr[t npair_groups + g + 1]), each with its
+     * cubature weight pair_weight[c] (>= 0) */
+    int32_t npair_groups;
+    const int32_t *pair_domains;
+    const double *pair_map;
+    const double *pair_feature;
+    const int32_t *pair_ptr;
+    const double *pair_weight;
 } sw_blob_view;
 
 /* The output surface a host reads (sinew_instance_read_surface): the render mesh when the

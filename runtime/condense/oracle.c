@@ -368,8 +368,8 @@ static void patch_pairs(sw_cond *c, const sw_reduced *red, sw_pose_space *ps) {
                           : -1 - ring_copy(c, red, gv[m], cv[2 * m], cv[2 * m + 1]);
         c->pp_active[c->np] = -1;
         c->pp_id[c->np] = ps->pairs[p];
-        c->pp_alpha[c->np] = SW_CONTACT_ALPHA * ps->tangent[p < ps->npairs_nearest ? 0 : 1];
-        c->pp_w[c->np++] = p < ps->npairs_nearest ? 1 - ps->blend : ps->blend;
+        c->pp_alpha[c->np] = SW_CONTACT_ALPHA * ps->pair_tan[p];
+        c->pp_w[c->np++] = ps->pair_w[p];
     }
     if (c->np > 0) ps->in_patch = c->pp_skip;
 }

@@ -15,10 +15,11 @@
  * couple two domains. Added after the cubature so it lands on the full (mirrored)
  * matrix. */
 static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32_t *pairs,
-                            const unsigned char *skip, int32_t npairs, double weight,
-                            double tangent, const double *q, int want_grad, int want_hess) {
+                            const unsigned char *skip, int32_t npairs, const double *weight,
+                            const double *tangent, const double *q, int want_grad,
+                            int want_hess) {
     const sw_blob_view *v = red->v;
-    double E = 0, k = weight * v->contact_k, al = tangent * SW_CONTACT_ALPHA;
+    double E = 0;
     int32_t rm = red->rmax;
     sw_reduced map = *red; /* the same map with the set's skinning transforms */
     map.act_R = (double *)set->act_R;
@@ -42,7 +43,8 @@ static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32
         for (int i = 0; i < 3; ++i)
             n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
         if (!(sw_penalty_gap(n, d) > 0)) continue;
-        double kk = k * cd[6], Nd[3];
+        const double al = (tangent ? tangent[p] : 1) * SW_CONTACT_ALPHA;
+        double kk = (weight ? weight[p] : 1) * v->contact_k * cd[6], Nd[3];
         sw_penalty_apply_N(n, al, d, Nd);
         E += sw_penalty_energy(kk, d, Nd);
         if (!want_grad) continue;
@@ -105,23 +107,17 @@ sw_pair_set sw_pose_pair_set(const sw_reduced *red) {
 }
 
 double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids, int32_t n,
-                             double weight, double tangent, const double *q, int want_grad,
-                             int want_hess) {
+                             const double *weight, const double *tangent, const double *q,
+                             int want_grad, int want_hess) {
     return contact_pairs(red, set, ids, NULL, n, weight, tangent, q, want_grad, want_hess);
 }
 
-/* The two nearest training poses' pairs with their pose-space blend weights (DESIGN.md
- * §8, thesis §3.2.3: the two schemes' forces interpolated). */
+/* The pairs the pose space gathered, each at its weight: the pose-space blend (DESIGN.md
+ * §8, thesis §3.2.3: the two schemes' forces interpolated) times its cubature weight. */
 double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,
                             int want_grad, int want_hess) {
-    if (ps->nearest < 0) return 0;
-    const unsigned char *skip = ps->in_patch;
+    if (ps->npairs == 0) return 0;
     sw_pair_set set = sw_pose_pair_set(red);
-    double E = contact_pairs(red, &set, ps->pairs, skip, ps->npairs_nearest, 1 - ps->blend,
-                             ps->tangent[0], q, want_grad, want_hess);
-    if (ps->blend > 0)
-        E += contact_pairs(red, &set, ps->pairs + ps->npairs_nearest,
-                           skip ? skip + ps->npairs_nearest : NULL, ps->npairs - ps->npairs_nearest,
-                           ps->blend, ps->tangent[1], q, want_grad, want_hess);
-    return E;
+    return contact_pairs(red, &set, ps->pairs, ps->in_patch, ps->npairs, ps->pair_w, ps->pair_tan,
+                         q, want_grad, want_hess);
 }

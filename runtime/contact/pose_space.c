@@ -57,7 +57,7 @@ void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones) {
     ps->tangent[0] = ps->tangent[1] = 0;
     ps->looked_up = 0; /* no motion yet: a pose on two branches takes the first stored */
     memset(ps->motion, 0, 4 * (size_t)nbones * sizeof(double));
-    ps->npairs_nearest = ps->npairs = ps->dropped = 0;
+    ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
 }
 
 /* Training pose t is stored on the branch cycle of u (the same pose: the bake stores a
@@ -79,7 +79,7 @@ static int same_pose(const sw_pose_space *ps, int32_t t, int32_t u) {
  * arrival is most aligned with the instance's own last motion wins (the first stored
  * on a tie, e.g. before the pose ever moved): a fold that buckled while the joint
  * bent stays buckled while it unbends. */
-static int32_t pick_branch(const sw_pose_space *ps, const sw_blob_view *v, int32_t rep) {
+int32_t sw_pose_space_branch(const sw_pose_space *ps, const sw_blob_view *v, int32_t rep) {
     size_t f = (size_t)4 * v->nbones;
     int32_t best = rep, t = rep;
     double best_s = -INFINITY;
@@ -101,7 +101,7 @@ static int32_t pick_branch(const sw_pose_space *ps, const sw_blob_view *v, int32
  * pose-space blend weight of the second (DESIGN.md §8: one sample when the nearest is
  * within 1e-3 or the second is more than 4 times as far, else a blend by distance).
  * A pose stored on several branches counts once; the instance's motion picks the
- * branch (pick_branch). Sets ps->nearest (-1 without training poses), ps->second and
+ * branch (sw_pose_space_branch). Sets ps->nearest (-1 without training poses), ps->second and
  * ps->blend. */
 void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T) {
     int32_t n0 = -1, n1 = -1;
@@ -138,27 +138,31 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
             ps->motion[i] = ps->feature[i] - ps->feature_last[i];
     memcpy(ps->feature_last, ps->feature, f * sizeof(double));
     ps->looked_up = 1;
-    ps->nearest = pick_branch(ps, v, n0);
-    ps->second = ps->blend > 0 ? pick_branch(ps, v, n1) : n1;
+    ps->nearest = sw_pose_space_branch(ps, v, n0);
+    ps->second = ps->blend > 0 ? sw_pose_space_branch(ps, v, n1) : n1;
 }
 
-/* Appends the pairs of training pose `pose` while the budget lasts. */
-static void gather_pose(sw_pose_space *ps, const sw_blob_view *v, int32_t pose) {
+/* Appends the pairs of training pose `pose` at weight w and tangential share tan while
+ * the budget lasts. */
+static void gather_pose(sw_pose_space *ps, const sw_blob_view *v, int32_t pose, double w,
+                        double tan) {
     for (int32_t c = v->contact_ptr[pose]; c < v->contact_ptr[pose + 1]; ++c) {
         if (ps->npairs == ps->max_pairs) {
             ps->dropped += v->contact_ptr[pose + 1] - c;
             return;
         }
+        ps->pair_w[ps->npairs] = w;
+        ps->pair_tan[ps->npairs] = tan;
         ps->pairs[ps->npairs++] = c;
     }
 }
 
 void sw_pose_space_gather_pairs(sw_pose_space *ps, const sw_blob_view *v) {
-    ps->npairs_nearest = ps->npairs = ps->dropped = 0;
+    ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
     if (ps->nearest < 0) return;
-    gather_pose(ps, v, ps->nearest);
+    gather_pose(ps, v, ps->nearest, 1 - ps->blend, ps->tangent[0]);
     ps->npairs_nearest = ps->npairs;
-    if (ps->blend > 0) gather_pose(ps, v, ps->second);
+    if (ps->blend > 0) gather_pose(ps, v, ps->second, ps->blend, ps->tangent[1]);
 }
 
 int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v) {

@@ -26,11 +26,25 @@ typedef struct sw_pose_space {
        linearly to 0 at the distance of its nearest other pose (sw_pose_space_lookup) */
     double tangent[2];
     /* the contact pairs in use: pairs[0, npairs_nearest) are the nearest pose's,
-       pairs[npairs_nearest, npairs) the second's (when blended) */
+       pairs[npairs_nearest, npairs) the second's (when blended); per pair, its weight
+       (pose-space blend times cubature weight) and its share of the tangential term.
+       Per-pair mode (sw_pair_space_gather): each group's nearest sample's pairs, then its
+       second's, group after group (npairs_nearest 0) */
     int32_t *pairs;    /* max_pairs contact ids */
+    double *pair_w;    /* max_pairs */
+    double *pair_tan;  /* max_pairs */
     int32_t max_pairs; /* the budget: at most this many pairs a step */
     int32_t npairs_nearest, npairs;
     int32_t dropped; /* pairs the budget left out this step */
+    /* per-pair mode (the blob's pair groups, pair_space.c): per group and training pose,
+       the feature distance to the group's nearest other distinct sample (INFINITY: none);
+       NULL in whole-pose mode */
+    double *pair_reach;
+    int32_t novel; /* groups whose nearest sample was farther than SW_PAIR_NOVEL this step */
+    /* ndomains^2: 1 for the pairs of domains (a, b) novel this step, whose contact the
+       exhaustive detection finds instead (NULL: no fallback, the nearest sample's pairs
+       stay in use) */
+    unsigned char *novel_mask;
     /* per pairs[] entry: 1 when a condensation patch evaluates the pair with its full-space
        positions instead (condense.h); NULL: none does */
     const unsigned char *in_patch;
@@ -57,5 +71,28 @@ void sw_pose_space_gather_pairs(sw_pose_space *ps, const sw_blob_view *v);
 
 /* The default pair budget: the pairs of the two training poses that hold the most. */
 int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v);
+
+/* Of the branches stored for training pose t (twin_next), the one the instance's last
+ * motion is on (t itself when it has one). */
+int32_t sw_pose_space_branch(const sw_pose_space *ps, const sw_blob_view *v, int32_t t);
+
+/* Per-pair mode (pair_space.c): a group whose nearest sample is farther than this
+ * (relative feature distance, DESIGN.md §8) is novel contact. */
+#define SW_PAIR_NOVEL 0.5
+
+/* Fills pair_reach (npair_groups ntrain). O(npair_groups ntrain^2), once at creation. */
+void sw_pair_space_reach(const sw_blob_view *v, double *pair_reach);
+
+/* Per-pair mode: every group's two nearest samples by its own feature of the pose T (a
+ * domain against itself: the whole pose's, after sw_pose_space_lookup), blended by
+ * distance (DESIGN.md §8), and their pairs of weight > 0 into ps->pairs with pair_w
+ * (blend times cubature weight) and pair_tan, at most max_pairs; sets npairs, dropped
+ * and novel. A group with no sample within SW_PAIR_NOVEL is novel: with novel_mask it is
+ * marked there and brings no pairs (the exhaustive detection's take its place). O(npair_groups
+ * ntrain + pairs). */
+void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double *T);
+
+/* The per-pair mode's budget: per group, its two fullest samples' pairs of weight > 0. */
+int32_t sw_pair_space_default_max_pairs(const sw_blob_view *v);
 
 #endif

@@ -143,18 +143,39 @@ static void make_pair(sw_self_contacts *sc, const sw_contact *c, int32_t i) {
 }
 
 int32_t sw_self_contacts_detect(sw_self_contacts *sc, const sw_reduced *red, const double *q) {
+    return sw_self_contacts_detect_pairs(sc, red, q, NULL);
+}
+
+/* Vertex gv's home domain has a pair in mask's row (mask NULL: every vertex). */
+static int row_set(const sw_self_contacts *sc, const unsigned char *mask, int32_t nd, int32_t gv) {
+    if (!mask) return 1;
+    int32_t a = sc->home[2 * gv];
+    if (a < 0) return 0;
+    for (int32_t b = 0; b < nd; ++b)
+        if (mask[a * nd + b]) return 1;
+    return 0;
+}
+
+int32_t sw_self_contacts_detect_pairs(sw_self_contacts *sc, const sw_reduced *red, const double *q,
+                                      const unsigned char *mask) {
     sw_self_mesh *m = &sc->m;
+    const int32_t nd = red->v->ndomains;
     map_vertices(sc, red, q);
     sw_bvh_refit_elements(&m->tet_bvh, m->tets, 4, sc->x, 0, m->ntets);
     sw_bvh_refit_nodes(&m->tet_bvh);
     int32_t n = 0;
     sc->tests = 0;
     for (int32_t si = 0; si < m->nsurf; ++si) {
+        if (!row_set(sc, mask, nd, m->surf[si])) continue;
         int32_t tested = 0;
         /* a vertex in no tet has no home copy: the detection never returns it as p, but a
            triangle corner always lies in a tet */
-        n += sw_self_detect_vertex(m, sc->x, si, &sc->found[n], &tested);
+        int32_t k = sw_self_detect_vertex(m, sc->x, si, &sc->found[n], &tested);
         sc->tests += tested;
+        if (k > 0 && mask &&
+            !mask[sc->home[2 * sc->found[n].p] * nd + sc->home[2 * sc->found[n].tri[0]]])
+            k = 0;
+        n += k;
     }
     /* the new pairs: their vertex had none before (both lists ascend in p) */
     int32_t fresh = 0, j = 0;

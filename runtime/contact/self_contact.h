@@ -53,6 +53,13 @@ sinew_result sw_self_contacts_build(sw_self_contacts *sc, const sw_blob_view *v,
  * the pairs in use before. */
 int32_t sw_self_contacts_detect(sw_self_contacts *sc, const sw_reduced *red, const double *q);
 
+/* The same restricted to pairs of domains: only vertices whose home domain a has a pair in
+ * `mask` (ndomains^2, row a, column b) are tested, and a contact is kept when mask[a nd + b]
+ * is set for its triangle's first corner's domain b (the pose-pairs mode's fallback on
+ * novel contact, pair_space.c). */
+int32_t sw_self_contacts_detect_pairs(sw_self_contacts *sc, const sw_reduced *red, const double *q,
+                                      const unsigned char *mask);
+
 /* Forgets the pairs in use. */
 void sw_self_contacts_clear(sw_self_contacts *sc);
 

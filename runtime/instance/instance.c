@@ -22,6 +22,7 @@ typedef struct {
     sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
     double rho;         /* its radius, in units of the rest diagonal */
     int exhaustive;     /* SINEW_SELF_CONTACT_EXHAUSTIVE: its detection's arrays */
+    int per_pair;       /* SINEW_SELF_CONTACT_POSE_PAIRS: the groups' reach */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -63,7 +64,13 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(ps->twin_next, (uint64_t)v->ntrain);
     TAKE(ps->reach, (uint64_t)v->ntrain);
     TAKE(ps->pairs, (uint64_t)z->max_pairs);
-    if (z->exhaustive) sw_self_contacts_take(p, v, &in->sc);
+    TAKE(ps->pair_w, (uint64_t)z->max_pairs);
+    TAKE(ps->pair_tan, (uint64_t)z->max_pairs);
+    ps->pair_reach = NULL;
+    ps->novel_mask = NULL;
+    if (z->per_pair) TAKE(ps->pair_reach, (uint64_t)v->npair_groups * (uint64_t)v->ntrain);
+    if (z->per_pair && v->ntets > 0) TAKE(ps->novel_mask, nd * nd);
+    if (z->exhaustive || (z->per_pair && v->ntets > 0)) sw_self_contacts_take(p, v, &in->sc);
     /* the solver */
     sw_solver *s = &in->solver;
     TAKE(s->q, R);
@@ -294,10 +301,13 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
         : d->max_patch_vertices > 0 && v->ntets == 0
             ? "max_patch_vertices needs a blob with the tet mesh (bake it again)"
         : d->self_contact != SINEW_SELF_CONTACT_POSE_SPACE &&
-                d->self_contact != SINEW_SELF_CONTACT_EXHAUSTIVE
-            ? "self_contact is neither pose-space nor exhaustive"
+                d->self_contact != SINEW_SELF_CONTACT_EXHAUSTIVE &&
+                d->self_contact != SINEW_SELF_CONTACT_POSE_PAIRS
+            ? "self_contact is none of pose-space, exhaustive, pose pairs"
         : d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE && v->ntets == 0
             ? "exhaustive self-contact needs a blob with the tet mesh (bake it again)"
+        : d->self_contact == SINEW_SELF_CONTACT_POSE_PAIRS && v->npair_groups == 0
+            ? "pose-pairs self-contact needs a blob with per-pair sections (bake it again)"
             : NULL;
     if (bad) {
         sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
@@ -311,7 +321,9 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     for (int32_t k = 0; k < v->ndomains; ++k)
         if (v->domains[k].rank > z->rmax) z->rmax = v->domains[k].rank;
     /* a budget above what the blob can ever need is what it needs */
-    int32_t need = sw_pose_space_default_max_pairs(v);
+    z->per_pair = d->self_contact == SINEW_SELF_CONTACT_POSE_PAIRS;
+    int32_t need =
+        z->per_pair ? sw_pair_space_default_max_pairs(v) : sw_pose_space_default_max_pairs(v);
     z->max_pairs = d->max_contact_pairs == 0 || d->max_contact_pairs > (uint32_t)need
                        ? need
                        : (int32_t)d->max_contact_pairs;
@@ -436,11 +448,12 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->wc.radius = 0.01 * in->size;
     sw_pose_space_link_twins(v, in->ps.twin_next);
     sw_pose_space_reach(v, in->ps.reach);
+    if (z.per_pair) sw_pair_space_reach(v, in->ps.pair_reach);
     in->cond.z = z.cond;
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
     in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
     in->self_mode = d.self_contact;
-    if (z.exhaustive) {
+    if (z.exhaustive || (z.per_pair && v->ntets > 0)) {
         sw_error e;
         if (sw_self_contacts_build(&in->sc, v, &e) != SINEW_OK) {
             sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
@@ -488,7 +501,8 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);
     if (inst->cond.z.max_verts > 0) sw_cond_forget(&inst->cond);
-    if (inst->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE) sw_self_contacts_clear(&inst->sc);
+    if (inst->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE || inst->ps.novel_mask)
+        sw_self_contacts_clear(&inst->sc);
     inst->ps.in_patch = NULL;
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;

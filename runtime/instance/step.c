@@ -72,8 +72,14 @@ static int exhaustive(const sinew_instance *in) {
     return in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE;
 }
 
+/* The exhaustive detection's pairs are in use: its mode, or the pose-pairs mode's fallback
+ * on novel contact. */
+static int detected(const sinew_instance *in) {
+    return exhaustive(in) || (in->ps.novel_mask && in->sc.npairs > 0);
+}
+
 sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) {
-    sw_step_contacts ct = {&in->ps, in->wc.world ? &in->wc : NULL, exhaustive(in) ? &in->sc : NULL,
+    sw_step_contacts ct = {&in->ps, in->wc.world ? &in->wc : NULL, detected(in) ? &in->sc : NULL,
                            self_seconds};
     return ct;
 }
@@ -86,8 +92,12 @@ static void phase_contact(sw_step_ctx *c) {
     if (exhaustive(in)) {
         in->ps.npairs = in->ps.npairs_nearest = in->ps.dropped = 0;
     } else {
-        sw_pose_space_gather_pairs(&in->ps, in->v);
+        if (in->self_mode == SINEW_SELF_CONTACT_POSE_PAIRS)
+            sw_pair_space_gather(&in->ps, in->v, in->pose.T_cur);
+        else
+            sw_pose_space_gather_pairs(&in->ps, in->v);
         c->st.self_contact_tests = c->st.self_contacts = (uint32_t)in->ps.npairs;
+        c->st.self_contact_novel = (uint32_t)in->ps.novel;
     }
     if (in->ps.dropped > 0) {
         c->st.status |= SINEW_STEP_BUDGET;
@@ -106,6 +116,13 @@ static void phase_self(sw_step_ctx *c) {
     if (exhaustive(in)) {
         sw_self_contacts_detect(&in->sc, &in->red, in->solver.q);
         c->st.self_contact_tests = (uint32_t)in->sc.tests;
+    } else if (in->ps.novel_mask) { /* pose-pairs: pairs of domains no sample is near */
+        sw_self_contacts_clear(&in->sc);
+        if (in->ps.novel > 0) {
+            sw_self_contacts_detect_pairs(&in->sc, &in->red, in->solver.q, in->ps.novel_mask);
+            c->st.self_contact_tests += (uint32_t)in->sc.tests;
+            c->st.self_contacts += (uint32_t)in->sc.npairs;
+        }
     }
     sw_step_contacts ct = sw_instance_contacts(in, NULL);
     sw_solver_block_pattern(&in->solver, in->v, &ct);

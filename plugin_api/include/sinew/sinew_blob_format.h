@@ -62,6 +62,22 @@
  *   COND_VERT_MASS    per vertex, its lumped mass (> 0; 0 only for a vertex in no tet)
  *   COND_CUB_TET_ID   per cubature tet (ncub), its tet id: the tet's domain, corners,
  *                     Dm^-1 and volume are the cubature tet's
+ *
+ * Optional sections (SINEW_BLOB_PAIR_SECTIONS, ids 45..50): pose-space self-contact per
+ * pair of domains (thesis §3.2.3), all six present or none. A blob without them is byte for
+ * byte what it was before they existed; a runtime that predates them skips them. A group
+ * is an ordered pair of domains (a, b): the contacts whose vertex p is in a (its CONTACT_VERTS
+ * domain) and whose triangle's first corner t0 is in b. Its pose feature is 6 uncentred PCA
+ * coordinates of b's surface in a's frame, a linear map of the two bones' relative rigid
+ * transform. Counts in PAIR_META (sinew_blob_pair_meta) and META (ntrain, ncontacts), rows:
+ *   PAIR_DOMAINS  per group, a and b (a == b: a domain against itself)
+ *   PAIR_MAP      per group, 6 x 12 row-major: feature = MAP [vec(R) ; t], R (row-major)
+ *                 and t the relative transform T_bone(a)^-1 T_bone(b)
+ *   PAIR_FEATURE  per group, per training pose, its 6 feature coordinates ([g][t][6])
+ *   PAIR_PTR      pose t's contacts of group g are [ptr[t G + g], ptr[t G + g + 1]), G groups;
+ *                 ptr[t G] = CONTACT_PTR[t], ptr[ntrain G] = ncontacts (a pose's contacts
+ *                 sorted by group)
+ *   PAIR_WEIGHT   per contact, its cubature weight >= 0 (eqs. 3.9-3.13; 0: left out)
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -181,13 +197,29 @@ typedef struct sinew_blob_section {
     X(43, COND_VERT_MASS,     8, double,  vert_mass,    1, nverts,     "nverts")                   \
     X(44, COND_CUB_TET_ID,    4, int32_t, cub_tet_id,   1, ncub,       "ncub")
 
+/* The optional per-pair self-contact (see above): counts named by SINEW_BLOB_PAIR_COUNTS
+ * from PAIR_META, with META's ntrain and ncontacts; rows as in SINEW_BLOB_SECTIONS. */
+#define SINEW_BLOB_PAIR_COUNTS(X) X(npair_groups)
+#define SINEW_BLOB_PAIR_SECTIONS(X)                                                                \
+    X(45, PAIR_META,         32, sinew_blob_pair_meta, pair_meta, 1, 1, "1")                       \
+    SINEW_BLOB_PAIR_ARRAY_SECTIONS(X)
+#define SINEW_BLOB_PAIR_ARRAY_SECTIONS(X)                                                          \
+    X(46, PAIR_DOMAINS,  4, int32_t, pair_domains, 1, 2 * npair_groups,  "2 npair_groups")         \
+    X(47, PAIR_MAP,      8, double,  pair_map,     1, 72 * npair_groups, "72 npair_groups")        \
+    X(48, PAIR_FEATURE,  8, double,  pair_feature, 1, 6 * npair_groups * ntrain,                   \
+      "6 npair_groups ntrain")                                                                     \
+    X(49, PAIR_PTR,      4, int32_t, pair_ptr,     1, npair_groups * ntrain + 1,                   \
+      "npair_groups ntrain + 1")                                                                   \
+    X(50, PAIR_WEIGHT,   8, double,  pair_weight,  1, ncontacts,         "ncontacts")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
 #define SINEW_BLOB_PLUS_ONE_(id, NAME, elem_size, type, field, by_meta, count, formula) +1
 /** Section ids; SINEW_SECTION_COUNT_V1 (26) is the number of sections every version-1 blob
  * has; SINEW_SECTION_RENDER_FIRST .. _RENDER_LAST are the optional render mesh's,
- * SINEW_SECTION_COND_FIRST .. _COND_LAST the optional condensation tet mesh's;
+ * SINEW_SECTION_COND_FIRST .. _COND_LAST the optional condensation tet mesh's,
+ * SINEW_SECTION_PAIR_FIRST .. _PAIR_LAST the optional per-pair self-contact's;
  * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
@@ -200,7 +232,11 @@ enum sinew_blob_section_id {
     SINEW_SECTION_COND_FIRST = SINEW_SECTION_COND_META,
     SINEW_SECTION_COND_LAST =
         SINEW_SECTION_RENDER_LAST SINEW_BLOB_COND_SECTIONS(SINEW_BLOB_PLUS_ONE_),
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_COND_LAST
+    SINEW_BLOB_PAIR_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_PAIR_FIRST = SINEW_SECTION_PAIR_META,
+    SINEW_SECTION_PAIR_LAST =
+        SINEW_SECTION_COND_LAST SINEW_BLOB_PAIR_SECTIONS(SINEW_BLOB_PLUS_ONE_),
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_PAIR_LAST
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
@@ -231,6 +267,12 @@ typedef struct sinew_blob_cond_meta {
     int32_t nvert_tets;  /**< (vertex, incident tet) pairs: 4 ntets */
     int32_t reserved[6]; /**< zero */
 } sinew_blob_cond_meta;
+
+/** Section PAIR_META: the per-pair self-contact's counts (32 bytes). */
+typedef struct sinew_blob_pair_meta {
+    int32_t npair_groups; /**< domain pairs with contacts (1 .. ndomains^2) */
+    int32_t reserved[7];  /**< zero */
+} sinew_blob_pair_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
 typedef struct sinew_blob_domain_record {

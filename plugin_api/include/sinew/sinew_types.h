@@ -107,7 +107,15 @@ typedef enum sinew_self_contact {
      * the reference's detection rule: contacts the bake never saw, at a cost that follows
      * the mesh (every vertex mapped, every tet's box refit). Needs a blob with the tet
      * mesh (sinew-bake writes it); INVALID_ARGUMENT otherwise */
-    SINEW_SELF_CONTACT_EXHAUSTIVE = 1
+    SINEW_SELF_CONTACT_EXHAUSTIVE = 1,
+    /** pose-space contact per pair of domains (thesis §3.2.3): each pair of domains finds
+     * its own two nearest training samples by a feature of those two bones alone, and
+     * applies their cubature pairs, blended; combinations of joints the bake never saw
+     * together still find close samples pair by pair. A pair whose nearest sample is far
+     * counts as novel contact (sinew_step_stats.self_contact_novel). Needs a blob with
+     * per-pair sections (sinew-bake writes them when training poses touch themselves);
+     * INVALID_ARGUMENT otherwise */
+    SINEW_SELF_CONTACT_POSE_PAIRS = 2
 } sinew_self_contact;
 
 /** How to create an instance of a blob. All memory is reserved at creation. */
@@ -145,8 +153,8 @@ typedef struct sinew_instance_def {
      * diagonal (the thesis's radii, for a mesh normalised to a unit cube, are this times
      * diagonal / longest side). 0 means 0.05; otherwise 0 < patch_radius <= 1. */
     float patch_radius;
-    /** Self-contact detection: SINEW_SELF_CONTACT_POSE_SPACE (the default) or
-     * SINEW_SELF_CONTACT_EXHAUSTIVE (see there). */
+    /** Self-contact detection: SINEW_SELF_CONTACT_POSE_SPACE (the default),
+     * SINEW_SELF_CONTACT_EXHAUSTIVE or SINEW_SELF_CONTACT_POSE_PAIRS (see there). */
     sinew_self_contact self_contact;
 } sinew_instance_def;
 
@@ -264,6 +272,10 @@ typedef struct sinew_step_stats {
     /** self-contact pairs in the solve: the pose-space pairs in use, or the exhaustive
      * detection's pairs at the end of the step */
     uint32_t self_contacts;
+    /** SINEW_SELF_CONTACT_POSE_PAIRS: pairs of domains whose nearest training sample was
+     * farther than half the feature's size (novel contact the bake never saw); 0 in the
+     * other modes */
+    uint32_t self_contact_novel;
 } sinew_step_stats;
 
 #ifdef __cplusplus

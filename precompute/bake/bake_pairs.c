@@ -1,0 +1,313 @@
+/* Pose-space self-contact per pair of domains (thesis §3.2.3, DESIGN.md §4.4 and §8): the
+ * training poses' contacts grouped by the ordered pair of domains (a, b) holding the
+ * contact's vertex and its triangle, a pose feature per group, and a cubature of each
+ * pose's pairs of a group.
+ *
+ * Feature: the thesis's uncentred PCA (6 coordinates) of b's surface in a's frame. Under
+ * the bones' rigid motion b's rest points X_i sit at y_i = R X_i + t in a's frame, R, t
+ * the relative transform T_bone(a)^-1 T_bone(b), linear in z = [vec(R); t] (12): the
+ * snapshots are Y = M Z with M (3n x 12) fixed. Their uncentred PCA is then the
+ * eigenproblem of S = G^1/2 Z Z^T G^1/2 (12 x 12) with G = M^T M, and the coordinates of a
+ * pose are w_k^T G^1/2 z: the runtime's feature is a 6 x 12 map of z, whatever the size
+ * of b. The feature is invariant to a rigid motion of the whole character. A domain
+ * against itself has no relative motion (z is constant): its groups keep a zero map and
+ * the runtime takes their samples from the whole skeleton's nearest poses.
+ *
+ * Cubature (eqs. 3.9-3.13): per (pose, group), non-negative weights for a few of its pairs
+ * whose reduced contact forces at the reference's solution sum to the group's whole
+ * reduced contact force within the tolerance, by greedy selection and NNLS (the pairs
+ * most aligned with the residual join, nnls.h re-solves). A pair that is apart at the
+ * reference's solution carries no force and is left out, as the thesis's cubature does. */
+#include <lapacke.h>
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_internal.h"
+#include "nnls.h"
+#include "penalty.h"
+
+void openblas_set_num_threads(int num_threads);
+
+/* The relative transform z = [vec(R); t] of bone b in bone a's frame for transforms T. */
+static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
+    const double *Ra = T + 12 * a, *ta = Ra + 9, *Rb = T + 12 * b, *tb = Rb + 9;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+            z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
+        z[9 + i] = Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) +
+                   Ra[6 + i] * (tb[2] - ta[2]);
+    }
+}
+
+/* The bone transforms of training pose k (in stored order). */
+static const double *train_T(const sw_bake_state *s, int32_t k) {
+    for (int32_t i = 0; i < s->ntrain_seq; ++i) {
+        if (k < s->train[i].npose) return s->train[i].T + (size_t)k * 12 * s->nb;
+        k -= s->train[i].npose;
+    }
+    return NULL;
+}
+
+/* Group g's 6 x 12 feature map (see above) from domain b's rest vertices and the training
+ * poses' relative transforms. */
+static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map) {
+    double G[144] = {0}, S[144] = {0}, ev[12], H[144], Gh[144];
+    memset(map, 0, 72 * sizeof(double));
+    if (a == b) return 1;
+    const int32_t n = s->dom_vert_ptr[b + 1] - s->dom_vert_ptr[b];
+    for (int32_t k = s->dom_vert_ptr[b]; k < s->dom_vert_ptr[b + 1]; ++k) {
+        const double *X = s->ch.mesh.X + 3 * (size_t)s->dom_verts[k];
+        for (int r = 0; r < 3; ++r) /* y_r = sum_c R_rc X_c + t_r, per coordinate r */
+            for (int c = 0; c < 3; ++c) {
+                for (int e = 0; e < 3; ++e)
+                    G[(3 * r + c) * 12 + 3 * r + e] += X[c] * X[e] / n;
+                G[(3 * r + c) * 12 + 9 + r] += X[c] / n;
+                G[(9 + r) * 12 + 3 * r + c] += X[c] / n;
+            }
+    }
+    for (int r = 0; r < 3; ++r)
+        G[(9 + r) * 12 + 9 + r] = 1;
+    /* G^1/2 by its eigenvectors */
+    memcpy(H, G, sizeof H);
+    openblas_set_num_threads(1);
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', 12, H, 12, ev) != 0) return 0;
+    for (int i = 0; i < 12; ++i)
+        for (int j = 0; j < 12; ++j) {
+            double acc = 0;
+            for (int k = 0; k < 12; ++k)
+                acc += H[i * 12 + k] * sqrt(fmax(ev[k], 0)) * H[j * 12 + k];
+            Gh[i * 12 + j] = acc;
+        }
+    for (int32_t t = 0; t < s->ntrain; ++t) { /* S = G^1/2 (sum z z^T) G^1/2 */
+        double z[12], u[12];
+        relative_z(train_T(s, t), s->domain_bone[a], s->domain_bone[b], z);
+        for (int i = 0; i < 12; ++i) {
+            u[i] = 0;
+            for (int j = 0; j < 12; ++j)
+                u[i] += Gh[i * 12 + j] * z[j];
+        }
+        for (int i = 0; i < 12; ++i)
+            for (int j = 0; j < 12; ++j)
+                S[i * 12 + j] += u[i] * u[j];
+    }
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', 12, S, 12, ev) != 0) return 0;
+    for (int k = 0; k < 6; ++k) { /* eigenvalues ascend: the top six, w_k^T G^1/2 */
+        int col = 11 - k;
+        for (int j = 0; j < 12; ++j) {
+            double acc = 0;
+            for (int i = 0; i < 12; ++i)
+                acc += S[i * 12 + col] * Gh[i * 12 + j];
+            map[12 * k + j] = acc;
+        }
+    }
+    return 1;
+}
+
+/* Reduced contact force of blob contact c at the reference solution x of a pose (global
+ * vertex positions, per-vertex skinning rotations R): into f (rank_total, zeroed first).
+ * Returns 0 when the pair is apart there. */
+static int pair_force(const sw_bake_state *s, const sw_blob_view *v, int32_t c, const double *x,
+                      const double *R, double *f) {
+    const int32_t *cv = v->contact_verts + 8 * (size_t)c;
+    const double *cd = v->contact_data + 7 * (size_t)c;
+    const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
+    int32_t gv[4];
+    double d[3] = {0, 0, 0}, n[3], Nd[3];
+    for (int m = 0; m < 4; ++m) {
+        gv[m] = s->dom_verts[s->dom_vert_ptr[cv[2 * m]] + cv[2 * m + 1]];
+        for (int i = 0; i < 3; ++i)
+            d[i] += coef[m] * x[3 * (size_t)gv[m] + i];
+    }
+    const double *Rp = R + 9 * (size_t)gv[0];
+    for (int i = 0; i < 3; ++i)
+        n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
+    memset(f, 0, (size_t)s->rank_total * sizeof(double));
+    if (!(sw_penalty_gap(n, d) > 0)) return 0;
+    sw_penalty_apply_N(n, SW_CONTACT_ALPHA, d, Nd);
+    for (int i = 0; i < 3; ++i)
+        Nd[i] *= cd[6];
+    for (int m = 0; m < 4; ++m) { /* f += coef_m (R_m U_m)^T (ka N d) */
+        const int32_t dm = cv[2 * m], r = s->rank[dm];
+        const double *Rm = R + 9 * (size_t)gv[m], *U = s->basis[dm] + 3 * (size_t)cv[2 * m + 1] * r;
+        double w[3]; /* R_m^T ka N d */
+        for (int i = 0; i < 3; ++i)
+            w[i] = coef[m] * (Rm[i] * Nd[0] + Rm[3 + i] * Nd[1] + Rm[6 + i] * Nd[2]);
+        double *fd = f + v->domains[dm].q_offset;
+        for (int32_t j = 0; j < r; ++j)
+            fd[j] += U[j] * w[0] + U[r + j] * w[1] + U[2 * r + j] * w[2];
+    }
+    return 1;
+}
+
+/* Cubature weights w (n) of pairs whose reduced forces are the columns of A (m x n,
+ * column-major): greedy selection with NNLS until |A w - b| <= tol |b|, b = A 1. A
+ * column of zeros (a pair apart) is never picked. */
+static sinew_result fit_weights(const double *A, int64_t m, int32_t n, double tol, double *w,
+                                double *scratch, int32_t *pick, sw_error *err) {
+    double *b = scratch, *res = b + m, *As = res + m, *ws = As + m * n;
+    memset(b, 0, (size_t)m * sizeof(double));
+    for (int32_t j = 0; j < n; ++j)
+        for (int64_t i = 0; i < m; ++i)
+            b[i] += A[j * m + i];
+    memset(w, 0, (size_t)n * sizeof(double));
+    const double bn = sqrt(sw_dot(b, b, m));
+    if (!(bn > 0)) return SINEW_OK; /* no force: no pair */
+    memcpy(res, b, (size_t)m * sizeof(double));
+    int32_t ns = 0;
+    while (ns < n && sqrt(sw_dot(res, res, m)) > tol * bn) {
+        int32_t best = -1;
+        double best_c = 0;
+        for (int32_t j = 0; j < n; ++j) {
+            double cn = sqrt(sw_dot(A + j * m, A + j * m, m));
+            if (!(cn > 0) || w[j] != 0) continue;
+            double c = sw_dot(A + j * m, res, m) / cn;
+            int taken = 0;
+            for (int32_t k = 0; k < ns; ++k)
+                taken |= pick[k] == j;
+            if (!taken && c > best_c) best_c = c, best = j;
+        }
+        if (best < 0) break;
+        pick[ns] = best;
+        memcpy(As + ns * m, A + best * m, (size_t)m * sizeof(double));
+        ++ns;
+        sw_nnls_stats st;
+        sinew_result r = sw_nnls(SW_NNLS_LAWSON_HANSON, As, m, ns, b, 0, 0, ws, &st, err);
+        if (r != SINEW_OK && r != SINEW_ERROR_NOT_CONVERGED) return r;
+        memcpy(res, b, (size_t)m * sizeof(double));
+        for (int32_t k = 0; k < ns; ++k) {
+            w[pick[k]] = ws[k];
+            for (int64_t i = 0; i < m; ++i)
+                res[i] -= ws[k] * As[k * m + i];
+        }
+    }
+    return SINEW_OK;
+}
+
+/* The groups: distinct (domain of p, domain of t0) over all contacts, ascending. */
+static int32_t *find_groups(const sw_blob_view *v, int32_t *ng) {
+    int32_t nd = v->ndomains, *seen = calloc((size_t)nd * nd, sizeof(int32_t)), n = 0;
+    int32_t *dom = malloc(((size_t)v->ncontacts + 1) * 2 * sizeof(int32_t));
+    if (!seen || !dom) {
+        free(seen);
+        free(dom);
+        return NULL;
+    }
+    for (int32_t c = 0; c < v->ncontacts; ++c)
+        seen[v->contact_verts[8 * (size_t)c] * nd + v->contact_verts[8 * (size_t)c + 2]] = 1;
+    for (int32_t i = 0; i < nd * nd; ++i)
+        if (seen[i]) dom[2 * n] = i / nd, dom[2 * n + 1] = i % nd, ++n;
+    free(seen);
+    *ng = n;
+    return dom;
+}
+
+sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    if (v->ncontacts == 0) return SINEW_OK; /* no pose touches itself: no groups */
+    const int32_t nd = v->ndomains, T = v->ntrain, R = v->rank_total;
+    int32_t G = 0, *dom = find_groups(v, &G);
+    int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t)), *pick = NULL;
+    int32_t *cv2 = malloc((size_t)v->ncontacts * 8 * sizeof(int32_t));
+    double *cd2 = malloc((size_t)v->ncontacts * 7 * sizeof(double)), *A = NULL, *scratch = NULL;
+    double *Rv = malloc((size_t)s->nv * 9 * sizeof(double)), *tv = malloc((size_t)s->nv * 24);
+    double *map, *feat, *wt;
+    int32_t *ptr, *pd;
+    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!dom || !gi || !cv2 || !cd2 || !Rv || !tv) goto oom;
+    map = sw_bake_own(out, calloc((size_t)G * 72, sizeof(double)));
+    feat = sw_bake_own(out, calloc((size_t)G * T * 6, sizeof(double)));
+    wt = sw_bake_own(out, calloc((size_t)v->ncontacts, sizeof(double)));
+    ptr = sw_bake_own(out, calloc((size_t)G * T + 1, sizeof(int32_t)));
+    pd = sw_bake_own(out, malloc((size_t)G * 2 * sizeof(int32_t)));
+    if (!map || !feat || !wt || !ptr || !pd) goto oom;
+    memcpy(pd, dom, (size_t)G * 2 * sizeof(int32_t));
+    for (int32_t g = 0; g < G; ++g) {
+        gi[dom[2 * g] * nd + dom[2 * g + 1]] = g;
+        if (!feature_map(s, dom[2 * g], dom[2 * g + 1], map + 72 * (size_t)g)) {
+            r = sw_error_set(err, SINEW_ERROR_NOT_CONVERGED,
+                             "pose-space pairs: no eigenvectors for the feature of domains %d, %d",
+                             dom[2 * g], dom[2 * g + 1]);
+            goto fail;
+        }
+        for (int32_t t = 0; t < T; ++t) {
+            double z[12];
+            relative_z(train_T(s, t), s->domain_bone[dom[2 * g]], s->domain_bone[dom[2 * g + 1]],
+                       z);
+            for (int k = 0; k < 6; ++k)
+                feat[6 * ((size_t)g * T + t) + k] = sw_dot(map + 72 * (size_t)g + 12 * k, z, 12);
+        }
+    }
+    /* each pose's contacts sorted by group (a counting sort keeps their order within one) */
+    memcpy(cv2, v->contact_verts, (size_t)v->ncontacts * 8 * sizeof(int32_t));
+    memcpy(cd2, v->contact_data, (size_t)v->ncontacts * 7 * sizeof(double));
+    int32_t *cvo = (int32_t *)v->contact_verts; /* the bake's own copies (sw_bake_reduce) */
+    double *cdo = (double *)v->contact_data;
+    int32_t most = 0;
+    for (int32_t t = 0; t < T; ++t) {
+        int32_t at = v->contact_ptr[t];
+        for (int32_t g = 0; g < G; ++g) {
+            ptr[(size_t)t * G + g] = at;
+            for (int32_t c = v->contact_ptr[t]; c < v->contact_ptr[t + 1]; ++c) {
+                if (gi[cv2[8 * (size_t)c] * nd + cv2[8 * (size_t)c + 2]] != g) continue;
+                memcpy(cvo + 8 * (size_t)at, cv2 + 8 * (size_t)c, 8 * sizeof(int32_t));
+                memcpy(cdo + 7 * (size_t)at, cd2 + 7 * (size_t)c, 7 * sizeof(double));
+                ++at;
+            }
+            int32_t cnt = at - ptr[(size_t)t * G + g];
+            if (cnt > most) most = cnt;
+        }
+    }
+    ptr[(size_t)G * T] = v->ncontacts;
+    /* the cubature of every (pose, group) */
+    A = malloc((size_t)R * most * sizeof(double));
+    scratch = malloc(((size_t)R * (most + 3) + most) * sizeof(double));
+    pick = malloc((size_t)most * sizeof(int32_t));
+    if (!A || !scratch || !pick) goto oom;
+    const double tol = s->p->contact_cubature_tol;
+    for (int32_t t = 0; t < T; ++t) {
+        const double *x = NULL;
+        int32_t k = t;
+        for (int32_t i = 0; i < s->ntrain_seq && !x; ++i)
+            if (k < s->train[i].npose)
+                x = s->train[i].x + (size_t)k * 3 * s->nv;
+            else
+                k -= s->train[i].npose;
+        if (v->contact_ptr[t + 1] == v->contact_ptr[t]) continue;
+        sw_bake_skin_transforms(s, train_T(s, t), Rv, tv);
+        for (int32_t g = 0; g < G; ++g) {
+            int32_t c0 = ptr[(size_t)t * G + g], n = ptr[(size_t)t * G + g + 1] - c0;
+            if (n == 0) continue;
+            if (tol <= 0) { /* no cubature: every pair at weight 1 */
+                for (int32_t c = 0; c < n; ++c)
+                    wt[c0 + c] = 1;
+                continue;
+            }
+            for (int32_t c = 0; c < n; ++c)
+                pair_force(s, v, c0 + c, x, Rv, A + (size_t)c * R);
+            if ((r = fit_weights(A, R, n, tol, wt + c0, scratch, pick, err)) != SINEW_OK)
+                goto fail;
+        }
+    }
+    v->npair_groups = G;
+    v->pair_domains = pd;
+    v->pair_map = map;
+    v->pair_feature = feat;
+    v->pair_ptr = ptr;
+    v->pair_weight = wt;
+    r = SINEW_OK;
+    goto fail;
+oom:
+    r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the pose-space pairs");
+fail:
+    free(dom);
+    free(gi);
+    free(cv2);
+    free(cd2);
+    free(Rv);
+    free(tv);
+    free(A);
+    free(scratch);
+    free(pick);
+    return r;
+}

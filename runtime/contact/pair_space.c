@@ -1,0 +1,145 @@
+/* Pose-space self-contact per pair of domains (thesis §3.2.3, DESIGN.md §4.4 and §8): the
+ * contact of a knuckle depends on its two neighbouring bones, not on the whole skeleton,
+ * so each group (domain a's vertices against domain b's triangles) looks up its own two
+ * nearest training samples by its own 6-coordinate feature (the uncentred PCA of b's
+ * surface in a's frame, blob_view.h), and applies their cubature pairs: poses the bake
+ * never saw together still find a close sample for every pair. A group of a domain
+ * against itself has no relative motion to tell poses apart and takes the whole pose's
+ * nearest samples (pose_space.c). */
+#include <math.h>
+#include <string.h>
+
+#include "pose_space.h"
+
+/* Group g's feature of the bone transforms T (12 per bone): pair_map times the relative
+ * transform [vec(R); t] of b's bone in a's frame. */
+static void group_feature(const sw_blob_view *v, int32_t g, const double *T, double c[6]) {
+    const int32_t a = v->domains[v->pair_domains[2 * g]].bone,
+                  b = v->domains[v->pair_domains[2 * g + 1]].bone;
+    const double *Ra = T + 12 * a, *ta = Ra + 9, *Rb = T + 12 * b, *tb = Rb + 9;
+    double z[12];
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+            z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
+        z[9 + i] = Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) +
+                   Ra[6 + i] * (tb[2] - ta[2]);
+    }
+    const double *M = v->pair_map + 72 * (int64_t)g;
+    for (int k = 0; k < 6; ++k) {
+        double acc = 0;
+        for (int j = 0; j < 12; ++j)
+            acc += M[12 * k + j] * z[j];
+        c[k] = acc;
+    }
+}
+
+static double dist6(const double *a, const double *b) {
+    double d = 0;
+    for (int k = 0; k < 6; ++k)
+        d += (a[k] - b[k]) * (a[k] - b[k]);
+    return sqrt(d);
+}
+
+/* Samples closer than this share a feature (poses that differ only elsewhere). */
+#define SW_PAIR_SAME 1e-12
+
+void sw_pair_space_reach(const sw_blob_view *v, double *reach) {
+    const int32_t T = v->ntrain;
+    for (int32_t g = 0; g < v->npair_groups; ++g)
+        for (int32_t t = 0; t < T; ++t) {
+            const double *ft = v->pair_feature + 6 * ((int64_t)g * T + t);
+            double best = INFINITY;
+            for (int32_t u = 0; u < T; ++u) {
+                double d = dist6(ft, v->pair_feature + 6 * ((int64_t)g * T + u));
+                if (d > SW_PAIR_SAME && d < best) best = d;
+            }
+            reach[(int64_t)g * T + t] = best;
+        }
+}
+
+/* Appends the pairs of weight > 0 of training pose t in group g, each at w times its
+ * cubature weight, while the budget lasts. */
+static void gather_group(sw_pose_space *ps, const sw_blob_view *v, int32_t g, int32_t t, double w,
+                         double tan) {
+    const int64_t i = (int64_t)t * v->npair_groups + g;
+    for (int32_t c = v->pair_ptr[i]; c < v->pair_ptr[i + 1]; ++c) {
+        if (!(v->pair_weight[c] > 0)) continue;
+        if (ps->npairs == ps->max_pairs) {
+            ps->dropped++;
+            continue;
+        }
+        ps->pair_w[ps->npairs] = w * v->pair_weight[c];
+        ps->pair_tan[ps->npairs] = tan;
+        ps->pairs[ps->npairs++] = c;
+    }
+}
+
+static double tangent_share(double s, double reach) {
+    return s >= reach ? 0.0 : 1.0 - s / reach; /* reach INFINITY: 1 */
+}
+
+void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double *T) {
+    ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
+    if (ps->novel_mask)
+        memset(ps->novel_mask, 0, (size_t)v->ndomains * (size_t)v->ndomains);
+    if (ps->nearest < 0) return;
+    const int32_t nt = v->ntrain;
+    for (int32_t g = 0; g < v->npair_groups; ++g) {
+        if (v->pair_domains[2 * g] == v->pair_domains[2 * g + 1]) { /* the whole pose's */
+            gather_group(ps, v, g, ps->nearest, 1 - ps->blend, ps->tangent[0]);
+            if (ps->blend > 0) gather_group(ps, v, g, ps->second, ps->blend, ps->tangent[1]);
+            continue;
+        }
+        double c[6], d0 = INFINITY, d1 = INFINITY;
+        int32_t n0 = -1, n1 = -1;
+        group_feature(v, g, T, c);
+        const double *F = v->pair_feature + 6 * (int64_t)g * nt;
+        for (int32_t t = 0; t < nt; ++t) {
+            double d = dist6(c, F + 6 * (int64_t)t);
+            if (d < d0) {
+                if (!(d0 - d <= SW_PAIR_SAME)) d1 = d0, n1 = n0; /* not the same sample again */
+                d0 = d, n0 = t;
+            } else if (d < d1 && d - d0 > SW_PAIR_SAME) {
+                d1 = d, n1 = t;
+            }
+        }
+        const double size = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3] +
+                                  c[4] * c[4] + c[5] * c[5]);
+        if (d0 > SW_PAIR_NOVEL * size) { /* no sample near: exhaustive detection instead */
+            ps->novel++;
+            if (ps->novel_mask) {
+                ps->novel_mask[v->pair_domains[2 * g] * v->ndomains + v->pair_domains[2 * g + 1]] =
+                    1;
+                continue;
+            }
+        }
+        double blend = 0;
+        if (n1 >= 0 && d0 >= 1e-3 * size && d1 <= 4 * d0) blend = d0 / (d0 + d1);
+        n0 = sw_pose_space_branch(ps, v, n0);
+        gather_group(ps, v, g, n0, 1 - blend, tangent_share(d0, ps->pair_reach[g * (int64_t)nt + n0]));
+        if (blend > 0) {
+            n1 = sw_pose_space_branch(ps, v, n1);
+            gather_group(ps, v, g, n1, blend,
+                         tangent_share(d1, ps->pair_reach[g * (int64_t)nt + n1]));
+        }
+    }
+}
+
+int32_t sw_pair_space_default_max_pairs(const sw_blob_view *v) {
+    int64_t total = 0;
+    for (int32_t g = 0; g < v->npair_groups; ++g) {
+        int32_t a = 0, b = 0; /* the fullest and second fullest samples */
+        for (int32_t t = 0; t < v->ntrain; ++t) {
+            const int64_t i = (int64_t)t * v->npair_groups + g;
+            int32_t n = 0;
+            for (int32_t c = v->pair_ptr[i]; c < v->pair_ptr[i + 1]; ++c)
+                n += v->pair_weight[c] > 0;
+            if (n > a)
+                b = a, a = n;
+            else if (n > b)
+                b = n;
+        }
+        total += a + b;
+    }
+    return (int32_t)(total < v->ncontacts ? total : v->ncontacts);
+}
