@@ -184,12 +184,13 @@ enum {
     P_WORLD,        /* quasistatic and dynamic against a table and a moving ball */
     P_WORLD_BUDGET, /* the same, max_world_contacts = 1 (BUDGET) */
     P_EXHAUSTIVE,   /* the clip, quasistatic and dynamic, exhaustive self-contact */
+    P_POSE_PAIRS,   /* the clip, quasistatic, pose-space self-contact per pair of domains */
     P_COUNT
 };
 static const char *const path_names[P_COUNT] = {
     "quasistatic", "dynamic", "translate jump", "rotation snap", "dt spikes",
     "cut",         "limited", "guard",          "failed",        "reset",
-    "pair budget", "world",   "world budget",   "exhaustive"};
+    "pair budget", "world",   "world budget",   "exhaustive",    "pose pairs"};
 
 typedef struct {
     int steps, failed;         /* steps made; of them, returning an error */
@@ -296,7 +297,21 @@ static sinew_transform ball_at(int s) {
     return t;
 }
 
-enum { I_Q, I_D, I_PAIRS, I_WQ, I_WD, I_WBUDGET, I_LIMIT, I_GUARD, I_FRESH, I_XQ, I_XD, I_COUNT };
+enum {
+    I_Q,
+    I_D,
+    I_PAIRS,
+    I_WQ,
+    I_WD,
+    I_WBUDGET,
+    I_LIMIT,
+    I_GUARD,
+    I_FRESH,
+    I_XQ,
+    I_XD,
+    I_PP,
+    I_COUNT
+};
 
 TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     const contract_fixture *f = fixture();
@@ -315,6 +330,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
                      ? SINEW_STEP_DYNAMIC
                      : SINEW_STEP_QUASISTATIC;
         if (i == I_XQ || i == I_XD) d.self_contact = SINEW_SELF_CONTACT_EXHAUSTIVE;
+        if (i == I_PP) d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS;
         if (i == I_PAIRS) d.max_contact_pairs = 1;
         if (i == I_WBUDGET) d.max_world_contacts = 1;
         size_t bytes = 0;
@@ -375,6 +391,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         step_path(&cr, P_PAIR_BUDGET, in[I_PAIRS], clip_pose(f, s), 1.0f / 30);
         step_path(&cr, P_EXHAUSTIVE, in[I_XQ], clip_pose(f, s), 1.0f / 30);
         step_path(&cr, P_EXHAUSTIVE, in[I_XD], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_POSE_PAIRS, in[I_PP], clip_pose(f, s), 1.0f / 30);
     }
     /* teleports: away and back, then a half turn of the whole character */
     moved_pose(f, 0, I3, far, pose);
@@ -476,7 +493,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         if (p != P_FAILED && p != P_GUARD && p != P_LIMITED)
             ENSUREF(r->min_iters >= 1, "path %s: a step with no Newton iteration", path_names[p]);
         /* a quasistatic step starts from the pose space, a dynamic one never */
-        int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET;
+        int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET || p == P_POSE_PAIRS;
         if (quasi) ENSUREF(r->all & SINEW_STEP_POSE_SPACE, "path %s", path_names[p]);
         if (!quasi && p != P_RESET && p != P_WORLD && p != P_EXHAUSTIVE)
             ENSUREF(!(r->any & SINEW_STEP_POSE_SPACE), "path %s", path_names[p]);
@@ -521,6 +538,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     ENSURE(!(rec[P_WORLD].any & SINEW_STEP_BUDGET));
     /* exhaustive self-contact found the fold's contacts itself */
     ENSUREF(rec[P_EXHAUSTIVE].self_contacts > 0, "the exhaustive mode found no self-contact");
+    ENSUREF(rec[P_POSE_PAIRS].self_contacts > 0, "the pose-pairs mode used no contact pair");
 
     /* ---- memory: the host allocator, once per instance at creation, never in a step */
     ENSUREF(heap_in_run == 0 && heap_frees_in_run == 0,

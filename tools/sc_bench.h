@@ -29,7 +29,7 @@ typedef struct sw_sc_bench {
     double speedup_mean, speedup_max, frame_share;
     int pairs_mode; /* the blob has per-pair sections: [2] and pp_* were measured */
     double pp_speedup_mean, pp_speedup_max, pp_frame_share;
-    long failed;          /* steps that did not return SINEW_OK (every mode) */
+    long failed;              /* steps that did not return SINEW_OK (every mode) */
     long allocs[3], locks[3]; /* in the exhaustive [1] and pose-pairs [2] timed steps */
 } sw_sc_bench;
 

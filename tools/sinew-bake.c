@@ -181,8 +181,7 @@ int main(int argc, char **argv) {
             if (!(ok = k >= 0))
                 fprintf(stderr, "%s: --eval-self-contact: pose-space or pose-pairs\n", tool);
             eval_mode = k == 1 ? SINEW_SELF_CONTACT_POSE_PAIRS : SINEW_SELF_CONTACT_POSE_SPACE;
-        }
-        else if (!strcmp(a, "--force"))
+        } else if (!strcmp(a, "--force"))
             force = 1;
         else if (!strcmp(a, "--json"))
             json = 1;

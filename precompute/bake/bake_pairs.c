@@ -35,8 +35,8 @@ static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j)
             z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
-        z[9 + i] = Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) +
-                   Ra[6 + i] * (tb[2] - ta[2]);
+        z[9 + i] =
+            Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) + Ra[6 + i] * (tb[2] - ta[2]);
     }
 }
 
@@ -184,6 +184,19 @@ static sinew_result fit_weights(const double *A, int64_t m, int32_t n, double to
     return SINEW_OK;
 }
 
+/* fit_weights with scratch of its own (bake_internal.h). */
+sinew_result sw_bake_pair_cubature(const double *A, int64_t m, int32_t n, double tol, double *w,
+                                   sw_error *err) {
+    double *scratch = malloc(((size_t)m * ((size_t)n + 3) + (size_t)n) * sizeof(double));
+    int32_t *pick = malloc(((size_t)n + 1) * sizeof(int32_t));
+    sinew_result r = scratch && pick ? fit_weights(A, m, n, tol, w, scratch, pick, err)
+                                     : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                                                    "out of memory for a pair cubature");
+    free(scratch);
+    free(pick);
+    return r;
+}
+
 /* The groups: distinct (domain of p, domain of t0) over all contacts, ascending. */
 static int32_t *find_groups(const sw_blob_view *v, int32_t *ng) {
     int32_t nd = v->ndomains, *seen = calloc((size_t)nd * nd, sizeof(int32_t)), n = 0;
@@ -285,8 +298,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
             }
             for (int32_t c = 0; c < n; ++c)
                 pair_force(s, v, c0 + c, x, Rv, A + (size_t)c * R);
-            if ((r = fit_weights(A, R, n, tol, wt + c0, scratch, pick, err)) != SINEW_OK)
-                goto fail;
+            if ((r = fit_weights(A, R, n, tol, wt + c0, scratch, pick, err)) != SINEW_OK) goto fail;
         }
     }
     v->npair_groups = G;

@@ -1,8 +1,8 @@
 /* Blob layout: header (64 bytes), section table (26 entries, 8 more with a render mesh, 10
- * more with the condensation tet mesh, 6 more with per-pair self-contact), then the sections in id order, each starting at a
- * multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers everything after the
- * header. A view without the optional groups writes exactly the 26 sections it always did,
- * byte for byte. */
+ * more with the condensation tet mesh, 6 more with per-pair self-contact), then the sections in id
+ * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
+ * everything after the header. A view without the optional groups writes exactly the 26 sections it
+ * always did, byte for byte. */
 #include "blob_write.h"
 
 #include <errno.h>

@@ -47,11 +47,10 @@ _Static_assert(SW_BLOB_INFLUENCES == 4, "the format stores 4 influences per vert
 static const struct {
     const char *name;
     uint32_t elem_size;
-} k_sections[SINEW_SECTION_ID_MAX + 1] = {[0] = {"unknown", 0},
-                                          SINEW_BLOB_SECTIONS(SECTION_INFO)
-                                              SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)
-                                                  SINEW_BLOB_COND_SECTIONS(SECTION_INFO)
-                                                      SINEW_BLOB_PAIR_SECTIONS(SECTION_INFO)};
+} k_sections[SINEW_SECTION_ID_MAX + 1] = {
+    [0] = {"unknown", 0},
+    SINEW_BLOB_SECTIONS(SECTION_INFO) SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)
+        SINEW_BLOB_COND_SECTIONS(SECTION_INFO) SINEW_BLOB_PAIR_SECTIONS(SECTION_INFO)};
 #undef SECTION_INFO
 
 /* Not instrumented for fuzzing coverage: its loop has no branch worth a fuzzer's

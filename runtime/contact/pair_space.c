@@ -11,9 +11,7 @@
 
 #include "pose_space.h"
 
-/* Group g's feature of the bone transforms T (12 per bone): pair_map times the relative
- * transform [vec(R); t] of b's bone in a's frame. */
-static void group_feature(const sw_blob_view *v, int32_t g, const double *T, double c[6]) {
+void sw_pair_space_feature(const sw_blob_view *v, int32_t g, const double *T, double c[6]) {
     const int32_t a = v->domains[v->pair_domains[2 * g]].bone,
                   b = v->domains[v->pair_domains[2 * g + 1]].bone;
     const double *Ra = T + 12 * a, *ta = Ra + 9, *Rb = T + 12 * b, *tb = Rb + 9;
@@ -21,8 +19,8 @@ static void group_feature(const sw_blob_view *v, int32_t g, const double *T, dou
     for (int i = 0; i < 3; ++i) {
         for (int j = 0; j < 3; ++j)
             z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
-        z[9 + i] = Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) +
-                   Ra[6 + i] * (tb[2] - ta[2]);
+        z[9 + i] =
+            Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) + Ra[6 + i] * (tb[2] - ta[2]);
     }
     const double *M = v->pair_map + 72 * (int64_t)g;
     for (int k = 0; k < 6; ++k) {
@@ -80,8 +78,7 @@ static double tangent_share(double s, double reach) {
 
 void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double *T) {
     ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
-    if (ps->novel_mask)
-        memset(ps->novel_mask, 0, (size_t)v->ndomains * (size_t)v->ndomains);
+    if (ps->novel_mask) memset(ps->novel_mask, 0, (size_t)v->ndomains * (size_t)v->ndomains);
     if (ps->nearest < 0) return;
     const int32_t nt = v->ntrain;
     for (int32_t g = 0; g < v->npair_groups; ++g) {
@@ -92,7 +89,7 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
         }
         double c[6], d0 = INFINITY, d1 = INFINITY;
         int32_t n0 = -1, n1 = -1;
-        group_feature(v, g, T, c);
+        sw_pair_space_feature(v, g, T, c);
         const double *F = v->pair_feature + 6 * (int64_t)g * nt;
         for (int32_t t = 0; t < nt; ++t) {
             double d = dist6(c, F + 6 * (int64_t)t);
@@ -103,8 +100,8 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
                 d1 = d, n1 = t;
             }
         }
-        const double size = sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3] +
-                                  c[4] * c[4] + c[5] * c[5]);
+        const double size =
+            sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3] + c[4] * c[4] + c[5] * c[5]);
         if (d0 > SW_PAIR_NOVEL * size) { /* no sample near: exhaustive detection instead */
             ps->novel++;
             if (ps->novel_mask) {
@@ -116,7 +113,8 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
         double blend = 0;
         if (n1 >= 0 && d0 >= 1e-3 * size && d1 <= 4 * d0) blend = d0 / (d0 + d1);
         n0 = sw_pose_space_branch(ps, v, n0);
-        gather_group(ps, v, g, n0, 1 - blend, tangent_share(d0, ps->pair_reach[g * (int64_t)nt + n0]));
+        gather_group(ps, v, g, n0, 1 - blend,
+                     tangent_share(d0, ps->pair_reach[g * (int64_t)nt + n0]));
         if (blend > 0) {
             n1 = sw_pose_space_branch(ps, v, n1);
             gather_group(ps, v, g, n1, blend,

@@ -16,8 +16,7 @@
  * matrix. */
 static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32_t *pairs,
                             const unsigned char *skip, int32_t npairs, const double *weight,
-                            const double *tangent, const double *q, int want_grad,
-                            int want_hess) {
+                            const double *tangent, const double *q, int want_grad, int want_hess) {
     const sw_blob_view *v = red->v;
     double E = 0;
     int32_t rm = red->rmax;

@@ -80,6 +80,10 @@ int32_t sw_pose_space_branch(const sw_pose_space *ps, const sw_blob_view *v, int
  * (relative feature distance, DESIGN.md §8) is novel contact. */
 #define SW_PAIR_NOVEL 0.5
 
+/* Group g's feature of the bone transforms T (12 per bone): pair_map times the relative
+ * transform [vec(R); t] of its second domain's bone in its first's frame. */
+void sw_pair_space_feature(const sw_blob_view *v, int32_t g, const double *T, double c[6]);
+
 /* Fills pair_reach (npair_groups ntrain). O(npair_groups ntrain^2), once at creation. */
 void sw_pair_space_reach(const sw_blob_view *v, double *pair_reach);
 

@@ -1,0 +1,302 @@
+/* Pose-space self-contact per pair of domains (issue 16, deliverable 2; bake_pairs.c,
+ * pair_space.c): the pair feature ignores a rigid motion of the whole character and
+ * is, at every training pose, the feature the bake stored; a pair cubature reproduces the
+ * reduced contact force it was fitted to within its tolerance; two identical samples
+ * blended are one; a joint bent far beyond every sample is novel contact that the
+ * exhaustive detection takes over; a corrupted pair section is refused. The step's
+ * real-time contract in this mode is test_step_contract's "pose pairs" path. */
+#include <math.h>
+#include <stdint.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_fixture.h"
+#include "bake_internal.h"
+#include "blob_load.h"
+#include "instance.h"
+#include "instance_internal.h"
+#include "sw_test.h"
+
+static bake_fixture fx;
+static int fx_ok = -1;
+
+/* The folding finger at 2,000 tets with a 12-frame clip. */
+static const bake_fixture *fixture(void) {
+    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 2000, 12, 0);
+    return fx_ok ? &fx : NULL;
+}
+
+static sinew_instance *pairs_instance(const bake_fixture *f) {
+    sinew_instance_def d = sinew_instance_def_default();
+    d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS;
+    sinew_instance *in = NULL;
+    return sinew_instance_create(f->blob, &d, &in) == SINEW_OK ? in : NULL;
+}
+
+/* T' = G T for every bone: a rotation by `angle` about the axis (1, 2, 3) and a shift. */
+static void move_rigidly(const double *T, int32_t nb, double angle, double *out) {
+    double a[3] = {1 / sqrt(14.0), 2 / sqrt(14.0), 3 / sqrt(14.0)}, c = cos(angle), s = sin(angle),
+           G[9], sh[3] = {3.5, -1.25, 7};
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            G[3 * i + j] = (i == j ? c : 0) + (1 - c) * a[i] * a[j] +
+                           s * (i == j ? 0 : ((j == (i + 1) % 3) ? -a[3 - i - j] : a[3 - i - j]));
+    for (int32_t b = 0; b < nb; ++b) {
+        const double *R = T + 12 * b, *t = R + 9;
+        double *Ro = out + 12 * b, *to = Ro + 9;
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j)
+                Ro[3 * i + j] = G[3 * i] * R[j] + G[3 * i + 1] * R[3 + j] + G[3 * i + 2] * R[6 + j];
+            to[i] = G[3 * i] * t[0] + G[3 * i + 1] * t[1] + G[3 * i + 2] * t[2] + sh[i];
+        }
+    }
+}
+
+TEST(the_pair_feature_ignores_rigid_motion_and_matches_the_bake) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    ENSUREF(v->npair_groups > 0, "the finger's training poses touch themselves: groups expected");
+    const int32_t nb = v->nbones;
+    double *moved = malloc(sizeof(double) * 12 * (size_t)nb);
+    ENSURE(moved);
+    int32_t checked = 0;
+    for (int32_t g = 0; g < v->npair_groups; ++g) {
+        if (v->pair_domains[2 * g] == v->pair_domains[2 * g + 1]) continue;
+        for (int32_t t = 0; t < v->ntrain; ++t, ++checked) {
+            const double *T = f->res.train_T + (size_t)t * 12 * nb;
+            double c[6], cm[6], size = 0;
+            sw_pair_space_feature(v, g, T, c);
+            move_rigidly(T, nb, 0.7, moved);
+            sw_pair_space_feature(v, g, moved, cm);
+            const double *stored = v->pair_feature + 6 * ((int64_t)g * v->ntrain + t);
+            for (int k = 0; k < 6; ++k)
+                size += c[k] * c[k];
+            size = sqrt(size);
+            for (int k = 0; k < 6; ++k) {
+                ENSUREF(fabs(c[k] - cm[k]) <= 1e-10 * size,
+                        "group %d pose %d coordinate %d: %g "
+                        "moved %g",
+                        g, t, k, c[k], cm[k]);
+                ENSUREF(fabs(c[k] - stored[k]) <= 1e-10 * size,
+                        "group %d pose %d coordinate %d: "
+                        "%g, the bake stored %g",
+                        g, t, k, c[k], stored[k]);
+            }
+        }
+    }
+    ENSURE(checked > 0);
+    free(moved);
+}
+
+TEST(a_pair_cubature_reproduces_its_reduced_force_within_tolerance) {
+    enum { M = 24, N = 80 };
+    double *A = calloc((size_t)M * N, sizeof(double)), w[N], b[M] = {0}, r[M];
+    ENSURE(A);
+    uint64_t seed = 12345;
+    for (int j = 0; j < N; ++j) {
+        if (j % 9 == 4) continue; /* a pair apart: no force */
+        for (int i = 0; i < M; ++i) {
+            seed = seed * 6364136223846793005ull + 1442695040888963407ull;
+            double u = (double)(seed >> 11) / 9007199254740992.0;
+            /* forces of one contact region: alike, with some spread */
+            A[(size_t)j * M + i] = (i % 3 == 0 ? 1.0 : 0.2) + 0.8 * (u - 0.5);
+        }
+    }
+    for (int j = 0; j < N; ++j)
+        for (int i = 0; i < M; ++i)
+            b[i] += A[(size_t)j * M + i];
+    double bn = 0;
+    for (int i = 0; i < M; ++i)
+        bn += b[i] * b[i];
+    bn = sqrt(bn);
+    const double tols[3] = {0.2, 0.05, 1e-6};
+    int kept_last = N + 1;
+    for (int k = 0; k < 3; ++k) {
+        sw_error err;
+        ENSUREF(sw_bake_pair_cubature(A, M, N, tols[k], w, &err) == SINEW_OK, "%s", err.msg);
+        int kept = 0;
+        memcpy(r, b, sizeof r);
+        for (int j = 0; j < N; ++j) {
+            ENSUREF(w[j] >= 0, "pair %d weight %g", j, w[j]);
+            if (j % 9 == 4) ENSUREF(w[j] == 0, "pair %d has no force, weight %g", j, w[j]);
+            kept += w[j] > 0;
+            for (int i = 0; i < M; ++i)
+                r[i] -= w[j] * A[(size_t)j * M + i];
+        }
+        double rn = 0;
+        for (int i = 0; i < M; ++i)
+            rn += r[i] * r[i];
+        ENSUREF(sqrt(rn) <= tols[k] * bn * (1 + 1e-9), "tol %g: residual %g of %g", tols[k],
+                sqrt(rn), bn);
+        ENSUREF(kept < N && kept <= kept_last + M, "tol %g: %d pairs kept of %d", tols[k], kept, N);
+        if (k == 0) ENSUREF(kept < 10, "a loose tolerance keeps few pairs: %d", kept);
+        kept_last = kept;
+    }
+    free(A);
+}
+
+TEST(two_identical_samples_blended_are_one) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_instance *in = pairs_instance(f);
+    ENSURE(in);
+    const int32_t nb = f->ch.skel.nbones, R = in->red.R;
+    int32_t frame = -1;
+    for (int k = 0; k < f->ch.clip.nframes && frame < 0; ++k) {
+        ENSURE(sw_instance_set_pose_d(in, f->ch.clip.T + (size_t)k * 12 * nb) == SINEW_OK);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+        if (in->ps.npairs > 0) frame = k;
+    }
+    ENSUREF(frame >= 0, "no clip frame uses a contact pair");
+    const int32_t n = in->ps.npairs;
+    int32_t *ids = malloc(sizeof(int32_t) * 2 * (size_t)n);
+    double *w = malloc(sizeof(double) * 2 * (size_t)n),
+           *tan = malloc(sizeof(double) * 2 * (size_t)n);
+    double *g1 = malloc(sizeof(double) * (size_t)R);
+    ENSURE(ids && w && tan && g1);
+    for (int32_t i = 0; i < n; ++i) { /* the same pairs twice, at 0.3 and 0.7 of the weight */
+        ids[i] = ids[n + i] = in->ps.pairs[i];
+        w[i] = 0.3 * in->ps.pair_w[i];
+        w[n + i] = 0.7 * in->ps.pair_w[i];
+        tan[i] = tan[n + i] = in->ps.pair_tan[i];
+    }
+    double *q = malloc(sizeof(double) * (size_t)R), e1 = 0;
+    ENSURE(q);
+    sw_pair_set set = sw_pose_pair_set(&in->red);
+    for (int k = 0; k < 8 && !(e1 > 0); ++k) { /* a state where the pairs press */
+        for (int32_t i = 0; i < R; ++i)
+            q[i] = in->solver.q[i] * (k < 4 ? 1 + 0.5 * k : -0.5 * (k - 3));
+        memset(in->red.g, 0, sizeof(double) * (size_t)R);
+        e1 = sw_contact_pairs_eval(&in->red, &set, in->ps.pairs, n, in->ps.pair_w, in->ps.pair_tan,
+                                   q, 1, 0);
+    }
+    memcpy(g1, in->red.g, sizeof(double) * (size_t)R);
+    memset(in->red.g, 0, sizeof(double) * (size_t)R);
+    double e2 = sw_contact_pairs_eval(&in->red, &set, ids, 2 * n, w, tan, q, 1, 0);
+    ENSUREF(e1 > 0, "the pairs never press: energy %g", e1);
+    ENSUREF(fabs(e1 - e2) <= 1e-12 * e1, "one sample %.17g, two halves %.17g", e1, e2);
+    double gn = 0;
+    for (int32_t i = 0; i < R; ++i)
+        gn = fmax(gn, fabs(g1[i]));
+    for (int32_t i = 0; i < R; ++i)
+        ENSUREF(fabs(g1[i] - in->red.g[i]) <= 1e-11 * gn, "gradient %d: %g against %g", i, g1[i],
+                in->red.g[i]);
+    free(ids);
+    free(w);
+    free(tan);
+    free(g1);
+    free(q);
+    sinew_instance_destroy(in);
+}
+
+/* Bone b is a descendant of bone a (or a itself). */
+static int descends(const sw_skeleton *sk, int32_t b, int32_t a) {
+    for (int32_t x = b; x >= 0; x = sk->parent[x])
+        if (x == a) return 1;
+    return 0;
+}
+
+/* The clip's frame k with the bone of domain 1 and its descendants turned by `angle` about
+ * the axis x through that bone's head joint: the two domains' relative motion. */
+static void bent_joint(const bake_fixture *f, int k, double angle, double *T) {
+    const sw_skeleton *sk = &f->ch.skel;
+    const int32_t nb = sk->nbones, bone = sw_blob_get_view(f->blob)->domains[1].bone;
+    memcpy(T, f->ch.clip.T + (size_t)k * 12 * nb, sizeof(double) * 12 * (size_t)nb);
+    const double *X = sk->joints + 3 * sk->bones[2 * bone], *R0 = T + 12 * bone;
+    double p[3], c = cos(angle), s = sin(angle), Q[9] = {1, 0, 0, 0, c, -s, 0, s, c};
+    for (int i = 0; i < 3; ++i) /* the joint where the pose put it */
+        p[i] = R0[3 * i] * X[0] + R0[3 * i + 1] * X[1] + R0[3 * i + 2] * X[2] + R0[9 + i];
+    for (int32_t b = 0; b < nb; ++b) {
+        if (!descends(sk, b, bone)) continue;
+        double *R = T + 12 * b, *t = R + 9, Rn[9], tn[3];
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j)
+                Rn[3 * i + j] = Q[3 * i] * R[j] + Q[3 * i + 1] * R[3 + j] + Q[3 * i + 2] * R[6 + j];
+            tn[i] = p[i] + Q[3 * i] * (t[0] - p[0]) + Q[3 * i + 1] * (t[1] - p[1]) +
+                    Q[3 * i + 2] * (t[2] - p[2]);
+        }
+        memcpy(R, Rn, sizeof Rn);
+        memcpy(t, tn, sizeof tn);
+    }
+}
+
+TEST(a_pose_far_from_every_sample_falls_back_to_detection) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_instance *in = pairs_instance(f);
+    ENSURE(in);
+    const int32_t nb = f->ch.skel.nbones;
+    double *T = malloc(sizeof(double) * 12 * (size_t)nb);
+    ENSURE(T);
+    /* the clip's own frames are near their samples */
+    uint32_t novel_clip = 0;
+    for (int k = 0; k < f->ch.clip.nframes; ++k) {
+        ENSURE(sw_instance_set_pose_d(in, f->ch.clip.T + (size_t)k * 12 * nb) == SINEW_OK);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+        sinew_step_stats st = {.struct_size = sizeof st};
+        ENSURE(sinew_instance_get_stats(in, &st) == SINEW_OK);
+        novel_clip += st.self_contact_novel;
+    }
+    ENSUREF(novel_clip == 0, "%u novel pairs of domains on the training clip", novel_clip);
+    /* the joint between the two domains bent far past the clip's bend, either way */
+    uint32_t novel = 0, tests = 0;
+    for (int sign = -1; sign <= 1; sign += 2) {
+        bent_joint(f, f->ch.clip.nframes - 1, sign * 2.6, T);
+        ENSURE(sw_instance_set_pose_d(in, T) == SINEW_OK);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+        sinew_step_stats st = {.struct_size = sizeof st};
+        ENSURE(sinew_instance_get_stats(in, &st) == SINEW_OK);
+        novel += st.self_contact_novel;
+        if (st.self_contact_novel > 0) tests += st.self_contact_tests;
+    }
+    ENSUREF(novel > 0, "no pair of domains was novel at a joint bent by 150 degrees more");
+    ENSUREF(tests > 0, "novel contact, but the exhaustive detection tested nothing");
+    free(T);
+    sinew_instance_destroy(in);
+}
+
+TEST(a_blob_with_a_corrupt_pair_section_is_refused) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *good = sw_blob_get_view(f->blob);
+    ENSURE(good->npair_groups > 0);
+    char msg[512];
+    sw_blob_view v = *good;
+    double *wt = malloc(sizeof(double) * (size_t)v.ncontacts);
+    int32_t *dom = malloc(sizeof(int32_t) * 2 * (size_t)v.npair_groups);
+    ENSURE(wt && dom);
+    memcpy(wt, v.pair_weight, sizeof(double) * (size_t)v.ncontacts);
+    wt[0] = -1;
+    v.pair_weight = wt;
+    ENSURE(sw_blob_validate_view(&v, msg, sizeof msg) == SINEW_ERROR_CORRUPT);
+    ENSUREF(strstr(msg, "PAIR_WEIGHT") && strstr(msg, "contact 0"), "%s", msg);
+    v = *good;
+    memcpy(dom, v.pair_domains, sizeof(int32_t) * 2 * (size_t)v.npair_groups);
+    dom[0] = v.ndomains;
+    v.pair_domains = dom;
+    ENSURE(sw_blob_validate_view(&v, msg, sizeof msg) == SINEW_ERROR_CORRUPT);
+    ENSUREF(strstr(msg, "PAIR_DOMAINS"), "%s", msg);
+    /* a group whose contacts are another pair of domains' */
+    v = *good;
+    memcpy(dom, v.pair_domains, sizeof(int32_t) * 2 * (size_t)v.npair_groups);
+    dom[1] = (dom[1] + 1) % v.ndomains;
+    v.pair_domains = dom;
+    sinew_result r = sw_blob_validate_view(&v, msg, sizeof msg);
+    ENSUREF(r == SINEW_ERROR_CORRUPT && strstr(msg, "PAIR_"), "%s", msg);
+    v = *good;
+    v.pair_ptr = NULL;
+    ENSURE(sw_blob_validate_view(&v, msg, sizeof msg) == SINEW_ERROR_INVALID_ARGUMENT);
+    free(wt);
+    free(dom);
+}
+
+TEST(release_fixture) {
+    if (fx_ok > 0) bake_fixture_free(&fx);
+}
+
+SW_TEST_MAIN(CASE(the_pair_feature_ignores_rigid_motion_and_matches_the_bake),
+             CASE(a_pair_cubature_reproduces_its_reduced_force_within_tolerance),
+             CASE(two_identical_samples_blended_are_one),
+             CASE(a_pose_far_from_every_sample_falls_back_to_detection),
+             CASE(a_blob_with_a_corrupt_pair_section_is_refused), CASE(release_fixture))
