@@ -31,13 +31,7 @@ void openblas_set_num_threads(int num_threads);
 
 /* The relative transform z = [vec(R); t] of bone b in bone a's frame for transforms T. */
 static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
-    const double *Ra = T + 12 * a, *ta = Ra + 9, *Rb = T + 12 * b, *tb = Rb + 9;
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j)
-            z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
-        z[9 + i] =
-            Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) + Ra[6 + i] * (tb[2] - ta[2]);
-    }
+    sw_relative_transform(T + 12 * (size_t)a, T + 12 * (size_t)b, z);
 }
 
 /* The bone transforms of training pose k (in stored order). */

@@ -9,19 +9,14 @@
 #include <math.h>
 #include <string.h>
 
+#include "dqs.h"
 #include "pose_space.h"
 
 void sw_pair_space_feature(const sw_blob_view *v, int32_t g, const double *T, double c[6]) {
     const int32_t a = v->domains[v->pair_domains[2 * g]].bone,
                   b = v->domains[v->pair_domains[2 * g + 1]].bone;
-    const double *Ra = T + 12 * a, *ta = Ra + 9, *Rb = T + 12 * b, *tb = Rb + 9;
     double z[12];
-    for (int i = 0; i < 3; ++i) {
-        for (int j = 0; j < 3; ++j)
-            z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
-        z[9 + i] =
-            Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) + Ra[6 + i] * (tb[2] - ta[2]);
-    }
+    sw_relative_transform(T + 12 * a, T + 12 * b, z);
     const double *M = v->pair_map + 72 * (int64_t)g;
     for (int k = 0; k < 6; ++k) {
         double acc = 0;

@@ -144,6 +144,16 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
     }
 }
 
+void sw_relative_transform(const double Ta[12], const double Tb[12], double z[12]) {
+    const double *Ra = Ta, *ta = Ta + 9, *Rb = Tb, *tb = Tb + 9;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+            z[3 * i + j] = Ra[i] * Rb[j] + Ra[3 + i] * Rb[3 + j] + Ra[6 + i] * Rb[6 + j];
+        z[9 + i] =
+            Ra[i] * (tb[0] - ta[0]) + Ra[3 + i] * (tb[1] - ta[1]) + Ra[6 + i] * (tb[2] - ta[2]);
+    }
+}
+
 double sw_pose_distance(const double *fa, const double *fb, int32_t nbones) {
     double d = 0;
     for (int32_t b = 0; b < nbones; ++b) {
