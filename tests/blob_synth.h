@@ -274,6 +274,50 @@ static inline void fixture_add_cond(fixture *f, cond_fixture *c) {
 #undef POINT
 }
 
+enum { NPG_MAX = 2 /* pair groups: one per contact at most */ };
+
+typedef struct pair_fixture {
+    int32_t pair_domains[2 * NPG_MAX];
+    double pair_map[72 * NPG_MAX], pair_feature[6 * NPG_MAX * NTR];
+    int32_t pair_ptr[NPG_MAX * NTR + 1];
+    double pair_weight[2];
+} pair_fixture;
+
+/* Gives f's view per-pair sections held in p: a group per distinct (domain of p, domain of
+ * t0) of the two contacts of pose 0, which are put in group order; made-up maps and
+ * features; the first pair weighted 0.75, the second 0 (left out). */
+static inline void fixture_add_pairs(fixture *f, pair_fixture *p) {
+    sw_blob_view *v = &f->v;
+    memset(p, 0, sizeof *p);
+    int32_t *cv = f->contact_verts;
+    if (cv[0] > cv[8] || (cv[0] == cv[8] && cv[2] > cv[10])) { /* swap the two contacts */
+        int32_t ti[8];
+        double td[7];
+        memcpy(ti, cv, sizeof ti), memcpy(cv, cv + 8, sizeof ti), memcpy(cv + 8, ti, sizeof ti);
+        memcpy(td, f->contact_data, sizeof td);
+        memcpy(f->contact_data, f->contact_data + 7, sizeof td);
+        memcpy(f->contact_data + 7, td, sizeof td);
+    }
+    const int32_t G = cv[0] == cv[8] && cv[2] == cv[10] ? 1 : 2;
+    for (int32_t g = 0; g < G; ++g)
+        p->pair_domains[2 * g] = cv[8 * g], p->pair_domains[2 * g + 1] = cv[8 * g + 2];
+    for (int32_t i = 0; i < 72 * G; ++i)
+        p->pair_map[i] = 0.125 * ((i * 7) % 11) - 0.5;
+    for (int32_t i = 0; i < 6 * G * NTR; ++i)
+        p->pair_feature[i] = 0.25 * ((i * 5) % 9) - 1.0;
+    /* pose 0: both contacts (one group holds both when G is 1), pose 1: none */
+    p->pair_ptr[0] = 0;
+    p->pair_ptr[1] = G == 1 ? 2 : 1;
+    for (int32_t i = 2; i <= G * NTR; ++i)
+        p->pair_ptr[i] = 2;
+    p->pair_weight[0] = 0.75;
+    p->pair_weight[1] = 0;
+    v->npair_groups = G;
+#define POINT(id, NAME, elem_size, type, field, ...) v->field = p->field;
+    SINEW_BLOB_PAIR_ARRAY_SECTIONS(POINT)
+#undef POINT
+}
+
 /* ---- helpers --------------------------------------------------------------------- */
 
 /* First field in which two views differ (counts, scalars bitwise, arrays bitwise, the
@@ -287,6 +331,7 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     SAME_BITS(nsurf_copies)
     SINEW_BLOB_RENDER_COUNTS(SAME_BITS)
     SINEW_BLOB_COND_COUNTS(SAME_BITS)
+    SINEW_BLOB_PAIR_COUNTS(SAME_BITS)
 #undef SAME_BITS
     SW_BLOB_COUNT_LOCALS(a);
 #define SAME_ARRAY(id, NAME, elem_size, type, field, by_meta, count, formula)                      \
@@ -299,6 +344,10 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     if (a->ntets > 0) {
         SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_COND_COUNTS);
         SINEW_BLOB_COND_ARRAY_SECTIONS(SAME_ARRAY)
+    }
+    if (a->npair_groups > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_PAIR_COUNTS);
+        SINEW_BLOB_PAIR_ARRAY_SECTIONS(SAME_ARRAY)
     }
 #undef SAME_ARRAY
     return NULL;

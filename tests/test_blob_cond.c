@@ -321,6 +321,47 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     free(b);
 }
 
+/* The same character with per-pair sections as well (all 50): written, parsed back the
+ * same, and the fuzz seed tests/fuzz/corpus/blob_fixed/synth_pairs.blob is these bytes
+ * (SINEW_WRITE_SEEDS=1 rewrites it), so the blob fuzzers start from the pair sections. */
+TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
+    static fixture f;
+    static render_fixture r;
+    static cond_fixture c;
+    static pair_fixture p;
+    fixture_init(&f, 3);
+    fixture_add_render(&f, &r);
+    fixture_add_cond(&f, &c);
+    fixture_add_pairs(&f, &p);
+    size_t size = 0;
+    sw_blob_view v;
+    uint8_t *b = write_parsed(&f, &size, &v);
+    ENSURE(b);
+    ENSURE(hdr(b)->section_count == SINEW_SECTION_ID_MAX);
+    const char *diff = view_diff(&v, &f.v);
+    ENSUREF(!diff, "the parsed view differs in %s", diff);
+    /* a contact listed in a group of other domains */
+    uint8_t *forged = copy_exact(b, size);
+    int32_t *dom = section(forged, SINEW_SECTION_PAIR_DOMAINS);
+    dom[1] = (dom[1] + 1) % ND;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "PAIR_", NULL));
+    free(forged);
+    forged = copy_exact(b, size);
+    ((int32_t *)section(forged, SINEW_SECTION_PAIR_PTR))[0] = 1;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "PAIR_PTR", "CONTACT_PTR"));
+    free(forged);
+    forged = copy_exact(b, size);
+    ((double *)section(forged, SINEW_SECTION_PAIR_FEATURE))[3] = NAN;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_NOT_FINITE, "PAIR_FEATURE", NULL));
+    free(forged);
+    forged = copy_exact(b, size);
+    ((sinew_blob_pair_meta *)section(forged, SINEW_SECTION_PAIR_META))->npair_groups = 10;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "PAIR_", NULL));
+    free(forged);
+    ENSURE(seed_is("synth_pairs.blob", b, size));
+    free(b);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
 }
@@ -328,5 +369,6 @@ TEST(release_fixture) {
 SW_TEST_MAIN(CASE(the_bake_writes_the_whole_tet_mesh), CASE(the_masses_are_the_reduced_masses),
              CASE(a_view_without_the_tet_mesh_writes_the_blob_of_before),
              CASE(the_writer_refuses_a_damaged_tet_mesh),
+             CASE(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer),
              CASE(the_loader_refuses_a_damaged_tet_mesh),
              CASE(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer), CASE(release_fixture))

@@ -13,18 +13,19 @@
  *   fuzz_blob_fixed  (fuzz_blob_fixed.c: SW_FUZZ_FIX_CHECKSUM and SW_FUZZ_STEP, linked
  *                    with the whole runtime) overwrites the checksum field before parsing,
  *                    so mutations reach the semantic checks (hostile blobs), and steps
- *                    accepted blobs: an instance in each step mode, the rest pose and
- *                    a bent one, a few steps each, the surface read back. A step that
- *                    reports success must leave a finite surface; nothing may crash.
- *                    Stepping costs ~50 times the parse, so one accepted input in
- *                    SW_FUZZ_STEP_EVERY (chosen by a hash of its bytes, so a crash
+ *                    accepted blobs: an instance in each step mode (and one in the
+ *                    pose-pairs self-contact mode when the blob has per-pair sections),
+ *                    the rest pose and a bent one, a few steps each, the surface read back. A step
+ * that reports success must leave a finite surface; nothing may crash. Stepping costs ~50 times the
+ * parse, so one accepted input in SW_FUZZ_STEP_EVERY (chosen by a hash of its bytes, so a crash
  *                    reproduces) is stepped; every one is parsed, validated and walked.
  *
  * Every input is copied into a 64-byte aligned buffer of exactly its size, so that ASan
  * reports a read one byte past it. An accepted blob is re-validated and every index
  * chain a runtime follows is walked (the optional render mesh's and condensation tet
- * mesh's too), the contact references and the tets' incidences with explicit checks (a
- * wrong index into one buffer mostly lands inside another section, unseen by ASan). */
+ * mesh's and the per-pair sections' too), the contact references and the tets' incidences with
+ * explicit checks (a wrong index into one buffer mostly lands inside another section, unseen by
+ * ASan). */
 #include <stdint.h>
 #include <stdlib.h>
 #include <string.h>
@@ -119,6 +120,25 @@ static double walk(const sw_blob_view *v) {
             if (!(v->contact_data[7 * (int64_t)c + 6] > 0)) abort();
         }
     }
+    /* the per-pair contact: every group's map, every pose's features and pairs of it, each
+       pair's vertex and triangle in the group's domains */
+    for (int32_t g = 0; g < v->npair_groups; ++g) {
+        const int32_t a = v->pair_domains[2 * g], b = v->pair_domains[2 * g + 1];
+        s += v->pair_map[72 * (int64_t)g + 71] + v->bone_joints[6 * v->domains[a].bone] +
+             v->bone_joints[6 * v->domains[b].bone];
+        for (int32_t t = 0; t < v->ntrain; ++t) {
+            const int64_t i = (int64_t)t * v->npair_groups + g;
+            s += v->pair_feature[6 * ((int64_t)g * v->ntrain + t) + 5];
+            for (int32_t c = v->pair_ptr[i]; c < v->pair_ptr[i + 1]; ++c) {
+                if (c < v->contact_ptr[t] || c >= v->contact_ptr[t + 1]) abort();
+                if (v->contact_verts[8 * (int64_t)c] != a ||
+                    v->contact_verts[8 * (int64_t)c + 2] != b)
+                    abort();
+                if (!(v->pair_weight[c] >= 0)) abort();
+                s += v->pair_weight[c];
+            }
+        }
+    }
     return s;
 }
 
@@ -158,9 +178,11 @@ static void step_blob(const void *data, size_t size, const sw_blob_view *v) {
     float *T = malloc((size_t)12 * nb * sizeof(float));
     float *pos = malloc((size_t)3 * ns * sizeof(float)),
           *nrm = malloc((size_t)3 * ns * sizeof(float));
-    for (int mode = 0; mode < 2 && T && pos && nrm; ++mode) {
+    for (int mode = 0; mode < 3 && T && pos && nrm; ++mode) {
+        if (mode == 2 && v->npair_groups == 0) break;
         sinew_instance_def d = sinew_instance_def_default();
-        d.mode = mode ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+        d.mode = mode == 1 ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+        if (mode == 2) d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS; /* per-pair contact */
         d.max_newton_iters = 3;
         sinew_instance *in = NULL;
         if (sinew_instance_create(blob, &d, &in) != SINEW_OK) continue; /* e.g. too large */

@@ -5,8 +5,8 @@
  * 30 s it reached more coverage than the 46 KB baked cylinder (1,045 edges against 970)
  * at 3 times the executions a second, so the cylinder seeds fuzz_blob instead. The same
  * character with a render mesh (synth_render.blob, test_render_embed) and with the
- * condensation tet mesh as well (synth_cond.blob, test_blob_cond) seed the optional
- * sections. */
+ * condensation tet mesh as well (synth_cond.blob, test_blob_cond) and per-pair contact
+ * sections too (synth_pairs.blob, test_blob_cond) seed the optional sections. */
 #define SW_FUZZ_FIX_CHECKSUM
 #define SW_FUZZ_STEP
 #include "fuzz_blob.c"
