@@ -311,6 +311,13 @@ int main(int argc, char **argv) {
     fprintf(stderr,
             "  poses: %d training, %d held-out; basis projection error train %.4f held-out %.4f\n",
             res.ntrain, res.nheldout, res.train_proj_error, res.heldout_proj_error);
+    int32_t kept = 0; /* the pose-space pairs the per-pair cubature keeps */
+    for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
+        kept += v->pair_weight[c] > 0;
+    fprintf(stderr,
+            "  self-contact: %d contact pairs over the training poses in %d pairs of domains; "
+            "the per-pair cubature keeps %d (--contact-tol %g)\n",
+            v->ncontacts, v->npair_groups, kept, p.contact_cubature_tol);
     if (v->nrender_verts > 0)
         fprintf(stderr,
                 "  output: the render mesh, %d vertices (%d welded duplicates), %d triangles, "
@@ -377,6 +384,8 @@ int main(int argc, char **argv) {
                    a->score_max, a->picks_score, a->picks_error, a->solved, a->seconds,
                    k + 1 == arep.nrounds ? "]" : "");
         }
+        printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d", v->ncontacts,
+               v->npair_groups, kept);
         printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
                res.simulate_cached ? "true" : "false", res.simulate_solved,
                absurd ? "true" : "false");
