@@ -463,6 +463,55 @@ TEST(bone_vertices_box) {
     sw_tetmesh_free(&m);
 }
 
+static int double_cmp(const void *pa, const void *pb) {
+    double a = *(const double *)pa, b = *(const double *)pb;
+    return a < b ? -1 : a > b;
+}
+
+/* A bone whose segment ends at the edge of its flesh (a head whose bone sits at the neck):
+ * bone 1 runs from x = -1 to the box's end face at x = 0 and dominates the whole box, so
+ * no surface vertex it dominates lies beside its segment, and the nearest of them (the end
+ * face's centre) is on it. Its flesh radius is then the median distance to its skin: it
+ * drives a core of interior vertices within 40% of that, not just the one tet the
+ * nearest skin (radius 0) left it with. */
+TEST(bone_vertices_of_a_bone_at_the_edge_of_its_flesh) {
+    sw_tetmesh m = {0};
+    sw_skeleton s = {0};
+    sw_weights w = {0};
+    sw_error err = {0};
+    make_box(13, 7, 7, 0.25, &m);
+    make_axis_skeleton(1.0, &s);
+    s.joints[0] = -2.0, s.joints[3] = -1.0, s.joints[6] = 0.0;
+    ENSURE(sw_weights_inverse_distance(&m, &s, &w, &err) == SINEW_OK);
+    int32_t *bov = malloc(sizeof(int32_t) * m.nverts);
+    double *d = malloc(sizeof(double) * m.nverts);
+    ENSUREF(sw_select_bone_vertices(&m, &s, &w, bov, &err) == SINEW_OK, "%s", err.msg);
+    int nd = 0, driven = 0;
+    for (int v = 0; v < m.nverts; ++v) { /* bone 1's skin: every box face vertex */
+        double x = m.X[3 * v], y = m.X[3 * v + 1], z = m.X[3 * v + 2];
+        ENSURE(w.w[2 * v + 1] > w.w[2 * v]);
+        if (x == 0 || x == 3.0 || fabs(fabs(y) - 0.75) < 1e-12 || fabs(fabs(z) - 0.75) < 1e-12)
+            d[nd++] = sqrt(x * x + y * y + z * z); /* to the segment's end (0, 0, 0) */
+    }
+    qsort(d, (size_t)nd, sizeof(double), double_cmp);
+    const double radius = d[nd / 2];
+    for (int v = 0; v < m.nverts; ++v) {
+        if (bov[v] != 1) continue;
+        driven++;
+        const double *X = m.X + 3 * v;
+        ENSUREF(sqrt(X[0] * X[0] + X[1] * X[1] + X[2] * X[2]) <= 0.4 * radius + 1e-12,
+                "vertex %d is beyond 40%% of the median radius %g", v, radius);
+    }
+    fprintf(stderr, "  bone at the edge: median skin distance %.3f, %d driven vertices\n", radius,
+            driven);
+    ENSUREF(driven > 4, "%d driven vertices: the flesh is held by one tet", driven);
+    free(d);
+    free(bov);
+    sw_weights_free(&w);
+    sw_skeleton_free(&s);
+    sw_tetmesh_free(&m);
+}
+
 /* Vertices driven by bone b, and whether they span 3-D (a tet of non-trivial volume). */
 static int driven_span(const sw_tetmesh *m, const int32_t *bov, int b, int *count) {
     int ids[4096], n = 0;
@@ -708,5 +757,6 @@ TEST(surface_arm) {
 
 SW_TEST_MAIN(CASE(cd_anim_semantics), CASE(cd_anim_malformed), CASE(cd_anim_elephant),
              CASE(pose_clip), CASE(inverse_distance_weights), CASE(bone_vertices_box),
-             CASE(bone_vertices_top_up_and_errors), CASE(dataset_elephant), CASE(dataset_hand),
-             CASE(corrupt_inputs), CASE(surface_arm))
+             CASE(bone_vertices_top_up_and_errors),
+             CASE(bone_vertices_of_a_bone_at_the_edge_of_its_flesh), CASE(dataset_elephant),
+             CASE(dataset_hand), CASE(corrupt_inputs), CASE(surface_arm))
