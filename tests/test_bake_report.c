@@ -58,6 +58,10 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     }
     const cJSON *doms = cJSON_GetObjectItemCaseSensitive(j, "domains");
     ENSURE(cJSON_GetArraySize(doms) == v->ndomains);
+    const cJSON *reg = cJSON_GetObjectItemCaseSensitive(j, "err_regions");
+    const cJSON *hreg = cJSON_GetObjectItemCaseSensitive(reg, "heldout");
+    ENSURE(cJSON_GetArraySize(hreg) >= 1 &&
+           num(cJSON_GetArrayItem(hreg, 0), "err_share") > 0); /* the largest share first */
     for (int32_t d = 0; d < v->ndomains && cJSON_GetArraySize(doms) == v->ndomains; ++d) {
         const cJSON *o = cJSON_GetArrayItem(doms, d);
         ENSURE(num(o, "rank") == v->domains[d].rank &&
@@ -152,7 +156,25 @@ TEST(clips_of_their_own_and_the_report) {
                                1.0,
                                0.5,
                                1,
-                               &arep};
+                               &arep,
+                               &et,
+                               &eh};
+    /* where the error is: shares in order, and all of it when every bone is listed */
+    for (int set = 0; set < 2; ++set) {
+        const sw_eval_result *ev = set ? &eh : &et;
+        double sum = 0, corr = 0;
+        ENSURE(ev->nregions >= 1 && ev->nregions <= SW_EVAL_REGIONS);
+        for (int32_t k = 0; k < ev->nregions; ++k) {
+            ENSURE(ev->region_err[k] >= 0 && ev->region_err[k] <= 1 && ev->region_corr[k] >= 0);
+            if (k > 0) ENSURE(ev->region_err[k] <= ev->region_err[k - 1]);
+            sum += ev->region_err[k];
+            corr += ev->region_corr[k];
+        }
+        ENSUREF(sum <= 1 + 1e-12 && corr <= 1 + 1e-12, "shares %g %g", sum, corr);
+        if (ch.skel.nbones <= SW_EVAL_REGIONS)
+            ENSUREF(fabs(sum - 1) < 1e-9, "%d bones, every one listed: shares sum to %g",
+                    ch.skel.nbones, sum);
+    }
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
@@ -162,7 +184,8 @@ TEST(clips_of_their_own_and_the_report) {
     snprintf(path, sizeof path, "%.1000s/report.html", dir);
     char *html = read_text(path);
     ENSURE(html && strstr(html, "<svg") && strstr(html, "heldout_sheet.png") &&
-           strstr(html, "Return") && strstr(html, "Adaptive training rounds"));
+           strstr(html, "Return") && strstr(html, "Adaptive training rounds") &&
+           strstr(html, "Where the error is"));
     free(html);
     struct stat st;
     snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);

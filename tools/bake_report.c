@@ -13,6 +13,9 @@
  *   adaptive [{train_poses, added, rank, err_train, err_heldout, proj_err_train,
  *              proj_err_heldout, picks_error (null: not verified), seconds}]: one per
  *              bake of the adaptive loop (bake_adaptive.h), or null without it
+ *   err_regions {train, heldout: [{bone, err_share, correction_share}]}: the bones whose
+ *              vertices (by their strongest bone) hold the largest shares of the squared
+ *              error (sw_eval_result's regions), or null
  *   contact_sheet: the PNG's file name, or null */
 #include "bake_report.h"
 
@@ -177,6 +180,19 @@ static cJSON *json_adaptive(const sw_adaptive_report *a) {
     return arr;
 }
 
+/* The regions of an evaluation (sw_eval_result): [{bone, err_share, correction_share}]. */
+static cJSON *json_regions(const sw_eval_result *e) {
+    cJSON *arr = cJSON_CreateArray();
+    for (int32_t k = 0; k < e->nregions; ++k) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "bone", e->region_bone[k]);
+        cJSON_AddNumberToObject(o, "err_share", e->region_err[k]);
+        cJSON_AddNumberToObject(o, "correction_share", e->region_corr[k]);
+        cJSON_AddItemToArray(arr, o);
+    }
+    return arr;
+}
+
 static char *report_json(const sw_bake_report_input *in, const report *r, int sheet) {
     const sw_bake_result *res = in->res;
     cJSON *j = cJSON_CreateObject();
@@ -204,6 +220,13 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddNumberToObject(sw, "mean_error", r->sweep_mean);
     cJSON_AddItemToObject(j, "domains", json_domains(in));
     cJSON_AddItemToObject(j, "adaptive", json_adaptive(in->adaptive));
+    if (in->eval_train && in->eval_heldout) {
+        cJSON *er = cJSON_AddObjectToObject(j, "err_regions");
+        cJSON_AddItemToObject(er, "train", json_regions(in->eval_train));
+        cJSON_AddItemToObject(er, "heldout", json_regions(in->eval_heldout));
+    } else {
+        cJSON_AddNullToObject(j, "err_regions");
+    }
     if (sheet)
         cJSON_AddStringToObject(j, "contact_sheet", SHEET_NAME);
     else
@@ -360,6 +383,26 @@ static int html_domains(FILE *f, const sw_bake_report_input *in) {
     return 1;
 }
 
+/* Where the error is: the bones whose vertices hold most of it, training and held-out. */
+static void html_regions(FILE *f, const sw_bake_report_input *in) {
+    if (!in->eval_train || !in->eval_heldout) return;
+    fprintf(f, "<h2>Where the error is</h2><p>The vertices split by their strongest bone: "
+               "the bones whose vertices hold the largest share of the squared error, with "
+               "their share of the squared physics correction. A share of the error far above "
+               "the share of the correction is a region the subspace misses; both near 1 is a "
+               "region that holds all the physics, e.g. flesh too loosely held by its bone."
+               "</p><table><tr><th>poses</th><th>bone</th><th>share of the error</th>"
+               "<th>share of the correction</th></tr>\n");
+    for (int set = 0; set < 2; ++set) {
+        const sw_eval_result *e = set ? in->eval_heldout : in->eval_train;
+        for (int32_t k = 0; k < e->nregions; ++k)
+            fprintf(f, "<tr><td>%s</td><td>%d</td><td>%.3f</td><td>%.3f</td></tr>\n",
+                    set ? "held-out" : "training", e->region_bone[k], e->region_err[k],
+                    e->region_corr[k]);
+    }
+    fprintf(f, "</table>\n");
+}
+
 /* The adaptive loop's rounds: a table and the held-out error per round. */
 static void html_adaptive(FILE *f, const sw_adaptive_report *a) {
     if (!a || a->nrounds < 1) return;
@@ -402,6 +445,7 @@ static int write_html(const char *path, const sw_bake_report_input *in, const re
                "<body>\n");
     html_summary(f, in);
     html_clips(f, r);
+    html_regions(f, in);
     int ok = html_domains(f, in);
     html_adaptive(f, in->adaptive);
     fprintf(f, "<h2>Stage times</h2>");

@@ -39,6 +39,9 @@ typedef struct sw_bake_report_input {
     int contact_sheet; /* render DIR/heldout_sheet.png (Embree; a few seconds) */
     /* the adaptive loop's rounds (sinew-bake --adaptive; NULL or 0 rounds: none) */
     const sw_adaptive_report *adaptive;
+    /* where the error is (sw_eval_result's regions) on the training and the held-out poses;
+       NULL: not shown */
+    const sw_eval_result *eval_train, *eval_heldout;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

@@ -285,7 +285,9 @@ int main(int argc, char **argv) {
                                    bake_seconds,
                                    eval_seconds,
                                    1,
-                                   ad.rounds > 0 ? &arep : NULL};
+                                   ad.rounds > 0 ? &arep : NULL,
+                                   &et,
+                                   &eh};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
@@ -336,6 +338,17 @@ int main(int argc, char **argv) {
             "  correction error (subspace vs full, share of the correction missed, on the bake's "
             "poses): train %.4f, held-out %.4f (%d failed steps)\n",
             et.correction_error, eh.correction_error, et.failed + eh.failed);
+    for (int set = 0; set < 2; ++set) {
+        const sw_eval_result *e = set ? &eh : &et;
+        if (e->nregions < 1) continue;
+        fprintf(stderr,
+                "  %s error by region (strongest bone: share of the error / of the "
+                "correction):",
+                set ? "held-out" : "training");
+        for (int32_t k = 0; k < e->nregions; ++k)
+            fprintf(stderr, " bone %d %.3f / %.3f%s", e->region_bone[k], e->region_err[k],
+                    e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
+    }
     if (absurd)
         fprintf(stderr,
                 "%s: WARNING: written with --force although its training error %.4f is at least "
@@ -386,6 +399,14 @@ int main(int argc, char **argv) {
         }
         printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d", v->ncontacts,
                v->npair_groups, kept);
+        for (int set = 0; set < 2; ++set) { /* [bone, share of the error, of the correction] */
+            const sw_eval_result *e = set ? &eh : &et;
+            printf(",\"err_regions_%s\":[", set ? "heldout" : "train");
+            for (int32_t k = 0; k < e->nregions; ++k)
+                printf("%s[%d,%.4f,%.4f]", k ? "," : "", e->region_bone[k], e->region_err[k],
+                       e->region_corr[k]);
+            printf("]");
+        }
         printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
                res.simulate_cached ? "true" : "false", res.simulate_solved,
                absurd ? "true" : "false");

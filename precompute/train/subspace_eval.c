@@ -21,7 +21,11 @@ sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const doub
     a->xs = malloc(n3);
     a->xd = malloc(n3);
     a->cnt = malloc((size_t)v->nverts * sizeof(double));
-    if (!a->xs || !a->xd || !a->cnt) {
+    a->skin_bone = v->skin_bone;
+    a->nbones = v->nbones;
+    a->bone_num = calloc((size_t)v->nbones, sizeof(double));
+    a->bone_den = calloc((size_t)v->nbones, sizeof(double));
+    if (!a->xs || !a->xd || !a->cnt || !a->bone_num || !a->bone_den) {
         sw_eval_acc_free(a);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     }
@@ -31,15 +35,21 @@ sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const doub
 void sw_eval_acc_add(sw_eval_acc *a, const sinew_instance *inst, const double *xf) {
     sw_instance_full_positions(inst, a->xs, a->cnt);
     sw_instance_dqs_positions(inst, a->xd);
-    for (int32_t i = 0; i < a->nverts; ++i)
+    for (int32_t i = 0; i < a->nverts; ++i) {
+        double vn = 0, vd = 0;
         for (int k = 0; k < 3; ++k) {
             double e = a->xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - a->xd[3 * i + k];
             double c = xf[3 * i + k] - a->rest[3 * i + k];
-            a->num += a->mass[i] * e * e;
-            a->den += a->mass[i] * b * b;
+            vn += a->mass[i] * e * e;
+            vd += a->mass[i] * b * b;
             a->l2n += e * e;
             a->l2d += c * c;
         }
+        a->num += vn;
+        a->den += vd;
+        a->bone_num[a->skin_bone[4 * (int64_t)i]] += vn;
+        a->bone_den[a->skin_bone[4 * (int64_t)i]] += vd;
+    }
     a->frames++;
 }
 
@@ -48,13 +58,28 @@ void sw_eval_acc_result(const sw_eval_acc *a, sw_eval_result *out) {
     out->correction_error = a->den > 0 ? sqrt(a->num / a->den) : 0;
     out->rel_l2 = a->l2d > 0 ? sqrt(a->l2n / a->l2d) : 0;
     out->frames = a->frames;
+    for (int32_t b = 0; b < a->nbones && a->num > 0; ++b) { /* the largest shares, in order */
+        if (!(a->bone_num[b] > 0)) continue;
+        int k = out->nregions < SW_EVAL_REGIONS ? out->nregions++ : SW_EVAL_REGIONS;
+        while (k > 0 && a->bone_num[b] > a->bone_num[out->region_bone[k - 1]]) {
+            if (k < SW_EVAL_REGIONS) out->region_bone[k] = out->region_bone[k - 1];
+            --k;
+        }
+        if (k < SW_EVAL_REGIONS) out->region_bone[k] = b;
+    }
+    for (int32_t r = 0; r < out->nregions; ++r) {
+        out->region_err[r] = a->bone_num[out->region_bone[r]] / a->num;
+        out->region_corr[r] = a->den > 0 ? a->bone_den[out->region_bone[r]] / a->den : 0;
+    }
 }
 
 void sw_eval_acc_free(sw_eval_acc *a) {
     free(a->xs);
     free(a->cnt);
     free(a->xd);
-    a->xs = a->cnt = a->xd = NULL;
+    free(a->bone_num);
+    free(a->bone_den);
+    a->xs = a->cnt = a->xd = a->bone_num = a->bone_den = NULL;
 }
 
 sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,

@@ -8,11 +8,24 @@
 #include "sinew/sinew.h"
 #include "sw_error.h"
 
+/* Regions of the error the result names: the bones whose vertices miss the most. */
+#define SW_EVAL_REGIONS 4
+
 typedef struct sw_eval_result {
     double correction_error; /* the ratio above */
     double rel_l2;           /* |x_sub - x_full| / |x_full - rest| (thesis §4.5 style) */
     int32_t frames;
     int32_t failed; /* steps that did not return SINEW_OK */
+    /* where the error is: the vertices split by their strongest skin bone, the
+       SW_EVAL_REGIONS bones (nregions of them) whose vertices hold the largest share of
+       the squared error |x_sub - x_full|_M^2 (region_err, largest first), with their
+       share of the squared correction |x_full - x_dqs|_M^2 (region_corr). A region
+       with a far larger share of the error than of the correction is where the subspace
+       fails; a share of both near 1 is a region that holds all the physics (e.g. free
+       flesh too loosely held by its bone) */
+    int32_t nregions;
+    int32_t region_bone[SW_EVAL_REGIONS];
+    double region_err[SW_EVAL_REGIONS], region_corr[SW_EVAL_REGIONS];
 } sw_eval_result;
 
 /* The sums behind the correction error, one frame at a time, for a caller that steps
@@ -23,7 +36,10 @@ typedef struct sw_eval_acc {
     int32_t nverts;
     double num, den, l2n, l2d;
     int32_t frames;
-    double *xs, *cnt, *xd; /* scratch: subspace, copy counts, DQS (3 nverts each) */
+    double *xs, *cnt, *xd;    /* scratch: subspace, copy counts, DQS (3 nverts each) */
+    const int32_t *skin_bone; /* the blob's 4 influences a vertex, strongest first */
+    int32_t nbones;
+    double *bone_num, *bone_den; /* num and den by the vertices' strongest bone */
 } sw_eval_acc;
 
 sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const double *mass,
