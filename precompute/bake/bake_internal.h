@@ -117,7 +117,8 @@ sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* The pairs stage's cubature of one (pose, group): weights w (n) >= 0 for the columns of A
  * (m x n, column-major: each pair's reduced contact force) with |A w - A 1| <= tol |A 1|,
- * picked greedily and re-solved by NNLS; a zero column keeps weight 0. */
+ * by the cubature trainer's greedy selector (cubature_train.h); a zero column keeps
+ * weight 0. */
 sinew_result sw_bake_pair_cubature(const double *A, int64_t m, int32_t n, double tol, double *w,
                                    sw_error *err);
 /* Records an owned allocation in the result (freed with it); returns p. */

@@ -15,8 +15,8 @@
  *
  * Cubature (eqs. 3.9-3.13): per (pose, group), non-negative weights for a few of its pairs
  * whose reduced contact forces at the reference's solution sum to the group's whole
- * reduced contact force within the tolerance, by greedy selection and NNLS (the pairs
- * most aligned with the residual join, nnls.h re-solves). A pair that is apart at the
+ * reduced contact force within the tolerance: the tet cubature's trainer
+ * (cubature_train.h, its greedy selector) with the pairs as candidates. A pair that is apart at the
  * reference's solution carries no force and is left out, as the thesis's cubature does. */
 #include <lapacke.h>
 #include <math.h>
@@ -24,7 +24,7 @@
 #include <string.h>
 
 #include "bake_internal.h"
-#include "nnls.h"
+#include "cubature_train.h"
 #include "penalty.h"
 
 void openblas_set_num_threads(int num_threads);
@@ -34,13 +34,20 @@ static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
     sw_relative_transform(T + 12 * (size_t)a, T + 12 * (size_t)b, z);
 }
 
-/* The bone transforms of training pose k (in stored order). */
+/* Training pose k (in stored order): its sequence, and k's index in it. */
+static const sw_pose_seq *train_seq(const sw_bake_state *s, int32_t k, int32_t *j) {
+    int32_t i = 0;
+    while (k >= s->train[i].npose)
+        k -= s->train[i++].npose;
+    *j = k;
+    return &s->train[i];
+}
+
+/* The bone transforms of training pose k. */
 static const double *train_T(const sw_bake_state *s, int32_t k) {
-    for (int32_t i = 0; i < s->ntrain_seq; ++i) {
-        if (k < s->train[i].npose) return s->train[i].T + (size_t)k * 12 * s->nb;
-        k -= s->train[i].npose;
-    }
-    return NULL;
+    int32_t j;
+    const sw_pose_seq *q = train_seq(s, k, &j);
+    return q->T + (size_t)j * 12 * s->nb;
 }
 
 /* Group g's 6 x 12 feature map (see above) from domain b's rest vertices and the training
@@ -134,60 +141,43 @@ static int pair_force(const sw_bake_state *s, const sw_blob_view *v, int32_t c, 
     return 1;
 }
 
-/* Cubature weights w (n) of pairs whose reduced forces are the columns of A (m x n,
- * column-major): greedy selection with NNLS until |A w - b| <= tol |b|, b = A 1. A
- * column of zeros (a pair apart) is never picked. */
-static sinew_result fit_weights(const double *A, int64_t m, int32_t n, double tol, double *w,
-                                double *scratch, int32_t *pick, sw_error *err) {
-    double *b = scratch, *res = b + m, *As = res + m, *ws = As + m * n;
-    memset(b, 0, (size_t)m * sizeof(double));
-    for (int32_t j = 0; j < n; ++j)
-        for (int64_t i = 0; i < m; ++i)
-            b[i] += A[j * m + i];
-    memset(w, 0, (size_t)n * sizeof(double));
-    const double bn = sqrt(sw_dot(b, b, m));
-    if (!(bn > 0)) return SINEW_OK; /* no force: no pair */
-    memcpy(res, b, (size_t)m * sizeof(double));
-    int32_t ns = 0;
-    while (ns < n && sqrt(sw_dot(res, res, m)) > tol * bn) {
-        int32_t best = -1;
-        double best_c = 0;
-        for (int32_t j = 0; j < n; ++j) {
-            double cn = sqrt(sw_dot(A + j * m, A + j * m, m));
-            if (!(cn > 0) || w[j] != 0) continue;
-            double c = sw_dot(A + j * m, res, m) / cn;
-            int taken = 0;
-            for (int32_t k = 0; k < ns; ++k)
-                taken |= pick[k] == j;
-            if (!taken && c > best_c) best_c = c, best = j;
-        }
-        if (best < 0) break;
-        pick[ns] = best;
-        memcpy(As + ns * m, A + best * m, (size_t)m * sizeof(double));
-        ++ns;
-        sw_nnls_stats st;
-        sinew_result r = sw_nnls(SW_NNLS_LAWSON_HANSON, As, m, ns, b, 0, 0, ws, &st, err);
-        if (r != SINEW_OK && r != SINEW_ERROR_NOT_CONVERGED) return r;
-        memcpy(res, b, (size_t)m * sizeof(double));
-        for (int32_t k = 0; k < ns; ++k) {
-            w[pick[k]] = ws[k];
-            for (int64_t i = 0; i < m; ++i)
-                res[i] -= ws[k] * As[k * m + i];
-        }
-    }
-    return SINEW_OK;
+/* Column `candidate` of a pair cubature's matrix (ctx: A, m rows, column-major). */
+typedef struct {
+    const double *A;
+    int64_t m;
+} pair_columns;
+
+static void pair_column(void *ctx, int64_t candidate, double *col) {
+    const pair_columns *pc = ctx;
+    memcpy(col, pc->A + candidate * pc->m, (size_t)pc->m * sizeof(double));
 }
 
-/* fit_weights with scratch of its own (bake_internal.h). */
 sinew_result sw_bake_pair_cubature(const double *A, int64_t m, int32_t n, double tol, double *w,
                                    sw_error *err) {
-    double *scratch = malloc(((size_t)m * ((size_t)n + 3) + (size_t)n) * sizeof(double));
-    int32_t *pick = malloc(((size_t)n + 1) * sizeof(int32_t));
-    sinew_result r = scratch && pick ? fit_weights(A, m, n, tol, w, scratch, pick, err)
-                                     : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
-                                                    "out of memory for a pair cubature");
-    free(scratch);
-    free(pick);
+    memset(w, 0, (size_t)n * sizeof(double));
+    double *b = calloc((size_t)m, sizeof(double));
+    if (!b)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for a pair cubature");
+    for (int32_t j = 0; j < n; ++j) /* the group's whole reduced force */
+        for (int64_t i = 0; i < m; ++i)
+            b[i] += A[j * m + i];
+    sinew_result r = SINEW_OK;
+    if (sw_dot(b, b, m) > 0) { /* (no force: no pair) */
+        pair_columns pc = {A, m};
+        sw_cubature_problem prob = {m, n, b, pair_column, &pc};
+        sw_cubature_params cp = sw_cubature_params_default();
+        cp.selector = SW_CUBATURE_GREEDY;
+        cp.tol = tol;
+        cp.max_points = n;
+        cp.candidates = n; /* every pair is a candidate each round: there are few */
+        sw_cubature_result cr;
+        r = sw_cubature_train(&prob, &cp, &cr, err);
+        if (r == SINEW_ERROR_NOT_CONVERGED) r = SINEW_OK; /* every pair kept: the best set */
+        for (int32_t k = 0; r == SINEW_OK && k < cr.n; ++k)
+            w[cr.ids[k]] = cr.weights[k];
+        sw_cubature_result_free(&cr);
+    }
+    free(b);
     return r;
 }
 
@@ -214,9 +204,9 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     if (v->ncontacts == 0) return SINEW_OK; /* no pose touches itself: no groups */
     const int32_t nd = v->ndomains, T = v->ntrain, R = v->rank_total;
     int32_t G = 0, *dom = find_groups(v, &G);
-    int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t)), *pick = NULL;
+    int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t));
     int32_t *cv2 = malloc((size_t)v->ncontacts * 8 * sizeof(int32_t));
-    double *cd2 = malloc((size_t)v->ncontacts * 7 * sizeof(double)), *A = NULL, *scratch = NULL;
+    double *cd2 = malloc((size_t)v->ncontacts * 7 * sizeof(double)), *A = NULL;
     double *Rv = malloc((size_t)s->nv * 9 * sizeof(double)), *tv = malloc((size_t)s->nv * 24);
     double *map, *feat, *wt;
     int32_t *ptr, *pd;
@@ -268,19 +258,12 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     ptr[(size_t)G * T] = v->ncontacts;
     /* the cubature of every (pose, group) */
     A = malloc((size_t)R * most * sizeof(double));
-    scratch = malloc(((size_t)R * (most + 3) + most) * sizeof(double));
-    pick = malloc((size_t)most * sizeof(int32_t));
-    if (!A || !scratch || !pick) goto oom;
+    if (!A) goto oom;
     const double tol = s->p->contact_cubature_tol;
     for (int32_t t = 0; t < T; ++t) {
-        const double *x = NULL;
-        int32_t k = t;
-        for (int32_t i = 0; i < s->ntrain_seq && !x; ++i)
-            if (k < s->train[i].npose)
-                x = s->train[i].x + (size_t)k * 3 * s->nv;
-            else
-                k -= s->train[i].npose;
         if (v->contact_ptr[t + 1] == v->contact_ptr[t]) continue;
+        int32_t j;
+        const double *x = train_seq(s, t, &j)->x + (size_t)j * 3 * s->nv; /* the reference's */
         sw_bake_skin_transforms(s, train_T(s, t), Rv, tv);
         for (int32_t g = 0; g < G; ++g) {
             int32_t c0 = ptr[(size_t)t * G + g], n = ptr[(size_t)t * G + g + 1] - c0;
@@ -292,7 +275,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
             }
             for (int32_t c = 0; c < n; ++c)
                 pair_force(s, v, c0 + c, x, Rv, A + (size_t)c * R);
-            if ((r = fit_weights(A, R, n, tol, wt + c0, scratch, pick, err)) != SINEW_OK) goto fail;
+            if ((r = sw_bake_pair_cubature(A, R, n, tol, wt + c0, err)) != SINEW_OK) goto fail;
         }
     }
     v->npair_groups = G;
@@ -313,7 +296,5 @@ fail:
     free(Rv);
     free(tv);
     free(A);
-    free(scratch);
-    free(pick);
     return r;
 }

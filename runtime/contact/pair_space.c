@@ -55,24 +55,12 @@ void sw_pair_space_reach(const sw_blob_view *v, double *reach) {
 static void gather_group(sw_pose_space *ps, const sw_blob_view *v, int32_t g, int32_t t, double w,
                          double tan) {
     const int64_t i = (int64_t)t * v->npair_groups + g;
-    for (int32_t c = v->pair_ptr[i]; c < v->pair_ptr[i + 1]; ++c) {
-        if (!(v->pair_weight[c] > 0)) continue;
-        if (ps->npairs == ps->max_pairs) {
-            ps->dropped++;
-            continue;
-        }
-        ps->pair_w[ps->npairs] = w * v->pair_weight[c];
-        ps->pair_tan[ps->npairs] = tan;
-        ps->pairs[ps->npairs++] = c;
-    }
-}
-
-static double tangent_share(double s, double reach) {
-    return s >= reach ? 0.0 : 1.0 - s / reach; /* reach INFINITY: 1 */
+    for (int32_t c = v->pair_ptr[i]; c < v->pair_ptr[i + 1]; ++c)
+        if (v->pair_weight[c] > 0) sw_pose_space_add_pair(ps, c, w * v->pair_weight[c], tan);
 }
 
 void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double *T) {
-    ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
+    ps->npairs = ps->dropped = ps->novel = 0;
     if (ps->novel_mask) memset(ps->novel_mask, 0, (size_t)v->ndomains * (size_t)v->ndomains);
     if (ps->nearest < 0) return;
     const int32_t nt = v->ntrain;
@@ -109,11 +97,11 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
         if (n1 >= 0 && d0 >= 1e-3 * size && d1 <= 4 * d0) blend = d0 / (d0 + d1);
         n0 = sw_pose_space_branch(ps, v, n0);
         gather_group(ps, v, g, n0, 1 - blend,
-                     tangent_share(d0, ps->pair_reach[g * (int64_t)nt + n0]));
+                     sw_pose_space_tangent_share(d0, ps->pair_reach[g * (int64_t)nt + n0]));
         if (blend > 0) {
             n1 = sw_pose_space_branch(ps, v, n1);
             gather_group(ps, v, g, n1, blend,
-                         tangent_share(d1, ps->pair_reach[g * (int64_t)nt + n1]));
+                         sw_pose_space_tangent_share(d1, ps->pair_reach[g * (int64_t)nt + n1]));
         }
     }
 }

@@ -47,7 +47,7 @@ void sw_pose_space_reach(const sw_blob_view *v, double *reach) {
  * 0.0196 / 0.1286 -> 0.0196 / 0.0888, finger 50K 0.0194 / 0.1361 -> 0.0194 / 0.1358,
  * 20K 0.0236 / 0.1817 -> 0.0236 / 0.1823, hand 0.0200 / 0.0448 -> 0.0200 / 0.0448;
  * elephant evaluations a step 4.65 -> 4.13 (fewer energy-guard stops). */
-static double tangent_share(double s, double reach) {
+double sw_pose_space_tangent_share(double s, double reach) {
     return s >= reach ? 0.0 : 1.0 - s / reach; /* reach INFINITY: 1 */
 }
 
@@ -57,7 +57,7 @@ void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones) {
     ps->tangent[0] = ps->tangent[1] = 0;
     ps->looked_up = 0; /* no motion yet: a pose on two branches takes the first stored */
     memset(ps->motion, 0, 4 * (size_t)nbones * sizeof(double));
-    ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
+    ps->npairs = ps->dropped = ps->novel = 0;
 }
 
 /* Training pose t is stored on the branch cycle of u (the same pose: the bake stores a
@@ -126,8 +126,8 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
        angles for small ones */
     double s0 = sqrt(fmax(d0, 0)), s1 = sqrt(fmax(d1, 0)); /* (rounding: d0 ~ -1e-17 at a sample) */
     if (n1 >= 0 && s0 >= 1e-3 && s1 <= 4 * s0) ps->blend = s0 / (s0 + s1);
-    ps->tangent[0] = tangent_share(s0, ps->reach[n0]);
-    ps->tangent[1] = n1 >= 0 ? tangent_share(s1, ps->reach[n1]) : 0;
+    ps->tangent[0] = sw_pose_space_tangent_share(s0, ps->reach[n0]);
+    ps->tangent[1] = n1 >= 0 ? sw_pose_space_tangent_share(s1, ps->reach[n1]) : 0;
     /* the last motion: kept while the pose holds still, so a pause does not switch branch */
     size_t f = (size_t)4 * v->nbones;
     double moved = 0;
@@ -142,27 +142,24 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
     ps->second = ps->blend > 0 ? sw_pose_space_branch(ps, v, n1) : n1;
 }
 
-/* Appends the pairs of training pose `pose` at weight w and tangential share tan while
- * the budget lasts. */
-static void gather_pose(sw_pose_space *ps, const sw_blob_view *v, int32_t pose, double w,
-                        double tan) {
-    for (int32_t c = v->contact_ptr[pose]; c < v->contact_ptr[pose + 1]; ++c) {
-        if (ps->npairs == ps->max_pairs) {
-            ps->dropped += v->contact_ptr[pose + 1] - c;
-            return;
-        }
-        ps->pair_w[ps->npairs] = w;
-        ps->pair_tan[ps->npairs] = tan;
-        ps->pairs[ps->npairs++] = c;
+void sw_pose_space_add_pair(sw_pose_space *ps, int32_t c, double w, double tan) {
+    if (ps->npairs == ps->max_pairs) {
+        ps->dropped++;
+        return;
     }
+    ps->pair_w[ps->npairs] = w;
+    ps->pair_tan[ps->npairs] = tan;
+    ps->pairs[ps->npairs++] = c;
 }
 
 void sw_pose_space_gather_pairs(sw_pose_space *ps, const sw_blob_view *v) {
-    ps->npairs_nearest = ps->npairs = ps->dropped = ps->novel = 0;
+    ps->npairs = ps->dropped = ps->novel = 0;
     if (ps->nearest < 0) return;
-    gather_pose(ps, v, ps->nearest, 1 - ps->blend, ps->tangent[0]);
-    ps->npairs_nearest = ps->npairs;
-    if (ps->blend > 0) gather_pose(ps, v, ps->second, ps->blend, ps->tangent[1]);
+    for (int32_t c = v->contact_ptr[ps->nearest]; c < v->contact_ptr[ps->nearest + 1]; ++c)
+        sw_pose_space_add_pair(ps, c, 1 - ps->blend, ps->tangent[0]);
+    if (ps->blend > 0)
+        for (int32_t c = v->contact_ptr[ps->second]; c < v->contact_ptr[ps->second + 1]; ++c)
+            sw_pose_space_add_pair(ps, c, ps->blend, ps->tangent[1]);
 }
 
 int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v) {

@@ -25,16 +25,15 @@ typedef struct sw_pose_space {
        `nearest` [0] and of `second` [1] carry: 1 at their own training pose, falling
        linearly to 0 at the distance of its nearest other pose (sw_pose_space_lookup) */
     double tangent[2];
-    /* the contact pairs in use: pairs[0, npairs_nearest) are the nearest pose's,
-       pairs[npairs_nearest, npairs) the second's (when blended); per pair, its weight
-       (pose-space blend times cubature weight) and its share of the tangential term.
-       Per-pair mode (sw_pair_space_gather): each group's nearest sample's pairs, then its
-       second's, group after group (npairs_nearest 0) */
+    /* the contact pairs in use, pairs[0, npairs): the nearest pose's, then the second's
+       (when blended), or in per-pair mode (sw_pair_space_gather) each group's nearest
+       sample's, then its second's, group after group; per pair, its weight (pose-space
+       blend times cubature weight) and its share of the tangential term */
     int32_t *pairs;    /* max_pairs contact ids */
     double *pair_w;    /* max_pairs */
     double *pair_tan;  /* max_pairs */
     int32_t max_pairs; /* the budget: at most this many pairs a step */
-    int32_t npairs_nearest, npairs;
+    int32_t npairs;
     int32_t dropped; /* pairs the budget left out this step */
     /* per-pair mode (the blob's pair groups, pair_space.c): per group and training pose,
        the feature distance to the group's nearest other distinct sample (INFINITY: none);
@@ -66,8 +65,16 @@ void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);
 void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T);
 
 /* Collects the contact pairs of the poses the lookup found into ps->pairs, the nearest
- * pose's first, at most max_pairs; sets npairs_nearest, npairs and dropped. */
+ * pose's first, at most max_pairs; sets npairs and dropped. */
 void sw_pose_space_gather_pairs(sw_pose_space *ps, const sw_blob_view *v);
+
+/* Appends contact c to the pairs in use at weight w and tangential share tan, or counts
+ * it in ps->dropped when the budget is spent (both modes' gathering). */
+void sw_pose_space_add_pair(sw_pose_space *ps, int32_t c, double w, double tan);
+
+/* The share of the tangential term the pairs of a training sample carry at feature
+ * distance s from it, reach its distance to its nearest other sample (pose_space.c). */
+double sw_pose_space_tangent_share(double s, double reach);
 
 /* The default pair budget: the pairs of the two training poses that hold the most. */
 int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v);

@@ -21,8 +21,10 @@ typedef struct {
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
     sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
     double rho;         /* its radius, in units of the rest diagonal */
-    int exhaustive;     /* SINEW_SELF_CONTACT_EXHAUSTIVE: its detection's arrays */
     int per_pair;       /* SINEW_SELF_CONTACT_POSE_PAIRS: the groups' reach */
+    /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
+       mode's fallback on novel contact when the blob has the tet mesh */
+    int detect;
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -69,8 +71,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     ps->pair_reach = NULL;
     ps->novel_mask = NULL;
     if (z->per_pair) TAKE(ps->pair_reach, (uint64_t)v->npair_groups * (uint64_t)v->ntrain);
-    if (z->per_pair && v->ntets > 0) TAKE(ps->novel_mask, nd * nd);
-    if (z->exhaustive || (z->per_pair && v->ntets > 0)) sw_self_contacts_take(p, v, &in->sc);
+    if (z->per_pair && z->detect) TAKE(ps->novel_mask, nd * nd);
+    if (z->detect) sw_self_contacts_take(p, v, &in->sc);
     /* the solver */
     sw_solver *s = &in->solver;
     TAKE(s->q, R);
@@ -335,7 +337,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
                                                        : (int32_t)d->max_world_contacts;
     z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs);
     z->rho = d->patch_radius > 0 ? d->patch_radius : SW_COND_DEFAULT_RADIUS;
-    z->exhaustive = d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE;
+    z->detect = d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE || (z->per_pair && v->ntets > 0);
     return SINEW_OK;
 }
 
@@ -453,7 +455,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
     in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
     in->self_mode = d.self_contact;
-    if (z.exhaustive || (z.per_pair && v->ntets > 0)) {
+    if (z.detect) {
         sw_error e;
         if (sw_self_contacts_build(&in->sc, v, &e) != SINEW_OK) {
             sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,

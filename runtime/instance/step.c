@@ -90,7 +90,7 @@ static void phase_contact(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_pose_space_lookup(&in->ps, in->v, in->pose.T_cur);
     if (exhaustive(in)) {
-        in->ps.npairs = in->ps.npairs_nearest = in->ps.dropped = 0;
+        in->ps.npairs = in->ps.dropped = 0;
     } else {
         if (in->self_mode == SINEW_SELF_CONTACT_POSE_PAIRS)
             sw_pair_space_gather(&in->ps, in->v, in->pose.T_cur);
