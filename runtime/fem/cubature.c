@@ -80,6 +80,43 @@ static void add_mode_products(double *H, int32_t R, int32_t r, const double *hm,
     }
 }
 
+/* Columns j0 .. j0 + nl - 1 (nl <= SW_CUB_COLS) of singular_frame_projections side by
+ * side: each column's sums in the order of a one-column loop, the columns in lanes that
+ * a vectorising compiler fills when nl is the constant SW_CUB_COLS (SSE2 pairs).
+ * Measured (callgrind over sinew-bench's clips, bitwise the same steps): Fox 1.99G ->
+ * 1.90G instructions, elephant 24.5G -> 23.6G, hand 1.25G -> 1.21G. (Compiling the pass for AVX2
+ * too, target_clones, made those steps slower here: 3.9 -> 7.2 ms.) */
+#define SW_CUB_COLS 4
+static void column_projections(const tet_map *tm, int32_t r, int32_t j0, int nl, double W[4][9],
+                               const double b[12], const double dpsi[3], double fscale,
+                               const int *mode, int n, double *out) {
+    double Gs[9][SW_CUB_COLS] = {{0}}, h[9][SW_CUB_COLS];
+    for (int c = 0; c < 4; ++c) {
+        const double *u0 = tm->U[c] + j0, *u1 = u0 + r, *u2 = u1 + r;
+        for (int i = 0; i < 3; ++i) {
+            const double *Wi = W[c] + 3 * i;
+            for (int l = 0; l < nl; ++l) {
+                double ai = Wi[0] * u0[l] + Wi[1] * u1[l] + Wi[2] * u2[l]; /* (U^T R_n U_n,j)_i */
+                Gs[3 * i][l] += ai * b[3 * c];
+                Gs[3 * i + 1][l] += ai * b[3 * c + 1];
+                Gs[3 * i + 2][l] += ai * b[3 * c + 2];
+            }
+        }
+    }
+    for (int l = 0; l < nl; ++l) {
+        out[j0 + l] = fscale * (dpsi[0] * Gs[0][l] + dpsi[1] * Gs[4][l] + dpsi[2] * Gs[8][l]);
+        double As[9], hl[9];
+        for (int k = 0; k < 9; ++k)
+            As[k] = Gs[k][l];
+        sw_corot_modes_dot(As, hl);
+        for (int k = 0; k < 9; ++k)
+            h[k][l] = hl[k];
+    }
+    for (int i = 0; i < n; ++i)
+        for (int l = 0; l < nl; ++l)
+            out[(int64_t)(1 + i) * r + j0 + l] = h[mode[i]][l];
+}
+
 /* The projections of one tet evaluated with its Hessian, through the singular frame of
  * its SVD F = U diag(s) V^T: column j of J moves F by G_j = sum_n J_n,j D_n^T (corner n's
  * Jacobian J_n = R_n U_n, shape gradient D_n), and in that frame Gs_j = U^T G_j V =
@@ -101,24 +138,11 @@ static void singular_frame_projections(const tet_map *tm, int32_t r, const doubl
     for (int c = 0; c < 4; ++c) /* b_n = V^T D_n */
         for (int i = 0; i < 3; ++i)
             b[3 * c + i] = V[i] * D[3 * c] + V[3 + i] * D[3 * c + 1] + V[6 + i] * D[3 * c + 2];
-    for (int32_t j = 0; j < r; ++j) {
-        double Gs[9] = {0}, h[9];
-        for (int c = 0; c < 4; ++c) {
-            const double *Un = tm->U[c];
-            double u0 = Un[j], u1 = Un[r + j], u2 = Un[2 * r + j];
-            for (int i = 0; i < 3; ++i) {
-                const double *Wi = W[c] + 3 * i;
-                double ai = Wi[0] * u0 + Wi[1] * u1 + Wi[2] * u2; /* (U^T R_n U_n,j)_i */
-                Gs[3 * i] += ai * b[3 * c];
-                Gs[3 * i + 1] += ai * b[3 * c + 1];
-                Gs[3 * i + 2] += ai * b[3 * c + 2];
-            }
-        }
-        out[j] = fscale * (dpsi[0] * Gs[0] + dpsi[1] * Gs[4] + dpsi[2] * Gs[8]);
-        sw_corot_modes_dot(Gs, h);
-        for (int i = 0; i < n; ++i)
-            out[(int64_t)(1 + i) * r + j] = h[mode[i]];
-    }
+    /* blocks of SW_CUB_COLS columns, then the rest */
+    int32_t j = 0;
+    for (; j + SW_CUB_COLS <= r; j += SW_CUB_COLS)
+        column_projections(tm, r, j, SW_CUB_COLS, W, b, dpsi, fscale, mode, n, out);
+    if (j < r) column_projections(tm, r, j, r - j, W, b, dpsi, fscale, mode, n, out);
 }
 
 /* One cubature pass over some domains, by one worker. */
