@@ -80,6 +80,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->qdot, R);
     TAKE(s->fin, R);
     TAKE(s->Hn, R * R);
+    TAKE(s->g_mat, R);
     TAKE(s->L, R * R);
     TAKE(s->dq, R);
     TAKE(s->qtrial, R);

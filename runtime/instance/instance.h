@@ -49,6 +49,12 @@ void sw_instance_step_prepare(sinew_instance *inst, float dt);
 double sw_instance_step_potential(sinew_instance *inst, float dt, const double *q, double *g,
                                   double *H, int exact_hessian);
 
+/* Tests: the potential, gradient and Newton matrix of the prepared step at its start, as
+ * the step's first Newton evaluation takes them (sw_potential_start: in dynamic mode from
+ * the material part evaluated for H(q_n), *cubature_pass 0); once after a prepare. */
+double sw_instance_step_start_potential(sinew_instance *inst, float dt, double *g, double *H,
+                                        int *cubature_pass);
+
 /* Evaluation only (O(N)): plain DQS of every simulation vertex at the current pose. */
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x);
 

@@ -59,6 +59,7 @@ static void step_begin(sw_step_ctx *c, sinew_instance *in, float dt) {
     c->st.struct_size = sizeof c->st;
     c->dc = step_coef(in, dt);
     memcpy(in->solver.qn, in->solver.q, (size_t)in->red.R * sizeof(double));
+    in->solver.mat_at_qn = 0;
     c->t = sw_now_seconds();
 }
 
@@ -171,14 +172,14 @@ static void phase_dynamics(sw_step_ctx *c) {
     }
     if (c->dc.dynamic) {
         sw_inertial_forces(in->v, &in->pose, s, c->dc.h);
-        sw_dyn_coef statics = c->dc;
-        statics.dynamic = 0;
         /* H_n: the material and pose-space self-contact (the exhaustive mode's pairs are
-           detected after the start state, phase_self) */
-        sw_step_contacts self = {&in->ps, NULL, NULL, NULL};
-        sw_potential(&in->red, &self, s, s->q, &statics, 1, 1);
+           detected after the start state, phase_self); Newton's first evaluation, at q_n,
+           starts from the same part instead of another cubature pass */
+        s->phi_mat = sw_potential_material(&in->red, &in->ps, s->q, 1, 1, NULL);
         c->st.potential_evals++;
         memcpy(s->Hn, in->red.H, (size_t)R * R * sizeof(double));
+        memcpy(s->g_mat, in->red.g, (size_t)R * sizeof(double));
+        s->mat_at_qn = 1;
     } else if (in->ps.nearest >= 0) {
         pose_space_start(in);
         c->st.status |= SINEW_STEP_POSE_SPACE;
@@ -423,5 +424,16 @@ double sw_instance_step_potential(sinew_instance *inst, float dt, const double *
     double phi = sw_potential(&inst->red, &ct, &inst->solver, q, &dc, g || H, want_hess);
     if (g) memcpy(g, inst->red.g, R * sizeof(double));
     if (H) memcpy(H, inst->red.H, R * R * sizeof(double));
+    return phi;
+}
+
+double sw_instance_step_start_potential(sinew_instance *inst, float dt, double *g, double *H,
+                                        int *cubature_pass) {
+    sw_dyn_coef dc = step_coef(inst, dt);
+    size_t R = (size_t)inst->red.R;
+    sw_step_contacts ct = sw_instance_contacts(inst, NULL);
+    double phi = sw_potential_start(&inst->red, &ct, &inst->solver, &dc, cubature_pass);
+    memcpy(g, inst->red.g, R * sizeof(double));
+    memcpy(H, inst->red.H, R * R * sizeof(double));
     return phi;
 }

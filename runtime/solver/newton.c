@@ -82,6 +82,15 @@ static double evaluate(sw_reduced *red, const sw_step_contacts *ct, const sw_sol
     return sw_potential(red, ct, s, q, dc, 1, want_hess);
 }
 
+/* Phi, g and H at the step's start, counted when it makes a cubature pass. */
+static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                             const sw_dyn_coef *dc, sinew_step_stats *st) {
+    int pass = 0;
+    double phi = sw_potential_start(red, ct, s, dc, &pass);
+    st->potential_evals += (uint32_t)pass;
+    return phi;
+}
+
 /* A chord update (on a Hessian factored at an earlier iterate of the step) that shrinks
  * the gradient by less than this is followed by a fresh factorisation. */
 /* Chord updates (on the factor of an earlier iterate's Hessian) follow a Newton update
@@ -118,7 +127,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
      * until an update is near the stationary point (SW_NEWTON_NEAR). The stationary point
      * is the same: only the path to it changes, and it is still a function of the step's
      * start alone. */
-    double phi = evaluate(red, ct, s, s->q, dc, 1, st);
+    double phi = evaluate_start(red, ct, s, dc, st);
     int have_h = 1; /* red->H is the Hessian at s->q, not yet factored */
     int fresh = 0;  /* s->L was factored at s->q */
     int trust = 1;  /* trial points are evaluated without H (chord updates may follow) */

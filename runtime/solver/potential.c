@@ -29,21 +29,31 @@ static void spring_matvec(const sw_blob_view *v, const sw_solver *s, const doubl
         }
 }
 
-double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
-                    const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess) {
+double sw_potential_material(sw_reduced *red, const sw_pose_space *ps, const double *q,
+                             int want_grad, int want_hess, double *self_seconds) {
     int32_t R = red->R;
     const sw_blob_view *v = red->v;
     if (want_grad) memset(red->g, 0, (size_t)R * sizeof(double));
     if (want_hess) memcpy(red->H, v->spring_hessian, (size_t)R * R * sizeof(double));
     double phi = sw_cubature_eval(red, q, want_grad, want_hess);
-    double t0 = ct->self_seconds ? sw_now_seconds() : 0;
-    phi += sw_pose_contact_eval(red, ct->ps, q, want_grad, want_hess);
+    double t0 = self_seconds ? sw_now_seconds() : 0;
+    phi += sw_pose_contact_eval(red, ps, q, want_grad, want_hess);
+    if (self_seconds) *self_seconds += sw_now_seconds() - t0;
+    return phi;
+}
+
+double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
+                         const double *q, const sw_dyn_coef *dc, double phi, int want_grad,
+                         int want_hess) {
+    int32_t R = red->R;
+    const sw_blob_view *v = red->v;
     if (ct->sc) {
+        double t0 = ct->self_seconds ? sw_now_seconds() : 0;
         sw_pair_set set = sw_self_contacts_pairs(ct->sc);
         phi += sw_contact_pairs_eval(red, &set, NULL, ct->sc->npairs, NULL, NULL, q, want_grad,
                                      want_hess);
+        if (ct->self_seconds) *ct->self_seconds += sw_now_seconds() - t0;
     }
-    if (ct->self_seconds) *ct->self_seconds += sw_now_seconds() - t0;
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
     spring_matvec(v, s, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);
@@ -79,4 +89,22 @@ double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver
             red->H[i] +=
                 dc->cm * v->mass[i] + dc->cd * (dc->alpha * v->mass[i] + dc->beta * s->Hn[i]);
     return phi;
+}
+
+double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver *s,
+                    const double *q, const sw_dyn_coef *dc, int want_grad, int want_hess) {
+    double phi = sw_potential_material(red, ct->ps, q, want_grad, want_hess, ct->self_seconds);
+    return sw_potential_rest(red, ct, s, q, dc, phi, want_grad, want_hess);
+}
+
+double sw_potential_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                          const sw_dyn_coef *dc, int *cubature_pass) {
+    int32_t R = red->R;
+    int at_qn = s->mat_at_qn && !memcmp(s->q, s->qn, (size_t)R * sizeof(double));
+    s->mat_at_qn = 0;
+    *cubature_pass = !at_qn;
+    if (!at_qn) return sw_potential(red, ct, s, s->q, dc, 1, 1);
+    memcpy(red->H, s->Hn, (size_t)R * R * sizeof(double));
+    memcpy(red->g, s->g_mat, (size_t)R * sizeof(double));
+    return sw_potential_rest(red, ct, s, s->q, dc, s->phi_mat, 1, 1);
 }
