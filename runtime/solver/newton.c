@@ -21,6 +21,14 @@ void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v) {
                               s->blk_size, s->blk_adj, s->blk_nz, s->blk_order);
     for (int32_t e = 0; e < v->ndomains; ++e)
         s->blk_pos[s->blk_order[e]] = e;
+    /* the bake's mass is U^T M U per domain; a blob whose is not gets dense products */
+    s->mass_blockdiag = 1;
+    for (int32_t a = 0; a < v->ndomains; ++a)
+        for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i)
+            for (int32_t j = 0; j < v->rank_total; ++j)
+                if ((j < s->blk_off[a] || j >= s->blk_off[a] + s->blk_size[a]) &&
+                    v->mass[(int64_t)i * v->rank_total + j] != 0)
+                    s->mass_blockdiag = 0;
 }
 
 /* The blocks a contact pair's four copies (cv: (domain, local) each) couple. */

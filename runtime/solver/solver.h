@@ -33,8 +33,9 @@ typedef struct sw_solver {
     int32_t *blk_pos;                        /* domain -> its place in blk_order */
     unsigned char *blk_nz;                   /* ndomains^2: the factor's block pattern */
     unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
-    uint32_t max_newton;                     /* Newton updates a step at most */
-    double dq_tiny; /* an update shorter than this converged (1e-9 of the size) */
+    int mass_blockdiag;  /* the blob's reduced mass is zero outside the domains' blocks */
+    uint32_t max_newton; /* Newton updates a step at most */
+    double dq_tiny;      /* an update shorter than this converged (1e-9 of the size) */
 } sw_solver;
 
 /* The time discretisation of a step: quasistatic (dynamic = 0) or backward Euler with
