@@ -28,7 +28,7 @@ static double num(const cJSON *o, const char *key) {
 
 /* The report's JSON against what the bake made. */
 static void check_json(const char *dir, const sw_bake_result *res, const sw_blob_view *v,
-                       double err_heldout) {
+                       double err_heldout, const sw_eval_result *eh) {
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);
@@ -41,6 +41,12 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     }
     ENSURE(num(j, "sinew_bake_report") == SW_BAKE_REPORT_VERSION);
     ENSURE_NEAR(num(j, "err_heldout"), err_heldout, 1e-9);
+    /* the seams between the finger's domains: apart, by less than the correction */
+    const cJSON *seams = cJSON_GetObjectItemCaseSensitive(j, "seams");
+    ENSURE_NEAR(num(seams, "heldout"), eh->seam, 1e-12);
+    ENSURE_NEAR(num(seams, "max_heldout"), eh->seam_max, 1e-12);
+    ENSUREF(eh->seam > 0 && eh->seam < 1 && eh->seam_max > 0 && eh->seam_max < 0.1,
+            "seams %g, largest %g", eh->seam, eh->seam_max);
     const cJSON *ch = cJSON_GetObjectItemCaseSensitive(j, "character");
     ENSURE(num(ch, "tets") > 500 && num(ch, "bones") == 3);
     const cJSON *clips = cJSON_GetObjectItemCaseSensitive(j, "clips");
@@ -179,7 +185,7 @@ TEST(clips_of_their_own_and_the_report) {
     snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
-    check_json(dir, &res, &res.view, eh.correction_error);
+    check_json(dir, &res, &res.view, eh.correction_error, &eh);
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.html", dir);
     char *html = read_text(path);

@@ -346,6 +346,57 @@ TEST(training_poses_are_reproduced) {
             e.correction_error);
 }
 
+/* The seams between domains (sw_instance_copy_spread) at the rest pose with one basis
+ * coordinate of one domain set: that domain's copy of a shared vertex v moves by its
+ * basis row u_v and the n_v - 1 other copies stay at rest, so the copies' squared
+ * distances from their mean sum to |u_v|^2 (n_v - 1) / n_v, and the largest distance is
+ * the largest |u_v| (n_v - 1) / n_v. */
+TEST(copy_spread_measures_the_seams) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    ENSURE(v->ndomains >= 2);
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    double *T = calloc(12 * (size_t)v->nbones, sizeof(double));
+    double *x = malloc(sizeof(double) * 3 * v->nverts), *cnt = malloc(sizeof(double) * v->nverts);
+    double *spread = malloc(sizeof(double) * v->nverts), *q = calloc(v->rank_total, sizeof(double));
+    double *u2 = calloc(v->nverts, sizeof(double)); /* |u_v|^2 of domain a's copies */
+    for (int32_t b = 0; b < v->nbones; ++b)
+        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    ENSURE(sw_instance_set_pose_d(inst, T) == SINEW_OK);
+    ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
+    int32_t a = 1, shared = 0; /* a domain next to another */
+    const sw_blob_domain *D = &v->domains[a];
+    int32_t j = D->rank - 1;
+    q[D->q_offset + j] = 1; /* orthonormal columns: a unit displacement field */
+    sw_instance_set_q(inst, q);
+    sw_instance_full_positions(inst, x, cnt);
+    double gap = sw_instance_copy_spread(inst, x, spread), want_gap = 0;
+    for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+        const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * D->rank;
+        int32_t gv = v->domain_verts[D->vert_begin + lv];
+        u2[gv] =
+            U[j] * U[j] + U[D->rank + j] * U[D->rank + j] + U[2 * D->rank + j] * U[2 * D->rank + j];
+    }
+    for (int32_t gv = 0; gv < v->nverts; ++gv) {
+        double n = cnt[gv], want = n >= 2 ? u2[gv] * (n - 1) / n : 0;
+        shared += n >= 2 && u2[gv] > 0;
+        if (n >= 2) want_gap = fmax(want_gap, sqrt(u2[gv]) * (n - 1) / n);
+        ENSUREF(fabs(spread[gv] - want) <= 1e-12 * (1 + want), "vertex %d: spread %g, want %g", gv,
+                spread[gv], want);
+    }
+    ENSUREF(shared > 0 && fabs(gap - want_gap) <= 1e-12 * (1 + want_gap),
+            "%d shared vertices moved; largest gap %g, want %g", shared, gap, want_gap);
+    sinew_instance_destroy(inst);
+    free(T);
+    free(x);
+    free(cnt);
+    free(spread);
+    free(q);
+    free(u2);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
 }
@@ -355,4 +406,4 @@ SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
              CASE(chord_updates_end_at_a_newton_stationary_point),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
              CASE(branches_follow_the_motion), CASE(training_poses_are_reproduced),
-             CASE(release_fixture))
+             CASE(copy_spread_measures_the_seams), CASE(release_fixture))

@@ -6,6 +6,8 @@
  *   source, character {name, tets, verts, bones, render_verts, render_tris, youngs,
  *                      poisson, density}
  *   err_train, err_heldout, proj_err_train, proj_err_heldout, cubature_fit, failed_steps
+ *   seams {train, heldout, max_train, max_heldout}: the domains' copies of a vertex apart
+ *              (sw_eval_result's seam, seam_max), or null
  *   bake_seconds, eval_seconds, stages [{name, seconds}]
  *   clips [{name, split "train" | "heldout", frames [clip frame], error [per frame]}]
  *   sweeps {poses, mean_error}: the training poses of no clip (joint sweeps, return path)
@@ -204,6 +206,15 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
     cJSON_AddNumberToObject(j, "proj_err_heldout", res->heldout_proj_error);
     cJSON_AddNumberToObject(j, "cubature_fit", res->cubature_error_max);
+    if (in->eval_train && in->eval_heldout) {
+        cJSON *o = cJSON_AddObjectToObject(j, "seams");
+        cJSON_AddItemToObject(o, "train", json_number(in->eval_train->seam));
+        cJSON_AddItemToObject(o, "heldout", json_number(in->eval_heldout->seam));
+        cJSON_AddItemToObject(o, "max_train", json_number(in->eval_train->seam_max));
+        cJSON_AddItemToObject(o, "max_heldout", json_number(in->eval_heldout->seam_max));
+    } else {
+        cJSON_AddNullToObject(j, "seams");
+    }
     cJSON_AddNumberToObject(j, "failed_steps", in->failed_steps);
     cJSON_AddNumberToObject(j, "bake_seconds", in->bake_seconds);
     cJSON_AddNumberToObject(j, "eval_seconds", in->eval_seconds);
@@ -336,6 +347,12 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
             "the physics correction the runtime misses; 0 exact, 1 no better than "
             "skinning)</td></tr>",
             in->err_train, in->err_heldout);
+    if (in->eval_train && in->eval_heldout)
+        fprintf(f,
+                "<tr><td>seams between domains</td><td>training %.4f, held-out %.4f of the "
+                "correction; largest gap %.2e, %.2e of the rest diagonal</td></tr>",
+                in->eval_train->seam, in->eval_heldout->seam, in->eval_train->seam_max,
+                in->eval_heldout->seam_max);
     fprintf(f,
             "<tr><td>basis projection error</td><td>training %.4f, held-out %.4f</td></tr>"
             "<tr><td>worst cubature fit</td><td>%.4f</td></tr><tr><td>failed steps</td><td>%d"

@@ -338,6 +338,10 @@ int main(int argc, char **argv) {
             "  correction error (subspace vs full, share of the correction missed, on the bake's "
             "poses): train %.4f, held-out %.4f (%d failed steps)\n",
             et.correction_error, eh.correction_error, et.failed + eh.failed);
+    fprintf(stderr,
+            "  seams (the domains' copies of a vertex apart, share of the correction; largest "
+            "gap over the rest diagonal): train %.4f, %.2e; held-out %.4f, %.2e\n",
+            et.seam, et.seam_max, eh.seam, eh.seam_max);
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *e = set ? &eh : &et;
         if (e->nregions < 1) continue;
@@ -374,6 +378,9 @@ int main(int argc, char **argv) {
                res.train_unsettled, res.heldout_unsettled, bake_seconds, eval_seconds,
                res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+        printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
+               "\"seam_max_heldout\":%.3e",
+               et.seam, eh.seam, et.seam_max, eh.seam_max);
         printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
                "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
                "\"embed_seconds\":%.4f",

@@ -17,6 +17,16 @@ sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const doub
     a->mass = mass;
     a->rest = v->rest;
     a->nverts = v->nverts;
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < v->nverts; ++i)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fmin(lo[k], v->rest[3 * i + k]);
+            hi[k] = fmax(hi[k], v->rest[3 * i + k]);
+        }
+    a->diag = v->nverts > 0
+                  ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                         (hi[2] - lo[2]) * (hi[2] - lo[2]))
+                  : 0;
     size_t n3 = (size_t)v->nverts * 3 * sizeof(double);
     a->xs = malloc(n3);
     a->xd = malloc(n3);
@@ -35,7 +45,10 @@ sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const doub
 void sw_eval_acc_add(sw_eval_acc *a, const sinew_instance *inst, const double *xf) {
     sw_instance_full_positions(inst, a->xs, a->cnt);
     sw_instance_dqs_positions(inst, a->xd);
+    double gap = sw_instance_copy_spread(inst, a->xs, a->cnt); /* cnt: scratch again */
+    if (gap > a->seam_max) a->seam_max = gap;
     for (int32_t i = 0; i < a->nverts; ++i) {
+        a->seam += a->mass[i] * a->cnt[i];
         double vn = 0, vd = 0;
         for (int k = 0; k < 3; ++k) {
             double e = a->xs[3 * i + k] - xf[3 * i + k], b = xf[3 * i + k] - a->xd[3 * i + k];
@@ -58,6 +71,8 @@ void sw_eval_acc_result(const sw_eval_acc *a, sw_eval_result *out) {
     out->correction_error = a->den > 0 ? sqrt(a->num / a->den) : 0;
     out->rel_l2 = a->l2d > 0 ? sqrt(a->l2n / a->l2d) : 0;
     out->frames = a->frames;
+    out->seam = a->den > 0 ? sqrt(a->seam / a->den) : 0;
+    out->seam_max = a->diag > 0 ? a->seam_max / a->diag : 0;
     for (int32_t b = 0; b < a->nbones && a->num > 0; ++b) { /* the largest shares, in order */
         if (!(a->bone_num[b] > 0)) continue;
         int k = out->nregions < SW_EVAL_REGIONS ? out->nregions++ : SW_EVAL_REGIONS;

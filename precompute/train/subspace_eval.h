@@ -26,6 +26,11 @@ typedef struct sw_eval_result {
     int32_t nregions;
     int32_t region_bone[SW_EVAL_REGIONS];
     double region_err[SW_EVAL_REGIONS], region_corr[SW_EVAL_REGIONS];
+    /* the seams the interface springs leave (sw_instance_copy_spread): the domains'
+       copies of a vertex apart from their mean, |x_copy - x_mean|_M over the correction
+       |x_full - x_dqs|_M (the correction error's denominator), and the largest
+       |x_copy - x_mean| of any frame over the rest bounding-box diagonal */
+    double seam, seam_max;
 } sw_eval_result;
 
 /* The sums behind the correction error, one frame at a time, for a caller that steps
@@ -35,6 +40,7 @@ typedef struct sw_eval_acc {
     const double *mass, *rest; /* nverts vertex masses, the blob's rest positions */
     int32_t nverts;
     double num, den, l2n, l2d;
+    double seam, seam_max, diag; /* sum of m |x_copy - x_mean|^2, largest gap, rest diagonal */
     int32_t frames;
     double *xs, *cnt, *xd;    /* scratch: subspace, copy counts, DQS (3 nverts each) */
     const int32_t *skin_bone; /* the blob's 4 influences a vertex, strongest first */

@@ -22,6 +22,13 @@ const double *sw_instance_q(const sinew_instance *inst);
  * Vertices in no domain get their skinned position. */
 void sw_instance_full_positions(const sinew_instance *inst, double *x, double *count);
 
+/* Evaluation only (O(N)): how far the domains' copies of a vertex stand apart, the seam
+ * the interface springs (thesis eq. 4.20) leave where the output takes one copy: with x
+ * from sw_instance_full_positions, spread[v] = sum over v's copies of |x_copy - x[v]|^2
+ * (nverts; 0 for a vertex with one copy or in a condensation patch). Returns the largest
+ * |x_copy - x[v]|. */
+double sw_instance_copy_spread(const sinew_instance *inst, const double *x, double *spread);
+
 /* Overwrites the reduced coordinates (rank_total doubles), e.g. to start a solve from a
  * known state. */
 void sw_instance_set_q(sinew_instance *inst, const double *q);

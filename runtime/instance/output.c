@@ -89,26 +89,37 @@ const double *sw_instance_q(const sinew_instance *inst) {
     return inst->solver.q;
 }
 
+/* Domain D's copy lv of its vertex (global gv) in world space, as the runtime's state
+ * places it: rest + U q skinned by the vertex's own DQS transform. */
+static void copy_position(const sinew_instance *inst, const sw_blob_domain *D, int32_t lv,
+                          int32_t gv, double x[3]) {
+    const sw_blob_view *v = inst->v;
+    int32_t r = D->rank;
+    double R[9], t[3], y[3];
+    sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
+    const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+    for (int i = 0; i < 3; ++i) {
+        double acc = v->rest[3 * gv + i];
+        for (int32_t j = 0; j < r; ++j)
+            acc += U[i * r + j] * inst->solver.q[D->q_offset + j];
+        y[i] = acc;
+    }
+    for (int i = 0; i < 3; ++i)
+        x[i] = R[3 * i] * y[0] + R[3 * i + 1] * y[1] + R[3 * i + 2] * y[2] + t[i];
+}
+
 void sw_instance_full_positions(const sinew_instance *inst, double *x, double *count) {
     const sw_blob_view *v = inst->v;
     memset(x, 0, 3 * (size_t)v->nverts * sizeof(double));
     memset(count, 0, (size_t)v->nverts * sizeof(double));
     for (int32_t k = 0; k < v->ndomains; ++k) {
         const sw_blob_domain *D = &v->domains[k];
-        int32_t r = D->rank;
         for (int32_t lv = 0; lv < D->vert_count; ++lv) {
             int32_t gv = v->domain_verts[D->vert_begin + lv];
-            double R[9], t[3], y[3];
-            sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
-            const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
-            for (int i = 0; i < 3; ++i) {
-                double acc = v->rest[3 * gv + i];
-                for (int32_t j = 0; j < r; ++j)
-                    acc += U[i * r + j] * inst->solver.q[D->q_offset + j];
-                y[i] = acc;
-            }
+            double y[3];
+            copy_position(inst, D, lv, gv, y);
             for (int i = 0; i < 3; ++i)
-                x[3 * gv + i] += R[3 * i] * y[0] + R[3 * i + 1] * y[1] + R[3 * i + 2] * y[2] + t[i];
+                x[3 * gv + i] += y[i];
             count[gv] += 1;
         }
     }
@@ -127,6 +138,26 @@ void sw_instance_full_positions(const sinew_instance *inst, double *x, double *c
                 x[3 * gv + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
         }
     }
+}
+
+double sw_instance_copy_spread(const sinew_instance *inst, const double *x, double *spread) {
+    const sw_blob_view *v = inst->v;
+    double gap = 0;
+    memset(spread, 0, (size_t)v->nverts * sizeof(double));
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        for (int32_t lv = 0; lv < D->vert_count; ++lv) {
+            int32_t gv = v->domain_verts[D->vert_begin + lv];
+            if (sw_cond_position(&inst->cond, gv)) continue; /* solved in full space */
+            double y[3], e = 0;
+            copy_position(inst, D, lv, gv, y);
+            for (int i = 0; i < 3; ++i)
+                e += (y[i] - x[3 * gv + i]) * (y[i] - x[3 * gv + i]);
+            spread[gv] += e;
+            if (sqrt(e) > gap) gap = sqrt(e);
+        }
+    }
+    return gap;
 }
 
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x) {
