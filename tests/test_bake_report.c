@@ -41,7 +41,12 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     }
     ENSURE(num(j, "sinew_bake_report") == SW_BAKE_REPORT_VERSION);
     ENSURE_NEAR(num(j, "err_heldout"), err_heldout, 1e-9);
-    /* the seams between the finger's domains: apart, by less than the correction */
+    /* the springs the bake chose, and the seams between the finger's domains: apart, by
+       less than the correction */
+    const cJSON *springs = cJSON_GetObjectItemCaseSensitive(j, "springs");
+    ENSURE_NEAR(num(springs, "k"), res->spring_k, 1e-9 * res->spring_k);
+    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(springs, "tried")) ==
+           res->nspring_tried);
     const cJSON *seams = cJSON_GetObjectItemCaseSensitive(j, "seams");
     ENSURE_NEAR(num(seams, "heldout"), eh->seam, 1e-12);
     ENSURE_NEAR(num(seams, "max_heldout"), eh->seam_max, 1e-12);

@@ -6,6 +6,8 @@
  *   source, character {name, tets, verts, bones, render_verts, render_tris, youngs,
  *                      poisson, density}
  *   err_train, err_heldout, proj_err_train, proj_err_heldout, cubature_fit, failed_steps
+ *   springs {k, eh, tried [[E h multiple, training error]]}: the interface springs'
+ *              stiffness and the choices the bake measured (bake_springs.c)
  *   seams {train, heldout, max_train, max_heldout}: the domains' copies of a vertex apart
  *              (sw_eval_result's seam, seam_max), or null
  *   bake_seconds, eval_seconds, stages [{name, seconds}]
@@ -206,6 +208,16 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
     cJSON_AddNumberToObject(j, "proj_err_heldout", res->heldout_proj_error);
     cJSON_AddNumberToObject(j, "cubature_fit", res->cubature_error_max);
+    cJSON *sp = cJSON_AddObjectToObject(j, "springs");
+    cJSON_AddNumberToObject(sp, "k", res->spring_k);
+    cJSON_AddNumberToObject(sp, "eh", res->spring_eh);
+    cJSON *tried = cJSON_AddArrayToObject(sp, "tried");
+    for (int32_t k = 0; k < res->nspring_tried; ++k) {
+        cJSON *pair = cJSON_CreateArray();
+        cJSON_AddItemToArray(pair, cJSON_CreateNumber(res->spring_tried_mult[k]));
+        cJSON_AddItemToArray(pair, json_number(res->spring_tried_err[k]));
+        cJSON_AddItemToArray(tried, pair);
+    }
     if (in->eval_train && in->eval_heldout) {
         cJSON *o = cJSON_AddObjectToObject(j, "seams");
         cJSON_AddItemToObject(o, "train", json_number(in->eval_train->seam));
@@ -347,6 +359,12 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
             "the physics correction the runtime misses; 0 exact, 1 no better than "
             "skinning)</td></tr>",
             in->err_train, in->err_heldout);
+    fprintf(f, "<tr><td>interface springs</td><td>k = %.4g (%.3g E h)", in->res->spring_k,
+            in->res->spring_eh > 0 ? in->res->spring_k / in->res->spring_eh : 0);
+    for (int32_t k = 0; k < in->res->nspring_tried; ++k)
+        fprintf(f, "%s%g E h: %.4f", k ? ", " : "; training error at ",
+                in->res->spring_tried_mult[k], in->res->spring_tried_err[k]);
+    fprintf(f, "</td></tr>");
     if (in->eval_train && in->eval_heldout)
         fprintf(f,
                 "<tr><td>seams between domains</td><td>training %.4f, held-out %.4f of the "

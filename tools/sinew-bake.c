@@ -66,7 +66,8 @@ static void usage(FILE *f) {
             "  --fold-share S   a bone whose tets hold less than S of the mesh's volume\n"
             "                   joins its parent's domain, 0..0.5 (default 0: off; 0.03\n"
             "                   folds the elephant's 24 bones into 11 domains)\n"
-            "  --spring-k K     interface spring stiffness, K > 0 (default 20 E h)\n"
+            "  --spring-k K     interface spring stiffness, K > 0 (default: of 20, 10, 5 and\n"
+            "                   2.5 E h the one with the lowest training error)\n"
             "  --pair-sweeps    also train on every joint swept together with its parent\n"
             "                   joint (combinations the single-joint sweeps never show)\n"
             "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
@@ -378,6 +379,11 @@ int main(int argc, char **argv) {
                res.train_unsettled, res.heldout_unsettled, bake_seconds, eval_seconds,
                res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+        printf(",\"spring_k\":%.6g,\"spring_tried\":[", res.spring_k);
+        for (int32_t k = 0; k < res.nspring_tried; ++k)
+            printf("%s[%.4g,%.5f]", k ? "," : "", res.spring_tried_mult[k],
+                   res.spring_tried_err[k]);
+        printf("]");
         printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
                "\"seam_max_heldout\":%.3e",
                et.seam, eh.seam, et.seam_max, eh.seam_max);

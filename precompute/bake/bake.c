@@ -11,6 +11,7 @@
 
 #include "bake_internal.h"
 #include "blob_load.h"
+#include "blob_write.h"
 #include "fem_corot.h"
 #include "weights_heat.h"
 
@@ -165,6 +166,7 @@ static void free_state(sw_bake_state *s) {
     free(s->dom_tet_ptr);
     free(s->dom_tets);
     free(s->copy_mass);
+    free(s->spring_unit);
     for (int32_t i = 0; i < s->ntrain_seq; ++i) {
         free(s->train[i].T);
         free(s->train[i].x);
@@ -373,24 +375,45 @@ double *sw_bake_heldout_path(const sw_bake_result *res, int32_t nbones, int32_t 
     return T;
 }
 
+sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *res,
+                                 sinew_self_contact sc, sw_eval_result *train, double *train_frames,
+                                 sw_error *err) {
+    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0, sc};
+    return sw_eval_correction_frames(blob, res->mass, res->train_T, res->train_x, res->ntrain, &o,
+                                     train_frames, train, err);
+}
+
 sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
                                    sinew_self_contact sc, sw_eval_result *train,
                                    sw_eval_result *heldout, double *train_frames,
                                    double *heldout_frames, sw_error *err) {
     memset(train, 0, sizeof *train);
     memset(heldout, 0, sizeof *heldout);
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0, sc};
-    sinew_result r = sw_eval_correction_frames(blob, res->mass, res->train_T, res->train_x,
-                                               res->ntrain, &o, train_frames, train, err);
+    sinew_result r = sw_bake_train_error(blob, res, sc, train, train_frames, err);
     if (r != SINEW_OK) return r;
     int32_t pre, n;
     double *T = sw_bake_heldout_path(res, sw_blob_get_view(blob)->nbones, &pre, &n);
     if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-    o.skip = pre;
+    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, pre, sc};
     r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, &o, heldout_frames,
                                   heldout, err);
     free(T);
     return r;
+}
+
+sinew_result sw_bake_result_blob(const sw_bake_result *res, void **mem, sinew_blob **blob,
+                                 sw_error *err) {
+    size_t size = 0;
+    *blob = NULL;
+    *mem = NULL;
+    sinew_result r = sw_blob_write_memory(&res->view, mem, &size, err);
+    if (r != SINEW_OK) return r;
+    sinew_blob_def d = sinew_blob_def_default();
+    d.data = *mem;
+    d.data_size = size;
+    if ((r = sinew_blob_load(&d, blob)) != SINEW_OK)
+        return sw_error_set(err, r, "the bake's blob does not load");
+    return SINEW_OK;
 }
 
 /* embed: the render mesh in the tets (embed.h), its figures into the report. */
@@ -494,15 +517,21 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
         (r = sw_bake_reduce(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_render(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_cond(&s, out, err)) != SINEW_OK ||
-        (r = sw_bake_pairs(&s, out, err)) != SINEW_OK)
+        (r = sw_bake_pairs(&s, out, err)) != SINEW_OK ||
+        (r = sw_bake_springs(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;
     {
-        char msg[96];
-        snprintf(msg, sizeof msg,
-                 "springs, mass, inertia, surface, %d pose-space contact pairs, the tet mesh",
-                 s.ncontacts);
+        char msg[256];
+        int at = snprintf(msg, sizeof msg, "springs k = %.4g", out->spring_k);
+        for (int32_t k = 0; k < out->nspring_tried; ++k) /* the choice: E h multiple: error */
+            at += snprintf(msg + at, sizeof msg - (size_t)at, "%s%g E h: %.4f",
+                           k ? ", " : " (training error at ", out->spring_tried_mult[k],
+                           out->spring_tried_err[k]);
+        snprintf(msg + at, sizeof msg - (size_t)at,
+                 "%s, mass, inertia, surface, %d pose-space contact pairs, the tet mesh",
+                 out->nspring_tried ? ")" : "", s.ncontacts);
         progress(&p, "reduce", t1 - t0, msg);
     }
     r = SINEW_OK;

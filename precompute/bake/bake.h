@@ -32,6 +32,11 @@
 #include "subspace_eval.h"
 #include "sw_mesh.h"
 
+/* The interface springs' stiffnesses a bake chooses from (sw_bake_params.spring_k 0):
+ * sw_bake_spring_mult(i) E h for i < SW_SPRING_CHOICES, stiffest first. */
+#define SW_SPRING_CHOICES 4
+double sw_bake_spring_mult(int i);
+
 typedef struct sw_bake_params {
     int32_t max_rank;              /* per domain (default 30) */
     double fold_share;             /* a bone whose tets hold less than this share of the
@@ -70,7 +75,9 @@ typedef struct sw_bake_params {
        (bake_cache.c). A re-bake that changes only the cubature, the rank or the report
        then takes seconds, not minutes. */
     const char *cache_dir;
-    double spring_k; /* interface springs per copy pair; 0: 20 E h (h the mean rest edge) */
+    double spring_k; /* interface springs per copy pair; 0 (default): the bake chooses among
+                        SW_SPRING_CHOICES multiples of E h (h the mean rest edge) the one the
+                        training poses prefer (bake_springs.c) */
     int threads;     /* 0: all cores */
     uint64_t seed;
     int progress; /* print stage progress to stderr */
@@ -119,6 +126,12 @@ typedef struct sw_bake_result {
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     double cubature_error_max; /* worst per-domain relative cubature training error */
+    /* the interface springs' stiffness in the blob, and the choices the bake measured
+       (sw_bake_params.spring_k 0): their E h multiples and training errors, stiffest
+       first (nspring_tried 0 when the caller gave the stiffness), and their unit E h */
+    double spring_k, spring_eh;
+    int32_t nspring_tried;
+    double spring_tried_mult[SW_SPRING_CHOICES], spring_tried_err[SW_SPRING_CHOICES];
     /* the render mesh's embedding (sw_character.render; all 0 without one): render
        vertices outside every tet, the largest distance of one from the tets, the largest
        |barycentric|, duplicates welded to another vertex, seconds (embed.h) */
@@ -188,6 +201,16 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *p, s
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
                             sinew_self_contact sc, sw_eval_result *train, sw_eval_result *heldout,
                             sw_error *err);
+
+/* The training half of sw_bake_errors_frames (train_frames: res->ntrain doubles or NULL). */
+sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *res,
+                                 sinew_self_contact sc, sw_eval_result *train, double *train_frames,
+                                 sw_error *err);
+
+/* The result's view written and loaded as a blob (its bytes in *mem, the caller's to
+ * free after sinew_blob_destroy). */
+sinew_result sw_bake_result_blob(const sw_bake_result *res, void **mem, sinew_blob **blob,
+                                 sw_error *err);
 
 /* The held-out poses on the path the reference solved them on (malloc'd, 12 nbones
  * each): the first *pre = res->heldout_after training poses, then the held-out ones,

@@ -9,7 +9,6 @@
 #include <unistd.h>
 
 #include "blob_load.h"
-#include "blob_write.h"
 #include "fem_corot.h"
 #include "instance.h"
 #include "sinew/sinew.h"
@@ -18,21 +17,6 @@
 sw_adaptive_params sw_adaptive_params_default(void) {
     sw_adaptive_params a = {4, 64, 8, 32, 0.0};
     return a;
-}
-
-/* A blob loaded from the bake's view (its bytes owned by *mem until the blob goes). */
-static sinew_result load_blob(const sw_bake_result *res, void **mem, sinew_blob **blob,
-                              sw_error *err) {
-    size_t size = 0;
-    *blob = NULL;
-    sinew_result r = sw_blob_write_memory(&res->view, mem, &size, err);
-    if (r != SINEW_OK) return r;
-    sinew_blob_def d = sinew_blob_def_default();
-    d.data = *mem;
-    d.data_size = size;
-    if ((r = sinew_blob_load(&d, blob)) != SINEW_OK)
-        return sw_error_set(err, r, "adaptive bake: the round's blob does not load");
-    return SINEW_OK;
 }
 
 /* What the proxy reads of a blob, and its scratch. */
@@ -266,7 +250,7 @@ sinew_result sw_bake_adaptive(const sw_character *c, const sw_bake_params *param
         p.nextra_poses = nextra;
         if ((r = sw_bake(c, &p, &res, err)) != SINEW_OK) break;
         rep->nrounds = round + 1;
-        if ((r = load_blob(&res, &mem, &blob, err)) == SINEW_OK &&
+        if ((r = sw_bake_result_blob(&res, &mem, &blob, err)) == SINEW_OK &&
             (r = measure(blob, &res, nextra, rd, err)) == SINEW_OK && prev && picked > 0)
             r = verify(prev, &res, picked, &rep->round[round - 1].picks_error, err);
         int last = round == a.rounds || nextra + a.add > a.budget ||

@@ -73,6 +73,10 @@ typedef struct sw_bake_state {
     int32_t *cub_n;
     int32_t **cub_local; /* index into the domain's dom_tets range */
     double **cub_w;
+    /* interface springs (bake_reduce.c): their Hessian at unit stiffness (rank_total^2)
+       and the stiffness of one vertex of the mesh, E h, the unit of the choice */
+    double *spring_unit;
+    double spring_eh;
     sw_pool *pool;
     sw_embedding embed; /* the render mesh in the tets (none: nverts 0) */
     /* progress of the running stage (sw_bake_progress) */
@@ -104,6 +108,10 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* The interface springs' stiffness (bake_springs.c), once the view is whole: the given
+ * sw_bake_params.spring_k, or the one of the sw_bake_spring_mult multiples of E h the training
+ * poses prefer. */
+sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* The render mesh's sections of the view from s->embed (nothing without a render mesh);
  * after sw_bake_reduce (bake_render.c). */
 sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);

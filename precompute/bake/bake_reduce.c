@@ -84,12 +84,11 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sw_blob_view *v = &out->view;
     int32_t R = s->rank_total, nd = s->nd, ncopies = s->dom_vert_ptr[nd];
-    /* per copy pair; the default scales with the stiffness of one vertex of the mesh,
-       E h: a fixed k locks the interface of a fine mesh (the domains' bases cannot
-       match there exactly) and measured best at 20 E h on the finger from 5K to 50K
-       tets (correction error 0.041 at 20K against 0.062 with k = 20 E) */
-    double kspring =
-        s->p->spring_k > 0 ? s->p->spring_k : 20.0 * s->ch.youngs * mean_edge(&s->ch.mesh);
+    /* per copy pair, in units of the stiffness of one vertex of the mesh, E h: a fixed k
+       locks the interface of a fine mesh (the domains' bases cannot match there exactly);
+       sw_bake_springs sets it when the caller does not (bake_springs.c) */
+    s->spring_eh = s->ch.youngs * mean_edge(&s->ch.mesh);
+    double kspring = s->p->spring_k > 0 ? s->p->spring_k : sw_bake_spring_mult(0) * s->spring_eh;
     sw_surface surf;
     memset(&surf, 0, sizeof surf);
     sinew_result r = sw_tetmesh_surface(&s->ch.mesh, &surf, err);
@@ -218,7 +217,13 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
                 copy_list[2 * at + 1] = k - s->dom_vert_ptr[d];
             }
     }
-    add_interface_springs(s, doms, copy_ptr_v, copy_list, kspring, spring);
+    if (!(s->spring_unit = calloc((size_t)R * R + 1, sizeof(double)))) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the springs");
+        goto done;
+    }
+    add_interface_springs(s, doms, copy_ptr_v, copy_list, 1.0, s->spring_unit);
+    for (int64_t i = 0; i < (int64_t)R * R; ++i)
+        spring[i] = kspring * s->spring_unit[i];
     /* output surface: the tet mesh's boundary; each vertex the mean of its copies */
     for (int32_t i = 0; i < s->nv; ++i)
         surf_index[i] = -1;

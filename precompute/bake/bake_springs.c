@@ -1,0 +1,70 @@
+/* The interface springs' stiffness (thesis eq. 4.20): k/2 |x_c - x_hub|^2 ties every copy
+ * of a vertex to its hub copy (bake_reduce.c). Too stiff, and the domains' bases, which
+ * cannot match exactly at an interface, lock each other: the reduced model holds only
+ * the motions both sides share there. Too soft, and the copies part (a seam the output
+ * shows) and the domains drift apart. Where between depends on the character: the
+ * training error is lowest at 10 E h on the hand, the fingers, the elephant and the
+ * robot, at 2.5-5 E h on the Fox (measured 2026-12-03, README section Game assets).
+ *
+ * So, unless the caller gives k, the bake measures the training error (the bake's own
+ * figure: pose-space self-contact, sw_bake_train_error) of the blob at each of
+ * SW_SPRING_CHOICES stiffnesses, stiffest first, and keeps the one with the lowest; a
+ * softer one must lower it by SW_SPRING_GAIN to be taken (the seams grow as k falls),
+ * and the search stops at the first one that does not lower it at all. The held-out
+ * poses are never looked at. The spring Hessian is linear in k: the choices scale the
+ * unit Hessian of bake_reduce.c, so a blob baked with sw_bake_params.spring_k = the chosen
+ * k is the very blob chosen. */
+#include <stdlib.h>
+#include <string.h>
+
+#include "bake_internal.h"
+
+double sw_bake_spring_mult(int i) {
+    static const double mult[SW_SPRING_CHOICES] = {20, 10, 5, 2.5};
+    return i >= 0 && i < SW_SPRING_CHOICES ? mult[i] : 0;
+}
+
+/* A softer stiffness is taken when its training error is below this share of the best
+ * so far. */
+#define SW_SPRING_GAIN 0.98
+
+static void set_springs(const sw_bake_state *s, sw_bake_result *out, double k) {
+    double *spring = (double *)out->view.spring_hessian; /* owned by out (bake_reduce.c) */
+    for (int64_t i = 0; i < (int64_t)s->rank_total * s->rank_total; ++i)
+        spring[i] = k * s->spring_unit[i];
+    out->spring_k = k;
+}
+
+sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    out->nspring_tried = 0;
+    out->spring_eh = s->spring_eh;
+    if (s->p->spring_k > 0) {
+        out->spring_k = s->p->spring_k;
+        return SINEW_OK;
+    }
+    int best = -1;
+    for (int c = 0; c < SW_SPRING_CHOICES; ++c) {
+        double mult = sw_bake_spring_mult(c);
+        set_springs(s, out, mult * s->spring_eh);
+        void *mem = NULL;
+        sinew_blob *blob = NULL;
+        sw_eval_result e;
+        sinew_result r = sw_bake_result_blob(out, &mem, &blob, err);
+        if (r == SINEW_OK)
+            r = sw_bake_train_error(blob, out, SINEW_SELF_CONTACT_POSE_SPACE, &e, NULL, err);
+        sinew_blob_destroy(blob);
+        free(mem);
+        if (r != SINEW_OK) return r;
+        out->spring_tried_mult[c] = mult;
+        /* a step that failed counts as no better than skinning */
+        out->spring_tried_err[c] = e.failed > 0 ? 1.0 : e.correction_error;
+        out->nspring_tried = c + 1;
+        double eb = best >= 0 ? out->spring_tried_err[best] : 0;
+        if (best < 0 || out->spring_tried_err[c] < SW_SPRING_GAIN * eb)
+            best = c;
+        else if (out->spring_tried_err[c] >= eb)
+            break; /* past the lowest */
+    }
+    set_springs(s, out, sw_bake_spring_mult(best) * s->spring_eh);
+    return SINEW_OK;
+}
