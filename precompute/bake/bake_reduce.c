@@ -30,8 +30,8 @@ static double mean_edge(const sw_tetmesh *m) {
     return m->ntets > 0 ? sum / (6.0 * m->ntets) : 0;
 }
 
-/* Interface springs (eq. 4.20) into the R x R spring Hessian: a vertex with copies in
- * several domains ties each to its hub, the copy in the domain whose bone is nearest the
+/* Interface springs (eq. 4.20) at unit stiffness into the R x R spring Hessian: a vertex with
+ * copies in several domains ties each to its hub, the copy in the domain whose bone is nearest the
  * skeleton's root (the lower domain on a tie), by k/2 |U_i q_i - U_j q_j|^2. Every pair
  * of copies tied instead (k(k-1)/2 springs, not k - 1) coupled sibling domains that
  * meet only at their parent's vertices, and the reduced Hessian's block graph then
@@ -42,7 +42,7 @@ static double mean_edge(const sw_tetmesh *m) {
  * 20K and 50K unchanged (no vertex of theirs has three copies). */
 static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *doms,
                                   const int32_t *copy_ptr_v, const int32_t *copy_list,
-                                  double kspring, double *spring) {
+                                  double *spring) {
     int32_t R = s->rank_total;
     for (int32_t gv = 0; gv < s->nv; ++gv) {
         int32_t hub = copy_ptr_v[gv], hub_depth = INT32_MAX;
@@ -61,7 +61,7 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
             int32_t oi = doms[di].q_offset, oj = doms[dj].q_offset;
             for (int c = 0; c < 3; ++c) {
                 for (int32_t x = 0; x < ri; ++x) {
-                    double ux = kspring * Ui[c * ri + x];
+                    double ux = Ui[c * ri + x];
                     if (ux == 0) continue;
                     for (int32_t y = 0; y < ri; ++y)
                         spring[(int64_t)(oi + x) * R + oi + y] += ux * Ui[c * ri + y];
@@ -71,7 +71,7 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
                     }
                 }
                 for (int32_t x = 0; x < rj; ++x) {
-                    double ux = kspring * Uj[c * rj + x];
+                    double ux = Uj[c * rj + x];
                     if (ux == 0) continue;
                     for (int32_t y = 0; y < rj; ++y)
                         spring[(int64_t)(oj + x) * R + oj + y] += ux * Uj[c * rj + y];
@@ -84,11 +84,10 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sw_blob_view *v = &out->view;
     int32_t R = s->rank_total, nd = s->nd, ncopies = s->dom_vert_ptr[nd];
-    /* per copy pair, in units of the stiffness of one vertex of the mesh, E h: a fixed k
-       locks the interface of a fine mesh (the domains' bases cannot match there exactly);
-       sw_bake_springs sets it when the caller does not (bake_springs.c) */
+    /* the interface springs at unit stiffness per copy pair, and the stiffness of one
+       vertex of the mesh, E h (a fixed k would lock the interface of a fine mesh, whose
+       domains' bases cannot match there exactly): sw_bake_springs scales them (bake_springs.c) */
     s->spring_eh = s->ch.youngs * mean_edge(&s->ch.mesh);
-    double kspring = s->p->spring_k > 0 ? s->p->spring_k : sw_bake_spring_mult(0) * s->spring_eh;
     sw_surface surf;
     memset(&surf, 0, sizeof surf);
     sinew_result r = sw_tetmesh_surface(&s->ch.mesh, &surf, err);
@@ -221,9 +220,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the springs");
         goto done;
     }
-    add_interface_springs(s, doms, copy_ptr_v, copy_list, 1.0, s->spring_unit);
-    for (int64_t i = 0; i < (int64_t)R * R; ++i)
-        spring[i] = kspring * s->spring_unit[i];
+    add_interface_springs(s, doms, copy_ptr_v, copy_list, s->spring_unit);
     /* output surface: the tet mesh's boundary; each vertex the mean of its copies */
     for (int32_t i = 0; i < s->nv; ++i)
         surf_index[i] = -1;

@@ -39,7 +39,7 @@ sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *er
     out->nspring_tried = 0;
     out->spring_eh = s->spring_eh;
     if (s->p->spring_k > 0) {
-        out->spring_k = s->p->spring_k;
+        set_springs(s, out, s->p->spring_k);
         return SINEW_OK;
     }
     int best = -1;
