@@ -1,8 +1,9 @@
 /* The interface springs' stiffness (thesis eq. 4.20): k/2 |x_c - x_hub|^2 ties every copy
  * of a vertex to its hub copy (bake_reduce.c). Too stiff, and the domains' bases, which
  * cannot match exactly at an interface, lock each other: the reduced model holds only
- * the motions both sides share there. Too soft, and the copies part (a seam the output
- * shows) and the domains drift apart. Where between depends on the character: the
+ * the motions both sides share there. Too soft, and the copies part (the output takes
+ * their mean, but each side of the seam follows its own domain: a crease) and the
+ * domains drift apart. Where between depends on the character: the
  * training error is lowest at 10 E h on the hand, the fingers, the elephant and the
  * robot, at 2.5-5 E h on the Fox (measured 2026-12-03, README section Game assets).
  *

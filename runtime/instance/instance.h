@@ -23,7 +23,8 @@ const double *sw_instance_q(const sinew_instance *inst);
 void sw_instance_full_positions(const sinew_instance *inst, double *x, double *count);
 
 /* Evaluation only (O(N)): how far the domains' copies of a vertex stand apart, the seam
- * the interface springs (thesis eq. 4.20) leave where the output takes one copy: with x
+ * the interface springs (thesis eq. 4.20) leave (the output takes the copies' mean, and
+ * the vertices beside an interface follow their own domain's copy): with x
  * from sw_instance_full_positions, spread[v] = sum over v's copies of |x_copy - x[v]|^2
  * (nverts; 0 for a vertex with one copy or in a condensation patch). Returns the largest
  * |x_copy - x[v]|. */
