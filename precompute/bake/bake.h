@@ -18,7 +18,10 @@
  *             inertia_modes, plus the static responses to the bones' accelerations
  *   cubature  per domain on the reduced elastic forces of snapshots and perturbed
  *             snapshots (eqs. 2.11-2.19)
- *   reduce    interface-spring Hessian (eq. 4.20), reduced mass, inertial projections
+ *   reduce    interface-spring Hessian (eq. 4.20) at unit stiffness, reduced mass,
+ *             inertial projections
+ *   springs   the springs' stiffness: the caller's, or of 20, 10, 5 and 2.5 E h the one
+ *             whose blob has the lowest training error (bake_springs.c)
  *   embed     with a render mesh (sw_character.render): its embedding in the tets, computed
  *             right after prepare (a mesh that does not fit fails before the long
  *             stages), written as the blob's render sections after reduce: the blob's
