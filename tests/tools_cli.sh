@@ -67,6 +67,10 @@ expect bake_tol_range 2 "--tol wants a number in the open range 0\.\.1, got '2'"
     "$bake" "${small[@]}" --tol 2 --out "$tmp/a.blob"
 expect bake_rank_range 2 "--max-rank wants an integer in 1\.\.1024, got '0'" \
     "$bake" "${small[@]}" --max-rank 0 --out "$tmp/a.blob"
+# an absurd spring stiffness: refused with the mesh's scale, nothing written
+expect bake_spring_absurd 1 "interface springs: stiffness 1e\+300 is [0-9.e+]+ E h .*above the 1e\+08 E h" \
+    "$bake" "${small[@]}" --frames 8 --spring-k 1e300 --out "$tmp/k.blob"
+[ -e "$tmp/k.blob" ] && { echo "FAIL bake_spring_absurd: wrote $tmp/k.blob" >&2; fails=$((fails + 1)); }
 expect bake_adaptive_range 2 "--adaptive wants an integer in 0\.\.32, got '40'" \
     "$bake" "${small[@]}" --adaptive 40 --out "$tmp/a.blob"
 expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'" \

@@ -254,7 +254,17 @@ int main(int argc, char **argv) {
         goto done;
     }
     double eval_seconds = sw_now_seconds() - t1;
-    int absurd = !(et.correction_error < SW_BAKE_MAX_TRAIN_ERROR);
+    /* a blob that cannot step its own training poses is no bake either (its error,
+       measured on the steps that did not fail, would say nothing) */
+    int absurd = !(et.correction_error < SW_BAKE_MAX_TRAIN_ERROR) || et.failed > 0;
+    if (absurd && !force && et.failed > 0) {
+        fprintf(stderr,
+                "%s: error: %d of the blob's steps through its own %d training poses failed (a "
+                "non-finite state: check the material and --spring-k); %s not written, or "
+                "--force to write it anyway\n",
+                tool, et.failed, res.ntrain, out_path);
+        goto done;
+    }
     if (absurd && !force) {
         fprintf(stderr,
                 "%s: error: the bake's training error is %.4f (at least %.2f: the subspace misses "
@@ -356,9 +366,9 @@ int main(int argc, char **argv) {
     }
     if (absurd)
         fprintf(stderr,
-                "%s: WARNING: written with --force although its training error %.4f is at least "
-                "%.2f: this blob misses most of the physics correction\n",
-                tool, et.correction_error, SW_BAKE_MAX_TRAIN_ERROR);
+                "%s: WARNING: written with --force although its training error is %.4f (refused "
+                "at %.2f) with %d failed steps: this blob misses most of the physics correction\n",
+                tool, et.correction_error, SW_BAKE_MAX_TRAIN_ERROR, et.failed);
     if (p.compare_selectors) {
         static const char *names[3] = {"greedy", "importance", "nnhtp"};
         for (int s = 0; s < 3; ++s)

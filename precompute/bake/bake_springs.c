@@ -15,6 +15,7 @@
  * poses are never looked at. The spring Hessian is linear in k: the choices scale the
  * unit Hessian of bake_reduce.c, so a blob baked with sw_bake_params.spring_k = the chosen
  * k is the very blob chosen. */
+#include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,28 +30,43 @@ double sw_bake_spring_mult(int i) {
  * so far. */
 #define SW_SPRING_GAIN 0.98
 
-static void set_springs(const sw_bake_state *s, sw_bake_result *out, double k) {
+/* A stiffness above this many E h swamps the flesh in Newton's matrix (its elastic part
+ * is lost to rounding next to the springs') and overflows the potential long before
+ * a double does; no choice comes near it. */
+#define SW_SPRING_MAX_EH 1e8
+
+/* The blob's springs at stiffness k; an error for an absurd sw_bake_params.spring_k
+ * (above SW_SPRING_MAX_EH E h, or springs that overflow). */
+static sinew_result set_springs(const sw_bake_state *s, sw_bake_result *out, double k,
+                                sw_error *err) {
     double *spring = (double *)out->view.spring_hessian; /* owned by out (bake_reduce.c) */
-    for (int64_t i = 0; i < (int64_t)s->rank_total * s->rank_total; ++i)
+    int finite = 1;
+    for (int64_t i = 0; i < (int64_t)s->rank_total * s->rank_total; ++i) {
         spring[i] = k * s->spring_unit[i];
+        finite &= isfinite(spring[i]) != 0;
+    }
     out->spring_k = k;
+    if (finite && !(k > SW_SPRING_MAX_EH * s->spring_eh)) return SINEW_OK;
+    return sw_error_set(
+        err, SINEW_ERROR_INVALID_ARGUMENT,
+        "interface springs: stiffness %g is %g E h (E h = %g for this mesh), above the %g E h "
+        "where they swamp the flesh (or overflow); without --spring-k the bake chooses among "
+        "2.5-20 E h",
+        k, s->spring_eh > 0 ? k / s->spring_eh : 0, s->spring_eh, SW_SPRING_MAX_EH);
 }
 
 sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     out->nspring_tried = 0;
     out->spring_eh = s->spring_eh;
-    if (s->p->spring_k > 0) {
-        set_springs(s, out, s->p->spring_k);
-        return SINEW_OK;
-    }
+    if (s->p->spring_k > 0) return set_springs(s, out, s->p->spring_k, err);
     int best = -1;
     for (int c = 0; c < SW_SPRING_CHOICES; ++c) {
         double mult = sw_bake_spring_mult(c);
-        set_springs(s, out, mult * s->spring_eh);
         void *mem = NULL;
         sinew_blob *blob = NULL;
         sw_eval_result e;
-        sinew_result r = sw_bake_result_blob(out, &mem, &blob, err);
+        sinew_result r = set_springs(s, out, mult * s->spring_eh, err);
+        if (r == SINEW_OK) r = sw_bake_result_blob(out, &mem, &blob, err);
         if (r == SINEW_OK)
             r = sw_bake_train_error(blob, out, SINEW_SELF_CONTACT_POSE_SPACE, &e, NULL, err);
         sinew_blob_destroy(blob);
@@ -66,6 +82,5 @@ sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *er
         else if (out->spring_tried_err[c] >= eb)
             break; /* past the lowest */
     }
-    set_springs(s, out, sw_bake_spring_mult(best) * s->spring_eh);
-    return SINEW_OK;
+    return set_springs(s, out, sw_bake_spring_mult(best) * s->spring_eh, err);
 }
