@@ -332,6 +332,33 @@ TEST(branches_follow_the_motion) {
     sinew_instance_destroy(inst);
 }
 
+/* Twins are poses within 1e-14 of each other (feature distance), which a hostile blob can
+ * chain without closing: 0 ~ 1 ~ 2 but 0 !~ 2. Every pose must still lie on exactly one
+ * cycle of twin_next, or the branch lookup walking from it never ends (a fuzzed blob did
+ * that). Three one-bone poses 1.5e-7 rad apart: neighbours at 5.6e-15, the ends 2.2e-14. */
+TEST(twins_form_cycles_on_any_poses) {
+    double pose[4 * 4];
+    int32_t next[4];
+    for (int k = 0; k < 4; ++k) {
+        double h = (k < 3 ? 1.5e-7 * k : 1.0) / 2; /* the last: far from every other */
+        double q[4] = {cos(h), sin(h), 0, 0};
+        memcpy(pose + 4 * k, q, sizeof q);
+    }
+    sw_blob_view v = {0};
+    v.nbones = 1;
+    v.ntrain = 4;
+    v.train_pose = pose;
+    sw_pose_space_link_twins(&v, next);
+    for (int32_t t = 0; t < 4; ++t) {
+        int32_t w = next[t], steps = 1;
+        while (w != t && steps <= 4)
+            w = next[w], steps++;
+        ENSUREF(w == t, "pose %d is not on a cycle of twin_next", t);
+    }
+    ENSURE(next[0] == 2 && next[2] == 1 && next[1] == 0); /* one cycle, stored order mostly */
+    ENSURE(next[3] == 3);
+}
+
 TEST(training_poses_are_reproduced) {
     const bake_fixture *f = fixture();
     ENSURE(f);
@@ -405,5 +432,6 @@ SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
              CASE(contact_tangential_share_fades_from_the_training_poses),
              CASE(chord_updates_end_at_a_newton_stationary_point),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
-             CASE(branches_follow_the_motion), CASE(training_poses_are_reproduced),
+             CASE(branches_follow_the_motion), CASE(twins_form_cycles_on_any_poses),
+             CASE(training_poses_are_reproduced),
              CASE(copy_spread_measures_the_seams), CASE(release_fixture))

@@ -85,13 +85,14 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
         }
         const double size =
             sqrt(c[0] * c[0] + c[1] * c[1] + c[2] * c[2] + c[3] * c[3] + c[4] * c[4] + c[5] * c[5]);
-        if (d0 > SW_PAIR_NOVEL * size) { /* no sample near: exhaustive detection instead */
+        /* no sample near: exhaustive detection instead. None comparable at all (a hostile
+           blob's feature basis can make every distance NaN): nothing to gather either. */
+        if (n0 < 0 || !(d0 <= SW_PAIR_NOVEL * size)) {
             ps->novel++;
-            if (ps->novel_mask) {
+            if (ps->novel_mask)
                 ps->novel_mask[v->pair_domains[2 * g] * v->ndomains + v->pair_domains[2 * g + 1]] =
                     1;
-                continue;
-            }
+            if (ps->novel_mask || n0 < 0) continue;
         }
         double blend = 0;
         if (n1 >= 0 && d0 >= 1e-3 * size && d1 <= 4 * d0) blend = d0 / (d0 + d1);

@@ -7,17 +7,27 @@
 
 /* twin_next: links the training poses stored more than once (one per branch of the
  * reference's path: on its return path a fold that buckled on the way in may stay
- * buckled on the way out) into cycles in stored order, once at creation. */
+ * buckled on the way out) into cycles in stored order, once at creation. Each pose joins
+ * the cycle of the first earlier pose u within 1e-14 of it, just before u (the cycle's
+ * end: u is its first on any honest blob, where twins are equal poses). "Within 1e-14"
+ * is not transitive on a hostile blob, and walking a chain that is not a cycle
+ * (sw_pose_space_branch, same_pose) would never end; built this way every pose is on
+ * exactly one cycle whatever the poses are. */
 void sw_pose_space_link_twins(const sw_blob_view *v, int32_t *twin_next) {
     size_t f = (size_t)4 * v->nbones;
     for (int32_t t = 0; t < v->ntrain; ++t) {
-        int32_t next = t;
-        for (int32_t k = 1; k < v->ntrain && next == t; ++k) { /* t+1, ..., wrapping round */
-            int32_t u = (t + k) % v->ntrain;
-            if (sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <= 1e-14)
-                next = u;
+        twin_next[t] = t;
+        for (int32_t u = 0; u < t; ++u) {
+            if (!(sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <=
+                  1e-14))
+                continue;
+            int32_t last = u; /* the cycle's last pose: the one before its first */
+            while (twin_next[last] != u)
+                last = twin_next[last];
+            twin_next[t] = u;
+            twin_next[last] = t;
+            break;
         }
-        twin_next[t] = next;
     }
 }
 
@@ -122,6 +132,7 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
             d1 = d, n1 = t;
         }
     }
+    if (n0 < 0) return; /* no distance comparable (NaN: only a hostile blob's poses) */
     /* the feature distance is sum (1 - cos^2(theta_b / 2)): its root is linear in the
        angles for small ones */
     double s0 = sqrt(fmax(d0, 0)), s1 = sqrt(fmax(d1, 0)); /* (rounding: d0 ~ -1e-17 at a sample) */
