@@ -433,5 +433,5 @@ SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
              CASE(chord_updates_end_at_a_newton_stationary_point),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
              CASE(branches_follow_the_motion), CASE(twins_form_cycles_on_any_poses),
-             CASE(training_poses_are_reproduced),
-             CASE(copy_spread_measures_the_seams), CASE(release_fixture))
+             CASE(training_poses_are_reproduced), CASE(copy_spread_measures_the_seams),
+             CASE(release_fixture))
