@@ -381,6 +381,12 @@ static inline void fix_checksum(uint8_t *blob, size_t size) {
     hdr(blob)->checksum = sw_blob_checksum(blob + 64, size - 64);
 }
 
+/* Cubature tet 3's second local index out of its domain (a forged case of
+ * test_blob_hostile.c, and the damaged blob test_blob.c's loader must log). */
+static inline void f_cub_index(uint8_t *b) {
+    ((int32_t *)section(b, SINEW_SECTION_CUB_TETS))[4 * 3 + 1] = 6;
+}
+
 /* The whole range [p, p + bytes) lies inside [base, base + size). */
 static inline int inside(const void *p, int64_t bytes, const uint8_t *base, size_t size) {
     const uint8_t *q = p;

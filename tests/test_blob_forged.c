@@ -1,12 +1,13 @@
 /* Forged blobs, field by field (issue 15): every count and index of the training and
  * contact sections (TRAIN_Q, TRAIN_POSE, CONTACT_PTR, CONTACT_VERTS, CONTACT_DATA and
- * META's ntrain and ncontacts), and the fields of the other sections that test_blob.c's
- * forged cases leave out (META's other counts and material, the domain records' ranges
- * and sums, the remaining negative indices). Each case changes one field of a valid
- * synthetic blob (blob_synth.h), or one count with the sections it sizes moved to the
- * end of the file and grown, fixes the checksum up, and checks that sw_blob_parse and
- * sinew_blob_load both refuse it with the expected code, that the message (and the
- * load's log line) names the section and the element, and that the view is untouched. */
+ * META's ntrain and ncontacts), and the fields of the other sections that
+ * test_blob_hostile.c's forged cases leave out (META's other counts and material, the
+ * domain records' ranges and sums, the remaining negative indices). Each case changes one
+ * field of a valid synthetic blob (blob_synth.h), or one count with the sections it sizes
+ * moved to the end of the file and grown, fixes the checksum up, and checks that
+ * sw_blob_parse and sinew_blob_load both refuse it with the expected code, that the
+ * message (and the load's log line) names the section and the element, and that the view
+ * is untouched. */
 #include <stddef.h>
 #include <stdint.h>
 #include <stdio.h>
@@ -202,7 +203,7 @@ static const forge_case k_cases[] = {
     F64("contact area NaN", CONTACT_DATA, 13, NAN, NOT_FINITE, "CONTACT_DATA", "element 13"),
     F64("contact area 0", CONTACT_DATA, 6, 0.0, CORRUPT, "CONTACT_DATA", "contact 0 has area"),
     F64("contact area < 0", CONTACT_DATA, 13, -0.5, CORRUPT, "CONTACT_DATA", "contact 1 has area"),
-    /* DOMAINS: the fields and sums test_blob.c does not forge */
+    /* DOMAINS: the fields and sums test_blob_hostile.c does not forge */
     FN("domains rank sum < rank_total", f_rank_more, CORRUPT, "DOMAINS", "ranks sum to 9"),
     FN("rank runs past rank_total", f_rank_less, CORRUPT, "DOMAINS", "rank 4 runs past"),
     FN("domains cubature sum < ncub", f_ncub_more, CORRUPT, "DOMAINS", "own 8 cubature tets"),
