@@ -355,7 +355,8 @@ TEST(twins_form_cycles_on_any_poses) {
             w = next[w], steps++;
         ENSUREF(w == t, "pose %d is not on a cycle of twin_next", t);
     }
-    ENSURE(next[0] == 2 && next[2] == 1 && next[1] == 0); /* one cycle, stored order mostly */
+    /* one cycle: 1 joins 0 (0 -> 1 -> 0), then 2 (not within 1e-14 of 0) joins 1, before it */
+    ENSURE(next[0] == 2 && next[2] == 1 && next[1] == 0);
     ENSURE(next[3] == 3);
 }
 
