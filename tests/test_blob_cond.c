@@ -37,8 +37,9 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     ENSURE(capsule_fixture());
     const sw_blob_view *v = sw_blob_get_view(fx.blob);
     const sw_tetmesh *m = &fx.ch.mesh;
-    ENSURE(hdr(fx.data)->section_count ==
-           SINEW_SECTION_COUNT_V1 + NCOND + (v->npair_groups > 0 ? NPAIR : 0));
+    ENSURE(hdr(fx.data)->section_count == SINEW_SECTION_COUNT_V1 + NCOND +
+                                              (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
+                                              (v->train_force ? 1u : 0u));
     ENSURE(v->ntets == m->ntets && v->nvert_tets == 4 * m->ntets && v->nverts == m->nverts);
     ENSURE(v->ndomains >= 2); /* tets in more than one domain, vertices with several copies */
     ENSURE(memcmp(v->tets, m->tets, 4 * sizeof(int32_t) * (size_t)m->ntets) == 0);
@@ -135,6 +136,7 @@ TEST(a_view_without_the_tet_mesh_writes_the_blob_of_before) {
 #define CLEAR(id, NAME, elem_size, type, field, ...) plain.field = NULL;
     SINEW_BLOB_COND_ARRAY_SECTIONS(CLEAR)
     SINEW_BLOB_PAIR_ARRAY_SECTIONS(CLEAR)
+    SINEW_BLOB_FORCE_SECTIONS(CLEAR)
 #undef CLEAR
     size_t size = 0;
     void *data = NULL;
@@ -321,9 +323,10 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     free(b);
 }
 
-/* The same character with per-pair sections as well (all 50): written, parsed back the
- * same, and the fuzz seed tests/fuzz/corpus/blob_fixed/synth_pairs.blob is these bytes
- * (SINEW_WRITE_SEEDS=1 rewrites it), so the blob fuzzers start from the pair sections. */
+/* The same character with per-pair sections and equilibrium forces as well (all 51):
+ * written, parsed back the same, and the fuzz seed
+ * tests/fuzz/corpus/blob_fixed/synth_pairs.blob is these bytes (SINEW_WRITE_SEEDS=1
+ * rewrites it), so the blob fuzzers start from every optional section. */
 TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     static fixture f;
     static render_fixture r;
@@ -333,6 +336,12 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     fixture_add_render(&f, &r);
     fixture_add_cond(&f, &c);
     fixture_add_pairs(&f, &p);
+    static double force[4096];
+    const int64_t nforce = (int64_t)f.v.ntrain * f.v.rank_total;
+    ENSURE(nforce <= 4096);
+    for (int64_t i = 0; i < nforce; ++i)
+        force[i] = 0.01 * (double)(i % 7) - 0.03;
+    f.v.train_force = force;
     size_t size = 0;
     sw_blob_view v;
     uint8_t *b = write_parsed(&f, &size, &v);
@@ -357,6 +366,15 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     forged = copy_exact(b, size);
     ((sinew_blob_pair_meta *)section(forged, SINEW_SECTION_PAIR_META))->npair_groups = 10;
     ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "PAIR_", NULL));
+    free(forged);
+    /* an equilibrium force that is not finite, or of another count than META's */
+    forged = copy_exact(b, size);
+    ((double *)section(forged, SINEW_SECTION_TRAIN_FORCE))[nforce - 1] = INFINITY;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_NOT_FINITE, "TRAIN_FORCE", NULL));
+    free(forged);
+    forged = copy_exact(b, size);
+    entry(forged, SINEW_SECTION_TRAIN_FORCE)->count -= 1;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "TRAIN_FORCE", "ntrain rank_total"));
     free(forged);
     ENSURE(seed_is("synth_pairs.blob", b, size));
     free(b);

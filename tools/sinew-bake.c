@@ -50,6 +50,7 @@ static void usage(FILE *f) {
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]]\n"
                "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
+               "                  [--no-pose-force]\n"
                "                  [--eval-self-contact pose-space|pose-pairs]\n"
                "                  [--cache DIR] [--threads T] [--force]\n"
                "                  [--json]\n"
@@ -80,6 +81,10 @@ static void usage(FILE *f) {
             "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
             "                   cut to a cubature that keeps their reduced force to T,\n"
             "                   0 <= T < 1 (default 0.05; 0: every pair kept)\n"
+            "  --no-pose-force  no pose-space equilibrium force in the blob (by default each\n"
+            "                   training pose carries the reduced force that makes its\n"
+            "                   projected solution the runtime's equilibrium there,\n"
+            "                   interpolated between poses)\n"
             "  --eval-self-contact M  the runtime's self-contact mode the bake's errors are\n"
             "                   measured in: pose-space (default) or pose-pairs\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
@@ -174,6 +179,8 @@ int main(int argc, char **argv) {
             p.inertia_modes = 1;
         else if (!strcmp(a, "--contact-modes"))
             p.contact_modes = 1;
+        else if (!strcmp(a, "--no-pose-force"))
+            p.pose_force = 0;
         else if (!strcmp(a, "--contact-tol") && next)
             ok = sw_tool_real(tool, a, argv[++i], -1e-300, 1, "in 0 <= T < 1",
                               &p.contact_cubature_tol);
@@ -256,7 +263,11 @@ int main(int argc, char **argv) {
     double eval_seconds = sw_now_seconds() - t1;
     /* a blob that cannot step its own training poses is no bake either (its error,
        measured on the steps that did not fail, would say nothing) */
-    int absurd = !(et.correction_error < SW_BAKE_MAX_TRAIN_ERROR) || et.failed > 0;
+    /* the reduced model's own training error: the equilibrium force makes the training
+       poses' errors their projections' whatever the model (bake_equilibrium.c) */
+    const double model_err =
+        res.model_train_error >= 0 ? res.model_train_error : et.correction_error;
+    int absurd = !(model_err < SW_BAKE_MAX_TRAIN_ERROR) || et.failed > 0;
     if (absurd && !force && et.failed > 0) {
         fprintf(stderr,
                 "%s: error: %d of the blob's steps through its own %d training poses failed (a "
@@ -268,10 +279,11 @@ int main(int argc, char **argv) {
     if (absurd && !force) {
         fprintf(stderr,
                 "%s: error: the bake's training error is %.4f (at least %.2f: the subspace misses "
-                "that share of the physics correction on its own training poses; a sound bake "
-                "misses a few percent); %s not written. Give a clip with more frames or joint "
-                "motion or a higher --max-rank, or --force to write it anyway\n",
-                tool, et.correction_error, SW_BAKE_MAX_TRAIN_ERROR, out_path);
+                "that share of the physics correction on its own training poses without the "
+                "equilibrium force; a sound bake misses a few percent); %s not written. Give a "
+                "clip with more frames or joint motion or a higher --max-rank, or --force to "
+                "write it anyway\n",
+                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
         goto done;
     }
     if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
@@ -349,6 +361,11 @@ int main(int argc, char **argv) {
             "  correction error (subspace vs full, share of the correction missed, on the bake's "
             "poses): train %.4f, held-out %.4f (%d failed steps)\n",
             et.correction_error, eh.correction_error, et.failed + eh.failed);
+    if (res.model_train_error >= 0)
+        fprintf(stderr,
+                "  equilibrium force at %d of %d training poses; the training error without it "
+                "%.4f\n",
+                res.force_poses, res.ntrain, res.model_train_error);
     fprintf(stderr,
             "  seams (the domains' copies of a vertex apart, share of the correction; largest "
             "gap over the rest diagonal): train %.4f, %.2e; held-out %.4f, %.2e\n",
@@ -368,7 +385,7 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "%s: WARNING: written with --force although its training error is %.4f (refused "
                 "at %.2f) with %d failed steps: this blob misses most of the physics correction\n",
-                tool, et.correction_error, SW_BAKE_MAX_TRAIN_ERROR, et.failed);
+                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, et.failed);
     if (p.compare_selectors) {
         static const char *names[3] = {"greedy", "importance", "nnhtp"};
         for (int s = 0; s < 3; ++s)
@@ -389,6 +406,7 @@ int main(int argc, char **argv) {
                res.train_unsettled, res.heldout_unsettled, bake_seconds, eval_seconds,
                res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f", res.force_poses, model_err);
         printf(",\"spring_k\":%.6g,\"spring_tried\":[", res.spring_k);
         for (int32_t k = 0; k < res.nspring_tried; ++k)
             printf("%s[%.4g,%.5f]", k ? "," : "", res.spring_tried_mult[k],

@@ -28,6 +28,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.pair_sweeps = 0;
     p.max_train_frames = 40;
     p.return_path = 0;
+    p.pose_force = 1;
     p.inertia_modes = 0;
     p.contact_cubature_tol = 0.05;
     p.heldout_fraction = 0.4;
@@ -518,20 +519,22 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
         (r = sw_bake_render(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_cond(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_pairs(&s, out, err)) != SINEW_OK ||
-        (r = sw_bake_springs(&s, out, err)) != SINEW_OK)
+        (r = sw_bake_springs(&s, out, err)) != SINEW_OK ||
+        (r = sw_bake_equilibrium(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();
     out->stage_seconds[5] = t1 - t0;
     {
-        char msg[256];
+        char msg[320];
         int at = snprintf(msg, sizeof msg, "springs k = %.4g", out->spring_k);
         for (int32_t k = 0; k < out->nspring_tried; ++k) /* the choice: E h multiple: error */
             at += snprintf(msg + at, sizeof msg - (size_t)at, "%s%g E h: %.4f",
                            k ? ", " : " (training error at ", out->spring_tried_mult[k],
                            out->spring_tried_err[k]);
         snprintf(msg + at, sizeof msg - (size_t)at,
-                 "%s, mass, inertia, surface, %d pose-space contact pairs, the tet mesh",
-                 out->nspring_tried ? ")" : "", s.ncontacts);
+                 "%s, mass, inertia, surface, %d pose-space contact pairs, the tet mesh, "
+                 "equilibrium forces at %d of %d training poses",
+                 out->nspring_tried ? ")" : "", s.ncontacts, out->force_poses, out->ntrain);
         progress(&p, "reduce", t1 - t0, msg);
     }
     r = SINEW_OK;

@@ -57,6 +57,9 @@ typedef struct sw_bake_params {
     int return_path;               /* also train on those frames played back from the last one
                                       (default 0; measured: finger held-out error 0.235 -> 0.164 at
                                       20K tets, unchanged at 50K where the rank grows 41 -> 63) */
+    int pose_force;                /* the pose-space equilibrium force (bake_equilibrium.c:
+                                      the training poses' projected solutions made the
+                                      runtime's equilibria there; default 1) */
     int contact_modes;             /* self-contact force modes (thesis §3.3.1): the static
                                       responses to the training poses' contact forces join
                                       the basis (bake_basis.c; default 0) */
@@ -134,6 +137,12 @@ typedef struct sw_bake_result {
        first (nspring_tried 0 when the caller gave the stiffness), and their unit E h */
     double spring_k, spring_eh;
     int32_t nspring_tried;
+    int32_t force_poses; /* training poses the blob holds an equilibrium force for */
+    /* the training error of the blob without its equilibrium force (the reduced model's
+       own; -1 when the blob has none, and its training error is that): what the force
+       hides on the training poses, and what the bake's sanity limit reads
+       (SW_BAKE_MAX_TRAIN_ERROR) */
+    double model_train_error;
     double spring_tried_mult[SW_SPRING_CHOICES], spring_tried_err[SW_SPRING_CHOICES];
     /* the render mesh's embedding (sw_character.render; all 0 without one): render
        vertices outside every tet, the largest distance of one from the tets, the largest

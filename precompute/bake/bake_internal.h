@@ -112,6 +112,9 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
  * sw_bake_params.spring_k, or the one of the sw_bake_spring_mult multiples of E h the training
  * poses prefer. */
 sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* The pose-space equilibrium force of every training pose (bake_equilibrium.c), once the
+ * view is whole and its springs chosen (sw_bake_params.pose_force; 0: none). */
+sinew_result sw_bake_equilibrium(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* The render mesh's sections of the view from s->embed (nothing without a render mesh);
  * after sw_bake_reduce (bake_render.c). */
 sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);

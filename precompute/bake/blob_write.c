@@ -1,5 +1,6 @@
 /* Blob layout: header (64 bytes), section table (26 entries, 8 more with a render mesh, 10
- * more with the condensation tet mesh, 6 more with per-pair self-contact), then the sections in id
+ * more with the condensation tet mesh, 6 more with per-pair self-contact, 1 more with the
+ * pose-space equilibrium force), then the sections in id
  * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
  * everything after the header. A view without the optional groups writes exactly the 26 sections it
  * always did, byte for byte. */
@@ -37,7 +38,7 @@ typedef struct group_metas {
 
 /* The sections of a validated view, in id order, into s; returns their number (26, plus 8
  * with a render mesh, plus 10 with the condensation tet mesh, plus 6 with per-pair
- * self-contact). `meta` and `g` must outlive
+ * self-contact, plus 1 with the equilibrium force). `meta` and `g` must outlive
  * the result. */
 static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
                          section_src s[SINEW_SECTION_ID_MAX]) {
@@ -66,6 +67,11 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
                                     SINEW_BLOB_PAIR_ARRAY_SECTIONS(SOURCE)};
         memcpy(s + n, pair, sizeof pair);
         n += (int)(sizeof pair / sizeof pair[0]);
+    }
+    if (v->train_force) {
+        const section_src force[] = {SINEW_BLOB_FORCE_SECTIONS(SOURCE)};
+        memcpy(s + n, force, sizeof force);
+        n += (int)(sizeof force / sizeof force[0]);
     }
     return n;
 }

@@ -1,4 +1,5 @@
-/* What the blob loader's files share (blob_load.c, blob_render.c, blob_cond.c): the message
+/* What the blob loader's files share (blob_load.c, blob_render.c, blob_cond.c, blob_pair.c,
+ * blob_force.c): the message
  * writer, the layer-1 reading of an optional group of sections (its meta section, presence
  * all or none, counts), the value checks, and the checks of a "vertex = mean of its domain
  * copies" list, which the tet boundary (SURF_COPY_PTR / SURF_COPIES) and the render nodes
@@ -121,5 +122,13 @@ sinew_result sw_blob_pair_fill(const uint8_t *bytes, const sinew_blob_section *s
  * CONTACT_PTR and every contact's domains, finite maps and features, weights >= 0 (nothing
  * when npair_groups is 0); after the contacts have been checked. */
 sinew_result sw_blob_pair_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 1 of the pose-space equilibrium force (blob_force.c): TRAIN_FORCE absent, or of
+ * META's ntrain rank_total doubles; points v->train_force at it (NULL when absent). */
+sinew_result sw_blob_force_fill(const uint8_t *bytes, const sinew_blob_section *s,
+                                const int found[], sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 2: every force finite (nothing when train_force is NULL). */
+sinew_result sw_blob_force_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
 #endif

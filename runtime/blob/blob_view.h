@@ -174,6 +174,11 @@ typedef struct sw_blob_view {
     const double *pair_feature;
     const int32_t *pair_ptr;
     const double *pair_weight;
+
+    /* the optional pose-space equilibrium force (NULL: none): per training pose t, the
+     * reduced force train_force[R t ..] that makes train_q[R t ..] the quasistatic step's
+     * equilibrium at pose t (pose_space.h, sw_pose_space_force) */
+    const double *train_force;
 } sw_blob_view;
 
 /* The output surface a host reads (sinew_instance_read_surface): the render mesh when the

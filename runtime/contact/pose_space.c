@@ -184,3 +184,18 @@ int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v) {
     }
     return a + b;
 }
+
+double sw_pose_space_force(const sw_pose_space *ps, int32_t R, const double *q, double *g) {
+    if (!ps->force || ps->nearest < 0) return 0;
+    const double w0 = (1 - ps->blend) * ps->tangent[0];
+    const double w1 = ps->blend > 0 ? ps->blend * ps->tangent[1] : 0;
+    const double *b0 = ps->force + (size_t)R * ps->nearest;
+    const double *b1 = w1 > 0 ? ps->force + (size_t)R * ps->second : b0;
+    double phi = 0;
+    for (int32_t i = 0; i < R; ++i) {
+        const double b = w0 * b0[i] + w1 * b1[i];
+        phi += b * q[i];
+        if (g) g[i] += b;
+    }
+    return phi;
+}

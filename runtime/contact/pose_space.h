@@ -47,6 +47,9 @@ typedef struct sw_pose_space {
     /* per pairs[] entry: 1 when a condensation patch evaluates the pair with its full-space
        positions instead (condense.h); NULL: none does */
     const unsigned char *in_patch;
+    /* the blob's pose-space equilibrium forces (sw_blob_view.train_force) when the step
+       applies them (sw_pose_space_force), else NULL */
+    const double *force;
 } sw_pose_space;
 
 /* Links the training poses stored more than once into cycles (twin_next, ntrain). */
@@ -75,6 +78,16 @@ void sw_pose_space_add_pair(sw_pose_space *ps, int32_t c, double w, double tan);
 /* The share of the tangential term the pairs of a training sample carry at feature
  * distance s from it, reach its distance to its nearest other sample (pose_space.c). */
 double sw_pose_space_tangent_share(double s, double reach);
+
+/* The pose-space equilibrium force's potential b . q, b = sum over the two nearest poses k
+ * of (pose-space weight) (locality share, `tangent`) b_k, whose gradient b it adds to g
+ * (R; NULL: none). The reduced model's own equilibrium at a training pose misses the
+ * reference's (the Galerkin minimum is not the projection); b_t, stored by the bake,
+ * is the force that closes that gap at pose t, and between poses it is interpolated as
+ * the thesis interpolates its per-pose contact cubatures (§3.2.3, after Pose Space
+ * Deformation [83]); it fades with the share as a pose leaves its samples. 0 without
+ * ps->force or a nearest pose. O(R). */
+double sw_pose_space_force(const sw_pose_space *ps, int32_t R, const double *q, double *g);
 
 /* The default pair budget: the pairs of the two training poses that hold the most. */
 int32_t sw_pose_space_default_max_pairs(const sw_blob_view *v);

@@ -456,6 +456,9 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
     in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
     in->self_mode = d.self_contact;
+    /* the bake's equilibrium forces hold for the contact it computed them with: the whole
+       pose's pairs (bake_equilibrium.c) */
+    in->ps.force = d.self_contact == SINEW_SELF_CONTACT_POSE_SPACE ? v->train_force : NULL;
     if (z.detect) {
         sw_error e;
         if (sw_self_contacts_build(&in->sc, v, &e) != SINEW_OK) {

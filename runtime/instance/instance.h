@@ -17,6 +17,10 @@ const double *sw_instance_surface(const sinew_instance *inst);
 /* Reduced coordinates (rank_total) of the last step. */
 const double *sw_instance_q(const sinew_instance *inst);
 
+/* The training pose the last step (or sw_instance_step_prepare) took as the nearest to
+ * its pose (-1: none). */
+int32_t sw_instance_nearest_pose(const sinew_instance *inst);
+
 /* Evaluation only (O(N), not part of the step): every simulation vertex's position,
  * the mean of its domain copies, into x (3 nverts); count is caller scratch (nverts).
  * Vertices in no domain get their skinned position. */

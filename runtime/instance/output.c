@@ -89,6 +89,10 @@ const double *sw_instance_q(const sinew_instance *inst) {
     return inst->solver.q;
 }
 
+int32_t sw_instance_nearest_pose(const sinew_instance *inst) {
+    return inst->ps.nearest;
+}
+
 /* Domain D's copy lv of its vertex (global gv) in world space, as the runtime's state
  * places it: rest + U q skinned by the vertex's own DQS transform. */
 static void copy_position(const sinew_instance *inst, const sw_blob_domain *D, int32_t lv,

@@ -101,6 +101,7 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
         if (ct->self_seconds) *ct->self_seconds += sw_now_seconds() - t0;
     }
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
+    phi += sw_pose_space_force(ct->ps, R, q, want_grad ? red->g : NULL);
     block_matvec(v, s, BLOCKS_SPRINGS, v->spring_hessian, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);
     if (want_grad)

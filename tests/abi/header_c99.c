@@ -72,11 +72,12 @@ SINEW_BLOB_SECTIONS(SW_ABI_ELEM_SIZE)
 /* The optional groups: the render mesh's and the condensation tet mesh's ids, in order. */
 SW_ABI_ASSERT(SINEW_SECTION_RENDER_FIRST == 27 && SINEW_SECTION_RENDER_LAST == 34, render_ids);
 SW_ABI_ASSERT(SINEW_SECTION_COND_FIRST == 35 && SINEW_SECTION_COND_LAST == 44, cond_ids);
-SW_ABI_ASSERT(SINEW_SECTION_PAIR_FIRST == 45 && SINEW_SECTION_PAIR_LAST == 50 &&
-                  SINEW_SECTION_ID_MAX == SINEW_SECTION_PAIR_LAST,
-              pair_ids);
+SW_ABI_ASSERT(SINEW_SECTION_PAIR_FIRST == 45 && SINEW_SECTION_PAIR_LAST == 50, pair_ids);
+SW_ABI_ASSERT(SINEW_SECTION_TRAIN_FORCE == 51 && SINEW_SECTION_ID_MAX == SINEW_SECTION_TRAIN_FORCE,
+              force_id);
 SINEW_BLOB_RENDER_SECTIONS(SW_ABI_ELEM_SIZE)
 SINEW_BLOB_COND_SECTIONS(SW_ABI_ELEM_SIZE)
+SINEW_BLOB_FORCE_SECTIONS(SW_ABI_ELEM_SIZE)
 
 /* Every public function, with the exact signature a host binary was built against. */
 typedef uint32_t (*sw_abi_version_fn)(void);

@@ -33,8 +33,9 @@ static_assert(SINEW_SECTION_META == 1 && SINEW_SECTION_COUNT_V1 == 26, "stable s
 SINEW_BLOB_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 SINEW_BLOB_RENDER_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 SINEW_BLOB_COND_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
+SINEW_BLOB_FORCE_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 static_assert(SINEW_SECTION_COND_FIRST == 35 && SINEW_SECTION_PAIR_FIRST == 45 &&
-                  SINEW_SECTION_ID_MAX == 50,
+                  SINEW_SECTION_TRAIN_FORCE == 51 && SINEW_SECTION_ID_MAX == 51,
               "optional section ids");
 static_assert(std::is_same<decltype(SINEW_VERSION), uint32_t>::value, "version is u32");
 

@@ -78,6 +78,14 @@
  *                 ptr[t G] = CONTACT_PTR[t], ptr[ntrain G] = ncontacts (a pose's contacts
  *                 sorted by group)
  *   PAIR_WEIGHT   per contact, its cubature weight >= 0 (eqs. 3.9-3.13; 0: left out)
+ *
+ * Optional section (SINEW_BLOB_FORCE_SECTIONS, id 51): the pose-space equilibrium force.
+ * A blob without it is byte for byte what it was before it existed; a runtime that
+ * predates it skips it (and steps as such a blob steps). Count from META:
+ *   TRAIN_FORCE   per training pose t, the reduced force b_t (rank_total doubles, finite)
+ *                 that makes TRAIN_Q's solution of t the quasistatic step's equilibrium at
+ *                 pose t: minus the gradient of the step's potential there, with t's
+ *                 pose-space self-contact ([t][rank_total])
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -212,6 +220,10 @@ typedef struct sinew_blob_section {
       "npair_groups ntrain + 1")                                                                   \
     X(50, PAIR_WEIGHT,   8, double,  pair_weight,  1, ncontacts,         "ncontacts")
 
+/* The optional pose-space equilibrium force (id 51): one section, its count from META. */
+#define SINEW_BLOB_FORCE_SECTIONS(X)                                                               \
+    X(51, TRAIN_FORCE,   8, double,  train_force,  1, ntrain * rank_total, "ntrain rank_total")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
@@ -219,7 +231,8 @@ typedef struct sinew_blob_section {
 /** Section ids; SINEW_SECTION_COUNT_V1 (26) is the number of sections every version-1 blob
  * has; SINEW_SECTION_RENDER_FIRST .. _RENDER_LAST are the optional render mesh's,
  * SINEW_SECTION_COND_FIRST .. _COND_LAST the optional condensation tet mesh's,
- * SINEW_SECTION_PAIR_FIRST .. _PAIR_LAST the optional per-pair self-contact's;
+ * SINEW_SECTION_PAIR_FIRST .. _PAIR_LAST the optional per-pair self-contact's,
+ * SINEW_SECTION_TRAIN_FORCE the optional pose-space equilibrium force;
  * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
@@ -236,7 +249,8 @@ enum sinew_blob_section_id {
     SINEW_SECTION_PAIR_FIRST = SINEW_SECTION_PAIR_META,
     SINEW_SECTION_PAIR_LAST =
         SINEW_SECTION_COND_LAST SINEW_BLOB_PAIR_SECTIONS(SINEW_BLOB_PLUS_ONE_),
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_PAIR_LAST
+    SINEW_BLOB_FORCE_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_TRAIN_FORCE
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
