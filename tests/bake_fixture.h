@@ -37,16 +37,21 @@ static inline int bake_fixture_make_params(bake_fixture *f, const char *sample, 
     return sinew_blob_load(&d, &f->blob) == SINEW_OK;
 }
 
-/* bake_fixture_make_params with the fixture's quick parameters (3 samples a joint sweep,
- * 8 clip frames) on `threads` bake threads, with the clip's return path when return_path
- * is set. */
-static inline int bake_fixture_make_threads(bake_fixture *f, const char *sample, int tets,
-                                            int frames, int return_path, int threads) {
+/* The fixture's quick bake parameters: 3 samples a joint sweep, 8 clip frames, `threads`
+ * bake threads, the clip's return path when return_path is set. */
+static inline sw_bake_params bake_fixture_params(int return_path, int threads) {
     sw_bake_params p = sw_bake_params_default();
     p.sweep_samples = 3;
     p.max_train_frames = 8;
     p.threads = threads;
     p.return_path = return_path;
+    return p;
+}
+
+/* bake_fixture_make_params with bake_fixture_params(return_path, threads). */
+static inline int bake_fixture_make_threads(bake_fixture *f, const char *sample, int tets,
+                                            int frames, int return_path, int threads) {
+    sw_bake_params p = bake_fixture_params(return_path, threads);
     return bake_fixture_make_params(f, sample, tets, frames, &p);
 }
 

@@ -10,11 +10,7 @@
 
 /* Bakes the fixture's finger with spring stiffness k (0: chosen) into f. */
 static int bake_with(bake_fixture *f, double k) {
-    sw_bake_params p = sw_bake_params_default();
-    p.sweep_samples = 3;
-    p.max_train_frames = 8;
-    p.threads = 2;
-    p.return_path = 1; /* a fold deep enough for contact pairs */
+    sw_bake_params p = bake_fixture_params(1, 2); /* return path: a fold with contact pairs */
     p.spring_k = k;
     return bake_fixture_make_params(f, "finger", 3000, 12, &p);
 }

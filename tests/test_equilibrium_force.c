@@ -25,11 +25,7 @@ static double dist(const double *a, const double *b, int32_t n) {
 }
 
 static int bake(bake_fixture *f, int pose_force) {
-    sw_bake_params p = sw_bake_params_default();
-    p.sweep_samples = 3;
-    p.max_train_frames = 8;
-    p.threads = 2;
-    p.return_path = 1; /* a fold deep enough for contact pairs */
+    sw_bake_params p = bake_fixture_params(1, 2); /* return path: a fold with contact pairs */
     p.pose_force = pose_force;
     return bake_fixture_make_params(f, "finger", 2000, 12, &p);
 }
