@@ -208,6 +208,11 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
     cJSON_AddNumberToObject(j, "proj_err_heldout", res->heldout_proj_error);
     cJSON_AddNumberToObject(j, "cubature_fit", res->cubature_error_max);
+    cJSON *eq = cJSON_AddObjectToObject(j, "equilibrium_force");
+    cJSON_AddNumberToObject(eq, "poses", res->force_poses);
+    cJSON_AddItemToObject(eq, "err_train_without",
+                          res->model_train_error >= 0 ? json_number(res->model_train_error)
+                                                      : cJSON_CreateNull());
     cJSON *sp = cJSON_AddObjectToObject(j, "springs");
     cJSON_AddNumberToObject(sp, "k", res->spring_k);
     cJSON_AddNumberToObject(sp, "eh", res->spring_eh);
@@ -359,6 +364,12 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
             "the physics correction the runtime misses; 0 exact, 1 no better than "
             "skinning)</td></tr>",
             in->err_train, in->err_heldout);
+    if (in->res->model_train_error >= 0)
+        fprintf(f,
+                "<tr><td>equilibrium force</td><td>at %d of %d training poses (each pose's "
+                "projected solution made the runtime's equilibrium there); training error "
+                "without it %.4f</td></tr>",
+                in->res->force_poses, in->res->ntrain, in->res->model_train_error);
     fprintf(f, "<tr><td>interface springs</td><td>k = %.4g (%.3g E h)", in->res->spring_k,
             in->res->spring_eh > 0 ? in->res->spring_k / in->res->spring_eh : 0);
     for (int32_t k = 0; k < in->res->nspring_tried; ++k)
