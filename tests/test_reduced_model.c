@@ -7,6 +7,7 @@
 #include <math.h>
 
 #include "bake_fixture.h"
+#include "blob_pose_index.h"
 #include "dqs.h"
 #include "instance.h"
 #include "instance_internal.h"
@@ -348,7 +349,7 @@ TEST(twins_form_cycles_on_any_poses) {
     v.nbones = 1;
     v.ntrain = 4;
     v.train_pose = pose;
-    sw_pose_space_link_twins(&v, next);
+    sw_pose_index_link_twins(&v, next);
     for (int32_t t = 0; t < 4; ++t) {
         int32_t w = next[t], steps = 1;
         while (w != t && steps <= 4)

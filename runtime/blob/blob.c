@@ -97,13 +97,16 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
         return r;
     }
 
-    sinew_blob *blob = sw_alloc(&d.allocator, sizeof *blob, SW_ALLOC_ALIGN);
+    /* the struct, then the pose index its instances share (blob_pose_index.h) */
+    const size_t head = (sizeof(sinew_blob) + 7) / 8 * 8, bytes = head + sw_pose_index_bytes(&view);
+    sinew_blob *blob = sw_alloc(&d.allocator, bytes, SW_ALLOC_ALIGN);
     if (!blob) {
         if (map) munmap(map, size);
         sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_OUT_OF_MEMORY,
-               "sinew_blob_load: out of memory (%zu bytes)", sizeof *blob);
+               "sinew_blob_load: out of memory (%zu bytes)", bytes);
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
+    sw_pose_index_build(&view, (char *)blob + head, &blob->poses);
     blob->view = view;
     blob->data = data;
     blob->size = size;

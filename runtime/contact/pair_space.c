@@ -9,6 +9,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "blob_pose_index.h"
 #include "dqs.h"
 #include "pose_space.h"
 
@@ -24,30 +25,6 @@ void sw_pair_space_feature(const sw_blob_view *v, int32_t g, const double *T, do
             acc += M[12 * k + j] * z[j];
         c[k] = acc;
     }
-}
-
-static double dist6(const double *a, const double *b) {
-    double d = 0;
-    for (int k = 0; k < 6; ++k)
-        d += (a[k] - b[k]) * (a[k] - b[k]);
-    return sqrt(d);
-}
-
-/* Samples closer than this share a feature (poses that differ only elsewhere). */
-#define SW_PAIR_SAME 1e-12
-
-void sw_pair_space_reach(const sw_blob_view *v, double *reach) {
-    const int32_t T = v->ntrain;
-    for (int32_t g = 0; g < v->npair_groups; ++g)
-        for (int32_t t = 0; t < T; ++t) {
-            const double *ft = v->pair_feature + 6 * ((int64_t)g * T + t);
-            double best = INFINITY;
-            for (int32_t u = 0; u < T; ++u) {
-                double d = dist6(ft, v->pair_feature + 6 * ((int64_t)g * T + u));
-                if (d > SW_PAIR_SAME && d < best) best = d;
-            }
-            reach[(int64_t)g * T + t] = best;
-        }
 }
 
 /* Appends the pairs of weight > 0 of training pose t in group g, each at w times its
@@ -75,7 +52,7 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
         sw_pair_space_feature(v, g, T, c);
         const double *F = v->pair_feature + 6 * (int64_t)g * nt;
         for (int32_t t = 0; t < nt; ++t) {
-            double d = dist6(c, F + 6 * (int64_t)t);
+            double d = sw_pair_feature_distance(c, F + 6 * (int64_t)t);
             if (d < d0) {
                 if (!(d0 - d <= SW_PAIR_SAME)) d1 = d0, n1 = n0; /* not the same sample again */
                 d0 = d, n0 = t;

@@ -5,44 +5,6 @@
 
 #include "dqs.h"
 
-/* twin_next: links the training poses stored more than once (one per branch of the
- * reference's path: on its return path a fold that buckled on the way in may stay
- * buckled on the way out) into cycles in stored order, once at creation. Each pose joins
- * the cycle of the first earlier pose u within 1e-14 of it, just before u (the cycle's
- * end: u is its first on any honest blob, where twins are equal poses). "Within 1e-14"
- * is not transitive on a hostile blob, and walking a chain that is not a cycle
- * (sw_pose_space_branch, same_pose) would never end; built this way every pose is on
- * exactly one cycle whatever the poses are. */
-void sw_pose_space_link_twins(const sw_blob_view *v, int32_t *twin_next) {
-    size_t f = (size_t)4 * v->nbones;
-    for (int32_t t = 0; t < v->ntrain; ++t) {
-        twin_next[t] = t;
-        for (int32_t u = 0; u < t; ++u) {
-            if (!(sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones) <=
-                  1e-14))
-                continue;
-            int32_t last = u; /* the cycle's last pose: the one before its first */
-            while (twin_next[last] != u)
-                last = twin_next[last];
-            twin_next[t] = u;
-            twin_next[last] = t;
-            break;
-        }
-    }
-}
-
-void sw_pose_space_reach(const sw_blob_view *v, double *reach) {
-    size_t f = (size_t)4 * v->nbones;
-    for (int32_t t = 0; t < v->ntrain; ++t) {
-        double best = INFINITY;
-        for (int32_t u = 0; u < v->ntrain; ++u) {
-            double d = sw_pose_distance(v->train_pose + f * t, v->train_pose + f * u, v->nbones);
-            if (d > 1e-14 && d < best) best = d; /* (twins: link_twins' threshold) */
-        }
-        reach[t] = sqrt(best);
-    }
-}
-
 /* The tangential share of a training pose's pairs at feature distance s (its root) from
  * it: the pairs' contact points and normals are the reference's at that pose, frozen
  * where it detected them (selfcontact.h). Along the normal they stay a sound law at other

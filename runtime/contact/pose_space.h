@@ -13,14 +13,13 @@ typedef struct sw_pose_space {
     double *feature;      /* 4 nbones: the current pose's feature */
     double *feature_last; /* 4 nbones: the pose feature of the last lookup */
     double *motion;       /* 4 nbones: the last change of pose between two lookups */
-    int32_t *twin_next;   /* ntrain: the next training pose storing the same pose (a
-                             cycle over its branches; itself when it has one) */
-    double *reach;        /* ntrain: each training pose's feature distance (its root) to the
-                             nearest other pose (INFINITY when there is none) */
-    int looked_up;        /* feature_last holds a pose */
-    int32_t nearest;      /* training pose nearest to the current pose, or -1 */
-    int32_t second;       /* the second nearest, or -1 */
-    double blend;         /* pose-space weight of `second` (0: `nearest` alone) */
+    /* the blob's pose index (blob_pose_index.h): twins and each pose's reach */
+    const int32_t *twin_next;
+    const double *reach;
+    int looked_up;   /* feature_last holds a pose */
+    int32_t nearest; /* training pose nearest to the current pose, or -1 */
+    int32_t second;  /* the second nearest, or -1 */
+    double blend;    /* pose-space weight of `second` (0: `nearest` alone) */
     /* the share of the contact law's tangential term (SW_CONTACT_ALPHA) that the pairs of
        `nearest` [0] and of `second` [1] carry: 1 at their own training pose, falling
        linearly to 0 at the distance of its nearest other pose (sw_pose_space_lookup) */
@@ -35,10 +34,9 @@ typedef struct sw_pose_space {
     int32_t max_pairs; /* the budget: at most this many pairs a step */
     int32_t npairs;
     int32_t dropped; /* pairs the budget left out this step */
-    /* per-pair mode (the blob's pair groups, pair_space.c): per group and training pose,
-       the feature distance to the group's nearest other distinct sample (INFINITY: none);
-       NULL in whole-pose mode */
-    double *pair_reach;
+    /* per-pair mode (the blob's pair groups, pair_space.c): the pose index's per-group
+       reach (blob_pose_index.h); NULL in whole-pose mode */
+    const double *pair_reach;
     int32_t novel; /* groups whose nearest sample was farther than SW_PAIR_NOVEL this step */
     /* ndomains^2: 1 for the pairs of domains (a, b) novel this step, whose contact the
        exhaustive detection finds instead (NULL: no fallback, the nearest sample's pairs
@@ -51,13 +49,6 @@ typedef struct sw_pose_space {
        applies them (sw_pose_space_force), else NULL */
     const double *force;
 } sw_pose_space;
-
-/* Links the training poses stored more than once into cycles (twin_next, ntrain). */
-void sw_pose_space_link_twins(const sw_blob_view *v, int32_t *twin_next);
-
-/* Fills reach (ntrain) for the training poses of v (a pose's twins do not count).
- * O(ntrain^2 nbones), once at creation. */
-void sw_pose_space_reach(const sw_blob_view *v, double *reach);
 
 /* Forgets the pose history: no motion, no nearest pose. */
 void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);
@@ -103,9 +94,6 @@ int32_t sw_pose_space_branch(const sw_pose_space *ps, const sw_blob_view *v, int
 /* Group g's feature of the bone transforms T (12 per bone): pair_map times the relative
  * transform [vec(R); t] of its second domain's bone in its first's frame. */
 void sw_pair_space_feature(const sw_blob_view *v, int32_t g, const double *T, double c[6]);
-
-/* Fills pair_reach (npair_groups ntrain). O(npair_groups ntrain^2), once at creation. */
-void sw_pair_space_reach(const sw_blob_view *v, double *pair_reach);
 
 /* Per-pair mode: every group's two nearest samples by its own feature of the pose T (a
  * domain against itself: the whole pose's, after sw_pose_space_lookup), blended by

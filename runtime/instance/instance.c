@@ -21,7 +21,7 @@ typedef struct {
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
     sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
     double rho;         /* its radius, in units of the rest diagonal */
-    int per_pair;       /* SINEW_SELF_CONTACT_POSE_PAIRS: the groups' reach */
+    int per_pair;       /* SINEW_SELF_CONTACT_POSE_PAIRS: the groups' samples */
     /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
        mode's fallback on novel contact when the blob has the tet mesh */
     int detect;
@@ -63,14 +63,10 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(ps->feature, 4 * nb);
     TAKE(ps->feature_last, 4 * nb);
     TAKE(ps->motion, 4 * nb);
-    TAKE(ps->twin_next, (uint64_t)v->ntrain);
-    TAKE(ps->reach, (uint64_t)v->ntrain);
     TAKE(ps->pairs, (uint64_t)z->max_pairs);
     TAKE(ps->pair_w, (uint64_t)z->max_pairs);
     TAKE(ps->pair_tan, (uint64_t)z->max_pairs);
-    ps->pair_reach = NULL;
     ps->novel_mask = NULL;
-    if (z->per_pair) TAKE(ps->pair_reach, (uint64_t)v->npair_groups * (uint64_t)v->ntrain);
     if (z->per_pair && z->detect) TAKE(ps->novel_mask, nd * nd);
     if (z->detect) sw_self_contacts_take(p, v, &in->sc);
     /* the solver */
@@ -449,9 +445,9 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sw_world_contacts_build(&in->wc, v);
     /* 2% of the character's size: what a surface vertex can travel in one step */
     in->wc.radius = 0.01 * in->size;
-    sw_pose_space_link_twins(v, in->ps.twin_next);
-    sw_pose_space_reach(v, in->ps.reach);
-    if (z.per_pair) sw_pair_space_reach(v, in->ps.pair_reach);
+    in->ps.twin_next = blob->poses.twin_next; /* the blob's, computed once at its load */
+    in->ps.reach = blob->poses.reach;
+    in->ps.pair_reach = z.per_pair ? blob->poses.pair_reach : NULL;
     in->cond.z = z.cond;
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);
     in->red.cub_w = z.cond.max_verts > 0 ? in->cond.cub_w : v->cub_weight;
