@@ -1,7 +1,8 @@
 /* Self-contact's building blocks: BVH point, box and closest-triangle queries against
- * brute force (with refits), the closest point on a triangle, the BVH's argument checks,
- * and the penalty's forces, Hessian and energy against finite differences. Detection on
- * structured blocks is in test_selfcontact.c; the random numbers in selfcontact_fixture.h. */
+ * brute force (with refits), the build against a full-sort reference, the closest point on a
+ * triangle, the BVH's argument checks, and the penalty's forces, Hessian and energy against finite
+ * differences. Detection on structured blocks is in test_selfcontact.c; the random numbers in
+ * selfcontact_fixture.h. */
 #include <stdint.h>
 
 #include "bvh.h"
@@ -96,6 +97,70 @@ TEST(bvh_point_and_box_queries_match_brute_force) {
     ENSURE(sw_bvh_query_point(&t, c0, stop_visit, NULL) == 1);
     sw_bvh_free(&t);
     sw_bvh_free(&t); /* zeroed: no-op */
+}
+
+/* The tree a median split by a full sort at every level builds (the build's definition):
+ * prims[lo, hi) sorted along the longest extent of their centroids, ties by id, halved. */
+typedef struct {
+    double c;
+    int32_t id;
+} ref_key;
+static int ref_cmp(const void *pa, const void *pb) {
+    const ref_key *a = pa, *b = pb;
+    return a->c < b->c ? -1 : a->c > b->c ? 1 : (a->id > b->id) - (a->id < b->id);
+}
+static int32_t ref_build(const double *boxes, int32_t *prims, int32_t *node, int32_t *next,
+                         int32_t lo, int32_t hi) {
+    int32_t at = (*next)++;
+    if (hi - lo <= SW_BVH_LEAF_SIZE) {
+        node[2 * at] = lo, node[2 * at + 1] = hi - lo;
+        return at;
+    }
+    double mn[3] = {INFINITY, INFINITY, INFINITY}, mx[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = lo; i < hi; ++i)
+        for (int k = 0; k < 3; ++k) {
+            double c = 0.5 * (boxes[6 * prims[i] + k] + boxes[6 * prims[i] + 3 + k]);
+            mn[k] = fmin(mn[k], c), mx[k] = fmax(mx[k], c);
+        }
+    int axis = 0;
+    for (int k = 1; k < 3; ++k)
+        if (mx[k] - mn[k] > mx[axis] - mn[axis]) axis = k;
+    ref_key *key = malloc(sizeof *key * (size_t)(hi - lo));
+    for (int32_t i = lo; i < hi; ++i)
+        key[i - lo] = (ref_key){0.5 * (boxes[6 * prims[i] + axis] + boxes[6 * prims[i] + 3 + axis]),
+                                prims[i]};
+    qsort(key, (size_t)(hi - lo), sizeof *key, ref_cmp);
+    for (int32_t i = lo; i < hi; ++i)
+        prims[i] = key[i - lo].id;
+    free(key);
+    int32_t mid = lo + (hi - lo) / 2;
+    ref_build(boxes, prims, node, next, lo, mid);
+    node[2 * at] = ref_build(boxes, prims, node, next, mid, hi), node[2 * at + 1] = 0;
+    return at;
+}
+
+/* The build selects each median instead of sorting (bvh.c): the same tree, node for node
+ * and leaf order for leaf order, on spread boxes and on boxes whose centroids tie. */
+TEST(bvh_build_is_the_full_sort_median_split) {
+    enum { N = 1500 };
+    static double boxes[6 * N];
+    static int32_t prims[N], node[4 * N];
+    for (int pass = 0; pass < 2; ++pass) {
+        random_boxes(N, boxes, 0.05);
+        if (pass == 1) /* centroids on a coarse grid: many ties, broken by id */
+            for (int32_t i = 0; i < 6 * N; ++i)
+                boxes[i] = round(4 * boxes[i]) / 4;
+        sw_bvh t;
+        ENSURE(sw_bvh_build(N, boxes, &t, NULL) == SINEW_OK);
+        int32_t next = 0;
+        for (int32_t i = 0; i < N; ++i)
+            prims[i] = i;
+        ref_build(boxes, prims, node, &next, 0, N);
+        ENSURE(t.nnodes == next);
+        ENSURE(memcmp(t.prims, prims, sizeof(int32_t) * N) == 0);
+        ENSURE(memcmp(t.node, node, sizeof(int32_t) * 2 * (size_t)next) == 0);
+        sw_bvh_free(&t);
+    }
 }
 
 TEST(bvh_closest_triangle_matches_brute_force) {
@@ -314,6 +379,7 @@ TEST(penalty_derivatives_match_finite_differences) {
 }
 
 SW_TEST_MAIN(CASE(bvh_point_and_box_queries_match_brute_force),
+             CASE(bvh_build_is_the_full_sort_median_split),
              CASE(bvh_closest_triangle_matches_brute_force),
              CASE(closest_point_triangle_is_the_minimum), CASE(bvh_rejects_bad_boxes),
              CASE(penalty_derivatives_match_finite_differences))
