@@ -5,10 +5,12 @@
  * of every bone that skins flesh, none for a bone that skins nothing, every mesh piece
  * anchored, the render mesh kept, the held-out clip as the character's clip). */
 #include <math.h>
+#include <unistd.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
+#include "embed.h"
 #include "mesh_io.h"
 #include "rig.h"
 #include "scene_character.h"
@@ -142,17 +144,25 @@ static int every_piece_anchored(const sw_character *c) {
     return ok;
 }
 
-TEST(fox_character) {
-    NEED_DATA("gltf-fox/Fox.glb");
+/* The Fox at 2,000 tets by `mesher`, Survey and Walk training, Run held out (a failure
+ * is counted and *rc says it). */
+static void fox(sw_mesher mesher, sw_character *c, sw_clip_split *clips,
+                sw_scene_character_info *info, sinew_result *rc_out) {
     char path[1024];
     snprintf(path, sizeof path, "%s/gltf-fox/Fox.glb", SINEW_SHARED_DATA_DIR);
-    sw_scene_character_options o = {2000, 0, 0, "Survey,Walk", "Run"};
+    sw_scene_character_options o = {2000, 0, 0, "Survey,Walk", "Run", mesher};
+    sw_error e;
+    *rc_out = sw_character_from_scene(path, &o, c, clips, info, &e);
+    ENSUREF(*rc_out == SINEW_OK, "%s", e.msg);
+}
+
+TEST(fox_character) {
+    NEED_DATA("gltf-fox/Fox.glb");
     sw_character c;
     sw_clip_split clips;
     sw_scene_character_info info;
-    sw_error e;
-    sinew_result rc = sw_character_from_scene(path, &o, &c, &clips, &info, &e);
-    ENSUREF(rc == SINEW_OK, "%s", e.msg);
+    sinew_result rc;
+    fox(SW_MESHER_LATTICE, &c, &clips, &info, &rc);
     if (rc) return;
     ENSURE(c.mesh.ntets > 1000 && c.mesh.ntets < 3000);
     ENSURE(c.skel.nbones == 24 && c.weights.nverts == c.mesh.nverts && c.weights.nbones == 24);
@@ -190,10 +200,45 @@ TEST(fox_character) {
     sw_character_free(&c);
 }
 
+/* TetGen fills the Fox's closed render surface (issue 14, item 2): the tet mesh holds
+ * exactly the volume the surface encloses and its boundary is that surface, so every render
+ * vertex embeds inside a tet (none outside, no barycentric beyond [0, 1]); the robot's
+ * render mesh (19 open primitives) is refused, naming the file and the open edges. */
+TEST(tetgen_fills_the_fox_and_refuses_the_robot) {
+    NEED_DATA("gltf-fox/Fox.glb");
+    sw_character c;
+    sw_scene_character_info info;
+    sw_error e;
+    sinew_result rc;
+    fox(SW_MESHER_TETGEN, &c, NULL, &info, &rc);
+    if (rc) return;
+    double vs = fabs(sw_trimesh_signed_volume(&c.render)), vt = sw_tetmesh_volume(&c.mesh);
+    fprintf(stderr, "    Fox by tetgen: %d tets (floor of its sharp features), %d run(s), %.2f s\n",
+            c.mesh.ntets, info.tetgen.runs, info.tetgen.seconds);
+    ENSURE(info.mesher == SW_MESHER_TETGEN && info.tetgen.welded_verts == 290);
+    /* (TetGen writes its points with 16 significant digits) */
+    ENSUREF(fabs(vt - vs) < 1e-6 * vs, "tets %.17g against the surface's %.17g", vt, vs);
+    sw_embedding emb;
+    ENSUREF(sw_embed_render(&c.mesh, &c.render, &emb, &e) == SINEW_OK, "%s", e.msg);
+    ENSUREF(emb.outside == 0 && emb.max_bary <= 1 + 1e-6, "%d outside, |b| %g", emb.outside,
+            emb.max_bary);
+    sw_embedding_free(&emb);
+    sw_character_free(&c);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/gltf-robot-quaternius/robot.glb", SINEW_SHARED_DATA_DIR);
+    if (access(path, R_OK) != 0) return;
+    sw_scene_character_options o = {2000, 0, 0, NULL, NULL, SW_MESHER_TETGEN};
+    ENSURE(sw_character_from_scene(path, &o, &c, NULL, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "robot.glb") && strstr(e.msg, "not closed"), "%s", e.msg);
+    o.mesher = (sw_mesher)7;
+    ENSURE(sw_character_from_scene(path, &o, &c, NULL, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "unknown mesher"), "%s", e.msg);
+}
+
 TEST(bad_inputs_name_the_file) {
     sw_character c;
     sw_error e;
-    sw_scene_character_options o = {50, 0, 0, NULL, NULL};
+    sw_scene_character_options o = {50, 0, 0, NULL, NULL, SW_MESHER_LATTICE};
     ENSURE(sw_character_from_scene("x.glb", &o, &c, NULL, NULL, &e) ==
            SINEW_ERROR_INVALID_ARGUMENT);
     ENSUREF(strstr(e.msg, "x.glb") && strstr(e.msg, "100..5000000"), "%s", e.msg);
@@ -202,7 +247,7 @@ TEST(bad_inputs_name_the_file) {
     NEED_DATA("gltf-fox/Fox.glb");
     char path[1024];
     snprintf(path, sizeof path, "%s/gltf-fox/Fox.glb", SINEW_SHARED_DATA_DIR);
-    sw_scene_character_options bad = {2000, 0, 0, "Survey", "Gallop"};
+    sw_scene_character_options bad = {2000, 0, 0, "Survey", "Gallop", SW_MESHER_LATTICE};
     ENSURE(sw_character_from_scene(path, &bad, &c, NULL, NULL, &e) == SINEW_ERROR_INVALID_ARGUMENT);
     ENSUREF(strstr(e.msg, "Fox.glb") && strstr(e.msg, "'Gallop'") &&
                 strstr(e.msg, "Survey, Walk, Run"),
@@ -212,4 +257,4 @@ TEST(bad_inputs_name_the_file) {
 SW_TEST_MAIN(CASE(split_default_takes_the_longest), CASE(split_honours_names_and_is_disjoint),
              CASE(split_rejects_bad_names), CASE(material_scales_with_size),
              CASE(weights_follow_the_render_surface), CASE(fox_character),
-             CASE(bad_inputs_name_the_file))
+             CASE(tetgen_fills_the_fox_and_refuses_the_robot), CASE(bad_inputs_name_the_file))

@@ -249,10 +249,17 @@ if [ -f "$fox" ]; then
     want=('"vertices": 1728, "triangles": 576, "joints": 24' 'Survey *3\.417 s *103 frames')
     expect_stdout inspect_fox "$inspect" "$fox" --json
     # --tets: the lattice fills the fox's render surface with about 5,000 positive tets
-    want=('"sim_tets": ([4-6][0-9]{3}|7[0-4][0-9]{2}),' '"sim_inverted": 0}'
+    want=('"sim_tets": ([4-6][0-9]{3}|7[0-4][0-9]{2}),' '"sim_inverted": 0, "sim_mesher": "lattice"'
         '0 inverted, 0 degenerate')
     expect_stdout inspect_fox_tets "$inspect" "$fox" --tets 5000 --json
+    # --mesher tetgen: the Debian program fills the closed surface (its sharp features
+    # set a floor near 12,000 tets) to the surface's own volume
+    want=('"sim_tets": 1[0-9]{4},' '"sim_volume": 66487\.[0-9]*, "surface_volume": 66487\.'
+        '"sim_mesher": "tetgen"' 'by tetgen')
+    expect_stdout inspect_fox_tetgen "$inspect" "$fox" --tets 5000 --mesher tetgen --json
 fi
+expect inspect_mesher_name 2 "--mesher takes lattice or tetgen, not 'gmsh'" \
+    "$inspect" x.glb --mesher gmsh
 
 # a glTF/FBX FILE (issue 14): its format, the options that do not apply to it or that
 # apply only to it, an unwritable report folder; with the fox, unknown clip names are
@@ -268,6 +275,10 @@ expect bench_frames_with_file 2 "--frames does not apply to a glTF/FBX FILE" \
 expect bake_clips_without_file 2 "--train-clips applies only to a glTF/FBX FILE" \
     "$bake" "${small[@]}" --train-clips A --out "$tmp/a.blob"
 expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$bench" x.glb --fps 0
+expect bake_mesher_name 2 "--mesher takes lattice or tetgen, not 'gmsh'" \
+    "$bake" x.glb --mesher gmsh --out "$tmp/a.blob"
+expect bake_mesher_without_file 2 "--mesher applies only to a glTF/FBX FILE" \
+    "$bake" "${small[@]}" --mesher tetgen --out "$tmp/a.blob"
 touch "$tmp/plain"
 expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"

@@ -15,6 +15,7 @@ packages=(
     libsuitesparse-dev # CHOLMOD: the reference's sparse direct solve (bake and tools only)
     libassimp-dev    # glTF/FBX import in the bake (DESIGN.md §5)
     libcjson-dev     # world files (precompute/io/world_io.c)
+    tetgen           # sinew-bake --mesher tetgen: run as a separate program, never linked (AGPL)
     abigail-tools    # abidw/abidiff: the ABI baseline test (tests/abi/abi_check.sh)
     clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
 )

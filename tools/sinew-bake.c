@@ -222,7 +222,11 @@ int main(int argc, char **argv) {
     fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
             ch.name[0] ? ch.name : source, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones,
             ch.clip.nframes);
-    if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
+    sw_quality quality = {0};
+    if (ca.file) {
+        sw_tetmesh_quality(&ch.mesh, 0, &quality);
+        sw_tool_print_scene(tool, &ch, &clips, &info, &quality);
+    }
     sw_tool_bake_clips(&ca, &clips, &p);
     sw_bake_result res;
     r = ad.rounds > 0 ? sw_bake_adaptive(&ch, &p, &ad, &res, &arep, &err)
@@ -421,6 +425,10 @@ int main(int argc, char **argv) {
                sw_blob_output_verts(v), sw_blob_output_ntris(v),
                v->nrender_verts > 0 ? "true" : "false", res.render_outside, res.render_max_outside,
                res.render_max_bary, res.embed_seconds);
+        if (ca.file)
+            printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
+                   info.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice", quality.min_dihedral_deg,
+                   quality.slivers);
         if (p.compare_selectors)
             printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
                    "\"nnhtp\":[%d,%.3f,%.4f]}",

@@ -347,7 +347,11 @@ int main(int argc, char **argv) {
     sw_scene_character_info info;
     sinew_result r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
     if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
-    if (ca.file) sw_tool_print_scene(tool, &ch, &clips, &info);
+    if (ca.file) {
+        sw_quality quality;
+        sw_tetmesh_quality(&ch.mesh, 0, &quality);
+        sw_tool_print_scene(tool, &ch, &clips, &info, &quality);
+    }
     int nf = ch.clip.nframes;
 
     /* 1. bake (or load) */

@@ -1,9 +1,10 @@
-/* sinew-inspect FILE [--fps F] [--height H] [--tets N] [--json]: what sw_scene_import makes
- * of a rigged glTF/FBX file (meshes merged, rigid and ignored, vertices, triangles, the first
- * joints, the clips, the bounding box, the weight cut to 4 influences) and, with --tets, the
- * simulation tet mesh the lattice mesher fills its render surface with (tet_lattice.h) and
- * that mesh's quality. With --json the last line is one JSON object. Exit 0 ok, 1 import
- * or meshing failed (message on stderr), 2 bad arguments. */
+/* sinew-inspect FILE [--fps F] [--height H] [--tets N] [--mesher M] [--json]: what
+ * sw_scene_import makes of a rigged glTF/FBX file (meshes merged, rigid and ignored, vertices,
+ * triangles, the first joints, the clips, the bounding box, the weight cut to 4 influences)
+ * and, with --tets, the simulation tet mesh the lattice mesher (tet_lattice.h) or TetGen
+ * (tetgen_run.h) fills its render surface with and that mesh's quality. With --json the last line
+ * is one JSON object. Exit 0 ok, 1 import or meshing failed (message on stderr), 2 bad arguments.
+ */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -11,18 +12,21 @@
 #include "mesh_io.h"
 #include "scene_import.h"
 #include "tet_lattice.h"
+#include "tetgen_run.h"
 #include "tool_common.h"
 
 static const char *tool = "sinew-inspect";
 
 static int usage(FILE *f) {
     fprintf(f,
-            "usage: %s FILE [--fps F] [--height H] [--tets N] [--json]\n"
+            "usage: %s FILE [--fps F] [--height H] [--tets N] [--mesher M] [--json]\n"
             "  FILE      a rigged glTF 2.0 (.gltf/.glb) or FBX character\n"
             "  --fps F   clip sampling rate (default 30)\n"
             "  --height H  scale the render mesh to H metres tall (default: file units)\n"
             "  --tets N  also fill the render surface with a simulation tet mesh of about N\n"
-            "            tets (100..5000000; a lattice cut by the winding number) and report it\n"
+            "            tets (100..5000000) and report it\n"
+            "  --mesher M  lattice (default: a lattice cut by the winding number, any\n"
+            "            surface) or tetgen (the Debian program, closed surfaces only)\n"
             "  --json    print one JSON object as the last line\n",
             tool);
     return f == stdout ? 0 : 2;
@@ -54,17 +58,24 @@ static void bbox(const sw_trimesh *m, double *size) {
 
 /* The simulation mesh of --tets and its quality. */
 typedef struct {
-    int on;
+    int on, tetgen;
     sw_tetmesh mesh;
     sw_lattice_report rep;
+    sw_tetgen_report tg;
     sw_quality q;
 } sim_mesh;
 
 static void print_sim_text(const sim_mesh *s) {
-    printf("simulation mesh: %d tets, %d vertices, lattice spacing %.4g, %d component(s), "
-           "volume %.4g (the surface's own %.4g), %.2f s\n",
-           s->mesh.ntets, s->mesh.nverts, s->rep.spacing, s->rep.components, s->rep.volume,
-           s->rep.surface_volume, s->rep.seconds);
+    if (s->tetgen)
+        printf("simulation mesh: %d tets, %d vertices, by tetgen (%d run(s), volume bound %.4g, "
+               "surface welded to %d vertices), volume %.4g (the surface's own %.4g), %.2f s\n",
+               s->mesh.ntets, s->mesh.nverts, s->tg.runs, s->tg.max_volume, s->tg.welded_verts,
+               s->tg.volume, s->rep.surface_volume, s->tg.seconds);
+    else
+        printf("simulation mesh: %d tets, %d vertices, lattice spacing %.4g, %d component(s), "
+               "volume %.4g (the surface's own %.4g), %.2f s\n",
+               s->mesh.ntets, s->mesh.nverts, s->rep.spacing, s->rep.components, s->rep.volume,
+               s->rep.surface_volume, s->rep.seconds);
     printf("  quality: dihedral angles %.1f..%.1f degrees, %d inverted, %d degenerate, %d "
            "slivers\n",
            s->q.min_dihedral_deg, s->q.max_dihedral_deg, s->q.inverted, s->q.degenerate,
@@ -114,18 +125,24 @@ static void print_json(const sw_imported_character *c, const double *size, const
     }
     printf("]");
     if (s->on)
-        printf(", \"sim_tets\": %d, \"sim_verts\": %d, \"sim_components\": %d, \"sim_spacing\": "
-               "%.6g, \"sim_volume\": %.6g, \"surface_volume\": %.6g, \"sim_seconds\": %.4f, "
-               "\"sim_min_dihedral_deg\": %.4g, \"sim_inverted\": %d",
-               s->mesh.ntets, s->mesh.nverts, s->rep.components, s->rep.spacing, s->rep.volume,
-               s->rep.surface_volume, s->rep.seconds, s->q.min_dihedral_deg, s->q.inverted);
+        printf(", \"sim_tets\": %d, \"sim_verts\": %d, \"sim_volume\": %.6g, \"surface_volume\": "
+               "%.6g, \"sim_seconds\": %.4f, \"sim_min_dihedral_deg\": %.4g, \"sim_inverted\": %d",
+               s->mesh.ntets, s->mesh.nverts, s->tetgen ? s->tg.volume : s->rep.volume,
+               s->rep.surface_volume, s->tetgen ? s->tg.seconds : s->rep.seconds,
+               s->q.min_dihedral_deg, s->q.inverted);
+    if (s->on && s->tetgen)
+        printf(", \"sim_mesher\": \"tetgen\", \"sim_runs\": %d, \"sim_max_volume\": %.6g",
+               s->tg.runs, s->tg.max_volume);
+    else if (s->on)
+        printf(", \"sim_mesher\": \"lattice\", \"sim_components\": %d, \"sim_spacing\": %.6g",
+               s->rep.components, s->rep.spacing);
     printf("}\n");
 }
 
 int main(int argc, char **argv) {
     const char *path = NULL;
     sw_import_options o = {0};
-    int json = 0, tets = 0;
+    int json = 0, tets = 0, tetgen = 0;
     for (int i = 1; i < argc; ++i) {
         if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return usage(stdout);
         if (!strcmp(argv[i], "--json")) {
@@ -141,6 +158,13 @@ int main(int argc, char **argv) {
         } else if (!strcmp(argv[i], "--tets")) {
             if (!sw_tool_int(tool, "--tets", i + 1 < argc ? argv[++i] : NULL, 100, 5000000, &tets))
                 return 2;
+        } else if (!strcmp(argv[i], "--mesher")) {
+            const char *m = i + 1 < argc ? argv[++i] : "";
+            if (strcmp(m, "lattice") && strcmp(m, "tetgen")) {
+                fprintf(stderr, "%s: --mesher takes lattice or tetgen, not '%s'\n", tool, m);
+                return 2;
+            }
+            tetgen = !strcmp(m, "tetgen");
         } else if (argv[i][0] == '-' || path) {
             fprintf(stderr, "%s: unexpected argument '%s'\n", tool, argv[i]);
             return usage(stderr);
@@ -159,11 +183,17 @@ int main(int argc, char **argv) {
     double size[3];
     bbox(&c.render, size);
     print_text(path, &c, size);
-    sim_mesh sim = {.on = tets > 0};
+    sim_mesh sim = {.on = tets > 0, .tetgen = tetgen};
     if (sim.on) {
-        sw_pool *pool = sw_pool_create(0);
-        sinew_result r = sw_tetmesh_from_surface(&c.render, tets, pool, &sim.mesh, &sim.rep, &err);
-        sw_pool_destroy(pool);
+        sinew_result r;
+        if (tetgen) {
+            r = sw_tetmesh_by_tetgen(&c.render, tets, NULL, &sim.mesh, &sim.tg, &err);
+            sim.rep.surface_volume = sw_trimesh_signed_volume(&c.render);
+        } else {
+            sw_pool *pool = sw_pool_create(0);
+            r = sw_tetmesh_from_surface(&c.render, tets, pool, &sim.mesh, &sim.rep, &err);
+            sw_pool_destroy(pool);
+        }
         if (r != SINEW_OK) {
             fprintf(stderr, "%s: %s (%s)\n", tool, err.msg, sinew_result_string(r));
             sw_imported_character_free(&c);

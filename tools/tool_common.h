@@ -260,6 +260,7 @@ static inline void sw_tool_progress_print(void *user, const char *stage, int64_t
 #ifdef SW_TOOL_CHARACTER_ARGS
 /* The character inputs sinew-bake and sinew-bench share: a named scene, or files. */
 #include "character_io.h"
+#include "mesh_io.h"
 #include "samples.h"
 #include "bake.h"
 #include "scene_character.h"
@@ -272,6 +273,7 @@ typedef struct sw_character_args {
     double fps, height;                      /* its clip rate and scale (0: defaults) */
     int tets, frames;
     int tets_given, data_given;
+    int tetgen; /* --mesher tetgen (FILE only) */
 } sw_character_args;
 
 /* The least --frames: the fewest clip frames a bake trains on (bake.h). */
@@ -284,6 +286,9 @@ typedef struct sw_character_args {
     "  --heldout-clips C  FILE's clips held out (never trained on)\n"                              \
     "  --fps F          FILE's clip sampling rate, 0 < F <= 1000 (default 30)\n"                   \
     "  --height H       scale FILE to H units tall, 0 < H < 1e6 (default: the file's units)\n"     \
+    "  --mesher M       what fills FILE's render surface: lattice (default; any surface, a\n"      \
+    "                   lattice cut by the winding number) | tetgen (the Debian program;\n"        \
+    "                   closed surfaces only, the boundary is the surface)\n"                      \
     "  --scene NAME     cylinder | finger | capsule (procedural samples) | elephant-cd |\n"        \
     "                   hand-libigl (real assets under --data DIR, default $SINEW_DATA_DIR or\n"   \
     "                   the build's shared data; --data only with these)\n"                        \
@@ -323,7 +328,6 @@ static inline int sw_character_args_take(sw_character_args *c, int argc, char **
                      : !strcmp(a, "--train-clips")   ? &c->train_clips
                      : !strcmp(a, "--heldout-clips") ? &c->heldout_clips
                      : !strcmp(a, "--mesh")          ? &c->mesh
-                     : !strcmp(a, "--mesh")          ? &c->mesh
                      : !strcmp(a, "--skeleton")      ? &c->tgf
                      : !strcmp(a, "--weights")       ? &c->weights
                      : !strcmp(a, "--clip")          ? &c->clip
@@ -332,6 +336,13 @@ static inline int sw_character_args_take(sw_character_args *c, int argc, char **
     if (s) {
         *s = argv[++*i];
         c->data_given |= s == &c->data_dir;
+        return 1;
+    }
+    if (!strcmp(a, "--mesher")) {
+        const char *m = argv[++*i];
+        *ok = !strcmp(m, "lattice") || !strcmp(m, "tetgen");
+        if (!*ok) fprintf(stderr, "%s: --mesher takes lattice or tetgen, not '%s'\n", c->tool, m);
+        c->tetgen = *ok && !strcmp(m, "tetgen");
         return 1;
     }
     if (!strcmp(a, "--tets")) {
@@ -379,13 +390,14 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
         return 0;
     }
     if (c->file) return sw_scene_file_args_valid(c);
-    if (c->train_clips || c->heldout_clips || c->fps > 0 || c->height > 0) {
+    if (c->train_clips || c->heldout_clips || c->fps > 0 || c->height > 0 || c->tetgen) {
         fprintf(stderr,
                 "%s: %s applies only to a glTF/FBX FILE (the clips are chosen by name there)\n", t,
                 c->train_clips     ? "--train-clips"
                 : c->heldout_clips ? "--heldout-clips"
                 : c->fps > 0       ? "--fps"
-                                   : "--height");
+                : c->height > 0    ? "--height"
+                                   : "--mesher");
         return 0;
     }
     if (c->scene) {
@@ -452,14 +464,24 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
 /* What a glTF/FBX FILE became (the mesher's lattice, the material, the clip split). */
 static inline void sw_tool_print_scene(const char *tool, const sw_character *ch,
                                        const sw_clip_split *clips,
-                                       const sw_scene_character_info *in) {
+                                       const sw_scene_character_info *in, const sw_quality *q) {
+    fprintf(stderr, "%s: render mesh %d vertices, %d triangles; ", tool, in->render_verts,
+            in->render_tris);
+    if (in->mesher == SW_MESHER_TETGEN)
+        fprintf(stderr, "tetgen: %d tets, volume bound %.4g, %d run(s), %.2f s", ch->mesh.ntets,
+                in->tetgen.max_volume, in->tetgen.runs, in->tetgen.seconds);
+    else
+        fprintf(stderr, "lattice spacing %.4g, %d piece(s)", in->lattice.spacing,
+                in->lattice.components);
     fprintf(stderr,
-            "%s: render mesh %d vertices, %d triangles; lattice spacing %.4g, %d piece(s) (%d "
-            "anchored); size %.4g (cube root of the volume), E %.4g, nu %.3g, density %.4g; %d "
-            "bone(s) skin no vertex most and drive none\n",
-            tool, in->render_verts, in->render_tris, in->lattice.spacing, in->lattice.components,
+            " (%d anchored); size %.4g (cube root of the volume), E %.4g, nu %.3g, density %.4g; "
+            "%d bone(s) skin no vertex most and drive none\n",
             in->anchored_components, in->size, ch->youngs, ch->poisson, ch->density,
             in->undriven_bones);
+    fprintf(stderr,
+            "%s: mesh quality: dihedral angles %.1f..%.1f degrees, %d sliver(s) under 5 degrees, "
+            "%d inverted, %d degenerate\n",
+            tool, q->min_dihedral_deg, q->max_dihedral_deg, q->slivers, q->inverted, q->degenerate);
     fprintf(stderr, "%s: clips: training", tool);
     for (int32_t i = 0; i < clips->ntrain; ++i)
         fprintf(stderr, "%s %s (%d frames)", i ? "," : "", clips->train_names[i],
@@ -497,8 +519,9 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
     memset(ch, 0, sizeof *ch);
     if (clips) memset(clips, 0, sizeof *clips);
     if (c->file) {
-        sw_scene_character_options o = {c->tets, c->fps, c->height, c->train_clips,
-                                        c->heldout_clips};
+        sw_scene_character_options o = {
+            c->tets,        c->fps,           c->height,
+            c->train_clips, c->heldout_clips, c->tetgen ? SW_MESHER_TETGEN : SW_MESHER_LATTICE};
         return sw_character_from_scene(c->file, &o, ch, clips, info, err);
     }
     sinew_result r =

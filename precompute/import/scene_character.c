@@ -246,16 +246,6 @@ static sinew_result drive_vertices(sw_character *c, sw_scene_character_info *inf
     return rc;
 }
 
-static double tetmesh_volume(const sw_tetmesh *m) {
-    double v = 0;
-    for (int32_t t = 0; t < m->ntets; ++t) {
-        const int32_t *k = m->tets + 4 * (size_t)t;
-        v += sw_tet_signed_volume(m->X + 3 * (size_t)k[0], m->X + 3 * (size_t)k[1],
-                                  m->X + 3 * (size_t)k[2], m->X + 3 * (size_t)k[3]);
-    }
-    return v;
-}
-
 /* The steps after the import; ic's skeleton and render mesh move into out. */
 static sinew_result build_character(const char *path, sw_imported_character *ic,
                                     const sw_scene_character_options *o, sw_character *out,
@@ -263,10 +253,16 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
                                     sw_error *err) {
     sinew_result rc = choose_clips(ic, o, split, err);
     if (rc) return rc;
-    sw_pool *pool = sw_pool_create(0);
-    rc =
-        sw_tetmesh_from_surface(&ic->render, o->target_tets, pool, &out->mesh, &info->lattice, err);
-    sw_pool_destroy(pool);
+    info->mesher = o->mesher;
+    if (o->mesher == SW_MESHER_TETGEN) {
+        rc =
+            sw_tetmesh_by_tetgen(&ic->render, o->target_tets, NULL, &out->mesh, &info->tetgen, err);
+    } else {
+        sw_pool *pool = sw_pool_create(0);
+        rc = sw_tetmesh_from_surface(&ic->render, o->target_tets, pool, &out->mesh, &info->lattice,
+                                     err);
+        sw_pool_destroy(pool);
+    }
     if (rc) return rc;
     out->skel = ic->skel; /* moved */
     memset(&ic->skel, 0, sizeof ic->skel);
@@ -284,7 +280,7 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
     info->weight_dropped_max = ic->weight_dropped_max;
     out->render = ic->render; /* moved: the bake embeds it (sw_character.render) */
     memset(&ic->render, 0, sizeof ic->render);
-    info->size = cbrt(tetmesh_volume(&out->mesh));
+    info->size = cbrt(sw_tetmesh_volume(&out->mesh));
     sw_scene_material(info->size, &out->youngs, &out->poisson, &out->density);
     sw_file_stem(path, out->name, sizeof out->name);
     return SINEW_OK;
@@ -308,6 +304,9 @@ sinew_result sw_character_from_scene(const char *path, const sw_scene_character_
     if (opt.target_tets < 100 || opt.target_tets > 5000000)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "%s: %d simulation tets asked (100..5000000)", path, opt.target_tets);
+    if (opt.mesher != SW_MESHER_LATTICE && opt.mesher != SW_MESHER_TETGEN)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: unknown mesher %d", path,
+                            (int)opt.mesher);
     sw_import_options io = {opt.fps, opt.target_height};
     sw_imported_character ic;
     sinew_result rc = sw_scene_import(path, &io, &ic, err);

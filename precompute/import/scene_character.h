@@ -1,7 +1,7 @@
 /* A simulation character from a rigged glTF 2.0 / FBX file (issue 14): the assimp import
- * (scene_import.h), a tet mesh the lattice mesher fills the render surface with
- * (tet_lattice.h), skin weights transferred from the artist's render weights
- * (sw_weights_from_surface), bone-driven vertices, a material relative to the
+ * (scene_import.h), a tet mesh the lattice mesher (tet_lattice.h) or TetGen (tetgen_run.h,
+ * closed surfaces only) fills the render surface with, skin weights transferred from the artist's
+ * render weights (sw_weights_from_surface), bone-driven vertices, a material relative to the
  * character's size, the render mesh kept for embedding (sw_character.render), and the
  * file's clips split into training and held-out clips by name.
  *
@@ -15,6 +15,12 @@
 #include "scene_import.h"
 #include "sw_mesh.h"
 #include "tet_lattice.h"
+#include "tetgen_run.h"
+
+typedef enum sw_mesher {
+    SW_MESHER_LATTICE = 0, /* any surface; the default (tet_lattice.h) */
+    SW_MESHER_TETGEN = 1   /* closed surfaces, boundary-conforming (tetgen_run.h) */
+} sw_mesher;
 
 /* Zero or NULL in a field means its default. */
 typedef struct sw_scene_character_options {
@@ -23,6 +29,7 @@ typedef struct sw_scene_character_options {
     double target_height;      /* > 0: scale to this height; 0: the file's units */
     const char *train_clips;   /* comma-separated clip names; NULL: the default split */
     const char *heldout_clips; /* comma-separated clip names; NULL: the default split */
+    sw_mesher mesher;          /* what fills the render surface with tets */
 } sw_scene_character_options;
 
 /* The file's clips as the bake uses them: training and held-out clips never share one. */
@@ -36,7 +43,9 @@ void sw_clip_split_free(sw_clip_split *s);
 
 /* What the import and the meshing did (for the bake's messages and its report). */
 typedef struct sw_scene_character_info {
-    sw_lattice_report lattice;
+    sw_mesher mesher;
+    sw_lattice_report lattice; /* SW_MESHER_LATTICE */
+    sw_tetgen_report tetgen;   /* SW_MESHER_TETGEN */
     int32_t render_verts, render_tris, nclips;
     int32_t anchored_components; /* mesh pieces with no driven vertex, anchored */
     int32_t undriven_bones;      /* bones that dominate no vertex: they drive none */

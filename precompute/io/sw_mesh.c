@@ -70,6 +70,27 @@ double sw_tet_signed_volume(const double *a, const double *b, const double *c, c
            6.0;
 }
 
+double sw_tetmesh_volume(const sw_tetmesh *m) {
+    double v = 0;
+    for (int32_t t = 0; t < m->ntets; ++t) {
+        const int32_t *k = m->tets + 4 * (int64_t)t;
+        v += sw_tet_signed_volume(m->X + 3 * (int64_t)k[0], m->X + 3 * (int64_t)k[1],
+                                  m->X + 3 * (int64_t)k[2], m->X + 3 * (int64_t)k[3]);
+    }
+    return v;
+}
+
+double sw_trimesh_signed_volume(const sw_trimesh *m) {
+    static const double o[3] = {0, 0, 0};
+    double v = 0;
+    for (int32_t t = 0; t < m->ntris; ++t) {
+        const int32_t *c = m->tris + 3 * (int64_t)t;
+        v += sw_tet_signed_volume(o, m->X + 3 * (int64_t)c[0], m->X + 3 * (int64_t)c[1],
+                                  m->X + 3 * (int64_t)c[2]);
+    }
+    return v;
+}
+
 sinew_result sw_trimesh_validate(const sw_trimesh *m, const char *who, sw_error *err) {
     if (!m || m->nverts < 3 || m->ntris < 1 || !m->X || !m->tris)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,

@@ -94,6 +94,11 @@ sinew_result sw_trimesh_validate(const sw_trimesh *m, const char *who, sw_error 
 
 /* Signed volume of tet (a,b,c,d): det[b-a, c-a, d-a] / 6. */
 double sw_tet_signed_volume(const double *a, const double *b, const double *c, const double *d);
+/* A tet mesh's volume (its tets' signed volumes summed). */
+double sw_tetmesh_volume(const sw_tetmesh *m);
+/* The volume a triangle surface encloses, by the divergence theorem: exact when it is
+ * closed, positive when it is oriented outward. */
+double sw_trimesh_signed_volume(const sw_trimesh *m);
 
 /* Validates a tet mesh: counts positive, indices in range, coordinates finite, no
  * tet with a repeated vertex, every tet of positive volume above `min_volume`
