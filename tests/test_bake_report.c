@@ -54,6 +54,11 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
             "seams %g, largest %g", eh->seam, eh->seam_max);
     const cJSON *ch = cJSON_GetObjectItemCaseSensitive(j, "character");
     ENSURE(num(ch, "tets") > 500 && num(ch, "bones") == 3);
+    /* the mesh's origin (the finger's own tets: no mesher) and quality */
+    ENSURE(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(ch, "mesher")));
+    const cJSON *q = cJSON_GetObjectItemCaseSensitive(ch, "quality");
+    ENSURE(num(q, "min_dihedral_deg") > 5 && num(q, "max_dihedral_deg") < 175 &&
+           num(q, "inverted") == 0 && num(q, "slivers") == 0);
     const cJSON *clips = cJSON_GetObjectItemCaseSensitive(j, "clips");
     ENSURE(cJSON_GetArraySize(clips) == 2);
     const char *want_name[2] = {"Bend", "Return"}, *want_split[2] = {"train", "heldout"};
@@ -169,7 +174,8 @@ TEST(clips_of_their_own_and_the_report) {
                                1,
                                &arep,
                                &et,
-                               &eh};
+                               &eh,
+                               NULL};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;

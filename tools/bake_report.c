@@ -4,7 +4,9 @@
  * report.json (schema 1):
  *   sinew_bake_report  1
  *   source, character {name, tets, verts, bones, render_verts, render_tris, youngs,
- *                      poisson, density}
+ *                      poisson, density, mesher (null: the character's own tet mesh),
+ *                      quality {min_dihedral_deg, max_dihedral_deg, slivers, inverted,
+ *                      degenerate} (sw_tetmesh_quality)}
  *   err_train, err_heldout, proj_err_train, proj_err_heldout, cubature_fit, failed_steps
  *   springs {k, eh, tried [[E h multiple, training error]]}: the interface springs'
  *              stiffness and the choices the bake measured (bake_springs.c)
@@ -32,6 +34,7 @@
 #include <sys/stat.h>
 
 #include "blob_load.h"
+#include "mesh_io.h"
 #include "tool_common.h"
 
 static const char *const stage_names[SW_BAKE_REPORT_STAGES] = {"prepare", "domains",  "simulate",
@@ -126,6 +129,16 @@ static cJSON *json_character(const sw_bake_report_input *in) {
     cJSON_AddNumberToObject(c, "youngs", ch->youngs);
     cJSON_AddNumberToObject(c, "poisson", ch->poisson);
     cJSON_AddNumberToObject(c, "density", ch->density);
+    cJSON_AddItemToObject(c, "mesher",
+                          in->mesher ? cJSON_CreateString(in->mesher) : cJSON_CreateNull());
+    sw_quality q;
+    sw_tetmesh_quality(&ch->mesh, 0, &q);
+    cJSON *qj = cJSON_AddObjectToObject(c, "quality");
+    cJSON_AddNumberToObject(qj, "min_dihedral_deg", q.min_dihedral_deg);
+    cJSON_AddNumberToObject(qj, "max_dihedral_deg", q.max_dihedral_deg);
+    cJSON_AddNumberToObject(qj, "slivers", q.slivers);
+    cJSON_AddNumberToObject(qj, "inverted", q.inverted);
+    cJSON_AddNumberToObject(qj, "degenerate", q.degenerate);
     return c;
 }
 
@@ -352,8 +365,17 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
     fprintf(f, "<h1>sinew bake report: ");
     html_text(f, in->source ? in->source : ch->name);
     fprintf(f, "</h1>\n<table>");
-    fprintf(f, "<tr><td>simulation mesh</td><td>%d tets, %d vertices, %d bones</td></tr>",
-            ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones);
+    sw_quality q;
+    sw_tetmesh_quality(&ch->mesh, 0, &q);
+    fprintf(f,
+            "<tr><td>simulation mesh</td><td>%d tets, %d vertices, %d bones; %s; dihedral "
+            "angles %.1f..%.1f degrees, %d sliver(s) under 5 degrees, %d inverted</td></tr>",
+            ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones,
+            !in->mesher ? "the character's own tet mesh"
+            : !strcmp(in->mesher, "tetgen")
+                ? "TetGen's mesh of the render surface"
+                : "a lattice cut by the render surface's winding number",
+            q.min_dihedral_deg, q.max_dihedral_deg, q.slivers, q.inverted);
     if (ch->render.nverts)
         fprintf(f, "<tr><td>render mesh</td><td>%d vertices, %d triangles</td></tr>",
                 ch->render.nverts, ch->render.ntris);

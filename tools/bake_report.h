@@ -42,6 +42,9 @@ typedef struct sw_bake_report_input {
     /* where the error is (sw_eval_result's regions) on the training and the held-out poses;
        NULL: not shown */
     const sw_eval_result *eval_train, *eval_heldout;
+    /* what made the simulation mesh ("lattice", "tetgen"; NULL: the character's own tet
+       mesh); the report shows it beside the mesh's quality (sw_tetmesh_quality) */
+    const char *mesher;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

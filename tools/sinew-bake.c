@@ -314,7 +314,10 @@ int main(int argc, char **argv) {
                                    1,
                                    ad.rounds > 0 ? &arep : NULL,
                                    &et,
-                                   &eh};
+                                   &eh,
+                                   !ca.file                          ? NULL
+                                   : info.mesher == SW_MESHER_TETGEN ? "tetgen"
+                                                                     : "lattice"};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
