@@ -11,9 +11,9 @@
  * requested number of tets.
  *
  * The boundary is the lattice's staircase: the render mesh is embedded in the result
- * (each render vertex in its nearest tet), not the other way round. TetGen (Debian
- * `tetgen`, AGPL) would give a boundary-conforming mesh for closed surfaces only, and
- * only as a separate program. */
+ * (each render vertex in its nearest tet), not the other way round. TetGen gives a
+ * boundary-conforming mesh of closed surfaces only (tetgen_run.h, `--mesher tetgen`; the
+ * README compares the two on the shared assets). */
 #ifndef SW_TET_LATTICE_H
 #define SW_TET_LATTICE_H
 
