@@ -727,10 +727,10 @@ TEST(surface_arm) {
     NEED_DATA("arm-libigl/arm.obj");
     sw_character c = {0};
     sw_error err = {0};
-    sw_lattice_report rep;
-    ENSUREF(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/arm.obj", 3000,
-                                      SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c,
-                                      &rep, &err) == SINEW_OK,
+    sw_mesher_report rep;
+    ENSUREF(sw_character_from_surface(
+                SINEW_SHARED_DATA_DIR "/arm-libigl/arm.obj", 3000, SW_MESHER_LATTICE,
+                SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c, &rep, &err) == SINEW_OK,
             "%s", err.msg);
     ENSURE(c.mesh.ntets >= 2000 && c.mesh.ntets <= 4500 && c.skel.nbones == 4);
     ENSURE(sw_tetmesh_validate(&c.mesh, 0.0, &err) == SINEW_OK);
@@ -743,15 +743,15 @@ TEST(surface_arm) {
     }
     ENSURE(strcmp(c.name, "arm") == 0 && c.clip.nframes == 4);
     fprintf(stderr, "    arm: %d tets, %d vertices, spacing %.4g, %d component(s)\n", c.mesh.ntets,
-            c.mesh.nverts, rep.spacing, rep.components);
+            c.mesh.nverts, rep.lattice.spacing, rep.lattice.components);
     sw_character_free(&c);
     ENSURE(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/none.obj", 3000,
-                                     SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c, NULL,
-                                     &err) == SINEW_ERROR_IO);
+                                     SW_MESHER_LATTICE, SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf",
+                                     NULL, 4, &c, NULL, &err) == SINEW_ERROR_IO);
     ENSURE(strstr(err.msg, "none.obj") != NULL && c.mesh.ntets == 0);
     ENSURE(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/arm.obj", 10,
-                                     SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c, NULL,
-                                     &err) == SINEW_ERROR_INVALID_ARGUMENT);
+                                     SW_MESHER_LATTICE, SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf",
+                                     NULL, 4, &c, NULL, &err) == SINEW_ERROR_INVALID_ARGUMENT);
     ENSURE(strstr(err.msg, "arm.obj") != NULL);
 }
 

@@ -140,6 +140,7 @@ TEST(embedding_reproduces_the_arm_at_rest) {
         sw_character c;
         sw_error err;
         ENSUREF(sw_character_from_surface(SINEW_SHARED_DATA_DIR "/arm-libigl/arm.obj", tets[k],
+                                          SW_MESHER_LATTICE,
                                           SINEW_SHARED_DATA_DIR "/arm-libigl/arm.tgf", NULL, 4, &c,
                                           NULL, &err) == SINEW_OK,
                 "%s", err.msg);

@@ -214,8 +214,8 @@ TEST(tetgen_fills_the_fox_and_refuses_the_robot) {
     if (rc) return;
     double vs = fabs(sw_trimesh_signed_volume(&c.render)), vt = sw_tetmesh_volume(&c.mesh);
     fprintf(stderr, "    Fox by tetgen: %d tets (floor of its sharp features), %d run(s), %.2f s\n",
-            c.mesh.ntets, info.tetgen.runs, info.tetgen.seconds);
-    ENSURE(info.mesher == SW_MESHER_TETGEN && info.tetgen.welded_verts == 290);
+            c.mesh.ntets, info.mesh.tetgen.runs, info.mesh.tetgen.seconds);
+    ENSURE(info.mesh.mesher == SW_MESHER_TETGEN && info.mesh.tetgen.welded_verts == 290);
     /* (TetGen writes its points with 16 significant digits) */
     ENSUREF(fabs(vt - vs) < 1e-6 * vs, "tets %.17g against the surface's %.17g", vt, vs);
     sw_embedding emb;

@@ -277,8 +277,10 @@ expect bake_clips_without_file 2 "--train-clips applies only to a glTF/FBX FILE"
 expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$bench" x.glb --fps 0
 expect bake_mesher_name 2 "--mesher takes lattice or tetgen, not 'gmsh'" \
     "$bake" x.glb --mesher gmsh --out "$tmp/a.blob"
-expect bake_mesher_without_file 2 "--mesher applies only to a glTF/FBX FILE" \
+expect bake_mesher_without_file 2 "--mesher applies only to a render surface to fill" \
     "$bake" "${small[@]}" --mesher tetgen --out "$tmp/a.blob"
+expect bake_mesher_with_tet_mesh 2 "--mesher applies only to a render surface to fill" \
+    "$bake" --mesh m.mesh --skeleton s.tgf --mesher lattice --out "$tmp/a.blob"
 touch "$tmp/plain"
 expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"

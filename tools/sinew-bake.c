@@ -316,7 +316,7 @@ int main(int argc, char **argv) {
                                    &et,
                                    &eh,
                                    !ca.file                          ? NULL
-                                   : info.mesher == SW_MESHER_TETGEN ? "tetgen"
+                                   : info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
                                                                      : "lattice"};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
@@ -430,7 +430,7 @@ int main(int argc, char **argv) {
                res.render_max_bary, res.embed_seconds);
         if (ca.file)
             printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
-                   info.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice", quality.min_dihedral_deg,
+                   info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice", quality.min_dihedral_deg,
                    quality.slivers);
         if (p.compare_selectors)
             printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"

@@ -11,8 +11,7 @@
 
 #include "mesh_io.h"
 #include "scene_import.h"
-#include "tet_lattice.h"
-#include "tetgen_run.h"
+#include "mesher.h"
 #include "tool_common.h"
 
 static const char *tool = "sinew-inspect";
@@ -60,8 +59,8 @@ static void bbox(const sw_trimesh *m, double *size) {
 typedef struct {
     int on, tetgen;
     sw_tetmesh mesh;
-    sw_lattice_report rep;
-    sw_tetgen_report tg;
+    sw_mesher_report r;
+    double surface_volume; /* the render surface's own (signed) */
     sw_quality q;
 } sim_mesh;
 
@@ -69,13 +68,14 @@ static void print_sim_text(const sim_mesh *s) {
     if (s->tetgen)
         printf("simulation mesh: %d tets, %d vertices, by tetgen (%d run(s), volume bound %.4g, "
                "surface welded to %d vertices), volume %.4g (the surface's own %.4g), %.2f s\n",
-               s->mesh.ntets, s->mesh.nverts, s->tg.runs, s->tg.max_volume, s->tg.welded_verts,
-               s->tg.volume, s->rep.surface_volume, s->tg.seconds);
+               s->mesh.ntets, s->mesh.nverts, s->r.tetgen.runs, s->r.tetgen.max_volume,
+               s->r.tetgen.welded_verts, s->r.tetgen.volume, s->surface_volume,
+               s->r.tetgen.seconds);
     else
         printf("simulation mesh: %d tets, %d vertices, lattice spacing %.4g, %d component(s), "
                "volume %.4g (the surface's own %.4g), %.2f s\n",
-               s->mesh.ntets, s->mesh.nverts, s->rep.spacing, s->rep.components, s->rep.volume,
-               s->rep.surface_volume, s->rep.seconds);
+               s->mesh.ntets, s->mesh.nverts, s->r.lattice.spacing, s->r.lattice.components,
+               s->r.lattice.volume, s->surface_volume, s->r.lattice.seconds);
     printf("  quality: dihedral angles %.1f..%.1f degrees, %d inverted, %d degenerate, %d "
            "slivers\n",
            s->q.min_dihedral_deg, s->q.max_dihedral_deg, s->q.inverted, s->q.degenerate,
@@ -127,15 +127,15 @@ static void print_json(const sw_imported_character *c, const double *size, const
     if (s->on)
         printf(", \"sim_tets\": %d, \"sim_verts\": %d, \"sim_volume\": %.6g, \"surface_volume\": "
                "%.6g, \"sim_seconds\": %.4f, \"sim_min_dihedral_deg\": %.4g, \"sim_inverted\": %d",
-               s->mesh.ntets, s->mesh.nverts, s->tetgen ? s->tg.volume : s->rep.volume,
-               s->rep.surface_volume, s->tetgen ? s->tg.seconds : s->rep.seconds,
+               s->mesh.ntets, s->mesh.nverts, s->tetgen ? s->r.tetgen.volume : s->r.lattice.volume,
+               s->surface_volume, s->tetgen ? s->r.tetgen.seconds : s->r.lattice.seconds,
                s->q.min_dihedral_deg, s->q.inverted);
     if (s->on && s->tetgen)
         printf(", \"sim_mesher\": \"tetgen\", \"sim_runs\": %d, \"sim_max_volume\": %.6g",
-               s->tg.runs, s->tg.max_volume);
+               s->r.tetgen.runs, s->r.tetgen.max_volume);
     else if (s->on)
         printf(", \"sim_mesher\": \"lattice\", \"sim_components\": %d, \"sim_spacing\": %.6g",
-               s->rep.components, s->rep.spacing);
+               s->r.lattice.components, s->r.lattice.spacing);
     printf("}\n");
 }
 
@@ -186,14 +186,11 @@ int main(int argc, char **argv) {
     sim_mesh sim = {.on = tets > 0, .tetgen = tetgen};
     if (sim.on) {
         sinew_result r;
-        if (tetgen) {
-            r = sw_tetmesh_by_tetgen(&c.render, tets, NULL, &sim.mesh, &sim.tg, &err);
-            sim.rep.surface_volume = sw_trimesh_signed_volume(&c.render);
-        } else {
-            sw_pool *pool = sw_pool_create(0);
-            r = sw_tetmesh_from_surface(&c.render, tets, pool, &sim.mesh, &sim.rep, &err);
-            sw_pool_destroy(pool);
-        }
+        sw_pool *pool = tetgen ? NULL : sw_pool_create(0);
+        r = sw_tetmesh_fill(&c.render, tets, tetgen ? SW_MESHER_TETGEN : SW_MESHER_LATTICE, pool,
+                            &sim.mesh, &sim.r, &err);
+        sw_pool_destroy(pool);
+        sim.surface_volume = sw_trimesh_signed_volume(&c.render);
         if (r != SINEW_OK) {
             fprintf(stderr, "%s: %s (%s)\n", tool, err.msg, sinew_result_string(r));
             sw_imported_character_free(&c);

@@ -273,7 +273,7 @@ typedef struct sw_character_args {
     double fps, height;                      /* its clip rate and scale (0: defaults) */
     int tets, frames;
     int tets_given, data_given;
-    int tetgen; /* --mesher tetgen (FILE only) */
+    int tetgen, mesher_given; /* --mesher tetgen; --mesher at all (surfaces only) */
 } sw_character_args;
 
 /* The least --frames: the fewest clip frames a bake trains on (bake.h). */
@@ -286,9 +286,10 @@ typedef struct sw_character_args {
     "  --heldout-clips C  FILE's clips held out (never trained on)\n"                              \
     "  --fps F          FILE's clip sampling rate, 0 < F <= 1000 (default 30)\n"                   \
     "  --height H       scale FILE to H units tall, 0 < H < 1e6 (default: the file's units)\n"     \
-    "  --mesher M       what fills FILE's render surface: lattice (default; any surface, a\n"      \
-    "                   lattice cut by the winding number) | tetgen (the Debian program;\n"        \
-    "                   closed surfaces only, the boundary is the surface)\n"                      \
+    "  --mesher M       what fills FILE's or a surface .obj's render surface with tets:\n"         \
+    "                   lattice (default; any surface, a lattice cut by the winding number)\n"     \
+    "                   | tetgen (the Debian program; closed surfaces only, the boundary is\n"     \
+    "                   the surface)\n"                                                            \
     "  --scene NAME     cylinder | finger | capsule (procedural samples) | elephant-cd |\n"        \
     "                   hand-libigl (real assets under --data DIR, default $SINEW_DATA_DIR or\n"   \
     "                   the build's shared data; --data only with these)\n"                        \
@@ -343,6 +344,7 @@ static inline int sw_character_args_take(sw_character_args *c, int argc, char **
         *ok = !strcmp(m, "lattice") || !strcmp(m, "tetgen");
         if (!*ok) fprintf(stderr, "%s: --mesher takes lattice or tetgen, not '%s'\n", c->tool, m);
         c->tetgen = *ok && !strcmp(m, "tetgen");
+        c->mesher_given = 1;
         return 1;
     }
     if (!strcmp(a, "--tets")) {
@@ -390,14 +392,20 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
         return 0;
     }
     if (c->file) return sw_scene_file_args_valid(c);
-    if (c->train_clips || c->heldout_clips || c->fps > 0 || c->height > 0 || c->tetgen) {
+    if (c->mesher_given && !(c->mesh && sw_tool_has_ext(c->mesh, "obj"))) {
+        fprintf(stderr,
+                "%s: --mesher applies only to a render surface to fill: a glTF/FBX FILE or "
+                "--mesh FILE.obj\n",
+                t);
+        return 0;
+    }
+    if (c->train_clips || c->heldout_clips || c->fps > 0 || c->height > 0) {
         fprintf(stderr,
                 "%s: %s applies only to a glTF/FBX FILE (the clips are chosen by name there)\n", t,
                 c->train_clips     ? "--train-clips"
                 : c->heldout_clips ? "--heldout-clips"
                 : c->fps > 0       ? "--fps"
-                : c->height > 0    ? "--height"
-                                   : "--mesher");
+                                   : "--height");
         return 0;
     }
     if (c->scene) {
@@ -467,12 +475,12 @@ static inline void sw_tool_print_scene(const char *tool, const sw_character *ch,
                                        const sw_scene_character_info *in, const sw_quality *q) {
     fprintf(stderr, "%s: render mesh %d vertices, %d triangles; ", tool, in->render_verts,
             in->render_tris);
-    if (in->mesher == SW_MESHER_TETGEN)
+    if (in->mesh.mesher == SW_MESHER_TETGEN)
         fprintf(stderr, "tetgen: %d tets, volume bound %.4g, %d run(s), %.2f s", ch->mesh.ntets,
-                in->tetgen.max_volume, in->tetgen.runs, in->tetgen.seconds);
+                in->mesh.tetgen.max_volume, in->mesh.tetgen.runs, in->mesh.tetgen.seconds);
     else
-        fprintf(stderr, "lattice spacing %.4g, %d piece(s)", in->lattice.spacing,
-                in->lattice.components);
+        fprintf(stderr, "lattice spacing %.4g, %d piece(s)", in->mesh.lattice.spacing,
+                in->mesh.lattice.components);
     fprintf(stderr,
             " (%d anchored); size %.4g (cube root of the volume), E %.4g, nu %.3g, density %.4g; "
             "%d bone(s) skin no vertex most and drive none\n",
@@ -527,7 +535,9 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
     sinew_result r =
         c->scene ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
         : sw_tool_has_ext(c->mesh, "obj")
-            ? sw_character_from_surface(c->mesh, c->tets, c->tgf, c->clip, c->frames, ch, NULL, err)
+            ? sw_character_from_surface(c->mesh, c->tets,
+                                        c->tetgen ? SW_MESHER_TETGEN : SW_MESHER_LATTICE, c->tgf,
+                                        c->clip, c->frames, ch, NULL, err)
             : sw_character_from_files(c->mesh, c->tgf, c->weights, c->clip, c->frames, ch, err);
     if (r == SINEW_OK && (computed || (c->mesh && !c->weights))) sw_weights_free(&ch->weights);
     return r;

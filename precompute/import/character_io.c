@@ -280,10 +280,10 @@ sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path
     return finish_character(mesh_path, tgf_path, weights_path, motion_path, nframes, out, err);
 }
 
-sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets,
+sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets, sw_mesher mesher,
                                        const char *tgf_path, const char *motion_path,
-                                       int32_t nframes, sw_character *out,
-                                       sw_lattice_report *report, sw_error *err) {
+                                       int32_t nframes, sw_character *out, sw_mesher_report *report,
+                                       sw_error *err) {
     if (!out) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "character: out is NULL");
     memset(out, 0, sizeof *out);
     if (!obj_path || !tgf_path)
@@ -292,7 +292,7 @@ sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets
     sw_trimesh surf;
     sinew_result rc = sw_read_obj(obj_path, &surf, err);
     if (rc) return rc;
-    rc = sw_tetmesh_from_surface(&surf, target_tets, NULL, &out->mesh, report, err);
+    rc = sw_tetmesh_fill(&surf, target_tets, mesher, NULL, &out->mesh, report, err);
     if (rc) {
         sw_trimesh_free(&surf);
         char msg[sizeof err->msg];
@@ -300,7 +300,7 @@ sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets
         sw_error_set(err, rc, "%s: %s", obj_path, msg);
         return rc;
     }
-    /* the artist's surface is what the runtime outputs, carried by the lattice's tets
+    /* the artist's surface is what the runtime outputs, carried by the generated tets
        (issue 14); finish_character frees it with the character on an error */
     out->render = surf;
     return finish_character(obj_path, tgf_path, NULL, motion_path, nframes, out, err);

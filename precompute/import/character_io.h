@@ -5,7 +5,7 @@
 #include "clip_io.h"
 #include "rig.h"
 #include "sw_mesh.h"
-#include "tet_lattice.h"
+#include "mesher.h"
 
 /* A clip that slerps every bone from identity to the pose given as one quaternion per
  * bone (x, y, z, w; libigl hand-pose.dmat) over `nframes` and back. */
@@ -20,15 +20,15 @@ sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path
                                      const char *weights_path, const char *motion_path,
                                      int32_t nframes, sw_character *out, sw_error *err);
 
-/* A character from a render surface (.obj; it need not be closed) filled with about
- * target_tets tets by the lattice mesher (tet_lattice.h; report may be NULL), a .tgf
+/* A character from a render surface (.obj; it need not be closed for the lattice) filled
+ * with about target_tets tets by `mesher` (mesher.h; report may be NULL), a .tgf
  * skeleton and optional motion as in sw_character_from_files; inverse-distance weights
  * (a caller may compute heat-diffusion weights instead, as sinew-bake does). out->render
  * is the surface itself: a bake embeds it and the blob outputs it (issue 14). */
-sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets,
+sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets, sw_mesher mesher,
                                        const char *tgf_path, const char *motion_path,
-                                       int32_t nframes, sw_character *out,
-                                       sw_lattice_report *report, sw_error *err);
+                                       int32_t nframes, sw_character *out, sw_mesher_report *report,
+                                       sw_error *err);
 
 /* The file's name without folder and extension, cut to cap - 1 bytes: a character's name. */
 void sw_file_stem(const char *path, char *name, size_t cap);

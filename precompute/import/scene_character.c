@@ -253,16 +253,10 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
                                     sw_error *err) {
     sinew_result rc = choose_clips(ic, o, split, err);
     if (rc) return rc;
-    info->mesher = o->mesher;
-    if (o->mesher == SW_MESHER_TETGEN) {
-        rc =
-            sw_tetmesh_by_tetgen(&ic->render, o->target_tets, NULL, &out->mesh, &info->tetgen, err);
-    } else {
-        sw_pool *pool = sw_pool_create(0);
-        rc = sw_tetmesh_from_surface(&ic->render, o->target_tets, pool, &out->mesh, &info->lattice,
-                                     err);
-        sw_pool_destroy(pool);
-    }
+    sw_pool *pool = o->mesher == SW_MESHER_LATTICE ? sw_pool_create(0) : NULL;
+    rc =
+        sw_tetmesh_fill(&ic->render, o->target_tets, o->mesher, pool, &out->mesh, &info->mesh, err);
+    sw_pool_destroy(pool);
     if (rc) return rc;
     out->skel = ic->skel; /* moved */
     memset(&ic->skel, 0, sizeof ic->skel);
@@ -304,9 +298,6 @@ sinew_result sw_character_from_scene(const char *path, const sw_scene_character_
     if (opt.target_tets < 100 || opt.target_tets > 5000000)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "%s: %d simulation tets asked (100..5000000)", path, opt.target_tets);
-    if (opt.mesher != SW_MESHER_LATTICE && opt.mesher != SW_MESHER_TETGEN)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "%s: unknown mesher %d", path,
-                            (int)opt.mesher);
     sw_import_options io = {opt.fps, opt.target_height};
     sw_imported_character ic;
     sinew_result rc = sw_scene_import(path, &io, &ic, err);

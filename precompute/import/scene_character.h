@@ -14,13 +14,7 @@
 
 #include "scene_import.h"
 #include "sw_mesh.h"
-#include "tet_lattice.h"
-#include "tetgen_run.h"
-
-typedef enum sw_mesher {
-    SW_MESHER_LATTICE = 0, /* any surface; the default (tet_lattice.h) */
-    SW_MESHER_TETGEN = 1   /* closed surfaces, boundary-conforming (tetgen_run.h) */
-} sw_mesher;
+#include "mesher.h"
 
 /* Zero or NULL in a field means its default. */
 typedef struct sw_scene_character_options {
@@ -43,9 +37,7 @@ void sw_clip_split_free(sw_clip_split *s);
 
 /* What the import and the meshing did (for the bake's messages and its report). */
 typedef struct sw_scene_character_info {
-    sw_mesher mesher;
-    sw_lattice_report lattice; /* SW_MESHER_LATTICE */
-    sw_tetgen_report tetgen;   /* SW_MESHER_TETGEN */
+    sw_mesher_report mesh; /* what filled the render surface */
     int32_t render_verts, render_tris, nclips;
     int32_t anchored_components; /* mesh pieces with no driven vertex, anchored */
     int32_t undriven_bones;      /* bones that dominate no vertex: they drive none */
