@@ -315,9 +315,9 @@ int main(int argc, char **argv) {
                                    ad.rounds > 0 ? &arep : NULL,
                                    &et,
                                    &eh,
-                                   !ca.file                          ? NULL
+                                   !ca.file                               ? NULL
                                    : info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
-                                                                     : "lattice"};
+                                                                          : "lattice"};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
@@ -430,8 +430,8 @@ int main(int argc, char **argv) {
                res.render_max_bary, res.embed_seconds);
         if (ca.file)
             printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
-                   info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice", quality.min_dihedral_deg,
-                   quality.slivers);
+                   info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
+                   quality.min_dihedral_deg, quality.slivers);
         if (p.compare_selectors)
             printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
                    "\"nnhtp\":[%d,%.3f,%.4f]}",
