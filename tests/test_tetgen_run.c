@@ -4,13 +4,37 @@
  * own diagnosis quoted), a missing or failing program, bad arguments. Needs the Debian
  * `tetgen` program (tools/setup-debian.sh installs it). */
 #define _POSIX_C_SOURCE 200809L
+#include <dirent.h>
 #include <stdint.h>
+#include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "mesh_io.h"
 #include "surface_fixture.h"
 #include "sw_test.h"
 #include "tetgen_run.h"
+
+/* TetGen's files go to a folder of the bake's own under $TMPDIR: point TMPDIR at a fresh
+ * folder, and `tmpdir_entries` tells afterwards whether anything was left behind. */
+static char tmp_base[64];
+static void private_tmpdir(void) {
+    snprintf(tmp_base, sizeof tmp_base, "/tmp/test_tetgen_run-XXXXXX");
+    if (!mkdtemp(tmp_base)) abort();
+    setenv("TMPDIR", tmp_base, 1);
+}
+static int tmpdir_entries(void) {
+    DIR *d = opendir(tmp_base);
+    int n = 0;
+    for (struct dirent *e; d && (e = readdir(d));)
+        n += strcmp(e->d_name, ".") && strcmp(e->d_name, "..");
+    if (d) closedir(d);
+    return n;
+}
+static void end_private_tmpdir(void) {
+    rmdir(tmp_base);
+    unsetenv("TMPDIR");
+}
 
 /* A valid mesh (positive tets, indices in range), every vertex used, and every vertex of
  * `surf` a vertex of the mesh at the very same coordinates. */
@@ -39,7 +63,9 @@ TEST(a_sphere_is_filled_to_its_exact_volume) {
     sw_tetmesh t;
     sw_tetgen_report rep;
     sw_error e;
+    private_tmpdir();
     ENSUREF(sw_tetmesh_by_tetgen(&s, 4000, NULL, &t, &rep, &e) == SINEW_OK, "%s", e.msg);
+    ENSUREF(tmpdir_entries() == 0, "TetGen's folder left in %s", tmp_base);
     sw_quality q;
     sw_tetmesh_quality(&t, 0, &q);
     fprintf(stderr,
@@ -60,6 +86,7 @@ TEST(a_sphere_is_filled_to_its_exact_volume) {
     ENSUREF(t.ntets > 16000 / 1.25 && t.ntets < 16000 * 1.25, "%d tets for 16000", t.ntets);
     sw_tetmesh_free(&t);
     sw_trimesh_free(&s);
+    end_private_tmpdir();
 }
 
 /* Render meshes split vertices at UV seams: a box whose every triangle has corners of its
@@ -127,8 +154,12 @@ TEST(a_self_intersecting_surface_is_refused_with_tetgens_reason) {
     sw_trimesh two = boxes(2, lo, 1.0, -1);
     sw_tetmesh t;
     sw_error e;
+    private_tmpdir();
     ENSURE(sw_tetmesh_by_tetgen(&two, 1000, NULL, &t, NULL, &e) == SINEW_ERROR_IO);
     ENSUREF(strstr(e.msg, "failed") && strstr(e.msg, "intersect"), "%s", e.msg);
+    /* the diagnosing run writes files of its own (surface.1.smesh): they go too */
+    ENSUREF(tmpdir_entries() == 0, "TetGen's folder left in %s", tmp_base);
+    end_private_tmpdir();
     ENSURE(t.ntets == 0 && t.X == NULL);
     sw_trimesh_free(&two);
 }

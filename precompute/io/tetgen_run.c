@@ -1,6 +1,7 @@
 /* TetGen as a separate program (tetgen_run.h). */
 #include "tetgen_run.h"
 
+#include <dirent.h>
 #include <errno.h>
 #include <fcntl.h>
 #include <math.h>
@@ -180,13 +181,18 @@ static sinew_result run_tetgen(const char *program, const char *off_path, const 
                         msg[0] ? msg : "no message");
 }
 
+/* The folder is the bake's own (mkdtemp): everything TetGen left there goes, whatever
+ * its switches wrote (the -d diagnosis writes surface.1.smesh, other builds .face/.edge). */
 static void remove_dir(const char *dir) {
-    static const char *const names[] = {"surface.off",    "surface.1.node", "surface.1.ele",
-                                        "surface.1.face", "surface.1.edge", "tetgen.log"};
-    char path[4200];
-    for (size_t i = 0; i < sizeof names / sizeof names[0]; ++i) {
-        snprintf(path, sizeof path, "%s/%s", dir, names[i]);
-        unlink(path);
+    DIR *d = opendir(dir);
+    if (d) {
+        char path[4400];
+        for (struct dirent *e; (e = readdir(d));) {
+            if (!strcmp(e->d_name, ".") || !strcmp(e->d_name, "..")) continue;
+            snprintf(path, sizeof path, "%s/%s", dir, e->d_name);
+            unlink(path);
+        }
+        closedir(d);
     }
     rmdir(dir);
 }
