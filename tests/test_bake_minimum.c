@@ -1,6 +1,7 @@
 /* The bake's least input (issue 15): a clip too short to train on is rejected with the
  * minimum and the reason, not written as a blob with empty cubature or a useless basis;
  * sw_bake_solutions gives the very poses and solutions sw_bake keeps. Small meshes. */
+#include <math.h>
 #include <string.h>
 
 #include "sw_test.h"
@@ -250,8 +251,57 @@ TEST(pair_sweeps_turn_a_joint_with_its_parent) {
     sw_character_free(&c);
 }
 
+/* The sum over joints of the squared angle of a bone in its parent (the bake's bend). */
+static double bend_of(const sw_skeleton *sk, const double *T) {
+    double sum = 0, L[9];
+    for (int32_t b = 0; b < sk->nbones; ++b) {
+        if (sk->parent[b] < 0) continue;
+        local_of(sk, T, b, L);
+        double c = 0.5 * (L[0] + L[4] + L[8] - 1.0);
+        double a = acos(c > 1 ? 1 : c < -1 ? -1 : c);
+        sum += a * a;
+    }
+    return sum;
+}
+
+/* The return path goes home from where the training part of the clip left the fold: the
+ * finger's 30-frame clip bends to its peak at frame 15 and its 18 training frames end at
+ * 17, part of the way back. Frames 16..13 are bent more than 17 (played back they would
+ * re-bend the fold to the peak first); the path is frames 12..0, each bent less than the
+ * one before, continuing from frame 17's solution, and no held-out pose. */
+TEST(return_path_goes_home_from_the_last_training_frame) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 30, &c, &err) == SINEW_OK);
+    sw_bake_params p = quick_params();
+    sw_bake_result a, b;
+    ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    p.return_path = 1;
+    ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
+    int32_t nb = c.skel.nbones, ntf = 18, m = b.ntrain - a.ntrain;
+    size_t pose = (size_t)12 * nb;
+    ENSUREF(m == 13, "%d poses on the return path, 13 wanted (frames 12..0)", m);
+    ENSURE(!memcmp(a.train_T, c.clip.T, sizeof(double) * pose * ntf)); /* frames 0..17 */
+    double last = bend_of(&c.skel, c.clip.T + pose * (ntf - 1));
+    ENSURE(bend_of(&c.skel, c.clip.T + pose * 13) > last); /* a frame left out: re-bent */
+    for (int32_t i = 0; i < m; ++i) {
+        const double *T = b.train_T + pose * (ntf + i);
+        ENSUREF(!memcmp(T, c.clip.T + pose * (12 - i), sizeof(double) * pose),
+                "return pose %d is not frame %d", i, 12 - i);
+        double bend = bend_of(&c.skel, T);
+        ENSUREF(bend < last, "return pose %d bent %.4f, the one before %.4f", i, bend, last);
+        last = bend;
+    }
+    ENSURE(b.nheldout == a.nheldout &&
+           !memcmp(a.heldout_T, b.heldout_T, sizeof(double) * pose * a.nheldout));
+    sw_bake_result_free(&a);
+    sw_bake_result_free(&b);
+    sw_character_free(&c);
+}
+
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
              CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain),
              CASE(pair_sweeps_turn_a_joint_with_its_parent),
              CASE(heldout_frames_are_measured_on_the_reference_path),
-             CASE(contact_modes_extend_the_basis))
+             CASE(contact_modes_extend_the_basis),
+             CASE(return_path_goes_home_from_the_last_training_frame))

@@ -54,9 +54,11 @@ typedef struct sw_bake_params {
                                       (default 0; issue 16: combinations the single sweeps
                                       never show; measured in the README) */
     int32_t max_train_frames;      /* clip frames used for training at most (default 40) */
-    int return_path;               /* also train on those frames played back from the last one
-                                      (default 0; measured: finger held-out error 0.235 -> 0.164 at
-                                      20K tets, unchanged at 50K where the rank grows 41 -> 63) */
+    int return_path;               /* also train on the way home (bake_poses.c, return_frames):
+                                      the first training clip's frames from its last one
+                                      backwards, each bent less than the one before, continuing
+                                      from the last one's solution (default 0; finger 50K
+                                      held-out 0.1358 -> 0.0781, README) */
     int pose_force;                /* the pose-space equilibrium force (bake_equilibrium.c:
                                       the training poses' projected solutions made the
                                       runtime's equilibria there; default 1) */

@@ -2,9 +2,10 @@
  * Training: the first (1 - heldout) frames of the clip (evenly subsampled), or with
  * training clips of their own (sw_bake_params.train_clips: a glTF file's clips) each of
  * them as its own path from rest, with
- * return_path the same frames played back from the last one (the return path: a fold
- * that buckled on the way in can stay buckled on the way out, and the runtime picks
- * the branch by the direction the pose arrives from), per joint, a sweep from rest to
+ * return_path the way home from the first one's last frame (its earlier frames
+ * backwards, each bent less than the one before: a fold that buckled on the way in can
+ * stay buckled on the way out, and the runtime picks the branch by the direction the
+ * pose arrives from), per joint, a sweep from rest to
  * the largest rotation the training frames give it, and the caller's extra poses
  * (sw_bake_params.extra_poses: the adaptive loop's) in paths from rest.
  * Held-out: the clip's remaining frames, or the held-out clips one after the other on
@@ -238,6 +239,42 @@ static int swept(const double *sweep_angle, int32_t b) {
     return b >= 0 && sweep_angle[b] > 1e-3;
 }
 
+/* How far pose T is bent from rest: the sum over the joints (bones with a parent; the
+ * root's motion is rigid) of the squared angle of the bone's rotation in its parent's. */
+static double joint_bend(const sw_skeleton *sk, const double *T) {
+    double sum = 0, L[9], axis[3];
+    for (int32_t b = 0; b < sk->nbones; ++b) {
+        if (sk->parent[b] < 0) continue;
+        local_rotation(sk, T, b, L);
+        double a = rotation_axis_angle(L, axis);
+        sum += a * a;
+    }
+    return sum;
+}
+
+/* The return path's poses: the first training clip's frames (in q, n of them) played
+ * back from the last one, keeping a frame only when it is bent less than every one kept
+ * before it (the last included), so that the path goes home from where the clip left
+ * the fold. A clip whose training part ends after its peak (the finger's: bend, then
+ * part of the way back) would otherwise be re-bent to the peak first, and the reference
+ * then unbends on a branch of its own: the finger 50K's held-out frames, which go on
+ * unbending from the last training frame, lie 0.11-0.15 (their correction's share) from
+ * any blend of two neighbouring samples of that re-bent path and as far from the way in.
+ * idx: at most n - 1 entries; returns how many. */
+static int32_t return_frames(const sw_skeleton *sk, const sw_pose_seq *q, int32_t n, int32_t nb,
+                             int32_t *idx) {
+    int32_t m = 0;
+    double bend = n > 0 ? joint_bend(sk, q->T + (size_t)(n - 1) * 12 * nb) : 0;
+    for (int32_t i = n - 2; i >= 0; --i) {
+        double b = joint_bend(sk, q->T + (size_t)i * 12 * nb);
+        if (b < bend) {
+            idx[m++] = i;
+            bend = b;
+        }
+    }
+    return m;
+}
+
 static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t njoint,
                           const double *sweep_axis, const double *sweep_angle, double *local) {
     const sw_skeleton *sk = &s->ch.skel;
@@ -257,14 +294,25 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
         if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
         fill_from_range(&s->train[qi], 0, &train[r], n, nb);
     }
-    if (nreturn > 0) { /* train[0]'s frames n-2 .. 0, continuing from its last solution */
-        if (!seq_alloc(&s->train[qi], nreturn, nb, s->nv)) return 0;
+    if (nreturn > 0) { /* train[0]'s frames on the way home, continuing from its last solution */
+        int32_t *idx = malloc((size_t)nreturn * sizeof(int32_t));
+        if (!idx) return 0;
+        nreturn = return_frames(sk, &s->train[0], n0, nb, idx);
+        if (nreturn > 0 && !seq_alloc(&s->train[qi], nreturn, nb, s->nv)) {
+            free(idx);
+            return 0;
+        }
         for (int32_t i = 0; i < nreturn; ++i)
-            memcpy(s->train[qi].T + (size_t)i * 12 * nb,
-                   s->train[0].T + (size_t)(nreturn - 1 - i) * 12 * nb, 12 * nb * sizeof(double));
-        s->train[0].then[1] = &s->train[qi];
-        s->train[qi].continues = 1;
-        qi++;
+            memcpy(s->train[qi].T + (size_t)i * 12 * nb, s->train[0].T + (size_t)idx[i] * 12 * nb,
+                   12 * nb * sizeof(double));
+        free(idx);
+        if (nreturn > 0) {
+            s->train[0].then[1] = &s->train[qi];
+            s->train[qi].continues = 1;
+            qi++;
+        } else { /* the clip ended at rest: nothing to go home through */
+            s->ntrain_seq--;
+        }
     }
     /* a sweep per joint, then (pair_sweeps) a sweep of every joint with its parent joint */
     for (int pass = 0; pass < 2; ++pass)
