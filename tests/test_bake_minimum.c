@@ -294,6 +294,15 @@ TEST(return_path_goes_home_from_the_last_training_frame) {
     }
     ENSURE(b.nheldout == a.nheldout &&
            !memcmp(a.heldout_T, b.heldout_T, sizeof(double) * pose * a.nheldout));
+    sw_bake_result_free(&b);
+    /* a training part that ends at rest has no way home: the bake is the one without */
+    memcpy(c.clip.T + pose * (ntf - 1), c.clip.T, sizeof(double) * pose);
+    ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
+    sw_bake_result_free(&a);
+    p.return_path = 0;
+    ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    ENSUREF(b.ntrain == a.ntrain && !memcmp(a.train_T, b.train_T, sizeof(double) * pose * a.ntrain),
+            "%d training poses with the return path, %d without", b.ntrain, a.ntrain);
     sw_bake_result_free(&a);
     sw_bake_result_free(&b);
     sw_character_free(&c);
