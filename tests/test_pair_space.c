@@ -15,6 +15,7 @@
 #include "blob_load.h"
 #include "instance.h"
 #include "instance_internal.h"
+#include "self_contact.h"
 #include "sw_test.h"
 
 static bake_fixture fx;
@@ -256,6 +257,72 @@ TEST(a_pose_far_from_every_sample_falls_back_to_detection) {
     sinew_instance_destroy(in);
 }
 
+/* Thesis §3.3.1: a cubature vertex is tested against the flesh around its trained
+ * triangle, since on a fine mesh it may enter a nearby triangle instead. At a clip frame's
+ * solution every pair whose vertex lies in a tet of those rings takes the triangle the
+ * reference's rule gives (self_detect.h), and the full-mesh detection at the same state
+ * finds a contact for that vertex too, most often the same triangle; the others keep
+ * their trained triangle, and the gathered weights are all kept. */
+TEST(cubature_vertices_are_tested_against_the_flesh_around_their_triangles) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_instance *in = pairs_instance(f);
+    ENSURE(in);
+    const sw_blob_view *v = sw_blob_get_view(f->blob);
+    const int32_t nb = f->ch.skel.nbones, ns = v->nsurf_verts;
+    int32_t *p_moved = malloc(sizeof(int32_t) * (size_t)ns),
+            *tri_moved = malloc(sizeof(int32_t) * 3 * (size_t)ns);
+    ENSURE(p_moved && tri_moved);
+    int32_t moved_total = 0, same = 0, frames = 0;
+    for (int k = 0; k < f->ch.clip.nframes; ++k) {
+        const double *T = f->ch.clip.T + (size_t)k * 12 * nb;
+        ENSURE(sw_instance_set_pose_d(in, T) == SINEW_OK);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+        /* the frame's gathered pairs again, tested at its solution */
+        sw_pair_space_gather(&in->ps, v, T);
+        if (in->ps.novel > 0 || in->ps.npairs == 0) continue;
+        double w_before = 0, w_after = 0;
+        for (int32_t i = 0; i < in->ps.npairs; ++i)
+            w_before += in->ps.pair_w[i];
+        sw_self_contacts_clear(&in->sc);
+        int32_t moved = sw_self_contacts_retest(&in->sc, &in->red, in->solver.q, &in->ps);
+        ENSURE(moved == in->sc.npairs && in->sc.tests > 0);
+        for (int32_t i = 0; i < in->ps.npairs; ++i)
+            w_after += in->ps.pair_w[i];
+        for (int32_t i = 0; i < moved; ++i) {
+            w_after += in->sc.w[i];
+            p_moved[i] = in->sc.act[4 * i];
+            for (int c = 0; c < 3; ++c)
+                tri_moved[3 * i + c] = in->sc.act[4 * i + 1 + c];
+        }
+        ENSUREF(fabs(w_after - w_before) <= 1e-12 * w_before, "weights %.17g before, %.17g after",
+                w_before, w_after);
+        /* the whole mesh's detection at the same state */
+        sw_self_contacts_detect(&in->sc, &in->red, in->solver.q);
+        for (int32_t i = 0; i < moved; ++i) {
+            int32_t j = 0;
+            while (j < in->sc.npairs && in->sc.act[4 * j] != p_moved[i])
+                ++j;
+            ENSUREF(j < in->sc.npairs,
+                    "frame %d: vertex %d entered a ring tet, but the whole "
+                    "mesh's detection finds no contact for it",
+                    k, p_moved[i]);
+            same += !memcmp(in->sc.act + 4 * j + 1, tri_moved + 3 * i, 3 * sizeof(int32_t));
+        }
+        moved_total += moved;
+        frames += moved > 0;
+    }
+    fprintf(stderr,
+            "    %d pairs moved on %d frames, %d of them to the triangle the whole mesh's "
+            "detection gives\n",
+            moved_total, frames, same);
+    ENSUREF(moved_total > 0, "no cubature vertex entered the flesh around its triangle");
+    ENSURE(2 * same >= moved_total);
+    free(p_moved);
+    free(tri_moved);
+    sinew_instance_destroy(in);
+}
+
 TEST(a_blob_with_a_corrupt_pair_section_is_refused) {
     const bake_fixture *f = fixture();
     ENSURE(f);
@@ -299,4 +366,5 @@ SW_TEST_MAIN(CASE(the_pair_feature_ignores_rigid_motion_and_matches_the_bake),
              CASE(a_pair_cubature_reproduces_its_reduced_force_within_tolerance),
              CASE(two_identical_samples_blended_are_one),
              CASE(a_pose_far_from_every_sample_falls_back_to_detection),
+             CASE(cubature_vertices_are_tested_against_the_flesh_around_their_triangles),
              CASE(a_blob_with_a_corrupt_pair_section_is_refused), CASE(release_fixture))

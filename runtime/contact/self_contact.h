@@ -33,12 +33,23 @@ typedef struct sw_self_contacts {
     /* the pairs in use, in the pose-space pairs' form (pose_contact.h): per pair the
        (domain, local) copies of p, t0, t1, t2, then b0..b2, R_p^T n, ka, and the slots'
        vertex ids (their transforms in vR, vt) */
-    int32_t *verts; /* 8 nsurf */
-    double *data;   /* 7 nsurf */
-    int32_t *act;   /* 4 nsurf */
-    int32_t npairs; /* pairs in use (at most one per surface vertex) */
-    int64_t tests;  /* candidate tets the last detection tested */
+    int32_t *verts;  /* 8 nsurf */
+    double *data;    /* 7 nsurf */
+    int32_t *act;    /* 4 nsurf */
+    double *w, *tan; /* nsurf: each pair's weight and tangential share (1 when detected) */
+    int32_t npairs;  /* pairs in use (at most nsurf) */
+    int64_t tests;   /* candidate tets the last detection tested */
+    /* the pose-pairs re-test's (sw_self_contacts_retest): the detection each vertex and
+       tet was last mapped or listed in (stamp), and the candidate tets of one pair */
+    int32_t *vstamp; /* nverts */
+    int32_t *tstamp; /* ntets */
+    int32_t *cand;   /* SW_RETEST_CANDIDATES: one pair's candidate tets */
+    int32_t stamp;
 } sw_self_contacts;
+
+/* The most tets a cubature vertex is tested against: those incident to its trained
+ * triangle's corners (about 30 on the samples' meshes). */
+#define SW_RETEST_CANDIDATES 1024
 
 /* Lays out the arrays for blob v in p (v must hold its tet mesh). */
 void sw_self_contacts_take(sw_mem_plan *p, const sw_blob_view *v, sw_self_contacts *sc);
@@ -59,6 +70,18 @@ int32_t sw_self_contacts_detect(sw_self_contacts *sc, const sw_reduced *red, con
  * novel contact, pair_space.c). */
 int32_t sw_self_contacts_detect_pairs(sw_self_contacts *sc, const sw_reduced *red, const double *q,
                                       const unsigned char *mask);
+
+/* Pose-pairs mode (thesis §3.3.1): each pair ps gathered, its cubature vertex p tested at
+ * the state q against the tets around its trained triangle (those incident to the
+ * triangle's corners) with the rule of self_detect.h. The thesis tests a cubature vertex
+ * against the other domain's every tet, because on a fine mesh p "could easily penetrate
+ * a nearby triangle instead" of the trained one; the ring holds those nearby triangles
+ * without mapping and refitting the whole domain each step. A pair whose p entered one of
+ * them becomes a pair in use (appended, at its gathered weight and tangential share) and
+ * leaves ps; the others keep their trained triangle. Maps only the vertices it reads.
+ * Returns how many pairs moved. */
+int32_t sw_self_contacts_retest(sw_self_contacts *sc, const sw_reduced *red, const double *q,
+                                sw_pose_space *ps);
 
 /* Forgets the pairs in use. */
 void sw_self_contacts_clear(sw_self_contacts *sc);

@@ -164,18 +164,49 @@ static void make_contact(const sw_self_mesh *sc, const double *x, int32_t si, co
     }
 }
 
+static void query_init(vertex_query *q, const sw_self_mesh *m, const double *x, int32_t si) {
+    q->sc = m;
+    q->x = x;
+    q->p = m->surf[si];
+    q->xp = x + 3 * (size_t)q->p;
+    q->tet = -1;
+    q->rest_depth = 0;
+}
+
 int sw_self_detect_vertex(const sw_self_mesh *m, const double *x, int32_t si, sw_contact *c,
                           int32_t *tested) {
     vertex_query q;
-    q.sc = m;
-    q.x = x;
-    q.p = m->surf[si];
-    q.xp = x + 3 * (size_t)q.p;
-    q.tet = -1;
-    q.rest_depth = 0;
+    query_init(&q, m, x, si);
     int32_t visits = sw_bvh_query_point(&m->tet_bvh, q.xp, visit_tet, &q);
     if (tested) *tested = visits;
     if (q.tet < 0) return 0;
     make_contact(m, x, si, &q, c);
     return 1;
+}
+
+int sw_self_detect_among(const sw_self_mesh *m, const double *x, int32_t si, const int32_t *tets,
+                         int32_t n, sw_self_hit *hit) {
+    vertex_query q;
+    query_init(&q, m, x, si);
+    for (int32_t i = 0; i < n; ++i)
+        visit_tet(&q, tets[i]);
+    hit->si = si;
+    hit->tet = q.tet;
+    hit->rest_depth = q.rest_depth;
+    hit->hit = q.hit;
+    return q.tet >= 0;
+}
+
+const int32_t *sw_self_hit_triangle(const sw_self_mesh *m, const sw_self_hit *hit) {
+    return m->tris + 3 * (size_t)hit->hit.tri;
+}
+
+void sw_self_detect_finish(const sw_self_mesh *m, const double *x, const sw_self_hit *hit,
+                           sw_contact *c) {
+    vertex_query q;
+    query_init(&q, m, x, hit->si);
+    q.tet = hit->tet;
+    q.rest_depth = hit->rest_depth;
+    q.hit = hit->hit;
+    make_contact(m, x, hit->si, &q, c);
 }

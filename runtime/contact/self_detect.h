@@ -67,4 +67,23 @@ void sw_self_mesh_measures(sw_self_mesh *m);
 int sw_self_detect_vertex(const sw_self_mesh *m, const double *x, int32_t si, sw_contact *c,
                           int32_t *tested);
 
+/* A vertex's chosen tet and rest triangle, before its contact is made. */
+typedef struct sw_self_hit {
+    int32_t si;  /* the vertex's index in surf */
+    int32_t tet; /* the tet it entered */
+    double rest_depth;
+    sw_bvh_closest hit; /* its rest point's closest rest-surface triangle */
+} sw_self_hit;
+
+/* The rule of sw_self_detect_vertex over the candidate tets tets[0..n) instead of
+ * tet_bvh's query (the pose-pairs mode's test of a cubature vertex against the flesh
+ * around its trained triangle, thesis §3.3.1): x must hold the vertex and the candidates'
+ * corners. 0 when the vertex is in none of them. The contact is then made by
+ * sw_self_detect_finish, once x also holds the corners of sw_self_hit_triangle. */
+int sw_self_detect_among(const sw_self_mesh *m, const double *x, int32_t si, const int32_t *tets,
+                         int32_t n, sw_self_hit *hit);
+const int32_t *sw_self_hit_triangle(const sw_self_mesh *m, const sw_self_hit *hit);
+void sw_self_detect_finish(const sw_self_mesh *m, const double *x, const sw_self_hit *hit,
+                           sw_contact *c);
+
 #endif

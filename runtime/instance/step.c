@@ -124,6 +124,12 @@ static void phase_self(sw_step_ctx *c) {
             c->st.self_contact_tests += (uint32_t)in->sc.tests;
             c->st.self_contacts += (uint32_t)in->sc.npairs;
         }
+        /* the cubature vertices against the flesh around their trained triangles */
+        int64_t tests = in->sc.tests;
+        /* a dynamic step's material part at q_n (phase_dynamics) held the moved pairs */
+        if (sw_self_contacts_retest(&in->sc, &in->red, in->solver.q, &in->ps) > 0)
+            in->solver.mat_at_qn = 0;
+        c->st.self_contact_tests += (uint32_t)(in->sc.tests - tests);
     }
     sw_step_contacts ct = sw_instance_contacts(in, NULL);
     sw_solver_block_pattern(&in->solver, in->v, &ct);

@@ -96,8 +96,8 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
     if (ct->sc) {
         double t0 = ct->self_seconds ? sw_now_seconds() : 0;
         sw_pair_set set = sw_self_contacts_pairs(ct->sc);
-        phi += sw_contact_pairs_eval(red, &set, NULL, ct->sc->npairs, NULL, NULL, q, want_grad,
-                                     want_hess);
+        phi += sw_contact_pairs_eval(red, &set, NULL, ct->sc->npairs, ct->sc->w, ct->sc->tan, q,
+                                     want_grad, want_hess);
         if (ct->self_seconds) *ct->self_seconds += sw_now_seconds() - t0;
     }
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);

@@ -267,7 +267,9 @@ typedef struct sinew_step_stats {
      * evaluation (inside ms_contact and ms_solve, which include it) */
     double ms_self_contact;
     /** self-contact candidates tested this step: the pose-space pairs in use, or the
-     * exhaustive detections' (vertex, tet) candidates whose boxes overlap */
+     * exhaustive detections' (vertex, tet) candidates whose boxes overlap; with
+     * SINEW_SELF_CONTACT_POSE_PAIRS also the tets each cubature vertex was tested
+     * against (those around its trained triangle) */
     uint32_t self_contact_tests;
     /** self-contact pairs in the solve: the pose-space pairs in use, or the exhaustive
      * detection's pairs at the end of the step */
