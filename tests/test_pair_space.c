@@ -15,6 +15,7 @@
 #include "blob_load.h"
 #include "instance.h"
 #include "instance_internal.h"
+#include "mat3.h"
 #include "self_contact.h"
 #include "sw_test.h"
 
@@ -198,14 +199,34 @@ static int descends(const sw_skeleton *sk, int32_t b, int32_t a) {
     return 0;
 }
 
+/* The axis bone b bends about in the clip: that of its rotation in the frame where it is
+ * turned furthest (the finger's joints all bend about one axis). */
+static void bend_axis(const bake_fixture *f, int32_t b, double axis[3]) {
+    const int32_t nb = f->ch.skel.nbones;
+    double best = -1;
+    for (int k = 0; k < f->ch.clip.nframes; ++k) {
+        const double *R = f->ch.clip.T + ((size_t)k * nb + b) * 12;
+        double w[3] = {R[7] - R[5], R[2] - R[6], R[3] - R[1]},
+               n = sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2]);
+        if (n > best && n > 0) {
+            best = n;
+            for (int i = 0; i < 3; ++i)
+                axis[i] = w[i] / n;
+        }
+    }
+}
+
 /* The clip's frame k with the bone of domain 1 and its descendants turned by `angle` about
- * the axis x through that bone's head joint: the two domains' relative motion. */
+ * the axis that bone bends about in the clip, through its head joint: the two domains'
+ * relative motion, past anything the clip does for |angle| well beyond its bend. */
 static void bent_joint(const bake_fixture *f, int k, double angle, double *T) {
     const sw_skeleton *sk = &f->ch.skel;
     const int32_t nb = sk->nbones, bone = sw_blob_get_view(f->blob)->domains[1].bone;
     memcpy(T, f->ch.clip.T + (size_t)k * 12 * nb, sizeof(double) * 12 * (size_t)nb);
     const double *X = sk->joints + 3 * sk->bones[2 * bone], *R0 = T + 12 * bone;
-    double p[3], c = cos(angle), s = sin(angle), Q[9] = {1, 0, 0, 0, c, -s, 0, s, c};
+    double p[3], axis[3] = {1, 0, 0}, Q[9];
+    bend_axis(f, bone, axis);
+    sw_m3_axis_angle(axis, angle, Q);
     for (int i = 0; i < 3; ++i) /* the joint where the pose put it */
         p[i] = R0[3 * i] * X[0] + R0[3 * i + 1] * X[1] + R0[3 * i + 2] * X[2] + R0[9 + i];
     for (int32_t b = 0; b < nb; ++b) {

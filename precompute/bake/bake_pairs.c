@@ -9,9 +9,11 @@
  * snapshots are Y = M Z with M (3n x 12) fixed. Their uncentred PCA is then the
  * eigenproblem of S = G^1/2 Z Z^T G^1/2 (12 x 12) with G = M^T M, and the coordinates of a
  * pose are w_k^T G^1/2 z: the runtime's feature is a 6 x 12 map of z, whatever the size
- * of b. The feature is invariant to a rigid motion of the whole character. A domain
- * against itself has no relative motion (z is constant): its groups keep a zero map and
- * the runtime takes their samples from the whole skeleton's nearest poses.
+ * of b. Where the training poses vary along fewer than six directions, the rest are the
+ * rigid motions they never made (complete_directions), not LAPACK's arbitrary vectors. The feature
+ * is invariant to a rigid motion of the whole character. A domain against itself has no relative
+ * motion (z is constant): its groups keep a zero map and the runtime takes their samples from the
+ * whole skeleton's nearest poses.
  *
  * Cubature (eqs. 3.9-3.13): per (pose, group), non-negative weights for a few of its pairs
  * whose reduced contact forces at the reference's solution sum to the group's whole
@@ -48,6 +50,53 @@ static const double *train_T(const sw_bake_state *s, int32_t k) {
     int32_t j;
     const sw_pose_seq *q = train_seq(s, k, &j);
     return q->T + (size_t)j * 12 * s->nb;
+}
+
+/* An eigenvalue of the training poses' S below this share of the largest is rounding: the
+ * poses do not vary along its direction, and which vector LAPACK returns for it depends
+ * on the machine's kernels. */
+#define SW_PAIR_FEATURE_RANK_TOL 1e-9
+
+/* Completes W's first `kept` rows (orthonormal) toward six with the rigid motions the
+ * training poses never made: b turned about each axis of a's frame, then moved along each
+ * (z = [vec(E_k); 0] and [0; e_k], E_k the cross-product matrix of e_k), carried into u =
+ * G^1/2 z and made orthogonal to the rows before them in this fixed order. Without them a
+ * group whose training poses bend one joint about one axis (a finger's knuckle: S of rank
+ * 3) has a feature blind to a twist or a sideways bend, and the novelty test
+ * (SW_PAIR_NOVEL) misses poses far from every sample; its remaining PCA directions would
+ * be arbitrary. Returns the rows added. */
+static int complete_directions(const double Gh[144], double W[6][12], int kept) {
+    int added = 0;
+    for (int c = 0; c < 6 && kept + added < 6; ++c) {
+        double z[12] = {0}, u[12], n0 = 0, n = 0;
+        if (c < 3) { /* E_c, row-major: E[r][s] = -eps(c, r, s) */
+            int r = (c + 1) % 3, q = (c + 2) % 3;
+            z[3 * r + q] = -1;
+            z[3 * q + r] = 1;
+        } else {
+            z[9 + c - 3] = 1;
+        }
+        for (int i = 0; i < 12; ++i) {
+            u[i] = 0;
+            for (int j = 0; j < 12; ++j)
+                u[i] += Gh[i * 12 + j] * z[j];
+            n0 += u[i] * u[i];
+        }
+        for (int k = 0; k < kept + added; ++k) { /* modified Gram-Schmidt */
+            double d = 0;
+            for (int i = 0; i < 12; ++i)
+                d += W[k][i] * u[i];
+            for (int i = 0; i < 12; ++i)
+                u[i] -= d * W[k][i];
+        }
+        for (int i = 0; i < 12; ++i)
+            n += u[i] * u[i];
+        if (!(n > 1e-12 * n0)) continue; /* within the directions already there */
+        for (int i = 0; i < 12; ++i)
+            W[kept + added][i] = u[i] / sqrt(n);
+        added++;
+    }
+    return added;
 }
 
 /* Group g's 6 x 12 feature map (see above) from domain b's rest vertices and the training
@@ -93,15 +142,19 @@ static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map
                 S[i * 12 + j] += u[i] * u[j];
     }
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', 12, S, 12, ev) != 0) return 0;
-    for (int k = 0; k < 6; ++k) { /* eigenvalues ascend: the top six, w_k^T G^1/2 */
-        int col = 11 - k;
+    double W[6][12]; /* the feature's directions w_k (unit, in u = G^1/2 z) */
+    int kept = 0;    /* eigenvalues ascend: the top six that the training poses vary along */
+    for (int k = 0; k < 6 && ev[11 - k] > SW_PAIR_FEATURE_RANK_TOL * ev[11]; ++k, ++kept)
+        for (int i = 0; i < 12; ++i)
+            W[k][i] = S[i * 12 + 11 - k];
+    kept += complete_directions(Gh, W, kept);
+    for (int k = 0; k < kept; ++k) /* the map's rows w_k^T G^1/2 (rows past `kept` stay 0) */
         for (int j = 0; j < 12; ++j) {
             double acc = 0;
             for (int i = 0; i < 12; ++i)
-                acc += S[i * 12 + col] * Gh[i * 12 + j];
+                acc += W[k][i] * Gh[i * 12 + j];
             map[12 * k + j] = acc;
         }
-    }
     return 1;
 }
 
