@@ -67,10 +67,10 @@ TEST(a_rebake_reads_the_solutions_back_and_writes_the_same_blob) {
     c.youngs /= 1.01;
     c.clip.T[12 * c.skel.nbones * (c.clip.nframes - 1)] += 1e-9;
     ENSUREF(sw_bake(&c, &cached, &r3, &err) == SINEW_OK, "%s", err.msg);
-    /* one file per chain: the clip's path (training then held-out frames) is solved
-       again, the joint sweeps are read back */
-    ENSURE(!r3.simulate_cached && r3.simulate_solved == c.clip.nframes && r2.simulate_solved == 0 &&
-           r1.simulate_solved == r1.ntrain + r1.nheldout);
+    /* one file per chain: the clip's path (training then held-out frames, and the way
+       home from its last training frame) is solved again, the joint sweeps are read back */
+    ENSURE(!r3.simulate_cached && r3.simulate_solved == c.clip.nframes + r3.return_poses &&
+           r2.simulate_solved == 0 && r1.simulate_solved == r1.ntrain + r1.nheldout);
     sw_bake_result_free(&r3);
     cached.self_contact = 0;
     ENSUREF(sw_bake(&c, &cached, &r3, &err) == SINEW_OK, "%s", err.msg);

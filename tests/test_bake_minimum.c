@@ -170,6 +170,7 @@ TEST(heldout_frames_are_measured_on_the_reference_path) {
     int32_t nb = c.skel.nbones, pre = -1, n = -1;
     size_t pt = (size_t)12 * nb * sizeof(double);
     ENSURE(a.heldout_after == 6 && a.nheldout == 4);
+    ENSURE(a.return_poses > 0); /* the held-out frames continue the clip: the way home too */
     double *T = sw_bake_heldout_path(&a, nb, &pre, &n);
     ENSURE(T && pre == 6 && n == 10);
     for (int32_t f = 0; f < n; ++f) /* the clip itself, frame after frame */
@@ -182,6 +183,7 @@ TEST(heldout_frames_are_measured_on_the_reference_path) {
     p.heldout_clips = &c.clip;
     p.nheldout_clips = 1;
     ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(a.return_poses == 0); /* named training clips: no way home unless asked for */
     T = sw_bake_heldout_path(&a, nb, &pre, &n);
     ENSURE(T && a.heldout_after == 0 && pre == 0 && n == a.nheldout &&
            !memcmp(T, a.heldout_T, (size_t)n * pt));
@@ -275,12 +277,15 @@ TEST(return_path_goes_home_from_the_last_training_frame) {
     ENSURE(sw_sample_make("finger", 1000, 30, &c, &err) == SINEW_OK);
     sw_bake_params p = quick_params();
     sw_bake_result a, b;
+    p.return_path = 0;
     ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
-    p.return_path = 1;
+    p.return_path = -1; /* the default: on, the held-out frames continue the training clip */
     ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
     int32_t nb = c.skel.nbones, ntf = 18, m = b.ntrain - a.ntrain;
     size_t pose = (size_t)12 * nb;
-    ENSUREF(m == 13, "%d poses on the return path, 13 wanted (frames 12..0)", m);
+    ENSUREF(m == 13 && b.return_poses == 13 && a.return_poses == 0,
+            "%d poses on the return path (%d reported), 13 wanted (frames 12..0)", m,
+            b.return_poses);
     ENSURE(!memcmp(a.train_T, c.clip.T, sizeof(double) * pose * ntf)); /* frames 0..17 */
     double last = bend_of(&c.skel, c.clip.T + pose * (ntf - 1));
     ENSURE(bend_of(&c.skel, c.clip.T + pose * 13) > last); /* a frame left out: re-bent */
@@ -297,6 +302,7 @@ TEST(return_path_goes_home_from_the_last_training_frame) {
     sw_bake_result_free(&b);
     /* a training part that ends at rest has no way home: the bake is the one without */
     memcpy(c.clip.T + pose * (ntf - 1), c.clip.T, sizeof(double) * pose);
+    p.return_path = 1;
     ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
     sw_bake_result_free(&a);
     p.return_path = 0;

@@ -5,7 +5,8 @@
  *              --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat] [--clip FILE])
  *              --out FILE.blob [--report DIR]
  *              [--selector greedy|importance|nnhtp] [--tol 0.05] [--max-rank R]
- *              [--compare-cubature] [--no-self-contact] [--return-path] [--inertia-modes]
+ *              [--compare-cubature] [--no-self-contact] [--return-path|--no-return-path]
+ *              [--inertia-modes]
  *              [--threads T] [--data DIR]
  *              [--force] [--json]
  *
@@ -45,7 +46,8 @@ static void usage(FILE *f) {
                "                  --out FILE.blob [--report DIR]\n"
                "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
                "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
-               "                  [--compare-cubature] [--no-self-contact] [--return-path]\n"
+               "                  [--compare-cubature] [--no-self-contact]\n"
+               "                  [--return-path|--no-return-path]\n"
                "                  [--pair-sweeps] [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]]\n"
@@ -71,7 +73,10 @@ static void usage(FILE *f) {
             "                   2.5 E h the one with the lowest training error)\n"
             "  --return-path    also train on the way home: from the first training clip's\n"
             "                   last frame, its earlier frames backwards, each bent less than\n"
-            "                   the one before (a fold keeps its branch on the way out)\n"
+            "                   the one before (a fold keeps its branch on the way out); by\n"
+            "                   default on where the held-out frames continue the training\n"
+            "                   clip (a --clip or a file's one clip split 60/40), off for\n"
+            "                   --train-clips; --no-return-path: never\n"
             "  --pair-sweeps    also train on every joint swept together with its parent\n"
             "                   joint (combinations the single-joint sweeps never show)\n"
             "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
@@ -166,6 +171,8 @@ int main(int argc, char **argv) {
             p.self_contact = 0;
         else if (!strcmp(a, "--return-path"))
             p.return_path = 1;
+        else if (!strcmp(a, "--no-return-path"))
+            p.return_path = 0;
         else if (!strcmp(a, "--pair-sweeps"))
             p.pair_sweeps = 1;
         else if (!strcmp(a, "--adaptive") && next)
@@ -404,17 +411,18 @@ int main(int argc, char **argv) {
     }
     if (json) {
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
-               "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"heldout_poses\":%d,"
+               "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
+               "\"heldout_poses\":%d,"
                "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
                "heldout\":%.5f,"
                "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
                "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,"
                "%.2f,%.2f]",
                out_path, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones, v->ndomains, v->rank_total,
-               v->ncub, res.cubature_error_max, res.ntrain, res.nheldout, res.train_proj_error,
-               res.heldout_proj_error, et.correction_error, eh.correction_error,
-               res.train_unsettled, res.heldout_unsettled, bake_seconds, eval_seconds,
-               res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
+               v->ncub, res.cubature_error_max, res.ntrain, res.return_poses, res.nheldout,
+               res.train_proj_error, res.heldout_proj_error, et.correction_error,
+               eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
+               eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f", res.force_poses, model_err);
         printf(",\"spring_k\":%.6g,\"spring_tried\":[", res.spring_k);

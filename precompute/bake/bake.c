@@ -27,7 +27,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.sweep_samples = 6;
     p.pair_sweeps = 0;
     p.max_train_frames = 40;
-    p.return_path = 0;
+    p.return_path = -1;
     p.pose_force = 1;
     p.inertia_modes = 0;
     p.contact_cubature_tol = 0.05;
@@ -294,6 +294,7 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
         (r = sw_bake_simulate_cached(s, &out->simulate_cached, err)) != SINEW_OK)
         return r;
     out->simulate_solved = (int32_t)s->solved_poses;
+    out->return_poses = s->return_poses;
     size_t na = (size_t)s->nb * 3 * sizeof(double);
     if (!(out->sweep_axis = sw_bake_own(out, malloc(na))) ||
         !(out->sweep_angle = sw_bake_own(out, malloc(na / 3))))

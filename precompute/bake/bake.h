@@ -57,8 +57,13 @@ typedef struct sw_bake_params {
     int return_path;               /* also train on the way home (bake_poses.c, return_frames):
                                       the first training clip's frames from its last one
                                       backwards, each bent less than the one before, continuing
-                                      from the last one's solution (default 0; finger 50K
-                                      held-out 0.1358 -> 0.0781, README) */
+                                      from the last one's solution. 1 on, 0 off, -1 (default)
+                                      on where the held-out frames continue the training
+                                      clip (a character's own clip split by
+                                      heldout_fraction: what plays after the training part
+                                      starts from its last frame), off for training clips
+                                      named in train_clips (finger 50K held-out 0.1358 ->
+                                      0.0781, README The way home) */
     int pose_force;                /* the pose-space equilibrium force (bake_equilibrium.c:
                                       the training poses' projected solutions made the
                                       runtime's equilibria there; default 1) */
@@ -131,6 +136,7 @@ typedef struct sw_bake_result {
     int32_t train_unsettled, heldout_unsettled;
     int simulate_cached;       /* the simulate stage read all its solutions from the cache */
     int32_t simulate_solved;   /* poses it solved (the others it read from the cache) */
+    int32_t return_poses;      /* training poses on the way home (sw_bake_params.return_path) */
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     double cubature_error_max; /* worst per-domain relative cubature training error */

@@ -2,7 +2,8 @@
  * Training: the first (1 - heldout) frames of the clip (evenly subsampled), or with
  * training clips of their own (sw_bake_params.train_clips: a glTF file's clips) each of
  * them as its own path from rest, with
- * return_path the way home from the first one's last frame (its earlier frames
+ * return_path (by default where the held-out frames continue the training clip) the way
+ * home from the first one's last frame (its earlier frames
  * backwards, each bent less than the one before: a fold that buckled on the way in can
  * stay buckled on the way out, and the runtime picks the branch by the direction the
  * pose arrives from), per joint, a sweep from rest to
@@ -275,12 +276,19 @@ static int32_t return_frames(const sw_skeleton *sk, const sw_pose_seq *q, int32_
     return m;
 }
 
-static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t njoint,
-                          const double *sweep_axis, const double *sweep_angle, double *local) {
+/* Whether the bake trains on the way home (sw_bake_params.return_path): by default where
+ * the held-out frames continue the training part of the character's own clip. */
+static int wants_return_path(const sw_bake_params *p, int32_t nheld) {
+    return p->return_path > 0 || (p->return_path < 0 && p->ntrain_clips == 0 && nheld > 0);
+}
+
+static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t nheld,
+                          int32_t njoint, const double *sweep_axis, const double *sweep_angle,
+                          double *local) {
     const sw_skeleton *sk = &s->ch.skel;
     int32_t nb = s->nb, cap = s->p->max_train_frames;
     int32_t n0 = ntr > 0 ? (train[0].count < cap ? train[0].count : cap) : 0;
-    int32_t nreturn = s->p->return_path && n0 >= 2 ? n0 - 1 : 0, npair = 0;
+    int32_t nreturn = wants_return_path(s->p, nheld) && n0 >= 2 ? n0 - 1 : 0, npair = 0;
     for (int32_t b = 0; s->p->pair_sweeps && b < nb; ++b)
         npair += swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b]);
     int32_t chain = s->p->extra_chain > 0 ? s->p->extra_chain : s->p->nextra_poses;
@@ -306,6 +314,7 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
             memcpy(s->train[qi].T + (size_t)i * 12 * nb, s->train[0].T + (size_t)idx[i] * 12 * nb,
                    12 * nb * sizeof(double));
         free(idx);
+        s->return_poses = nreturn;
         if (nreturn > 0) {
             s->train[0].then[1] = &s->train[qi];
             s->train[qi].continues = 1;
@@ -373,7 +382,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
                 sw_bake_min_frames(s->p->heldout_fraction));
         goto done;
     }
-    if (!training_poses(s, train, ntr, njoint, sweep_axis, sweep_angle, local) ||
+    if (!training_poses(s, train, ntr, nheld, njoint, sweep_axis, sweep_angle, local) ||
         !heldout_poses(s, held, nheld, sweep_axis, sweep_angle, local))
         goto oom;
     goto done;
