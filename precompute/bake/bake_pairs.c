@@ -52,6 +52,16 @@ static const double *train_T(const sw_bake_state *s, int32_t k) {
     return q->T + (size_t)j * 12 * s->nb;
 }
 
+/* u = G^1/2 z: a relative transform in the coordinates where the surface's mean squared
+ * displacement is |u|^2. */
+static void whiten(const double Gh[144], const double z[12], double u[12]) {
+    for (int i = 0; i < 12; ++i) {
+        u[i] = 0;
+        for (int j = 0; j < 12; ++j)
+            u[i] += Gh[i * 12 + j] * z[j];
+    }
+}
+
 /* An eigenvalue of the training poses' S below this share of the largest is rounding: the
  * poses do not vary along its direction, and which vector LAPACK returns for it depends
  * on the machine's kernels. */
@@ -76,12 +86,9 @@ static int complete_directions(const double Gh[144], double W[6][12], int kept) 
         } else {
             z[9 + c - 3] = 1;
         }
-        for (int i = 0; i < 12; ++i) {
-            u[i] = 0;
-            for (int j = 0; j < 12; ++j)
-                u[i] += Gh[i * 12 + j] * z[j];
+        whiten(Gh, z, u);
+        for (int i = 0; i < 12; ++i)
             n0 += u[i] * u[i];
-        }
         for (int k = 0; k < kept + added; ++k) { /* modified Gram-Schmidt */
             double d = 0;
             for (int i = 0; i < 12; ++i)
@@ -132,11 +139,7 @@ static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map
     for (int32_t t = 0; t < s->ntrain; ++t) { /* S = G^1/2 (sum z z^T) G^1/2 */
         double z[12], u[12];
         relative_z(train_T(s, t), s->domain_bone[a], s->domain_bone[b], z);
-        for (int i = 0; i < 12; ++i) {
-            u[i] = 0;
-            for (int j = 0; j < 12; ++j)
-                u[i] += Gh[i * 12 + j] * z[j];
-        }
+        whiten(Gh, z, u);
         for (int i = 0; i < 12; ++i)
             for (int j = 0; j < 12; ++j)
                 S[i * 12 + j] += u[i] * u[j];
