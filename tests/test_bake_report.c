@@ -216,6 +216,94 @@ TEST(clips_of_their_own_and_the_report) {
     sw_character_free(&ch);
 }
 
+/* A bare skeleton (no clip): the held-out poses are random combined poses, which the
+ * report shows as a held-out set of their own, each pose's error the evaluation's; no
+ * empty training clip is listed. */
+TEST(random_heldout_poses_in_the_report) {
+    sw_character ch;
+    sw_error e;
+    ENSURE(sw_sample_make("finger", 1000, 8, &ch, &e) == SINEW_OK);
+    ch.clip.nframes = 0; /* the sample's clip unused: sweeps train, random poses are held out */
+    sw_bake_params p = sw_bake_params_default();
+    p.threads = 2;
+    p.random_poses = 4;
+    sw_bake_result res;
+    sinew_result r = sw_bake(&ch, &p, &res, &e);
+    ENSUREF(r == SINEW_OK, "%s", e.msg);
+    if (r) {
+        sw_character_free(&ch);
+        return;
+    }
+    ENSURE(res.nheldout == 4);
+    for (int32_t k = 0; k < res.nheldout; ++k)
+        ENSURE(res.heldout_clip[k] < 0);
+    void *mem = NULL;
+    size_t size = 0;
+    ENSURE(sw_blob_write_memory(&res.view, &mem, &size, &e) == SINEW_OK);
+    sinew_blob_def bd = sinew_blob_def_default();
+    bd.data = mem;
+    bd.data_size = size;
+    sinew_blob *blob = NULL;
+    ENSURE(sinew_blob_load(&bd, &blob) == SINEW_OK);
+    double *fe = malloc(sizeof(double) * (size_t)(res.ntrain + res.nheldout));
+    sw_eval_result et, eh;
+    ENSURE(blob && fe &&
+           sw_bake_errors_frames(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, &et, &eh, fe,
+                                 fe + res.ntrain, &e) == SINEW_OK);
+    sw_bake_report_input in = {"finger",
+                               &ch,
+                               &res,
+                               blob,
+                               NULL,
+                               0,
+                               NULL,
+                               0,
+                               fe,
+                               fe + res.ntrain,
+                               et.correction_error,
+                               eh.correction_error,
+                               0,
+                               1.0,
+                               0.5,
+                               0,
+                               NULL,
+                               &et,
+                               &eh,
+                               NULL};
+    char dir[1024];
+    snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);
+    r = blob && fe ? sw_bake_report_write(dir, &in, &e) : SINEW_ERROR_INVALID_ARGUMENT;
+    ENSUREF(r == SINEW_OK, "%s", e.msg);
+    char path[1100];
+    snprintf(path, sizeof path, "%.1000s/report.json", dir);
+    char *text = read_text(path);
+    cJSON *j = text ? cJSON_Parse(text) : NULL;
+    ENSURE(j != NULL);
+    const cJSON *clips = cJSON_GetObjectItemCaseSensitive(j, "clips");
+    ENSURE(cJSON_GetArraySize(clips) == 1);
+    if (cJSON_GetArraySize(clips) == 1) {
+        const cJSON *c = cJSON_GetArrayItem(clips, 0);
+        const cJSON *name = cJSON_GetObjectItemCaseSensitive(c, "name"),
+                    *split = cJSON_GetObjectItemCaseSensitive(c, "split"),
+                    *frames = cJSON_GetObjectItemCaseSensitive(c, "frames"),
+                    *err = cJSON_GetObjectItemCaseSensitive(c, "error");
+        ENSURE(cJSON_IsString(name) && !strcmp(name->valuestring, "random combined poses"));
+        ENSURE(cJSON_IsString(split) && !strcmp(split->valuestring, "heldout"));
+        ENSURE(cJSON_GetArraySize(frames) == 4 && cJSON_GetArraySize(err) == 4);
+        for (int k = 0; k < 4 && cJSON_GetArraySize(err) == 4; ++k) {
+            ENSURE(cJSON_GetArrayItem(frames, k)->valuedouble == k);
+            ENSURE_NEAR(cJSON_GetArrayItem(err, k)->valuedouble, fe[res.ntrain + k], 1e-12);
+        }
+    }
+    cJSON_Delete(j);
+    free(text);
+    free(fe);
+    sinew_blob_destroy(blob);
+    free(mem);
+    sw_bake_result_free(&res);
+    sw_character_free(&ch);
+}
+
 /* Held-out clips need training clips; a clip of another skeleton is named. */
 TEST(bad_clip_lists_rejected) {
     sw_character ch;
@@ -236,4 +324,5 @@ TEST(bad_clip_lists_rejected) {
     sw_character_free(&ch);
 }
 
-SW_TEST_MAIN(CASE(clips_of_their_own_and_the_report), CASE(bad_clip_lists_rejected))
+SW_TEST_MAIN(CASE(clips_of_their_own_and_the_report), CASE(random_heldout_poses_in_the_report),
+             CASE(bad_clip_lists_rejected))

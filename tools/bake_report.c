@@ -67,7 +67,8 @@ static void report_free(report *r) {
     memset(r, 0, sizeof *r);
 }
 
-/* The poses of one split labelled `label` as a clip of the report. */
+/* The poses of one split labelled `label` as a clip of the report (label -1: the poses
+ * of no clip, numbered in order: a bare skeleton's random combined held-out poses). */
 static int gather_clip(report_clip *c, int32_t npose, const int32_t *labels, const int32_t *frames,
                        const double *errors, int32_t label) {
     c->frame = malloc(sizeof(int32_t) * ((size_t)npose + 1));
@@ -75,10 +76,15 @@ static int gather_clip(report_clip *c, int32_t npose, const int32_t *labels, con
     if (!c->frame || !c->error) return 0;
     for (int32_t k = 0; k < npose; ++k)
         if (labels[k] == label) {
-            c->frame[c->n] = frames[k];
+            c->frame[c->n] = label < 0 ? c->n : frames[k];
             c->error[c->n++] = errors[k];
         }
     return 1;
+}
+
+/* Whether the held-out poses are random combined poses (no clip to hold out). */
+static int heldout_random(const sw_bake_result *res) {
+    return res->nheldout > 0 && res->heldout_clip[0] < 0;
 }
 
 static int gather(const sw_bake_report_input *in, report *r) {
@@ -93,15 +99,24 @@ static int gather(const sw_bake_report_input *in, report *r) {
         for (int32_t i = 0; i < n; ++i) {
             report_clip *c = &r->clips[r->nclips++];
             c->heldout = s;
+            int32_t label = s && heldout_random(res) ? -1 : i;
             if (names)
                 snprintf(c->name, sizeof c->name, "%s", names[i]);
+            else if (label < 0)
+                snprintf(c->name, sizeof c->name, "random combined poses");
             else
                 snprintf(c->name, sizeof c->name, "%s (%s part)",
                          in->ch->name[0] ? in->ch->name : "clip", s ? "held-out" : "training");
             if (!gather_clip(c, npose, s ? res->heldout_clip : res->train_clip,
                              s ? res->heldout_frame : res->train_frame,
-                             s ? in->heldout_frames : in->train_frames, i))
+                             s ? in->heldout_frames : in->train_frames, label))
                 return 0;
+            if (!names && c->n == 0) { /* no clip to show (a bare skeleton trains on sweeps) */
+                free(c->frame);
+                free(c->error);
+                memset(c, 0, sizeof *c);
+                r->nclips--;
+            }
         }
     }
     double sum = 0;
