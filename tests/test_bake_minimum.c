@@ -157,6 +157,56 @@ static void local_of(const sw_skeleton *sk, const double *T, int32_t b, double L
 /* Pair sweeps (issue 16): the finger's tip joint swept together with its parent joint, a
  * sequence of sweep_samples poses after the single sweeps, the last of them each joint at
  * its own sweep's end; the held-out poses stay the same. */
+/* Sibling sweeps (default on): the finger with its tip joint hung from the root, so the
+ * middle and tip joints are siblings whose flesh meets, is trained on both swept together
+ * as well, sweep_samples poses after the single sweeps, the last with each joint at its
+ * own sweep's end; sibling_sweeps 0 leaves them out and the held-out poses are the same. */
+TEST(sibling_sweeps_turn_two_children_of_one_joint_together) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 6, &c, &err) == SINEW_OK);
+    int32_t nb = c.skel.nbones, tip = -1, root = -1, n;
+    for (int32_t k = 0; k < nb; ++k) {
+        if (c.skel.parent[k] < 0) root = k;
+        if (c.skel.parent[k] >= 0 && c.skel.parent[c.skel.parent[k]] >= 0) tip = k;
+    }
+    ENSURE(tip >= 0 && root >= 0);
+    if (tip < 0 || root < 0) return;
+    int32_t mid = c.skel.parent[tip];
+    c.skel.parent[tip] = root; /* (the clip's bone transforms are the skeleton's world ones) */
+    sw_bake_params p = quick_params();
+    n = p.sweep_samples;
+    sw_bake_result a, b;
+    p.sibling_sweeps = 0;
+    ENSUREF(sw_bake_solutions(&c, &p, &a, &err) == SINEW_OK, "%s", err.msg);
+    p.sibling_sweeps = 1;
+    ENSUREF(sw_bake_solutions(&c, &p, &b, &err) == SINEW_OK, "%s", err.msg);
+    ENSUREF(b.ntrain == a.ntrain + n, "%d training poses with sibling sweeps, %d without", b.ntrain,
+            a.ntrain);
+    ENSURE(b.nheldout == a.nheldout &&
+           !memcmp(a.heldout_T, b.heldout_T, sizeof(double) * 12 * nb * a.nheldout));
+    ENSURE(!memcmp(a.train_T, b.train_T, sizeof(double) * 12 * nb * a.ntrain));
+    /* the single sweeps end a's poses in bone order (the tip's after the middle's); the
+       siblings' pair sweep ends b's */
+    int32_t first = tip < mid ? tip : mid, second = tip < mid ? mid : tip;
+    const double *pair = b.train_T + (size_t)12 * nb * (b.ntrain - 1),
+                 *second_end = a.train_T + (size_t)12 * nb * (a.ntrain - 1),
+                 *first_end = a.train_T + (size_t)12 * nb * (a.ntrain - 1 - n);
+    double L[9], Ls[9];
+    for (int j = 0; j < 2; ++j) {
+        int32_t bone = j ? second : first;
+        local_of(&c.skel, pair, bone, L);
+        local_of(&c.skel, j ? second_end : first_end, bone, Ls);
+        for (int i = 0; i < 9; ++i)
+            ENSURE_NEAR(L[i], Ls[i], 1e-12);
+        ENSUREF(fabs(Ls[0] - 1) + fabs(Ls[4] - 1) + fabs(Ls[8] - 1) > 1e-3,
+                "bone %d's sweep does not turn it", bone);
+    }
+    sw_bake_result_free(&a);
+    sw_bake_result_free(&b);
+    sw_character_free(&c);
+}
+
 /* The held-out frames of the character's clip are solved after its training frames on
  * one path, and measured on that path (sw_bake_heldout_path): the training frames first,
  * unmeasured; held-out clips of their own start from rest. */
@@ -317,6 +367,7 @@ TEST(return_path_goes_home_from_the_last_training_frame) {
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
              CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain),
              CASE(pair_sweeps_turn_a_joint_with_its_parent),
+             CASE(sibling_sweeps_turn_two_children_of_one_joint_together),
              CASE(heldout_frames_are_measured_on_the_reference_path),
              CASE(contact_modes_extend_the_basis),
              CASE(return_path_goes_home_from_the_last_training_frame))

@@ -48,7 +48,8 @@ static void usage(FILE *f) {
                "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
                "                  [--compare-cubature] [--no-self-contact]\n"
                "                  [--return-path|--no-return-path]\n"
-               "                  [--pair-sweeps] [--adaptive R [--adaptive-add K]\n"
+               "                  [--pair-sweeps] [--no-sibling-sweeps]\n"
+               "                  [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]]\n"
                "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
@@ -79,6 +80,9 @@ static void usage(FILE *f) {
             "                   --train-clips; --no-return-path: never\n"
             "  --pair-sweeps    also train on every joint swept together with its parent\n"
             "                   joint (combinations the single-joint sweeps never show)\n"
+            "  --no-sibling-sweeps  do not train on two sibling joints whose flesh meets\n"
+            "                   swept together (by default each such pair is: the flesh\n"
+            "                   between them shears with the difference of their bends)\n"
             "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
             "                   (default 64) random combined poses the blob steps worst (the\n"
             "                   full-space force its state leaves over plain skinning's) to\n"
@@ -175,6 +179,8 @@ int main(int argc, char **argv) {
             p.return_path = 0;
         else if (!strcmp(a, "--pair-sweeps"))
             p.pair_sweeps = 1;
+        else if (!strcmp(a, "--no-sibling-sweeps"))
+            p.sibling_sweeps = 0;
         else if (!strcmp(a, "--adaptive") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, SW_ADAPTIVE_MAX_ROUNDS, &ad.rounds);
         else if (!strcmp(a, "--adaptive-add") && next)

@@ -26,6 +26,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.selector = SW_CUBATURE_NNHTP;
     p.sweep_samples = 6;
     p.pair_sweeps = 0;
+    p.sibling_sweeps = 1;
     p.max_train_frames = 40;
     p.return_path = -1;
     p.pose_force = 1;
@@ -353,6 +354,8 @@ sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *para
     sw_bake_params p = params ? *params : sw_bake_params_default();
     sw_bake_state s;
     sinew_result r = bake_begin(&s, &p, c, err);
+    /* the domains first: sibling joints are swept together where their flesh meets */
+    if (r == SINEW_OK) r = sw_bake_domains(&s, err);
     if (r == SINEW_OK) r = solve_poses(&s, out, err);
     free_state(&s);
     if (r != SINEW_OK) sw_bake_result_free(out);

@@ -53,6 +53,8 @@ typedef struct sw_bake_params {
     int pair_sweeps;               /* also sweep every joint together with its parent joint
                                       (default 0; issue 16: combinations the single sweeps
                                       never show; measured in the README) */
+    int sibling_sweeps;            /* also sweep every two sibling joints whose flesh meets
+                                      together (default 1; bake_poses.c, sweep_pairs) */
     int32_t max_train_frames;      /* clip frames used for training at most (default 40) */
     int return_path;               /* also train on the way home (bake_poses.c, return_frames):
                                       the first training clip's frames from its last one
@@ -203,7 +205,7 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *p, sw_bake_res
                      sw_error *err);
 void sw_bake_result_free(sw_bake_result *r);
 
-/* Only the bake's evaluation data: the stages prepare, poses and simulate of sw_bake with
+/* Only the bake's evaluation data: the stages prepare, domains, poses and simulate of sw_bake with
  * the same parameters, filling out's ntrain, nheldout, *_unsettled, mass, train_T/x and
  * heldout_T/x exactly as sw_bake does (no view). For a blob baked elsewhere with the
  * same parameters (sinew-bench --blob), so that sw_bake_errors measures it on the very

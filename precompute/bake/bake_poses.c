@@ -282,15 +282,61 @@ static int wants_return_path(const sw_bake_params *p, int32_t nheld) {
     return p->return_path > 0 || (p->return_path < 0 && p->ntrain_clips == 0 && nheld > 0);
 }
 
+/* The domain that holds bone b's flesh: b's own, or (a bone folded into its parent's
+ * domain, or one that owns no tet) its nearest ancestor's; -1 if none has one. */
+static int32_t bone_domain(const sw_bake_state *s, int32_t b) {
+    for (; b >= 0; b = s->ch.skel.parent[b])
+        for (int32_t d = 0; d < s->nd; ++d)
+            if (s->domain_bone[d] == b) return d;
+    return -1;
+}
+
+/* Whether the flesh of bones a and b meets: one domain holds both, or their domains share
+ * a vertex (the copies are ascending per domain: a merge). */
+static int flesh_meets(const sw_bake_state *s, int32_t a, int32_t b) {
+    int32_t da = bone_domain(s, a), db = bone_domain(s, b);
+    if (da < 0 || db < 0) return 0;
+    if (da == db) return 1;
+    int32_t i = s->dom_vert_ptr[da], j = s->dom_vert_ptr[db];
+    while (i < s->dom_vert_ptr[da + 1] && j < s->dom_vert_ptr[db + 1]) {
+        int32_t u = s->dom_verts[i], w = s->dom_verts[j];
+        if (u == w) return 1;
+        i += u < w;
+        j += w < u;
+    }
+    return 0;
+}
+
+/* The joints swept in pairs (pairs[2 k], pairs[2 k + 1]; NULL: only counted), returns
+ * how many: two sibling joints whose flesh meets (sibling_sweeps: the flesh between two
+ * fingers' metacarpals is sheared by the difference of their bends, which neither sweep
+ * alone shows), and with pair_sweeps every joint with its parent joint. */
+static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, int32_t *pairs) {
+    const sw_skeleton *sk = &s->ch.skel;
+    int32_t n = 0;
+    for (int32_t a = 0; s->p->sibling_sweeps && a < s->nb; ++a)
+        for (int32_t b = a + 1; b < s->nb; ++b)
+            if (sk->parent[a] == sk->parent[b] && sk->parent[a] >= 0 && swept(sweep_angle, a) &&
+                swept(sweep_angle, b) && flesh_meets(s, a, b)) {
+                if (pairs) pairs[2 * n] = a, pairs[2 * n + 1] = b;
+                n++;
+            }
+    for (int32_t b = 0; s->p->pair_sweeps && b < s->nb; ++b)
+        if (swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b])) {
+            if (pairs) pairs[2 * n] = b, pairs[2 * n + 1] = sk->parent[b];
+            n++;
+        }
+    return n;
+}
+
 static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t nheld,
                           int32_t njoint, const double *sweep_axis, const double *sweep_angle,
                           double *local) {
     const sw_skeleton *sk = &s->ch.skel;
     int32_t nb = s->nb, cap = s->p->max_train_frames;
     int32_t n0 = ntr > 0 ? (train[0].count < cap ? train[0].count : cap) : 0;
-    int32_t nreturn = wants_return_path(s->p, nheld) && n0 >= 2 ? n0 - 1 : 0, npair = 0;
-    for (int32_t b = 0; s->p->pair_sweeps && b < nb; ++b)
-        npair += swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b]);
+    int32_t nreturn = wants_return_path(s->p, nheld) && n0 >= 2 ? n0 - 1 : 0;
+    int32_t npair = sweep_pairs(s, sweep_angle, NULL);
     int32_t chain = s->p->extra_chain > 0 ? s->p->extra_chain : s->p->nextra_poses;
     int32_t nextra = s->p->nextra_poses > 0 ? (s->p->nextra_poses + chain - 1) / chain : 0;
     s->ntrain_seq = ntr + (nreturn > 0) + njoint + npair + nextra;
@@ -323,19 +369,24 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
             s->ntrain_seq--;
         }
     }
-    /* a sweep per joint, then (pair_sweeps) a sweep of every joint with its parent joint */
-    for (int pass = 0; pass < 2; ++pass)
-        for (int32_t b = 0; b < nb; ++b) {
-            int32_t bones[2] = {b, sk->parent[b]}, n = s->p->sweep_samples;
-            if (!swept(sweep_angle, b) || (pass == 1 && !npair) ||
-                (pass == 1 && !swept(sweep_angle, bones[1])))
-                continue;
-            if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
-            for (int32_t i = 0; i < n; ++i)
-                sweep_pose(s, bones, pass + 1, i + 1, n, sweep_axis, sweep_angle, local,
-                           s->train[qi].T + (size_t)i * 12 * nb);
-            qi++;
+    /* a sweep per joint, then the pairs' sweeps, both joints of a pair turned together */
+    int32_t *pairs = malloc(sizeof(int32_t) * (2 * (size_t)npair + 1));
+    if (!pairs) return 0;
+    sweep_pairs(s, sweep_angle, pairs);
+    for (int32_t k = 0; k < nb + npair; ++k) { /* the joints (swept ones), then the pairs */
+        int32_t b = k < nb ? k : -1, n = s->p->sweep_samples;
+        if (k < nb && !swept(sweep_angle, b)) continue;
+        const int32_t *bones = k < nb ? &b : pairs + 2 * (k - nb);
+        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) {
+            free(pairs);
+            return 0;
         }
+        for (int32_t i = 0; i < n; ++i)
+            sweep_pose(s, bones, k < nb ? 1 : 2, i + 1, n, sweep_axis, sweep_angle, local,
+                       s->train[qi].T + (size_t)i * 12 * nb);
+        qi++;
+    }
+    free(pairs);
     /* the caller's poses (the adaptive loop's), `chain` at a time on a path from rest */
     for (int32_t at = 0; at < s->p->nextra_poses; at += chain, ++qi) {
         int32_t n = s->p->nextra_poses - at < chain ? s->p->nextra_poses - at : chain;
