@@ -329,6 +329,20 @@ static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, in
     return n;
 }
 
+/* Training sequence *qi (then advanced): sweep_samples poses turning the nsw `bones`
+ * together from rest to their sweeps' ends. Returns 0 when out of memory. */
+static int add_sweep(sw_bake_state *s, const int32_t *bones, int nsw, const double *sweep_axis,
+                     const double *sweep_angle, double *local, int32_t *qi) {
+    int32_t n = s->p->sweep_samples;
+    sw_pose_seq *q = &s->train[*qi];
+    if (!seq_alloc(q, n, s->nb, s->nv)) return 0;
+    for (int32_t i = 0; i < n; ++i)
+        sweep_pose(s, bones, nsw, i + 1, n, sweep_axis, sweep_angle, local,
+                   q->T + (size_t)i * 12 * s->nb);
+    ++*qi;
+    return 1;
+}
+
 static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t nheld,
                           int32_t njoint, const double *sweep_axis, const double *sweep_angle,
                           double *local) {
@@ -371,22 +385,14 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
     }
     /* a sweep per joint, then the pairs' sweeps, both joints of a pair turned together */
     int32_t *pairs = malloc(sizeof(int32_t) * (2 * (size_t)npair + 1));
-    if (!pairs) return 0;
-    sweep_pairs(s, sweep_angle, pairs);
-    for (int32_t k = 0; k < nb + npair; ++k) { /* the joints (swept ones), then the pairs */
-        int32_t b = k < nb ? k : -1, n = s->p->sweep_samples;
-        if (k < nb && !swept(sweep_angle, b)) continue;
-        const int32_t *bones = k < nb ? &b : pairs + 2 * (k - nb);
-        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) {
-            free(pairs);
-            return 0;
-        }
-        for (int32_t i = 0; i < n; ++i)
-            sweep_pose(s, bones, k < nb ? 1 : 2, i + 1, n, sweep_axis, sweep_angle, local,
-                       s->train[qi].T + (size_t)i * 12 * nb);
-        qi++;
-    }
+    int ok = pairs != NULL;
+    if (ok) sweep_pairs(s, sweep_angle, pairs);
+    for (int32_t b = 0; ok && b < nb; ++b)
+        if (swept(sweep_angle, b)) ok = add_sweep(s, &b, 1, sweep_axis, sweep_angle, local, &qi);
+    for (int32_t k = 0; ok && k < npair; ++k)
+        ok = add_sweep(s, pairs + 2 * k, 2, sweep_axis, sweep_angle, local, &qi);
     free(pairs);
+    if (!ok) return 0;
     /* the caller's poses (the adaptive loop's), `chain` at a time on a path from rest */
     for (int32_t at = 0; at < s->p->nextra_poses; at += chain, ++qi) {
         int32_t n = s->p->nextra_poses - at < chain ? s->p->nextra_poses - at : chain;
