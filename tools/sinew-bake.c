@@ -143,6 +143,9 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 0, 256, &p.threads);
         else if (!strcmp(a, "--max-rank") && next)
             ok = sw_tool_int(tool, a, argv[++i], 1, 1024, &p.max_rank);
+        else if (!strcmp(a, "--pca-strain") && next)
+            ok = sw_tool_real(tool, a, argv[++i], -1e-300, nextafter(1.0, 2.0), "in 0..1",
+                              &p.pca_strain);
         else if (!strcmp(a, "--tol") && next)
             ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in the open range 0..1", &p.cubature_tol);
         else if (!strcmp(a, "--selector") && next) {

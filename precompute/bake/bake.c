@@ -21,6 +21,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.max_rank = 30;
     p.fold_share = 0;
     p.pca_energy = 0.9999;
+    p.pca_strain = 0.7;
     p.cubature_tol = 0.05;
     p.cubature_max = 1000;
     p.selector = SW_CUBATURE_NNHTP;
@@ -261,16 +262,17 @@ static void progress(const sw_bake_params *p, const char *stage, double secs, co
 static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
     sw_bake_params p = *pp;
     if (p.max_rank < 1 || p.max_rank > 1024 || !(p.pca_energy > 0 && p.pca_energy <= 1) ||
-        !(p.cubature_tol > 0 && p.cubature_tol < 1) || p.cubature_max < 1 || p.sweep_samples < 1 ||
-        p.sweep_samples > 1000 || p.max_train_frames < 1 ||
-        !(p.heldout_fraction >= 0 && p.heldout_fraction < 1) || !(p.spring_k >= 0) ||
-        !isfinite(p.spring_k) || !(p.fold_share >= 0 && p.fold_share < 0.5) ||
+        !(p.pca_strain >= 0 && p.pca_strain <= 1) || !(p.cubature_tol > 0 && p.cubature_tol < 1) ||
+        p.cubature_max < 1 || p.sweep_samples < 1 || p.sweep_samples > 1000 ||
+        p.max_train_frames < 1 || !(p.heldout_fraction >= 0 && p.heldout_fraction < 1) ||
+        !(p.spring_k >= 0) || !isfinite(p.spring_k) || !(p.fold_share >= 0 && p.fold_share < 0.5) ||
         !(p.contact_cubature_tol >= 0 && p.contact_cubature_tol < 1))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "bake parameters out of range (rank %d, energy %g, cubature tol %g, "
+                            "bake parameters out of range (rank %d, energy %g, strain share %g, "
+                            "cubature tol %g, "
                             "max %d, sweep %d, frames %d, held-out %g, spring %g, fold share %g, "
                             "contact cubature tol %g)",
-                            p.max_rank, p.pca_energy, p.cubature_tol, p.cubature_max,
+                            p.max_rank, p.pca_energy, p.pca_strain, p.cubature_tol, p.cubature_max,
                             p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k,
                             p.fold_share, p.contact_cubature_tol);
     if (p.ntrain_clips < 0 || p.nheldout_clips < 0 || (p.ntrain_clips > 0 && !p.train_clips) ||

@@ -46,6 +46,9 @@ typedef struct sw_bake_params {
                                       mesh's volume joins its parent's domain (default 0: every
                                       bone that owns tets is a domain; bake_domains.c) */
     double pca_energy;             /* fraction of snapshot energy kept (default 0.9999) */
+    double pca_strain;             /* the PCA's inner product: this share from the snapshots'
+                                      rest strain energy, the rest from their plain products
+                                      (default 0.7; 0: plain PCA; bake_basis.c) */
     double cubature_tol;           /* default 0.05 */
     int32_t cubature_max;          /* per domain (default 1000) */
     sw_cubature_selector selector; /* default NN-HTP */

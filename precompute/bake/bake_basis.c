@@ -1,16 +1,22 @@
 /* Skinning-correction basis (thesis §4.4.1, eq. 4.13): each full-space solution x is
  * pulled back through the skinning transform, d_v = R_v^T (x_v - t_v) - rest_v, and
  * each domain gets the uncentred PCA of its vertices' d over the training poses:
- * the leading eigenvectors of the snapshot Gram matrix D^T D, lifted back to
- * U = D V S^-1 and re-orthonormalised. Rows of bone-driven vertices are zero, so in
- * the subspace those vertices follow their bone exactly, as in the reference. A bake for
+ * the leading eigenvectors of the snapshots' Gram matrix, lifted back to
+ * U = D V S^-1 and re-orthonormalised. The Gram matrix mixes the plain products D D^T
+ * with the snapshots' rest strain-energy products D K D^T (sw_bake_params.pca_strain):
+ * the step finds the reduced energy's minimum, which for a linear model is the reference
+ * projected in the energy norm (the Galerkin projection), so the span is chosen for
+ * what that projection keeps of the training snapshots. Rows of bone-driven vertices are zero, so
+ * in the subspace those vertices follow their bone exactly, as in the reference. A bake for
  * dynamics appends inertia modes (add_inertia_modes). */
+#include <cblas.h>
 #include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "bake_internal.h"
+#include "fem_corot.h"
 #include "fullsim.h"
 #include "penalty.h"
 #include "selfcontact.h"
@@ -67,12 +73,8 @@ static int32_t orthonormalise(double *U, int64_t m, int32_t r) {
  * add contention (and races a thread sanitizer cannot see through). */
 void openblas_set_num_threads(int num_threads);
 
-/* Rank-r basis (row-major 3n x r) of a domain from snapshots D (T x 3n, row per pose). */
-static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_rank, double energy,
-                          int64_t unit_row, int32_t *rank_out, double *kept_out) {
-    double *G = calloc((size_t)T * T, sizeof(double)), *ev = malloc((size_t)T * sizeof(double));
-    double *U = NULL;
-    if (!G || !ev) goto done;
+/* G (T x T) = D D^T, the plain products of the snapshots D (T rows of m). */
+static void plain_gram(const double *D, int32_t T, int64_t m, double *G) {
     for (int32_t a = 0; a < T; ++a)
         for (int32_t b = a; b < T; ++b) {
             double g = 0;
@@ -80,6 +82,103 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
                 g += D[(size_t)a * m + i] * D[(size_t)b * m + i];
             G[(size_t)a * T + b] = G[(size_t)b * T + a] = g;
         }
+}
+
+/* Tets a pass of strain_gram takes: each adds 7 columns to the T-row strain matrix. */
+#define STRAIN_CHUNK 128
+#define SQRT1_2 0.70710678118654752440
+
+/* Per tet and snapshot, the strain e = sym(grad d) gives 2 Psi = 2 mu dev(e):dev(e) +
+ * (2 mu / 3 + lambda) tr(e)^2, written as 7 numbers whose squares sum to vol 2 Psi; G
+ * accumulates their products chunk by chunk of tets, in order (the bake is the same on
+ * any thread count). */
+int sw_bake_strain_gram(const sw_bake_state *s, int32_t dm, const double *D, int32_t T, double *G) {
+    int64_t m = 3 * (int64_t)(s->dom_vert_ptr[dm + 1] - s->dom_vert_ptr[dm]);
+    double mu, lambda;
+    sw_lame(s->ch.youngs, s->ch.poisson, &mu, &lambda);
+    int32_t ntd = s->dom_tet_ptr[dm + 1] - s->dom_tet_ptr[dm];
+    const int64_t cols = 7 * STRAIN_CHUNK;
+    int32_t *local_of = malloc((size_t)s->nv * sizeof(int32_t)),
+            *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t) + 1);
+    double *dminv = malloc((size_t)ntd * 9 * sizeof(double) + 1),
+           *vol = malloc((size_t)ntd * sizeof(double) + 1),
+           *S = malloc((size_t)T * cols * sizeof(double));
+    int ok = local_of && tet_local && dminv && vol && S;
+    if (ok) {
+        sw_bake_domain_tets(s, dm, local_of, tet_local, dminv, vol);
+        memset(G, 0, (size_t)T * T * sizeof(double));
+    }
+    for (int32_t c0 = 0; ok && c0 < ntd; c0 += STRAIN_CHUNK) {
+        int32_t nc = ntd - c0 < STRAIN_CHUNK ? ntd - c0 : STRAIN_CHUNK;
+        for (int32_t c = 0; c < nc; ++c) {
+            const int32_t *loc = tet_local + 4 * (c0 + c);
+            double Dg[12];
+            sw_tet_shape_gradients(dminv + 9 * (c0 + c), Dg);
+            double dev = sqrt(2 * mu * vol[c0 + c]),
+                   bulk = sqrt(fmax(2 * mu / 3 + lambda, 0) * vol[c0 + c]);
+            for (int32_t a = 0; a < T; ++a) {
+                double g[9] = {0}; /* grad d = sum over corners d_k Dg_k^T */
+                for (int k = 0; k < 4; ++k) {
+                    const double *dk = D + (size_t)a * m + 3 * loc[k];
+                    for (int i = 0; i < 3; ++i)
+                        for (int j = 0; j < 3; ++j)
+                            g[3 * i + j] += dk[i] * Dg[3 * k + j];
+                }
+                double tr = g[0] + g[4] + g[8], *e = S + (size_t)a * cols + 7 * c;
+                e[0] = dev * (g[0] - tr / 3);
+                e[1] = dev * (g[4] - tr / 3);
+                e[2] = dev * (g[8] - tr / 3);
+                e[3] = dev * SQRT1_2 * (g[1] + g[3]); /* 2 e01^2 = ((g01 + g10) / sqrt 2)^2 */
+                e[4] = dev * SQRT1_2 * (g[2] + g[6]);
+                e[5] = dev * SQRT1_2 * (g[5] + g[7]);
+                e[6] = bulk * tr;
+            }
+        }
+        cblas_dsyrk(CblasRowMajor, CblasUpper, CblasNoTrans, T, 7 * nc, 1.0, S, (int)cols, 1.0, G,
+                    T);
+    }
+    for (int32_t a = 0; ok && a < T; ++a)
+        for (int32_t b = a + 1; b < T; ++b)
+            G[(size_t)b * T + a] = G[(size_t)a * T + b];
+    free(local_of);
+    free(tet_local);
+    free(dminv);
+    free(vol);
+    free(S);
+    return ok;
+}
+
+/* The Gram matrix G (T x T) domain dm's PCA takes (sw_bake_params.pca_strain = w): the
+ * plain and the strain-energy products, each scaled to unit trace, mixed 1 - w : w.
+ * 0 when out of memory. */
+static int snapshot_gram(const sw_bake_state *s, int32_t dm, const double *D, int32_t T, int64_t m,
+                         double *G) {
+    double w = s->p->pca_strain;
+    plain_gram(D, T, m, G);
+    if (w <= 0) return 1;
+    double *GK = malloc((size_t)T * T * sizeof(double));
+    if (!GK || !sw_bake_strain_gram(s, dm, D, T, GK)) {
+        free(GK);
+        return 0;
+    }
+    double trp = 0, trk = 0;
+    for (int32_t a = 0; a < T; ++a) {
+        trp += G[(size_t)a * T + a];
+        trk += GK[(size_t)a * T + a];
+    }
+    for (size_t i = 0; i < (size_t)T * T; ++i)
+        G[i] = (trp > 0 ? (1 - w) * G[i] / trp : 0) + (trk > 0 ? w * GK[i] / trk : 0);
+    free(GK);
+    return 1;
+}
+
+/* Rank-r basis (row-major 3n x r) of a domain from snapshots D (T x 3n, row per pose) and
+ * their Gram matrix G (T x T, overwritten). */
+static double *domain_pca(const double *D, int32_t T, int64_t m, double *G, int32_t max_rank,
+                          double energy, int64_t unit_row, int32_t *rank_out, double *kept_out) {
+    double *ev = malloc((size_t)T * sizeof(double));
+    double *U = NULL;
+    if (!ev) goto done;
     openblas_set_num_threads(1);
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', T, G, T, ev) != 0) goto done;
     double total = 0;
@@ -118,7 +217,6 @@ static double *domain_pca(const double *D, int32_t T, int64_t m, int32_t max_ran
     }
     *rank_out = r;
 done:
-    free(G);
     free(ev);
     return U;
 }
@@ -347,7 +445,13 @@ static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
             }
         }
     }
-    if (!(P = domain_pca(L, T, n3, SW_CONTACT_LOADS, 0.9999, 0, &nl, &kept))) goto done;
+    double *G = malloc((size_t)T * T * sizeof(double));
+    if (G) {
+        plain_gram(L, T, n3, G);
+        P = domain_pca(L, T, n3, G, SW_CONTACT_LOADS, 0.9999, 0, &nl, &kept);
+    }
+    free(G);
+    if (!P) goto done;
     if (nl > 0 && !(F = malloc((size_t)nl * n3 * sizeof(double)))) goto done;
     for (int32_t j = 0; j < nl; ++j) /* P is n3 x nl, row-major: load j is its column */
         for (int64_t e = 0; e < n3; ++e)
@@ -395,9 +499,12 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         int32_t free0 = 0; /* the domain's first free vertex (0 when it has none) */
         while (free0 < n && s->ch.bone_of_vertex[s->dom_verts[base + free0]] >= 0)
             free0++;
-        s->basis[dm] =
-            domain_pca(D, T, 3 * (int64_t)n, s->p->max_rank, s->p->pca_energy,
-                       free0 < n ? 3 * (int64_t)free0 : 0, &s->rank[dm], &out->basis_energy[dm]);
+        double *G = malloc((size_t)T * T * sizeof(double));
+        if (G && snapshot_gram(s, dm, D, T, 3 * (int64_t)n, G))
+            s->basis[dm] = domain_pca(D, T, 3 * (int64_t)n, G, s->p->max_rank, s->p->pca_energy,
+                                      free0 < n ? 3 * (int64_t)free0 : 0, &s->rank[dm],
+                                      &out->basis_energy[dm]);
+        free(G);
         free(D);
         if (!s->basis[dm]) goto oom;
     }

@@ -165,17 +165,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     sw_cubature_result cr;
     memset(&cr, 0, sizeof cr);
     if (!local_of || !tet_local || !dminv || !vol || !q || !inv_norm || !dq) goto done;
-    for (int32_t k = 0; k < nvd; ++k)
-        local_of[s->dom_verts[base + k]] = k;
-    for (int32_t i = 0; i < ntd; ++i) {
-        const int32_t *tet = s->ch.mesh.tets + 4 * (int64_t)s->dom_tets[t0 + i];
-        double Xe[12];
-        for (int k = 0; k < 4; ++k) {
-            tet_local[4 * i + k] = local_of[tet[k]];
-            memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)tet[k], 24);
-        }
-        sw_tet_rest(Xe, dminv + 9 * i, vol + i);
-    }
+    sw_bake_domain_tets(s, dom, local_of, tet_local, dminv, vol);
     /* samples: snapshots projected, then perturbed copies */
     double *rms = calloc((size_t)r, sizeof(double));
     if (!rms) goto done;

@@ -97,6 +97,11 @@ void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R 
                              double *t /* 3 nv */);
 
 sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err);
+/* Rest data of domain dm's tets in dom_tets order: each corner's copy in the domain
+ * (tet_local, 4 a tet), Dm^-1 (9 a tet; zero for a degenerate tet) and rest volume (0 for
+ * a degenerate tet). local_of: nverts ints of scratch. */
+void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
+                         double *dminv, double *vol);
 sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err);
 /* The reference simulator's parameters of the simulate stage (threads aside). */
@@ -106,6 +111,11 @@ sw_fullsim_params sw_bake_sim_params(const sw_bake_state *s);
  * *cached when they were read back. */
 sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err);
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* G (T x T) = D K D^T: the products of the snapshots D (T rows of domain dm's 3 n copies'
+ * displacements) in the rest linear-elastic energy of the domain's tets, K the stiffness
+ * of the co-rotational energy (eq. 2.3) at rest (bake_basis.c; the PCA's strain share,
+ * sw_bake_params.pca_strain). 0 when out of memory. */
+int sw_bake_strain_gram(const sw_bake_state *s, int32_t dm, const double *D, int32_t T, double *G);
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);

@@ -1,0 +1,157 @@
+/* The basis's strain-energy inner product (bake_basis.c, sw_bake_params.pca_strain): the
+ * snapshots' Gram matrix in the rest energy equals d_a^T K d_b with K the co-rotational
+ * element's own stiffness at rest (fem_corot.c), on a domain that is a part of the mesh;
+ * a rigid motion of the domain costs nothing; and a strain share outside 0..1 is an
+ * error that names it. */
+#include <math.h>
+#include <stdint.h>
+#include <string.h>
+
+#include "bake_internal.h"
+#include "fem_corot.h"
+#include "samples.h"
+#include "sw_test.h"
+
+/* A unit cube of five tets (the middle one regular), vertices 0..7 at the corners. */
+static double cube_X[24];
+static int32_t cube_tets[20] = {0, 1, 3, 4, 1, 2, 3, 6, 1, 4, 5, 6, 3, 4, 6, 7, 1, 3, 4, 6};
+
+/* A state with two domains: 0 holds tets 0, 1, 4 (its copies: the vertices they touch),
+ * 1 holds tets 2, 3. */
+typedef struct {
+    sw_bake_state s;
+    int32_t vert_ptr[3], verts[16], tet_ptr[3], tets[5];
+} cube_state;
+
+static void cube_make(cube_state *c) {
+    memset(c, 0, sizeof *c);
+    for (int v = 0; v < 8; ++v) { /* corners in the order 0 (0,0,0) 1 (1,0,0) 2 (1,1,0)
+                                     3 (0,1,0), then the same at z = 1 */
+        static const int xy[4][2] = {{0, 0}, {1, 0}, {1, 1}, {0, 1}};
+        cube_X[3 * v] = xy[v % 4][0] * 1.3;
+        cube_X[3 * v + 1] = xy[v % 4][1] * 0.9;
+        cube_X[3 * v + 2] = (v / 4) * 1.1;
+    }
+    c->s.ch.mesh.X = cube_X;
+    c->s.ch.mesh.tets = cube_tets;
+    c->s.ch.mesh.nverts = c->s.nv = 8;
+    c->s.ch.mesh.ntets = c->s.nt = 5;
+    c->s.ch.youngs = 3e4;
+    c->s.ch.poisson = 0.3;
+    static const int32_t tets0[] = {0, 1, 4}, tets1[] = {2, 3};
+    int32_t nt = 0, nvc = 0;
+    c->tet_ptr[0] = c->vert_ptr[0] = 0;
+    for (int d = 0; d < 2; ++d) {
+        const int32_t *list = d == 0 ? tets0 : tets1;
+        int n = d == 0 ? 3 : 2, has[8] = {0};
+        for (int i = 0; i < n; ++i) {
+            c->tets[nt++] = list[i];
+            for (int k = 0; k < 4; ++k)
+                has[cube_tets[4 * list[i] + k]] = 1;
+        }
+        for (int v = 0; v < 8; ++v)
+            if (has[v]) c->verts[nvc++] = v;
+        c->tet_ptr[d + 1] = nt;
+        c->vert_ptr[d + 1] = nvc;
+    }
+    c->s.nd = 2;
+    c->s.dom_tet_ptr = c->tet_ptr;
+    c->s.dom_tets = c->tets;
+    c->s.dom_vert_ptr = c->vert_ptr;
+    c->s.dom_verts = c->verts;
+}
+
+/* d^T K e over domain dm's tets, K from the co-rotational element's Hessian at rest. */
+static double energy_product(const cube_state *c, int dm, const double *d, const double *e) {
+    double mu, lambda, sum = 0;
+    sw_lame(c->s.ch.youngs, c->s.ch.poisson, &mu, &lambda);
+    int32_t base = c->vert_ptr[dm], n = c->vert_ptr[dm + 1] - base;
+    for (int32_t i = c->tet_ptr[dm]; i < c->tet_ptr[dm + 1]; ++i) {
+        const int32_t *tet = cube_tets + 4 * c->tets[i];
+        double X[12], Dm[9], vol, f[12], K[144], de[12], ee[12];
+        for (int k = 0; k < 4; ++k) {
+            int loc = 0;
+            while (loc < n && c->verts[base + loc] != tet[k])
+                loc++;
+            memcpy(X + 3 * k, cube_X + 3 * tet[k], 24);
+            memcpy(de + 3 * k, d + 3 * loc, 24);
+            memcpy(ee + 3 * k, e + 3 * loc, 24);
+        }
+        if (!sw_tet_rest(X, Dm, &vol)) return NAN;
+        sw_corot_eval(X, Dm, vol, mu, lambda, f, K, 0);
+        for (int a = 0; a < 12; ++a)
+            for (int b = 0; b < 12; ++b)
+                sum += de[a] * K[12 * a + b] * ee[b];
+    }
+    return sum;
+}
+
+static double uniform(uint64_t *seed) {
+    *seed = *seed * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*seed >> 11) / 9007199254740992.0 * 2 - 1;
+}
+
+TEST(strain_gram_is_the_rest_stiffness_of_the_domain) {
+    cube_state c;
+    cube_make(&c);
+    uint64_t seed = 7;
+    for (int dm = 0; dm < 2; ++dm) {
+        int32_t n = c.vert_ptr[dm + 1] - c.vert_ptr[dm];
+        enum { T = 4 };
+        double D[T * 24], G[T * T];
+        for (int i = 0; i < T * 3 * n; ++i)
+            D[i] = 0.01 * uniform(&seed);
+        ENSURE(sw_bake_strain_gram(&c.s, dm, D, T, G));
+        double scale = 0;
+        for (int a = 0; a < T; ++a)
+            scale = fmax(scale, fabs(G[a * T + a]));
+        ENSUREF(scale > 0, "domain %d: no energy", dm);
+        for (int a = 0; a < T; ++a)
+            for (int b = 0; b < T; ++b) {
+                double ref = energy_product(&c, dm, D + a * 3 * n, D + b * 3 * n);
+                ENSUREF(fabs(G[a * T + b] - ref) <= 1e-9 * scale,
+                        "domain %d: G[%d][%d] %.12g, d K d %.12g", dm, a, b, G[a * T + b], ref);
+            }
+    }
+}
+
+TEST(a_rigid_motion_of_the_domain_costs_no_strain_energy) {
+    cube_state c;
+    cube_make(&c);
+    int32_t n = c.vert_ptr[1] - c.vert_ptr[0];
+    double D[3 * 24], G[9];
+    for (int32_t j = 0; j < n; ++j) {
+        const double *X = cube_X + 3 * c.verts[j];
+        double w[3] = {0.2, -0.5, 0.7}; /* an infinitesimal rotation: w x X */
+        double *t = D + 3 * j, *r = D + 3 * n + 3 * j, *s = D + 6 * n + 3 * j;
+        t[0] = 0.3, t[1] = -0.1, t[2] = 0.05;
+        r[0] = w[1] * X[2] - w[2] * X[1];
+        r[1] = w[2] * X[0] - w[0] * X[2];
+        r[2] = w[0] * X[1] - w[1] * X[0];
+        s[0] = 0.1 * X[0], s[1] = 0, s[2] = 0; /* a stretch along x, for scale */
+    }
+    ENSURE(sw_bake_strain_gram(&c.s, 0, D, 3, G));
+    ENSUREF(G[8] > 0, "the stretch costs %g", G[8]);
+    ENSUREF(fabs(G[0]) <= 1e-12 * G[8] && fabs(G[4]) <= 1e-12 * G[8],
+            "translation %g, rotation %g against the stretch's %g", G[0], G[4], G[8]);
+}
+
+TEST(a_strain_share_outside_0_1_is_an_error) {
+    sw_character ch;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 5, &ch, &err) == SINEW_OK);
+    sw_bake_params p = sw_bake_params_default();
+    const double bad[] = {-0.1, 1.5, NAN};
+    for (int i = 0; i < 3; ++i) {
+        p.pca_strain = bad[i];
+        sw_bake_result r;
+        ENSUREF(sw_bake(&ch, &p, &r, &err) == SINEW_ERROR_INVALID_ARGUMENT, "share %g baked",
+                bad[i]);
+        ENSUREF(strstr(err.msg, "strain share"), "%s", err.msg);
+    }
+    sw_character_free(&ch);
+}
+
+SW_TEST_MAIN(CASE(strain_gram_is_the_rest_stiffness_of_the_domain),
+             CASE(a_rigid_motion_of_the_domain_costs_no_strain_energy),
+             CASE(a_strain_share_outside_0_1_is_an_error))
