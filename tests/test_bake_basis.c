@@ -101,7 +101,7 @@ TEST(strain_gram_is_the_rest_stiffness_of_the_domain) {
         double D[T * 24], G[T * T];
         for (int i = 0; i < T * 3 * n; ++i)
             D[i] = 0.01 * uniform(&seed);
-        ENSURE(sw_bake_strain_gram(&c.s, dm, D, T, G));
+        ENSURE(sw_bake_strain_products(&c.s, dm, D, T, NULL, 0, G));
         double scale = 0;
         for (int a = 0; a < T; ++a)
             scale = fmax(scale, fabs(G[a * T + a]));
@@ -112,6 +112,12 @@ TEST(strain_gram_is_the_rest_stiffness_of_the_domain) {
                 ENSUREF(fabs(G[a * T + b] - ref) <= 1e-9 * scale,
                         "domain %d: G[%d][%d] %.12g, d K d %.12g", dm, a, b, G[a * T + b], ref);
             }
+        /* rows against other rows: the first one against the last three */
+        double G13[3];
+        ENSURE(sw_bake_strain_products(&c.s, dm, D, 1, D + 3 * n, 3, G13));
+        for (int b = 0; b < 3; ++b)
+            ENSUREF(fabs(G13[b] - G[b + 1]) <= 1e-12 * scale,
+                    "domain %d: A K B^T %.12g, Gram %.12g", dm, G13[b], G[b + 1]);
     }
 }
 
@@ -130,10 +136,46 @@ TEST(a_rigid_motion_of_the_domain_costs_no_strain_energy) {
         r[2] = w[0] * X[1] - w[1] * X[0];
         s[0] = 0.1 * X[0], s[1] = 0, s[2] = 0; /* a stretch along x, for scale */
     }
-    ENSURE(sw_bake_strain_gram(&c.s, 0, D, 3, G));
+    ENSURE(sw_bake_strain_products(&c.s, 0, D, 3, NULL, 0, G));
     ENSUREF(G[8] > 0, "the stretch costs %g", G[8]);
     ENSUREF(fabs(G[0]) <= 1e-12 * G[8] && fabs(G[4]) <= 1e-12 * G[8],
             "translation %g, rotation %g against the stretch's %g", G[0], G[4], G[8]);
+}
+
+/* The 1K finger, five frames, two poses a sweep, on 2 threads. */
+static int bake_finger(sw_bake_params *p, sw_bake_result *r) {
+    sw_character ch;
+    sw_error err;
+    if (sw_sample_make("finger", 1000, 5, &ch, &err) != SINEW_OK) return 0;
+    p->sweep_samples = 2;
+    p->threads = 2;
+    sinew_result res = sw_bake(&ch, p, r, &err);
+    if (res != SINEW_OK) fprintf(stderr, "  bake: %s\n", err.msg);
+    sw_character_free(&ch);
+    return res == SINEW_OK;
+}
+
+TEST(galerkin_errors_bound_the_projection_and_vanish_on_a_full_span) {
+    sw_bake_params p = sw_bake_params_default();
+    sw_bake_result r;
+    ENSURE(bake_finger(&p, &r));
+    fprintf(stderr, "  default: projection %.4f / %.4f, Galerkin %.4f / %.4f\n", r.train_proj_error,
+            r.heldout_proj_error, r.train_galerkin_error, r.heldout_galerkin_error);
+    ENSUREF(r.train_galerkin_error >= r.train_proj_error - 1e-12 &&
+                r.heldout_galerkin_error >= r.heldout_proj_error - 1e-12,
+            "Galerkin %g / %g below the projection %g / %g", r.train_galerkin_error,
+            r.heldout_galerkin_error, r.train_proj_error, r.heldout_proj_error);
+    ENSUREF(r.heldout_galerkin_error > 0, "held-out Galerkin error %g", r.heldout_galerkin_error);
+    sw_bake_result_free(&r);
+    p.pca_energy = 1; /* every snapshot in the span */
+    p.max_rank = 1024;
+    ENSURE(bake_finger(&p, &r));
+    fprintf(stderr, "  full span: projection %.2e, Galerkin %.2e (training)\n", r.train_proj_error,
+            r.train_galerkin_error);
+    ENSUREF(r.train_proj_error < 1e-6 && r.train_galerkin_error < 1e-5,
+            "full span: training projection %g, Galerkin %g", r.train_proj_error,
+            r.train_galerkin_error);
+    sw_bake_result_free(&r);
 }
 
 TEST(a_strain_share_outside_0_1_is_an_error) {
@@ -154,4 +196,5 @@ TEST(a_strain_share_outside_0_1_is_an_error) {
 
 SW_TEST_MAIN(CASE(strain_gram_is_the_rest_stiffness_of_the_domain),
              CASE(a_rigid_motion_of_the_domain_costs_no_strain_energy),
+             CASE(galerkin_errors_bound_the_projection_and_vanish_on_a_full_span),
              CASE(a_strain_share_outside_0_1_is_an_error))

@@ -40,6 +40,7 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     }
     ENSURE(num(j, "sinew_bake_report") == SW_BAKE_REPORT_VERSION);
     ENSURE_NEAR(num(j, "err_heldout"), err_heldout, 1e-9);
+    ENSURE_NEAR(num(j, "galerkin_err_heldout"), res->heldout_galerkin_error, 1e-9);
     /* the springs the bake chose, and the seams between the finger's domains: apart, by
        less than the correction */
     const cJSON *springs = cJSON_GetObjectItemCaseSensitive(j, "springs");

@@ -7,7 +7,8 @@
  *                      poisson, density, mesher (null: the character's own tet mesh),
  *                      quality {min_dihedral_deg, max_dihedral_deg, slivers, inverted,
  *                      degenerate} (sw_tetmesh_quality)}
- *   err_train, err_heldout, proj_err_train, proj_err_heldout, cubature_fit, failed_steps
+ *   err_train, err_heldout, proj_err_train, proj_err_heldout, galerkin_err_train,
+ *   galerkin_err_heldout (null: not definite), cubature_fit, failed_steps
  *   springs {k, eh, tried [[E h multiple, training error]]}: the interface springs'
  *              stiffness and the choices the bake measured (bake_springs.c)
  *   seams {train, heldout, max_train, max_heldout}: the domains' copies of a vertex apart
@@ -235,6 +236,8 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddItemToObject(j, "err_heldout", json_number(in->err_heldout));
     cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
     cJSON_AddNumberToObject(j, "proj_err_heldout", res->heldout_proj_error);
+    cJSON_AddItemToObject(j, "galerkin_err_train", json_number(res->train_galerkin_error));
+    cJSON_AddItemToObject(j, "galerkin_err_heldout", json_number(res->heldout_galerkin_error));
     cJSON_AddNumberToObject(j, "cubature_fit", res->cubature_error_max);
     cJSON *eq = cJSON_AddObjectToObject(j, "equilibrium_force");
     cJSON_AddNumberToObject(eq, "poses", res->force_poses);
@@ -421,10 +424,13 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
                 in->eval_heldout->seam_max);
     fprintf(f,
             "<tr><td>basis projection error</td><td>training %.4f, held-out %.4f</td></tr>"
+            "<tr><td>the same in the linearised model's energy (Galerkin: what the step can "
+            "reach)</td><td>training %.4f, held-out %.4f</td></tr>"
             "<tr><td>worst cubature fit</td><td>%.4f</td></tr><tr><td>failed steps</td><td>%d"
             "</td></tr><tr><td>bake time</td><td>%.1f s (+ %.1f s evaluation)</td></tr></table>\n",
-            in->res->train_proj_error, in->res->heldout_proj_error, in->res->cubature_error_max,
-            in->failed_steps, in->bake_seconds, in->eval_seconds);
+            in->res->train_proj_error, in->res->heldout_proj_error, in->res->train_galerkin_error,
+            in->res->heldout_galerkin_error, in->res->cubature_error_max, in->failed_steps,
+            in->bake_seconds, in->eval_seconds);
 }
 
 static void html_clips(FILE *f, const report *r) {

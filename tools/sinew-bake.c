@@ -37,6 +37,13 @@
 #include "samples.h"
 #include "subspace_eval.h"
 
+/* v as a JSON number, or null when it is not finite (buf: 32 chars). */
+static const char *json_number(double v, char *buf) {
+    if (!isfinite(v)) return "null";
+    snprintf(buf, 32, "%.5f", v);
+    return buf;
+}
+
 static void usage(FILE *f) {
     fprintf(f, "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
                "                   [--fps F] [--height H] |\n"
@@ -360,8 +367,10 @@ int main(int argc, char **argv) {
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].cub_count);
     fprintf(stderr, "), worst cubature fit %.4f\n", res.cubature_error_max);
     fprintf(stderr,
-            "  poses: %d training, %d held-out; basis projection error train %.4f held-out %.4f\n",
-            res.ntrain, res.nheldout, res.train_proj_error, res.heldout_proj_error);
+            "  poses: %d training, %d held-out; basis projection error train %.4f held-out %.4f; "
+            "in the linearised model's energy (Galerkin) %.4f / %.4f\n",
+            res.ntrain, res.nheldout, res.train_proj_error, res.heldout_proj_error,
+            res.train_galerkin_error, res.heldout_galerkin_error);
     int32_t kept = 0; /* the pose-space pairs the per-pair cubature keeps */
     for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
         kept += v->pair_weight[c] > 0;
@@ -419,6 +428,7 @@ int main(int argc, char **argv) {
                     res.selector_points[s], res.selector_seconds[s], res.selector_error[s]);
     }
     if (json) {
+        char gt[32], gh[32];
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
                "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
                "\"heldout_poses\":%d,"
@@ -434,6 +444,9 @@ int main(int argc, char **argv) {
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f", res.force_poses, model_err);
+        printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
+               json_number(res.train_galerkin_error, gt),
+               json_number(res.heldout_galerkin_error, gh));
         printf(",\"spring_k\":%.6g,\"spring_tried\":[", res.spring_k);
         for (int32_t k = 0; k < res.nspring_tried; ++k)
             printf("%s[%.4g,%.5f]", k ? "," : "", res.spring_tried_mult[k],

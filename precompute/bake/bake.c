@@ -526,6 +526,7 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
         (r = sw_bake_cond(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_pairs(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_springs(&s, out, err)) != SINEW_OK ||
+        (r = sw_bake_galerkin(&s, out, err)) != SINEW_OK ||
         (r = sw_bake_equilibrium(&s, out, err)) != SINEW_OK)
         goto done;
     t1 = sw_now_seconds();

@@ -144,6 +144,11 @@ typedef struct sw_bake_result {
     int32_t return_poses;      /* training poses on the way home (sw_bake_params.return_path) */
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
+    /* the same snapshots projected in the reduced model's linearised energy, its domains
+       coupled by the blob's springs: the minimum the step finds, before the cubature, the
+       contact and the nonlinearity (bake_galerkin.c; NAN when that energy is not
+       definite) */
+    double train_galerkin_error, heldout_galerkin_error;
     double cubature_error_max; /* worst per-domain relative cubature training error */
     /* the interface springs' stiffness in the blob, and the choices the bake measured
        (sw_bake_params.spring_k 0): their E h multiples and training errors, stiffest

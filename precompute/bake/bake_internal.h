@@ -110,12 +110,23 @@ sw_fullsim_params sw_bake_sim_params(const sw_bake_state *s);
  * solutions read back when the cache holds this bake's, else solved and stored. Sets
  * *cached when they were read back. */
 sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err);
+/* The un-skinned displacements of one pose (bake_basis.c, thesis eq. 4.13): d (3 nv) from
+ * positions x and bone transforms T, d_v = R_v^T (x_v - t_v) - rest_v (0 at bone-driven
+ * vertices); R (9 nv) and t (3 nv) are scratch for the skinning transforms. */
+void sw_bake_unskin(const sw_bake_state *s, const double *T, const double *x, double *R, double *t,
+                    double *d);
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-/* G (T x T) = D K D^T: the products of the snapshots D (T rows of domain dm's 3 n copies'
- * displacements) in the rest linear-elastic energy of the domain's tets, K the stiffness
- * of the co-rotational energy (eq. 2.3) at rest (bake_basis.c; the PCA's strain share,
- * sw_bake_params.pca_strain). 0 when out of memory. */
-int sw_bake_strain_gram(const sw_bake_state *s, int32_t dm, const double *D, int32_t T, double *G);
+/* The Galerkin errors (bake_galerkin.c), once the springs are chosen: the training and
+ * held-out snapshots projected in the reduced model's linearised energy (sw_bake_result
+ * train_galerkin_error, heldout_galerkin_error). */
+sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* G (na x nb) = A K B^T: the products of the rows of A and B (na and nb rows of domain dm's
+ * 3 n copies' displacements) in the rest linear-elastic energy of the domain's tets, K
+ * the stiffness of the co-rotational energy (eq. 2.3) at rest (bake_basis.c). B NULL: the
+ * Gram matrix of A (na x na). 0 when out of memory. The PCA's strain share
+ * (sw_bake_params.pca_strain) and the Galerkin errors (bake_galerkin.c) take them. */
+int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A, int32_t na,
+                            const double *B, int32_t nb, double *G);
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
