@@ -44,9 +44,7 @@
  * and scales it by the stiffness it chooses (bake_springs.c; the fixture keeps 20 E h),
  * so the fixture blob's spring Hessian rounds differently. And again (from
  * 0x6b13019a2b7bbe0f): the blob carries the pose-space equilibrium force
- * (bake_equilibrium.c), which every step near a training pose applies. And again (from
- * 0x1bec772129eb29c9): the basis is the PCA of the snapshots in an inner product that is
- * 0.7 their rest strain energy (bake_basis.c, sw_bake_params.pca_strain), another span.
+ * (bake_equilibrium.c), which every step near a training pose applies.
  * The thread counts here are instances stepped on several host threads (no task
  * callbacks); instances 1 and 3 are dynamic. */
 #include <pthread.h>
@@ -59,7 +57,7 @@
 enum { NINST = 4, STEPS = 24 };
 
 /* FNV-1a 64 of the four instances' surfaces, instance after instance. */
-#define GOLDEN_SURFACE_HASH 0xc37ae5e696d87a85ull
+#define GOLDEN_SURFACE_HASH 0x1bec772129eb29c9ull
 
 typedef struct {
     const bake_fixture *f;

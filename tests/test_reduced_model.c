@@ -261,13 +261,9 @@ TEST(chord_updates_end_at_a_newton_stationary_point) {
         dq = sqrt(dq);
         qn = sqrt(qn);
         /* the solve's own test is SW_NEWTON_LAST_UPDATE |q| on its last update; one more
-         * Newton update from there is about as small or smaller when the iterate is near
-         * the stationary point. Not always smaller: the contact pairs make the potential
-         * piecewise smooth, and a step that ended on its first Newton update (under 5% of |q|)
-         * may leave one of a little more (the fixture's frame 8 with the strain-weighted
-         * basis, bake_basis.c: 5.4%); a chord update ending away from the stationary point
-         * would leave far more */
-        ENSUREF(dq <= 2 * SW_NEWTON_LAST_UPDATE * qn + 1e-9,
+         * Newton update from there is smaller when the iterate is near the stationary
+         * point */
+        ENSUREF(dq <= SW_NEWTON_LAST_UPDATE * qn + 1e-9,
                 "frame %d: a Newton update from the solution moves %g of %g", k, dq, qn);
     }
     ENSUREF(2 * converged >= f->ch.clip.nframes, "%d of %d steps converged", converged,

@@ -21,7 +21,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.max_rank = 30;
     p.fold_share = 0;
     p.pca_energy = 0.9999;
-    p.pca_strain = 0.7;
+    p.pca_strain = 0;
     p.cubature_tol = 0.05;
     p.cubature_max = 1000;
     p.selector = SW_CUBATURE_NNHTP;

@@ -48,7 +48,8 @@ typedef struct sw_bake_params {
     double pca_energy;             /* fraction of snapshot energy kept (default 0.9999) */
     double pca_strain;             /* the PCA's inner product: this share from the snapshots'
                                       rest strain energy, the rest from their plain products
-                                      (default 0.7; 0: plain PCA; bake_basis.c) */
+                                      (default 0: plain PCA; bake_basis.c: at the same rank
+                                      no better, measured in the README) */
     double cubature_tol;           /* default 0.05 */
     int32_t cubature_max;          /* per domain (default 1000) */
     sw_cubature_selector selector; /* default NN-HTP */
