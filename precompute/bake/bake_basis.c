@@ -69,11 +69,6 @@ static int32_t orthonormalise(double *U, int64_t m, int32_t r) {
     return kept;
 }
 
-/* OpenBLAS (linked explicitly, precompute/CMakeLists.txt). The Gram matrices are small
- * and the bake's parallelism is across training poses, so its own worker threads only
- * add contention (and races a thread sanitizer cannot see through). */
-void openblas_set_num_threads(int num_threads);
-
 /* G (T x T) = D D^T, the plain products of the snapshots D (T rows of m). */
 static void plain_gram(const double *D, int32_t T, int64_t m, double *G) {
     for (int32_t a = 0; a < T; ++a)
@@ -133,6 +128,7 @@ int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A,
            *SA = malloc((size_t)na * cols * sizeof(double) + 1),
            *SB = sym ? SA : malloc((size_t)nb * cols * sizeof(double) + 1);
     int ok = local_of && tet_local && dminv && vol && SA && SB;
+    openblas_set_num_threads(1);
     if (ok) {
         sw_bake_domain_tets(s, dm, local_of, tet_local, dminv, vol);
         memset(G, 0, (size_t)na * nb * sizeof(double));

@@ -16,8 +16,6 @@
 
 #include "bake_internal.h"
 
-void openblas_set_num_threads(int num_threads);
-
 /* The un-skinned snapshots of n poses (T: 12 nb each, x: 3 nv each) into D (n x 3 nv). */
 static int unskin_all(const sw_bake_state *s, const double *T, const double *x, int32_t n,
                       double *D) {

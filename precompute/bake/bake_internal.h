@@ -11,6 +11,12 @@
 #include "selfcontact.h"
 #include "thread_pool.h"
 
+/* OpenBLAS (linked explicitly, precompute/CMakeLists.txt). The bake's dense products are
+ * small and its parallelism is across training poses and domains, so its stages call
+ * this with 1: OpenBLAS's own worker threads only add contention (and races a thread
+ * sanitizer cannot see through). */
+void openblas_set_num_threads(int num_threads);
+
 /* A sequence of poses simulated in order (each warm-starts the next). */
 typedef struct sw_pose_seq {
     int32_t npose;

@@ -29,8 +29,6 @@
 #include "cubature_train.h"
 #include "penalty.h"
 
-void openblas_set_num_threads(int num_threads);
-
 /* The relative transform z = [vec(R); t] of bone b in bone a's frame for transforms T. */
 static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
     sw_relative_transform(T + 12 * (size_t)a, T + 12 * (size_t)b, z);
