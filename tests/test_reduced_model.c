@@ -8,6 +8,7 @@
 
 #include "bake_fixture.h"
 #include "blob_pose_index.h"
+#include "cubature.h"
 #include "dqs.h"
 #include "instance.h"
 #include "instance_internal.h"
@@ -225,28 +226,32 @@ TEST(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone) {
     sinew_instance_destroy(b);
 }
 
-/* Chord updates (newton.c) reuse an earlier iterate's factor: every step over the clip
- * must still end where a full Newton update from its solution, on the exact potential's
- * own gradient and (projected) Hessian, moves the shape by less than the solve's
- * convergence test allows (steps the update cap ended are skipped: in the fold, plain
- * Newton takes more than five updates too), and chord updates must have been taken. */
-TEST(chord_updates_end_at_a_newton_stationary_point) {
+/* Every step over the clip in Newton mode `mode` must end where a full Newton update from
+ * its solution, on the exact potential's own gradient and (projected) Hessian, moves the
+ * shape by less than the solve's convergence test allows (steps the update cap ended are
+ * skipped: in the fold, plain Newton takes more than five updates too). Counts the
+ * updates, factorisations and rest-Hessian updates of the steps. */
+static void ends_at_newton_stationary_points(sinew_newton_hessian mode, uint32_t *updates,
+                                             uint32_t *factors, uint32_t *rest) {
     const bake_fixture *f = fixture();
     ENSURE(f);
     int32_t R = sw_blob_get_view(f->blob)->rank_total;
+    sinew_instance_def d = sinew_instance_def_default();
+    d.newton_hessian = mode;
     sinew_instance *inst;
-    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
     float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones);
     double *q = malloc(sizeof(double) * R), *g = malloc(sizeof(double) * R),
            *H = malloc(sizeof(double) * R * R);
-    uint32_t updates = 0, factors = 0;
+    *updates = *factors = *rest = 0;
     int converged = 0;
     for (int k = 0; k < f->ch.clip.nframes; ++k) {
         step_to_frame(f, inst, k, pose);
         sinew_step_stats st = {.struct_size = sizeof st};
         ENSURE(sinew_instance_get_stats(inst, &st) == SINEW_OK);
-        updates += st.newton_iterations;
-        factors += st.factorizations;
+        *updates += st.newton_iterations;
+        *factors += st.factorizations;
+        *rest += st.rest_updates;
         if (!(st.status & SINEW_STEP_CONVERGED)) continue; /* the update cap ended it */
         converged++;
         memcpy(q, sw_instance_q(inst), sizeof(double) * R);
@@ -268,12 +273,100 @@ TEST(chord_updates_end_at_a_newton_stationary_point) {
     }
     ENSUREF(2 * converged >= f->ch.clip.nframes, "%d of %d steps converged", converged,
             f->ch.clip.nframes);
-    ENSUREF(factors < updates, "no chord update taken: %u factorisations for %u updates", factors,
-            updates);
     free(pose);
     free(q);
     free(g);
     free(H);
+    sinew_instance_destroy(inst);
+}
+
+/* Chord updates (newton.c) reuse an earlier iterate's factor: the steps still end at
+ * Newton stationary points, and chord updates were taken. */
+TEST(chord_updates_end_at_a_newton_stationary_point) {
+    uint32_t updates, factors, rest;
+    ends_at_newton_stationary_points(SINEW_NEWTON_HESSIAN_CURRENT, &updates, &factors, &rest);
+    ENSUREF(factors < updates, "no chord update taken: %u factorisations for %u updates", factors,
+            updates);
+    ENSURE(rest == 0);
+}
+
+/* Updates on the rest Hessian (newton.c) end with a shorter last update than Newton's,
+ * since their error is not quadratic in its length: the steps end at Newton stationary
+ * points all the same, and the rest updates were taken. */
+TEST(rest_first_updates_end_at_a_newton_stationary_point) {
+    uint32_t updates, factors, rest;
+    ends_at_newton_stationary_points(SINEW_NEWTON_HESSIAN_REST_FIRST, &updates, &factors, &rest);
+    fprintf(stderr, "    %u updates, %u of them on the rest Hessian, %u factorisations\n", updates,
+            rest, factors);
+    ENSUREF(rest > 0, "no rest update taken (%u updates)", updates);
+}
+
+/* The largest difference between the cubature's domain blocks of H at q = 0 (the pose
+ * set on inst) and the rest Hessian's, over the largest entry of the rest Hessian. */
+static double rest_hessian_gap(sinew_instance *inst) {
+    const sw_blob_view *v = inst->v;
+    int32_t R = v->rank_total;
+    double *q = calloc((size_t)R, sizeof(double));
+    if (!q) return INFINITY;
+    sw_reduced_skin(&inst->red, inst->bone_dq);
+    memset(inst->red.g, 0, sizeof(double) * (size_t)R);
+    memset(inst->red.H, 0, sizeof(double) * (size_t)R * R);
+    sw_cubature_eval(&inst->red, q, 1, 1);
+    double gap = 0, top = 0;
+    const double *B = inst->red.h_rest;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        int32_t r = v->domains[k].rank, o = v->domains[k].q_offset;
+        for (int32_t i = 0; i < r; ++i)
+            for (int32_t j = 0; j < r; ++j) {
+                double h = inst->red.H[(int64_t)(o + i) * R + o + j], b = B[(int64_t)i * r + j];
+                gap = fmax(gap, fabs(h - b));
+                top = fmax(top, fabs(b));
+            }
+        B += (int64_t)r * r;
+    }
+    free(q);
+    return top > 0 ? gap / top : INFINITY;
+}
+
+/* The rest Hessian (cubature.h) is the cubature's Hessian at q = 0 of the rest shape and
+ * of the whole character turned and moved rigidly (each tet's corners turn together: U^T
+ * R^T (R K0 R^T) R U = U^T K0 U); at a bent pose of the clip the tets across the joint
+ * turn apart and it is not. */
+TEST(rest_hessian_is_the_hessian_of_the_rigidly_moved_rest_shape) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    int32_t nb = f->ch.skel.nbones;
+    sinew_instance_def d = sinew_instance_def_default();
+    d.newton_hessian = SINEW_NEWTON_HESSIAN_REST_FIRST;
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK && inst->red.h_rest);
+    double *T = malloc(sizeof(double) * 12 * (size_t)nb);
+    ENSURE(T);
+    const double c = cos(0.9), s = sin(0.9), axis[3] = {0.48, 0.6, 0.64}; /* unit */
+    double Rm[9]; /* Rodrigues: turned by 0.9 rad about the axis */
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) {
+            double cross = (i == j) ? 0 : ((j == (i + 1) % 3) ? -axis[3 - i - j] : axis[3 - i - j]);
+            Rm[3 * i + j] = (i == j ? c : 0) + (1 - c) * axis[i] * axis[j] + s * cross;
+        }
+    for (int32_t b = 0; b < nb; ++b) {
+        memcpy(T + 12 * b, Rm, sizeof Rm);
+        T[12 * b + 9] = 1.5;
+        T[12 * b + 10] = -2;
+        T[12 * b + 11] = 0.25;
+    }
+    double rest = rest_hessian_gap(inst); /* the pose of a fresh instance: rest */
+    ENSURE(sw_instance_set_pose_d(inst, T) == SINEW_OK);
+    double moved = rest_hessian_gap(inst);
+    int k = f->ch.clip.nframes / 2; /* the clip bends the finger most half way */
+    ENSURE(sw_instance_set_pose_d(inst, f->ch.clip.T + (size_t)k * 12 * nb) == SINEW_OK);
+    double bent = rest_hessian_gap(inst);
+    fprintf(stderr,
+            "    largest difference over the largest entry: rest %.2e, moved %.2e, bent %.2e\n",
+            rest, moved, bent);
+    ENSUREF(rest <= 1e-12 && moved <= 1e-9, "rest %g, rigidly moved %g", rest, moved);
+    ENSUREF(bent >= 1e-3, "bent %g: the test cannot tell the poses apart", bent);
+    free(T);
     sinew_instance_destroy(inst);
 }
 
@@ -433,6 +526,8 @@ TEST(release_fixture) {
 SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
              CASE(contact_tangential_share_fades_from_the_training_poses),
              CASE(chord_updates_end_at_a_newton_stationary_point),
+             CASE(rest_first_updates_end_at_a_newton_stationary_point),
+             CASE(rest_hessian_is_the_hessian_of_the_rigidly_moved_rest_shape),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
              CASE(branches_follow_the_motion), CASE(twins_form_cycles_on_any_poses),
              CASE(training_poses_are_reproduced), CASE(copy_spread_measures_the_seams),

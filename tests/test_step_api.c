@@ -356,6 +356,14 @@ TEST(bad_defs_are_rejected_with_a_logged_reason) {
     ENSURE(sinew_instance_create(f->blob, (const sinew_instance_def *)(void *)old, &inst) ==
            SINEW_OK);
     sinew_instance_destroy(inst);
+    /* a Newton Hessian that is none of the three */
+    d = sinew_instance_def_default();
+    d.logger = (sinew_logger){count_log, &lc, SINEW_LOG_DEBUG};
+    d.newton_hessian = (sinew_newton_hessian)3;
+    int calls = lc.calls;
+    ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_ERROR_INVALID_ARGUMENT && !inst);
+    ENSURE(lc.calls == calls + 1 && lc.last_id == SINEW_MSG_INSTANCE_INVALID_ARGUMENT &&
+           lc.last_level == SINEW_LOG_ERROR);
 }
 
 TEST(every_phase_reports_its_time_and_counts) {

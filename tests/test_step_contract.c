@@ -185,12 +185,13 @@ enum {
     P_WORLD_BUDGET, /* the same, max_world_contacts = 1 (BUDGET) */
     P_EXHAUSTIVE,   /* the clip, quasistatic and dynamic, exhaustive self-contact */
     P_POSE_PAIRS,   /* the clip, quasistatic, pose-space self-contact per pair of domains */
+    P_REST_FIRST,   /* the clip, quasistatic, Newton starting on the rest Hessian */
     P_COUNT
 };
 static const char *const path_names[P_COUNT] = {
-    "quasistatic", "dynamic", "translate jump", "rotation snap", "dt spikes",
-    "cut",         "limited", "guard",          "failed",        "reset",
-    "pair budget", "world",   "world budget",   "exhaustive",    "pose pairs"};
+    "quasistatic",  "dynamic",    "translate jump", "rotation snap", "dt spikes",   "cut",
+    "limited",      "guard",      "failed",         "reset",         "pair budget", "world",
+    "world budget", "exhaustive", "pose pairs",     "rest first"};
 
 typedef struct {
     int steps, failed;         /* steps made; of them, returning an error */
@@ -199,6 +200,7 @@ typedef struct {
     uint32_t pairs_dropped, world_dropped, world_contacts, world_rounds;
     uint32_t budget_bits;
     uint32_t self_contacts; /* self-contact pairs in the solves, summed */
+    uint32_t rest_updates;  /* Newton updates on the rest Hessian, summed */
 } path_record;
 
 typedef struct {
@@ -242,6 +244,7 @@ static sinew_result step_path(contract_run *cr, int p, sinew_instance *inst, con
     if (st.world_rounds > r->world_rounds) r->world_rounds = st.world_rounds;
     r->budget_bits |= st.budget_exceeded;
     r->self_contacts += st.self_contacts;
+    r->rest_updates += st.rest_updates;
     return res;
 }
 
@@ -310,6 +313,7 @@ enum {
     I_XQ,
     I_XD,
     I_PP,
+    I_REST,
     I_COUNT
 };
 
@@ -332,6 +336,10 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         if (i == I_XQ || i == I_XD) d.self_contact = SINEW_SELF_CONTACT_EXHAUSTIVE;
         if (i == I_PP) d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS;
         if (i == I_PAIRS) d.max_contact_pairs = 1;
+        /* Newton on the current Hessian in the plain quasistatic path, starting on the rest
+           Hessian in its own (the default's choice depends on the blob) */
+        if (i == I_Q || i == I_FRESH) d.newton_hessian = SINEW_NEWTON_HESSIAN_CURRENT;
+        if (i == I_REST) d.newton_hessian = SINEW_NEWTON_HESSIAN_REST_FIRST;
         if (i == I_WBUDGET) d.max_world_contacts = 1;
         size_t bytes = 0;
         int before = heap.allocs;
@@ -392,6 +400,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         step_path(&cr, P_EXHAUSTIVE, in[I_XQ], clip_pose(f, s), 1.0f / 30);
         step_path(&cr, P_EXHAUSTIVE, in[I_XD], clip_pose(f, s), 1.0f / 30);
         step_path(&cr, P_POSE_PAIRS, in[I_PP], clip_pose(f, s), 1.0f / 30);
+        step_path(&cr, P_REST_FIRST, in[I_REST], clip_pose(f, s), 1.0f / 30);
     }
     /* teleports: away and back, then a half turn of the whole character */
     moved_pose(f, 0, I3, far, pose);
@@ -493,7 +502,8 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         if (p != P_FAILED && p != P_GUARD && p != P_LIMITED)
             ENSUREF(r->min_iters >= 1, "path %s: a step with no Newton iteration", path_names[p]);
         /* a quasistatic step starts from the pose space, a dynamic one never */
-        int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET || p == P_POSE_PAIRS;
+        int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET || p == P_POSE_PAIRS ||
+                    p == P_REST_FIRST;
         if (quasi) ENSUREF(r->all & SINEW_STEP_POSE_SPACE, "path %s", path_names[p]);
         if (!quasi && p != P_RESET && p != P_WORLD && p != P_EXHAUSTIVE)
             ENSUREF(!(r->any & SINEW_STEP_POSE_SPACE), "path %s", path_names[p]);
@@ -539,6 +549,12 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     /* exhaustive self-contact found the fold's contacts itself */
     ENSUREF(rec[P_EXHAUSTIVE].self_contacts > 0, "the exhaustive mode found no self-contact");
     ENSUREF(rec[P_POSE_PAIRS].self_contacts > 0, "the pose-pairs mode used no contact pair");
+    /* each Newton in its own path: the rest-first updates ran, and only there */
+    ENSUREF(rec[P_REST_FIRST].rest_updates > 0 && rec[P_QUASISTATIC].rest_updates == 0,
+            "rest updates %u in the rest-first path, %u on the current Hessian",
+            rec[P_REST_FIRST].rest_updates, rec[P_QUASISTATIC].rest_updates);
+    ENSURE(rec[P_REST_FIRST].any & SINEW_STEP_CONVERGED &&
+           !(rec[P_REST_FIRST].any & ~(SINEW_STEP_CONVERGED | SINEW_STEP_POSE_SPACE)));
 
     /* ---- memory: the host allocator, once per instance at creation, never in a step */
     ENSUREF(heap_in_run == 0 && heap_frees_in_run == 0,

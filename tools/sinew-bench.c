@@ -125,6 +125,7 @@
 #include "world_bench.h"
 #include "dyn_bench.h"
 #include "crowd_bench.h"
+#include "newton_bench.h"
 #include "sc_bench.h"
 #include "dqs_bench.h"
 #include "gap_bench.h"
@@ -142,6 +143,7 @@ static void usage(FILE *f) {
                "                   [--world FILE.json [--rho R] [--patch-budget N]]\n"
                "                   [--dynamic [--hold-frames H]] [--instances N]\n"
                "                   [--self-contact pose-space|exhaustive] [--sc-compare]\n"
+               "                   [--newton-compare]\n"
                "                   [--error-gap] [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
@@ -178,6 +180,8 @@ static void usage(FILE *f) {
             "  --self-contact M    pose-space (default) or exhaustive: the runtime's mode\n"
             "                      (sinew_instance_def.self_contact) for the timing and errors\n"
             "  --sc-compare        also time self-contact in both modes over the clip: sc_*\n"
+            "  --newton-compare    also time the quasistatic step with Newton on the current\n"
+            "                      and starting on the rest Hessian over the clip: newton_*\n"
             "  --error-gap         also the runtime against its basis's projection on the\n"
             "                      bake's held-out poses (not with --blob alone): gap_*\n"
             "  --dynamic           also run the runtime in dynamic mode against the reference's\n"
@@ -256,7 +260,7 @@ int main(int argc, char **argv) {
     int json = 0, full_frames = 0, contract_steps = 10000, threads = 0, bake_errors = 0;
     int dynamic = 0, hold_frames = 0, instances = 0, patch_budget = 0;
     sinew_self_contact self_mode = SINEW_SELF_CONTACT_POSE_SPACE;
-    int sc_compare = 0, error_gap = 0;
+    int sc_compare = 0, error_gap = 0, newton_compare = 0;
     sw_cond_bench_params cond = {{0}, 0, 0, NULL};
     sw_fullsim_params ref_solver = sw_fullsim_params_default(); /* the reference's options */
     for (int i = 1; i < argc; ++i) {
@@ -296,6 +300,8 @@ int main(int argc, char **argv) {
                                  : SINEW_SELF_CONTACT_POSE_SPACE;
         } else if (!strcmp(a, "--sc-compare"))
             sc_compare = 1;
+        else if (!strcmp(a, "--newton-compare"))
+            newton_compare = 1;
         else if (!strcmp(a, "--error-gap"))
             error_gap = 1;
         else if (!strcmp(a, "--dynamic"))
@@ -625,6 +631,16 @@ int main(int argc, char **argv) {
         failed_steps += scb.failed;
         sw_sc_bench_print(&scb, stderr, 0);
     }
+    /* 11. Newton on the current and on the rest Hessian, when asked */
+    sw_newton_bench nwb;
+    memset(&nwb, 0, sizeof nwb);
+    if (newton_compare) {
+        float dt = 1.0f / (float)(ch.clip.fps > 0 ? ch.clip.fps : 30);
+        if ((r = sw_newton_bench_run(blob, ch.clip.T, nf, dt, 3, &nwb, &err)) != SINEW_OK)
+            return sw_tool_failed(r, &err, "sinew-bench: Newton comparison failed: ");
+        failed_steps += nwb.failed;
+        sw_newton_bench_print(&nwb, stderr, 0);
+    }
     /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
     char e_tr[32] = "null", e_ho[32] = "null";
     if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
@@ -686,6 +702,7 @@ int main(int argc, char **argv) {
                                                ? "pose_pairs"
                                                : "pose_space");
     if (json && sc_compare) sw_sc_bench_print(&scb, stdout, 1);
+    if (json && newton_compare) sw_newton_bench_print(&nwb, stdout, 1);
     if (json && error_gap) sw_gap_bench_print(&gap, stdout, 1);
     if (json && clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",

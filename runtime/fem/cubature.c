@@ -1,6 +1,7 @@
 #include "cubature.h"
 
 #include <stddef.h>
+#include <stdint.h>
 
 #include "blob_load.h"
 #include "fem_corot.h"
@@ -145,6 +146,35 @@ static void singular_frame_projections(const tet_map *tm, int32_t r, const doubl
     if (j < r) column_projections(tm, r, j, r - j, W, b, dpsi, fscale, mode, n, out);
 }
 
+/* One cubature tet with its Hessian: returns w E and leaves J^T f in hm[0, r) (f = -dE/dx),
+ * and adds w J^T K J to the upper triangle of the domain block H (row stride ld) through
+ * the element's nonzero modes in the singular frame (eq. 2.12 through the modes, J^T K J =
+ * sum_k w_k (J^T g_k) (J^T g_k)^T). V_cache warm-starts the SVD and keeps its V. */
+static double tet_with_hessian(const tet_map *tm, int32_t r, const double x[12],
+                               const double dminv[9], double vol, const sw_blob_view *v,
+                               double *V_cache, uint32_t project, double w, double *H, int32_t ld,
+                               double *hm) {
+    double U[9], sv[3], V[9], dpsi[3], wm[9], a[9];
+    double e = w * sw_corot_eval_svd(x, dminv, vol, v->mu, v->lambda, V_cache, project, U, sv, V,
+                                     dpsi, wm);
+    int mode[9], n = 0;
+    for (int mk = 0; mk < 9; ++mk)
+        if (wm[mk] != 0.0) {
+            a[n] = w * wm[mk];
+            mode[n++] = mk;
+        }
+    singular_frame_projections(tm, r, dminv, U, V, dpsi, -vol, mode, n, hm);
+    if (n > 0) add_mode_products(H, ld, r, hm + r, a, n);
+    return e;
+}
+
+/* A domain block filled in its upper triangle (row stride ld): mirror it. */
+static void mirror_upper(double *H, int32_t ld, int32_t r) {
+    for (int32_t i = 0; i < r; ++i)
+        for (int32_t j = i + 1; j < r; ++j)
+            H[(int64_t)j * ld + i] = H[(int64_t)i * ld + j];
+}
+
 /* One cubature pass over some domains, by one worker. */
 typedef struct {
     sw_reduced *m;
@@ -190,32 +220,78 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
                     m->g[o + j] -= w * hm[j];
                 continue;
             }
-            /* With the Hessian: J^T f and J^T g_k of the element's nonzero modes in the
-             * singular frame (eq. 2.12 through the modes, J^T K J = sum_k w_k (J^T g_k)
-             * (J^T g_k)^T) */
-            double U[9], sv[3], V[9], dpsi[3], wm[9], a[9];
             m->ecub[c] =
-                w * sw_corot_eval_svd(x, dminv, v->cub_vol[c], v->mu, v->lambda,
-                                      m->svd_V + 9 * (int64_t)c, project, U, sv, V, dpsi, wm);
-            int mode[9], n = 0;
-            for (int mk = 0; mk < 9; ++mk)
-                if (wm[mk] != 0.0) {
-                    a[n] = w * wm[mk];
-                    mode[n++] = mk;
-                }
-            singular_frame_projections(&tm, r, dminv, U, V, dpsi, -v->cub_vol[c], mode, n, hm);
+                tet_with_hessian(&tm, r, x, dminv, v->cub_vol[c], v, m->svd_V + 9 * (int64_t)c,
+                                 project, w, m->H + (int64_t)o * m->R + o, m->R, hm);
             for (int32_t j = 0; j < r; ++j)
                 m->g[o + j] -= w * hm[j];
-            if (n > 0) add_mode_products(m->H + (int64_t)o * m->R + o, m->R, r, hm + r, a, n);
         }
-        if (want_hess) /* the block was filled in its upper triangle: mirror */
-            for (int32_t i = 0; i < r; ++i)
-                for (int32_t j = i + 1; j < r; ++j)
-                    m->H[(int64_t)(o + j) * m->R + o + i] = m->H[(int64_t)(o + i) * m->R + o + j];
+        if (want_hess) mirror_upper(m->H + (int64_t)o * m->R + o, m->R, r);
     }
 }
 
+void sw_cubature_rest_hessian(sw_reduced *m, double *blocks) {
+    static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const sw_blob_view *v = m->v;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank;
+        for (int64_t i = 0; i < (int64_t)r * r; ++i)
+            blocks[i] = 0;
+        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
+            tet_map tm;
+            double x[12], V[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+            for (int n = 0; n < 4; ++n) {
+                int32_t lv = v->cub_tets[4 * c + n];
+                const double *X = v->rest + 3 * (int64_t)v->domain_verts[D->vert_begin + lv];
+                tm.U[n] = v->basis + D->basis_offset + (int64_t)3 * lv * r;
+                tm.R[n] = I3;
+                for (int i = 0; i < 3; ++i)
+                    x[3 * n + i] = X[i];
+            }
+            (void)tet_with_hessian(&tm, r, x, v->cub_dminv + 9 * c, v->cub_vol[c], v, V,
+                                   SW_COROT_PROJECT_PSD, v->cub_weight[c], blocks, r, m->hm);
+        }
+        mirror_upper(blocks, r, r);
+        blocks += (int64_t)r * r;
+    }
+}
+
+int64_t sw_cubature_rest_hessian_size(const sw_blob_view *v) {
+    int64_t n = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k)
+        n += (int64_t)v->domains[k].rank * v->domains[k].rank;
+    return n;
+}
+
+double sw_cubature_hessian_madds(const sw_blob_view *v) {
+    double n = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        double r = v->domains[k].rank;
+        n += v->domains[k].cub_count * (4.5 * r * (r + 1) + 88 * r);
+    }
+    return n;
+}
+
+static double cubature_pass(sw_reduced *m, const double *q, int want_grad, int want_hess);
+
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess) {
+    if (want_hess != SW_CUB_HESSIAN_REST) return cubature_pass(m, q, want_grad, want_hess);
+    double E = cubature_pass(m, q, want_grad, 0);
+    const sw_blob_view *v = m->v;
+    const double *B = m->h_rest;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        int32_t r = v->domains[k].rank, o = v->domains[k].q_offset;
+        for (int32_t i = 0; i < r; ++i)
+            for (int32_t j = 0; j < r; ++j)
+                m->H[(int64_t)(o + i) * m->R + o + j] += B[(int64_t)i * r + j];
+        B += (int64_t)r * r;
+    }
+    return E;
+}
+
+/* Every domain's tets at q, on the host's task workers when it gave them. */
+static double cubature_pass(sw_reduced *m, const double *q, int want_grad, int want_hess) {
     const sw_blob_view *v = m->v;
     cub_pass p = {m, q, want_grad, want_hess};
     const sinew_task_callbacks *t = m->tasks;

@@ -14,6 +14,26 @@
  * tests; the step never asks for it). Warm starts each element's SVD from m->svd_V and
  * updates it. */
 #define SW_CUB_HESSIAN_EXACT 2
+/* want_hess == SW_CUB_HESSIAN_REST: a gradient pass, and the rest Hessian's domain blocks
+ * (m->h_rest, sw_cubature_rest_hessian) added to m->H in place of the Hessian at q: the
+ * first updates of a quasistatic Newton step (newton.c says why and when). */
+#define SW_CUB_HESSIAN_REST 3
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess);
+
+/* The cubature's Hessian at the rest shape (q = 0, every skinning rotation the identity:
+ * the elements' linear stiffness, eq. 2.12 at F = I), domain k's block (r_k x r_k,
+ * row-major) at blocks + sum_{j<k} r_j^2. A tet whose corners turn with one rotation R
+ * has the Hessian U^T R^T (R K0 R^T) R U = U^T K0 U at any pose as long as it does not
+ * deform, so this stands for the Hessian wherever the flesh follows its bones. Uses the
+ * first worker's scratch; at creation only. */
+void sw_cubature_rest_hessian(sw_reduced *m, double *blocks);
+
+/* sum over domains of r_k^2: the rest Hessian's doubles. */
+int64_t sw_cubature_rest_hessian_size(const sw_blob_view *v);
+
+/* Multiply-adds a Hessian pass costs beyond a gradient pass (the element modes'
+ * projections, about 100 a basis column, and their products, 9 r (r + 1) / 2, less the
+ * gradient's 12 r), summed over the cubature tets: what SW_CUB_HESSIAN_REST saves. */
+double sw_cubature_hessian_madds(const sw_blob_view *v);
 
 #endif

@@ -40,6 +40,9 @@ typedef struct sw_reduced {
     /* The cubature weights in use (ncub): the blob's, except while a condensation patch
      * holds some tets (0 there, the rest of their domain renormalised, condense.h). */
     const double *cub_w;
+    /* The rest Hessian's domain blocks (sw_cubature_rest_hessian), NULL where the instance
+     * never starts Newton on it. */
+    const double *h_rest;
 } sw_reduced;
 
 /* Skins every active vertex with the bones' dual quaternions (act_R, act_t), which m keeps

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "bbox.h"
+#include "cubature.h"
 #include "def_read.h"
 #include "instance.h"
 #include "instance_internal.h"
@@ -25,6 +26,7 @@ typedef struct {
     /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
        mode's fallback on novel contact when the blob has the tet mesh */
     int detect;
+    int rest; /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -58,6 +60,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->Jc, 12 * rm);
     TAKE(m->hc, 12 * rm);
     TAKE(m->svd_V, 9 * (uint64_t)v->ncub);
+    in->h_rest = NULL;
+    if (z->rest) TAKE(in->h_rest, (uint64_t)sw_cubature_rest_hessian_size(v));
     /* the pose space */
     sw_pose_space *ps = &in->ps;
     TAKE(ps->feature, 4 * nb);
@@ -307,6 +311,10 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
             ? "exhaustive self-contact needs a blob with the tet mesh (bake it again)"
         : d->self_contact == SINEW_SELF_CONTACT_POSE_PAIRS && v->npair_groups == 0
             ? "pose-pairs self-contact needs a blob with per-pair sections (bake it again)"
+        : d->newton_hessian != SINEW_NEWTON_HESSIAN_AUTO &&
+                d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT &&
+                d->newton_hessian != SINEW_NEWTON_HESSIAN_REST_FIRST
+            ? "newton_hessian is none of auto, current, rest-first"
             : NULL;
     if (bad) {
         sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
@@ -335,6 +343,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs);
     z->rho = d->patch_radius > 0 ? d->patch_radius : SW_COND_DEFAULT_RADIUS;
     z->detect = d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE || (z->per_pair && v->ntets > 0);
+    z->rest = d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT;
     return SINEW_OK;
 }
 
@@ -399,6 +408,35 @@ static void state_bounds(sinew_instance *in) {
         in->u_max[k] = umax;
         in->q_bound[k] = SW_LIMIT_TRAIN * qmax;
         if (umax > 0) in->q_bound[k] = fmax(in->q_bound[k], SW_LIMIT_SIZE * in->size / umax);
+    }
+}
+
+/* Where a factorisation costs at least this share of the multiply-adds the rest Hessian
+ * saves a cubature pass, SINEW_NEWTON_HESSIAN_AUTO keeps the current Hessian: every
+ * rest-first update costs a factorisation, and one the energy rejects also a gradient
+ * pass before the step goes on as before. Measured shares (sw_solver_factor_madds over
+ * sw_cubature_hessian_madds; the same ratio of a factorisation's time to a Hessian
+ * pass's extra time within 0.1) and the instructions of the steps over sinew-bench's clip
+ * with the current Hessian -> rest-first (callgrind): finger 50K 0.013, 0.230G -> 0.145G;
+ * hand 0.095, 1.244G -> 0.689G; Fox 0.10, 2.20G -> 2.05G; elephant 0.62, 24.7G -> 29.9G
+ * (its factor keeps 68 blocks for the springs' cross-body ties, and most of its
+ * rest-first updates are rejected: its stretched flesh stiffens in rotation). */
+#define SW_REST_FACTOR_SHARE 0.3
+
+/* The def's newton_hessian made concrete: with the rest Hessian, its blocks computed
+ * (a cubature pass at rest) and red.h_rest set. *share: a factorisation's multiply-adds
+ * over those the rest Hessian saves a pass. */
+static void choose_newton_hessian(sinew_instance *in, sinew_newton_hessian want, double *share) {
+    const sw_blob_view *v = in->v;
+    double saved = sw_cubature_hessian_madds(v);
+    *share = saved > 0 ? sw_solver_factor_madds(&in->solver, v) / saved : INFINITY;
+    int rest = want == SINEW_NEWTON_HESSIAN_REST_FIRST ||
+               (want == SINEW_NEWTON_HESSIAN_AUTO && *share < SW_REST_FACTOR_SHARE);
+    in->solver.rest_first = rest;
+    in->red.h_rest = NULL;
+    if (rest) {
+        sw_cubature_rest_hessian(&in->red, in->h_rest);
+        in->red.h_rest = in->h_rest;
     }
 }
 
@@ -467,11 +505,15 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
     sw_solver_order_blocks(&in->solver, v);
+    double share;
+    choose_newton_hessian(in, d.newton_hessian, &share);
     sinew_instance_reset(in);
     sw_log(&d.logger, SINEW_LOG_INFO, SINEW_MSG_INSTANCE_CREATED,
            "sinew_instance_create: %zu bytes in one block; %d active vertices, rank %d, %d "
-           "contact pairs a step at most",
-           sw_plan_size(&plan), in->red.nact, in->red.R, z.max_pairs);
+           "contact pairs a step at most; quasistatic Newton starts on the %s Hessian (a "
+           "factorisation costs %.2f of what the rest Hessian saves a pass)",
+           sw_plan_size(&plan), in->red.nact, in->red.R, z.max_pairs,
+           in->solver.rest_first ? "rest" : "current", share);
     *out = in;
     return SINEW_OK;
 }

@@ -35,6 +35,7 @@ typedef struct sw_solver {
     unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
     int mass_blockdiag;  /* the blob's reduced mass is zero outside the domains' blocks */
     uint32_t max_newton; /* Newton updates a step at most */
+    int rest_first;      /* quasistatic steps start on the rest Hessian (red->h_rest) */
     double dq_tiny;      /* an update shorter than this converged (1e-9 of the size) */
 } sw_solver;
 
@@ -96,6 +97,11 @@ int sw_solver_factor(sw_reduced *red, sw_solver *s);
 
 /* x = H^-1 x with the factor of sw_solver_factor. */
 void sw_solver_factor_solve(const sw_reduced *red, const sw_solver *s, double *x);
+
+/* Multiply-adds of one factorisation of the springs' block pattern (the fill included, no
+ * contact pairs), for the choice of SINEW_NEWTON_HESSIAN_AUTO. At creation: it uses
+ * s->blk_nz as scratch (every step sets it again). */
+double sw_solver_factor_madds(sw_solver *s, const sw_blob_view *v);
 
 /* Newton from s->q with the energy guard, into s->q; fills st's iterations, status
  * (CONVERGED, GUARD), residual, energy and potential_evals. A non-finite potential

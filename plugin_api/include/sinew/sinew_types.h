@@ -118,6 +118,25 @@ typedef enum sinew_self_contact {
     SINEW_SELF_CONTACT_POSE_PAIRS = 2
 } sinew_self_contact;
 
+/** The Hessian a quasistatic step's Newton updates start on (sinew_instance_def). */
+typedef enum sinew_newton_hessian {
+    /** the library chooses per blob at creation: the rest Hessian first where a
+     * factorisation of the reduced Hessian costs less than a third of the multiply-adds
+     * the rest Hessian saves a cubature pass (most characters), the current one where
+     * the domains' couplings make the factorisation dear (the 24-bone elephant) */
+    SINEW_NEWTON_HESSIAN_AUTO = 0,
+    /** every Newton update on the Hessian at an iterate of the step (a cubature pass
+     * with the element Hessians), chord updates on an earlier factor once it converges */
+    SINEW_NEWTON_HESSIAN_CURRENT = 1,
+    /** the updates start on the rest Hessian (the cubature's stiffness at the rest
+     * shape, the contact pairs' and springs' Hessian at the start point), factored once,
+     * each trial a gradient pass; an update the energy rejects or one that shrinks the
+     * gradient too little hands the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration.
+     * The stationary point is the same; dynamic steps always use the current Hessian
+     * (their damping needs it anyway). Reserves the rest Hessian's domain blocks */
+    SINEW_NEWTON_HESSIAN_REST_FIRST = 2
+} sinew_newton_hessian;
+
 /** How to create an instance of a blob. All memory is reserved at creation. */
 typedef struct sinew_instance_def {
     uint32_t struct_size;      /**< sizeof(sinew_instance_def), set by the default */
@@ -156,6 +175,9 @@ typedef struct sinew_instance_def {
     /** Self-contact detection: SINEW_SELF_CONTACT_POSE_SPACE (the default),
      * SINEW_SELF_CONTACT_EXHAUSTIVE or SINEW_SELF_CONTACT_POSE_PAIRS (see there). */
     sinew_self_contact self_contact;
+    /** The Hessian quasistatic Newton updates start on: SINEW_NEWTON_HESSIAN_AUTO (the
+     * default), _CURRENT or _REST_FIRST (see there). */
+    sinew_newton_hessian newton_hessian;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -175,6 +197,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.max_patch_vertices = 0;
     d.patch_radius = 0.0f;
     d.self_contact = SINEW_SELF_CONTACT_POSE_SPACE;
+    d.newton_hessian = SINEW_NEWTON_HESSIAN_AUTO;
     return d;
 }
 
@@ -278,6 +301,9 @@ typedef struct sinew_step_stats {
      * farther than half the feature's size (novel contact the bake never saw); 0 in the
      * other modes */
     uint32_t self_contact_novel;
+    /** Newton updates taken on the rest Hessian (SINEW_NEWTON_HESSIAN_REST_FIRST, or
+     * _AUTO where it chose it); the other updates are counted in newton_iterations too */
+    uint32_t rest_updates;
 } sinew_step_stats;
 
 #ifdef __cplusplus

@@ -1,0 +1,140 @@
+/* sinew-bench --newton-compare (newton_bench.h). */
+#include "newton_bench.h"
+
+#include <math.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "bbox.h"
+#include "blob_load.h"
+#include "instance.h"
+#include "rt_interpose.h"
+
+static int cmp_double(const void *a, const void *b) {
+    double x = *(const double *)a, y = *(const double *)b;
+    return (x > y) - (x < y);
+}
+
+/* Mode k's instance (0 current, 1 rest-first) over the clip: the timed steps' figures,
+ * and each frame's output surface of the last pass in surf (3 ns floats a frame). */
+static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int nframes, float dt,
+                             int reps, float *surf, double *ms, sw_newton_bench *out,
+                             sw_error *err) {
+    sinew_instance_def def = sinew_instance_def_default();
+    def.newton_hessian = k ? SINEW_NEWTON_HESSIAN_REST_FIRST : SINEW_NEWTON_HESSIAN_CURRENT;
+    sinew_instance *inst;
+    sinew_result r = sinew_instance_create(blob, &def, &inst);
+    if (r != SINEW_OK)
+        return sw_error_set(err, r, "cannot create a %s instance: %s",
+                            k ? "rest-first" : "current-Hessian", sinew_result_string(r));
+    int nb = (int)sinew_blob_bone_count(blob);
+    uint32_t ns = sinew_blob_surface_vertex_count(blob);
+    for (int f = 0; f < nframes; ++f) { /* untimed pass */
+        sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
+        out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
+    }
+    if (k) sw_rt_count_begin();
+    int steps = 0;
+    for (int rep = 0; rep < reps; ++rep)
+        for (int f = 0; f < nframes; ++f, ++steps) {
+            sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
+            out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
+            sinew_step_stats st = {.struct_size = sizeof st};
+            sinew_instance_get_stats(inst, &st);
+            ms[steps] = st.ms_skin + st.ms_contact + st.ms_dynamics + st.ms_world + st.ms_oracle +
+                        st.ms_solve + st.ms_output;
+            out->evals[k] += st.potential_evals;
+            out->factors[k] += st.factorizations;
+            out->rest[k] += st.rest_updates;
+            if (rep == reps - 1)
+                sinew_instance_read_surface(inst, surf + (size_t)f * 3 * ns, NULL, ns);
+        }
+    if (k) {
+        sw_rt_counts c = sw_rt_count_end();
+        unsigned active = sw_rt_interpose_active();
+        out->allocs = active & SW_RT_CAT_ALLOCS
+                          ? (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0))
+                          : -1;
+        out->locks = active & SW_RT_CAT_LOCKS ? (long)c.locks : -1;
+    }
+    qsort(ms, (size_t)steps, sizeof *ms, cmp_double);
+    out->steps = steps;
+    out->step_ms[k] = ms[steps / 2];
+    out->evals[k] /= steps;
+    out->factors[k] /= steps;
+    out->rest[k] /= steps;
+    if (k) {
+        def.newton_hessian = SINEW_NEWTON_HESSIAN_AUTO;
+        sinew_instance *a;
+        if (sinew_instance_create(blob, &def, &a) == SINEW_OK) {
+            sw_instance_set_pose_d(a, T);
+            sinew_instance_step(a, dt);
+            sinew_step_stats st = {.struct_size = sizeof st};
+            sinew_instance_get_stats(a, &st);
+            out->auto_rest = st.rest_updates > 0;
+            sinew_instance_destroy(a);
+        }
+    }
+    sinew_instance_destroy(inst);
+    return SINEW_OK;
+}
+
+sinew_result sw_newton_bench_run(const sinew_blob *blob, const double *T, int nframes, float dt,
+                                 int reps, sw_newton_bench *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    if (!blob || !T || nframes < 1 || reps < 1 || !(dt > 0))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "newton bench: bad arguments");
+    size_t ns = sinew_blob_surface_vertex_count(blob), n = (size_t)nframes * 3 * ns;
+    float *surf = malloc(2 * n * sizeof(float));
+    double *ms = malloc((size_t)nframes * (size_t)reps * sizeof(double));
+    if (!surf || !ms) {
+        free(surf);
+        free(ms);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "newton bench: out of memory");
+    }
+    sinew_result r = run_mode(blob, 0, T, nframes, dt, reps, surf, ms, out, err);
+    if (r == SINEW_OK) r = run_mode(blob, 1, T, nframes, dt, reps, surf + n, ms, out, err);
+    if (r == SINEW_OK) {
+        out->speedup = out->step_ms[1] > 0 ? out->step_ms[0] / out->step_ms[1] : INFINITY;
+        double gap = 0;
+        for (size_t i = 0; i < n; i += 3) {
+            double d2 = 0;
+            for (int c = 0; c < 3; ++c)
+                d2 += (double)(surf[i + c] - surf[n + i + c]) * (surf[i + c] - surf[n + i + c]);
+            gap = fmax(gap, sqrt(d2));
+        }
+        const sw_blob_view *v = sw_blob_get_view(blob);
+        double lo[3], hi[3];
+        sw_bbox_empty(lo, hi);
+        sw_bbox_add(lo, hi, v->nverts, v->rest);
+        double size = sw_bbox_diagonal(lo, hi);
+        out->surface_gap = size > 0 ? gap / size : gap;
+    }
+    free(surf);
+    free(ms);
+    return r;
+}
+
+void sw_newton_bench_print(const sw_newton_bench *b, FILE *f, int json) {
+    if (!json) {
+        fprintf(f,
+                "sinew-bench: Newton over %d steps: current Hessian %.4f ms a step (%.2f "
+                "passes, %.2f factorisations), rest-first %.4f ms (%.2f passes, %.2f "
+                "factorisations, %.2f rest updates): %.2fx; surfaces apart by %.2e of the size "
+                "at most; auto chooses the %s Hessian; rest-first allocs %ld, locks %ld\n",
+                b->steps, b->step_ms[0], b->evals[0], b->factors[0], b->step_ms[1], b->evals[1],
+                b->factors[1], b->rest[1], b->speedup, b->surface_gap,
+                b->auto_rest ? "rest" : "current", b->allocs, b->locks);
+        return;
+    }
+    fprintf(f,
+            ",\"newton_steps\":%d,\"newton_step_ms_current\":%.5f,"
+            "\"newton_step_ms_rest_first\":%.5f,\"newton_rest_first_speedup\":%.3f,"
+            "\"newton_evals_current\":%.3f,\"newton_evals_rest_first\":%.3f,"
+            "\"newton_factors_current\":%.3f,\"newton_factors_rest_first\":%.3f,"
+            "\"newton_rest_updates\":%.3f,\"newton_surface_gap\":%.3e,\"newton_auto_rest\":%d,"
+            "\"newton_rest_allocs_in_step\":%ld,\"newton_rest_locks_in_step\":%ld",
+            b->steps, b->step_ms[0], b->step_ms[1], b->speedup, b->evals[0], b->evals[1],
+            b->factors[0], b->factors[1], b->rest[1], b->surface_gap, b->auto_rest, b->allocs,
+            b->locks);
+}
