@@ -3,7 +3,8 @@
  * minimum-degree order of the spring couplings (plus the fill and the contact pairs of
  * the step), chord updates on an earlier factor once the iterate converges fast, and an
  * energy guard: a trial point whose energy grows is halved, up to five times, and the
- * best iterate is kept. */
+ * best iterate is kept. A quasistatic step may start with updates on the rest Hessian
+ * (rest_first_updates) before the current Hessian's. */
 #include <math.h>
 #include <string.h>
 
@@ -152,29 +153,41 @@ static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_sol
 /* Rest-first updates (SINEW_NEWTON_HESSIAN_REST_FIRST) go on while each shrinks the
  * gradient to this share of its value or less; a slower one hands the step to the current
  * Hessian. Measured on the Fox's Run (callgrind, instructions of the steps over the clip,
- * 4.40G with the current Hessian): 4.10G at 0.3 (1.71 rest updates a step), 4.29G at
- * 0.5, 3.36G at 0.9, but there 4.6 of the 5 updates a step allowed are rest updates and
+ * 2.20G with the current Hessian): 2.05G at 0.3 (1.71 rest updates a step), 2.15G at
+ * 0.5, 1.68G at 0.9, but there 4.6 of the 5 updates a step allowed are rest updates and
  * the step ends at the cap, not at its last-update test. The hand and the finger end
  * in one update at any of these. */
 #define SW_REST_KEEP 0.3
-#ifndef SW_REST_LAST_UPDATE
+/* A rest update's error is not quadratic in its length, as a Newton update's is: the last
+ * one must be shorter. At SW_NEWTON_LAST_UPDATE a step of the test fixture ended where a
+ * Newton update from its solution still moved 5.8% of |q| (test_reduced_model's bound is
+ * 5%); at half of it every step ends within the bound, and the hand and the finger still
+ * take one update a step. */
 #define SW_REST_LAST_UPDATE (0.5 * SW_NEWTON_LAST_UPDATE)
-#endif
+
+/* A non-finite potential: the state back to q_n, the step FAILED. */
+static sinew_result step_failed(sw_solver *s, int32_t R, sinew_step_stats *st) {
+    memcpy(s->q, s->qn, (size_t)R * sizeof(double));
+    st->status |= SINEW_STEP_FAILED;
+    return SINEW_ERROR_NOT_FINITE;
+}
 
 /* What rest_first_updates left: the step done, or its iteration to go on from s->q. */
 enum rest_outcome { REST_DONE, REST_HAND_OVER, REST_NOT_FINITE };
 
 /* Quasistatic Newton updates on the rest Hessian (SW_CUB_HESSIAN_REST: the cubature's
- * stiffness at the rest shape, the contact pairs' and springs' Hessian at the start point),
- * factored once at the start; each trial is a gradient pass, accepted when the energy does
- * not rise. The minimum is the same as the current Hessian's; only the path changes. A
- * tet that turns with its bones without deforming has that very Hessian (cubature.h),
- * so where the flesh follows the skeleton each update costs a gradient pass instead of a
- * Hessian pass and a factorisation (the Fox: 0.28 against 1.2 + 0.12 ms). Where it does
- * not (stretched elements stiffen in their rotation modes), the first rejected update or
- * one that shrinks the gradient by less than SW_REST_KEEP hands the step to the current
- * Hessian's iteration at the best iterate. On entry phi and red->g are the start point's
- * (with the rest Hessian in red->H); *gn is |g| there, g0 the step's first. */
+ * stiffness at the rest shape, with the contact pairs' and springs' Hessians at the
+ * iterate), each factored at its iterate, each trial a gradient pass accepted when the
+ * energy does not rise. The minimum is the same as the current Hessian's; only the path
+ * changes. A tet that turns with its bones without deforming has that very Hessian
+ * (cubature.h), so where the flesh follows the skeleton an update costs a gradient pass
+ * and a factorisation instead of a Hessian pass and a factorisation (the Fox: 0.28 and
+ * 0.12 ms against 1.2 and 0.12 ms). Where it does not (stretched elements stiffen in their
+ * rotation modes), the first rejected update or one that shrinks the gradient by less
+ * than SW_REST_KEEP hands the step to the current Hessian's iteration at the best iterate.
+ * (The rest Hessian factored once for the whole step missed the contact pairs that start
+ * to touch during it: 15 of the Fox's 35 steps rejected an update.) On entry phi, red->g
+ * and red->H are the start point's; *gn is |g| there, g0 the step's first. */
 static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_contacts *ct,
                                             sw_solver *s, const sw_dyn_coef *dc,
                                             sinew_step_stats *st, double *phi, double *gn,
@@ -239,11 +252,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
         phi = evaluate(red, ct, s, s->q, dc, SW_CUB_HESSIAN_REST, st);
         gn = g0 = sqrt(sw_dot(red->g, red->g, R));
         enum rest_outcome o = rest_first_updates(red, ct, s, dc, st, &phi, &gn, g0, &it0);
-        if (o == REST_NOT_FINITE) {
-            memcpy(s->q, s->qn, (size_t)R * sizeof(double));
-            st->status |= SINEW_STEP_FAILED;
-            return SINEW_ERROR_NOT_FINITE;
-        }
+        if (o == REST_NOT_FINITE) return step_failed(s, R, st);
         if (o == REST_DONE) {
             st->residual = g0 > 0 ? gn / g0 : 0;
             st->energy = phi;
@@ -260,11 +269,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
     int trust = 1;  /* trial points are evaluated without H (chord updates may follow) */
     int probe = 0;  /* the next update, from the factor at hand, is taken only if the last */
     for (uint32_t it = it0;; ++it) {
-        if (!isfinite(phi) || !isfinite(gn)) {
-            memcpy(s->q, s->qn, (size_t)R * sizeof(double));
-            st->status |= SINEW_STEP_FAILED;
-            return SINEW_ERROR_NOT_FINITE;
-        }
+        if (!isfinite(phi) || !isfinite(gn)) return step_failed(s, R, st);
         /* 1e-5 of the step's first gradient: the position error it leaves is far below
          * the subspace's own (measured: tighter costs iterations, not accuracy) */
         if (gn <= 1e-5 * g0 || gn == 0) {
