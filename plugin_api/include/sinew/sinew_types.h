@@ -121,17 +121,17 @@ typedef enum sinew_self_contact {
 /** The Hessian a quasistatic step's Newton updates start on (sinew_instance_def). */
 typedef enum sinew_newton_hessian {
     /** the library chooses per blob at creation: the rest Hessian first where a
-     * factorisation of the reduced Hessian costs less than a third of the multiply-adds
-     * the rest Hessian saves a cubature pass (most characters), the current one where
-     * the domains' couplings make the factorisation dear (the 24-bone elephant) */
+     * factorisation of the reduced Hessian costs less than 0.3 of the multiply-adds the
+     * rest Hessian saves a cubature pass (most characters), the current one where the
+     * domains' couplings make the factorisation dear (the 24-bone elephant) */
     SINEW_NEWTON_HESSIAN_AUTO = 0,
     /** every Newton update on the Hessian at an iterate of the step (a cubature pass
      * with the element Hessians), chord updates on an earlier factor once it converges */
     SINEW_NEWTON_HESSIAN_CURRENT = 1,
     /** the updates start on the rest Hessian (the cubature's stiffness at the rest
-     * shape, the contact pairs' and springs' Hessian at the start point), factored once,
-     * each trial a gradient pass; an update the energy rejects or one that shrinks the
-     * gradient too little hands the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration.
+     * shape, the contact pairs' and springs' Hessians at the iterate), factored at each
+     * update, each trial a gradient pass; an update the energy rejects or one shrinking
+     * the gradient too little hands the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration.
      * The stationary point is the same; dynamic steps always use the current Hessian
      * (their damping needs it anyway). Reserves the rest Hessian's domain blocks */
     SINEW_NEWTON_HESSIAN_REST_FIRST = 2
