@@ -9,6 +9,7 @@
 #include "blob_load.h"
 #include "instance.h"
 #include "rt_interpose.h"
+#include "tool_common.h"
 
 static int cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
@@ -41,8 +42,7 @@ static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int
             out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
             sinew_step_stats st = {.struct_size = sizeof st};
             sinew_instance_get_stats(inst, &st);
-            ms[steps] = st.ms_skin + st.ms_contact + st.ms_dynamics + st.ms_world + st.ms_oracle +
-                        st.ms_solve + st.ms_output;
+            ms[steps] = sw_step_ms(&st);
             out->evals[k] += st.potential_evals;
             out->factors[k] += st.factorizations;
             out->rest[k] += st.rest_updates;
@@ -51,11 +51,7 @@ static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int
         }
     if (k) {
         sw_rt_counts c = sw_rt_count_end();
-        unsigned active = sw_rt_interpose_active();
-        out->allocs = active & SW_RT_CAT_ALLOCS
-                          ? (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0))
-                          : -1;
-        out->locks = active & SW_RT_CAT_LOCKS ? (long)c.locks : -1;
+        sw_rt_counts_report(&c, &out->allocs, &out->locks);
     }
     qsort(ms, (size_t)steps, sizeof *ms, cmp_double);
     out->steps = steps;

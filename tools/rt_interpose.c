@@ -554,3 +554,11 @@ const char *sw_rt_counts_describe(const sw_rt_counts *c, char *buf, size_t n) {
 #undef PUT
     return buf;
 }
+
+void sw_rt_counts_report(const sw_rt_counts *c, long *allocs, long *locks) {
+    unsigned active = (unsigned)sw_rt_interpose_active();
+    *allocs = active & SW_RT_CAT_ALLOCS
+                  ? (long)(c->allocs + c->frees + (active & SW_RT_CAT_MAPS ? c->maps : 0))
+                  : -1;
+    *locks = active & SW_RT_CAT_LOCKS ? (long)c->locks : -1;
+}

@@ -68,6 +68,11 @@ sw_rt_counts sw_rt_count_end(void);
  * a self-check that counts: make it outside a counted section. */
 int sw_rt_interpose_active(void);
 
+/* What a benchmark reports of counts c: *allocs the allocation, free and (when observed)
+ * mapping calls, *locks the lock calls, each -1 when this build cannot observe its
+ * category (sw_rt_interpose_active). */
+void sw_rt_counts_report(const sw_rt_counts *c, long *allocs, long *locks);
+
 /* Whether calls of this one function are counted in this build (its category is
  * active and, in sanitizer builds, a live probe saw the hook fire for it: GCC 12's
  * ThreadSanitizer runs no hook for aligned_alloc, posix_memalign, memalign, valloc or

@@ -7,6 +7,7 @@
 #include "blob_load.h"
 #include "instance.h"
 #include "rt_interpose.h"
+#include "tool_common.h"
 
 /* One mode's pass: the figures of its timed steps. */
 static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, const double *T,
@@ -36,8 +37,7 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
             out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
             sinew_step_stats st = {.struct_size = sizeof st};
             sinew_instance_get_stats(inst, &st);
-            double step = st.ms_skin + st.ms_contact + st.ms_dynamics + st.ms_world + st.ms_oracle +
-                          st.ms_solve + st.ms_output;
+            double step = sw_step_ms(&st);
             sc_sum += st.ms_self_contact;
             step_sum += step;
             out->ms_max[k] = fmax(out->ms_max[k], st.ms_self_contact);
@@ -47,11 +47,7 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
         }
     if (count_rt) {
         sw_rt_counts c = sw_rt_count_end();
-        unsigned active = sw_rt_interpose_active();
-        out->allocs[k] = active & SW_RT_CAT_ALLOCS
-                             ? (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0))
-                             : -1;
-        out->locks[k] = active & SW_RT_CAT_LOCKS ? (long)c.locks : -1;
+        sw_rt_counts_report(&c, &out->allocs[k], &out->locks[k]);
     }
     out->steps = steps;
     out->ms_mean[k] = sc_sum / steps;

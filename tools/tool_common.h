@@ -18,6 +18,12 @@
 #define SINEW_SHARED_DATA_DIR "../shared/data"
 #endif
 
+/* A step's wall time in ms: the sum of its phases in sinew_step_stats. */
+static inline double sw_step_ms(const sinew_step_stats *st) {
+    return st->ms_skin + st->ms_contact + st->ms_dynamics + st->ms_world + st->ms_oracle +
+           st->ms_solve + st->ms_output;
+}
+
 /* The folder of the real assets: $SINEW_DATA_DIR, else the build's shared data folder. */
 static inline const char *sw_tool_data_dir(void) {
     return getenv("SINEW_DATA_DIR") ? getenv("SINEW_DATA_DIR") : SINEW_SHARED_DATA_DIR;

@@ -128,7 +128,7 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
     out->err_world_sub = den > 0 ? sqrt(num / den) : 0;
     /* the real-time contract with world contact active */
     out->allocs = out->locks = -1;
-    unsigned active = sw_rt_interpose_active();
+    (void)sw_rt_interpose_active(); /* its self-check counts: outside the counted steps */
     if (out->contract_steps > 0 && r == SINEW_OK) {
         sw_rt_count_begin();
         for (int s = 0; s < out->contract_steps; ++s) {
@@ -137,9 +137,7 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
             out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
         }
         sw_rt_counts c = sw_rt_count_end();
-        if (active & SW_RT_CAT_ALLOCS)
-            out->allocs = (long)(c.allocs + c.frees + (active & SW_RT_CAT_MAPS ? c.maps : 0));
-        if (active & SW_RT_CAT_LOCKS) out->locks = (long)c.locks;
+        sw_rt_counts_report(&c, &out->allocs, &out->locks);
     }
     free(xs), free(cnt), free(xd), free(xo);
     sinew_instance_destroy(inst);

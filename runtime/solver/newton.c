@@ -165,6 +165,18 @@ static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_sol
  * take one update a step. */
 #define SW_REST_LAST_UPDATE (0.5 * SW_NEWTON_LAST_UPDATE)
 
+/* An update s->dq shorter than `share` of |q| (or than dq_tiny) is the step's last: taken
+ * without evaluating its end point, counted, the step CONVERGED; returns 1 then. */
+static int took_last_update(sw_solver *s, int32_t R, double share, sinew_step_stats *st) {
+    double dqn = sqrt(sw_dot(s->dq, s->dq, R));
+    if (!(dqn <= share * sqrt(sw_dot(s->q, s->q, R)) || dqn <= s->dq_tiny)) return 0; /* NaN too */
+    for (int32_t i = 0; i < R; ++i)
+        s->q[i] += s->dq[i];
+    st->newton_iterations++;
+    st->status |= SINEW_STEP_CONVERGED;
+    return 1;
+}
+
 /* A non-finite potential: the state back to q_n, the step FAILED. */
 static sinew_result step_failed(sw_solver *s, int32_t R, sinew_step_stats *st) {
     memcpy(s->q, s->qn, (size_t)R * sizeof(double));
@@ -203,13 +215,8 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
         if (!sw_solver_factor(red, s)) return REST_HAND_OVER;
         st->factorizations++;
         factored_direction(red, s);
-        double dqn = sqrt(sw_dot(s->dq, s->dq, R));
-        if (dqn <= SW_REST_LAST_UPDATE * sqrt(sw_dot(s->q, s->q, R)) || dqn <= s->dq_tiny) {
-            for (int32_t i = 0; i < R; ++i)
-                s->q[i] += s->dq[i];
-            st->newton_iterations++;
+        if (took_last_update(s, R, SW_REST_LAST_UPDATE, st)) {
             st->rest_updates++;
-            st->status |= SINEW_STEP_CONVERGED;
             return REST_DONE;
         }
         memcpy(s->qtrial, s->q, (size_t)R * sizeof(double));
@@ -305,14 +312,8 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
          * lower, and |q| ~ 0 leaves the relative test nothing to compare with. Where
          * |q| > dq_tiny / SW_NEWTON_LAST_UPDATE it implies the relative test, so it changes nothing
          * else. */
+        if (took_last_update(s, R, SW_NEWTON_LAST_UPDATE, st)) break;
         double dqn = sqrt(sw_dot(s->dq, s->dq, R));
-        if (dqn <= SW_NEWTON_LAST_UPDATE * sqrt(sw_dot(s->q, s->q, R)) || dqn <= s->dq_tiny) {
-            for (int32_t i = 0; i < R; ++i)
-                s->q[i] += s->dq[i];
-            st->newton_iterations++;
-            st->status |= SINEW_STEP_CONVERGED;
-            break;
-        }
         if (probe) { /* not the last: a Newton update from here, with its Hessian */
             probe = 0;
             phi = evaluate(red, ct, s, s->q, dc, 1, st);
