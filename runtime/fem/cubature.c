@@ -175,6 +175,21 @@ static void mirror_upper(double *H, int32_t ld, int32_t r) {
             H[(int64_t)j * ld + i] = H[(int64_t)i * ld + j];
 }
 
+/* H (row stride ld) += B (r x r, row-major). */
+static void add_block(double *H, int32_t ld, const double *B, int32_t r) {
+    for (int32_t i = 0; i < r; ++i)
+        for (int32_t j = 0; j < r; ++j)
+            H[(int64_t)i * ld + j] += B[(int64_t)i * r + j];
+}
+
+/* Domain k's block of m->h_ref, after those of the domains before it. */
+static double *ref_block(const sw_reduced *m, int32_t k) {
+    int64_t off = 0;
+    for (int32_t j = 0; j < k; ++j)
+        off += (int64_t)m->v->domains[j].rank * m->v->domains[j].rank;
+    return m->h_ref + off;
+}
+
 /* One cubature pass over some domains, by one worker. */
 typedef struct {
     sw_reduced *m;
@@ -196,6 +211,15 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
         const double *qd = p->q + o;
+        /* the tets' Hessian goes to the domain's block of H, or first to the reference's
+         * (cubature.h) when this pass refreshes it */
+        double *Hd = m->H + (int64_t)o * m->R + o, *ref = NULL;
+        int32_t ld = m->R;
+        if (want_hess == 1 && m->h_ref) {
+            ref = ref_block(m, (int32_t)k);
+            for (int64_t i = 0; i < (int64_t)r * r; ++i)
+                ref[i] = 0;
+        }
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12];
             double w = m->cub_w[c];
@@ -222,11 +246,16 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
             }
             m->ecub[c] =
                 tet_with_hessian(&tm, r, x, dminv, v->cub_vol[c], v, m->svd_V + 9 * (int64_t)c,
-                                 project, w, m->H + (int64_t)o * m->R + o, m->R, hm);
+                                 project, w, ref ? ref : Hd, ref ? r : ld, hm);
             for (int32_t j = 0; j < r; ++j)
                 m->g[o + j] -= w * hm[j];
         }
-        if (want_hess) mirror_upper(m->H + (int64_t)o * m->R + o, m->R, r);
+        if (ref) {
+            mirror_upper(ref, r, r);
+            add_block(Hd, ld, ref, r);
+        } else if (want_hess) {
+            mirror_upper(Hd, ld, r);
+        }
     }
 }
 
@@ -276,15 +305,13 @@ double sw_cubature_hessian_madds(const sw_blob_view *v) {
 static double cubature_pass(sw_reduced *m, const double *q, int want_grad, int want_hess);
 
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess) {
-    if (want_hess != SW_CUB_HESSIAN_REST) return cubature_pass(m, q, want_grad, want_hess);
+    if (want_hess != SW_CUB_HESSIAN_REF) return cubature_pass(m, q, want_grad, want_hess);
     double E = cubature_pass(m, q, want_grad, 0);
     const sw_blob_view *v = m->v;
-    const double *B = m->h_rest;
+    const double *B = m->h_ref;
     for (int32_t k = 0; k < v->ndomains; ++k) {
         int32_t r = v->domains[k].rank, o = v->domains[k].q_offset;
-        for (int32_t i = 0; i < r; ++i)
-            for (int32_t j = 0; j < r; ++j)
-                m->H[(int64_t)(o + i) * m->R + o + j] += B[(int64_t)i * r + j];
+        add_block(m->H + (int64_t)o * m->R + o, m->R, B, r);
         B += (int64_t)r * r;
     }
     return E;

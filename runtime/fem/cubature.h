@@ -14,10 +14,12 @@
  * tests; the step never asks for it). Warm starts each element's SVD from m->svd_V and
  * updates it. */
 #define SW_CUB_HESSIAN_EXACT 2
-/* want_hess == SW_CUB_HESSIAN_REST: a gradient pass, and the rest Hessian's domain blocks
- * (m->h_rest, sw_cubature_rest_hessian) added to m->H in place of the Hessian at q: the
- * first updates of a quasistatic Newton step (newton.c says why and when). */
-#define SW_CUB_HESSIAN_REST 3
+/* want_hess == SW_CUB_HESSIAN_REF: a gradient pass, and the reference Hessian's domain
+ * blocks (m->h_ref) added to m->H in place of the Hessian at q: the first updates of a
+ * quasistatic Newton step (newton.c says why and when). With m->h_ref set, a pass with the
+ * (projected) Hessian at q also stores its domain blocks there: the next steps' reference
+ * is the Hessian last evaluated, which follows the pose far closer than the rest one. */
+#define SW_CUB_HESSIAN_REF 3
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess);
 
 /* The cubature's Hessian at the rest shape (q = 0, every skinning rotation the identity:
@@ -33,7 +35,7 @@ int64_t sw_cubature_rest_hessian_size(const sw_blob_view *v);
 
 /* Multiply-adds a Hessian pass costs beyond a gradient pass (the element modes'
  * projections, about 100 a basis column, and their products, 9 r (r + 1) / 2, less the
- * gradient's 12 r), summed over the cubature tets: what SW_CUB_HESSIAN_REST saves. */
+ * gradient's 12 r), summed over the cubature tets: what SW_CUB_HESSIAN_REF saves. */
 double sw_cubature_hessian_madds(const sw_blob_view *v);
 
 #endif

@@ -40,9 +40,11 @@ typedef struct sw_reduced {
     /* The cubature weights in use (ncub): the blob's, except while a condensation patch
      * holds some tets (0 there, the rest of their domain renormalised, condense.h). */
     const double *cub_w;
-    /* The rest Hessian's domain blocks (sw_cubature_rest_hessian), NULL where the instance
-     * never starts Newton on it. */
-    const double *h_rest;
+    /* The cubature Hessian's domain blocks that quasistatic steps start Newton on
+     * (SW_CUB_HESSIAN_REF): the rest Hessian after a reset (sw_cubature_rest_hessian),
+     * then those of the instance's last current-Hessian pass, which each such pass
+     * refreshes (cubature.c). NULL where the instance never starts Newton on them. */
+    double *h_ref;
 } sw_reduced;
 
 /* Skins every active vertex with the bones' dual quaternions (act_R, act_t), which m keeps

@@ -60,8 +60,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->Jc, 12 * rm);
     TAKE(m->hc, 12 * rm);
     TAKE(m->svd_V, 9 * (uint64_t)v->ncub);
-    in->h_rest = NULL;
-    if (z->rest) TAKE(in->h_rest, (uint64_t)sw_cubature_rest_hessian_size(v));
+    in->h_ref = NULL;
+    if (z->rest) TAKE(in->h_ref, (uint64_t)sw_cubature_rest_hessian_size(v));
     /* the pose space */
     sw_pose_space *ps = &in->ps;
     TAKE(ps->feature, 4 * nb);
@@ -424,7 +424,7 @@ static void state_bounds(sinew_instance *in) {
 #define SW_REST_FACTOR_SHARE 0.3
 
 /* The def's newton_hessian made concrete: with the rest Hessian, its blocks computed
- * (a cubature pass at rest) and red.h_rest set. *share: a factorisation's multiply-adds
+ * (red.h_ref set; sinew_instance_reset fills it). *share: a factorisation's multiply-adds
  * over those the rest Hessian saves a pass. */
 static void choose_newton_hessian(sinew_instance *in, sinew_newton_hessian want, double *share) {
     const sw_blob_view *v = in->v;
@@ -433,11 +433,7 @@ static void choose_newton_hessian(sinew_instance *in, sinew_newton_hessian want,
     int rest = want == SINEW_NEWTON_HESSIAN_REST_FIRST ||
                (want == SINEW_NEWTON_HESSIAN_AUTO && *share < SW_REST_FACTOR_SHARE);
     in->solver.rest_first = rest;
-    in->red.h_rest = NULL;
-    if (rest) {
-        sw_cubature_rest_hessian(&in->red, in->h_rest);
-        in->red.h_rest = in->h_rest;
-    }
+    in->red.h_ref = rest ? in->h_ref : NULL;
 }
 
 SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew_instance_def *def,
@@ -553,6 +549,8 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
         memset(V, 0, 9 * sizeof(double));
         V[0] = V[4] = V[8] = 1;
     }
+    /* Newton's reference Hessian back to the rest one (a cubature pass at rest) */
+    if (inst->red.h_ref) sw_cubature_rest_hessian(&inst->red, inst->red.h_ref);
     memset(&inst->stats, 0, sizeof inst->stats);
     inst->stats.struct_size = sizeof inst->stats;
     return SINEW_OK;

@@ -32,7 +32,7 @@ struct sinew_instance {
     double *surf_x, *surf_n;      /* 3 per output surface vertex each (sw_blob_output_verts) */
     double *node_x;               /* 3 per render node: the mean of its copies (render mesh only) */
     int32_t *weld_tris;           /* 3 per render triangle: its corners' weld representatives */
-    double *h_rest; /* the rest Hessian's domain blocks (red.h_rest when it is in use) */
+    double *h_ref; /* Newton's reference Hessian's domain blocks (red.h_ref when in use) */
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
 };

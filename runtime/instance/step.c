@@ -145,7 +145,10 @@ static void phase_self(sw_step_ctx *c) {
  * q converged to energy 80.8 and 46% correction error where the training solution's
  * minimum at 83.0 is within 2.5%). Starting from the pose-space prediction every frame
  * makes the quasistatic shape a function of the pose alone (no drift, no dependence on
- * the frames before). O(R). */
+ * the frames before), to the solve's tolerance: Newton's path from there may start on the
+ * Hessian of an earlier step (newton.c), and a step ends within its last update,
+ * SW_NEWTON_LAST_UPDATE |q|, of the stationary point (the fixture's played and
+ * arrived-at shapes: 8e-4 |q| apart at most). O(R). */
 static void pose_space_start(sinew_instance *in) {
     const sw_blob_view *v = in->v;
     int32_t R = in->red.R;

@@ -35,7 +35,7 @@ typedef struct sw_solver {
     unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
     int mass_blockdiag;  /* the blob's reduced mass is zero outside the domains' blocks */
     uint32_t max_newton; /* Newton updates a step at most */
-    int rest_first;      /* quasistatic steps start on the rest Hessian (red->h_rest) */
+    int rest_first;      /* quasistatic steps start on the reference Hessian (red->h_ref) */
     double dq_tiny;      /* an update shorter than this converged (1e-9 of the size) */
 } sw_solver;
 

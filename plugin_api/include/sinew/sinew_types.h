@@ -128,12 +128,15 @@ typedef enum sinew_newton_hessian {
     /** every Newton update on the Hessian at an iterate of the step (a cubature pass
      * with the element Hessians), chord updates on an earlier factor once it converges */
     SINEW_NEWTON_HESSIAN_CURRENT = 1,
-    /** the updates start on the rest Hessian (the cubature's stiffness at the rest
-     * shape, the contact pairs' and springs' Hessians at the iterate), factored at each
-     * update, each trial a gradient pass; an update the energy rejects or one shrinking
-     * the gradient too little hands the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration.
-     * The stationary point is the same; dynamic steps always use the current Hessian
-     * (their damping needs it anyway). Reserves the rest Hessian's domain blocks */
+    /** the updates start on a reference Hessian (the cubature's: at the rest shape after
+     * creation or a reset, then the last one a step evaluated; the contact pairs' and
+     * springs' Hessians at the iterate), factored at each update, each trial a gradient
+     * pass; an update the energy rejects or one shrinking the gradient too little hands
+     * the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration, whose Hessian becomes the
+     * reference. The stationary point is the same, so the shape at a pose depends on the
+     * frames before only within the solve's tolerance (replays from a reset are bitwise
+     * the same); dynamic steps always use the current Hessian (their damping needs it
+     * anyway). Reserves the reference Hessian's domain blocks */
     SINEW_NEWTON_HESSIAN_REST_FIRST = 2
 } sinew_newton_hessian;
 
