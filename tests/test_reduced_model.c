@@ -235,6 +235,92 @@ TEST(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone) {
     sinew_instance_destroy(b);
 }
 
+/* The prediction of a step's pose: the blend of its two nearest training solutions. */
+static void prediction(const sinew_instance *in, double *p) {
+    const sw_blob_view *v = in->v;
+    int32_t R = v->rank_total, a = in->ps.nearest;
+    int32_t b = in->ps.blend == 0 ? a : in->ps.second;
+    for (int32_t i = 0; i < R; ++i)
+        p[i] = (1 - in->ps.blend) * v->train_q[(size_t)R * a + i] +
+               in->ps.blend * v->train_q[(size_t)R * b + i];
+}
+
+/* A quasistatic step starts from its pose's prediction plus the last step's offset from
+ * its own (step.c); after a pose jump, a reset or a failed step, from the prediction
+ * alone. */
+TEST(quasistatic_start_is_the_prediction_plus_the_last_offset) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    int32_t R = sw_blob_get_view(f->blob)->rank_total, nb = f->ch.skel.nbones;
+    int k = f->ch.clip.nframes / 2;
+    sinew_instance *in;
+    ENSURE(sinew_instance_create(f->blob, NULL, &in) == SINEW_OK);
+    /* poses halfway between the clip's frames: not training poses, so the solutions are
+     * off their predictions */
+    double *T = malloc(sizeof(double) * 12 * (size_t)nb), *qa = malloc(sizeof(double) * (size_t)R),
+           *pa = malloc(sizeof(double) * (size_t)R), *pk = malloc(sizeof(double) * (size_t)R);
+    ENSURE(T && qa && pa && pk);
+    const double *clip = f->ch.clip.T;
+    for (int j = 0; j < k; ++j) {
+        halfway_pose(clip + (size_t)j * 12 * nb, clip + (size_t)(j + 1) * 12 * nb, nb, T);
+        ENSURE(sw_instance_set_pose_d(in, T) == SINEW_OK);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+    }
+    memcpy(qa, sw_instance_q(in), sizeof(double) * (size_t)R);
+    prediction(in, pa);
+    double off = 0, qn = 0;
+    for (int32_t i = 0; i < R; ++i) {
+        off = fmax(off, fabs(qa[i] - pa[i]));
+        qn = fmax(qn, fabs(qa[i]));
+    }
+    ENSUREF(off > 1e-3 * qn, "no offset from the prediction (%g of %g)", off, qn);
+    /* the next pose: prediction plus offset */
+    halfway_pose(clip + (size_t)k * 12 * nb, clip + (size_t)(k + 1) * 12 * nb, nb, T);
+    ENSURE(sw_instance_set_pose_d(in, T) == SINEW_OK);
+    sw_instance_step_prepare(in, 1.0f / 30);
+    prediction(in, pk);
+    double gap = 0;
+    for (int32_t i = 0; i < R; ++i)
+        gap = fmax(gap, fabs(sw_instance_q(in)[i] - (pk[i] + (qa[i] - pa[i]))));
+    ENSUREF(gap <= 1e-12 * qn, "start %g from the prediction plus the offset", gap);
+    /* the same pose declared a cut: the prediction alone */
+    ENSURE(sinew_instance_mark_teleport(in) == SINEW_OK);
+    memcpy((double *)sw_instance_q(in), qa, sizeof(double) * (size_t)R);
+    sw_instance_step_prepare(in, 1.0f / 30);
+    gap = 0;
+    for (int32_t i = 0; i < R; ++i)
+        gap = fmax(gap, fabs(sw_instance_q(in)[i] - pk[i]));
+    ENSUREF(gap == 0, "after a cut the start is %g from the prediction", gap);
+    /* and after a reset, from a state with an offset */
+    ENSURE(sinew_instance_reset(in) == SINEW_OK);
+    memcpy((double *)sw_instance_q(in), qa, sizeof(double) * (size_t)R);
+    ENSURE(sw_instance_set_pose_d(in, T) == SINEW_OK);
+    sw_instance_step_prepare(in, 1.0f / 30);
+    prediction(in, pk); /* (the lookup follows the motion: a reset forgot it) */
+    gap = 0;
+    for (int32_t i = 0; i < R; ++i)
+        gap = fmax(gap, fabs(sw_instance_q(in)[i] - pk[i]));
+    fprintf(stderr, "    offset %.3g (|q| up to %.3g) carried to the next pose's start\n", off, qn);
+    ENSUREF(gap == 0, "after a reset the start is %g from the prediction", gap);
+    /* and after a failed step (a non-finite state: the start carries it, the solve fails) */
+    ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+    for (int32_t i = 0; i < R; ++i)
+        ((double *)sw_instance_q(in))[i] = 1e300;
+    ENSURE(sw_instance_set_pose_d(in, T) == SINEW_OK); /* held: nearer than any sample */
+    ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_ERROR_NOT_FINITE);
+    sw_instance_step_prepare(in, 1.0f / 30);
+    prediction(in, pk);
+    gap = 0;
+    for (int32_t i = 0; i < R; ++i)
+        gap = fmax(gap, fabs(sw_instance_q(in)[i] - pk[i]));
+    ENSUREF(gap == 0, "after a failed step the start is %g from the prediction", gap);
+    free(T);
+    free(qa);
+    free(pa);
+    free(pk);
+    sinew_instance_destroy(in);
+}
+
 /* Every step over the clip in Newton mode `mode` must end where a full Newton update from
  * its solution, on the exact potential's own gradient and (projected) Hessian, moves the
  * shape by less than the solve's convergence test allows (steps the update cap ended are
@@ -610,6 +696,7 @@ SW_TEST_MAIN(CASE(gradient_matches_finite_differences_with_contact_pairs),
              CASE(chord_updates_end_at_a_newton_stationary_point),
              CASE(rest_first_updates_end_at_a_newton_stationary_point),
              CASE(reference_hessian_is_the_last_evaluated_and_reset_restores_the_rest_one),
+             CASE(quasistatic_start_is_the_prediction_plus_the_last_offset),
              CASE(rest_hessian_is_the_hessian_of_the_rigidly_moved_rest_shape),
              CASE(quasistatic_shape_depends_on_the_pose_and_its_last_motion_alone),
              CASE(branches_follow_the_motion), CASE(twins_form_cycles_on_any_poses),

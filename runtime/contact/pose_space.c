@@ -26,6 +26,7 @@ double sw_pose_space_tangent_share(double s, double reach) {
 void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones) {
     ps->nearest = ps->second = -1;
     ps->blend = 0;
+    ps->d_nearest = ps->d_last = INFINITY;
     ps->tangent[0] = ps->tangent[1] = 0;
     ps->looked_up = 0; /* no motion yet: a pose on two branches takes the first stored */
     memset(ps->motion, 0, 4 * (size_t)nbones * sizeof(double));
@@ -79,6 +80,7 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
     int32_t n0 = -1, n1 = -1;
     ps->nearest = ps->second = -1;
     ps->blend = 0;
+    ps->d_nearest = ps->d_last = INFINITY;
     ps->tangent[0] = ps->tangent[1] = 0;
     if (v->ntrain < 1) return;
     sw_pose_feature(T, v->bone_parent, v->nbones, ps->feature);
@@ -95,6 +97,8 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
         }
     }
     if (n0 < 0) return; /* no distance comparable (NaN: only a hostile blob's poses) */
+    ps->d_nearest = d0;
+    if (ps->looked_up) ps->d_last = sw_pose_distance(ps->feature, ps->feature_last, v->nbones);
     /* the feature distance is sum (1 - cos^2(theta_b / 2)): its root is linear in the
        angles for small ones */
     double s0 = sqrt(fmax(d0, 0)), s1 = sqrt(fmax(d1, 0)); /* (rounding: d0 ~ -1e-17 at a sample) */

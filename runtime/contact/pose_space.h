@@ -20,6 +20,9 @@ typedef struct sw_pose_space {
     int32_t nearest; /* training pose nearest to the current pose, or -1 */
     int32_t second;  /* the second nearest, or -1 */
     double blend;    /* pose-space weight of `second` (0: `nearest` alone) */
+    /* feature distances of the current pose to `nearest` and to the last lookup's pose
+       (INFINITY without one) */
+    double d_nearest, d_last;
     /* the share of the contact law's tangential term (SW_CONTACT_ALPHA) that the pairs of
        `nearest` [0] and of `second` [1] carry: 1 at their own training pose, falling
        linearly to 0 at the distance of its nearest other pose (sw_pose_space_lookup) */

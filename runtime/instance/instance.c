@@ -84,6 +84,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->L, R * R);
     TAKE(s->dq, R);
     TAKE(s->qtrial, R);
+    TAKE(s->q_pred, R);
     TAKE(s->tmp, R);
     TAKE(s->tmp2, R);
     TAKE(s->blk_off, nd);
@@ -525,6 +526,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     int32_t R = inst->red.R, nb = inst->v->nbones;
     memset(inst->solver.q, 0, (size_t)R * sizeof(double));
     memset(inst->solver.qdot, 0, (size_t)R * sizeof(double));
+    inst->solver.pred_valid = 0;
     sw_pose_history *ph = &inst->pose;
     for (int32_t b = 0; b < nb; ++b) { /* the rest pose: identity transforms */
         memset(ph->T_cur + 12 * b, 0, 12 * sizeof(double));

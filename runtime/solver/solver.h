@@ -27,7 +27,12 @@ typedef struct sw_solver {
     int mat_at_qn;
     double *L;           /* R x R: the block Cholesky factor */
     double *dq, *qtrial; /* R each: Newton update, the iterate before it */
-    double *tmp, *tmp2;  /* R each: scratch */
+    /* R: the pose-space prediction the last quasistatic step started from (step.c,
+     * pose_space_start), valid while the steps since it moved the pose continuously
+     * and did not fail */
+    double *q_pred;
+    int pred_valid;
+    double *tmp, *tmp2; /* R each: scratch */
     /* H's domain blocks and their elimination order (leaves of the coupling graph first) */
     int32_t *blk_off, *blk_size, *blk_order; /* ndomains each */
     int32_t *blk_pos;                        /* domain -> its place in blk_order */
