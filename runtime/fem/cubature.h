@@ -27,7 +27,7 @@ double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_
  * row-major) at blocks + sum_{j<k} r_j^2. A tet whose corners turn with one rotation R
  * has the Hessian U^T R^T (R K0 R^T) R U = U^T K0 U at any pose as long as it does not
  * deform, so this stands for the Hessian wherever the flesh follows its bones. Uses the
- * first worker's scratch; at creation only. */
+ * first worker's scratch; at creation and at sinew_instance_reset. */
 void sw_cubature_rest_hessian(sw_reduced *m, double *blocks);
 
 /* sum over domains of r_k^2: the rest Hessian's doubles. */
