@@ -11,11 +11,6 @@
 #include "rt_interpose.h"
 #include "tool_common.h"
 
-static int cmp_double(const void *a, const void *b) {
-    double x = *(const double *)a, y = *(const double *)b;
-    return (x > y) - (x < y);
-}
-
 /* Mode k's instance (0 current, 1 rest-first) over the clip: the timed steps' figures,
  * and each frame's output surface of the last pass in surf (3 ns floats a frame). */
 static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int nframes, float dt,
@@ -53,9 +48,8 @@ static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int
         sw_rt_counts c = sw_rt_count_end();
         sw_rt_counts_report(&c, &out->allocs, &out->locks);
     }
-    qsort(ms, (size_t)steps, sizeof *ms, cmp_double);
     out->steps = steps;
-    out->step_ms[k] = ms[steps / 2];
+    out->step_ms[k] = sw_median(ms, steps);
     out->evals[k] /= steps;
     out->factors[k] /= steps;
     out->rest[k] /= steps;
