@@ -12,11 +12,14 @@
 #include "bake.h"
 #include "blob_synth.h"
 #include "character_io.h"
+#include "dqs.h"
 #include "embed.h"
 #include "instance.h"
+#include "instance_internal.h"
 #include "mesh_io.h"
 #include "rt_interpose.h"
 #include "samples.h"
+#include "sinew/sinew_world.h"
 #include "surface_normals.h"
 #include "sw_test.h"
 
@@ -409,6 +412,124 @@ TEST(the_step_with_a_render_mesh_allocates_and_locks_nothing) {
              active);
 }
 
+/* r cut to the triangles wholly in the upper half of its longest extent, its vertices
+ * renumbered (a render mesh over part of the body). */
+static void keep_upper_half(sw_trimesh *r) {
+    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
+    for (int32_t i = 0; i < r->nverts; ++i)
+        for (int k = 0; k < 3; ++k) {
+            lo[k] = fmin(lo[k], r->X[3 * i + k]);
+            hi[k] = fmax(hi[k], r->X[3 * i + k]);
+        }
+    int a = 0;
+    for (int k = 1; k < 3; ++k)
+        if (hi[k] - lo[k] > hi[a] - lo[a]) a = k;
+    double mid = 0.5 * (lo[a] + hi[a]);
+    int32_t *map = malloc(sizeof(int32_t) * (size_t)r->nverts), nt = 0, nv = 0;
+    for (int32_t i = 0; i < r->nverts; ++i)
+        map[i] = -1;
+    for (int32_t t = 0; t < r->ntris; ++t) {
+        const int32_t *c = r->tris + 3 * t;
+        if (r->X[3 * c[0] + a] <= mid || r->X[3 * c[1] + a] <= mid || r->X[3 * c[2] + a] <= mid)
+            continue;
+        for (int k = 0; k < 3; ++k) {
+            if (map[c[k]] < 0) map[c[k]] = nv++;
+            r->tris[3 * nt + k] = c[k];
+        }
+        nt++;
+    }
+    double *X = malloc(sizeof(double) * 3 * (size_t)nv);
+    for (int32_t i = 0; i < r->nverts; ++i)
+        if (map[i] >= 0) memcpy(X + 3 * map[i], r->X + 3 * i, 3 * sizeof(double));
+    for (int32_t k = 0; k < 3 * nt; ++k)
+        r->tris[k] = map[r->tris[k]];
+    free(r->X);
+    free(map);
+    r->X = X;
+    r->nverts = nv;
+    r->ntris = nt;
+}
+
+/* Under a render mesh the boundary's surface copies are read only by the world's contact:
+ * an instance skins them only while a world is attached (instance.c's active vertices).
+ * Stepped without one, then with an empty world: every copy the world reads sits where
+ * its own skinning of the current pose and the state put it. */
+TEST(surface_copies_follow_the_pose_once_a_world_is_attached) {
+    /* the finger under a render mesh of its upper half: the other half's boundary
+       vertices carry no render node */
+    sw_character ch;
+    sw_bake_result res;
+    sw_error err;
+    void *data = NULL;
+    size_t size = 0;
+    sinew_blob *blob;
+    ENSURE(sw_sample_make("finger", 2000, 12, &ch, &err) == SINEW_OK);
+    ENSURE(make_render(&ch.mesh, &ch.render));
+    keep_upper_half(&ch.render);
+    sw_bake_params p = sw_bake_params_default();
+    p.sweep_samples = 3;
+    p.max_train_frames = 8;
+    p.threads = 2;
+    ENSUREF(sw_bake(&ch, &p, &res, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(sw_blob_write_memory(&res.view, &data, &size, &err) == SINEW_OK);
+    sinew_blob_def bd = sinew_blob_def_default();
+    bd.data = data;
+    bd.data_size = size;
+    ENSURE(sinew_blob_load(&bd, &blob) == SINEW_OK);
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    const uint32_t nb = (uint32_t)ch.skel.nbones;
+    sinew_instance *in;
+    sinew_world *w;
+    sinew_world_def wd = sinew_world_def_default();
+    ENSURE(sinew_instance_create(blob, NULL, &in) == SINEW_OK);
+    ENSURE(sinew_world_create(&wd, &w) == SINEW_OK);
+    ENSUREF(in->red.nact_step < in->red.nact && !in->red.skin_surface,
+            "%d of %d active vertices every step", in->red.nact_step, in->red.nact);
+    float *T = malloc(sizeof(float) * 12 * nb);
+    ENSURE(T);
+    int s = 0;
+    for (; s < 4; ++s) {
+        for (uint32_t i = 0; i < 12 * nb; ++i)
+            T[i] = (float)ch.clip.T[(size_t)s * 12 * nb + i];
+        ENSURE(sinew_instance_set_pose(in, T, nb) == SINEW_OK);
+        ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+    }
+    ENSURE(sinew_instance_set_world(in, w) == SINEW_OK && in->red.skin_surface);
+    for (uint32_t i = 0; i < 12 * nb; ++i) /* a pose the surface copies were never skinned at */
+        T[i] = (float)ch.clip.T[(size_t)(s + 2) * 12 * nb + i];
+    ENSURE(sinew_instance_set_pose(in, T, nb) == SINEW_OK);
+    ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+    double gap = 0;
+    for (int32_t i = 0; i < v->nsurf_copies; ++i) {
+        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+        int32_t lv = v->surf_copies[2 * i + 1], gv = v->domain_verts[D->vert_begin + lv],
+                r = D->rank;
+        double Rm[9], t[3], y[3], x[3];
+        sw_dqs_blend(in->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, Rm, t);
+        for (int k = 0; k < 3; ++k) {
+            y[k] = v->rest[3 * (int64_t)gv + k];
+            for (int32_t j = 0; j < r; ++j)
+                y[k] += v->basis[D->basis_offset + (int64_t)(3 * lv + k) * r + j] *
+                        in->solver.q[D->q_offset + j];
+        }
+        for (int k = 0; k < 3; ++k) {
+            x[k] = Rm[3 * k] * y[0] + Rm[3 * k + 1] * y[1] + Rm[3 * k + 2] * y[2] + t[k];
+            gap = fmax(gap, fabs(x[k] - in->wc.copy_x[3 * (int64_t)i + k]));
+        }
+    }
+    fprintf(stderr, "    %d surface copies with a world: within %.2e of their own skinning\n",
+            v->nsurf_copies, gap);
+    ENSUREF(gap <= 1e-9 * in->size, "a surface copy is %g from its own skinning", gap);
+    ENSURE(sinew_instance_set_world(in, NULL) == SINEW_OK && !in->red.skin_surface);
+    free(T);
+    sinew_world_destroy(w);
+    sinew_instance_destroy(in);
+    sinew_blob_destroy(blob);
+    free(data);
+    sw_bake_result_free(&res);
+    sw_character_free(&ch);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) {
         sinew_blob_destroy(fx.blob);
@@ -423,4 +544,5 @@ SW_TEST_MAIN(CASE(embedding_reproduces_the_arm_at_rest), CASE(embedding_refuses_
              CASE(welded_duplicates_move_and_shade_as_one),
              CASE(the_loader_rejects_a_damaged_render_mesh),
              CASE(the_synthetic_render_blob_round_trips_and_seeds_the_fuzzer),
-             CASE(the_step_with_a_render_mesh_allocates_and_locks_nothing), CASE(release_fixture))
+             CASE(the_step_with_a_render_mesh_allocates_and_locks_nothing),
+             CASE(surface_copies_follow_the_pose_once_a_world_is_attached), CASE(release_fixture))

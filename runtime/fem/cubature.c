@@ -2,6 +2,7 @@
 
 #include <stddef.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "blob_load.h"
 #include "fem_corot.h"
@@ -16,38 +17,6 @@ typedef struct {
     const double *U[4];
     const double *R[4];
 } tet_map;
-
-/* out = J^T v = sum_n U_n^T (R_n^T v_n) (v: 12): each sum over the corners' 12 basis rows
- * in row order, four columns side by side. */
-static void project_corners(const tet_map *tm, int32_t r, const double v[12], double *out) {
-    double w[12];
-    for (int n = 0; n < 4; ++n) /* R_n^T v_n */
-        for (int k = 0; k < 3; ++k)
-            w[3 * n + k] = tm->R[n][k] * v[3 * n] + tm->R[n][3 + k] * v[3 * n + 1] +
-                           tm->R[n][6 + k] * v[3 * n + 2];
-    int32_t j = 0;
-    for (; j + 4 <= r; j += 4) { /* four independent chains, each in row order */
-        double a0 = 0, a1 = 0, a2 = 0, a3 = 0;
-        for (int row = 0; row < 12; ++row) {
-            const double *Ur = tm->U[row / 3] + (row % 3) * r + j;
-            double c = w[row];
-            a0 += Ur[0] * c;
-            a1 += Ur[1] * c;
-            a2 += Ur[2] * c;
-            a3 += Ur[3] * c;
-        }
-        out[j] = a0;
-        out[j + 1] = a1;
-        out[j + 2] = a2;
-        out[j + 3] = a3;
-    }
-    for (; j < r; ++j) {
-        double acc = 0;
-        for (int row = 0; row < 12; ++row)
-            acc += tm->U[row / 3][(row % 3) * r + j] * w[row];
-        out[j] = acc;
-    }
-}
 
 /* The upper triangle of the domain block H (row stride R) += sum_k (a_k h_k)(h_k)^T over
  * the n projections h_k (at hm + k r), a_k their weights: each entry adds its terms in k
@@ -190,6 +159,91 @@ static double *ref_block(const sw_reduced *m, int32_t k) {
     return m->h_ref + off;
 }
 
+/* ---- the cubature tets' corners ---------------------------------------------------- */
+
+enum { CORNER_CHUNK = 1 << 16 };
+
+/* The index of local vertex lv among corner_lv[lo, hi) (ascending, lv among them). */
+static int32_t corner_of(const int32_t *corner_lv, int32_t lo, int32_t hi, int32_t lv) {
+    --hi;
+    while (lo < hi) {
+        int32_t mid = lo + (hi - lo) / 2;
+        if (corner_lv[mid] < lv)
+            lo = mid + 1;
+        else
+            hi = mid;
+    }
+    return lo;
+}
+
+int32_t sw_cubature_corners(const sw_blob_view *v, sw_reduced *m) {
+    uint64_t bits[CORNER_CHUNK / 64];
+    int32_t n = 0;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        const sw_blob_domain *D = &v->domains[k];
+        if (m) m->corner_begin[k] = n;
+        for (int32_t lo = 0; lo < D->vert_count; lo += CORNER_CHUNK) {
+            memset(bits, 0, sizeof bits);
+            for (int32_t i = 4 * D->cub_begin; i < 4 * (D->cub_begin + D->cub_count); ++i) {
+                int32_t lv = v->cub_tets[i] - lo;
+                if (lv >= 0 && lv < CORNER_CHUNK) bits[lv / 64] |= 1ull << (lv % 64);
+            }
+            for (int32_t i = 0; i < CORNER_CHUNK && lo + i < D->vert_count; ++i)
+                if (bits[i / 64] >> (i % 64) & 1) {
+                    if (m) m->corner_lv[n] = lo + i;
+                    n++;
+                }
+        }
+        if (!m) continue;
+        for (int32_t i = 4 * D->cub_begin; i < 4 * (D->cub_begin + D->cub_count); ++i) {
+            int32_t c = corner_of(m->corner_lv, m->corner_begin[k], n, v->cub_tets[i]);
+            m->cub_corner[i] = c;
+            m->corner_act[c] = m->cub_act[i]; /* the vertex's, whichever tet names it */
+        }
+    }
+    if (m) m->corner_begin[v->ndomains] = n;
+    return n;
+}
+
+/* Domain k's corners placed at its coordinates qd (corner_x), their summed forces zeroed. */
+static void place_corners(sw_reduced *m, int32_t k, const double *qd) {
+    const sw_blob_domain *D = &m->v->domains[k];
+    for (int32_t i = m->corner_begin[k]; i < m->corner_begin[k + 1]; ++i) {
+        sw_reduced_position(m, D, m->corner_lv[i], m->corner_act[i], qd, m->corner_x + 3 * i, NULL);
+        m->corner_f[3 * i] = m->corner_f[3 * i + 1] = m->corner_f[3 * i + 2] = 0;
+    }
+}
+
+/* Cubature tet c of domain D: its corners' positions x from corner_x, and with tm its map. */
+static void tet_corners(const sw_reduced *m, const sw_blob_domain *D, int32_t c, double x[12],
+                        tet_map *tm) {
+    const int32_t *cc = m->cub_corner + 4 * c;
+    for (int n = 0; n < 4; ++n) {
+        for (int i = 0; i < 3; ++i)
+            x[3 * n + i] = m->corner_x[3 * cc[n] + i];
+        if (!tm) continue;
+        tm->U[n] = m->v->basis + D->basis_offset + (int64_t)3 * m->v->cub_tets[4 * c + n] * D->rank;
+        tm->R[n] = m->act_R + 9 * m->cub_act[4 * c + n];
+    }
+}
+
+/* g_d -= sum over domain k's corners of U_i^T R_i^T f_i, the forces its tets summed on
+ * them (J^T f a corner at a time: each basis row read once a pass, not once a tet). */
+static void project_corner_forces(sw_reduced *m, int32_t k, double *gd) {
+    const sw_blob_domain *D = &m->v->domains[k];
+    int32_t r = D->rank;
+    for (int32_t i = m->corner_begin[k]; i < m->corner_begin[k + 1]; ++i) {
+        const double *Rm = m->act_R + 9 * m->corner_act[i], *f = m->corner_f + 3 * i;
+        const double *U0 = m->v->basis + D->basis_offset + (int64_t)3 * m->corner_lv[i] * r,
+                     *U1 = U0 + r, *U2 = U1 + r;
+        double w0 = Rm[0] * f[0] + Rm[3] * f[1] + Rm[6] * f[2],
+               w1 = Rm[1] * f[0] + Rm[4] * f[1] + Rm[7] * f[2],
+               w2 = Rm[2] * f[0] + Rm[5] * f[1] + Rm[8] * f[2];
+        for (int32_t j = 0; j < r; ++j)
+            gd[j] -= U0[j] * w0 + U1[j] * w1 + U2[j] * w2;
+    }
+}
+
 /* One cubature pass over some domains, by one worker. */
 typedef struct {
     sw_reduced *m;
@@ -210,7 +264,8 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
     for (uint32_t k = begin; k < end; ++k) {
         const sw_blob_domain *D = &v->domains[k];
         int32_t r = D->rank, o = D->q_offset;
-        const double *qd = p->q + o;
+        /* each corner placed once for all its tets */
+        place_corners(m, (int32_t)k, p->q + o);
         /* the tets' Hessian goes to the domain's block of H, or first to the reference's
          * (cubature.h) when this pass refreshes it */
         double *Hd = m->H + (int64_t)o * m->R + o, *ref = NULL;
@@ -228,20 +283,16 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
                 continue;
             }
             tet_map tm;
-            for (int n = 0; n < 4; ++n) {
-                int32_t lv = v->cub_tets[4 * c + n], a = m->cub_act[4 * c + n];
-                tm.U[n] = v->basis + D->basis_offset + (int64_t)3 * lv * r;
-                tm.R[n] = m->act_R + 9 * a;
-                sw_reduced_position(m, D, lv, a, qd, x + 3 * n, NULL);
-            }
+            tet_corners(m, D, c, x, want_hess ? &tm : NULL);
             const double *dminv = v->cub_dminv + 9 * c;
-            if (!want_hess) { /* energy, and J^T f (the polar rotation: no SVD) */
+            if (!want_hess) { /* energy, and its forces summed on the corners (no SVD) */
                 m->ecub[c] = w * sw_corot_eval(x, dminv, v->cub_vol[c], v->mu, v->lambda,
                                                want_grad ? f : NULL, NULL, project);
                 if (!want_grad) continue;
-                project_corners(&tm, r, f, hm);
-                for (int32_t j = 0; j < r; ++j)
-                    m->g[o + j] -= w * hm[j];
+                const int32_t *cc = m->cub_corner + 4 * c;
+                for (int n = 0; n < 4; ++n)
+                    for (int i = 0; i < 3; ++i)
+                        m->corner_f[3 * cc[n] + i] += w * f[3 * n + i];
                 continue;
             }
             m->ecub[c] =
@@ -250,12 +301,40 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
             for (int32_t j = 0; j < r; ++j)
                 m->g[o + j] -= w * hm[j];
         }
+        if (want_grad && !want_hess) project_corner_forces(m, (int32_t)k, m->g + o);
         if (ref) {
             mirror_upper(ref, r, r);
             add_block(Hd, ld, ref, r);
         } else if (want_hess) {
             mirror_upper(Hd, ld, r);
         }
+    }
+}
+
+void sw_cubature_refresh_ref(sw_reduced *m, const double *q, const unsigned char *refresh) {
+    const sw_blob_view *v = m->v;
+    for (int32_t k = 0; k < v->ndomains; ++k) {
+        if (!refresh[k]) continue;
+        const sw_blob_domain *D = &v->domains[k];
+        int32_t r = D->rank, o = D->q_offset;
+        double *Hd = m->H + (int64_t)o * m->R + o, *ref = ref_block(m, k);
+        for (int32_t i = 0; i < r; ++i) /* the old block out of H */
+            for (int32_t j = 0; j < r; ++j) {
+                Hd[(int64_t)i * m->R + j] -= ref[(int64_t)i * r + j];
+                ref[(int64_t)i * r + j] = 0;
+            }
+        place_corners(m, k, q + o);
+        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
+            double x[12];
+            if (m->cub_w[c] == 0.0) continue;
+            tet_map tm;
+            tet_corners(m, D, c, x, &tm);
+            (void)tet_with_hessian(&tm, r, x, v->cub_dminv + 9 * c, v->cub_vol[c], v,
+                                   m->svd_V + 9 * (int64_t)c, SW_COROT_PROJECT_PSD, m->cub_w[c],
+                                   ref, r, m->hm);
+        }
+        mirror_upper(ref, r, r);
+        add_block(Hd, m->R, ref, r);
     }
 }
 

@@ -3,7 +3,7 @@
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq) {
     const sw_blob_view *v = m->v;
     m->bone_dq = bone_dq;
-    for (int32_t a = 0; a < m->nact; ++a) {
+    for (int32_t a = 0; a < (m->skin_surface ? m->nact : m->nact_step); ++a) {
         int32_t gv = m->act_vert[a];
         sw_dqs_blend(bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, m->act_R + 9 * a,
                      m->act_t + 3 * a);

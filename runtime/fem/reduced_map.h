@@ -18,17 +18,29 @@
 
 typedef struct sw_reduced {
     const sw_blob_view *v;
-    int32_t R;              /* rank_total: the length of q */
-    int32_t rmax;           /* the largest domain rank */
-    int32_t nact;           /* active vertices */
-    int32_t *act_vert;      /* nact: the global vertex of each, ascending */
-    int32_t *cub_act;       /* 4 ncub: active index of each cubature tet corner */
-    int32_t *copy_act;      /* nsurf_copies: active index of each surface copy */
-    int32_t *contact_act;   /* 4 ncontacts: active index of p, t0, t1, t2 */
-    int32_t *node_copy_act; /* nrender_copies: active index of each render node copy */
-    double *act_R, *act_t;  /* 9 and 3 per active vertex: its skinning transform */
-    double *g;              /* R: gradient accumulator */
-    double *H;              /* R x R: Hessian accumulator */
+    int32_t R;         /* rank_total: the length of q */
+    int32_t rmax;      /* the largest domain rank */
+    int32_t nact;      /* active vertices */
+    int32_t nact_step; /* the first nact_step: those every step reads (instance.c) */
+    int32_t *act_vert; /* nact: the global vertex of each, ascending in both parts */
+    /* The rest, surface copies only, are skinned only when read: with a world attached or
+     * (no render mesh) as the output. */
+    int skin_surface;
+    int32_t *cub_act; /* 4 ncub: active index of each cubature tet corner */
+    /* The cubature tets' corners, each (domain, local vertex) once (sw_cubature_corners):
+     * a pass places each once and sums the forces of its tets on it (cubature.c). Domain
+     * k's are corner_begin[k] .. corner_begin[k + 1] - 1, in local vertex order. */
+    int32_t ncorner;
+    int32_t *corner_begin;           /* ndomains + 1 */
+    int32_t *corner_lv, *corner_act; /* ncorner: local vertex and active index */
+    int32_t *cub_corner;             /* 4 ncub: the corner of each cubature tet corner */
+    double *corner_x, *corner_f;     /* 3 ncorner: a pass's positions and summed forces */
+    int32_t *copy_act;               /* nsurf_copies: active index of each surface copy */
+    int32_t *contact_act;            /* 4 ncontacts: active index of p, t0, t1, t2 */
+    int32_t *node_copy_act;          /* nrender_copies: active index of each render node copy */
+    double *act_R, *act_t;           /* 9 and 3 per active vertex: its skinning transform */
+    double *g;                       /* R: gradient accumulator */
+    double *H;                       /* R x R: Hessian accumulator */
     /* Scratch of each task worker w < nworkers (one without task callbacks): */
     double *hm;       /* 10 x rmax at hm + 10 rmax w: its J^T f and J^T g_k (cubature.c) */
     double *ecub;     /* ncub: each cubature tet's weighted energy */
@@ -47,8 +59,9 @@ typedef struct sw_reduced {
     double *h_ref;
 } sw_reduced;
 
-/* Skins every active vertex with the bones' dual quaternions (act_R, act_t), which m keeps
- * (bone_dq) for vertices skinned on demand. */
+/* Skins the active vertices (the first nact_step, or all with skin_surface) with the
+ * bones' dual quaternions (act_R, act_t), which m keeps (bone_dq) for vertices skinned on
+ * demand. */
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 
 /* Position x of copy (domain D, local vertex lv, active index a) for the domain's

@@ -16,7 +16,9 @@
 /* Sizes of the layout that the blob alone does not fix. */
 typedef struct {
     int32_t nact;       /* active vertices (active_vertices) */
+    int32_t nact_step;  /* those the step itself reads (ACT_STEP) */
     int32_t rmax;       /* the largest domain rank */
+    int32_t ncorner;    /* the cubature tets' corners (sw_cubature_corners) */
     int32_t max_pairs;  /* the contact pair budget */
     int32_t max_world;  /* the world candidate budget */
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
@@ -47,6 +49,12 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     sw_reduced *m = &in->red;
     TAKE(m->act_vert, na);
     TAKE(m->cub_act, 4 * (uint64_t)v->ncub);
+    TAKE(m->corner_begin, nd + 1);
+    TAKE(m->corner_lv, (uint64_t)z->ncorner);
+    TAKE(m->corner_act, (uint64_t)z->ncorner);
+    TAKE(m->cub_corner, 4 * (uint64_t)v->ncub);
+    TAKE(m->corner_x, 3 * (uint64_t)z->ncorner);
+    TAKE(m->corner_f, 3 * (uint64_t)z->ncorner);
     TAKE(m->copy_act, (uint64_t)v->nsurf_copies);
     TAKE(m->contact_act, 4 * (uint64_t)v->ncontacts);
     TAKE(m->node_copy_act, (uint64_t)v->nrender_copies);
@@ -87,6 +95,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->q_pred, R);
     TAKE(s->tmp, R);
     TAKE(s->tmp2, R);
+    TAKE(s->dom_g2, nd);
+    TAKE(s->refresh, nd);
     TAKE(s->blk_off, nd);
     TAKE(s->blk_size, nd);
     TAKE(s->blk_order, nd);
@@ -196,30 +206,34 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
 
 /* ---- active vertices ------------------------------------------------------------- */
 
-/* The vertices the step skins: every cubature tet corner, boundary surface copy, render
- * node copy and pose-space contact vertex, each once. visit() is called with the global vertex of
- * every such reference and the slot that receives its active index. */
+/* The vertices the step skins: every cubature tet corner, render node copy and pose-space
+ * contact vertex (ACT_STEP), and every boundary surface copy (ACT_SURFACE: read only by
+ * the world's contact and by the output of a blob without a render mesh), each once.
+ * visit() is called with the global vertex of every such reference of the tiers asked
+ * for and the slot that receives its active index. */
+enum { ACT_STEP = 1, ACT_SURFACE = 2 };
 typedef void (*visit_fn)(void *ctx, int32_t gv, int32_t *slot);
 
-static void visit_active(const sw_blob_view *v, sw_reduced *m, visit_fn visit, void *ctx) {
-    for (int32_t k = 0; k < v->ndomains; ++k) {
+static void visit_active(const sw_blob_view *v, sw_reduced *m, int tiers, visit_fn visit,
+                         void *ctx) {
+    for (int32_t k = 0; k < v->ndomains && (tiers & ACT_STEP); ++k) {
         const sw_blob_domain *D = &v->domains[k];
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
             for (int j = 0; j < 4; ++j)
                 visit(ctx, v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]],
                       m ? &m->cub_act[4 * c + j] : NULL);
     }
-    for (int32_t i = 0; i < v->nsurf_copies; ++i) {
+    for (int32_t i = 0; i < v->nsurf_copies && (tiers & ACT_SURFACE); ++i) {
         const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
         visit(ctx, v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]],
               m ? &m->copy_act[i] : NULL);
     }
-    for (int32_t i = 0; i < v->nrender_copies; ++i) {
+    for (int32_t i = 0; i < v->nrender_copies && (tiers & ACT_STEP); ++i) {
         const sw_blob_domain *D = &v->domains[v->render_node_copies[2 * i]];
         visit(ctx, v->domain_verts[D->vert_begin + v->render_node_copies[2 * i + 1]],
               m ? &m->node_copy_act[i] : NULL);
     }
-    for (int32_t c = 0; c < v->ncontacts; ++c)
+    for (int32_t c = 0; c < v->ncontacts && (tiers & ACT_STEP); ++c)
         for (int k = 0; k < 4; ++k) {
             const sw_blob_domain *D = &v->domains[v->contact_verts[8 * c + 2 * k]];
             visit(ctx, v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]],
@@ -227,7 +241,7 @@ static void visit_active(const sw_blob_view *v, sw_reduced *m, visit_fn visit, v
         }
 }
 
-/* Active vertices are found a chunk of the mesh's vertices at a time in a bit set on
+/* Active vertices are found a chunk of the mesh's vertices at a time in bit sets on
  * the stack, so that sizing needs no memory at all. */
 enum { CHUNK = 1 << 16 };
 typedef struct {
@@ -242,34 +256,51 @@ static void mark_in_chunk(void *ctx, int32_t gv, int32_t *slot) {
         c->bits[(gv - c->lo) / 64] |= 1ull << ((gv - c->lo) % 64);
 }
 
-/* The number of active vertices; with act_vert, also their global ids, ascending. */
-static int32_t active_vertices(const sw_blob_view *v, int32_t *act_vert) {
-    chunk_marks c;
-    int32_t n = 0;
-    for (c.lo = 0; c.lo < v->nverts; c.lo += CHUNK) {
-        memset(c.bits, 0, sizeof c.bits);
-        visit_active(v, NULL, mark_in_chunk, &c);
-        for (int32_t i = 0; i < CHUNK && c.lo + i < v->nverts; ++i)
-            if (c.bits[i / 64] >> (i % 64) & 1) {
-                if (act_vert) act_vert[n] = c.lo + i;
-                n++;
+/* The number of active vertices, and in *nstep those of ACT_STEP. With act_vert (and
+ * nstep the count sizing found), also their global ids: ACT_STEP's ascending in
+ * [0, nstep), then the surface copies' that are not among them, ascending. */
+static int32_t active_vertices(const sw_blob_view *v, int32_t *act_vert, int32_t *nstep) {
+    chunk_marks cs, cf;
+    int32_t ns = 0, nf = 0, base = act_vert ? *nstep : 0;
+    for (cs.lo = 0; cs.lo < v->nverts; cs.lo += CHUNK) {
+        cf.lo = cs.lo;
+        memset(cs.bits, 0, sizeof cs.bits);
+        memset(cf.bits, 0, sizeof cf.bits);
+        visit_active(v, NULL, ACT_STEP, mark_in_chunk, &cs);
+        visit_active(v, NULL, ACT_SURFACE, mark_in_chunk, &cf);
+        for (int32_t i = 0; i < CHUNK && cs.lo + i < v->nverts; ++i) {
+            int in_step = cs.bits[i / 64] >> (i % 64) & 1,
+                in_surf = cf.bits[i / 64] >> (i % 64) & 1;
+            if (in_step) {
+                if (act_vert) act_vert[ns] = cs.lo + i;
+                ns++;
+            } else if (in_surf) {
+                if (act_vert) act_vert[base + nf] = cs.lo + i;
+                nf++;
             }
+        }
     }
-    return n;
+    *nstep = ns;
+    return ns + nf;
 }
 
-/* Writes the active index of gv (present in the ascending act_vert) into *slot. */
+/* The active index of global vertex gv: a search among ACT_STEP's, then the rest. */
 static void assign_active(void *ctx, int32_t gv, int32_t *slot) {
     const sw_reduced *m = ctx;
-    int32_t lo = 0, hi = m->nact - 1;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (m->act_vert[mid] < gv)
-            lo = mid + 1;
-        else
-            hi = mid;
+    int32_t ranges[2][2] = {{0, m->nact_step}, {m->nact_step, m->nact}};
+    for (int h = 0; h < 2; ++h) {
+        int32_t lo = ranges[h][0], hi = ranges[h][1] - 1;
+        if (lo > hi) continue;
+        while (lo < hi) {
+            int32_t mid = lo + (hi - lo) / 2;
+            if (m->act_vert[mid] < gv)
+                lo = mid + 1;
+            else
+                hi = mid;
+        }
+        *slot = lo;
+        if (m->act_vert[lo] == gv) return;
     }
-    *slot = lo;
 }
 
 /* ---- creation -------------------------------------------------------------------- */
@@ -324,7 +355,8 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     }
     z->nworkers = tasks ? (int32_t)d->tasks.worker_count : 1;
     if (!d->allocator.alloc) d->allocator = blob->allocator;
-    z->nact = active_vertices(v, NULL);
+    z->nact = active_vertices(v, NULL, &z->nact_step);
+    z->ncorner = sw_cubature_corners(v, NULL);
     z->rmax = 0;
     for (int32_t k = 0; k < v->ndomains; ++k)
         if (v->domains[k].rank > z->rmax) z->rmax = v->domains[k].rank;
@@ -472,8 +504,12 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.nworkers = z.nworkers;
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
-    (void)active_vertices(v, in->red.act_vert);
-    visit_active(v, &in->red, assign_active, &in->red);
+    in->red.nact_step = z.nact_step;
+    (void)active_vertices(v, in->red.act_vert, &in->red.nact_step);
+    visit_active(v, &in->red, ACT_STEP | ACT_SURFACE, assign_active, &in->red);
+    /* without a render mesh the surface copies are the output */
+    in->red.skin_surface = v->nrender_verts == 0;
+    in->red.ncorner = sw_cubature_corners(v, &in->red); /* after cub_act */
     if (v->nrender_verts > 0) sw_render_weld_tris(v, in->weld_tris);
     in->ps.max_pairs = z.max_pairs;
     in->wc.max_cand = z.max_world;
