@@ -1,6 +1,5 @@
 /* The runtime's cubature pass (runtime/fem/cubature.c): each tet corner placed once for
- * all its tets, the forces summed on the corners and projected a corner at a time, and
- * the rest-first updates' partial refresh of the reference Hessian. */
+ * all its tets, the forces summed on the corners and projected a corner at a time. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -125,66 +124,9 @@ TEST(corner_gradient_equals_the_tets_own_projection) {
     sinew_instance_destroy(in);
 }
 
-/* Domain k's block of the R x R matrix H (r x r, row-major) into out. */
-static void domain_block(const sw_blob_view *v, const double *H, int32_t k, double *out) {
-    int32_t R = v->rank_total, r = v->domains[k].rank, o = v->domains[k].q_offset;
-    for (int32_t i = 0; i < r; ++i)
-        memcpy(out + (int64_t)i * r, H + (int64_t)(o + i) * R + o, sizeof(double) * (size_t)r);
-}
-
-/* sw_cubature_refresh_ref on every other domain of a reference pass at a bent pose: those
- * domains' reference and H blocks become the Hessian at the pose (as a pass with the
- * Hessian computes it), the others' stay the rest Hessian's, bitwise. */
-TEST(refresh_replaces_the_marked_domains_blocks_only) {
-    sinew_instance *in = bent_instance(SINEW_NEWTON_HESSIAN_REST_FIRST),
-                   *plain = bent_instance(SINEW_NEWTON_HESSIAN_CURRENT);
-    ENSURE(in && plain && in->red.h_ref && !plain->red.h_ref);
-    const sw_blob_view *v = in->v;
-    ENSURE(v->ndomains >= 2);
-    int32_t R = v->rank_total;
-    int64_t nref = sw_cubature_rest_hessian_size(v);
-    double *q = calloc((size_t)R, sizeof(double)), *rest = malloc(sizeof(double) * (size_t)nref),
-           *a = malloc(sizeof(double) * (size_t)nref), *b = malloc(sizeof(double) * (size_t)nref);
-    unsigned char *mark = malloc((size_t)v->ndomains);
-    ENSURE(q && rest && a && b && mark);
-    memcpy(rest, in->red.h_ref, sizeof(double) * (size_t)nref); /* fresh: the rest Hessian */
-    sinew_instance *both[2] = {in, plain};
-    for (int i = 0; i < 2; ++i) {
-        memset(both[i]->red.g, 0, sizeof(double) * (size_t)R);
-        memset(both[i]->red.H, 0, sizeof(double) * (size_t)R * R);
-    }
-    sw_cubature_eval(&in->red, q, 1, SW_CUB_HESSIAN_REF);
-    sw_cubature_eval(&plain->red, q, 1, 1); /* the Hessian at the pose */
-    for (int32_t k = 0; k < v->ndomains; ++k)
-        mark[k] = k % 2 == 0;
-    sw_cubature_refresh_ref(&in->red, q, mark);
-    int64_t off = 0;
-    double moved = 0;
-    for (int32_t k = 0; k < v->ndomains; ++k) {
-        int32_t r = v->domains[k].rank;
-        size_t bytes = sizeof(double) * (size_t)r * (size_t)r;
-        domain_block(v, in->red.H, k, a);
-        domain_block(v, plain->red.H, k, b);
-        const double *want = mark[k] ? b : rest + off;
-        ENSUREF(!memcmp(a, want, bytes), "domain %d (%s): H's block", k,
-                mark[k] ? "refreshed" : "kept");
-        ENSUREF(!memcmp(in->red.h_ref + off, want, bytes), "domain %d (%s): the reference", k,
-                mark[k] ? "refreshed" : "kept");
-        for (int64_t i = 0; mark[k] && i < (int64_t)r * r; ++i)
-            moved = fmax(moved, fabs(b[i] - rest[off + i]) / (fabs(rest[off + i]) + 1e-30));
-        off += (int64_t)r * r;
-    }
-    fprintf(stderr, "    refreshed blocks moved from rest by up to %.3g relative\n", moved);
-    ENSUREF(moved >= 1e-3, "bent %g: the test cannot tell the poses apart", moved);
-    free(q), free(rest), free(a), free(b), free(mark);
-    sinew_instance_destroy(in);
-    sinew_instance_destroy(plain);
-}
-
 TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
 }
 
 SW_TEST_MAIN(CASE(corners_list_each_cubature_vertex_once_in_its_domain),
-             CASE(corner_gradient_equals_the_tets_own_projection),
-             CASE(refresh_replaces_the_marked_domains_blocks_only), CASE(release_fixture))
+             CASE(corner_gradient_equals_the_tets_own_projection), CASE(release_fixture))

@@ -311,33 +311,6 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
     }
 }
 
-void sw_cubature_refresh_ref(sw_reduced *m, const double *q, const unsigned char *refresh) {
-    const sw_blob_view *v = m->v;
-    for (int32_t k = 0; k < v->ndomains; ++k) {
-        if (!refresh[k]) continue;
-        const sw_blob_domain *D = &v->domains[k];
-        int32_t r = D->rank, o = D->q_offset;
-        double *Hd = m->H + (int64_t)o * m->R + o, *ref = ref_block(m, k);
-        for (int32_t i = 0; i < r; ++i) /* the old block out of H */
-            for (int32_t j = 0; j < r; ++j) {
-                Hd[(int64_t)i * m->R + j] -= ref[(int64_t)i * r + j];
-                ref[(int64_t)i * r + j] = 0;
-            }
-        place_corners(m, k, q + o);
-        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
-            double x[12];
-            if (m->cub_w[c] == 0.0) continue;
-            tet_map tm;
-            tet_corners(m, D, c, x, &tm);
-            (void)tet_with_hessian(&tm, r, x, v->cub_dminv + 9 * c, v->cub_vol[c], v,
-                                   m->svd_V + 9 * (int64_t)c, SW_COROT_PROJECT_PSD, m->cub_w[c],
-                                   ref, r, m->hm);
-        }
-        mirror_upper(ref, r, r);
-        add_block(Hd, m->R, ref, r);
-    }
-}
-
 void sw_cubature_rest_hessian(sw_reduced *m, double *blocks) {
     static const double I3[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
     const sw_blob_view *v = m->v;

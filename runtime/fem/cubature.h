@@ -22,13 +22,6 @@
 #define SW_CUB_HESSIAN_REF 3
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess);
 
-/* The reference blocks (m->h_ref) of the domains k with refresh[k] replaced by the
- * cubature's projected Hessian at q, and m->H's blocks of those domains changed by the
- * same difference, so that H is what a SW_CUB_HESSIAN_REF pass at q would have built on
- * the refreshed reference. Gradient and energy are left as they are (the pass at q
- * computed them). The rest-first updates' partial refresh (newton.c). */
-void sw_cubature_refresh_ref(sw_reduced *m, const double *q, const unsigned char *refresh);
-
 /* The cubature tets' corners, each (domain, local vertex) once: returns their count, and
  * with m (whose cub_act is filled) lists them in m's corner arrays (reduced_map.h). Sizing
  * (m NULL) needs no memory: a chunk of a domain's vertices at a time in a bit set on the

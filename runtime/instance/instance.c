@@ -95,8 +95,6 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->q_pred, R);
     TAKE(s->tmp, R);
     TAKE(s->tmp2, R);
-    TAKE(s->dom_g2, nd);
-    TAKE(s->refresh, nd);
     TAKE(s->blk_off, nd);
     TAKE(s->blk_size, nd);
     TAKE(s->blk_order, nd);

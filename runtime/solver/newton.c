@@ -4,8 +4,8 @@
  * the step), chord updates on an earlier factor once the iterate converges fast, and an
  * energy guard: a trial point whose energy grows is halved, up to five times, and the
  * best iterate is kept. A quasistatic step may start with updates on a reference Hessian
- * (rest_first_updates: the rest one, then the last one evaluated, refreshed in the
- * domains where it went stale) before the current Hessian's. */
+ * (rest_first_updates: the rest one, then the last one evaluated) before the current
+ * Hessian's. */
 #include <math.h>
 #include <string.h>
 
@@ -190,39 +190,6 @@ static sinew_result step_failed(sw_solver *s, int32_t R, sinew_step_stats *st) {
     return SINEW_ERROR_NOT_FINITE;
 }
 
-/* A slow rest-first update first refreshes the reference where it went stale, up to this
- * many times a step, before it hands the step over: the domains whose own gradient shrank
- * to no less than SW_REFRESH_STALE of its value get their Hessian at the iterate
- * (sw_cubature_refresh_ref), the others keep theirs, and the updates go on. Measured on
- * the Fox's Run (callgrind over its steps): 0.910G -> 0.866G instructions (2.46 -> 2.91
- * factorisations a step, the partial passes not counted among the evaluations). The
- * path is sensitive to these: a stale share of 0.3, 0.4 or 0.7 took 0.883G, 0.873G and
- * 0.936G, one refresh a step 0.917G; refreshing only domains that hold 1% or more of
- * the gradient 0.948G. */
-#define SW_REST_REFRESHES 3
-#define SW_REFRESH_STALE 0.5
-
-/* Each domain's squared gradient norm into out. */
-static void domain_gradients(const sw_reduced *red, double *out) {
-    for (int32_t k = 0; k < red->v->ndomains; ++k) {
-        const sw_blob_domain *D = &red->v->domains[k];
-        out[k] = sw_dot(red->g + D->q_offset, red->g + D->q_offset, D->rank);
-    }
-}
-
-/* Marks in s->refresh the domains a slow update found stale (SW_REFRESH_STALE against
- * their gradients before it, in s->dom_g2). Returns how many. */
-static int32_t stale_domains(const sw_reduced *red, sw_solver *s) {
-    int32_t n = 0;
-    for (int32_t k = 0; k < red->v->ndomains; ++k) {
-        const sw_blob_domain *D = &red->v->domains[k];
-        double g2 = sw_dot(red->g + D->q_offset, red->g + D->q_offset, D->rank);
-        s->refresh[k] = g2 > SW_REFRESH_STALE * SW_REFRESH_STALE * s->dom_g2[k];
-        n += s->refresh[k];
-    }
-    return n;
-}
-
 /* What rest_first_updates left: the step done, or its iteration to go on from s->q. */
 enum rest_outcome { REST_DONE, REST_HAND_OVER, REST_NOT_FINITE };
 
@@ -234,11 +201,9 @@ enum rest_outcome { REST_DONE, REST_HAND_OVER, REST_NOT_FINITE };
  * bones without deforming has that very Hessian (cubature.h), so where the flesh follows
  * the skeleton an update costs a gradient pass and a factorisation instead of a Hessian
  * pass and a factorisation (the Fox: 0.28 and 0.12 ms against 1.2 and 0.12 ms). Where it
- * does not (stretched elements stiffen in their rotation modes), an update that shrinks
- * the gradient by less than SW_REST_KEEP first refreshes the reference in the domains
- * where it went stale (SW_REST_REFRESHES), and the first rejected update, or a slow one
- * with no refresh left, hands the step to the current Hessian's iteration at the best
- * iterate, whose Hessian passes then become the
+ * does not (stretched elements stiffen in their rotation modes), the first rejected
+ * update or one that shrinks the gradient by less than SW_REST_KEEP hands the step to the
+ * current Hessian's iteration at the best iterate, whose Hessian passes then become the
  * reference of the next steps: the pose of the last hand-over is nearer than the rest
  * pose. Measured on the Fox's Run (callgrind over its steps): 2.09G -> 1.42G instructions
  * (passes a step 5.2 -> 4.06, reference updates 1.71 -> 3.06); the bakes' errors train /
@@ -254,7 +219,6 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
                                             double g0, uint32_t *it) {
     int32_t R = red->R;
     double last = SW_REST_LAST_UPDATE; /* SW_NEWTON_LAST_UPDATE after a fast update */
-    int refreshes = 0;
     for (;; ++*it) {
         if (!isfinite(*phi) || !isfinite(*gn)) return REST_NOT_FINITE;
         if (*gn <= 1e-5 * g0 || *gn == 0) { /* as sw_newton_solve's own test */
@@ -270,7 +234,6 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
             return REST_DONE;
         }
         memcpy(s->qtrial, s->q, (size_t)R * sizeof(double));
-        domain_gradients(red, s->dom_g2);
         double phi0 = *phi;
         for (int32_t i = 0; i < R; ++i)
             s->q[i] += s->dq[i];
@@ -285,12 +248,6 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
         st->rest_updates++;
         int slow = gnew > SW_REST_KEEP * *gn;
         *gn = gnew;
-        if (slow && refreshes < SW_REST_REFRESHES && stale_domains(red, s) > 0) {
-            sw_cubature_refresh_ref(red, s->q, s->refresh);
-            refreshes++;
-            last = SW_REST_LAST_UPDATE;
-            continue;
-        }
         if (slow) {
             ++*it;
             return REST_HAND_OVER;

@@ -33,10 +33,6 @@ typedef struct sw_solver {
     double *q_pred;
     int pred_valid;
     double *tmp, *tmp2; /* R each: scratch */
-    /* ndomains each: the domains' squared gradient norms before a rest-first update, and
-     * the domains whose reference that update found stale (newton.c) */
-    double *dom_g2;
-    unsigned char *refresh;
     /* H's domain blocks and their elimination order (leaves of the coupling graph first) */
     int32_t *blk_off, *blk_size, *blk_order; /* ndomains each */
     int32_t *blk_pos;                        /* domain -> its place in blk_order */

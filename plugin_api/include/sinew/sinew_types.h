@@ -131,14 +131,12 @@ typedef enum sinew_newton_hessian {
     /** the updates start on a reference Hessian (the cubature's: at the rest shape after
      * creation or a reset, then the last one a step evaluated; the contact pairs' and
      * springs' Hessians at the iterate), factored at each update, each trial a gradient
-     * pass; an update shrinking the gradient too little first re-evaluates the reference
-     * in the domains whose own gradient did not shrink (a few times a step at most), and
-     * an update the energy rejects, or a slow one after those, hands the step to
-     * SINEW_NEWTON_HESSIAN_CURRENT's iteration, whose Hessian becomes the reference. The stationary
-     * point is the same, so the shape at a pose depends on the frames before only within the
-     * solve's tolerance (replays from a reset are bitwise the same); dynamic steps always use the
-     * current Hessian (their damping needs it anyway). Reserves the reference Hessian's domain
-     * blocks */
+     * pass; an update the energy rejects or one shrinking the gradient too little hands
+     * the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration, whose Hessian becomes the
+     * reference. The stationary point is the same, so the shape at a pose depends on the
+     * frames before only within the solve's tolerance (replays from a reset are bitwise
+     * the same); dynamic steps always use the current Hessian (their damping needs it
+     * anyway). Reserves the reference Hessian's domain blocks */
     SINEW_NEWTON_HESSIAN_REST_FIRST = 2
 } sinew_newton_hessian;
 
