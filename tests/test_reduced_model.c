@@ -327,7 +327,7 @@ TEST(quasistatic_start_is_the_prediction_plus_the_last_offset) {
  * skipped: in the fold, plain Newton takes more than five updates too). Counts the
  * updates, factorisations and rest-Hessian updates of the steps. */
 static void ends_at_newton_stationary_points(sinew_newton_hessian mode, uint32_t *updates,
-                                             uint32_t *factors, uint32_t *rest) {
+                                             uint32_t *factors, uint32_t *rest, uint32_t *probed) {
     const bake_fixture *f = fixture();
     ENSURE(f);
     int32_t R = sw_blob_get_view(f->blob)->rank_total;
@@ -338,7 +338,7 @@ static void ends_at_newton_stationary_points(sinew_newton_hessian mode, uint32_t
     float *pose = malloc(sizeof(float) * 12 * f->ch.skel.nbones);
     double *q = malloc(sizeof(double) * R), *g = malloc(sizeof(double) * R),
            *H = malloc(sizeof(double) * R * R);
-    *updates = *factors = *rest = 0;
+    *updates = *factors = *rest = *probed = 0;
     int converged = 0;
     for (int k = 0; k < f->ch.clip.nframes; ++k) {
         step_to_frame(f, inst, k, pose);
@@ -347,6 +347,9 @@ static void ends_at_newton_stationary_points(sinew_newton_hessian mode, uint32_t
         *updates += st.newton_iterations;
         *factors += st.factorizations;
         *rest += st.rest_updates;
+        /* a step whose updates were all on the reference and one of them on the factor of
+           the iterate before (newton.c's probe after a fast update) */
+        *probed += st.rest_updates == st.newton_iterations && st.factorizations < st.rest_updates;
         if (!(st.status & SINEW_STEP_CONVERGED)) continue; /* the update cap ended it */
         converged++;
         memcpy(q, sw_instance_q(inst), sizeof(double) * R);
@@ -378,8 +381,9 @@ static void ends_at_newton_stationary_points(sinew_newton_hessian mode, uint32_t
 /* Chord updates (newton.c) reuse an earlier iterate's factor: the steps still end at
  * Newton stationary points, and chord updates were taken. */
 TEST(chord_updates_end_at_a_newton_stationary_point) {
-    uint32_t updates, factors, rest;
-    ends_at_newton_stationary_points(SINEW_NEWTON_HESSIAN_CURRENT, &updates, &factors, &rest);
+    uint32_t updates, factors, rest, probed;
+    ends_at_newton_stationary_points(SINEW_NEWTON_HESSIAN_CURRENT, &updates, &factors, &rest,
+                                     &probed);
     ENSUREF(factors < updates, "no chord update taken: %u factorisations for %u updates", factors,
             updates);
     ENSURE(rest == 0);
@@ -387,13 +391,18 @@ TEST(chord_updates_end_at_a_newton_stationary_point) {
 
 /* Updates on the rest Hessian (newton.c) end with a shorter last update than Newton's,
  * since their error is not quadratic in its length: the steps end at Newton stationary
- * points all the same, and the rest updates were taken. */
+ * points all the same, and the rest updates were taken, some steps ending on the factor
+ * of the iterate before a fast update (the probe). */
 TEST(rest_first_updates_end_at_a_newton_stationary_point) {
-    uint32_t updates, factors, rest;
-    ends_at_newton_stationary_points(SINEW_NEWTON_HESSIAN_REST_FIRST, &updates, &factors, &rest);
-    fprintf(stderr, "    %u updates, %u of them on the rest Hessian, %u factorisations\n", updates,
-            rest, factors);
+    uint32_t updates, factors, rest, probed;
+    ends_at_newton_stationary_points(SINEW_NEWTON_HESSIAN_REST_FIRST, &updates, &factors, &rest,
+                                     &probed);
+    fprintf(stderr,
+            "    %u updates, %u of them on the rest Hessian, %u factorisations; %u steps "
+            "ended on the factor of the iterate before\n",
+            updates, rest, factors, probed);
     ENSUREF(rest > 0, "no rest update taken (%u updates)", updates);
+    ENSUREF(probed > 0, "no step ended on the factor of the iterate before (%u updates)", updates);
 }
 
 /* The largest difference between domain blocks (sw_cubature_rest_hessian's layout), over

@@ -171,6 +171,15 @@ static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_sol
  * took more passes: 1.28G at a shrink to 0.15, 1.45G at 0.3.) */
 #define SW_REST_LAST_UPDATE (0.5 * SW_NEWTON_LAST_UPDATE)
 
+/* After a fast reference update the factor at hand is the last iterate's, whose matrix
+ * differs from the new one only in the contact pairs' Hessian (the reference and the
+ * springs do not change within the updates): it first tells whether the update from
+ * here is the last (SW_NEWTON_LAST_UPDATE), taken then without a new factorisation; if
+ * not, the iterate's own factor gives the update as before, so no pass is added. The
+ * Fox's Run (callgrind over its steps): 0.911G -> 0.844G instructions, factorisations a
+ * step 2.46 -> 1.8. (Taking the chord update and evaluating its end point instead, tried
+ * before, took more passes.) */
+
 /* An update s->dq shorter than `share` of |q| (or than dq_tiny) is the step's last: taken
  * without evaluating its end point, counted, the step CONVERGED; returns 1 then. */
 static int took_last_update(sw_solver *s, int32_t R, double share, sinew_step_stats *st) {
@@ -219,6 +228,7 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
                                             double g0, uint32_t *it) {
     int32_t R = red->R;
     double last = SW_REST_LAST_UPDATE; /* SW_NEWTON_LAST_UPDATE after a fast update */
+    int probe = 0; /* the factor at hand is the last iterate's, after a fast update */
     for (;; ++*it) {
         if (!isfinite(*phi) || !isfinite(*gn)) return REST_NOT_FINITE;
         if (*gn <= 1e-5 * g0 || *gn == 0) { /* as sw_newton_solve's own test */
@@ -226,6 +236,14 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
             return REST_DONE;
         }
         if (*it == s->max_newton) return REST_DONE;
+        if (probe) { /* the factor at hand may show that this update is the last */
+            probe = 0;
+            factored_direction(red, s);
+            if (took_last_update(s, R, last, st)) {
+                st->rest_updates++;
+                return REST_DONE;
+            }
+        }
         if (!sw_solver_factor(red, s)) return REST_HAND_OVER;
         st->factorizations++;
         factored_direction(red, s);
@@ -253,6 +271,7 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
             return REST_HAND_OVER;
         }
         last = SW_NEWTON_LAST_UPDATE;
+        probe = 1;
     }
 }
 
