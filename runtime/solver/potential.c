@@ -36,17 +36,24 @@ static int block_in(const sw_solver *s, int32_t nd, enum block_set set, int32_t 
 static void block_matvec(const sw_blob_view *v, const sw_solver *s, enum block_set set,
                          const double *A, const double *x, double *y) {
     int32_t R = v->rank_total, nd = v->ndomains;
-    for (int32_t a = 0; a < nd; ++a)
-        for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i) {
-            const double *Ai = A + (int64_t)i * R;
-            double acc = 0;
-            for (int32_t b = 0; b < nd; ++b) {
-                if (!block_in(s, nd, set, a, b)) continue;
-                for (int32_t j = s->blk_off[b]; j < s->blk_off[b] + s->blk_size[b]; ++j)
+    for (int32_t a = 0; a < nd; ++a) {
+        int32_t i0 = s->blk_off[a], i1 = i0 + s->blk_size[a];
+        for (int32_t i = i0; i < i1; ++i)
+            y[i] = 0;
+        /* block by block, each row's terms still in column order (the set asked once a
+           block pair, not once a row) */
+        for (int32_t b = 0; b < nd; ++b) {
+            if (!block_in(s, nd, set, a, b)) continue;
+            int32_t j0 = s->blk_off[b], j1 = j0 + s->blk_size[b];
+            for (int32_t i = i0; i < i1; ++i) {
+                const double *Ai = A + (int64_t)i * R;
+                double acc = y[i];
+                for (int32_t j = j0; j < j1; ++j)
                     acc += Ai[j] * x[j];
+                y[i] = acc;
             }
-            y[i] = acc;
         }
+    }
 }
 
 /* y = M x: over the diagonal blocks when the blob's mass is block diagonal (the bake's
