@@ -8,6 +8,7 @@
 #include <string.h>
 
 #include "bvh.h"
+#include "sorted.h"
 #include "penalty.h"
 #include "vec3.h"
 
@@ -91,7 +92,7 @@ static sinew_result validate(const sw_tetmesh *m, const sw_surface *s, double fa
     for (int32_t t = 0; t < s->ntris; ++t) {
         const int32_t *v = s->tris + 3 * (size_t)t;
         for (int k = 0; k < 3; ++k)
-            if (sw_self_surf_index(s->verts, s->nverts, v[k]) < 0)
+            if (sw_sorted_index(s->verts, s->nverts, v[k]) < 0)
                 return sw_error_set(
                     err, SINEW_ERROR_INVALID_ARGUMENT,
                     "sw_selfcontact_create: surface triangle %d vertex %d is not in the "

@@ -6,6 +6,7 @@
 #include <string.h>
 
 #include "dqs.h"
+#include "sorted.h"
 #include "vec3.h"
 
 void sw_self_contacts_take(sw_mem_plan *p, const sw_blob_view *v, sw_self_contacts *sc) {
@@ -257,7 +258,7 @@ int32_t sw_self_contacts_retest(sw_self_contacts *sc, const sw_reduced *red, con
     next_stamp(sc, v);
     for (int32_t i = 0; i < ps->npairs; ++i) {
         const int32_t c = ps->pairs[i], *ca = red->contact_act + 4 * (int64_t)c;
-        int32_t p = red->act_vert[ca[0]], si = sw_self_surf_index(m->surf, m->nsurf, p);
+        int32_t p = red->act_vert[ca[0]], si = sw_sorted_index(m->surf, m->nsurf, p);
         int32_t tv[3] = {red->act_vert[ca[1]], red->act_vert[ca[2]], red->act_vert[ca[3]]};
         sw_self_hit hit;
         int found = 0;

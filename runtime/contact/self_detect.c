@@ -5,19 +5,8 @@
 #include <math.h>
 #include <string.h>
 
+#include "sorted.h"
 #include "vec3.h"
-
-int32_t sw_self_surf_index(const int32_t *surf, int32_t n, int32_t v) {
-    int32_t lo = 0, hi = n;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (surf[mid] < v)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return (lo < n && surf[lo] == v) ? lo : -1;
-}
 
 void sw_self_mesh_measures(sw_self_mesh *m) {
     for (int32_t i = 0; i < m->nsurf; ++i)
@@ -39,7 +28,7 @@ void sw_self_mesh_measures(sw_self_mesh *m) {
         m->tri_area[t] = area;
         m->tri_edge[t] = longest;
         for (int k = 0; k < 3; ++k)
-            m->ring[sw_self_surf_index(m->surf, m->nsurf, v[k])] += area;
+            m->ring[sw_sorted_index(m->surf, m->nsurf, v[k])] += area;
     }
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t i = 0; i < m->nverts; ++i)

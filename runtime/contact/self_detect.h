@@ -52,9 +52,6 @@ typedef struct sw_self_mesh {
     sw_bvh tet_bvh; /* topology from the rest pose, refit per detection */
 } sw_self_mesh;
 
-/* Index of vertex v in the ascending list surf[0..n), or -1. */
-int32_t sw_self_surf_index(const int32_t *surf, int32_t n, int32_t v);
-
 /* Fills ring, tri_area, tri_edge and rest_diag from X, tris and surf (ka of eq. 3.4 needs
  * the one-ring area of the vertex and the area of the triangle; the neighbour rule the
  * longest edge). */

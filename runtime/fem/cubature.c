@@ -6,6 +6,7 @@
 
 #include "blob_load.h"
 #include "fem_corot.h"
+#include "sorted.h"
 
 /* A cubature tet's corners in the subspace map (reduced_map.h): corner n's rows of the
  * domain's basis U_n (3 x r) and its skinning rotation R_n, so that its Jacobian is
@@ -163,19 +164,6 @@ static double *ref_block(const sw_reduced *m, int32_t k) {
 
 enum { CORNER_CHUNK = 1 << 16 };
 
-/* The index of local vertex lv among corner_lv[lo, hi) (ascending, lv among them). */
-static int32_t corner_of(const int32_t *corner_lv, int32_t lo, int32_t hi, int32_t lv) {
-    --hi;
-    while (lo < hi) {
-        int32_t mid = lo + (hi - lo) / 2;
-        if (corner_lv[mid] < lv)
-            lo = mid + 1;
-        else
-            hi = mid;
-    }
-    return lo;
-}
-
 int32_t sw_cubature_corners(const sw_blob_view *v, sw_reduced *m) {
     uint64_t bits[CORNER_CHUNK / 64];
     int32_t n = 0;
@@ -196,7 +184,8 @@ int32_t sw_cubature_corners(const sw_blob_view *v, sw_reduced *m) {
         }
         if (!m) continue;
         for (int32_t i = 4 * D->cub_begin; i < 4 * (D->cub_begin + D->cub_count); ++i) {
-            int32_t c = corner_of(m->corner_lv, m->corner_begin[k], n, v->cub_tets[i]);
+            int32_t b = m->corner_begin[k],
+                    c = b + sw_sorted_index(m->corner_lv + b, n - b, v->cub_tets[i]);
             m->cub_corner[i] = c;
             m->corner_act[c] = m->cub_act[i]; /* the vertex's, whichever tet names it */
         }

@@ -12,6 +12,7 @@
 #include "instance_internal.h"
 #include "log.h"
 #include "mem_plan.h"
+#include "sorted.h"
 
 /* Sizes of the layout that the blob alone does not fix. */
 typedef struct {
@@ -282,23 +283,13 @@ static int32_t active_vertices(const sw_blob_view *v, int32_t *act_vert, int32_t
     return ns + nf;
 }
 
-/* The active index of global vertex gv: a search among ACT_STEP's, then the rest. */
+/* The active index of global vertex gv: among ACT_STEP's, else among the rest. */
 static void assign_active(void *ctx, int32_t gv, int32_t *slot) {
     const sw_reduced *m = ctx;
-    int32_t ranges[2][2] = {{0, m->nact_step}, {m->nact_step, m->nact}};
-    for (int h = 0; h < 2; ++h) {
-        int32_t lo = ranges[h][0], hi = ranges[h][1] - 1;
-        if (lo > hi) continue;
-        while (lo < hi) {
-            int32_t mid = lo + (hi - lo) / 2;
-            if (m->act_vert[mid] < gv)
-                lo = mid + 1;
-            else
-                hi = mid;
-        }
-        *slot = lo;
-        if (m->act_vert[lo] == gv) return;
-    }
+    int32_t i = sw_sorted_index(m->act_vert, m->nact_step, gv);
+    *slot = i >= 0 ? i
+                   : m->nact_step +
+                         sw_sorted_index(m->act_vert + m->nact_step, m->nact - m->nact_step, gv);
 }
 
 /* ---- creation -------------------------------------------------------------------- */
