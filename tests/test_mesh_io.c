@@ -447,6 +447,12 @@ TEST(weights_are_checked_and_normalised) {
     p = write_text("wzero.dmat", "2 2\n1 0\n0 0\n");
     ENSURE(err_is(sw_read_weights(p, 2, 2, &w, &e), &e, SINEW_ERROR_DEGENERATE, p, 0));
     ENSURE(all_zero(&w, sizeof w));
+    /* finite weights whose sum overflows still sum to 1 (fuzz_dmat: were all 0) */
+    p = write_text("whuge.dmat", "2 1\n1e308\n1.5e308\n");
+    ENSURE(sw_read_weights(p, 1, 2, &w, &e) == SINEW_OK);
+    ENSURE_NEAR(w.w[0], 0.4, 1e-15);
+    ENSURE_NEAR(w.w[1], 0.6, 1e-15);
+    sw_weights_free(&w);
     p = write_text("wnobone.dmat", "0 2\n"); /* 2 vertices, no bone column (fuzz_dmat) */
     ENSURE(err_is(sw_read_weights(p, 2, 0, &w, &e), &e, SINEW_ERROR_DEGENERATE, p, 1));
     ENSURE(all_zero(&w, sizeof w));

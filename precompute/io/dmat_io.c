@@ -5,6 +5,7 @@
  *         "cols rows\n" and exactly cols*rows little-endian float64, column-major.
  * (Layout as libigl readDMAT/writeDMAT: one '\n' or '\r' ends each header line.)
  * We return row-major data, so the readers transpose. */
+#include <float.h>
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -230,6 +231,15 @@ static sinew_result weights_from(const char *path, int32_t rows, int32_t cols, d
             }
             if (row[b] < 0.0) row[b] = 0.0; /* round-off of the weight solver */
             sum += row[b];
+        }
+        if (!rc && !(sum <= DBL_MAX)) { /* finite weights whose sum overflows: the row
+                                            over its largest first, then over its sum */
+            double top = 0.0;
+            for (int32_t b = 0; b < cols; ++b)
+                top = row[b] > top ? row[b] : top;
+            sum = 0.0;
+            for (int32_t b = 0; b < cols; ++b)
+                sum += (row[b] /= top);
         }
         if (!rc && !(sum > 0.0))
             rc = sw_error_set(err, SINEW_ERROR_DEGENERATE, "%s: vertex %d has all-zero weights",
