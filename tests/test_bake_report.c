@@ -26,8 +26,26 @@ static double num(const cJSON *o, const char *key) {
 }
 
 /* The report's JSON against what the bake made. */
+/* The report's heldout_beyond_training (j's) is sw_bake_beyond_training's list, *count
+ * long. */
+static void check_beyond(const cJSON *j, const sw_bake_result *res, const sw_skeleton *sk,
+                         int32_t *count) {
+    sw_joint_reach want[32];
+    int32_t n = *count = sw_bake_beyond_training(res, sk, want, 32);
+    const cJSON *bt = cJSON_GetObjectItemCaseSensitive(j, "heldout_beyond_training");
+    ENSUREF(cJSON_IsArray(bt) && cJSON_GetArraySize(bt) == n, "%d joints beyond training", n);
+    for (int32_t k = 0; k < n && cJSON_GetArraySize(bt) == n; ++k) {
+        const cJSON *o = cJSON_GetArrayItem(bt, k);
+        ENSURE(num(o, "bone") == want[k].bone);
+        ENSURE_NEAR(num(o, "heldout_deg"), want[k].heldout_deg, 1e-9);
+        ENSURE_NEAR(num(o, "train_deg"), want[k].train_deg, 1e-9);
+        ENSURE(num(o, "heldout_deg") > SW_BEYOND_RATIO * num(o, "train_deg"));
+        ENSURE(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(o, "name"))); /* no file names */
+    }
+}
+
 static void check_json(const char *dir, const sw_bake_result *res, const sw_blob_view *v,
-                       double err_heldout, const sw_eval_result *eh) {
+                       const sw_skeleton *sk, double err_heldout, const sw_eval_result *eh) {
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);
@@ -85,6 +103,8 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
         ENSURE(num(o, "energy") > 0.9 && num(o, "energy") <= 1.0);
     }
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == 6);
+    int32_t nbeyond;
+    check_beyond(j, res, sk, &nbeyond);
     const cJSON *sheet = cJSON_GetObjectItemCaseSensitive(j, "contact_sheet");
     ENSURE(cJSON_IsString(sheet));
     /* the adaptive loop's rounds, as given (the second not verified: null) */
@@ -200,7 +220,7 @@ TEST(clips_of_their_own_and_the_report) {
     snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
-    check_json(dir, &res, &res.view, eh.correction_error, &eh);
+    check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh);
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.html", dir);
     char *html = read_text(path);
@@ -275,6 +295,10 @@ TEST(random_heldout_poses_in_the_report) {
     char *text = read_text(path);
     cJSON *j = text ? cJSON_Parse(text) : NULL;
     ENSURE(j != NULL);
+    /* random combined poses turn each joint within its sweep: none beyond training */
+    int32_t nbeyond = -1;
+    check_beyond(j, &res, &ch.skel, &nbeyond);
+    ENSURE(nbeyond == 0);
     const cJSON *clips = cJSON_GetObjectItemCaseSensitive(j, "clips");
     ENSURE(cJSON_GetArraySize(clips) == 1);
     if (cJSON_GetArraySize(clips) == 1) {

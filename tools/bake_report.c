@@ -23,6 +23,10 @@
  *   err_regions {train, heldout: [{bone, err_share, correction_share}]}: the bones whose
  *              vertices (by their strongest bone) hold the largest shares of the squared
  *              error (sw_eval_result's regions), or null
+ *   heldout_beyond_training [{bone, name (null: the file names none), heldout_deg,
+ *              train_deg}]: the joints the held-out poses bend further than the training
+ *              poses (sw_bake_beyond_training), the largest multiple of the trained bend
+ *              first, at most 32
  *   contact_sheet: the PNG's file name, or null */
 #include "bake_report.h"
 
@@ -52,11 +56,15 @@ typedef struct report_clip {
     double *error;
 } report_clip;
 
+#define REPORT_BEYOND 32 /* joints listed beyond training, at most */
+
 typedef struct report {
     report_clip *clips;
     int32_t nclips;
     int32_t sweep_poses;
     double sweep_mean;
+    sw_joint_reach beyond[REPORT_BEYOND]; /* sw_bake_beyond_training's, largest first */
+    int32_t nbeyond, nbeyond_all;
 } report;
 
 static void report_free(report *r) {
@@ -125,7 +133,9 @@ static int gather(const sw_bake_report_input *in, report *r) {
         if (res->train_clip[k] < 0 && isfinite(in->train_frames[k]))
             sum += in->train_frames[k], r->sweep_poses++;
     r->sweep_mean = r->sweep_poses ? sum / r->sweep_poses : 0;
-    return 1;
+    r->nbeyond_all = sw_bake_beyond_training(res, &in->ch->skel, r->beyond, REPORT_BEYOND);
+    r->nbeyond = r->nbeyond_all < REPORT_BEYOND ? r->nbeyond_all : REPORT_BEYOND;
+    return r->nbeyond_all >= 0;
 }
 
 /* A number for JSON: non-finite (a failed step) becomes null. */
@@ -285,6 +295,18 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
         cJSON_AddItemToObject(er, "heldout", json_regions(in->eval_heldout));
     } else {
         cJSON_AddNullToObject(j, "err_regions");
+    }
+    cJSON *bt = cJSON_AddArrayToObject(j, "heldout_beyond_training");
+    for (int32_t k = 0; k < r->nbeyond; ++k) {
+        cJSON *o = cJSON_CreateObject();
+        cJSON_AddNumberToObject(o, "bone", r->beyond[k].bone);
+        if (in->ch->bone_names)
+            cJSON_AddStringToObject(o, "name", in->ch->bone_names[r->beyond[k].bone]);
+        else
+            cJSON_AddNullToObject(o, "name");
+        cJSON_AddNumberToObject(o, "heldout_deg", r->beyond[k].heldout_deg);
+        cJSON_AddNumberToObject(o, "train_deg", r->beyond[k].train_deg);
+        cJSON_AddItemToArray(bt, o);
     }
     if (sheet)
         cJSON_AddStringToObject(j, "contact_sheet", SHEET_NAME);
@@ -492,6 +514,27 @@ static void html_regions(FILE *f, const sw_bake_report_input *in) {
     fprintf(f, "</table>\n");
 }
 
+/* The joints the held-out poses bend further than any training pose: where the basis
+ * extrapolates, and what training motion would cover. */
+static void html_beyond(FILE *f, const sw_bake_report_input *in, const report *r) {
+    if (r->nbeyond < 1) return;
+    fprintf(f, "<h2>Held-out motion beyond training</h2><p>%d joint%s turn%s further in the "
+               "held-out poses than in any training pose (more than %.2f times and %.0f degrees "
+               "beyond). The subspace learnt the flesh of the bends it was shown: there it "
+               "extrapolates, and the held-out error says how well. Training clips that reach "
+               "these bends cover them.</p><table><tr><th>bone</th><th>largest bend held-out"
+               "</th><th>largest bend in training</th></tr>\n",
+            r->nbeyond_all, r->nbeyond_all == 1 ? "" : "s", r->nbeyond_all == 1 ? "s" : "",
+            SW_BEYOND_RATIO, SW_BEYOND_DEG);
+    for (int32_t k = 0; k < r->nbeyond; ++k) {
+        fprintf(f, "<tr><td>%d ", r->beyond[k].bone);
+        if (in->ch->bone_names) html_text(f, in->ch->bone_names[r->beyond[k].bone]);
+        fprintf(f, "</td><td>%.1f&deg;</td><td>%.1f&deg;</td></tr>\n", r->beyond[k].heldout_deg,
+                r->beyond[k].train_deg);
+    }
+    fprintf(f, "</table>\n");
+}
+
 /* The adaptive loop's rounds: a table and the held-out error per round. */
 static void html_adaptive(FILE *f, const sw_adaptive_report *a) {
     if (!a || a->nrounds < 1) return;
@@ -535,6 +578,7 @@ static int write_html(const char *path, const sw_bake_report_input *in, const re
     html_summary(f, in);
     html_clips(f, r);
     html_regions(f, in);
+    html_beyond(f, in, r);
     int ok = html_domains(f, in);
     html_adaptive(f, in->adaptive);
     fprintf(f, "<h2>Stage times</h2>");

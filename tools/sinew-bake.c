@@ -38,6 +38,8 @@
 #include "subspace_eval.h"
 
 /* v as a JSON number, or null when it is not finite (buf: 32 chars). */
+#define BAKE_BEYOND 32 /* joints listed beyond training, at most (8 in the summary) */
+
 static const char *json_number(double v, char *buf) {
     if (!isfinite(v)) return "null";
     snprintf(buf, 32, "%.5f", v);
@@ -416,6 +418,20 @@ int main(int argc, char **argv) {
             fprintf(stderr, " bone %d %.3f / %.3f%s", e->region_bone[k], e->region_err[k],
                     e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
     }
+    sw_joint_reach beyond[BAKE_BEYOND];
+    int32_t nbeyond = sw_bake_beyond_training(&res, &ch.skel, beyond, BAKE_BEYOND);
+    if (nbeyond > BAKE_BEYOND) nbeyond = BAKE_BEYOND;
+    if (nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
+        int32_t shown = nbeyond < 8 ? nbeyond : 8;
+        fprintf(stderr, "  held-out poses bend %d joint%s beyond training (largest bend held-out "
+                        "/ in training, degrees):", nbeyond, nbeyond == 1 ? "" : "s");
+        for (int32_t k = 0; k < shown; ++k) {
+            fprintf(stderr, " bone %d", beyond[k].bone);
+            if (ch.bone_names) fprintf(stderr, " %s", ch.bone_names[beyond[k].bone]);
+            fprintf(stderr, " %.1f / %.1f%s", beyond[k].heldout_deg, beyond[k].train_deg,
+                    k + 1 < shown ? "," : nbeyond > shown ? ", ...\n" : "\n");
+        }
+    }
     if (absurd)
         fprintf(stderr,
                 "%s: WARNING: written with --force although its training error is %.4f (refused "
@@ -492,6 +508,16 @@ int main(int argc, char **argv) {
                        e->region_corr[k]);
             printf("]");
         }
+        printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
+        for (int32_t k = 0; k < nbeyond; ++k) {
+            printf("%s[%d,", k ? "," : "", beyond[k].bone);
+            if (ch.bone_names)
+                sw_tool_json_string(ch.bone_names[beyond[k].bone]);
+            else
+                printf("null");
+            printf(",%.2f,%.2f]", beyond[k].heldout_deg, beyond[k].train_deg);
+        }
+        printf("]");
         printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
                res.simulate_cached ? "true" : "false", res.simulate_solved,
                absurd ? "true" : "false");

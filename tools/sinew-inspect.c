@@ -31,21 +31,6 @@ static int usage(FILE *f) {
     return f == stdout ? 0 : 2;
 }
 
-/* Prints s as a JSON string (quotes and control characters escaped). */
-static void json_string(const char *s) {
-    putchar('"');
-    for (; *s; ++s) {
-        unsigned char c = (unsigned char)*s;
-        if (c == '"' || c == '\\')
-            printf("\\%c", c);
-        else if (c < 0x20)
-            printf("\\u%04x", c);
-        else
-            putchar(c);
-    }
-    putchar('"');
-}
-
 static void bbox(const sw_trimesh *m, double *size) {
     double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
     for (int32_t v = 0; v < m->nverts; ++v)
@@ -111,7 +96,7 @@ static void print_json(const sw_imported_character *c, const double *size, const
            size[0], size[1], size[2], c->unit_scale, c->weight_dropped_max, c->weight_dropped_mean);
     for (int32_t b = 0; b < c->skel.nbones; ++b) {
         if (b) printf(", ");
-        json_string(c->bone_names[b]);
+        sw_tool_json_string(c->bone_names[b]);
     }
     printf("], \"parents\": [");
     for (int32_t b = 0; b < c->skel.nbones; ++b)
@@ -119,7 +104,7 @@ static void print_json(const sw_imported_character *c, const double *size, const
     printf("], \"clips\": [");
     for (int32_t i = 0; i < c->nclips; ++i) {
         printf("%s{\"name\": ", i ? ", " : "");
-        json_string(c->clips[i].name);
+        sw_tool_json_string(c->clips[i].name);
         printf(", \"duration_s\": %.6g, \"frames\": %d}", c->clips[i].duration_s,
                c->clips[i].clip.nframes);
     }

@@ -120,6 +120,22 @@ static inline int sw_tool_format(const char *tool, const char *flag, const char 
     return 0;
 }
 
+/* Prints s to stdout as a JSON string (quotes, backslashes and control characters
+ * escaped): names from files (bones, clips) in a tool's --json line. */
+static inline void sw_tool_json_string(const char *s) {
+    putchar('"');
+    for (; *s; ++s) {
+        unsigned char c = (unsigned char)*s;
+        if (c == '"' || c == '\\')
+            printf("\\%c", c);
+        else if (c < 0x20)
+            printf("\\u%04x", c);
+        else
+            putchar(c);
+    }
+    putchar('"');
+}
+
 static inline int sw_cmp_double(const void *a, const void *b) {
     double x = *(const double *)a, y = *(const double *)b;
     return (x > y) - (x < y);

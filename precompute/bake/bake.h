@@ -202,6 +202,30 @@ void sw_bake_random_poses(const sw_skeleton *sk, const double *sweep_axis,
                           const double *sweep_angle, uint64_t seed, int32_t n, double *local,
                           double *T);
 
+/* The largest angle (radians, in [0, pi]) each joint turns from rest in its parent's frame
+ * over the n poses T (12 nbones each), raised into angle[nbones] (the caller starts it,
+ * e.g. at 0), and with axis (3 per bone, may be NULL) the axis at that angle: the measure
+ * of a joint's sweep (the largest bend the training poses give it). */
+void sw_bake_joint_reach(const sw_skeleton *sk, const double *T, int32_t n, double *angle,
+                         double *axis);
+
+/* A joint the held-out poses turn further than the training poses do. */
+typedef struct sw_joint_reach {
+    int32_t bone;
+    double heldout_deg, train_deg; /* the largest angles (degrees), sw_bake_joint_reach's */
+} sw_joint_reach;
+
+#define SW_BEYOND_RATIO 1.25 /* held-out above 1.25 times the trained angle ... */
+#define SW_BEYOND_DEG 5.0    /* ... and 5 degrees more: beyond training */
+
+/* The joints r's held-out poses bend beyond its training range (its sweeps' angles), the
+ * largest multiple of the trained bend first, at most max of them into out; returns how many there are (-1 out
+ * of memory). There the basis extrapolates: a held-out clip that turns a joint two or
+ * three times as far as the training clips is beyond what the bake learnt (README "The
+ * Fox's Run is beyond its training"). Random held-out poses stay within the sweeps. */
+int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk,
+                                sw_joint_reach *out, int32_t max);
+
 /* The fewest clip frames a bake can train on: it trains on the first
  * floor((1 - heldout_fraction) F) frames and holds out the rest, and learns its basis and
  * cubature from the deformation of the training poses (each joint is also swept up to the

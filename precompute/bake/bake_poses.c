@@ -132,6 +132,45 @@ static int32_t clip_ranges(const sw_bake_state *s, clip_range *train, clip_range
     return ntr;
 }
 
+void sw_bake_joint_reach(const sw_skeleton *sk, const double *T, int32_t n, double *angle,
+                         double *axis) {
+    int32_t nb = sk->nbones;
+    for (int32_t f = 0; f < n; ++f)
+        for (int32_t b = 0; b < nb; ++b) {
+            if (sk->parent[b] < 0) continue;
+            double L[9], ax[3];
+            local_rotation(sk, T + (size_t)f * 12 * nb, b, L);
+            double a = rotation_axis_angle(L, ax);
+            if (a > angle[b]) {
+                angle[b] = a;
+                if (axis) memcpy(axis + 3 * b, ax, sizeof ax);
+            }
+        }
+}
+
+int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk,
+                                sw_joint_reach *out, int32_t max) {
+    int32_t nb = sk->nbones, n = 0, total = 0;
+    double *reach = calloc((size_t)nb + 1, sizeof(double));
+    if (!reach) return -1;
+    if (r->heldout_T && r->sweep_angle) sw_bake_joint_reach(sk, r->heldout_T, r->nheldout, reach, NULL);
+    const double deg = 57.29577951308232;
+    for (int32_t b = 0; b < nb; ++b) {
+        double h = reach[b] * deg, t = r->sweep_angle ? r->sweep_angle[b] * deg : 0;
+        if (!(h > SW_BEYOND_RATIO * t && h - t > SW_BEYOND_DEG)) continue;
+        sw_joint_reach j = {b, h, t};
+        total++;
+        int32_t k = n < max ? n++ : max; /* insertion by multiple of the trained bend */
+        while (k > 0 && h * out[k - 1].train_deg > out[k - 1].heldout_deg * t) {
+            if (k < max) out[k] = out[k - 1];
+            --k;
+        }
+        if (k < max) out[k] = j;
+    }
+    free(reach);
+    return total;
+}
+
 /* The largest rotation each joint reaches in the training ranges: its sweep. Without a
  * clip, 90 degrees about an axis across the bone. */
 static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32_t ntr,
@@ -139,17 +178,8 @@ static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32
     const sw_skeleton *sk = &s->ch.skel;
     int32_t nb = s->nb;
     for (int32_t r = 0; r < ntr; ++r)
-        for (int32_t f = train[r].first; f < train[r].first + train[r].count; ++f)
-            for (int32_t b = 0; b < nb; ++b) {
-                if (sk->parent[b] < 0) continue;
-                double L[9], axis[3];
-                local_rotation(sk, train[r].clip->T + (size_t)f * 12 * nb, b, L);
-                double a = rotation_axis_angle(L, axis);
-                if (a > sweep_angle[b]) {
-                    sweep_angle[b] = a;
-                    memcpy(sweep_axis + 3 * b, axis, sizeof axis);
-                }
-            }
+        sw_bake_joint_reach(sk, train[r].clip->T + (size_t)train[r].first * 12 * nb,
+                            train[r].count, sweep_angle, sweep_axis);
     if (ntr > 0) return;
     for (int32_t b = 0; b < nb; ++b) {
         if (sk->parent[b] < 0) continue;

@@ -258,8 +258,10 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
         sw_tetmesh_fill(&ic->render, o->target_tets, o->mesher, pool, &out->mesh, &info->mesh, err);
     sw_pool_destroy(pool);
     if (rc) return rc;
-    out->skel = ic->skel; /* moved */
+    out->skel = ic->skel; /* moved, with its names */
     memset(&ic->skel, 0, sizeof ic->skel);
+    out->bone_names = ic->bone_names;
+    ic->bone_names = NULL;
     if ((rc = sw_weights_from_surface(&out->mesh, &ic->render, &ic->weights, &out->weights, err)) ||
         (rc = drive_vertices(out, info, err)))
         return rc;

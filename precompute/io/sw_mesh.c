@@ -55,6 +55,7 @@ void sw_character_free(sw_character *c) {
     sw_clip_free(&c->clip);
     sw_trimesh_free(&c->render);
     free(c->bone_of_vertex);
+    free(c->bone_names);
     memset(c, 0, sizeof *c);
 }
 

@@ -77,6 +77,7 @@ typedef struct sw_character {
      * tets and the runtime's output surface is this mesh in its own vertex order
      * (issue 14); otherwise the output surface is the tet mesh's boundary. */
     sw_trimesh render;
+    char (*bone_names)[64]; /* skel.nbones names from the file (glTF/FBX nodes), or NULL */
 } sw_character;
 
 void sw_tetmesh_free(sw_tetmesh *m);
