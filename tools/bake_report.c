@@ -518,12 +518,13 @@ static void html_regions(FILE *f, const sw_bake_report_input *in) {
  * extrapolates, and what training motion would cover. */
 static void html_beyond(FILE *f, const sw_bake_report_input *in, const report *r) {
     if (r->nbeyond < 1) return;
-    fprintf(f, "<h2>Held-out motion beyond training</h2><p>%d joint%s turn%s further in the "
-               "held-out poses than in any training pose (more than %.2f times and %.0f degrees "
-               "beyond). The subspace learnt the flesh of the bends it was shown: there it "
-               "extrapolates, and the held-out error says how well. Training clips that reach "
-               "these bends cover them.</p><table><tr><th>bone</th><th>largest bend held-out"
-               "</th><th>largest bend in training</th></tr>\n",
+    fprintf(f,
+            "<h2>Held-out motion beyond training</h2><p>%d joint%s turn%s further in the "
+            "held-out poses than in any training pose (more than %.2f times and %.0f degrees "
+            "beyond). The subspace learnt the flesh of the bends it was shown: there it "
+            "extrapolates, and the held-out error says how well. Training clips that reach "
+            "these bends cover them.</p><table><tr><th>bone</th><th>largest bend held-out"
+            "</th><th>largest bend in training</th></tr>\n",
             r->nbeyond_all, r->nbeyond_all == 1 ? "" : "s", r->nbeyond_all == 1 ? "s" : "",
             SW_BEYOND_RATIO, SW_BEYOND_DEG);
     for (int32_t k = 0; k < r->nbeyond; ++k) {

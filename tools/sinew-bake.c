@@ -423,13 +423,17 @@ int main(int argc, char **argv) {
     if (nbeyond > BAKE_BEYOND) nbeyond = BAKE_BEYOND;
     if (nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
         int32_t shown = nbeyond < 8 ? nbeyond : 8;
-        fprintf(stderr, "  held-out poses bend %d joint%s beyond training (largest bend held-out "
-                        "/ in training, degrees):", nbeyond, nbeyond == 1 ? "" : "s");
+        fprintf(stderr,
+                "  held-out poses bend %d joint%s beyond training (largest bend held-out "
+                "/ in training, degrees):",
+                nbeyond, nbeyond == 1 ? "" : "s");
         for (int32_t k = 0; k < shown; ++k) {
             fprintf(stderr, " bone %d", beyond[k].bone);
             if (ch.bone_names) fprintf(stderr, " %s", ch.bone_names[beyond[k].bone]);
             fprintf(stderr, " %.1f / %.1f%s", beyond[k].heldout_deg, beyond[k].train_deg,
-                    k + 1 < shown ? "," : nbeyond > shown ? ", ...\n" : "\n");
+                    k + 1 < shown     ? ","
+                    : nbeyond > shown ? ", ...\n"
+                                      : "\n");
         }
     }
     if (absurd)

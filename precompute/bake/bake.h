@@ -219,12 +219,12 @@ typedef struct sw_joint_reach {
 #define SW_BEYOND_DEG 5.0    /* ... and 5 degrees more: beyond training */
 
 /* The joints r's held-out poses bend beyond its training range (its sweeps' angles), the
- * largest multiple of the trained bend first, at most max of them into out; returns how many there are (-1 out
- * of memory). There the basis extrapolates: a held-out clip that turns a joint two or
+ * largest multiple of the trained bend first, at most max of them into out; returns how many there
+ * are (-1 out of memory). There the basis extrapolates: a held-out clip that turns a joint two or
  * three times as far as the training clips is beyond what the bake learnt (README "The
  * Fox's Run is beyond its training"). Random held-out poses stay within the sweeps. */
-int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk,
-                                sw_joint_reach *out, int32_t max);
+int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, sw_joint_reach *out,
+                                int32_t max);
 
 /* The fewest clip frames a bake can train on: it trains on the first
  * floor((1 - heldout_fraction) F) frames and holds out the rest, and learns its basis and

@@ -148,12 +148,13 @@ void sw_bake_joint_reach(const sw_skeleton *sk, const double *T, int32_t n, doub
         }
 }
 
-int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk,
-                                sw_joint_reach *out, int32_t max) {
+int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, sw_joint_reach *out,
+                                int32_t max) {
     int32_t nb = sk->nbones, n = 0, total = 0;
     double *reach = calloc((size_t)nb + 1, sizeof(double));
     if (!reach) return -1;
-    if (r->heldout_T && r->sweep_angle) sw_bake_joint_reach(sk, r->heldout_T, r->nheldout, reach, NULL);
+    if (r->heldout_T && r->sweep_angle)
+        sw_bake_joint_reach(sk, r->heldout_T, r->nheldout, reach, NULL);
     const double deg = 57.29577951308232;
     for (int32_t b = 0; b < nb; ++b) {
         double h = reach[b] * deg, t = r->sweep_angle ? r->sweep_angle[b] * deg : 0;
@@ -178,8 +179,8 @@ static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32
     const sw_skeleton *sk = &s->ch.skel;
     int32_t nb = s->nb;
     for (int32_t r = 0; r < ntr; ++r)
-        sw_bake_joint_reach(sk, train[r].clip->T + (size_t)train[r].first * 12 * nb,
-                            train[r].count, sweep_angle, sweep_axis);
+        sw_bake_joint_reach(sk, train[r].clip->T + (size_t)train[r].first * 12 * nb, train[r].count,
+                            sweep_angle, sweep_axis);
     if (ntr > 0) return;
     for (int32_t b = 0; b < nb; ++b) {
         if (sk->parent[b] < 0) continue;
