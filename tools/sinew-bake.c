@@ -37,9 +37,9 @@
 #include "samples.h"
 #include "subspace_eval.h"
 
-/* v as a JSON number, or null when it is not finite (buf: 32 chars). */
 #define BAKE_BEYOND 32 /* joints listed beyond training, at most (8 in the summary) */
 
+/* v as a JSON number, or null when it is not finite (buf: 32 chars). */
 static const char *json_number(double v, char *buf) {
     if (!isfinite(v)) return "null";
     snprintf(buf, 32, "%.5f", v);
@@ -419,14 +419,14 @@ int main(int argc, char **argv) {
                     e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
     }
     sw_joint_reach beyond[BAKE_BEYOND];
-    int32_t nbeyond = sw_bake_beyond_training(&res, &ch.skel, beyond, BAKE_BEYOND);
-    if (nbeyond > BAKE_BEYOND) nbeyond = BAKE_BEYOND;
+    int32_t nbeyond_all = sw_bake_beyond_training(&res, &ch.skel, beyond, BAKE_BEYOND);
+    int32_t nbeyond = nbeyond_all < BAKE_BEYOND ? nbeyond_all : BAKE_BEYOND;
     if (nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
         int32_t shown = nbeyond < 8 ? nbeyond : 8;
         fprintf(stderr,
                 "  held-out poses bend %d joint%s beyond training (largest bend held-out "
                 "/ in training, degrees):",
-                nbeyond, nbeyond == 1 ? "" : "s");
+                nbeyond_all, nbeyond_all == 1 ? "" : "s");
         for (int32_t k = 0; k < shown; ++k) {
             fprintf(stderr, " bone %d", beyond[k].bone);
             if (ch.bone_names) fprintf(stderr, " %s", ch.bone_names[beyond[k].bone]);
