@@ -45,7 +45,8 @@ static void check_beyond(const cJSON *j, const sw_bake_result *res, const sw_ske
 }
 
 static void check_json(const char *dir, const sw_bake_result *res, const sw_blob_view *v,
-                       const sw_skeleton *sk, double err_heldout, const sw_eval_result *eh) {
+                       const sw_skeleton *sk, double err_heldout, const sw_eval_result *eh,
+                       const double *modes) {
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);
@@ -105,6 +106,14 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == 6);
     int32_t nbeyond;
     check_beyond(j, res, sk, &nbeyond);
+    const cJSON *bm = cJSON_GetObjectItemCaseSensitive(j, "err_heldout_by_mode");
+    for (int k = 0; k < SW_BAKE_MODES; ++k) {
+        const cJSON *m = cJSON_GetObjectItemCaseSensitive(bm, sw_bake_mode_keys[k]);
+        if (isnan(modes[k]))
+            ENSURE(cJSON_IsNull(m));
+        else
+            ENSURE(cJSON_IsNumber(m) && fabs(m->valuedouble - modes[k]) < 1e-12);
+    }
     const cJSON *sheet = cJSON_GetObjectItemCaseSensitive(j, "contact_sheet");
     ENSURE(cJSON_IsString(sheet));
     /* the adaptive loop's rounds, as given (the second not verified: null) */
@@ -180,6 +189,21 @@ TEST(clips_of_their_own_and_the_report) {
     arep.round[0] =
         (sw_adaptive_round){10, 0, 20, 0.02, 0.25, 0.01, 0.1, 0.3, 0.9, 0.6, 0.5, 10, 1.0};
     arep.round[1] = (sw_adaptive_round){14, 4, 24, 0.02, 0.2, 0.01, 0.08, 0, 0, 0, -1, 4, 1.0};
+    /* the held-out error in every self-contact mode: the measured mode's as given, the
+       others each sw_bake_errors' held-out figure in that mode */
+    double modes[SW_BAKE_MODES];
+    ENSURE(sw_bake_mode_errors(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, eh.correction_error,
+                               modes, &e) == SINEW_OK);
+    for (int k = 0; k < SW_BAKE_MODES; ++k) {
+        if (!res.view.npair_groups && sw_bake_modes[k] == SINEW_SELF_CONTACT_POSE_PAIRS) {
+            ENSURE(isnan(modes[k]));
+            continue;
+        }
+        sw_eval_result mt, mh;
+        ENSURE(sw_bake_errors(blob, &res, sw_bake_modes[k], &mt, &mh, &e) == SINEW_OK);
+        ENSUREF(modes[k] == mh.correction_error, "%s: %g against %g", sw_bake_mode_names[k],
+                modes[k], mh.correction_error);
+    }
     sw_bake_report_input in = {"finger",
                                &ch,
                                &res,
@@ -199,7 +223,8 @@ TEST(clips_of_their_own_and_the_report) {
                                &arep,
                                &et,
                                &eh,
-                               NULL};
+                               NULL,
+                               modes};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;
@@ -220,13 +245,14 @@ TEST(clips_of_their_own_and_the_report) {
     snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
-    check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh);
+    check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes);
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.html", dir);
     char *html = read_text(path);
     ENSURE(html && strstr(html, "<svg") && strstr(html, "heldout_sheet.png") &&
            strstr(html, "Return") && strstr(html, "Adaptive training rounds") &&
-           strstr(html, "Where the error is"));
+           strstr(html, "Where the error is") &&
+           strstr(html, "Held-out error by self-contact mode"));
     free(html);
     struct stat st;
     snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);
@@ -285,6 +311,7 @@ TEST(random_heldout_poses_in_the_report) {
                                NULL,
                                &et,
                                &eh,
+                               NULL,
                                NULL};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);

@@ -23,6 +23,9 @@
  *   err_regions {train, heldout: [{bone, err_share, correction_share}]}: the bones whose
  *              vertices (by their strongest bone) hold the largest shares of the squared
  *              error (sw_eval_result's regions), or null
+ *   err_heldout_by_mode {pose_space, pose_pairs, exhaustive}: the held-out error in each
+ *              self-contact mode (null: not measured, or the blob has no per-pair sections),
+ *              or null
  *   heldout_beyond_training [{bone, name (null: the file names none), heldout_deg,
  *              train_deg}]: the joints the held-out poses bend further than the training
  *              poses (sw_bake_beyond_training), the largest multiple of the trained bend
@@ -296,6 +299,13 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     } else {
         cJSON_AddNullToObject(j, "err_regions");
     }
+    if (in->mode_err_heldout) {
+        cJSON *m = cJSON_AddObjectToObject(j, "err_heldout_by_mode");
+        for (int k = 0; k < SW_BAKE_MODES; ++k)
+            cJSON_AddItemToObject(m, sw_bake_mode_keys[k], json_number(in->mode_err_heldout[k]));
+    } else {
+        cJSON_AddNullToObject(j, "err_heldout_by_mode");
+    }
     cJSON *bt = cJSON_AddArrayToObject(j, "heldout_beyond_training");
     for (int32_t k = 0; k < r->nbeyond; ++k) {
         cJSON *o = cJSON_CreateObject();
@@ -514,6 +524,26 @@ static void html_regions(FILE *f, const sw_bake_report_input *in) {
     fprintf(f, "</table>\n");
 }
 
+/* The held-out error in each self-contact mode an instance can take. */
+static void html_modes(FILE *f, const sw_bake_report_input *in) {
+    if (!in->mode_err_heldout) return;
+    fprintf(f, "<h2>Held-out error by self-contact mode</h2><p>The same held-out poses stepped "
+               "with each self-contact mode of <code>sinew_instance_def.self_contact</code>: "
+               "pose-space applies the contact of the nearest training poses (cheapest; suits "
+               "motion like the training clips), pose-pairs that of the nearest sample of "
+               "each pair of domains and detects the rest, exhaustive detects every contact "
+               "(suits combinations of joints no training pose holds).</p><table><tr>");
+    for (int k = 0; k < SW_BAKE_MODES; ++k)
+        fprintf(f, "<th>%s</th>", sw_bake_mode_names[k]);
+    fprintf(f, "</tr><tr>");
+    for (int k = 0; k < SW_BAKE_MODES; ++k)
+        if (isfinite(in->mode_err_heldout[k]))
+            fprintf(f, "<td>%.4f</td>", in->mode_err_heldout[k]);
+        else
+            fprintf(f, "<td>&ndash;</td>");
+    fprintf(f, "</tr></table>\n");
+}
+
 /* The joints the held-out poses bend further than any training pose: where the basis
  * extrapolates, and what training motion would cover. */
 static void html_beyond(FILE *f, const sw_bake_report_input *in, const report *r) {
@@ -579,6 +609,7 @@ static int write_html(const char *path, const sw_bake_report_input *in, const re
     html_summary(f, in);
     html_clips(f, r);
     html_regions(f, in);
+    html_modes(f, in);
     html_beyond(f, in, r);
     int ok = html_domains(f, in);
     html_adaptive(f, in->adaptive);

@@ -45,6 +45,9 @@ typedef struct sw_bake_report_input {
     /* what made the simulation mesh ("lattice", "tetgen"; NULL: the character's own tet
        mesh); the report shows it beside the mesh's quality (sw_tetmesh_quality) */
     const char *mesher;
+    /* the held-out error in each self-contact mode (sw_bake_mode_errors, SW_BAKE_MODES, NaN:
+       not measured); NULL: not shown */
+    const double *mode_err_heldout;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

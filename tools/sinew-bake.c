@@ -292,6 +292,14 @@ int main(int argc, char **argv) {
         sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         goto done;
     }
+    /* the held-out error in each self-contact mode an instance can take
+       (sinew_instance_def.self_contact): which suits this character's motion */
+    double mode_err[SW_BAKE_MODES];
+    char num[32];
+    if ((r = sw_bake_mode_errors(blob, &res, eval_mode, eh.correction_error, mode_err, &err))) {
+        sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        goto done;
+    }
     double eval_seconds = sw_now_seconds() - t1;
     /* a blob that cannot step its own training poses is no bake either (its error,
        measured on the steps that did not fail, would say nothing) */
@@ -345,7 +353,8 @@ int main(int argc, char **argv) {
                                    &eh,
                                    !ca.file                               ? NULL
                                    : info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
-                                                                          : "lattice"};
+                                                                          : "lattice",
+                                   mode_err};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
@@ -418,6 +427,11 @@ int main(int argc, char **argv) {
             fprintf(stderr, " bone %d %.3f / %.3f%s", e->region_bone[k], e->region_err[k],
                     e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
     }
+    fprintf(stderr, "  held-out error by self-contact mode:");
+    for (int k = 0; k < SW_BAKE_MODES; ++k)
+        fprintf(stderr, " %s %s%s", sw_bake_mode_names[k],
+                isfinite(mode_err[k]) ? json_number(mode_err[k], num) : "-",
+                k + 1 < SW_BAKE_MODES ? "," : "\n");
     sw_joint_reach beyond[BAKE_BEYOND];
     int32_t nbeyond_all = sw_bake_beyond_training(&res, &ch.skel, beyond, BAKE_BEYOND);
     int32_t nbeyond = nbeyond_all < BAKE_BEYOND ? nbeyond_all : BAKE_BEYOND;
@@ -512,6 +526,11 @@ int main(int argc, char **argv) {
                        e->region_corr[k]);
             printf("]");
         }
+        printf(",\"err_heldout_by_mode\":{");
+        for (int k = 0; k < SW_BAKE_MODES; ++k)
+            printf("%s\"%s\":%s", k ? "," : "", sw_bake_mode_keys[k],
+                   json_number(mode_err[k], num));
+        printf("}");
         printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
         for (int32_t k = 0; k < nbeyond; ++k) {
             printf("%s[%d,", k ? "," : "", beyond[k].bone);

@@ -390,6 +390,21 @@ sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *r
                                      train_frames, train, err);
 }
 
+/* The held-out half of sw_bake_errors_frames. */
+static sinew_result heldout_error(const sinew_blob *blob, const sw_bake_result *res,
+                                  sinew_self_contact sc, sw_eval_result *heldout,
+                                  double *heldout_frames, sw_error *err) {
+    memset(heldout, 0, sizeof *heldout);
+    int32_t pre, n;
+    double *T = sw_bake_heldout_path(res, sw_blob_get_view(blob)->nbones, &pre, &n);
+    if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, pre, sc};
+    sinew_result r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, &o,
+                                               heldout_frames, heldout, err);
+    free(T);
+    return r;
+}
+
 sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,
                                    sinew_self_contact sc, sw_eval_result *train,
                                    sw_eval_result *heldout, double *train_frames,
@@ -398,14 +413,32 @@ sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result 
     memset(heldout, 0, sizeof *heldout);
     sinew_result r = sw_bake_train_error(blob, res, sc, train, train_frames, err);
     if (r != SINEW_OK) return r;
-    int32_t pre, n;
-    double *T = sw_bake_heldout_path(res, sw_blob_get_view(blob)->nbones, &pre, &n);
-    if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, pre, sc};
-    r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, &o, heldout_frames,
-                                  heldout, err);
-    free(T);
-    return r;
+    return heldout_error(blob, res, sc, heldout, heldout_frames, err);
+}
+
+const sinew_self_contact sw_bake_modes[SW_BAKE_MODES] = {
+    SINEW_SELF_CONTACT_POSE_SPACE, SINEW_SELF_CONTACT_POSE_PAIRS, SINEW_SELF_CONTACT_EXHAUSTIVE};
+const char *const sw_bake_mode_names[SW_BAKE_MODES] = {"pose-space", "pose-pairs", "exhaustive"};
+const char *const sw_bake_mode_keys[SW_BAKE_MODES] = {"pose_space", "pose_pairs", "exhaustive"};
+
+sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *res,
+                                 sinew_self_contact measured, double measured_err,
+                                 double err_mode[SW_BAKE_MODES], sw_error *err) {
+    const sw_blob_view *v = sw_blob_get_view(blob);
+    for (int k = 0; k < SW_BAKE_MODES; ++k) {
+        err_mode[k] = NAN;
+        if (sw_bake_modes[k] == measured) {
+            err_mode[k] = measured_err;
+            continue;
+        }
+        if (sw_bake_modes[k] == SINEW_SELF_CONTACT_POSE_PAIRS && (!v || v->npair_groups == 0))
+            continue; /* no per-pair sections: the mode is not available */
+        sw_eval_result h;
+        sinew_result r = heldout_error(blob, res, sw_bake_modes[k], &h, NULL, err);
+        if (r != SINEW_OK) return r;
+        if (h.failed == 0 && h.frames > 0) err_mode[k] = h.correction_error;
+    }
+    return SINEW_OK;
 }
 
 sinew_result sw_bake_result_blob(const sw_bake_result *res, void **mem, sinew_blob **blob,
