@@ -108,7 +108,7 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     check_beyond(j, res, sk, &nbeyond);
     const cJSON *bm = cJSON_GetObjectItemCaseSensitive(j, "err_heldout_by_mode");
     for (int k = 0; k < SW_BAKE_MODES; ++k) {
-        const cJSON *m = cJSON_GetObjectItemCaseSensitive(bm, sw_bake_mode_keys[k]);
+        const cJSON *m = cJSON_GetObjectItemCaseSensitive(bm, sw_self_contact_keys[k]);
         if (isnan(modes[k]))
             ENSURE(cJSON_IsNull(m));
         else
@@ -195,13 +195,13 @@ TEST(clips_of_their_own_and_the_report) {
     ENSURE(sw_bake_mode_errors(blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, eh.correction_error,
                                modes, &e) == SINEW_OK);
     for (int k = 0; k < SW_BAKE_MODES; ++k) {
-        if (!res.view.npair_groups && sw_bake_modes[k] == SINEW_SELF_CONTACT_POSE_PAIRS) {
+        if (!res.view.npair_groups && (sinew_self_contact)k == SINEW_SELF_CONTACT_POSE_PAIRS) {
             ENSURE(isnan(modes[k]));
             continue;
         }
         sw_eval_result mt, mh;
-        ENSURE(sw_bake_errors(blob, &res, sw_bake_modes[k], &mt, &mh, &e) == SINEW_OK);
-        ENSUREF(modes[k] == mh.correction_error, "%s: %g against %g", sw_bake_mode_names[k],
+        ENSURE(sw_bake_errors(blob, &res, (sinew_self_contact)k, &mt, &mh, &e) == SINEW_OK);
+        ENSUREF(modes[k] == mh.correction_error, "%s: %g against %g", sw_self_contact_names[k],
                 modes[k], mh.correction_error);
     }
     sw_bake_report_input in = {"finger",

@@ -23,7 +23,7 @@
  *   err_regions {train, heldout: [{bone, err_share, correction_share}]}: the bones whose
  *              vertices (by their strongest bone) hold the largest shares of the squared
  *              error (sw_eval_result's regions), or null
- *   err_heldout_by_mode {pose_space, pose_pairs, exhaustive}: the held-out error in each
+ *   err_heldout_by_mode {pose_space, exhaustive, pose_pairs}: the held-out error in each
  *              self-contact mode (null: not measured, or the blob has no per-pair sections),
  *              or null
  *   heldout_beyond_training [{bone, name (null: the file names none), heldout_deg,
@@ -302,7 +302,7 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     if (in->mode_err_heldout) {
         cJSON *m = cJSON_AddObjectToObject(j, "err_heldout_by_mode");
         for (int k = 0; k < SW_BAKE_MODES; ++k)
-            cJSON_AddItemToObject(m, sw_bake_mode_keys[k], json_number(in->mode_err_heldout[k]));
+            cJSON_AddItemToObject(m, sw_self_contact_keys[k], json_number(in->mode_err_heldout[k]));
     } else {
         cJSON_AddNullToObject(j, "err_heldout_by_mode");
     }
@@ -534,7 +534,7 @@ static void html_modes(FILE *f, const sw_bake_report_input *in) {
                "each pair of domains and detects the rest, exhaustive detects every contact "
                "(suits combinations of joints no training pose holds).</p><table><tr>");
     for (int k = 0; k < SW_BAKE_MODES; ++k)
-        fprintf(f, "<th>%s</th>", sw_bake_mode_names[k]);
+        fprintf(f, "<th>%s</th>", sw_self_contact_names[k]);
     fprintf(f, "</tr><tr>");
     for (int k = 0; k < SW_BAKE_MODES; ++k)
         if (isfinite(in->mode_err_heldout[k]))

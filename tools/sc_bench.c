@@ -4,6 +4,7 @@
 #include <math.h>
 #include <string.h>
 
+#include "bake.h"
 #include "blob_load.h"
 #include "instance.h"
 #include "rt_interpose.h"
@@ -18,9 +19,8 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
     sinew_instance *inst;
     sinew_result r = sinew_instance_create(blob, &def, &inst);
     const int k = (int)mode; /* 0 pose-space, 1 exhaustive, 2 pose-pairs */
-    static const char *const names[3] = {"pose-space", "exhaustive", "pose-pairs"};
     if (r != SINEW_OK)
-        return sw_error_set(err, r, "cannot create a %s instance: %s", names[k],
+        return sw_error_set(err, r, "cannot create a %s instance: %s", sw_self_contact_names[k],
                             sinew_result_string(r));
     int nb = (int)sinew_blob_bone_count(blob);
     double sc_sum = 0, step_sum = 0;

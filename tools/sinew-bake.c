@@ -429,7 +429,7 @@ int main(int argc, char **argv) {
     }
     fprintf(stderr, "  held-out error by self-contact mode:");
     for (int k = 0; k < SW_BAKE_MODES; ++k)
-        fprintf(stderr, " %s %s%s", sw_bake_mode_names[k],
+        fprintf(stderr, " %s %s%s", sw_self_contact_names[k],
                 isfinite(mode_err[k]) ? json_number(mode_err[k], num) : "-",
                 k + 1 < SW_BAKE_MODES ? "," : "\n");
     sw_joint_reach beyond[BAKE_BEYOND];
@@ -528,7 +528,7 @@ int main(int argc, char **argv) {
         }
         printf(",\"err_heldout_by_mode\":{");
         for (int k = 0; k < SW_BAKE_MODES; ++k)
-            printf("%s\"%s\":%s", k ? "," : "", sw_bake_mode_keys[k],
+            printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k],
                    json_number(mode_err[k], num));
         printf("}");
         printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */

@@ -291,13 +291,10 @@ int main(int argc, char **argv) {
         else if (!strcmp(a, "--hold-frames") && next)
             ok = sw_tool_int(tool, a, argv[++i], 2, 100000, &hold_frames);
         else if (!strcmp(a, "--self-contact") && next) {
-            int k = sw_tool_choice(
-                argv[++i], (const char *const[]){"pose-space", "exhaustive", "pose-pairs", 0});
+            int k = sw_tool_choice(argv[++i], sw_self_contact_names);
             if (!(ok = k >= 0))
                 fprintf(stderr, "%s: --self-contact: pose-space, exhaustive or pose-pairs\n", tool);
-            self_mode = k == 1   ? SINEW_SELF_CONTACT_EXHAUSTIVE
-                        : k == 2 ? SINEW_SELF_CONTACT_POSE_PAIRS
-                                 : SINEW_SELF_CONTACT_POSE_SPACE;
+            self_mode = ok ? (sinew_self_contact)k : SINEW_SELF_CONTACT_POSE_SPACE;
         } else if (!strcmp(a, "--sc-compare"))
             sc_compare = 1;
         else if (!strcmp(a, "--newton-compare"))
@@ -694,11 +691,7 @@ int main(int argc, char **argv) {
                "\"crowd_lone_median_ms\":%.4f",
                cb.instances, cb.threads, cb.frames, cb.ms, cb.us_per_instance, cb.scaling,
                cb.vs_lone, cb.ms_1thread, cb.lone_ms, cb.lone_median_ms);
-    if (json)
-        printf(",\"self_contact\":\"%s\"", self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive"
-                                           : self_mode == SINEW_SELF_CONTACT_POSE_PAIRS
-                                               ? "pose_pairs"
-                                               : "pose_space");
+    if (json) printf(",\"self_contact\":\"%s\"", sw_self_contact_keys[self_mode]);
     if (json && sc_compare) sw_sc_bench_print(&scb, stdout, 1);
     if (json && newton_compare) sw_newton_bench_print(&nwb, stdout, 1);
     if (json && error_gap) sw_gap_bench_print(&gap, stdout, 1);

@@ -416,25 +416,25 @@ sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result 
     return heldout_error(blob, res, sc, heldout, heldout_frames, err);
 }
 
-const sinew_self_contact sw_bake_modes[SW_BAKE_MODES] = {
-    SINEW_SELF_CONTACT_POSE_SPACE, SINEW_SELF_CONTACT_POSE_PAIRS, SINEW_SELF_CONTACT_EXHAUSTIVE};
-const char *const sw_bake_mode_names[SW_BAKE_MODES] = {"pose-space", "pose-pairs", "exhaustive"};
-const char *const sw_bake_mode_keys[SW_BAKE_MODES] = {"pose_space", "pose_pairs", "exhaustive"};
+const char *const sw_self_contact_names[SW_BAKE_MODES + 1] = {"pose-space", "exhaustive",
+                                                              "pose-pairs", NULL};
+const char *const sw_self_contact_keys[SW_BAKE_MODES] = {"pose_space", "exhaustive", "pose_pairs"};
 
 sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *res,
                                  sinew_self_contact measured, double measured_err,
                                  double err_mode[SW_BAKE_MODES], sw_error *err) {
     const sw_blob_view *v = sw_blob_get_view(blob);
     for (int k = 0; k < SW_BAKE_MODES; ++k) {
+        const sinew_self_contact mode = (sinew_self_contact)k;
         err_mode[k] = NAN;
-        if (sw_bake_modes[k] == measured) {
+        if (mode == measured) {
             err_mode[k] = measured_err;
             continue;
         }
-        if (sw_bake_modes[k] == SINEW_SELF_CONTACT_POSE_PAIRS && (!v || v->npair_groups == 0))
+        if (mode == SINEW_SELF_CONTACT_POSE_PAIRS && (!v || v->npair_groups == 0))
             continue; /* no per-pair sections: the mode is not available */
         sw_eval_result h;
-        sinew_result r = heldout_error(blob, res, sw_bake_modes[k], &h, NULL, err);
+        sinew_result r = heldout_error(blob, res, mode, &h, NULL, err);
         if (r != SINEW_OK) return r;
         if (h.failed == 0 && h.frames > 0) err_mode[k] = h.correction_error;
     }

@@ -261,17 +261,17 @@ sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
                             sinew_self_contact sc, sw_eval_result *train, sw_eval_result *heldout,
                             sw_error *err);
 
-/* The self-contact modes an instance can take (sinew_instance_def.self_contact), in the
- * order the bake reports them, with their names and JSON keys. */
+/* The self-contact modes an instance can take (sinew_instance_def.self_contact), indexed
+ * by sinew_self_contact's value: their names (the tools' flags; NULL after the last, for
+ * sw_tool_choice) and JSON keys. */
 #define SW_BAKE_MODES 3
-extern const sinew_self_contact sw_bake_modes[SW_BAKE_MODES];
-extern const char *const sw_bake_mode_names[SW_BAKE_MODES];
-extern const char *const sw_bake_mode_keys[SW_BAKE_MODES];
+extern const char *const sw_self_contact_names[SW_BAKE_MODES + 1];
+extern const char *const sw_self_contact_keys[SW_BAKE_MODES];
 
-/* The held-out error of `blob` in each mode of sw_bake_modes, measured as sw_bake_errors
- * measures it, into err_mode: `measured_err` for the mode `measured` (already measured),
- * NaN for the pose-pairs mode of a blob without per-pair sections and for a mode whose
- * steps failed. Which mode suits the character's motion: on clips like its training
+/* The held-out error of `blob` in each self-contact mode, measured as sw_bake_errors
+ * measures it, into err_mode (indexed by the mode's value): `measured_err` for the mode `measured`
+ * (already measured), NaN for the pose-pairs mode of a blob without per-pair sections and for a
+ * mode whose steps failed. Which mode suits the character's motion: on clips like its training
  * clips the pose-space mode, on combinations of joints no training pose holds the
  * detecting modes (README "The Fox's Run is beyond its training"). */
 sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *res,
