@@ -44,6 +44,7 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
             out->tests_mean[k] += st.self_contact_tests;
             out->pairs_mean[k] += st.self_contacts;
             out->novel_mean[k] += st.self_contact_novel;
+            out->apart_mean[k] += st.self_contacts_apart;
         }
     if (count_rt) {
         sw_rt_counts c = sw_rt_count_end();
@@ -55,6 +56,7 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
     out->tests_mean[k] /= steps;
     out->pairs_mean[k] /= steps;
     out->novel_mean[k] /= steps;
+    out->apart_mean[k] /= steps;
     if (k == 0) out->frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
     if (k == 2) out->pp_frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
     sinew_instance_destroy(inst);
@@ -85,10 +87,11 @@ void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
     if (!json) {
         fprintf(f,
                 "sinew-bench: self-contact over %d steps: pose-space %.4f ms mean, %.4f max "
-                "(%.1f pairs, %.3f of the step); exhaustive %.4f ms mean, %.4f max (%.0f "
+                "(%.1f pairs, %.1f left apart, %.3f of the step); exhaustive %.4f ms mean, %.4f max (%.0f "
                 "candidates, %.1f pairs); speedup %.1fx mean, %.1fx max; exhaustive allocs %ld, "
                 "locks %ld\n",
-                b->steps, b->ms_mean[0], b->ms_max[0], b->tests_mean[0], b->frame_share,
+                b->steps, b->ms_mean[0], b->ms_max[0], b->tests_mean[0], b->apart_mean[0],
+                b->frame_share,
                 b->ms_mean[1], b->ms_max[1], b->tests_mean[1], b->pairs_mean[1], b->speedup_mean,
                 b->speedup_max, b->allocs[1], b->locks[1]);
         if (b->pairs_mode)
@@ -106,12 +109,13 @@ void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
             "\"sc_exh_ms_max\":%.5f,\"sc_speedup_mean\":%.2f,\"sc_speedup_max\":%.2f,"
             "\"sc_frame_share\":%.4f,\"sc_exh_frame_share\":%.4f,\"sc_pairs\":%.1f,"
             "\"sc_exh_pairs\":%.1f,\"sc_exh_contacts\":%.1f,\"sc_step_ms\":%.4f,"
-            "\"sc_exh_step_ms\":%.4f,\"sc_exh_allocs_in_step\":%ld,\"sc_exh_locks_in_step\":%ld",
+            "\"sc_exh_step_ms\":%.4f,\"sc_exh_allocs_in_step\":%ld,\"sc_exh_locks_in_step\":%ld,"
+            "\"sc_apart\":%.2f",
             b->steps, b->ms_mean[0], b->ms_max[0], b->ms_mean[1], b->ms_max[1], b->speedup_mean,
             b->speedup_max, b->frame_share,
             b->step_mean[1] > 0 ? b->ms_mean[1] / b->step_mean[1] : 0, b->tests_mean[0],
             b->tests_mean[1], b->pairs_mean[1], b->step_mean[0], b->step_mean[1], b->allocs[1],
-            b->locks[1]);
+            b->locks[1], b->apart_mean[0]);
     if (b->pairs_mode)
         fprintf(f,
                 ",\"sc_pp_ms_mean\":%.5f,\"sc_pp_ms_max\":%.5f,\"sc_pp_speedup_mean\":%.2f,"

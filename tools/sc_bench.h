@@ -9,6 +9,7 @@
  *                        pairs in use, or the exhaustive (vertex, tet) candidates)
  *   pairs_mean           pairs in the solve a step (self_contacts)
  *   novel_mean           pairs of domains with novel contact a step (pose-pairs)
+ *   apart_mean           pose-space pairs left out a step as come apart (pose_contact.h)
  * for each mode ([0] pose-space, [1] exhaustive, [2] pose-pairs), and
  *   speedup_mean = ms_mean[1] / ms_mean[0], speedup_max = ms_max[1] / ms_max[0],
  *   frame_share = the pose-space mode's self-contact time over its steps' time,
@@ -25,7 +26,8 @@
 
 typedef struct sw_sc_bench {
     int steps; /* timed steps of each mode */
-    double ms_mean[3], ms_max[3], step_mean[3], tests_mean[3], pairs_mean[3], novel_mean[3];
+    double ms_mean[3], ms_max[3], step_mean[3], tests_mean[3], pairs_mean[3], novel_mean[3],
+        apart_mean[3];
     double speedup_mean, speedup_max, frame_share;
     int pairs_mode; /* the blob has per-pair sections: [2] and pp_* were measured */
     double pp_speedup_mean, pp_speedup_max, pp_frame_share;
@@ -42,7 +44,8 @@ sinew_result sw_sc_bench_run(const sinew_blob *blob, const double *T, int nframe
  * sc_exh_ms_max, sc_speedup_mean, sc_speedup_max, sc_frame_share, sc_exh_frame_share,
  * sc_pairs (pose-space pairs tested), sc_exh_pairs (exhaustive candidates tested),
  * sc_exh_contacts, sc_step_ms, sc_exh_step_ms, sc_exh_allocs_in_step,
- * sc_exh_locks_in_step; with a pose-pairs pass sc_pp_ms_mean, sc_pp_ms_max,
+ * sc_exh_locks_in_step, sc_apart (pose-space pairs left out as come apart); with a
+ * pose-pairs pass sc_pp_ms_mean, sc_pp_ms_max,
  * sc_pp_speedup_mean, sc_pp_speedup_max, sc_pp_frame_share, sc_pp_pairs, sc_pp_novel,
  * sc_pp_allocs_in_step, sc_pp_locks_in_step. */
 void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json);

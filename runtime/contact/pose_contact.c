@@ -14,6 +14,22 @@
  * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
  * couple two domains. Added after the cubature so it lands on the full (mirrored)
  * matrix. */
+/* Pair c of set at q: its four slots' domains D and positions x (the vertex, then the
+ * triangle's corners) and the gap d = sum b_i x_ti - x_p; map carries set's transforms. */
+static void pair_gap(const sw_reduced *map, const sw_pair_set *set, int32_t c, const double *q,
+                     const sw_blob_domain *D[4], double x[4][3], double d[3]) {
+    const int32_t *cv = set->verts + 8 * (int64_t)c, *ca = set->act + 4 * (int64_t)c;
+    const double *cd = set->data + 7 * (int64_t)c;
+    const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
+    d[0] = d[1] = d[2] = 0;
+    for (int m = 0; m < 4; ++m) {
+        D[m] = &map->v->domains[cv[2 * m]];
+        sw_reduced_position(map, D[m], cv[2 * m + 1], ca[m], q + D[m]->q_offset, x[m], NULL);
+        for (int i = 0; i < 3; ++i)
+            d[i] += coef[m] * x[m][i];
+    }
+}
+
 static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32_t *pairs,
                             const unsigned char *skip, int32_t npairs, const double *weight,
                             const double *tangent, const double *q, int want_grad, int want_hess) {
@@ -30,13 +46,8 @@ static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32
         const double *cd = set->data + 7 * (int64_t)c;
         const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
         const sw_blob_domain *D[4];
-        double x[4][3], d[3] = {0, 0, 0};
-        for (int m = 0; m < 4; ++m) {
-            D[m] = &v->domains[cv[2 * m]];
-            sw_reduced_position(&map, D[m], cv[2 * m + 1], ca[m], q + D[m]->q_offset, x[m], NULL);
-            for (int i = 0; i < 3; ++i)
-                d[i] += coef[m] * x[m][i];
-        }
+        double x[4][3], d[3];
+        pair_gap(&map, set, c, q, D, x, d);
         const double *Rp = set->act_R + 9 * (int64_t)ca[0];
         double n[3];
         for (int i = 0; i < 3; ++i)
@@ -119,4 +130,35 @@ double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const doub
     sw_pair_set set = sw_pose_pair_set(red);
     return contact_pairs(red, &set, ps->pairs, ps->in_patch, ps->npairs, ps->pair_w, ps->pair_tan,
                          q, want_grad, want_hess);
+}
+
+/* Whether the pair's vertex lies farther from its contact point on the triangle than
+ * SW_PAIR_APART times the triangle's longest edge over 1 - share (x, d from pair_gap). */
+static int pair_apart(double x[4][3], const double d[3], double share) {
+    double e2 = 0;
+    for (int a = 1; a < 4; ++a)
+        for (int b = a + 1; b < 4; ++b) {
+            double l[3] = {x[a][0] - x[b][0], x[a][1] - x[b][1], x[a][2] - x[b][2]};
+            double l2 = l[0] * l[0] + l[1] * l[1] + l[2] * l[2];
+            if (l2 > e2) e2 = l2;
+        }
+    double f = 1 - share;
+    return (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]) * f * f > SW_PAIR_APART * SW_PAIR_APART * e2;
+}
+
+int32_t sw_pose_contacts_drop_apart(sw_pose_space *ps, const sw_reduced *red, const double *q) {
+    sw_pair_set set = sw_pose_pair_set(red);
+    int32_t kept = 0;
+    for (int32_t i = 0; i < ps->npairs; ++i) {
+        const sw_blob_domain *D[4];
+        double x[4][3], d[3];
+        pair_gap(red, &set, ps->pairs[i], q, D, x, d);
+        if (pair_apart(x, d, ps->pair_tan[i])) continue;
+        ps->pairs[kept] = ps->pairs[i];
+        ps->pair_w[kept] = ps->pair_w[i];
+        ps->pair_tan[kept++] = ps->pair_tan[i];
+    }
+    int32_t apart = ps->npairs - kept;
+    ps->npairs = kept;
+    return apart;
 }

@@ -39,4 +39,26 @@ double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int3
 double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,
                             int want_grad, int want_hess);
 
+/* A pose-space pair is where the reference found vertex p pressed against the triangle
+ * at a training pose. At another pose the two may have come apart while p still lies
+ * behind the triangle's plane, and the penalty, quadratic in the gap, would pull p across
+ * it to a surface it does not touch. A pair whose vertex lies farther from its contact
+ * point than this many triangle edges (the longest), over 1 - s where s is the pair's
+ * locality share (pair_tan: 1 at its own training pose, 0 at the nearest other one), is
+ * not the reference's contact there; at its own pose a pair always stays, so the step
+ * applies the reference's contact set where the bake solved it. Measured (the bakes'
+ * held-out errors): the Fox trained on Survey and Run with Walk held out (a gait whose
+ * legs swing less than the training's) 0.425 -> 0.151, its Galerkin error 0.156; with Run
+ * held out 0.283 -> 0.268; elephant 0.0909 -> 0.0868; the robot in the pose-pairs mode
+ * 0.169 -> 0.070; finger 50K, hand, robot unchanged, bare hand 0.400 -> 0.402. (1.0 and
+ * 1.5 edges within 0.002 of each other on the Fox; without the share, the bare hand's
+ * training poses lost pairs and its springs' choice moved: 0.410.) */
+#define SW_PAIR_APART 1.0
+
+/* Drops from ps->pairs (with pair_w, pair_tan) every pair that has come apart at q
+ * (SW_PAIR_APART), keeping the others' order; returns how many. The step decides once, at
+ * its start state, so every evaluation of the solve sums the same pairs (as a reference
+ * contact round does). O(npairs r). */
+int32_t sw_pose_contacts_drop_apart(sw_pose_space *ps, const sw_reduced *red, const double *q);
+
 #endif

@@ -110,10 +110,17 @@ static void phase_contact(sw_step_ctx *c) {
     c->st.ms_self_contact = c->st.ms_contact;
 }
 
-/* Exhaustive mode: the pairs touching at the start state. Either mode: the pairs in use
+/* Exhaustive mode: the pairs touching at the start state. Pose-space modes: the pairs
+ * that have come apart there dropped (pose_contact.h). Either mode: the pairs in use
  * fix the Hessian's block pattern for the step (the factorisations add their fill). */
 static void phase_self(sw_step_ctx *c) {
     sinew_instance *in = c->in;
+    int32_t apart = exhaustive(in) ? 0 : sw_pose_contacts_drop_apart(&in->ps, &in->red, in->solver.q);
+    if (apart > 0) {
+        in->solver.mat_at_qn = 0; /* a dynamic step's material part at q_n held them */
+        c->st.contact_pairs = c->st.self_contacts = (uint32_t)in->ps.npairs;
+        c->st.self_contacts_apart = (uint32_t)apart;
+    }
     if (exhaustive(in)) {
         sw_self_contacts_detect(&in->sc, &in->red, in->solver.q);
         c->st.self_contact_tests = (uint32_t)in->sc.tests;

@@ -307,6 +307,11 @@ typedef struct sinew_step_stats {
     /** Newton updates taken on the rest Hessian (SINEW_NEWTON_HESSIAN_REST_FIRST, or
      * _AUTO where it chose it); the other updates are counted in newton_iterations too */
     uint32_t rest_updates;
+    /** pose-space modes: the nearest samples' pairs left out this step because their
+     * vertex had come apart from its triangle at the start state (farther from its
+     * contact point than the triangle's longest edge); counted in self_contact_tests, not
+     * in contact_pairs or self_contacts */
+    uint32_t self_contacts_apart;
 } sinew_step_stats;
 
 #ifdef __cplusplus
