@@ -72,7 +72,8 @@ TEST(a_pair_is_kept_while_its_vertex_is_near_its_contact_point) {
     ENSURE(x && count);
     int32_t best = 0; /* the training pose with the most pairs: the deepest fold */
     for (int32_t t = 1; t < v->ntrain; ++t)
-        if (v->contact_ptr[t + 1] - v->contact_ptr[t] > v->contact_ptr[best + 1] - v->contact_ptr[best])
+        if (v->contact_ptr[t + 1] - v->contact_ptr[t] >
+            v->contact_ptr[best + 1] - v->contact_ptr[best])
             best = t;
     sw_pose_space *ps = &in->ps;
     int32_t n = v->contact_ptr[best + 1] - v->contact_ptr[best];
@@ -93,7 +94,8 @@ TEST(a_pair_is_kept_while_its_vertex_is_near_its_contact_point) {
             }
             int32_t apart = sw_pose_contacts_drop_apart(ps, &in->red, sw_instance_q(in));
             ENSURE(apart + ps->npairs == n);
-            if (share == 1) ENSUREF(apart == 0, "frame %d: %d pairs dropped at their own pose", k, (int)apart);
+            if (share == 1)
+                ENSUREF(apart == 0, "frame %d: %d pairs dropped at their own pose", k, (int)apart);
             int32_t at = 0; /* walks the kept list alongside */
             for (int32_t i = 0; i < n; ++i) {
                 double r = f2 * gap_ratio(v, v->contact_ptr[best] + i, x) /
@@ -105,8 +107,8 @@ TEST(a_pair_is_kept_while_its_vertex_is_near_its_contact_point) {
                     at++;
                 }
                 if (fabs(r - 1) < 0.1) continue;
-                ENSUREF(kept == (r < 1), "frame %d, share %.1f: pair %d at %.3f of the limit %s",
-                        k, share, (int)i, r, kept ? "kept" : "dropped");
+                ENSUREF(kept == (r < 1), "frame %d, share %.1f: pair %d at %.3f of the limit %s", k,
+                        share, (int)i, r, kept ? "kept" : "dropped");
                 kept_any += kept && share == 0;
                 apart_any += !kept;
             }

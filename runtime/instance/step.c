@@ -115,7 +115,8 @@ static void phase_contact(sw_step_ctx *c) {
  * fix the Hessian's block pattern for the step (the factorisations add their fill). */
 static void phase_self(sw_step_ctx *c) {
     sinew_instance *in = c->in;
-    int32_t apart = exhaustive(in) ? 0 : sw_pose_contacts_drop_apart(&in->ps, &in->red, in->solver.q);
+    int32_t apart =
+        exhaustive(in) ? 0 : sw_pose_contacts_drop_apart(&in->ps, &in->red, in->solver.q);
     if (apart > 0) {
         in->solver.mat_at_qn = 0; /* a dynamic step's material part at q_n held them */
         c->st.contact_pairs = c->st.self_contacts = (uint32_t)in->ps.npairs;
