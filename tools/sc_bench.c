@@ -87,10 +87,9 @@ void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json) {
     if (!json) {
         fprintf(f,
                 "sinew-bench: self-contact over %d steps: pose-space %.4f ms mean, %.4f max "
-                "(%.1f pairs, %.1f left apart, %.3f of the step); exhaustive %.4f ms mean, %.4f "
-                "max (%.0f "
-                "candidates, %.1f pairs); speedup %.1fx mean, %.1fx max; exhaustive allocs %ld, "
-                "locks %ld\n",
+                "(%.1f pairs, %.1f left apart, %.3f of the step); exhaustive %.4f ms mean, "
+                "%.4f max (%.0f candidates, %.1f pairs); speedup %.1fx mean, %.1fx max; "
+                "exhaustive allocs %ld, locks %ld\n",
                 b->steps, b->ms_mean[0], b->ms_max[0], b->tests_mean[0], b->apart_mean[0],
                 b->frame_share, b->ms_mean[1], b->ms_max[1], b->tests_mean[1], b->pairs_mean[1],
                 b->speedup_mean, b->speedup_max, b->allocs[1], b->locks[1]);

@@ -45,9 +45,8 @@ sinew_result sw_sc_bench_run(const sinew_blob *blob, const double *T, int nframe
  * sc_pairs (pose-space pairs tested), sc_exh_pairs (exhaustive candidates tested),
  * sc_exh_contacts, sc_step_ms, sc_exh_step_ms, sc_exh_allocs_in_step,
  * sc_exh_locks_in_step, sc_apart (pose-space pairs left out as come apart); with a
- * pose-pairs pass sc_pp_ms_mean, sc_pp_ms_max,
- * sc_pp_speedup_mean, sc_pp_speedup_max, sc_pp_frame_share, sc_pp_pairs, sc_pp_novel,
- * sc_pp_allocs_in_step, sc_pp_locks_in_step. */
+ * pose-pairs pass sc_pp_ms_mean, sc_pp_ms_max, sc_pp_speedup_mean, sc_pp_speedup_max,
+ * sc_pp_frame_share, sc_pp_pairs, sc_pp_novel, sc_pp_allocs_in_step, sc_pp_locks_in_step. */
 void sw_sc_bench_print(const sw_sc_bench *b, FILE *f, int json);
 
 #endif

@@ -4,16 +4,6 @@
 
 #include "penalty.h"
 
-/* Self-contact pairs (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
- * training poses' pairs or the exhaustive mode's, each the reference's penalty
- * E = 1/2 k ka d^T N d with d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and
- * n = R_p n_rest (alpha:
- * SW_CONTACT_ALPHA times the pose's tangential share, pose_space.c), applied
- * while the pair collides (the Heaviside of eq. 3.12: p behind the triangle along n).
- * Per pair the slots of one domain are summed into G_d = sum coef_m J_m (3 x r_d), so
- * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
- * couple two domains. Added after the cubature so it lands on the full (mirrored)
- * matrix. */
 /* Pair c of set at q: its four slots' domains D and positions x (the vertex, then the
  * triangle's corners) and the gap d = sum b_i x_ti - x_p; map carries set's transforms. */
 static void pair_gap(const sw_reduced *map, const sw_pair_set *set, int32_t c, const double *q,
@@ -30,6 +20,16 @@ static void pair_gap(const sw_reduced *map, const sw_pair_set *set, int32_t c, c
     }
 }
 
+/* Self-contact pairs (blob_view.h, thesis eqs. 3.4-3.6 and §3.2.3): the nearest
+ * training poses' pairs or the exhaustive mode's, each the reference's penalty
+ * E = 1/2 k ka d^T N d with d = sum b_i x_ti - x_p, N = (1 - alpha) n n^T + alpha I and
+ * n = R_p n_rest (alpha:
+ * SW_CONTACT_ALPHA times the pose's tangential share, pose_space.c), applied
+ * while the pair collides (the Heaviside of eq. 3.12: p behind the triangle along n).
+ * Per pair the slots of one domain are summed into G_d = sum coef_m J_m (3 x r_d), so
+ * the gradient is k ka G_d^T N d and the Hessian blocks k ka G_a^T N G_b, which may
+ * couple two domains. Added after the cubature so it lands on the full (mirrored)
+ * matrix. */
 static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32_t *pairs,
                             const unsigned char *skip, int32_t npairs, const double *weight,
                             const double *tangent, const double *q, int want_grad, int want_hess) {

@@ -309,8 +309,9 @@ typedef struct sinew_step_stats {
     uint32_t rest_updates;
     /** pose-space modes: the nearest samples' pairs left out this step because their
      * vertex had come apart from its triangle at the start state (farther from its
-     * contact point than the triangle's longest edge); counted in self_contact_tests, not
-     * in contact_pairs or self_contacts */
+     * contact point than the triangle's longest edge, and farther still the nearer the
+     * pose is to the pair's own training pose, where a pair always stays); counted in
+     * self_contact_tests, not in contact_pairs or self_contacts */
     uint32_t self_contacts_apart;
 } sinew_step_stats;
 
