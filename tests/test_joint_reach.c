@@ -47,17 +47,25 @@ TEST(joint_reach_is_each_bend_in_its_parents_frame) {
     chain(&sk, joints, bones, parent);
     static const double axis[NB][3] = {{0, 0, 1}, {1, 0, 0}, {0, 1, 0}, {0, 0.6, 0.8}, {0, 0, 1}};
     double T[2][12 * NB];
-    static const double a0[NB] = {50, 30, 20, 10, 0}, a1[NB] = {-70, 10, 25, 0, 0};
+    /* bone 4's 1e-4 degrees: an arc cosine of the trace would read it 3e-5 off */
+    static const double a0[NB] = {50, 30, 20, 10, 1e-4}, a1[NB] = {-70, 10, 25, 0, 0};
     pose(&sk, a0, axis, T[0]);
     pose(&sk, a1, axis, T[1]);
     double reach[NB] = {0}, ax[3 * NB] = {0};
     sw_bake_joint_reach(&sk, T[0], 2, reach, ax);
     /* the root's turn moves the whole chain rigidly: not measured */
     ENSURE(reach[0] == 0);
-    static const double want[NB] = {0, 30, 25, 10, 0};
-    for (int32_t b = 1; b < NB; ++b) /* the angle is an arc cosine: ~1e-8 near 0 */
-        ENSUREF(fabs(reach[b] - want[b] * DEG) < (want[b] > 0 ? 1e-9 : 1e-7),
-                "bone %d: %g degrees, want %g", b, reach[b] / DEG, want[b]);
+    static const double want[NB] = {0, 30, 25, 10, 1e-4};
+    for (int32_t b = 1; b < NB; ++b) /* to rounding, however small the bend */
+        ENSUREF(fabs(reach[b] / (want[b] * DEG) - 1) < 1e-9, "bone %d: %.12g degrees, want %g", b,
+                reach[b] / DEG, want[b]);
+    /* a half turn and the least turn short of it */
+    static const double half[NB] = {0, 180, 180 - 1e-4, 0, 0};
+    double Th[12 * NB], reach_h[NB] = {0};
+    pose(&sk, half, axis, Th);
+    sw_bake_joint_reach(&sk, Th, 1, reach_h, NULL);
+    ENSURE_NEAR(reach_h[1] / DEG, 180, 1e-9);
+    ENSURE_NEAR(reach_h[2] / DEG, 180 - 1e-4, 1e-9);
     /* the axis is the one at the largest bend, in the parent's frame */
     for (int i = 0; i < 3; ++i) {
         ENSURE_NEAR(ax[3 * 1 + i], axis[1][i], 1e-9);

@@ -37,13 +37,13 @@ static void local_rotation(const sw_skeleton *sk, const double *T, int32_t b, do
             L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
 }
 
-/* Axis-angle of a rotation matrix (angle in [0, pi]). */
+/* Axis-angle of a rotation matrix (angle in [0, pi]). The angle is atan2(sin, cos) of
+ * the skew part's length (2 sin) and the trace (1 + 2 cos): acos of the trace alone
+ * loses half the digits near 0 and pi (a 1e-8 rad turn reads as 0 or 1.5e-8). */
 static double rotation_axis_angle(const double R[9], double axis[3]) {
-    double c = 0.5 * (R[0] + R[4] + R[8] - 1.0);
-    c = c > 1 ? 1 : c < -1 ? -1 : c;
-    double angle = acos(c);
     double a[3] = {R[7] - R[5], R[2] - R[6], R[3] - R[1]};
     double n = sw_v3_norm(a);
+    double angle = atan2(0.5 * n, 0.5 * (R[0] + R[4] + R[8] - 1.0));
     if (n < 1e-12) { /* angle 0 or pi: take the column of the largest diagonal of R + I */
         int k = R[0] >= R[4] && R[0] >= R[8] ? 0 : R[4] >= R[8] ? 1 : 2;
         for (int i = 0; i < 3; ++i)
