@@ -49,14 +49,14 @@ typedef struct sw_bake_params {
     double pca_strain;             /* the PCA's inner product: this share from the snapshots'
                                       rest strain energy, the rest from their plain products
                                       (default 0: plain PCA; bake_basis.c: at the same rank
-                                      no better, measured in the README) */
+                                      no better, docs/accuracy.md) */
     double cubature_tol;           /* default 0.05 */
     int32_t cubature_max;          /* per domain (default 1000) */
     sw_cubature_selector selector; /* default NN-HTP */
     int32_t sweep_samples;         /* poses per joint sweep (default 6) */
     int pair_sweeps;               /* also sweep every joint together with its parent joint
                                       (default 0; issue 16: combinations the single sweeps
-                                      never show; measured in the README) */
+                                      never show; docs/accuracy.md) */
     int sibling_sweeps;            /* also sweep every two sibling joints whose flesh meets
                                       together (default 1; bake_poses.c, sweep_pairs) */
     int32_t max_train_frames;      /* clip frames used for training at most (default 40) */
@@ -69,7 +69,7 @@ typedef struct sw_bake_params {
                                       heldout_fraction: what plays after the training part
                                       starts from its last frame), off for training clips
                                       named in train_clips (finger 50K held-out 0.1358 ->
-                                      0.0781, README The way home) */
+                                      0.0781, docs/accuracy.md The way home) */
     int pose_force;                /* the pose-space equilibrium force (bake_equilibrium.c:
                                       the training poses' projected solutions made the
                                       runtime's equilibria there; default 1) */
@@ -221,8 +221,8 @@ typedef struct sw_joint_reach {
 /* The joints r's held-out poses bend beyond its training range (its sweeps' angles), the
  * largest multiple of the trained bend first, at most max of them into out; returns how many there
  * are (-1 out of memory). There the basis extrapolates: a held-out clip that turns a joint two or
- * three times as far as the training clips is beyond what the bake learnt (README "The
- * Fox's Run is beyond its training"). Random held-out poses stay within the sweeps. */
+ * three times as far as the training clips is beyond what the bake learnt (docs/accuracy.md
+ * "The Fox's Run is beyond its training"). Random held-out poses stay within the sweeps. */
 int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, sw_joint_reach *out,
                                 int32_t max);
 
@@ -273,7 +273,7 @@ extern const char *const sw_self_contact_keys[SW_BAKE_MODES];
  * (already measured), NaN for the pose-pairs mode of a blob without per-pair sections and for a
  * mode whose steps failed. Which mode suits the character's motion: on clips like its training
  * clips the pose-space mode, on combinations of joints no training pose holds the
- * detecting modes (README "The Fox's Run is beyond its training"). */
+ * detecting modes (docs/accuracy.md "The Fox's Run is beyond its training"). */
 sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *res,
                                  sinew_self_contact measured, double measured_err,
                                  double err_mode[SW_BAKE_MODES], sw_error *err);

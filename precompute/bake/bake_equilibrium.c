@@ -9,7 +9,7 @@
  * the training poses as it does their contact pairs (thesis §3.2.3, after Pose Space
  * Deformation [83]).
  *
- * Measured (sinew-bake, the README's bakes, train / held-out error without -> with):
+ * Measured (sinew-bake, the bakes of docs/accuracy.md, train / held-out error without -> with):
  * Fox 0.0214 / 0.2909 -> 0.0074 / 0.2909, hand 0.0179 / 0.0448 -> 0.0064 / 0.0429,
  * finger 50K 0.0178 / 0.1360 -> 0.0082 / 0.1358, elephant 0.0196 / 0.0891 -> 0.0092 /
  * 0.0890, robot (10K tets) 0.0219 / 0.0755 -> 0.0075 / 0.0755. Without the fade by the

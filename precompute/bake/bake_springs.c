@@ -5,7 +5,7 @@
  * their mean, but each side of the seam follows its own domain: a crease) and the
  * domains drift apart. Where between depends on the character: the
  * training error is lowest at 10 E h on the hand, the fingers, the elephant and the
- * robot, at 2.5-5 E h on the Fox (measured 2026-12-03, README section Game assets).
+ * robot, at 2.5-5 E h on the Fox (measured 2026-12-03, docs/game-assets.md).
  *
  * So, unless the caller gives k, the bake measures the training error (the bake's own
  * figure: pose-space self-contact, sw_bake_train_error) of the blob at each of
