@@ -10,6 +10,7 @@
 #include <sys/stat.h>
 
 #include "bake.h"
+#include "pose_space.h"
 #include "bake_report.h"
 #include "samples.h"
 #include "sw_test.h"

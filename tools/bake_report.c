@@ -43,6 +43,7 @@
 
 #include "blob_load.h"
 #include "mesh_io.h"
+#include "pose_space.h"
 #include "tool_common.h"
 
 static const char *const stage_names[SW_BAKE_REPORT_STAGES] = {"prepare", "domains",  "simulate",

@@ -39,6 +39,9 @@
  *   phase_ms  median ms/frame of each phase of the step (the step's own stats: skin,
  *             contact, dynamics, solve, output), and potential_evals, the mean number of
  *             potential evaluations (cubature passes) a step
+ *   beyond_training_frames  timed clip frames the step flagged SINEW_STEP_BEYOND_TRAINING
+ *             (a joint bent beyond the bake's training poses); beyond_training_deg_max and
+ *             beyond_training_bone: the furthest such bend's excess (degrees) and its bone
  * Ratios: speedup_vs_full = full_ms / sub_ms, cost_vs_dqs = sub_ms / dqs_ms.
  * With --world FILE (a world file, samples/worlds) it then runs the reference and the
  * runtime with that world on the same mesh and motion (world_bench.h) and adds
@@ -464,6 +467,8 @@ int main(int argc, char **argv) {
     double *sub = malloc((size_t)nf * sizeof(double));
     double *phase = malloc((size_t)nf * NPHASES * sizeof(double)), evals = 0, factors = 0;
     long failed_steps = 0; /* steps that did not return SINEW_OK (a non-finite state) */
+    int beyond_frames = 0, beyond_bone = -1; /* frames bent beyond the bake's training */
+    double beyond_deg = 0;
     for (int f = 0; f < nf; ++f) {
         double t0 = sw_now_seconds();
         sw_instance_set_pose_d(inst, ch.clip.T + (size_t)f * 12 * ch.skel.nbones);
@@ -479,6 +484,9 @@ int main(int argc, char **argv) {
             phase[(size_t)k * nf + f] = ms[k];
         evals += st.potential_evals / (double)nf;
         factors += st.factorizations / (double)nf;
+        beyond_frames += (st.status & SINEW_STEP_BEYOND_TRAINING) != 0;
+        if (st.beyond_training_deg > beyond_deg)
+            beyond_deg = st.beyond_training_deg, beyond_bone = st.beyond_training_bone;
     }
     double sub_ms = sw_median(sub, nf), phase_ms[NPHASES];
     for (int k = 0; k < NPHASES; ++k)
@@ -682,8 +690,10 @@ int main(int argc, char **argv) {
             sw_linear_solver_name(full_solver), full_unsettled, full_newton_max, full_mean,
             full_max);
     if (json)
-        printf(",\"factorizations\":%.2f,\"instance_bytes\":%zu,\"blob_bytes\":%zu", factors,
-               instance_bytes, blob_bytes);
+        printf(",\"factorizations\":%.2f,\"instance_bytes\":%zu,\"blob_bytes\":%zu,"
+               "\"beyond_training_frames\":%d,\"beyond_training_deg_max\":%.2f,"
+               "\"beyond_training_bone\":%d",
+               factors, instance_bytes, blob_bytes, beyond_frames, beyond_deg, beyond_bone);
     if (json && instances)
         printf(",\"crowd_instances\":%d,\"crowd_threads\":%d,\"crowd_frames\":%d,"
                "\"crowd_ms\":%.4f,\"crowd_us_per_instance\":%.3f,\"crowd_scaling\":%.3f,"

@@ -215,10 +215,8 @@ typedef struct sw_joint_reach {
     double heldout_deg, train_deg; /* the largest angles (degrees), sw_bake_joint_reach's */
 } sw_joint_reach;
 
-#define SW_BEYOND_RATIO 1.25 /* held-out above 1.25 times the trained angle ... */
-#define SW_BEYOND_DEG 5.0    /* ... and 5 degrees more: beyond training */
-
-/* The joints r's held-out poses bend beyond its training range (its sweeps' angles), the
+/* The joints r's held-out poses bend beyond its training range (its sweeps' angles; the
+ * step's rule, sw_joint_beyond_training), the
  * largest multiple of the trained bend first, at most max of them into out; returns how many there
  * are (-1 out of memory). There the basis extrapolates: a held-out clip that turns a joint two or
  * three times as far as the training clips is beyond what the bake learnt (docs/accuracy.md

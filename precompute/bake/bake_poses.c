@@ -21,6 +21,7 @@
 #include "bake_internal.h"
 #include "fullsim.h"
 #include "mat3.h"
+#include "pose_space.h"
 #include "vec3.h"
 
 /* Rotation part of a clip's bone transform relative to its parent: L = R_p^T R_b. */
@@ -158,7 +159,7 @@ int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, 
     const double deg = 57.29577951308232;
     for (int32_t b = 0; b < nb; ++b) {
         double h = reach[b] * deg, t = r->sweep_angle ? r->sweep_angle[b] * deg : 0;
-        if (!(h > SW_BEYOND_RATIO * t && h - t > SW_BEYOND_DEG)) continue;
+        if (!sw_joint_beyond_training(reach[b], r->sweep_angle ? r->sweep_angle[b] : 0)) continue;
         sw_joint_reach j = {b, h, t};
         total++;
         int32_t k = n < max ? n++ : max; /* insertion by multiple of the trained bend */

@@ -63,20 +63,33 @@ static void pair_reach(const sw_blob_view *v, double *reach) {
         }
 }
 
-/* Parts in mem: reach (ntrain doubles), pair_reach (npair_groups ntrain doubles), then
- * twin_next (ntrain int32): the doubles first keep every part 8-byte aligned. */
+static void joint_bend(const sw_blob_view *v, double *bend) {
+    for (int32_t b = 0; b < v->nbones; ++b) {
+        bend[b] = 0;
+        if (v->bone_parent[b] < 0) continue;
+        for (int32_t t = 0; t < v->ntrain; ++t)
+            bend[b] = fmax(bend[b],
+                           sw_pose_feature_bend(v->train_pose + 4 * ((size_t)v->nbones * t + b)));
+    }
+}
+
+/* Parts in mem: reach (ntrain doubles), pair_reach (npair_groups ntrain doubles),
+ * joint_bend (nbones doubles), then twin_next (ntrain int32): the doubles first keep every
+ * part 8-byte aligned. */
 size_t sw_pose_index_bytes(const sw_blob_view *v) {
-    const size_t T = (size_t)v->ntrain, G = (size_t)v->npair_groups;
-    return sizeof(double) * (T + G * T) + sizeof(int32_t) * T;
+    const size_t T = (size_t)v->ntrain, G = (size_t)v->npair_groups, B = (size_t)v->nbones;
+    return sizeof(double) * (T + G * T + B) + sizeof(int32_t) * T;
 }
 
 void sw_pose_index_build(const sw_blob_view *v, void *mem, sw_pose_index *ix) {
-    const size_t T = (size_t)v->ntrain, G = (size_t)v->npair_groups;
+    const size_t T = (size_t)v->ntrain, G = (size_t)v->npair_groups, B = (size_t)v->nbones;
     double *d = mem;
     ix->reach = d;
     ix->pair_reach = G > 0 ? d + T : NULL;
-    ix->twin_next = (int32_t *)(void *)(d + T + G * T);
+    ix->joint_bend = d + T + G * T;
+    ix->twin_next = (int32_t *)(void *)(d + T + G * T + B);
     sw_pose_index_link_twins(v, ix->twin_next);
     pose_reach(v, ix->reach);
     if (ix->pair_reach) pair_reach(v, ix->pair_reach);
+    joint_bend(v, ix->joint_bend);
 }

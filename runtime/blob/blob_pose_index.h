@@ -3,8 +3,9 @@
  * one pose on several branches of the reference's path (twins), and how far each sample
  * lies from its nearest other one, whole pose and per pair of domains (the reach the
  * pose-space lookups fade a sample's tangential contact and equilibrium force over,
- * pose_space.h). They depend on the blob alone; computed per instance they cost
- * O(ntrain^2) at every creation (the robot's 290 poses: 8.5 ms of a 10 ms creation). */
+ * pose_space.h), and how far the training poses bend each joint (what the step calls
+ * beyond training, sw_pose_space_beyond). They depend on the blob alone; computed per instance they
+ * cost O(ntrain^2) at every creation (the robot's 290 poses: 8.5 ms of a 10 ms creation). */
 #ifndef SW_BLOB_POSE_INDEX_H
 #define SW_BLOB_POSE_INDEX_H
 
@@ -21,6 +22,8 @@ typedef struct sw_pose_index {
     double *pair_reach; /* npair_groups ntrain: per group and pose, the feature distance to
                            the group's nearest other distinct sample (INFINITY: none); NULL
                            without per-pair sections */
+    double *joint_bend; /* nbones: each joint's largest bend (sw_pose_feature_bend) over the
+                           training poses; 0 for a root (its turn is rigid motion) */
 } sw_pose_index;
 
 /* Bytes sw_pose_index_build needs for v (8-byte aligned parts). */

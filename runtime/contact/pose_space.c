@@ -119,6 +119,29 @@ void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double
     ps->second = ps->blend > 0 ? sw_pose_space_branch(ps, v, n1) : n1;
 }
 
+static const double RAD_PER_DEG = 0.017453292519943295;
+
+int sw_joint_beyond_training(double bend, double trained) {
+    return bend > SW_BEYOND_RATIO * trained && bend - trained > SW_BEYOND_DEG * RAD_PER_DEG;
+}
+
+int32_t sw_pose_space_beyond(const sw_pose_space *ps, const sw_blob_view *v, int32_t *bone,
+                             double *excess) {
+    int32_t n = 0;
+    *bone = -1;
+    *excess = 0;
+    if (v->ntrain < 1 || !ps->joint_bend) return 0;
+    for (int32_t b = 0; b < v->nbones; ++b) {
+        if (v->bone_parent[b] < 0) continue;
+        double bend = sw_pose_feature_bend(ps->feature + 4 * b), trained = ps->joint_bend[b];
+        if (!sw_joint_beyond_training(bend, trained)) continue;
+        ++n;
+        double deg = (bend - trained) / RAD_PER_DEG;
+        if (deg > *excess) *excess = deg, *bone = b;
+    }
+    return n;
+}
+
 void sw_pose_space_add_pair(sw_pose_space *ps, int32_t c, double w, double tan) {
     if (ps->npairs == ps->max_pairs) {
         ps->dropped++;

@@ -16,10 +16,11 @@ typedef struct sw_pose_space {
     /* the blob's pose index (blob_pose_index.h): twins and each pose's reach */
     const int32_t *twin_next;
     const double *reach;
-    int looked_up;   /* feature_last holds a pose */
-    int32_t nearest; /* training pose nearest to the current pose, or -1 */
-    int32_t second;  /* the second nearest, or -1 */
-    double blend;    /* pose-space weight of `second` (0: `nearest` alone) */
+    const double *joint_bend; /* nbones: each joint's largest bend in training (the index's) */
+    int looked_up;            /* feature_last holds a pose */
+    int32_t nearest;          /* training pose nearest to the current pose, or -1 */
+    int32_t second;           /* the second nearest, or -1 */
+    double blend;             /* pose-space weight of `second` (0: `nearest` alone) */
     /* feature distances of the current pose to `nearest` and to the last lookup's pose
        (INFINITY without one) */
     double d_nearest, d_last;
@@ -60,6 +61,22 @@ void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);
  * weight, and updates the pose motion. Sets nearest (-1 without training poses), second,
  * blend and tangent. O(ntrain nbones). */
 void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T);
+
+/* A joint is bent beyond training when its bend (radians) exceeds the largest a training
+ * pose gives it (trained) by more than SW_BEYOND_RATIO times and SW_BEYOND_DEG degrees:
+ * there the subspace extrapolates (the Fox's Run bends its hip 4 times as far as Survey
+ * and Walk, and misses 0.27 of its correction against 0.008 on those clips;
+ * docs/accuracy.md "The Fox's Run is beyond its training"). The one rule of the bake's
+ * held-out list (sw_bake_beyond_training) and the step's stat. */
+#define SW_BEYOND_RATIO 1.25
+#define SW_BEYOND_DEG 5.0
+int sw_joint_beyond_training(double bend, double trained);
+
+/* After sw_pose_space_lookup: how many joints the current pose bends beyond training
+ * (0 without training poses), the one furthest beyond (*bone, -1: none) and by how many
+ * degrees (*excess, 0: none). O(nbones). */
+int32_t sw_pose_space_beyond(const sw_pose_space *ps, const sw_blob_view *v, int32_t *bone,
+                             double *excess);
 
 /* Collects the contact pairs of the poses the lookup found into ps->pairs, the nearest
  * pose's first, at most max_pairs; sets npairs and dropped. */

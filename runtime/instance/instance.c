@@ -507,6 +507,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->wc.radius = 0.01 * in->size;
     in->ps.twin_next = blob->poses.twin_next; /* the blob's, computed once at its load */
     in->ps.reach = blob->poses.reach;
+    in->ps.joint_bend = blob->poses.joint_bend;
     in->ps.pair_reach = z.per_pair ? blob->poses.pair_reach : NULL;
     in->cond.z = z.cond;
     if (z.cond.max_verts > 0) sw_cond_build(&in->cond, v, z.rho * in->size);

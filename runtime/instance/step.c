@@ -1,7 +1,8 @@
 /* The per-frame step (DESIGN.md §4) as the list of its phases, each a function of the
  * step context:
  *   skin      dual-quaternion skinning of the active vertices (eq. 4.13)
- *   contact   the training poses nearest to the pose, their contact pairs (§3.2.3)
+ *   contact   the training poses nearest to the pose, their contact pairs (§3.2.3), and
+ *             the joints the pose bends beyond every training pose
  *   dynamics  teleports, inertial forces, the start state, the frozen damping Hessian
  *   self      exhaustive self-contact: the pairs touching at the start state
  *             (self_contact.h); either mode: the Hessian's block pattern
@@ -90,6 +91,9 @@ sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) 
 static void phase_contact(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_pose_space_lookup(&in->ps, in->v, in->pose.T_cur);
+    c->st.joints_beyond_training = (uint32_t)sw_pose_space_beyond(
+        &in->ps, in->v, &c->st.beyond_training_bone, &c->st.beyond_training_deg);
+    if (c->st.joints_beyond_training > 0) c->st.status |= SINEW_STEP_BEYOND_TRAINING;
     if (exhaustive(in)) {
         in->ps.npairs = in->ps.dropped = 0;
     } else {

@@ -144,6 +144,12 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
     }
 }
 
+double sw_pose_feature_bend(const double q[4]) {
+    /* 2 atan2(|v|, |w|), not 2 acos(w): exact to rounding near 0 */
+    double v = sqrt(q[1] * q[1] + q[2] * q[2] + q[3] * q[3]);
+    return 2.0 * atan2(v, fabs(q[0]));
+}
+
 void sw_relative_transform(const double Ta[12], const double Tb[12], double z[12]) {
     const double *Ra = Ta, *ta = Ta + 9, *Rb = Tb, *tb = Tb + 9;
     for (int i = 0; i < 3; ++i) {

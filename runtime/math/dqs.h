@@ -36,6 +36,10 @@ void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int
  * writes 4 * nbones doubles. Invariant to the character's global placement. */
 void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature);
 
+/* The angle (radians, [0, pi]) of the rotation a pose feature's unit quaternion q holds:
+ * how far the bone is bent from its rest in its parent's frame. */
+double sw_pose_feature_bend(const double q[4]);
+
 /* z = [vec(R); t] (R row-major) of Tb in Ta's frame, Ta^-1 Tb, for rigid transforms Ta, Tb
  * (12 each): the per-pair contact feature's input (bake_pairs.c, pair_space.c). */
 void sw_relative_transform(const double Ta[12], const double Tb[12], double z[12]);

@@ -49,7 +49,8 @@
     X(offsetof(sinew_step_stats, ms_output))                                                       \
     X(offsetof(sinew_step_stats, active_vertices))                                                 \
     X(offsetof(sinew_step_stats, budget_exceeded))                                                 \
-    X(offsetof(sinew_step_stats, ms_self_contact))
+    X(offsetof(sinew_step_stats, ms_self_contact))                                                 \
+    X(offsetof(sinew_step_stats, beyond_training_deg))
 
 #ifdef __cplusplus
 extern "C" {

@@ -247,6 +247,12 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
  * scaled back onto their bound (its velocity zeroed), or a velocity scaled down to the
  * speed bound; the output is the limited state */
 #define SINEW_STEP_LIMITED 64u
+/** the pose bends a joint beyond the bake's training: more than 1.25 times and 5 degrees
+ * further than any training pose bends it (joints_beyond_training says how many). The
+ * subspace then extrapolates, and the correction it gives misses more than on the motion
+ * it was baked from (the Fox baked on its walk and played running: 0.27 of the correction
+ * missed, against 0.008 on the walk); bake with motion that reaches those bends. */
+#define SINEW_STEP_BEYOND_TRAINING 128u
 
 /** Budgets of an instance (sinew_step_stats.budget_exceeded bits). */
 #define SINEW_BUDGET_CONTACT_PAIRS 1u  /**< sinew_instance_def.max_contact_pairs */
@@ -313,6 +319,15 @@ typedef struct sinew_step_stats {
      * pose is to the pair's own training pose, where a pair always stays); counted in
      * self_contact_tests, not in contact_pairs or self_contacts */
     uint32_t self_contacts_apart;
+    /** joints the pose bends beyond the bake's training (SINEW_STEP_BEYOND_TRAINING): a
+     * joint's bend is its bone's rotation from rest in its parent's frame, the angle the
+     * bake's held-out list (heldout_beyond_training) measures too */
+    uint32_t joints_beyond_training;
+    /** the bone whose joint is bent furthest beyond training, -1 when none is */
+    int32_t beyond_training_bone;
+    uint32_t reserved2; /**< zero */
+    /** how far (degrees) that joint's bend exceeds the largest of the training poses */
+    double beyond_training_deg;
 } sinew_step_stats;
 
 #ifdef __cplusplus
