@@ -45,9 +45,10 @@ static void check_beyond(const cJSON *j, const sw_bake_result *res, const sw_ske
     }
 }
 
+/* flagged_out: the training [0] and held-out [1] frames the report marks beyond training. */
 static void check_json(const char *dir, const sw_bake_result *res, const sw_blob_view *v,
                        const sw_skeleton *sk, double err_heldout, const sw_eval_result *eh,
-                       const double *modes) {
+                       const double *modes, int flagged_out[2]) {
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);
@@ -107,6 +108,27 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == 6);
     int32_t nbeyond;
     check_beyond(j, res, sk, &nbeyond);
+    /* per frame, the joints it bends beyond training: each pose's own count, some
+       held-out frame's nonzero exactly when the bake lists a joint beyond */
+    int flagged[2] = {0, 0};
+    for (int i = 0; i < 2 && cJSON_GetArraySize(clips) == 2; ++i) {
+        const cJSON *b =
+            cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(clips, i), "beyond_training");
+        ENSURE(cJSON_GetArraySize(b) == want_n[i]);
+        for (int32_t k = 0, t = 0; k < want_n[i] && cJSON_GetArraySize(b) == want_n[i]; ++k) {
+            const double *T = res->heldout_T + (size_t)k * 12 * sk->nbones;
+            if (i == 0) { /* the k-th training pose of the clip */
+                while (t < res->ntrain && res->train_clip[t] != 0)
+                    ++t;
+                T = res->train_T + (size_t)t++ * 12 * sk->nbones;
+            }
+            int32_t want = sw_bake_pose_beyond(sk, T, res->sweep_angle);
+            ENSURE(cJSON_GetArrayItem(b, k)->valuedouble == want);
+            flagged[i] += want > 0;
+        }
+    }
+    ENSUREF((flagged[1] > 0) == (nbeyond > 0), "%d frames beyond training, %d joints listed",
+            flagged[1], nbeyond);
     const cJSON *bm = cJSON_GetObjectItemCaseSensitive(j, "err_heldout_by_mode");
     for (int k = 0; k < SW_BAKE_MODES; ++k) {
         const cJSON *m = cJSON_GetObjectItemCaseSensitive(bm, sw_self_contact_keys[k]);
@@ -127,6 +149,8 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
         ENSURE_NEAR(num(a0, "picks_error"), 0.5, 1e-12);
         ENSURE(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(a1, "picks_error")));
     }
+    flagged_out[0] = flagged[0];
+    flagged_out[1] = flagged[1];
     cJSON_Delete(j);
     free(text);
 }
@@ -246,7 +270,26 @@ TEST(clips_of_their_own_and_the_report) {
     snprintf(dir, sizeof dir, "%s/test_bake_report_out", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
-    check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes);
+    int flagged[2] = {-1, -1};
+    check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes, flagged);
+    ENSURE(flagged[0] == 0); /* a training clip never bends beyond itself */
+    /* had the training reached half as far, the reversed fold would bend beyond it: the
+       report marks those frames (and lists the joints) as the rule says */
+    for (int32_t b = 0; b < ch.skel.nbones; ++b)
+        res.sweep_angle[b] *= 0.5;
+    char dir2[1100];
+    snprintf(dir2, sizeof dir2, "%.1000s_half", dir);
+    ENSURE(sw_bake_report_write(dir2, &in, &e) == SINEW_OK);
+    flagged[1] = -1;
+    check_json(dir2, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes, flagged);
+    ENSUREF(flagged[1] > 0, "%d held-out frames beyond half the training's bends", flagged[1]);
+    char path2[1200];
+    snprintf(path2, sizeof path2, "%s/report.html", dir2);
+    char *html2 = read_text(path2);
+    ENSURE(html2 && strstr(html2, "stroke=\"#c00\"")); /* the marks in the plot */
+    free(html2);
+    for (int32_t b = 0; b < ch.skel.nbones; ++b)
+        res.sweep_angle[b] *= 2;
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.html", dir);
     char *html = read_text(path);

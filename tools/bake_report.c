@@ -58,6 +58,8 @@ typedef struct report_clip {
     int32_t n;
     int32_t *frame;
     double *error;
+    int32_t *beyond; /* per frame: joints bent beyond training (sw_bake_pose_beyond) */
+    int32_t nbeyond; /* frames with any */
 } report_clip;
 
 #define REPORT_BEYOND 32 /* joints listed beyond training, at most */
@@ -75,20 +77,31 @@ static void report_free(report *r) {
     for (int32_t i = 0; i < r->nclips; ++i) {
         free(r->clips[i].frame);
         free(r->clips[i].error);
+        free(r->clips[i].beyond);
     }
     free(r->clips);
     memset(r, 0, sizeof *r);
 }
 
 /* The poses of one split labelled `label` as a clip of the report (label -1: the poses
- * of no clip, numbered in order: a bare skeleton's random combined held-out poses). */
+ * of no clip, numbered in order: a bare skeleton's random combined held-out poses), each
+ * with its error and the joints it bends beyond the bake's training (T: the split's
+ * poses, 12 nbones each). */
 static int gather_clip(report_clip *c, int32_t npose, const int32_t *labels, const int32_t *frames,
-                       const double *errors, int32_t label) {
+                       const double *errors, int32_t label, const double *T,
+                       const sw_bake_report_input *in) {
+    const sw_skeleton *sk = &in->ch->skel;
     c->frame = malloc(sizeof(int32_t) * ((size_t)npose + 1));
     c->error = malloc(sizeof(double) * ((size_t)npose + 1));
-    if (!c->frame || !c->error) return 0;
+    c->beyond = malloc(sizeof(int32_t) * ((size_t)npose + 1));
+    if (!c->frame || !c->error || !c->beyond) return 0;
     for (int32_t k = 0; k < npose; ++k)
         if (labels[k] == label) {
+            int32_t b =
+                sw_bake_pose_beyond(sk, T + (size_t)k * 12 * sk->nbones, in->res->sweep_angle);
+            if (b < 0) return 0;
+            c->nbeyond += b > 0;
+            c->beyond[c->n] = b;
             c->frame[c->n] = label < 0 ? c->n : frames[k];
             c->error[c->n++] = errors[k];
         }
@@ -122,11 +135,13 @@ static int gather(const sw_bake_report_input *in, report *r) {
                          in->ch->name[0] ? in->ch->name : "clip", s ? "held-out" : "training");
             if (!gather_clip(c, npose, s ? res->heldout_clip : res->train_clip,
                              s ? res->heldout_frame : res->train_frame,
-                             s ? in->heldout_frames : in->train_frames, label))
+                             s ? in->heldout_frames : in->train_frames, label,
+                             s ? res->heldout_T : res->train_T, in))
                 return 0;
             if (!names && c->n == 0) { /* no clip to show (a bare skeleton trains on sweeps) */
                 free(c->frame);
                 free(c->error);
+                free(c->beyond);
                 memset(c, 0, sizeof *c);
                 r->nclips--;
             }
@@ -176,15 +191,18 @@ static cJSON *json_clips(const report *r) {
     cJSON *a = cJSON_CreateArray();
     for (int32_t i = 0; i < r->nclips; ++i) {
         const report_clip *c = &r->clips[i];
-        cJSON *o = cJSON_CreateObject(), *f = cJSON_CreateArray(), *e = cJSON_CreateArray();
+        cJSON *o = cJSON_CreateObject(), *f = cJSON_CreateArray(), *e = cJSON_CreateArray(),
+              *b = cJSON_CreateArray();
         cJSON_AddStringToObject(o, "name", c->name);
         cJSON_AddStringToObject(o, "split", c->heldout ? "heldout" : "train");
         for (int32_t k = 0; k < c->n; ++k) {
             cJSON_AddItemToArray(f, cJSON_CreateNumber(c->frame[k]));
             cJSON_AddItemToArray(e, json_number(c->error[k]));
+            cJSON_AddItemToArray(b, cJSON_CreateNumber(c->beyond[k]));
         }
         cJSON_AddItemToObject(o, "frames", f);
         cJSON_AddItemToObject(o, "error", e);
+        cJSON_AddItemToObject(o, "beyond_training", b);
         cJSON_AddItemToArray(a, o);
     }
     return a;
@@ -354,9 +372,10 @@ static void html_text(FILE *f, const char *s) {
 #define PAD 34
 
 /* A line plot of y over x (n points; NaN points skipped) with y from 0 to ymax, the x axis
- * named xname. */
+ * named xname; a red tick under every point whose mark is nonzero (NULL: none). */
 static void svg_line(FILE *f, const char *title, const char *xname, const int32_t *x,
-                     const double *y, int32_t n, double ymax, const char *colour) {
+                     const double *y, const int32_t *mark, int32_t n, double ymax,
+                     const char *colour) {
     fprintf(f, "<figure><figcaption>");
     html_text(f, title);
     fprintf(f, "</figcaption><svg width=\"%d\" height=\"%d\" viewBox=\"0 0 %d %d\">", PLOT_W,
@@ -374,6 +393,11 @@ static void svg_line(FILE *f, const char *title, const char *xname, const int32_
             "<text x=\"%d\" y=\"%d\" font-size=\"10\" text-anchor=\"end\">%d</text>",
             PAD + 4, ymax, PLOT_H - PAD, PAD, PLOT_H - PAD + 14, xname, xmin, PLOT_W - PAD,
             PLOT_H - PAD + 14, xmax);
+    for (int32_t k = 0; mark && k < n; ++k)
+        if (mark[k])
+            fprintf(f, "<line x1=\"%.1f\" y1=\"%d\" x2=\"%.1f\" y2=\"%d\" stroke=\"#c00\"/>",
+                    PAD + sx * (x[k] - xmin), PLOT_H - PAD + 2, PAD + sx * (x[k] - xmin),
+                    PLOT_H - PAD + 6);
     fprintf(f, "<polyline fill=\"none\" stroke=\"%s\" stroke-width=\"1.5\" points=\"", colour);
     for (int32_t k = 0; k < n; ++k)
         if (isfinite(y[k]))
@@ -471,14 +495,20 @@ static void html_clips(FILE *f, const report *r) {
     for (int32_t i = 0; i < r->nclips; ++i)
         for (int32_t k = 0; k < r->clips[i].n; ++k)
             if (isfinite(r->clips[i].error[k])) ymax = fmax(ymax, r->clips[i].error[k]);
-    fprintf(f, "<h2>Correction error of every clip frame</h2><p>Training clips in blue, "
-               "held-out clips (never trained on) in orange; same scale.</p><div class=\"row\">");
+    fprintf(f,
+            "<h2>Correction error of every clip frame</h2><p>Training clips in blue, "
+            "held-out clips (never trained on) in orange; same scale. A red tick marks a "
+            "frame that bends a joint beyond every training pose (more than %.2f times "
+            "and %.0f degrees further), as the runtime flags it "
+            "(SINEW_STEP_BEYOND_TRAINING).</p><div class=\"row\">",
+            SW_BEYOND_RATIO, SW_BEYOND_DEG);
     for (int32_t i = 0; i < r->nclips; ++i) {
-        char title[160];
-        snprintf(title, sizeof title, "%s (%s, %d frames)", r->clips[i].name,
-                 r->clips[i].heldout ? "held out" : "training", r->clips[i].n);
-        svg_line(f, title, "frame", r->clips[i].frame, r->clips[i].error, r->clips[i].n, ymax,
-                 r->clips[i].heldout ? "#d2691e" : "#1f77b4");
+        const report_clip *c = &r->clips[i];
+        char title[200];
+        snprintf(title, sizeof title, "%s (%s, %d frames, %d beyond training)", c->name,
+                 c->heldout ? "held out" : "training", c->n, c->nbeyond);
+        svg_line(f, title, "frame", c->frame, c->error, c->beyond, c->n, ymax,
+                 c->heldout ? "#d2691e" : "#1f77b4");
     }
     fprintf(f,
             "</div><p>Joint sweeps and other training poses of no clip: %d, mean error "
@@ -595,7 +625,8 @@ static void html_adaptive(FILE *f, const sw_adaptive_report *a) {
         if (isfinite(y[k])) ymax = fmax(ymax, y[k]);
     }
     fprintf(f, "</table>");
-    svg_line(f, "held-out correction error per round", "round", x, y, a->nrounds, ymax, "#d2691e");
+    svg_line(f, "held-out correction error per round", "round", x, y, NULL, a->nrounds, ymax,
+             "#d2691e");
 }
 
 static int write_html(const char *path, const sw_bake_report_input *in, const report *r,

@@ -224,6 +224,12 @@ typedef struct sw_joint_reach {
 int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, sw_joint_reach *out,
                                 int32_t max);
 
+/* How many joints pose T (12 nbones) bends beyond the trained bends (trained: per bone,
+ * radians; a bake's sweep_angle) by the step's rule (sw_joint_beyond_training): the
+ * report marks such frames, as the step flags them (SINEW_STEP_BEYOND_TRAINING). -1 out
+ * of memory. */
+int32_t sw_bake_pose_beyond(const sw_skeleton *sk, const double *T, const double *trained);
+
 /* The fewest clip frames a bake can train on: it trains on the first
  * floor((1 - heldout_fraction) F) frames and holds out the rest, and learns its basis and
  * cubature from the deformation of the training poses (each joint is also swept up to the

@@ -173,6 +173,17 @@ int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, 
     return total;
 }
 
+int32_t sw_bake_pose_beyond(const sw_skeleton *sk, const double *T, const double *trained) {
+    double *bend = calloc((size_t)sk->nbones + 1, sizeof(double));
+    if (!bend) return -1;
+    sw_bake_joint_reach(sk, T, 1, bend, NULL);
+    int32_t n = 0;
+    for (int32_t b = 0; b < sk->nbones; ++b)
+        n += sk->parent[b] >= 0 && sw_joint_beyond_training(bend[b], trained ? trained[b] : 0);
+    free(bend);
+    return n;
+}
+
 /* The largest rotation each joint reaches in the training ranges: its sweep. Without a
  * clip, 90 degrees about an axis across the bone. */
 static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32_t ntr,
