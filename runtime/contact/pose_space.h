@@ -13,14 +13,15 @@ typedef struct sw_pose_space {
     double *feature;      /* 4 nbones: the current pose's feature */
     double *feature_last; /* 4 nbones: the pose feature of the last lookup */
     double *motion;       /* 4 nbones: the last change of pose between two lookups */
-    /* the blob's pose index (blob_pose_index.h): twins and each pose's reach */
+    /* the blob's pose index (blob_pose_index.h): twins, each pose's reach, and each
+       joint's largest bend in training (nbones; sw_pose_space_beyond) */
     const int32_t *twin_next;
     const double *reach;
-    const double *joint_bend; /* nbones: each joint's largest bend in training (the index's) */
-    int looked_up;            /* feature_last holds a pose */
-    int32_t nearest;          /* training pose nearest to the current pose, or -1 */
-    int32_t second;           /* the second nearest, or -1 */
-    double blend;             /* pose-space weight of `second` (0: `nearest` alone) */
+    const double *joint_bend;
+    int looked_up;   /* feature_last holds a pose */
+    int32_t nearest; /* training pose nearest to the current pose, or -1 */
+    int32_t second;  /* the second nearest, or -1 */
+    double blend;    /* pose-space weight of `second` (0: `nearest` alone) */
     /* feature distances of the current pose to `nearest` and to the last lookup's pose
        (INFINITY without one) */
     double d_nearest, d_last;
