@@ -1,11 +1,13 @@
 /* The adaptive training loop (precompute/bake/bake_adaptive.h; issue 16, item 1): each
  * round adds the candidates its proxy scores worst, and the reference confirms they are
  * poses the blob gets wrong (worse than the held-out poses); a round solves only its new
- * poses (the other chains come from the cache); the added poses are never held-out ones;
+ * poses (the other chains come from the cache), and a re-bake with another cubature none;
+ * the added poses are never held-out ones;
  * the budget and the target stop the loop; the caller's extra poses are checked. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
+#include <unistd.h>
 
 #include "bake_adaptive.h"
 #include "samples.h"
@@ -64,6 +66,36 @@ TEST(rounds_add_the_poses_the_blob_gets_wrong_and_solve_only_those) {
     sw_character_free(&c);
 }
 
+/* Every candidate picked, so a re-bake picks the same poses whatever its scores: with only
+ * the cubature changed, its rounds read every chain back from the cache (the picks go in
+ * as paths in the candidates' order; in the scores' order a changed blob renamed them). */
+TEST(an_adaptive_rebake_that_changes_only_the_cubature_solves_nothing) {
+    char dir[] = "/tmp/sinew-adaptive-XXXXXX";
+    ENSURE(mkdtemp(dir));
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 5, &c, &err) == SINEW_OK);
+    sw_bake_params p = quick();
+    p.cache_dir = dir;
+    sw_adaptive_params a = sw_adaptive_params_default();
+    a.rounds = 1;
+    a.add = a.candidates = 6;
+    sw_bake_result res;
+    sw_adaptive_report rep;
+    ENSUREF(sw_bake_adaptive(&c, &p, &a, &res, &rep, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(rep.nrounds == 2 && rep.round[1].added == 6 && rep.round[1].solved == 6);
+    sw_bake_result_free(&res);
+    p.cubature_tol = 0.2;
+    ENSUREF(sw_bake_adaptive(&c, &p, &a, &res, &rep, &err) == SINEW_OK, "%s", err.msg);
+    fprintf(stderr, "    re-bake: solved %d, %d\n", rep.round[0].solved, rep.round[1].solved);
+    ENSURE(rep.nrounds == 2 && rep.round[0].solved == 0 && rep.round[1].solved == 0);
+    sw_bake_result_free(&res);
+    sw_character_free(&c);
+    char cmd[128];
+    snprintf(cmd, sizeof cmd, "rm -rf %s", dir);
+    ENSURE(system(cmd) == 0);
+}
+
 TEST(bad_loop_parameters_and_extra_poses_are_named) {
     sw_character c;
     sw_error err;
@@ -112,4 +144,5 @@ TEST(bad_loop_parameters_and_extra_poses_are_named) {
 }
 
 SW_TEST_MAIN(CASE(rounds_add_the_poses_the_blob_gets_wrong_and_solve_only_those),
+             CASE(an_adaptive_rebake_that_changes_only_the_cubature_solves_nothing),
              CASE(bad_loop_parameters_and_extra_poses_are_named))

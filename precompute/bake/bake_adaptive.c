@@ -128,15 +128,21 @@ static sinew_result pick(const sinew_blob *blob, const sw_bake_result *res, cons
     }
     rd->picks_score = 0;
     int32_t added = 0;
-    for (; added < a->add; ++added) { /* the add highest, highest first */
+    for (; added < a->add; ++added) { /* the add highest (a failed step scores -1) */
         int32_t best = 0;
         for (int32_t i = 1; i < n; ++i)
             if (sc[i] > sc[best]) best = i;
         if (sc[best] < 0) break; /* the rest failed to step: no pose to learn from */
-        memcpy(*extra + (size_t)(*nextra)++ * pose, T + best * pose, pose * sizeof(double));
         rd->picks_score += sc[best];
         sc[best] = -2;
     }
+    /* appended in the candidates' own order, not the scores': the picks are solved as paths
+     * from rest, so a re-bake whose blob picks the same poses in another order (one that
+     * changes only the cubature or the rank) names the same chains and reads them from the
+     * simulate cache instead of solving them again */
+    for (int32_t i = 0; i < n; ++i)
+        if (sc[i] == -2)
+            memcpy(*extra + (size_t)(*nextra)++ * pose, T + i * pose, pose * sizeof(double));
     rd->picks_score = added > 0 ? rd->picks_score / added : 0;
     *npicked = added;
     scorer_free(&s);
