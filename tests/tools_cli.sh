@@ -77,6 +77,8 @@ expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'"
     "$bench" --scene finger --tets 10
 expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \
     "$bench" "${small[@]}" --full-frames 0
+expect bench_timing_passes_range 2 "--timing-passes wants an integer in 1\.\.1000, got '0'" \
+    "$bench" "${small[@]}" --timing-passes 0
 expect bench_instances_range 2 "--instances wants an integer in 1\.\.4096, got '0'" \
     "$bench" "${small[@]}" --instances 0
 expect bench_instances_range_high 2 "--instances wants an integer in 1\.\.4096, got '4097'" \
@@ -163,6 +165,18 @@ if [ -s "$tmp/f.blob" ] &&
     grep -q "correction error on clip frames" "$tmp/clip.err" ||
         { echo "FAIL clip_errors: the summary does not say clip frames" >&2; ok=0; }
     if [ "$ok" -eq 1 ]; then echo "ok   clip_errors"; else fails=$((fails + 1)); fi
+    # --timing-passes replays the clip for the timing only: the same errors, its count said
+    if "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --contract-steps 10 \
+        --timing-passes 3 --json >"$tmp/passes.json" 2>"$tmp/passes.err" &&
+        [ "$(key "$tmp/passes.json" timing_passes)" = 3 ] &&
+        [ "$(key "$tmp/clip.json" timing_passes)" = 1 ] &&
+        [ "$(key "$tmp/passes.json" err_clip_heldout)" = "$(key "$tmp/clip.json" err_clip_heldout)" ] &&
+        [[ $(key "$tmp/passes.json" sub_ms) =~ ^[0-9.]+$ ]]; then
+        echo "ok   timing_passes"
+    else
+        echo "FAIL timing_passes: other errors, or no timing_passes in the JSON" >&2
+        fails=$((fails + 1))
+    fi
 else
     echo "FAIL clip_errors: the bench failed" >&2
     tail -n 3 "$tmp/clip.err" >&2

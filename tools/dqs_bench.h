@@ -11,7 +11,8 @@
 #include "blob_view.h"
 #include "sw_mesh.h"
 
-/* The median ms a frame over the clip's first `frames` poses; -1 when out of memory. */
-double sw_dqs_bench_ms(const sw_blob_view *v, const sw_clip *clip, int frames);
+/* The median ms a frame over the clip's first `frames` poses, each frame's least time over
+ * `passes` plays of them (1: one play); -1 when out of memory. */
+double sw_dqs_bench_ms(const sw_blob_view *v, const sw_clip *clip, int frames, int passes);
 
 #endif
