@@ -49,7 +49,7 @@ typedef struct sw_bake_params {
     double pca_strain;             /* the PCA's inner product: this share from the snapshots'
                                       rest strain energy, the rest from their plain products
                                       (default 0: plain PCA; bake_basis.c: at the same rank
-                                      no better, docs/accuracy.md) */
+                                      no better, docs/generalisation.md) */
     double cubature_tol;           /* default 0.05 */
     int32_t cubature_max;          /* per domain (default 1000) */
     sw_cubature_selector selector; /* default NN-HTP */
@@ -219,7 +219,7 @@ typedef struct sw_joint_reach {
  * step's rule, sw_joint_beyond_training), the
  * largest multiple of the trained bend first, at most max of them into out; returns how many there
  * are (-1 out of memory). There the basis extrapolates: a held-out clip that turns a joint two or
- * three times as far as the training clips is beyond what the bake learnt (docs/accuracy.md
+ * three times as far as the training clips is beyond what the bake learnt (docs/generalisation.md
  * "The Fox's Run is beyond its training"). Random held-out poses stay within the sweeps. */
 int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, sw_joint_reach *out,
                                 int32_t max);
@@ -277,7 +277,7 @@ extern const char *const sw_self_contact_keys[SW_BAKE_MODES];
  * (already measured), NaN for the pose-pairs mode of a blob without per-pair sections and for a
  * mode whose steps failed. Which mode suits the character's motion: on clips like its training
  * clips the pose-space mode, on combinations of joints no training pose holds the
- * detecting modes (docs/accuracy.md "The Fox's Run is beyond its training"). */
+ * detecting modes (docs/generalisation.md "The Fox's Run is beyond its training"). */
 sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *res,
                                  sinew_self_contact measured, double measured_err,
                                  double err_mode[SW_BAKE_MODES], sw_error *err);

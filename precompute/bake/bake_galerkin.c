@@ -8,7 +8,7 @@
  * projection error is (each domain's copies against the snapshot, relative), shows how
  * much of the runtime's error the span and the springs already decide, before the
  * cubature, the contact and the nonlinearity: the Fox's Run 0.266 against a projection of
- * 0.185 and a runtime error of 0.283 (docs/accuracy.md, The Galerkin projection). */
+ * 0.185 and a runtime error of 0.283 (docs/generalisation.md, The Galerkin projection). */
 #include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
