@@ -11,7 +11,8 @@
  *             its first K frames)
  *   sub_ms    median subspace step + surface read ms/frame over the clip; with
  *             --timing-passes P each frame's time is its least over P plays of the clip
- *             (machine noise only adds time), and dqs_ms's likewise (timing_passes)
+ *             (machine noise only adds time), and dqs_ms's likewise (timing_passes);
+ *             failed_steps counts the steps of every play
  *   dqs_ms    median ms/frame of DQS of the output surface (positions and normals): the
  *             render mesh's own vertices when the blob embeds one (issue 14), so
  *             cost_vs_dqs is the cost against skinning the very mesh a host draws
@@ -169,8 +170,8 @@ static void usage(FILE *f) {
             "                      (default 10000)\n"
             "  --threads T         0..256 (default 0: all cores); also the crowd's threads\n"
             "  --timing-passes P   play the clip P times for sub_ms and dqs_ms, each frame's\n"
-            "                      least time of the P, 1..1000 (default 1; the errors and the\n"
-            "                      step's counts are the first play's)\n"
+            "                      least time of the P, 1..1000 (default 1; the errors and\n"
+            "                      counts: the first play's; failed_steps: every play's)\n"
             "  --out DIR           write the subspace surface of every clip frame as\n"
             "                      DIR/frame_NNNN.obj; with --world, the condensed run's\n"
             "                      (the first radius) as DIR/condensed/frame_NNNN.obj, the\n"
@@ -496,7 +497,9 @@ int main(int argc, char **argv) {
                 *pk = pass == 0 ? ph[k] : fmin(*pk, ph[k]);
             }
             sub[f] = pass == 0 ? ms : fmin(sub[f], ms);
-            if (pass > 0) continue; /* the counts are the first play's */
+            if (pass > 0)
+                continue; /* the counts are the first play's (a failed step is
+                             counted in any play: none is hidden) */
             evals += st.potential_evals / (double)nf;
             factors += st.factorizations / (double)nf;
             beyond_frames += (st.status & SINEW_STEP_BEYOND_TRAINING) != 0;
