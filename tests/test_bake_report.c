@@ -4,6 +4,7 @@
  * the report's JSON parses back (cJSON) with the bake's figures, and the page and the
  * contact sheet are written. A 1,000-tet finger: a few seconds. */
 #include <cjson/cJSON.h>
+#include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -310,9 +311,31 @@ TEST(clips_of_their_own_and_the_report) {
     sw_character_free(&ch);
 }
 
-/* A bare skeleton (no clip): the held-out poses are random combined poses, which the
- * report shows as a held-out set of their own, each pose's error the evaluation's; no
- * empty training clip is listed. */
+/* The angle of joint b's turn between poses A and B (its rotations in its parent's). */
+static double joint_turn(const sw_skeleton *sk, const double *A, const double *B, int32_t b) {
+    const double *Ra = A + 12 * b, *Rb = B + 12 * b;
+    double La[9], Lb[9], D[9];
+    int32_t p = sk->parent[b];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) { /* L = R_parent^T R_b */
+            La[3 * i + j] = Ra[j + 0] * (p < 0 ? (i == 0) : A[12 * p + i]) +
+                            Ra[3 + j] * (p < 0 ? (i == 1) : A[12 * p + 3 + i]) +
+                            Ra[6 + j] * (p < 0 ? (i == 2) : A[12 * p + 6 + i]);
+            Lb[3 * i + j] = Rb[j + 0] * (p < 0 ? (i == 0) : B[12 * p + i]) +
+                            Rb[3 + j] * (p < 0 ? (i == 1) : B[12 * p + 3 + i]) +
+                            Rb[6 + j] * (p < 0 ? (i == 2) : B[12 * p + 6 + i]);
+        }
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) /* D = La^T Lb */
+            D[3 * i + j] = La[i] * Lb[j] + La[3 + i] * Lb[3 + j] + La[6 + i] * Lb[6 + j];
+    double s = sqrt((D[7] - D[5]) * (D[7] - D[5]) + (D[2] - D[6]) * (D[2] - D[6]) +
+                    (D[3] - D[1]) * (D[3] - D[1]));
+    return atan2(0.5 * s, 0.5 * (D[0] + D[4] + D[8] - 1));
+}
+
+/* A bare skeleton (no clip): the held-out poses are random combined poses, each reached
+ * from the one before in heldout_steps poses, which the report shows as a held-out set of
+ * their own, each pose's error the evaluation's; no empty training clip is listed. */
 TEST(random_heldout_poses_in_the_report) {
     sw_character ch;
     sw_error e;
@@ -321,6 +344,7 @@ TEST(random_heldout_poses_in_the_report) {
     sw_bake_params p = sw_bake_params_default();
     p.threads = 2;
     p.random_poses = 4;
+    p.heldout_steps = 3;
     sw_bake_result res;
     sinew_result r = sw_bake(&ch, &p, &res, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
@@ -328,9 +352,41 @@ TEST(random_heldout_poses_in_the_report) {
         sw_character_free(&ch);
         return;
     }
-    ENSURE(res.nheldout == 4);
+    ENSURE(res.nheldout == 12);
     for (int32_t k = 0; k < res.nheldout; ++k)
         ENSURE(res.heldout_clip[k] < 0);
+    /* every third pose is the random pose a one-step path gives; on the way to it every
+       joint turns by a third of its way there at a time, the first from rest */
+    int32_t nb = ch.skel.nbones;
+    double *T1 = malloc(sizeof(double) * 4 * 12 * (size_t)nb),
+           *local = malloc(sizeof(double) * SW_RANDOM_POSE_SCRATCH * (size_t)nb),
+           *rest = malloc(sizeof(double) * 12 * (size_t)nb);
+    ENSURE(T1 && local && rest);
+    if (T1 && local && rest && res.nheldout == 12) {
+        sw_bake_random_poses(&ch.skel, res.sweep_axis, res.sweep_angle, p.seed, 4, 1, local, T1);
+        for (int32_t k = 0; k < 9 * nb; ++k)
+            local[k] = k % 9 % 4 == 0; /* identity rotations: the rest pose */
+        sw_forward_kinematics(&ch.skel, local, NULL, rest);
+        double largest = 0;
+        for (int32_t k = 0; k < 4; ++k) {
+            const double *end = res.heldout_T + (size_t)(3 * k + 2) * 12 * nb;
+            ENSURE(!memcmp(end, T1 + (size_t)k * 12 * nb, sizeof(double) * 12 * (size_t)nb));
+            const double *from = k ? end - 3 * 12 * (size_t)nb : rest;
+            for (int32_t b = 0; b < nb; ++b) {
+                double whole = joint_turn(&ch.skel, from, end, b);
+                for (int st = 0; st < 3; ++st) {
+                    const double *a = st ? end - (size_t)(3 - st) * 12 * nb : from;
+                    const double *c = end - (size_t)(2 - st) * 12 * nb;
+                    ENSURE_NEAR(joint_turn(&ch.skel, a, c, b), whole / 3, 1e-9);
+                }
+                if (whole > largest) largest = whole;
+            }
+        }
+        ENSURE(largest > 0.1); /* the path moves */
+    }
+    free(T1);
+    free(local);
+    free(rest);
     void *mem = NULL;
     sinew_blob *blob = NULL;
     double *fe = NULL; /* per pose: the training poses', then the held-out ones' */
@@ -380,8 +436,8 @@ TEST(random_heldout_poses_in_the_report) {
                     *err = cJSON_GetObjectItemCaseSensitive(c, "error");
         ENSURE(cJSON_IsString(name) && !strcmp(name->valuestring, "random combined poses"));
         ENSURE(cJSON_IsString(split) && !strcmp(split->valuestring, "heldout"));
-        ENSURE(cJSON_GetArraySize(frames) == 4 && cJSON_GetArraySize(err) == 4);
-        for (int k = 0; k < 4 && cJSON_GetArraySize(err) == 4; ++k) {
+        ENSURE(cJSON_GetArraySize(frames) == 12 && cJSON_GetArraySize(err) == 12);
+        for (int k = 0; k < 12 && cJSON_GetArraySize(err) == 12; ++k) {
             ENSURE(cJSON_GetArrayItem(frames, k)->valuedouble == k);
             ENSURE_NEAR(cJSON_GetArrayItem(err, k)->valuedouble, fe[res.ntrain + k], 1e-12);
         }

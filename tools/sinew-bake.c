@@ -60,7 +60,7 @@ static void usage(FILE *f) {
                "                  [--pair-sweeps] [--no-sibling-sweeps]\n"
                "                  [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
-               "                  [--adaptive-target E]]\n"
+               "                  [--adaptive-target E]] [--heldout-steps S]\n"
                "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
                "                  [--no-pose-force]\n"
                "                  [--eval-self-contact pose-space|pose-pairs]\n"
@@ -97,6 +97,9 @@ static void usage(FILE *f) {
             "                   full-space force its state leaves over plain skinning's) to\n"
             "                   the training poses and bake again, until B poses (default 32)\n"
             "                   are added or the held-out error is at most E\n"
+            "  --heldout-steps S  without a clip, the 10 random held-out poses are each\n"
+            "                   reached from the one before in S held-out poses, 1..64\n"
+            "                   (default 4; the reference depends on the path)\n"
             "  --contact-modes  also the static responses to the training poses' self-contact\n"
             "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
             "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
@@ -201,6 +204,8 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &ad.candidates);
         else if (!strcmp(a, "--adaptive-budget") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, 1000000, &ad.budget);
+        else if (!strcmp(a, "--heldout-steps") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 64, &p.heldout_steps);
         else if (!strcmp(a, "--adaptive-target") && next)
             ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in 0..1", &ad.target);
         else if (!strcmp(a, "--inertia-modes"))

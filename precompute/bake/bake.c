@@ -35,6 +35,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.contact_cubature_tol = 0.05;
     p.heldout_fraction = 0.4;
     p.random_poses = 10;
+    p.heldout_steps = 4;
     p.self_contact = 1;
     p.spring_k = 0;
     p.cache_dir = NULL;
@@ -275,6 +276,12 @@ static sinew_result check_params(const sw_bake_params *pp, sw_error *err) {
                             p.max_rank, p.pca_energy, p.pca_strain, p.cubature_tol, p.cubature_max,
                             p.sweep_samples, p.max_train_frames, p.heldout_fraction, p.spring_k,
                             p.fold_share, p.contact_cubature_tol);
+    if (p.random_poses < 0 || p.heldout_steps < 1 || p.heldout_steps > 64 ||
+        (int64_t)p.random_poses * p.heldout_steps > 1000000)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "random held-out poses: %d poses in %d steps each (steps 1..64, "
+                            "at most 1000000 poses in all)",
+                            p.random_poses, p.heldout_steps);
     if (p.ntrain_clips < 0 || p.nheldout_clips < 0 || (p.ntrain_clips > 0 && !p.train_clips) ||
         (p.nheldout_clips > 0 && !p.heldout_clips) || (p.nheldout_clips > 0 && !p.ntrain_clips))
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,

@@ -87,6 +87,11 @@ typedef struct sw_bake_params {
                                       on the 3K finger) */
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
     int32_t random_poses;          /* held-out poses when there is no clip (default 10) */
+    int32_t heldout_steps;         /* ... each reached from the one before in this many
+                                      held-out poses, 1..64 (default 4): the reference is
+                                      path dependent, and a jump of up to 90 degrees a
+                                      joint lands its contact on another branch
+                                      (docs/generalisation.md, "Held-out poses on a path") */
     int self_contact;              /* in the training simulations (default 1) */
     /* A folder for the simulate stage's results (NULL, the default: none): a bake finds
        there the full-space solutions of a bake with the same mesh, weights, material,
@@ -195,12 +200,17 @@ typedef struct sw_bake_result {
     double *sweep_axis, *sweep_angle;
 } sw_bake_result;
 
-/* n random combined poses (12 nbones each into T): every joint turned about its sweep
- * axis by a uniform share of its sweep angle, from `seed` (the held-out poses of a bake
- * without a clip are these with sw_bake_params.seed). local: 9 nbones doubles scratch. */
+/* n random combined poses, each reached in `steps` poses (n * steps poses of 12 nbones
+ * doubles each into T): every joint turned about its sweep axis by a uniform share of its
+ * sweep angle, from `seed`, and before each the steps - 1 poses on the way from the pose
+ * before it (the first from rest), every joint's angle moved by equal shares. Pose
+ * (k + 1) steps - 1 is random pose k whatever `steps` is. The held-out poses of a bake
+ * without a clip are these with sw_bake_params.seed and .heldout_steps. local:
+ * SW_RANDOM_POSE_SCRATCH nbones doubles of scratch. */
+#define SW_RANDOM_POSE_SCRATCH 11
 void sw_bake_random_poses(const sw_skeleton *sk, const double *sweep_axis,
-                          const double *sweep_angle, uint64_t seed, int32_t n, double *local,
-                          double *T);
+                          const double *sweep_angle, uint64_t seed, int32_t n, int32_t steps,
+                          double *local, double *T);
 
 /* The largest angle (radians, in [0, pi]) each joint turns from rest in its parent's frame
  * over the n poses T (12 nbones each), raised into angle[nbones] (the caller starts it,

@@ -106,7 +106,7 @@ static sinew_result pick(const sinew_blob *blob, const sw_bake_result *res, cons
     int32_t nb = sk->nbones, n = a->candidates;
     size_t pose = (size_t)12 * nb;
     double *T = malloc((size_t)n * pose * sizeof(double)), *sc = malloc((size_t)n * sizeof(double));
-    double *local = malloc((size_t)nb * 9 * sizeof(double));
+    double *local = malloc((size_t)nb * SW_RANDOM_POSE_SCRATCH * sizeof(double));
     double *grown = realloc(*extra, ((size_t)*nextra + a->add) * pose * sizeof(double));
     scorer s;
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
@@ -119,7 +119,7 @@ static sinew_result pick(const sinew_blob *blob, const sw_bake_result *res, cons
                    ? sw_error_set(err, r, "adaptive bake: out of memory for candidates")
                    : r;
     }
-    sw_bake_random_poses(sk, res->sweep_axis, res->sweep_angle, seed, n, local, T);
+    sw_bake_random_poses(sk, res->sweep_axis, res->sweep_angle, seed, n, 1, local, T);
     rd->score_mean = rd->score_max = 0;
     for (int32_t i = 0; i < n; ++i) {
         sc[i] = score(&s, T + i * pose);

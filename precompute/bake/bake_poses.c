@@ -11,8 +11,9 @@
  * (sw_bake_params.extra_poses: the adaptive loop's) in paths from rest.
  * Held-out: the clip's remaining frames, or the held-out clips one after the other on
  * one path from rest, never used to build the basis or cubature; without a clip, random combined
- * poses with a fixed seed. Each sequence is solved in order (every solve warm-starts the next);
- * sequences run in parallel, one thread each. */
+ * poses with a fixed seed, each reached from the one before in heldout_steps poses. Each sequence
+ * is solved in order (every solve warm-starts the next); sequences run in parallel, one thread
+ * each. */
 #include <math.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -236,25 +237,41 @@ static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld
         return 1;
     }
     if (s->p->random_poses <= 0) return 1;
-    n = s->p->random_poses;
+    /* a path through the random poses, as a host's motion moves: solved pose to pose, a
+       jump of up to 90 degrees a joint left the reference's contact on another branch
+       (0.24 of the bare hand's correction from the same pose reached gradually) */
+    n = s->p->random_poses * s->p->heldout_steps;
     if (!seq_alloc(&s->heldout, n, nb, s->nv)) return 0;
-    sw_bake_random_poses(&s->ch.skel, sweep_axis, sweep_angle, s->p->seed, n, local, s->heldout.T);
+    sw_bake_random_poses(&s->ch.skel, sweep_axis, sweep_angle, s->p->seed, s->p->random_poses,
+                         s->p->heldout_steps, local, s->heldout.T);
     return 1;
 }
 
 void sw_bake_random_poses(const sw_skeleton *sk, const double *sweep_axis,
-                          const double *sweep_angle, uint64_t seed, int32_t n, double *local,
-                          double *T) {
+                          const double *sweep_angle, uint64_t seed, int32_t n, int32_t steps,
+                          double *local, double *T) {
+    double *from = local + 9 * (size_t)sk->nbones; /* each joint's angle at the pose before */
+    for (int32_t k = 0; k < sk->nbones; ++k)
+        from[k] = 0;
     for (int32_t i = 0; i < n; ++i) {
+        double *to = from + sk->nbones;
         for (int32_t k = 0; k < sk->nbones; ++k) {
             double u = (double)(splitmix(&seed) >> 11) * 0x1.0p-53;
-            sw_m3_axis_angle(sweep_axis + 3 * k, sweep_angle[k] * u, local + 9 * k);
-            if (!(sweep_angle[k] > 0)) {
-                memset(local + 9 * k, 0, 9 * sizeof(double));
-                local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;
-            }
+            to[k] = sweep_angle[k] > 0 ? sweep_angle[k] * u : 0;
         }
-        sw_forward_kinematics(sk, local, NULL, T + (size_t)i * 12 * sk->nbones);
+        for (int32_t st = 1; st <= steps; ++st) {
+            for (int32_t k = 0; k < sk->nbones; ++k) {
+                double a = st == steps ? to[k] : from[k] + (to[k] - from[k]) * st / steps;
+                sw_m3_axis_angle(sweep_axis + 3 * k, a, local + 9 * k);
+                if (!(sweep_angle[k] > 0)) {
+                    memset(local + 9 * k, 0, 9 * sizeof(double));
+                    local[9 * k] = local[9 * k + 4] = local[9 * k + 8] = 1;
+                }
+            }
+            sw_forward_kinematics(sk, local, NULL,
+                                  T + ((size_t)i * steps + st - 1) * 12 * sk->nbones);
+        }
+        memcpy(from, to, (size_t)sk->nbones * sizeof(double));
     }
 }
 
@@ -452,7 +469,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     clip_range *train = calloc((size_t)nr, sizeof *train), *held = calloc((size_t)nr, sizeof *held);
     double *sweep_axis = calloc((size_t)nb * 3, sizeof(double));
     double *sweep_angle = calloc((size_t)nb, sizeof(double));
-    double *local = malloc((size_t)nb * 9 * sizeof(double));
+    double *local = malloc((size_t)nb * SW_RANDOM_POSE_SCRATCH * sizeof(double));
     sinew_result rc = SINEW_OK;
     if (!train || !held || !sweep_axis || !sweep_angle || !local) goto oom;
     int32_t ntr = clip_ranges(s, train, held, &nheld);
