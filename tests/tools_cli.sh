@@ -73,6 +73,8 @@ expect bake_spring_absurd 1 "interface springs: stiffness 1e\+300 is [0-9.e+]+ E
 [ -e "$tmp/k.blob" ] && { echo "FAIL bake_spring_absurd: wrote $tmp/k.blob" >&2; fails=$((fails + 1)); }
 expect bake_adaptive_range 2 "--adaptive wants an integer in 0\.\.32, got '40'" \
     "$bake" "${small[@]}" --adaptive 40 --out "$tmp/a.blob"
+expect bake_heldout_steps_range 2 "--heldout-steps wants an integer in 1\.\.64, got '0'" \
+    "$bake" "${small[@]}" --heldout-steps 0 --out "$tmp/a.blob"
 expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'" \
     "$bench" --scene finger --tets 10
 expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \
