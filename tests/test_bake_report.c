@@ -451,7 +451,8 @@ TEST(random_heldout_poses_in_the_report) {
     sw_character_free(&ch);
 }
 
-/* Held-out clips need training clips; a clip of another skeleton is named. */
+/* Held-out clips need training clips; a clip of another skeleton is named; so is a
+ * number of steps to the random held-out poses out of range. */
 TEST(bad_clip_lists_rejected) {
     sw_character ch;
     sw_error e;
@@ -468,6 +469,14 @@ TEST(bad_clip_lists_rejected) {
     p.ntrain_clips = 1;
     ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
     ENSUREF(strstr(e.msg, "training clip 0 has 2 bones"), "%s", e.msg);
+    /* an absurd number of steps to the random held-out poses is named, not baked */
+    sw_bake_params q = sw_bake_params_default();
+    q.heldout_steps = 0;
+    ENSURE(sw_bake(&ch, &q, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "10 poses in 0 steps each"), "%s", e.msg);
+    q.heldout_steps = 65;
+    ENSURE(sw_bake(&ch, &q, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "in 65 steps each (steps 1..64"), "%s", e.msg);
     sw_character_free(&ch);
 }
 

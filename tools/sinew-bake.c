@@ -382,10 +382,15 @@ int main(int argc, char **argv) {
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].cub_count);
     fprintf(stderr, "), worst cubature fit %.4f\n", res.cubature_error_max);
+    /* random held-out poses (no clip) come on a path: say what the count is made of */
+    char held_how[96] = "";
+    if (res.nheldout > 0 && res.heldout_clip[0] < 0)
+        snprintf(held_how, sizeof held_how, " (%d random combined poses, each reached in %d steps)",
+                 res.nheldout / p.heldout_steps, p.heldout_steps);
     fprintf(stderr,
-            "  poses: %d training, %d held-out; basis projection error train %.4f held-out %.4f; "
-            "in the linearised model's energy (Galerkin) %.4f / %.4f\n",
-            res.ntrain, res.nheldout, res.train_proj_error, res.heldout_proj_error,
+            "  poses: %d training, %d held-out%s; basis projection error train %.4f held-out "
+            "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
+            res.ntrain, res.nheldout, held_how, res.train_proj_error, res.heldout_proj_error,
             res.train_galerkin_error, res.heldout_galerkin_error);
     int32_t kept = 0; /* the pose-space pairs the per-pair cubature keeps */
     for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
