@@ -311,26 +311,11 @@ TEST(clips_of_their_own_and_the_report) {
     sw_character_free(&ch);
 }
 
-/* The angle of joint b's turn between poses A and B (its rotations in its parent's). */
-static double joint_turn(const sw_skeleton *sk, const double *A, const double *B, int32_t b) {
-    const double *Ra = A + 12 * b, *Rb = B + 12 * b;
-    double La[9], Lb[9], D[9];
-    int32_t p = sk->parent[b];
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) { /* L = R_parent^T R_b */
-            La[3 * i + j] = Ra[j + 0] * (p < 0 ? (i == 0) : A[12 * p + i]) +
-                            Ra[3 + j] * (p < 0 ? (i == 1) : A[12 * p + 3 + i]) +
-                            Ra[6 + j] * (p < 0 ? (i == 2) : A[12 * p + 6 + i]);
-            Lb[3 * i + j] = Rb[j + 0] * (p < 0 ? (i == 0) : B[12 * p + i]) +
-                            Rb[3 + j] * (p < 0 ? (i == 1) : B[12 * p + 3 + i]) +
-                            Rb[6 + j] * (p < 0 ? (i == 2) : B[12 * p + 6 + i]);
-        }
-    for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j) /* D = La^T Lb */
-            D[3 * i + j] = La[i] * Lb[j] + La[3 + i] * Lb[3 + j] + La[6 + i] * Lb[6 + j];
-    double s = sqrt((D[7] - D[5]) * (D[7] - D[5]) + (D[2] - D[6]) * (D[2] - D[6]) +
-                    (D[3] - D[1]) * (D[3] - D[1]));
-    return atan2(0.5 * s, 0.5 * (D[0] + D[4] + D[8] - 1));
+/* Each joint's bend from rest at pose T (sw_bake_joint_reach over that one pose). */
+static void bends(const sw_skeleton *sk, const double *T, double *angle) {
+    for (int32_t b = 0; b < sk->nbones; ++b)
+        angle[b] = 0;
+    sw_bake_joint_reach(sk, T, 1, angle, NULL);
 }
 
 /* A bare skeleton (no clip): the held-out poses are random combined poses, each reached
@@ -356,37 +341,34 @@ TEST(random_heldout_poses_in_the_report) {
     for (int32_t k = 0; k < res.nheldout; ++k)
         ENSURE(res.heldout_clip[k] < 0);
     /* every third pose is the random pose a one-step path gives; on the way to it every
-       joint turns by a third of its way there at a time, the first from rest */
+       joint (turning about its own sweep axis) bends by a third of its way there at a
+       time, the first from rest */
     int32_t nb = ch.skel.nbones;
     double *T1 = malloc(sizeof(double) * 4 * 12 * (size_t)nb),
            *local = malloc(sizeof(double) * SW_RANDOM_POSE_SCRATCH * (size_t)nb),
-           *rest = malloc(sizeof(double) * 12 * (size_t)nb);
-    ENSURE(T1 && local && rest);
-    if (T1 && local && rest && res.nheldout == 12) {
+           *bend = calloc(3 * (size_t)nb, sizeof(double));
+    ENSURE(T1 && local && bend);
+    if (T1 && local && bend && res.nheldout == 12) {
         sw_bake_random_poses(&ch.skel, res.sweep_axis, res.sweep_angle, p.seed, 4, 1, local, T1);
-        for (int32_t k = 0; k < 9 * nb; ++k)
-            local[k] = k % 9 % 4 == 0; /* identity rotations: the rest pose */
-        sw_forward_kinematics(&ch.skel, local, NULL, rest);
-        double largest = 0;
+        double *from = bend, *to = bend + nb, *at = bend + 2 * nb, largest = 0;
         for (int32_t k = 0; k < 4; ++k) {
             const double *end = res.heldout_T + (size_t)(3 * k + 2) * 12 * nb;
             ENSURE(!memcmp(end, T1 + (size_t)k * 12 * nb, sizeof(double) * 12 * (size_t)nb));
-            const double *from = k ? end - 3 * 12 * (size_t)nb : rest;
-            for (int32_t b = 0; b < nb; ++b) {
-                double whole = joint_turn(&ch.skel, from, end, b);
-                for (int st = 0; st < 3; ++st) {
-                    const double *a = st ? end - (size_t)(3 - st) * 12 * nb : from;
-                    const double *c = end - (size_t)(2 - st) * 12 * nb;
-                    ENSURE_NEAR(joint_turn(&ch.skel, a, c, b), whole / 3, 1e-9);
-                }
-                if (whole > largest) largest = whole;
+            bends(&ch.skel, end, to);
+            for (int st = 1; st <= 3; ++st) {
+                bends(&ch.skel, res.heldout_T + (size_t)(3 * k + st - 1) * 12 * nb, at);
+                for (int32_t b = 0; b < nb; ++b)
+                    ENSURE_NEAR(at[b], from[b] + (to[b] - from[b]) * st / 3, 1e-9);
             }
+            for (int32_t b = 0; b < nb; ++b)
+                largest = fmax(largest, fabs(to[b] - from[b]));
+            memcpy(from, to, sizeof(double) * (size_t)nb);
         }
         ENSURE(largest > 0.1); /* the path moves */
     }
     free(T1);
     free(local);
-    free(rest);
+    free(bend);
     void *mem = NULL;
     sinew_blob *blob = NULL;
     double *fe = NULL; /* per pose: the training poses', then the held-out ones' */
