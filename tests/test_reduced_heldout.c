@@ -119,8 +119,10 @@ static void compare(baked *b, const char *name, double qs_bound, double dyn_boun
     sw_fullsim_destroy(sim);
     /* the training frames too, for the record: a dynamic step never starts from a stored
        solution, so they are not much easier than the held-out ones */
-    sw_eval_options o = {SINEW_STEP_DYNAMIC, dt, SW_BAKE_EVAL_NEWTON, 0,
-                         SINEW_SELF_CONTACT_POSE_SPACE};
+    sw_eval_options o = {.mode = SINEW_STEP_DYNAMIC,
+                         .dt = dt,
+                         .max_newton = SW_BAKE_EVAL_NEWTON,
+                         .self_contact = SINEW_SELF_CONTACT_POSE_SPACE};
     sw_eval_result ed, edt;
     sinew_result r =
         sw_eval_correction_opts(b->blob, b->res.mass, b->ch.clip.T, xref, first, &o, &edt, &err);

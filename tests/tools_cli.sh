@@ -75,6 +75,8 @@ expect bake_adaptive_range 2 "--adaptive wants an integer in 0\.\.32, got '40'" 
     "$bake" "${small[@]}" --adaptive 40 --out "$tmp/a.blob"
 expect bake_heldout_steps_range 2 "--heldout-steps wants an integer in 1\.\.64, got '0'" \
     "$bake" "${small[@]}" --heldout-steps 0 --out "$tmp/a.blob"
+expect bake_reference_spread_range 2 "--reference-spread wants an integer in 1\.\.1000000, got '0'" \
+    "$bake" "${small[@]}" --reference-spread 0 --out "$tmp/a.blob"
 expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'" \
     "$bench" --scene finger --tets 10
 expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \
@@ -127,10 +129,11 @@ expect bench_bake_errors_without_blob 2 "--bake-errors applies only with --blob"
     "$bench" "${small[@]}" --frames 4 --bake-errors
 
 # one definition of the training and held-out error: the bake and the bench
-# --blob --bake-errors (the bake's poses solved anew) agree
+# --blob --bake-errors (the bake's poses solved anew) agree (--reference-spread measures
+# beside the errors, never changes them)
 key() { tail -n 1 "$1" | grep -oE "\"$2\":(\"[a-z_]*\"|[0-9.]+|null)" | cut -d: -f2; }
-if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --json >"$tmp/bake.json" \
-    2>"$tmp/bake.err" &&
+if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference-spread 1 \
+    --json >"$tmp/bake.json" 2>"$tmp/bake.err" &&
     "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --bake-errors \
         --contract-steps 10 --json >"$tmp/bench.json" 2>"$tmp/bench.err"; then
     for k in err_train err_heldout; do
@@ -144,6 +147,12 @@ if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --json >"$t
     done
     [ "$(key "$tmp/bench.json" err_source)" = '"bake_default_poses"' ] ||
         { echo "FAIL same_errors: err_source is not bake_default_poses" >&2; fails=$((fails + 1)); }
+    # every held-out pose measured, the runtime's figure the bake's held-out error
+    [ "$(key "$tmp/bake.json" poses)" = "$(key "$tmp/bake.json" heldout_poses)" ] &&
+        [ "$(key "$tmp/bake.json" runtime)" = "$(key "$tmp/bake.json" err_heldout)" ] &&
+        [[ $(key "$tmp/bake.json" from_skin) =~ ^[0-9.]+$ ]] &&
+        grep -q "reference spread at" "$tmp/bake.err" ||
+        { echo "FAIL reference_spread: $(tail -n 1 "$tmp/bake.json" | grep -oE '"ref_spread":\{[^}]*\}')" >&2; fails=$((fails + 1)); }
 else
     echo "FAIL same_errors: the bake or the bench failed" >&2
     tail -n 3 "$tmp/bake.err" "$tmp/bench.err" >&2

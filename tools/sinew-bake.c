@@ -64,6 +64,7 @@ static void usage(FILE *f) {
                "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
                "                  [--no-pose-force]\n"
                "                  [--eval-self-contact pose-space|pose-pairs]\n"
+               "                  [--reference-spread K]\n"
                "                  [--cache DIR] [--threads T] [--force]\n"
                "                  [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
@@ -110,7 +111,13 @@ static void usage(FILE *f) {
             "                   projected solution the runtime's equilibrium there,\n"
             "                   interpolated between poses)\n"
             "  --eval-self-contact M  the runtime's self-contact mode the bake's errors are\n"
-            "                   measured in: pose-space (default) or pose-pairs\n"
+            "                   measured in: pose-space (default) or pose-pairs\n");
+    fprintf(f,
+            "  --reference-spread K  at every K-th held-out pose, three more full-space\n"
+            "                   solves: from plain skinning, from the reference and from the\n"
+            "                   runtime's state; how far they land from the reference says\n"
+            "                   how well the reference is defined, and whether the runtime\n"
+            "                   sits by another equilibrium\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
             "                   flesh lags and overshoots as the reference does; a higher rank\n"
@@ -131,7 +138,7 @@ int main(int argc, char **argv) {
     sw_character_args ca;
     sw_character_args_init(&ca, tool);
     const char *out_path = NULL, *report_dir = NULL;
-    int json = 0, force = 0;
+    int json = 0, force = 0, spread_every = 0;
     sinew_self_contact eval_mode = SINEW_SELF_CONTACT_POSE_SPACE;
     sw_bake_params p = sw_bake_params_default();
     sw_adaptive_params ad = sw_adaptive_params_default();
@@ -204,6 +211,8 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &ad.candidates);
         else if (!strcmp(a, "--adaptive-budget") && next)
             ok = sw_tool_int(tool, a, argv[++i], 0, 1000000, &ad.budget);
+        else if (!strcmp(a, "--reference-spread") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 1000000, &spread_every);
         else if (!strcmp(a, "--heldout-steps") && next)
             ok = sw_tool_int(tool, a, argv[++i], 1, 64, &p.heldout_steps);
         else if (!strcmp(a, "--adaptive-target") && next)
@@ -303,6 +312,14 @@ int main(int argc, char **argv) {
     char num[32];
     if ((r = sw_bake_mode_errors(blob, &res, eval_mode, eh.correction_error, mode_err, &err))) {
         sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
+        goto done;
+    }
+    sw_bake_spread spread; /* --reference-spread */
+    memset(&spread, 0, sizeof spread);
+    if (spread_every > 0 &&
+        (r = sw_bake_reference_spread(&ch, &p, blob, &res, eval_mode, spread_every, &spread,
+                                      &err)) != SINEW_OK) {
+        sw_tool_failed(r, &err, "%s: --reference-spread: ", tool);
         goto done;
     }
     double eval_seconds = sw_now_seconds() - t1;
@@ -442,6 +459,13 @@ int main(int argc, char **argv) {
         fprintf(stderr, " %s %s%s", sw_self_contact_names[k],
                 isfinite(mode_err[k]) ? json_number(mode_err[k], num) : "-",
                 k + 1 < SW_BAKE_MODES ? "," : "\n");
+    if (spread_every > 0)
+        fprintf(stderr,
+                "  reference spread at %d held-out poses (every %d-th): runtime %.4f; full-space "
+                "solves from plain skinning %.4f, from the reference %.4f, from the runtime's "
+                "state %.4f (moved it %.4f); %d unconverged, %d left out\n",
+                spread.poses, spread_every, spread.runtime, spread.from_skin, spread.from_reference,
+                spread.polished, spread.polish_move, spread.unconverged, spread.failed);
     sw_joint_reach beyond[BAKE_BEYOND];
     int32_t nbeyond_all = sw_bake_beyond_training(&res, &ch.skel, beyond, BAKE_BEYOND);
     int32_t nbeyond = nbeyond_all < BAKE_BEYOND ? nbeyond_all : BAKE_BEYOND;
@@ -541,6 +565,13 @@ int main(int argc, char **argv) {
             printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k],
                    json_number(mode_err[k], num));
         printf("}");
+        if (spread_every > 0)
+            printf(",\"ref_spread\":{\"every\":%d,\"poses\":%d,\"runtime\":%.5f,"
+                   "\"from_skin\":%.5f,\"from_reference\":%.5f,\"polished\":%.5f,"
+                   "\"polish_move\":%.5f,\"unconverged\":%d,\"failed\":%d}",
+                   spread_every, spread.poses, spread.runtime, spread.from_skin,
+                   spread.from_reference, spread.polished, spread.polish_move, spread.unconverged,
+                   spread.failed);
         printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
         for (int32_t k = 0; k < nbeyond; ++k) {
             printf("%s[%d,", k ? "," : "", beyond[k].bone);

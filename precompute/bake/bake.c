@@ -392,20 +392,28 @@ double *sw_bake_heldout_path(const sw_bake_result *res, int32_t nbones, int32_t 
 sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *res,
                                  sinew_self_contact sc, sw_eval_result *train, double *train_frames,
                                  sw_error *err) {
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0, sc};
+    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
+                         .dt = 1.0f / 30,
+                         .max_newton = SW_BAKE_EVAL_NEWTON,
+                         .self_contact = sc};
     return sw_eval_correction_frames(blob, res->mass, res->train_T, res->train_x, res->ntrain, &o,
                                      train_frames, train, err);
 }
 
-/* The held-out half of sw_bake_errors_frames. */
-static sinew_result heldout_error(const sinew_blob *blob, const sw_bake_result *res,
-                                  sinew_self_contact sc, sw_eval_result *heldout,
-                                  double *heldout_frames, sw_error *err) {
+sinew_result sw_bake_heldout_error(const sinew_blob *blob, const sw_bake_result *res,
+                                   sinew_self_contact sc, sw_eval_frame_fn on_frame, void *ctx,
+                                   sw_eval_result *heldout, double *heldout_frames, sw_error *err) {
     memset(heldout, 0, sizeof *heldout);
     int32_t pre, n;
     double *T = sw_bake_heldout_path(res, sw_blob_get_view(blob)->nbones, &pre, &n);
     if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, pre, sc};
+    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
+                         .dt = 1.0f / 30,
+                         .max_newton = SW_BAKE_EVAL_NEWTON,
+                         .skip = pre,
+                         .self_contact = sc,
+                         .on_frame = on_frame,
+                         .frame_ctx = ctx};
     sinew_result r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, &o,
                                                heldout_frames, heldout, err);
     free(T);
@@ -420,7 +428,7 @@ sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result 
     memset(heldout, 0, sizeof *heldout);
     sinew_result r = sw_bake_train_error(blob, res, sc, train, train_frames, err);
     if (r != SINEW_OK) return r;
-    return heldout_error(blob, res, sc, heldout, heldout_frames, err);
+    return sw_bake_heldout_error(blob, res, sc, NULL, NULL, heldout, heldout_frames, err);
 }
 
 const char *const sw_self_contact_names[SW_BAKE_MODES + 1] = {"pose-space", "exhaustive",
@@ -441,7 +449,7 @@ sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *r
         if (mode == SINEW_SELF_CONTACT_POSE_PAIRS && (!v || v->npair_groups == 0))
             continue; /* no per-pair sections: the mode is not available */
         sw_eval_result h;
-        sinew_result r = heldout_error(blob, res, mode, &h, NULL, err);
+        sinew_result r = sw_bake_heldout_error(blob, res, mode, NULL, NULL, &h, NULL, err);
         if (r != SINEW_OK) return r;
         if (h.failed == 0 && h.frames > 0) err_mode[k] = h.correction_error;
     }

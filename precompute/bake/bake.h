@@ -292,6 +292,40 @@ sinew_result sw_bake_mode_errors(const sinew_blob *blob, const sw_bake_result *r
                                  sinew_self_contact measured, double measured_err,
                                  double err_mode[SW_BAKE_MODES], sw_error *err);
 
+/* The held-out half of sw_bake_errors_frames, on_frame (NULL: none) called with ctx after
+ * each held-out pose is measured (sw_eval_options; `pose` counts the path's leading
+ * training poses too: sw_bake_heldout_path). */
+sinew_result sw_bake_heldout_error(const sinew_blob *blob, const sw_bake_result *res,
+                                   sinew_self_contact sc, sw_eval_frame_fn on_frame, void *ctx,
+                                   sw_eval_result *heldout, double *heldout_frames, sw_error *err);
+
+/* How well the held-out references are defined (bake_spread.c; sinew-bake
+ * --reference-spread): at every `every`-th held-out pose (every - 1, 2 every - 1, ...)
+ * that the blob steps along the held-out path in self-contact mode sc, three full-space
+ * solves with the reference's parameters at that pose, started from plain skinning, from
+ * the reference and from the runtime's state. Each is measured as the correction error
+ * measures the runtime (|x - x_ref|_M over |x_ref - x_dqs|_M, summed over the poses before
+ * the ratio): `from_skin` is how far a reference that had not walked the path lands from
+ * the bake's, `from_reference` how far a fresh solve moves the reference itself (its own
+ * precision: the contact set starts afresh, Newton's tolerance is relative to its start),
+ * `polished` how far the full-space equilibrium nearest the runtime's state is from the
+ * reference (0: the runtime is off the one equilibrium; near `runtime`: it sits by
+ * another), `polish_move` how far that solve moved the runtime's state. */
+typedef struct sw_bake_spread {
+    int32_t poses;         /* held-out poses measured */
+    double runtime;        /* the runtime's correction error at those poses */
+    double from_skin;      /* the full-space solve from plain skinning, against the reference */
+    double from_reference; /* the solve from the reference, against it */
+    double polished;       /* the full-space solve from the runtime's state, against it */
+    double polish_move;    /* that solve against the runtime's state */
+    int32_t unconverged;   /* solves that ended unconverged (kept, as the reference keeps them) */
+    int32_t failed;        /* poses left out: a step or a solve that did not stay finite */
+} sw_bake_spread;
+sinew_result sw_bake_reference_spread(const sw_character *ch, const sw_bake_params *p,
+                                      const sinew_blob *blob, const sw_bake_result *res,
+                                      sinew_self_contact sc, int32_t every, sw_bake_spread *out,
+                                      sw_error *err);
+
 /* The training half of sw_bake_errors_frames (train_frames: res->ntrain doubles or NULL). */
 sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *res,
                                  sinew_self_contact sc, sw_eval_result *train, double *train_frames,

@@ -214,8 +214,10 @@ static sinew_result measure(const sinew_blob *blob, const sw_bake_result *res, i
 static sinew_result verify(const sinew_blob *prev, const sw_bake_result *res, int32_t n,
                            double *out, sw_error *err) {
     int32_t first = res->ntrain - n, nb = res->view.nbones, nv = res->view.nverts;
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, SW_BAKE_EVAL_NEWTON, 0,
-                         SINEW_SELF_CONTACT_POSE_SPACE};
+    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
+                         .dt = 1.0f / 30,
+                         .max_newton = SW_BAKE_EVAL_NEWTON,
+                         .self_contact = SINEW_SELF_CONTACT_POSE_SPACE};
     sw_eval_result e;
     sinew_result r =
         sw_eval_correction_opts(prev, res->mass, res->train_T + (size_t)first * 12 * nb,

@@ -50,7 +50,7 @@ static uint64_t character_key(sw_bake_state *s) {
     MIX(h, s->ch.youngs);
     MIX(h, s->ch.poisson);
     MIX(h, s->ch.density);
-    sw_fullsim_params fp = sw_bake_sim_params(s); /* field by field: no padding bytes */
+    sw_fullsim_params fp = sw_bake_sim_params(s->p); /* field by field: no padding bytes */
     int32_t ints[] = {(int32_t)fp.integrator, fp.self_contact,    fp.ground,
                       (int32_t)fp.hessian,    (int32_t)fp.solver, fp.contact_rounds,
                       fp.contact_set_check,   fp.max_newton,      fp.pcg_max};

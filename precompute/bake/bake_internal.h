@@ -111,7 +111,7 @@ void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, 
 sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err);
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err);
 /* The reference simulator's parameters of the simulate stage (threads aside). */
-sw_fullsim_params sw_bake_sim_params(const sw_bake_state *s);
+sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p);
 /* The simulate stage through the cache of sw_bake_params.cache_dir (bake_cache.c): the
  * solutions read back when the cache holds this bake's, else solved and stored. Sets
  * *cached when they were read back. */

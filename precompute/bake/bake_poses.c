@@ -546,9 +546,9 @@ static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
     }
 }
 
-sw_fullsim_params sw_bake_sim_params(const sw_bake_state *s) {
+sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p) {
     sw_fullsim_params fp = sw_fullsim_params_default();
-    fp.self_contact = s->p->self_contact;
+    fp.self_contact = p->self_contact;
     return fp;
 }
 
@@ -570,7 +570,7 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
         int i = atomic_fetch_add(&ctx->next, 1);
         if (i >= ctx->nseq) break;
         sw_pose_seq *q = ctx->seqs[i];
-        sw_fullsim_params fp = sw_bake_sim_params(s);
+        sw_fullsim_params fp = sw_bake_sim_params(s->p);
         /* a chained path (the clip's training then held-out frames) is the longest serial
            run: it gets every core (the simulator's results do not depend on its thread
            count), the others one each */

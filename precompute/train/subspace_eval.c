@@ -100,8 +100,10 @@ void sw_eval_acc_free(sw_eval_acc *a) {
 sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,
                                 const double *x_full, int32_t npose, uint32_t max_newton,
                                 sw_eval_result *out, sw_error *err) {
-    sw_eval_options o = {SINEW_STEP_QUASISTATIC, 1.0f / 30, max_newton, 0,
-                         SINEW_SELF_CONTACT_POSE_SPACE};
+    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
+                         .dt = 1.0f / 30,
+                         .max_newton = max_newton,
+                         .self_contact = SINEW_SELF_CONTACT_POSE_SPACE};
     return sw_eval_correction_opts(blob, mass, T, x_full, npose, &o, out, err);
 }
 
@@ -149,6 +151,7 @@ sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mas
         /* the frame's own share, by the same formula; a frame with no correction to miss
            (the rest pose) counts 0 */
         if (fe) *fe = acc.den > den ? sqrt((acc.num - num) / (acc.den - den)) : 0.0;
+        if (o->on_frame) o->on_frame(o->frame_ctx, f, inst, x_full + (size_t)(f - o->skip) * 3 * n);
     }
     sw_eval_acc_result(&acc, out);
     out->failed = failed;

@@ -64,16 +64,25 @@ sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, cons
                                 const double *x_full, int32_t npose, uint32_t max_newton,
                                 sw_eval_result *out, sw_error *err);
 
+/* Called after each compared pose is added: `pose` its index on the path (0 .. npose),
+ * `x_full` its reference, `inst` the instance that has just stepped it (a measurement
+ * beside the error: sw_bake_reference_spread). */
+typedef void (*sw_eval_frame_fn)(void *ctx, int32_t pose, const sinew_instance *inst,
+                                 const double *x_full);
+
 /* How sw_eval_correction_opts steps: the instance's mode, the step's dt, Newton's
  * iterations a step, `skip` leading poses stepped but not compared (a dynamic path's
- * lead-in: its held-out frames depend on the frames before them), and the instance's
- * self-contact mode (0: pose-space, the default). */
+ * lead-in: its held-out frames depend on the frames before them), the instance's
+ * self-contact mode (0: pose-space, the default), and an optional per-pose callback
+ * (NULL: none). */
 typedef struct sw_eval_options {
     sinew_step_mode mode;
     float dt;
     uint32_t max_newton;
     int32_t skip;
     sinew_self_contact self_contact;
+    sw_eval_frame_fn on_frame;
+    void *frame_ctx;
 } sw_eval_options;
 
 /* As sw_eval_correction with options: steps through all npose poses and compares the
