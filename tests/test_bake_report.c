@@ -156,6 +156,27 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     free(text);
 }
 
+/* DIR/report.json's ref_spread: the figures given, or null without them. */
+static void check_spread_json(const char *dir, const sw_bake_spread *s) {
+    char path[1100];
+    snprintf(path, sizeof path, "%.1000s/report.json", dir);
+    char *text = read_text(path);
+    cJSON *j = text ? cJSON_Parse(text) : NULL;
+    ENSURE(j != NULL);
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(j, "ref_spread");
+    if (!s) {
+        ENSURE(cJSON_IsNull(o));
+    } else {
+        ENSURE(cJSON_IsObject(o) && num(o, "poses") == s->poses &&
+               num(o, "unconverged") == s->unconverged && num(o, "failed") == s->failed);
+        ENSURE(num(o, "runtime") == s->runtime && num(o, "from_skin") == s->from_skin &&
+               num(o, "from_reference") == s->from_reference && num(o, "polished") == s->polished &&
+               num(o, "polish_move") == s->polish_move);
+    }
+    cJSON_Delete(j);
+    free(text);
+}
+
 /* The bake's blob loaded (its bytes in *mem) and measured on the bake's poses, each
  * pose's error in *fe (training poses first); 0 on any failure. */
 static int blob_and_errors(const sw_bake_result *res, void **mem, sinew_blob **blob, double **fe,
@@ -230,6 +251,11 @@ TEST(clips_of_their_own_and_the_report) {
         ENSUREF(modes[k] == mh.correction_error, "%s: %g against %g", sw_self_contact_names[k],
                 modes[k], mh.correction_error);
     }
+    /* how well the held-out references are defined, at every second held-out pose */
+    sw_bake_spread spread;
+    ENSURE(sw_bake_reference_spread(&ch, &p, blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, 2, &spread,
+                                    &e) == SINEW_OK);
+    ENSURE(spread.poses == res.nheldout / 2);
     sw_bake_report_input in = {"finger",
                                &ch,
                                &res,
@@ -250,7 +276,8 @@ TEST(clips_of_their_own_and_the_report) {
                                &et,
                                &eh,
                                NULL,
-                               modes};
+                               modes,
+                               &spread};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;
@@ -273,6 +300,7 @@ TEST(clips_of_their_own_and_the_report) {
     ENSUREF(r == SINEW_OK, "%s", e.msg);
     int flagged[2] = {-1, -1};
     check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes, flagged);
+    check_spread_json(dir, &spread);
     ENSURE(flagged[0] == 0); /* a training clip never bends beyond itself */
     /* had the training reached half as far, the reversed fold would bend beyond it: the
        report marks those frames (and lists the joints) as the rule says */
@@ -297,7 +325,8 @@ TEST(clips_of_their_own_and_the_report) {
     ENSURE(html && strstr(html, "<svg") && strstr(html, "heldout_sheet.png") &&
            strstr(html, "Return") && strstr(html, "Adaptive training rounds") &&
            strstr(html, "Where the error is") &&
-           strstr(html, "Held-out error by self-contact mode"));
+           strstr(html, "Held-out error by self-contact mode") &&
+           strstr(html, "How well the held-out reference is defined"));
     free(html);
     struct stat st;
     snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);
@@ -394,11 +423,13 @@ TEST(random_heldout_poses_in_the_report) {
                                &et,
                                &eh,
                                NULL,
+                               NULL,
                                NULL};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
+    check_spread_json(dir, NULL); /* not measured: null */
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);

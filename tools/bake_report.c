@@ -325,6 +325,20 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     } else {
         cJSON_AddNullToObject(j, "err_heldout_by_mode");
     }
+    if (in->spread) {
+        const sw_bake_spread *s = in->spread;
+        cJSON *o = cJSON_AddObjectToObject(j, "ref_spread");
+        cJSON_AddNumberToObject(o, "poses", s->poses);
+        cJSON_AddItemToObject(o, "runtime", json_number(s->runtime));
+        cJSON_AddItemToObject(o, "from_skin", json_number(s->from_skin));
+        cJSON_AddItemToObject(o, "from_reference", json_number(s->from_reference));
+        cJSON_AddItemToObject(o, "polished", json_number(s->polished));
+        cJSON_AddItemToObject(o, "polish_move", json_number(s->polish_move));
+        cJSON_AddNumberToObject(o, "unconverged", s->unconverged);
+        cJSON_AddNumberToObject(o, "failed", s->failed);
+    } else {
+        cJSON_AddNullToObject(j, "ref_spread");
+    }
     cJSON *bt = cJSON_AddArrayToObject(j, "heldout_beyond_training");
     for (int32_t k = 0; k < r->nbeyond; ++k) {
         cJSON *o = cJSON_CreateObject();
@@ -575,6 +589,28 @@ static void html_modes(FILE *f, const sw_bake_report_input *in) {
     fprintf(f, "</tr></table>\n");
 }
 
+/* How well the held-out references are defined: full-space solves from other starts. */
+static void html_spread(FILE *f, const sw_bake_report_input *in) {
+    const sw_bake_spread *s = in->spread;
+    if (!s || s->poses < 1) return;
+    fprintf(f,
+            "<h2>How well the held-out reference is defined</h2><p>The reference solved each "
+            "held-out pose from the pose before it. At %d of them the full-space simulator "
+            "solved the pose again from other starts; each is measured as the runtime's "
+            "error is (the share of the correction). Where the first two are near 0 the "
+            "reference is the one equilibrium of the pose and the held-out error is the "
+            "runtime's alone; where they are large the flesh rests in more than one, and the "
+            "error also says which one the runtime found.</p><table>"
+            "<tr><td>the runtime at these poses</td><td>%.4f</td></tr>"
+            "<tr><td>the simulator from plain skinning</td><td>%.4f</td></tr>"
+            "<tr><td>the simulator from the reference (its own precision)</td><td>%.4f</td></tr>"
+            "<tr><td>the simulator from the runtime's state</td><td>%.4f (it moved the "
+            "runtime's state %.4f)</td></tr></table><p>%d of the solves ended unconverged, "
+            "%d poses were left out.</p>\n",
+            s->poses, s->runtime, s->from_skin, s->from_reference, s->polished, s->polish_move,
+            s->unconverged, s->failed);
+}
+
 /* The joints the held-out poses bend further than any training pose: where the basis
  * extrapolates, and what training motion would cover. */
 static void html_beyond(FILE *f, const sw_bake_report_input *in, const report *r) {
@@ -642,6 +678,7 @@ static int write_html(const char *path, const sw_bake_report_input *in, const re
     html_clips(f, r);
     html_regions(f, in);
     html_modes(f, in);
+    html_spread(f, in);
     html_beyond(f, in, r);
     int ok = html_domains(f, in);
     html_adaptive(f, in->adaptive);

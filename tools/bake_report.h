@@ -48,6 +48,9 @@ typedef struct sw_bake_report_input {
     /* the held-out error in each self-contact mode (sw_bake_mode_errors, SW_BAKE_MODES, NaN:
        not measured); NULL: not shown */
     const double *mode_err_heldout;
+    /* how well the held-out references are defined (sw_bake_reference_spread, sinew-bake
+       --reference-spread); NULL: not measured */
+    const sw_bake_spread *spread;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

@@ -376,7 +376,8 @@ int main(int argc, char **argv) {
                                    !ca.file                               ? NULL
                                    : info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
                                                                           : "lattice",
-                                   mode_err};
+                                   mode_err,
+                                   spread_every > 0 ? &spread : NULL};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
