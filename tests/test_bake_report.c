@@ -156,6 +156,11 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     free(text);
 }
 
+/* a and b the same to JSON's printing (cJSON keeps 15 digits where they read back close) */
+static int same(double a, double b) {
+    return fabs(a - b) <= 1e-12 * fmax(1.0, fabs(b));
+}
+
 /* DIR/report.json's ref_spread: the figures given, or null without them. */
 static void check_spread_json(const char *dir, const sw_bake_spread *s) {
     char path[1100];
@@ -169,9 +174,21 @@ static void check_spread_json(const char *dir, const sw_bake_spread *s) {
     } else {
         ENSURE(cJSON_IsObject(o) && num(o, "poses") == s->poses &&
                num(o, "unconverged") == s->unconverged && num(o, "failed") == s->failed);
-        ENSURE(num(o, "runtime") == s->runtime && num(o, "from_skin") == s->from_skin &&
-               num(o, "from_reference") == s->from_reference && num(o, "polished") == s->polished &&
-               num(o, "polish_move") == s->polish_move);
+        ENSURE(same(num(o, "runtime"), s->runtime) && same(num(o, "from_skin"), s->from_skin) &&
+               same(num(o, "from_reference"), s->from_reference) &&
+               same(num(o, "polished"), s->polished) &&
+               same(num(o, "polish_move"), s->polish_move));
+        const cJSON *pp = cJSON_GetObjectItemCaseSensitive(o, "per_pose");
+        ENSURE(cJSON_GetArraySize(pp) == s->poses);
+        for (int32_t k = 0; k < s->poses && cJSON_GetArraySize(pp) == s->poses; ++k) {
+            const cJSON *e = cJSON_GetArrayItem(pp, k);
+            const sw_bake_spread_pose *q = &s->per_pose[k];
+            ENSURE(num(e, "heldout") == q->heldout && same(num(e, "runtime"), q->runtime) &&
+                   same(num(e, "from_skin"), q->from_skin) &&
+                   same(num(e, "from_reference"), q->from_reference) &&
+                   same(num(e, "polished"), q->polished) &&
+                   same(num(e, "correction"), q->correction));
+        }
     }
     cJSON_Delete(j);
     free(text);
@@ -331,6 +348,7 @@ TEST(clips_of_their_own_and_the_report) {
     struct stat st;
     snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);
     ENSURE(stat(path, &st) == 0 && st.st_size > 1000);
+    sw_bake_spread_free(&spread);
     free(fe);
     sinew_blob_destroy(blob);
     free(mem);

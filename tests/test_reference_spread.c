@@ -41,12 +41,33 @@ TEST(one_equilibrium_is_found_from_every_start) {
             s.from_skin, s.from_reference, s.polished);
     /* so the polish moved the runtime's state by its error (triangle inequality) */
     ENSURE(fabs(s.polish_move - s.runtime) <= s.polished + 1e-12);
+    /* per pose: every held-out pose in order, each with a correction landing on its
+       reference (a pose back near rest has almost none: its shares are of rounding); the
+       whole figure a weighted mean of the poses' own (between the least and the most) */
+    double lo = INFINITY, hi = 0, cmax = 0;
+    for (int32_t k = 0; k < s.poses; ++k)
+        cmax = fmax(cmax, s.per_pose[k].correction);
+    for (int32_t k = 0; k < s.poses; ++k) {
+        const sw_bake_spread_pose *q = &s.per_pose[k];
+        ENSURE(q->heldout == k && q->correction >= 0);
+        lo = fmin(lo, q->runtime);
+        hi = fmax(hi, q->runtime);
+        if (q->correction < 1e-3 * cmax) continue;
+        ENSUREF(q->from_skin < 1e-3 && q->from_reference < 1e-3 && q->polished < 1e-3,
+                "pose %d: %g %g %g", k, q->from_skin, q->from_reference, q->polished);
+    }
+    ENSUREF(lo <= s.runtime && s.runtime <= hi, "%g in [%g, %g]", s.runtime, lo, hi);
     /* every second pose: poses 1, 3, 5, ... */
     sw_bake_spread s2;
     ENSURE(sw_bake_reference_spread(&f.ch, &p, f.blob, &f.res, SINEW_SELF_CONTACT_POSE_SPACE, 2,
                                     &s2, &e) == SINEW_OK);
     ENSURE(s2.poses == f.res.nheldout / 2 && s2.failed == 0);
     ENSURE(s2.from_skin < 1e-3 && s2.polished < 1e-3 && s2.runtime > 0);
+    for (int32_t k = 0; k < s2.poses; ++k) /* the same poses' own figures as before */
+        ENSURE(s2.per_pose[k].heldout == 2 * k + 1 &&
+               s2.per_pose[k].runtime == s.per_pose[2 * k + 1].runtime);
+    sw_bake_spread_free(&s2);
+    sw_bake_spread_free(&s);
     bake_fixture_free(&f);
 }
 

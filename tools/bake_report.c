@@ -336,6 +336,18 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
         cJSON_AddItemToObject(o, "polish_move", json_number(s->polish_move));
         cJSON_AddNumberToObject(o, "unconverged", s->unconverged);
         cJSON_AddNumberToObject(o, "failed", s->failed);
+        cJSON *pp = cJSON_AddArrayToObject(o, "per_pose");
+        for (int32_t k = 0; k < s->poses; ++k) {
+            const sw_bake_spread_pose *q = &s->per_pose[k];
+            cJSON *e = cJSON_CreateObject();
+            cJSON_AddNumberToObject(e, "heldout", q->heldout);
+            cJSON_AddItemToObject(e, "runtime", json_number(q->runtime));
+            cJSON_AddItemToObject(e, "from_skin", json_number(q->from_skin));
+            cJSON_AddItemToObject(e, "from_reference", json_number(q->from_reference));
+            cJSON_AddItemToObject(e, "polished", json_number(q->polished));
+            cJSON_AddItemToObject(e, "correction", json_number(q->correction));
+            cJSON_AddItemToArray(pp, e);
+        }
     } else {
         cJSON_AddNullToObject(j, "ref_spread");
     }
@@ -606,9 +618,32 @@ static void html_spread(FILE *f, const sw_bake_report_input *in) {
             "<tr><td>the simulator from the reference (its own precision)</td><td>%.4f</td></tr>"
             "<tr><td>the simulator from the runtime's state</td><td>%.4f (it moved the "
             "runtime's state %.4f)</td></tr></table><p>%d of the solves ended unconverged, "
-            "%d poses were left out.</p>\n",
+            "%d poses were left out. Per held-out pose, same scale:</p><div class=\"row\">\n",
             s->poses, s->runtime, s->from_skin, s->from_reference, s->polished, s->polish_move,
             s->unconverged, s->failed);
+    int32_t *x = malloc(sizeof(int32_t) * (size_t)s->poses);
+    double *y = malloc(sizeof(double) * 4 * (size_t)s->poses), ymax = 0.05;
+    if (x && y) {
+        for (int32_t k = 0; k < s->poses; ++k) {
+            const sw_bake_spread_pose *q = &s->per_pose[k];
+            const double v[4] = {q->runtime, q->from_skin, q->from_reference, q->polished};
+            x[k] = q->heldout;
+            for (int i = 0; i < 4; ++i) {
+                y[(size_t)i * s->poses + k] = v[i];
+                if (isfinite(v[i])) ymax = fmax(ymax, v[i]);
+            }
+        }
+        static const char *const title[4] = {"the runtime", "the simulator from plain skinning",
+                                             "the simulator from the reference",
+                                             "the simulator from the runtime's state"};
+        static const char *const colour[4] = {"#d2691e", "#7f7f7f", "#2ca02c", "#1f77b4"};
+        for (int i = 0; i < 4; ++i)
+            svg_line(f, title[i], "held-out pose", x, y + (size_t)i * s->poses, NULL, s->poses,
+                     ymax, colour[i]);
+    }
+    fprintf(f, "</div>\n");
+    free(x);
+    free(y);
 }
 
 /* The joints the held-out poses bend further than any training pose: where the basis

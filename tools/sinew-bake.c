@@ -289,6 +289,8 @@ int main(int argc, char **argv) {
     sinew_blob_def bd = sinew_blob_def_default();
     int status = 1;
     double *frame_err = NULL; /* every training pose's error, then every held-out one's */
+    sw_bake_spread spread;    /* --reference-spread */
+    memset(&spread, 0, sizeof spread);
     if ((r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot serialise the blob: ", tool);
         goto done;
@@ -314,8 +316,6 @@ int main(int argc, char **argv) {
         sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
         goto done;
     }
-    sw_bake_spread spread; /* --reference-spread */
-    memset(&spread, 0, sizeof spread);
     if (spread_every > 0 &&
         (r = sw_bake_reference_spread(&ch, &p, blob, &res, eval_mode, spread_every, &spread,
                                       &err)) != SINEW_OK) {
@@ -573,6 +573,13 @@ int main(int argc, char **argv) {
                    spread_every, spread.poses, spread.runtime, spread.from_skin,
                    spread.from_reference, spread.polished, spread.polish_move, spread.unconverged,
                    spread.failed);
+        for (int32_t k = 0; spread_every > 0 && k < spread.poses; ++k) {
+            /* [held-out pose, runtime, from_skin, from_reference, polished, correction] */
+            const sw_bake_spread_pose *q = &spread.per_pose[k];
+            printf("%s[%d,%.5f,%.5f,%.5f,%.5f,%.4g]%s", k ? "," : ",\"ref_spread_poses\":[",
+                   q->heldout, q->runtime, q->from_skin, q->from_reference, q->polished,
+                   q->correction, k + 1 == spread.poses ? "]" : "");
+        }
         printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
         for (int32_t k = 0; k < nbeyond; ++k) {
             printf("%s[%d,", k ? "," : "", beyond[k].bone);
@@ -588,6 +595,7 @@ int main(int argc, char **argv) {
                absurd ? "true" : "false");
     }
 done:
+    sw_bake_spread_free(&spread);
     sinew_blob_destroy(blob);
     free(mem);
     free(frame_err);

@@ -310,7 +310,13 @@ sinew_result sw_bake_heldout_error(const sinew_blob *blob, const sw_bake_result 
  * precision: the contact set starts afresh, Newton's tolerance is relative to its start),
  * `polished` how far the full-space equilibrium nearest the runtime's state is from the
  * reference (0: the runtime is off the one equilibrium; near `runtime`: it sits by
- * another), `polish_move` how far that solve moved the runtime's state. */
+ * another), `polish_move` how far that solve moved the runtime's state; per pose the same
+ * shares of that pose alone. */
+typedef struct sw_bake_spread_pose {
+    int32_t heldout;                                     /* the held-out pose's index */
+    double runtime, from_skin, from_reference, polished; /* its own shares */
+    double correction; /* |x_ref - x_dqs|_M: the shares' denominator (near 0: rounding) */
+} sw_bake_spread_pose;
 typedef struct sw_bake_spread {
     int32_t poses;         /* held-out poses measured */
     double runtime;        /* the runtime's correction error at those poses */
@@ -320,11 +326,13 @@ typedef struct sw_bake_spread {
     double polish_move;    /* that solve against the runtime's state */
     int32_t unconverged;   /* solves that ended unconverged (kept, as the reference keeps them) */
     int32_t failed;        /* poses left out: a step or a solve that did not stay finite */
+    sw_bake_spread_pose *per_pose; /* `poses` of them, in order (sw_bake_spread_free) */
 } sw_bake_spread;
 sinew_result sw_bake_reference_spread(const sw_character *ch, const sw_bake_params *p,
                                       const sinew_blob *blob, const sw_bake_result *res,
                                       sinew_self_contact sc, int32_t every, sw_bake_spread *out,
                                       sw_error *err);
+void sw_bake_spread_free(sw_bake_spread *s);
 
 /* The training half of sw_bake_errors_frames (train_frames: res->ntrain doubles or NULL). */
 sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *res,

@@ -28,6 +28,7 @@ typedef struct {
     /* sums over the measured poses of squared mass norms, as sw_eval_acc sums them */
     double runtime, from_skin, from_ref, polished, moved, den;
     int32_t poses, unconverged, failed;
+    sw_bake_spread_pose *per_pose; /* room for every measured pose */
 } spread_ctx;
 
 /* sum_v m_v |a_v - b_v|^2 */
@@ -67,12 +68,21 @@ static void spread_pose(void *vctx, int32_t pose, const sinew_instance *inst, co
         c->failed++;
         return;
     }
+    double rt = mass_dist2(c->mass, c->xs, xr, c->nv), den = mass_dist2(c->mass, xr, c->xd, c->nv);
     c->from_skin += skin[0];
     c->from_ref += ref[0];
     c->polished += pol[0];
     c->moved += pol[1];
-    c->runtime += mass_dist2(c->mass, c->xs, xr, c->nv);
-    c->den += mass_dist2(c->mass, xr, c->xd, c->nv);
+    c->runtime += rt;
+    c->den += den;
+    /* the pose's own shares (0 where it has no correction to miss, as the bake's frames) */
+    double inv = den > 0 ? 1 / den : 0;
+    c->per_pose[c->poses] = (sw_bake_spread_pose){.heldout = pose - c->pre,
+                                                  .runtime = sqrt(rt * inv),
+                                                  .from_skin = sqrt(skin[0] * inv),
+                                                  .from_reference = sqrt(ref[0] * inv),
+                                                  .polished = sqrt(pol[0] * inv),
+                                                  .correction = sqrt(den)};
     c->poses++;
 }
 
@@ -108,8 +118,9 @@ sinew_result sw_bake_reference_spread(const sw_character *ch, const sw_bake_para
     c.xs = malloc(n3 * sizeof(double) + 1);
     c.xd = malloc(n3 * sizeof(double) + 1);
     c.cnt = malloc((size_t)c.nv * sizeof(double) + 1);
+    out->per_pose = c.per_pose = calloc((size_t)(res->nheldout / every) + 1, sizeof *c.per_pose);
     sinew_result r = SINEW_OK;
-    if (!T || !w || !c.xs || !c.xd || !c.cnt) {
+    if (!T || !w || !c.xs || !c.xd || !c.cnt || !c.per_pose) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "reference spread: out of memory");
         goto done;
     }
@@ -143,5 +154,12 @@ done:
     free(c.xs);
     free(c.xd);
     free(c.cnt);
+    if (r != SINEW_OK) sw_bake_spread_free(out);
     return r;
+}
+
+void sw_bake_spread_free(sw_bake_spread *s) {
+    free(s->per_pose);
+    s->per_pose = NULL;
+    s->poses = 0;
 }
