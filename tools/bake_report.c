@@ -162,6 +162,36 @@ static cJSON *json_number(double v) {
     return isfinite(v) ? cJSON_CreateNumber(v) : cJSON_CreateNull();
 }
 
+/* The four shares of sw_bake_spread (the whole figure's, or one pose's) into o. */
+static void json_spread_shares(cJSON *o, double runtime, double from_skin, double from_reference,
+                               double polished) {
+    cJSON_AddItemToObject(o, "runtime", json_number(runtime));
+    cJSON_AddItemToObject(o, "from_skin", json_number(from_skin));
+    cJSON_AddItemToObject(o, "from_reference", json_number(from_reference));
+    cJSON_AddItemToObject(o, "polished", json_number(polished));
+}
+
+/* --reference-spread's figures, whole and per pose (null: not measured). */
+static cJSON *json_spread(const sw_bake_spread *s) {
+    if (!s) return cJSON_CreateNull();
+    cJSON *o = cJSON_CreateObject();
+    cJSON_AddNumberToObject(o, "poses", s->poses);
+    json_spread_shares(o, s->runtime, s->from_skin, s->from_reference, s->polished);
+    cJSON_AddItemToObject(o, "polish_move", json_number(s->polish_move));
+    cJSON_AddNumberToObject(o, "unconverged", s->unconverged);
+    cJSON_AddNumberToObject(o, "failed", s->failed);
+    cJSON *pp = cJSON_AddArrayToObject(o, "per_pose");
+    for (int32_t k = 0; k < s->poses; ++k) {
+        const sw_bake_spread_pose *q = &s->per_pose[k];
+        cJSON *e = cJSON_CreateObject();
+        cJSON_AddNumberToObject(e, "heldout", q->heldout);
+        json_spread_shares(e, q->runtime, q->from_skin, q->from_reference, q->polished);
+        cJSON_AddItemToObject(e, "correction", json_number(q->correction));
+        cJSON_AddItemToArray(pp, e);
+    }
+    return o;
+}
+
 static cJSON *json_character(const sw_bake_report_input *in) {
     const sw_character *ch = in->ch;
     cJSON *c = cJSON_CreateObject();
@@ -325,32 +355,7 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     } else {
         cJSON_AddNullToObject(j, "err_heldout_by_mode");
     }
-    if (in->spread) {
-        const sw_bake_spread *s = in->spread;
-        cJSON *o = cJSON_AddObjectToObject(j, "ref_spread");
-        cJSON_AddNumberToObject(o, "poses", s->poses);
-        cJSON_AddItemToObject(o, "runtime", json_number(s->runtime));
-        cJSON_AddItemToObject(o, "from_skin", json_number(s->from_skin));
-        cJSON_AddItemToObject(o, "from_reference", json_number(s->from_reference));
-        cJSON_AddItemToObject(o, "polished", json_number(s->polished));
-        cJSON_AddItemToObject(o, "polish_move", json_number(s->polish_move));
-        cJSON_AddNumberToObject(o, "unconverged", s->unconverged);
-        cJSON_AddNumberToObject(o, "failed", s->failed);
-        cJSON *pp = cJSON_AddArrayToObject(o, "per_pose");
-        for (int32_t k = 0; k < s->poses; ++k) {
-            const sw_bake_spread_pose *q = &s->per_pose[k];
-            cJSON *e = cJSON_CreateObject();
-            cJSON_AddNumberToObject(e, "heldout", q->heldout);
-            cJSON_AddItemToObject(e, "runtime", json_number(q->runtime));
-            cJSON_AddItemToObject(e, "from_skin", json_number(q->from_skin));
-            cJSON_AddItemToObject(e, "from_reference", json_number(q->from_reference));
-            cJSON_AddItemToObject(e, "polished", json_number(q->polished));
-            cJSON_AddItemToObject(e, "correction", json_number(q->correction));
-            cJSON_AddItemToArray(pp, e);
-        }
-    } else {
-        cJSON_AddNullToObject(j, "ref_spread");
-    }
+    cJSON_AddItemToObject(j, "ref_spread", json_spread(in->spread));
     cJSON *bt = cJSON_AddArrayToObject(j, "heldout_beyond_training");
     for (int32_t k = 0; k < r->nbeyond; ++k) {
         cJSON *o = cJSON_CreateObject();
