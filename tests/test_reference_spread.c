@@ -36,7 +36,7 @@ TEST(one_equilibrium_is_found_from_every_start) {
     ENSUREF(fabs(s.runtime - eh.correction_error) <= 1e-9 * eh.correction_error, "%.12g vs %.12g",
             s.runtime, eh.correction_error);
     ENSURE(s.runtime > 0.01); /* the subspace misses some: the polish has a way to go */
-    /* one equilibrium: both starts end on the reference, to Newton's tolerance */
+    /* one equilibrium: all three starts end on the reference, to Newton's tolerance */
     ENSUREF(s.from_skin < 1e-3 && s.from_reference < 1e-3 && s.polished < 1e-3, "%g %g %g",
             s.from_skin, s.from_reference, s.polished);
     /* so the polish moved the runtime's state by its error (triangle inequality) */
