@@ -63,9 +63,12 @@ TEST(one_equilibrium_is_found_from_every_start) {
                                     &s2, &e) == SINEW_OK);
     ENSURE(s2.poses == f.res.nheldout / 2 && s2.failed == 0);
     ENSURE(s2.from_skin < 1e-3 && s2.polished < 1e-3 && s2.runtime > 0);
-    for (int32_t k = 0; k < s2.poses; ++k) /* the same poses' own figures as before */
-        ENSURE(s2.per_pose[k].heldout == 2 * k + 1 &&
-               s2.per_pose[k].runtime == s.per_pose[2 * k + 1].runtime);
+    for (int32_t k = 0; k < s2.poses; ++k) { /* the same poses' own figures as before, */
+        const sw_bake_spread_pose *a = &s2.per_pose[k], *b = &s.per_pose[2 * k + 1];
+        ENSURE(a->heldout == 2 * k + 1 && a->runtime == b->runtime); /* the solves' bitwise: */
+        ENSURE(a->from_skin == b->from_skin && a->from_reference == b->from_reference &&
+               a->polished == b->polished); /* none depends on the poses measured before */
+    }
     sw_bake_spread_free(&s2);
     sw_bake_spread_free(&s);
     bake_fixture_free(&f);
