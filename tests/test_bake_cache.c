@@ -10,6 +10,7 @@
 
 #include "bake.h"
 #include "blob_write.h"
+#include "fullsim.h"
 #include "samples.h"
 #include "sim_cache.h"
 #include "sw_test.h"
@@ -33,6 +34,17 @@ static int same_solutions(const sw_bake_result *a, const sw_bake_result *b, size
     return a->ntrain == b->ntrain && a->nheldout == b->nheldout &&
            !memcmp(a->train_x, b->train_x, a->ntrain * px) &&
            !memcmp(a->heldout_x, b->heldout_x, a->nheldout * px);
+}
+
+/* |a - b| over |b - rest| across n poses' solutions */
+static double rel_apart(const sw_character *c, const double *a, const double *b, int32_t n) {
+    double d = 0, s = 0;
+    int64_t nv3 = 3 * (int64_t)c->mesh.nverts;
+    for (int64_t k = 0; k < n * nv3; ++k) {
+        d += (a[k] - b[k]) * (a[k] - b[k]);
+        s += (b[k] - c->mesh.X[k % nv3]) * (b[k] - c->mesh.X[k % nv3]);
+    }
+    return sqrt(d / s);
 }
 
 TEST(a_rebake_reads_the_solutions_back_and_writes_the_same_blob) {
@@ -76,6 +88,19 @@ TEST(a_rebake_reads_the_solutions_back_and_writes_the_same_blob) {
     ENSUREF(sw_bake(&c, &cached, &r3, &err) == SINEW_OK, "%s", err.msg);
     ENSURE(!r3.simulate_cached);
     sw_bake_result_free(&r3);
+    /* the reference's solver (sinew-bake --solver): a miss, solved by the other solver, the
+       same equilibria within the solvers' tolerances */
+    cached.self_contact = 1;
+    sw_fullsim_params direct = sw_fullsim_params_default();
+    direct.solver = SW_SOLVER_CHOLMOD;
+    cached.reference = &direct;
+    ENSUREF(sw_bake(&c, &cached, &r3, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(!r3.simulate_cached && r3.ntrain == r0.ntrain && !same_solutions(&r0, &r3, px));
+    double apart = rel_apart(&c, r0.train_x, r3.train_x, r0.ntrain);
+    printf("    CHOLMOD against PCG references: %.2e of the displacement\n", apart);
+    ENSURE(apart < 1e-4);
+    sw_bake_result_free(&r3);
+    cached.reference = NULL;
     /* a cache "folder" that is a file: an error that names it, before any solve */
     char file[160];
     snprintf(file, sizeof file, "%s/plain", dir);

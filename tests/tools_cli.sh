@@ -77,6 +77,8 @@ expect bake_heldout_steps_range 2 "--heldout-steps wants an integer in 1\.\.64, 
     "$bake" "${small[@]}" --heldout-steps 0 --out "$tmp/a.blob"
 expect bake_reference_spread_range 2 "--reference-spread wants an integer in 1\.\.1000000, got '0'" \
     "$bake" "${small[@]}" --reference-spread 0 --out "$tmp/a.blob"
+expect bake_solver_name 2 "--solver wants one of auto \| cholmod \| pcg, got 'lu'" \
+    "$bake" "${small[@]}" --solver lu --out "$tmp/a.blob"
 expect bench_tets_range 2 "--tets wants an integer in 1000\.\.2000000, got '10'" \
     "$bench" --scene finger --tets 10
 expect bench_full_frames_range 2 "--full-frames wants an integer in 1\.\.100000, got '0'" \

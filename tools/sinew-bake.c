@@ -7,6 +7,7 @@
  *              [--selector greedy|importance|nnhtp] [--tol 0.05] [--max-rank R]
  *              [--compare-cubature] [--no-self-contact] [--return-path|--no-return-path]
  *              [--inertia-modes]
+ *              [--solver S] [--hessian M] [--contact-rounds R] [--set-check C]
  *              [--threads T] [--data DIR]
  *              [--force] [--json]
  *
@@ -26,6 +27,7 @@
 #include <time.h>
 
 #define SW_TOOL_CHARACTER_ARGS
+#define SW_TOOL_REFERENCE_ARGS
 #include "tool_common.h"
 #include "sw_mesh.h"
 
@@ -64,7 +66,7 @@ static void usage(FILE *f) {
                "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
                "                  [--no-pose-force]\n"
                "                  [--eval-self-contact pose-space|pose-pairs]\n"
-               "                  [--reference-spread K]\n"
+               "                  [--reference-spread K] [reference options]\n"
                "                  [--cache DIR] [--threads T] [--force]\n"
                "                  [--json]\n"
                "character:\n" SW_CHARACTER_USAGE);
@@ -128,9 +130,11 @@ static void usage(FILE *f) {
             "  --force          write the blob even when its training error is %.2f or more\n"
             "                   (the share of the physics correction it misses on its own\n"
             "                   training poses; without --force that is an error)\n"
-            "  --json           one JSON object with the figures as the last stdout line\n"
-            "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
+            "  --json           one JSON object with the figures as the last stdout line\n",
             SW_BAKE_MAX_TRAIN_ERROR);
+    fprintf(f, "reference options (every full-space solve of the bake; a change of them\n"
+               "solves the poses again instead of reading the cache):\n" SW_REFERENCE_USAGE
+               "exit status: 0 blob written, 1 failed, 2 bad arguments\n");
 }
 
 int main(int argc, char **argv) {
@@ -141,6 +145,8 @@ int main(int argc, char **argv) {
     int json = 0, force = 0, spread_every = 0;
     sinew_self_contact eval_mode = SINEW_SELF_CONTACT_POSE_SPACE;
     sw_bake_params p = sw_bake_params_default();
+    sw_fullsim_params reference = sw_fullsim_params_default(); /* its solver options */
+    p.reference = &reference;
     sw_adaptive_params ad = sw_adaptive_params_default();
     sw_adaptive_report arep;
     ad.rounds = 0;
@@ -152,8 +158,9 @@ int main(int argc, char **argv) {
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1;
-        if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
-            /* a character option, consumed */
+        if (sw_character_args_take(&ca, argc, argv, &i, &ok) ||
+            sw_reference_args_take(&reference, argc, argv, &i, &ok)) {
+            /* a character or reference option, consumed */
         } else if (!strcmp(a, "--out") && next)
             out_path = argv[++i];
         else if (!strcmp(a, "--report") && next)
@@ -512,7 +519,8 @@ int main(int argc, char **argv) {
                eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
-        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f", res.force_poses, model_err);
+        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\"",
+               res.force_poses, model_err, sw_linear_solver_name(reference.solver));
         printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
                json_number(res.train_galerkin_error, gt),
                json_number(res.heldout_galerkin_error, gh));

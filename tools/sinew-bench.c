@@ -373,6 +373,7 @@ int main(int argc, char **argv) {
     /* 1. bake (or load) */
     sw_bake_params bp = sw_bake_params_default();
     bp.threads = threads;
+    bp.reference = &ref_solver; /* its bake's solves as its full frames' */
     bp.progress = 1;
     sw_tool_progress bar;
     sw_tool_progress_init(&bar, tool);
@@ -426,10 +427,7 @@ int main(int argc, char **argv) {
     /* 2. full-space reference over the first K clip frames (same motion, all cores) */
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.threads = threads;
-    fp.solver = ref_solver.solver;
-    fp.contact_rounds = ref_solver.contact_rounds;
-    fp.hessian = ref_solver.hessian;
-    fp.contact_set_check = ref_solver.contact_set_check;
+    sw_fullsim_params_take_solver(&fp, &ref_solver);
     sw_fullsim *sim = NULL;
     int kf = full_frames > 0 && full_frames < nf ? full_frames : nf; /* default: the whole clip */
     double *full = malloc((size_t)(kf > 0 ? kf : 1) * sizeof(double));

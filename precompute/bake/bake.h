@@ -93,6 +93,11 @@ typedef struct sw_bake_params {
                                       joint lands its contact on another branch
                                       (docs/generalisation.md, "Held-out poses on a path") */
     int self_contact;              /* in the training simulations (default 1) */
+    /* The full-space reference's solver options (fullsim.h): its solver, hessian,
+       contact_rounds and contact_set_check are taken for every full-space solve of the
+       bake (training, held-out, the spread), and a change of them misses the cache. NULL
+       (default): sw_fullsim_params_default's. */
+    const struct sw_fullsim_params *reference;
     /* A folder for the simulate stage's results (NULL, the default: none): a bake finds
        there the full-space solutions of a bake with the same mesh, weights, material,
        simulator and poses and skips solving them; otherwise it stores its own

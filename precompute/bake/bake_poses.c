@@ -548,6 +548,7 @@ static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
 
 sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p) {
     sw_fullsim_params fp = sw_fullsim_params_default();
+    if (p->reference) sw_fullsim_params_take_solver(&fp, p->reference);
     fp.self_contact = p->self_contact;
     return fp;
 }

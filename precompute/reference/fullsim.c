@@ -46,6 +46,13 @@ sw_fullsim_params sw_fullsim_params_default(void) {
     return p;
 }
 
+void sw_fullsim_params_take_solver(sw_fullsim_params *to, const sw_fullsim_params *from) {
+    to->solver = from->solver;
+    to->hessian = from->hessian;
+    to->contact_rounds = from->contact_rounds;
+    to->contact_set_check = from->contact_set_check;
+}
+
 /* ---- creation ----------------------------------------------------------------- */
 
 int sw_fullsim_all_finite(const double *a, int64_t n) {
