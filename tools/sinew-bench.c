@@ -161,8 +161,9 @@ static void usage(FILE *f) {
             "                      as the bake splits a clip: err_clip_train, err_clip_heldout\n"
             "                      (err_source \"clip\"), not the bake's figures\n"
             "  --bake-errors       with --blob: re-solve the bake's training and held-out poses\n"
-            "                      (default bake parameters; as slow as the bake's simulate\n"
-            "                      stage) and report the bake's err_train/err_heldout\n"
+            "                      (default bake parameters, the reference options below; as\n"
+            "                      slow as the bake's simulate stage) and report the bake's "
+            "err_train/err_heldout\n"
             "                      (err_source \"bake_default_poses\")\n"
             "  --full-frames K     time the reference over the first K clip frames, 1..100000\n"
             "                      (default: the whole clip)\n"
@@ -203,9 +204,10 @@ static void usage(FILE *f) {
             "                      1..4096, each offset in time, on 1 thread and on T\n"
             "                      (--threads) host pthreads, and report crowd_ms,\n"
             "                      crowd_us_per_instance, crowd_scaling, crowd_vs_lone\n"
-            "  --json              one JSON object with the figures as the last stdout line\n"
-            "reference options (the full-space run the bench times; a bake it runs uses the\n"
-            "defaults):\n" SW_REFERENCE_USAGE "exit status: 0 done, 1 failed, 2 bad arguments\n");
+            "  --json              one JSON object with the figures as the last stdout line\n");
+    fprintf(f, "reference options (the full-space run the bench times, and the full-space solves\n"
+               "of a bake it runs or of --bake-errors):\n" SW_REFERENCE_USAGE
+               "exit status: 0 done, 1 failed, 2 bad arguments\n");
 }
 
 /* The subspace surface of every clip frame as DIR/frame_NNNN.obj (for sinew-render);
@@ -521,7 +523,8 @@ int main(int argc, char **argv) {
     /* 5. errors against full-space solutions, always by the bake's definition
        (sw_bake_errors): on the bake's poses when it baked here; a given blob on the clip
        frames the reference solved above (split as the bake splits a clip), or, with
-       --bake-errors, on the bake's poses solved anew with the default parameters */
+       --bake-errors, on the bake's poses solved anew with the default parameters and the
+       reference options */
     sw_eval_result et, eh;
     int clip_errors = blob_path && !bake_errors;
     const char *err_source = !blob_path ? "bake" : clip_errors ? "clip" : "bake_default_poses";
