@@ -149,6 +149,11 @@ if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference
     done
     [ "$(key "$tmp/bench.json" err_source)" = '"bake_default_poses"' ] ||
         { echo "FAIL same_errors: err_source is not bake_default_poses" >&2; fails=$((fails + 1)); }
+    # the bake says which reference its figures are measured against
+    [ "$(key "$tmp/bake.json" ref_solver)" = '"auto"' ] &&
+        [ "$(key "$tmp/bake.json" ref_hessian)" = '"adaptive"' ] &&
+        grep -q "references solved by: solver auto, adaptive Hessians" "$tmp/bake.err" ||
+        { echo "FAIL reference_named: $(key "$tmp/bake.json" ref_solver) $(key "$tmp/bake.json" ref_hessian)" >&2; fails=$((fails + 1)); }
     # every held-out pose measured, the runtime's figure the bake's held-out error
     [ "$(key "$tmp/bake.json" poses)" = "$(key "$tmp/bake.json" heldout_poses)" ] &&
         [ "$(key "$tmp/bake.json" runtime)" = "$(key "$tmp/bake.json" err_heldout)" ] &&

@@ -417,6 +417,9 @@ int main(int argc, char **argv) {
             "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
             res.ntrain, res.nheldout, held_how, res.train_proj_error, res.heldout_proj_error,
             res.train_galerkin_error, res.heldout_galerkin_error);
+    fprintf(stderr, "  references solved by: solver %s, %s Hessians, at most %d contact rounds\n",
+            sw_linear_solver_name(reference.solver), sw_hessian_mode_name(reference.hessian),
+            reference.contact_rounds);
     int32_t kept = 0; /* the pose-space pairs the per-pair cubature keeps */
     for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
         kept += v->pair_weight[c] > 0;
@@ -519,8 +522,10 @@ int main(int argc, char **argv) {
                eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
-        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\"",
-               res.force_poses, model_err, sw_linear_solver_name(reference.solver));
+        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
+               "\"ref_hessian\":\"%s\"",
+               res.force_poses, model_err, sw_linear_solver_name(reference.solver),
+               sw_hessian_mode_name(reference.hessian));
         printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
                json_number(res.train_galerkin_error, gt),
                json_number(res.heldout_galerkin_error, gh));

@@ -18,6 +18,10 @@ const char *sw_linear_solver_name(sw_linear_solver s) {
     return s == SW_SOLVER_CHOLMOD ? "cholmod" : s == SW_SOLVER_PCG ? "pcg" : "auto";
 }
 
+const char *sw_hessian_mode_name(sw_hessian_mode m) {
+    return m == SW_HESSIAN_PROJECTED ? "projected" : m == SW_HESSIAN_EXACT ? "exact" : "adaptive";
+}
+
 sw_fullsim_params sw_fullsim_params_default(void) {
     sw_fullsim_params p;
     memset(&p, 0, sizeof p);

@@ -50,6 +50,8 @@ typedef enum sw_hessian_mode {
     SW_HESSIAN_EXACT = 2      /* always exact, truncated PCG (Newton-CG) */
 } sw_hessian_mode;
 
+const char *sw_hessian_mode_name(sw_hessian_mode m);
+
 /* Which linear solver takes the Newton systems. */
 typedef enum sw_linear_solver {
     /* PCG: measured on the finger's 40-frame fold at 20K tets (3,984 vertices, 2 cores),
