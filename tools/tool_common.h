@@ -585,9 +585,13 @@ static inline int sw_reference_args_take(sw_fullsim_params *p, int argc, char **
                                          int *ok) {
     const char *a = argv[*i], *v = *i + 1 < argc ? argv[*i + 1] : NULL;
     if (!v) return 0;
-    /* names in enum order: sw_linear_solver, sw_hessian_mode */
-    static const char *const solvers[] = {"auto", "cholmod", "pcg", NULL};
-    static const char *const hessians[] = {"adaptive", "projected", "exact", NULL};
+    /* in enum order, by the names the summaries print (fullsim.h) */
+    const char *const solvers[] = {sw_linear_solver_name(SW_SOLVER_AUTO),
+                                   sw_linear_solver_name(SW_SOLVER_CHOLMOD),
+                                   sw_linear_solver_name(SW_SOLVER_PCG), NULL};
+    const char *const hessians[] = {sw_hessian_mode_name(SW_HESSIAN_ADAPTIVE),
+                                    sw_hessian_mode_name(SW_HESSIAN_PROJECTED),
+                                    sw_hessian_mode_name(SW_HESSIAN_EXACT), NULL};
     static const char *const off_on[] = {"off", "on", NULL};
     int k;
     ++*i;

@@ -626,7 +626,7 @@ sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
     sw_bake_progress_begin(s, "simulate", poses);
     /* one task per worker; each worker pulls sequences until none is left. The direct
        solver's factorisations (--solver cholmod) run on OpenBLAS: with its own threads
-       beside the workers, the Fox's simulate stage spun for 524 s, with 1 it took 131 s */
+       beside the workers, the Fox's simulate stage spun for 524 s, with 1 it took 124 s */
     openblas_set_num_threads(1);
     sw_pool_parallel_for(s->pool, sw_pool_size(s->pool), simulate_worker, &ctx);
     if (atomic_load(&ctx.failed) > 0)
