@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include "bake.h"
+#include "mat3.h"
 #include "pose_space.h"
 #include "bake_report.h"
 #include "samples.h"
@@ -482,6 +483,75 @@ TEST(random_heldout_poses_in_the_report) {
     sw_character_free(&ch);
 }
 
+/* A joint range (sw_character.range) bounds the sweeps and the random combined poses of
+ * a bake without a clip: each joint swept to its largest turn in the range, about its
+ * axis there; a joint the range leaves at rest is never bent; every pose within the
+ * range. A range of another skeleton, one not finite and one that turns no joint are
+ * refused, each naming the range. */
+TEST(joint_range_bounds_sweeps_and_random_poses) {
+    sw_character ch;
+    sw_error e;
+    ENSURE(sw_sample_make("finger", 1000, 8, &ch, &e) == SINEW_OK);
+    ch.clip.nframes = 0;
+    int32_t nb = ch.skel.nbones;
+    ENSURE(nb == 3);
+    if (nb != 3) {
+        sw_character_free(&ch);
+        return;
+    }
+    /* frames: rest, bone 1 at 40 degrees, at 20 degrees about z; bone 2 always at rest */
+    double local[9 * 3], range_T[3 * 12 * 3], deg = 0.017453292519943295;
+    static const double z[3] = {0, 0, 1}, turn[3] = {0, 40, 20};
+    for (int f = 0; f < 3; ++f) {
+        for (int32_t b = 0; b < nb; ++b)
+            sw_m3_axis_angle(z, b == 1 ? turn[f] * deg : 0, local + 9 * b);
+        sw_forward_kinematics(&ch.skel, local, NULL, range_T + (size_t)f * 12 * nb);
+    }
+    sw_bake_params p = sw_bake_params_default();
+    p.threads = 2;
+    p.sweep_samples = 3;
+    p.random_poses = 3;
+    p.heldout_steps = 2;
+    sw_bake_result res;
+    /* refused: another skeleton's, not finite, at rest throughout */
+    ch.range = (sw_clip){nb - 1, 3, 30.0, range_T};
+    ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "joint range") != NULL, "%s", e.msg);
+    ch.range = (sw_clip){nb, 3, 30.0, range_T};
+    double keep = range_T[12 * nb + 5];
+    range_T[12 * nb + 5] = NAN;
+    ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_NOT_FINITE);
+    ENSUREF(strstr(e.msg, "joint range: frame 1") != NULL, "%s", e.msg);
+    range_T[12 * nb + 5] = keep;
+    ch.range = (sw_clip){nb, 1, 30.0, range_T}; /* the rest frame alone */
+    ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(e.msg, "joint range turns no joint") != NULL, "%s", e.msg);
+    ch.range = (sw_clip){nb, 3, 30.0, range_T};
+    sinew_result r = sw_bake(&ch, &p, &res, &e);
+    ch.range = (sw_clip){0, 0, 0, NULL}; /* borrowed: not the character's to free */
+    ENSUREF(r == SINEW_OK, "%s", e.msg);
+    if (r) {
+        sw_character_free(&ch);
+        return;
+    }
+    ENSURE_NEAR(res.sweep_angle[1], 40 * deg, 1e-12);
+    ENSURE(res.sweep_angle[2] == 0);
+    ENSURE_NEAR(fabs(res.sweep_axis[5]), 1, 1e-12); /* bone 1 about z */
+    ENSURE(res.ntrain == 3 && res.nheldout == 6);
+    double bend[3], reach = 0;
+    for (int32_t k = 0; k < res.ntrain + res.nheldout; ++k) {
+        const double *T = k < res.ntrain ? res.train_T + (size_t)k * 12 * nb
+                                         : res.heldout_T + (size_t)(k - res.ntrain) * 12 * nb;
+        bends(&ch.skel, T, bend);
+        ENSUREF(bend[1] <= 40 * deg + 1e-12, "pose %d bends bone 1 by %g", k, bend[1] / deg);
+        ENSUREF(bend[2] < 1e-9, "pose %d bends bone 2 by %g", k, bend[2] / deg);
+        if (k < res.ntrain) reach = fmax(reach, bend[1]);
+    }
+    ENSURE_NEAR(reach, 40 * deg, 1e-9); /* the sweep reaches the range's end */
+    sw_bake_result_free(&res);
+    sw_character_free(&ch);
+}
+
 /* Held-out clips need training clips; a clip of another skeleton is named; so is a
  * number of steps to the random held-out poses out of range. */
 TEST(bad_clip_lists_rejected) {
@@ -512,4 +582,4 @@ TEST(bad_clip_lists_rejected) {
 }
 
 SW_TEST_MAIN(CASE(clips_of_their_own_and_the_report), CASE(random_heldout_poses_in_the_report),
-             CASE(bad_clip_lists_rejected))
+             CASE(joint_range_bounds_sweeps_and_random_poses), CASE(bad_clip_lists_rejected))

@@ -680,6 +680,39 @@ TEST(dataset_hand) {
     sw_character_free(&c);
 }
 
+/* A joint range read from the hand's pose: rest, the pose (the dataset clip's middle
+ * frame, bitwise), rest. A pose of another skeleton or not finite is refused, naming the
+ * file, and the range read before is kept. */
+TEST(joint_range_from_a_pose) {
+    NEED_DATA("hand-libigl/hand.mesh");
+    sw_character c = {0};
+    sw_error err = {0};
+    ENSURE(sw_character_from_dataset(SINEW_SHARED_DATA_DIR, "hand-libigl", 41, &c, &err) ==
+           SINEW_OK);
+    ENSUREF(sw_character_read_range(HAND_DIR "/hand-pose.dmat", &c, &err) == SINEW_OK, "%s",
+            err.msg);
+    ENSURE(c.range.nbones == 20 && c.range.nframes == 3);
+    if (c.range.nframes == 3 && c.clip.nframes == 41)
+        ENSURE(!memcmp(c.range.T + 12 * 20, c.clip.T + 20 * 12 * 20, sizeof(double) * 12 * 20) &&
+               !memcmp(c.range.T, c.clip.T, sizeof(double) * 12 * 20));
+    const char *bad[2] = {"19 quaternions", "nan"};
+    for (int k = 0; k < 2; ++k) {
+        FILE *f = fopen(TMP("range.dmat"), "wb");
+        ENSURE(f);
+        if (!f) break;
+        fprintf(f, "1 %d\n", k ? 80 : 76);
+        for (int i = 0; i < (k ? 80 : 76); ++i)
+            fprintf(f, "%s\n", k && i == 5 ? "nan" : i % 4 == 3 ? "1" : "0");
+        fclose(f);
+        double *kept = c.range.T;
+        ENSURE(sw_character_read_range(TMP("range.dmat"), &c, &err) != SINEW_OK);
+        ENSUREF(strstr(err.msg, "range.dmat") != NULL, "%s: %s", bad[k], err.msg);
+        ENSURE(c.range.T == kept && c.range.nframes == 3);
+    }
+    remove(TMP("range.dmat"));
+    sw_character_free(&c);
+}
+
 TEST(corrupt_inputs) {
     sw_character c = {0};
     sw_error err = {0};
@@ -759,4 +792,5 @@ SW_TEST_MAIN(CASE(cd_anim_semantics), CASE(cd_anim_malformed), CASE(cd_anim_elep
              CASE(pose_clip), CASE(inverse_distance_weights), CASE(bone_vertices_box),
              CASE(bone_vertices_top_up_and_errors),
              CASE(bone_vertices_of_a_bone_at_the_edge_of_its_flesh), CASE(dataset_elephant),
-             CASE(dataset_hand), CASE(corrupt_inputs), CASE(surface_arm))
+             CASE(dataset_hand), CASE(joint_range_from_a_pose), CASE(corrupt_inputs),
+             CASE(surface_arm))

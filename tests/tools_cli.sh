@@ -101,6 +101,12 @@ expect bake_surface_missing 1 "a\.obj" "$bake" --mesh "$tmp/a.obj" --skeleton s.
     --out "$tmp/a.blob"
 expect bake_clip_format 2 "--clip 'c\.bvh': not a format it reads; accepted: \.txt" \
     "$bake" --mesh a.mesh --skeleton s.tgf --clip c.bvh --out "$tmp/a.blob"
+expect bake_range_with_clip 2 "--joint-range does not apply with --clip" \
+    "$bake" --mesh a.mesh --skeleton s.tgf --clip c.txt --joint-range r.dmat --out "$tmp/a.blob"
+expect bench_range_with_scene 2 "--joint-range does not apply to --scene" \
+    "$bench" "${small[@]}" --joint-range r.dmat
+expect bake_range_format 2 "--joint-range 'r\.bvh': not a format it reads; accepted: \.txt" \
+    "$bake" --mesh a.mesh --skeleton s.tgf --joint-range r.bvh --out "$tmp/a.blob"
 expect bench_world_format 2 "--world 'w\.yaml': not a format it reads; accepted: \.json" \
     "$bench" "${small[@]}" --world w.yaml
 expect render_out_format 2 "--out '.*a\.jpg': not a format it reads; accepted: \.png" \

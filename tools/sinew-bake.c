@@ -53,7 +53,7 @@ static void usage(FILE *f) {
                "                   [--fps F] [--height H] |\n"
                "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
                "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-               "                   [--clip FILE [--frames F]])\n"
+               "                   [--clip FILE [--frames F] | --joint-range FILE])\n"
                "                  --out FILE.blob [--report DIR]\n"
                "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
                "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
@@ -408,10 +408,13 @@ int main(int argc, char **argv) {
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].cub_count);
     fprintf(stderr, "), worst cubature fit %.4f\n", res.cubature_error_max);
     /* random held-out poses (no clip) come on a path: say what the count is made of */
-    char held_how[96] = "";
+    char held_how[128] = "";
     if (res.nheldout > 0 && res.heldout_clip[0] < 0)
-        snprintf(held_how, sizeof held_how, " (%d random combined poses, each reached in %d steps)",
-                 res.nheldout / p.heldout_steps, p.heldout_steps);
+        snprintf(held_how, sizeof held_how,
+                 " (%d random combined poses, each reached in %d steps, %s)",
+                 res.nheldout / p.heldout_steps, p.heldout_steps,
+                 ch.range.nframes > 0 ? "the joints within --joint-range"
+                                      : "every joint within 90 degrees");
     fprintf(stderr,
             "  poses: %d training, %d held-out%s; basis projection error train %.4f held-out "
             "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
@@ -523,9 +526,9 @@ int main(int argc, char **argv) {
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
-               "\"ref_hessian\":\"%s\"",
+               "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d",
                res.force_poses, model_err, sw_linear_solver_name(reference.solver),
-               sw_hessian_mode_name(reference.hessian));
+               sw_hessian_mode_name(reference.hessian), ch.range.nframes);
         printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
                json_number(res.train_galerkin_error, gt),
                json_number(res.heldout_galerkin_error, gh));

@@ -290,6 +290,7 @@ static inline void sw_tool_progress_print(void *user, const char *stage, int64_t
 typedef struct sw_character_args {
     const char *tool; /* for messages */
     const char *scene, *mesh, *tgf, *weights, *clip, *data_dir;
+    const char *joint_range;                 /* --joint-range: a pose or animation */
     const char *file;                        /* a rigged glTF/FBX character (positional) */
     const char *train_clips, *heldout_clips; /* its clips by name */
     double fps, height;                      /* its clip rate and scale (0: defaults) */
@@ -323,7 +324,11 @@ typedef struct sw_character_args {
     "  --mesh FILE      a tet mesh: .mesh (MEDIT) | .node/.ele (TetGen); needs --skeleton\n"       \
     "  --skeleton FILE  a .tgf skeleton (with --mesh only)\n"                                      \
     "  --weights FILE   .dmat skin weights (with --mesh only; default: computed)\n"                \
-    "  --clip FILE      a .txt bone animation or a .dmat pose (with --mesh only)\n"
+    "  --clip FILE      a .txt bone animation or a .dmat pose (with --mesh only)\n"                \
+    "  --joint-range FILE  each joint's range of motion (with --mesh and no --clip): its\n"        \
+    "                   largest turn in a .dmat pose or .txt bone animation bounds the\n"          \
+    "                   joint sweeps and random combined poses (default: 90 degrees across\n"      \
+    "                   every bone)\n"
 
 static inline void sw_character_args_init(sw_character_args *c, const char *tool) {
     memset(c, 0, sizeof *c);
@@ -354,6 +359,7 @@ static inline int sw_character_args_take(sw_character_args *c, int argc, char **
                      : !strcmp(a, "--skeleton")      ? &c->tgf
                      : !strcmp(a, "--weights")       ? &c->weights
                      : !strcmp(a, "--clip")          ? &c->clip
+                     : !strcmp(a, "--joint-range")   ? &c->joint_range
                      : !strcmp(a, "--data")          ? &c->data_dir
                                                      : NULL;
     if (s) {
@@ -388,10 +394,15 @@ static inline int sw_character_is_sample(const char *name) {
 
 /* A glTF/FBX FILE: its format, and no option of the other inputs (each named). */
 static inline int sw_scene_file_args_valid(const sw_character_args *c) {
-    const char *opts[] = {c->tgf, c->weights, c->clip, c->data_given ? c->data_dir : NULL,
-                          c->frames ? "" : NULL},
-               *names[] = {"--skeleton", "--weights", "--clip", "--data", "--frames"};
-    for (int k = 0; k < 5; ++k)
+    const char *opts[] = {c->tgf,
+                          c->weights,
+                          c->clip,
+                          c->data_given ? c->data_dir : NULL,
+                          c->frames ? "" : NULL,
+                          c->joint_range},
+               *names[] = {"--skeleton", "--weights", "--clip",
+                           "--data",     "--frames",  "--joint-range"};
+    for (int k = 0; k < 6; ++k)
         if (opts[k]) {
             fprintf(stderr,
                     "%s: %s does not apply to a glTF/FBX FILE (it brings its skeleton, weights "
@@ -431,9 +442,9 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
         return 0;
     }
     if (c->scene) {
-        const char *files[] = {c->tgf, c->weights, c->clip},
-                   *names[] = {"--skeleton", "--weights", "--clip"};
-        for (int k = 0; k < 3; ++k)
+        const char *files[] = {c->tgf, c->weights, c->clip, c->joint_range},
+                   *names[] = {"--skeleton", "--weights", "--clip", "--joint-range"};
+        for (int k = 0; k < 4; ++k)
             if (files[k]) {
                 fprintf(stderr,
                         "%s: %s does not apply to --scene (the scene brings its own); it "
@@ -476,6 +487,13 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
                 t);
         return 0;
     }
+    if (c->joint_range && c->clip) {
+        fprintf(stderr,
+                "%s: --joint-range does not apply with --clip (the clip's training frames "
+                "bound the joint sweeps)\n",
+                t);
+        return 0;
+    }
     if (c->frames && !c->clip) {
         fprintf(stderr,
                 "%s: --frames does not apply to --mesh without --clip (it bounds the clip's "
@@ -488,7 +506,9 @@ static inline int sw_character_args_valid(const sw_character_args *c) {
            sw_tool_format(t, "--skeleton", c->tgf, "tgf", ".tgf") &&
            (!c->weights || sw_tool_format(t, "--weights", c->weights, "dmat", ".dmat")) &&
            (!c->clip || sw_tool_format(t, "--clip", c->clip, "txt dmat",
-                                       ".txt (bone animation), .dmat (pose quaternions)"));
+                                       ".txt (bone animation), .dmat (pose quaternions)")) &&
+           (!c->joint_range || sw_tool_format(t, "--joint-range", c->joint_range, "txt dmat",
+                                              ".txt (bone animation), .dmat (pose quaternions)"));
 }
 
 /* What a glTF/FBX FILE became (the mesher's lattice, the material, the clip split). */
@@ -562,6 +582,8 @@ static inline sinew_result sw_character_args_make(const sw_character_args *c, sw
                                         c->clip, c->frames, ch, NULL, err)
             : sw_character_from_files(c->mesh, c->tgf, c->weights, c->clip, c->frames, ch, err);
     if (r == SINEW_OK && (computed || (c->mesh && !c->weights))) sw_weights_free(&ch->weights);
+    if (r == SINEW_OK && c->joint_range && (r = sw_character_read_range(c->joint_range, ch, err)))
+        sw_character_free(ch);
     return r;
 }
 #endif

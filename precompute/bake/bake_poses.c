@@ -186,7 +186,12 @@ int32_t sw_bake_pose_beyond(const sw_skeleton *sk, const double *T, const double
 }
 
 /* The largest rotation each joint reaches in the training ranges: its sweep. Without a
- * clip, 90 degrees about an axis across the bone. */
+ * clip, the largest in the character's joint range (sw_character.range) or else 90
+ * degrees about an axis across the bone. A bare skeleton says nothing of its joints'
+ * limits: the 90 degrees bend a hand's metacarpals into the palm independently, which
+ * no hand does, and 70% of the bare hand's held-out error was there; the hand's own
+ * pose as its range took it from 0.369 to 0.100 (docs/generalisation.md, "Joint
+ * ranges"). */
 static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32_t ntr,
                           double *sweep_axis, double *sweep_angle) {
     const sw_skeleton *sk = &s->ch.skel;
@@ -195,6 +200,10 @@ static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32
         sw_bake_joint_reach(sk, train[r].clip->T + (size_t)train[r].first * 12 * nb, train[r].count,
                             sweep_angle, sweep_axis);
     if (ntr > 0) return;
+    if (s->ch.range.nframes > 0) {
+        sw_bake_joint_reach(sk, s->ch.range.T, s->ch.range.nframes, sweep_angle, sweep_axis);
+        return;
+    }
     for (int32_t b = 0; b < nb; ++b) {
         if (sk->parent[b] < 0) continue;
         const double *h = sk->joints + 3 * sk->bones[2 * b],
@@ -486,6 +495,11 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
                               "the basis and the cubature are learnt from the training poses' "
                               "deformation",
                               s->p->ntrain_clips);
+        else if (ntr == 0 && s->ch.range.nframes > 0)
+            rc = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                              "no training poses: the joint range turns no joint (every bone "
+                              "at rest in its %d frames), so nothing is swept",
+                              s->ch.range.nframes);
         else
             rc = sw_error_set(
                 err, SINEW_ERROR_INVALID_ARGUMENT,

@@ -20,6 +20,12 @@ sinew_result sw_character_from_files(const char *mesh_path, const char *tgf_path
                                      const char *weights_path, const char *motion_path,
                                      int32_t nframes, sw_character *out, sw_error *err);
 
+/* Each joint's range of motion from a file (sw_character.range): a .dmat pose (one
+ * quaternion per bone, as sw_character_from_files takes it) or a .txt bone animation,
+ * read against ch->skel and kept in ch->range (replacing any range before). Errors name
+ * the file; ch is unchanged then. */
+sinew_result sw_character_read_range(const char *path, sw_character *ch, sw_error *err);
+
 /* A character from a render surface (.obj; it need not be closed for the lattice) filled
  * with about target_tets tets by `mesher` (mesher.h; report may be NULL), a .tgf
  * skeleton and optional motion as in sw_character_from_files; inverse-distance weights

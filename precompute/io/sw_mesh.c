@@ -53,6 +53,7 @@ void sw_character_free(sw_character *c) {
     sw_skeleton_free(&c->skel);
     sw_weights_free(&c->weights);
     sw_clip_free(&c->clip);
+    sw_clip_free(&c->range);
     sw_trimesh_free(&c->render);
     free(c->bone_of_vertex);
     free(c->bone_names);

@@ -70,6 +70,11 @@ typedef struct sw_character {
     sw_weights weights;
     int32_t *bone_of_vertex; /* nverts: bone driving this vertex rigidly, or -1 (free flesh) */
     sw_clip clip;
+    /* Each joint's range of motion (nframes 0: none given): its largest turn over these
+     * frames bounds the bake's joint sweeps and random combined poses where the bake has
+     * no clip to train on; without it they turn every joint 90 degrees across its bone,
+     * the palm's metacarpals too (docs/generalisation.md, "Joint ranges"). */
+    sw_clip range;
     double youngs;  /* Young's modulus E */
     double poisson; /* Poisson ratio nu */
     double density; /* mass per unit rest volume */
