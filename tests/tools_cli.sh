@@ -75,6 +75,10 @@ expect bake_adaptive_range 2 "--adaptive wants an integer in 0\.\.32, got '40'" 
     "$bake" "${small[@]}" --adaptive 40 --out "$tmp/a.blob"
 expect bake_heldout_steps_range 2 "--heldout-steps wants an integer in 1\.\.64, got '0'" \
     "$bake" "${small[@]}" --heldout-steps 0 --out "$tmp/a.blob"
+expect bake_random_poses_range 2 "--random-poses wants an integer in 1\.\.10000, got '0'" \
+    "$bake" "${small[@]}" --random-poses 0 --out "$tmp/a.blob"
+expect bake_seed_range 2 "--seed wants an integer in 0\.\.2147483647, got '-1'" \
+    "$bake" "${small[@]}" --seed -1 --out "$tmp/a.blob"
 expect bake_reference_spread_range 2 "--reference-spread wants an integer in 1\.\.1000000, got '0'" \
     "$bake" "${small[@]}" --reference-spread 0 --out "$tmp/a.blob"
 expect bake_solver_name 2 "--solver wants one of auto \| cholmod \| pcg, got 'lu'" \

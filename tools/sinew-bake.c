@@ -63,6 +63,7 @@ static void usage(FILE *f) {
                "                  [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]] [--heldout-steps S]\n"
+               "                  [--random-poses N] [--seed S]\n"
                "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
                "                  [--no-pose-force]\n"
                "                  [--eval-self-contact pose-space|pose-pairs]\n"
@@ -103,6 +104,10 @@ static void usage(FILE *f) {
             "  --heldout-steps S  without a clip, the 10 random held-out poses are each\n"
             "                   reached from the one before in S held-out poses, 1..64\n"
             "                   (default 4; the reference depends on the path)\n"
+            "  --random-poses N  without a clip, N random held-out poses, 1..10000\n"
+            "                   (default 10; more define the held-out figure better)\n"
+            "  --seed S         the bake's random draws (held-out poses, adaptive candidates,\n"
+            "                   cubature candidates), 0..2147483647 (default 1592614637)\n"
             "  --contact-modes  also the static responses to the training poses' self-contact\n"
             "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
             "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
@@ -222,7 +227,13 @@ int main(int argc, char **argv) {
             ok = sw_tool_int(tool, a, argv[++i], 1, 1000000, &spread_every);
         else if (!strcmp(a, "--heldout-steps") && next)
             ok = sw_tool_int(tool, a, argv[++i], 1, 64, &p.heldout_steps);
-        else if (!strcmp(a, "--adaptive-target") && next)
+        else if (!strcmp(a, "--random-poses") && next)
+            ok = sw_tool_int(tool, a, argv[++i], 1, 10000, &p.random_poses);
+        else if (!strcmp(a, "--seed") && next) {
+            int seed = 0;
+            ok = sw_tool_int(tool, a, argv[++i], 0, 2147483647, &seed);
+            p.seed = (uint64_t)seed;
+        } else if (!strcmp(a, "--adaptive-target") && next)
             ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in 0..1", &ad.target);
         else if (!strcmp(a, "--inertia-modes"))
             p.inertia_modes = 1;
@@ -526,9 +537,10 @@ int main(int argc, char **argv) {
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
-               "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d",
+               "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
                res.force_poses, model_err, sw_linear_solver_name(reference.solver),
-               sw_hessian_mode_name(reference.hessian), ch.range.nframes);
+               sw_hessian_mode_name(reference.hessian), ch.range.nframes,
+               (unsigned long long)p.seed);
         printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
                json_number(res.train_galerkin_error, gt),
                json_number(res.heldout_galerkin_error, gh));

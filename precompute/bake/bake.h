@@ -108,8 +108,9 @@ typedef struct sw_bake_params {
                         SW_SPRING_CHOICES multiples of E h (h the mean rest edge) the one the
                         training poses prefer (bake_springs.c) */
     int threads;     /* 0: all cores */
-    uint64_t seed;
-    int progress; /* print stage progress to stderr */
+    uint64_t seed;   /* the random draws: held-out poses, adaptive candidates, cubature
+                        candidates (default 0x5eed5eed) */
+    int progress;    /* print stage progress to stderr */
     /* Called as a long stage advances: `done` of `total` units (solved poses in
        "simulate", trained domains in "cubature"), `elapsed` seconds since the stage
        began. Called from the bake's worker threads, one call at a time (the bake
