@@ -664,10 +664,13 @@ int main(int argc, char **argv) {
         failed_steps += nwb.failed;
         sw_newton_bench_print(&nwb, stderr, 0);
     }
-    /* an empty part of the clip's split (very few frames, --full-frames 1) has no error */
+    /* an empty part of the clip's split (very few frames, --full-frames 1) has no error, nor
+       has one whose frames are at rest (a share of rounding: sw_eval_result.no_correction) */
     char e_tr[32] = "null", e_ho[32] = "null";
-    if (!clip_errors || et.frames > 0) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
-    if (!clip_errors || eh.frames > 0) snprintf(e_ho, sizeof e_ho, "%.5f", eh.correction_error);
+    int has_tr = !clip_errors || (et.frames > 0 && !et.no_correction),
+        has_ho = !clip_errors || (eh.frames > 0 && !eh.no_correction);
+    if (has_tr) snprintf(e_tr, sizeof e_tr, "%.5f", et.correction_error);
+    if (has_ho) snprintf(e_ho, sizeof e_ho, "%.5f", eh.correction_error);
     fprintf(stderr,
             "sinew-bench: full %.2f ms, subspace %.3f ms, DQS %.3f ms per frame; speedup %.1fx, "
             "cost %.1fx DQS;\n",
@@ -676,7 +679,14 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "             correction error on clip frames (not the bake's figures): train "
                 "%s (%d frames) held-out %s (%d frames);\n",
-                et.frames > 0 ? e_tr : "n/a", et.frames, eh.frames > 0 ? e_ho : "n/a", eh.frames);
+                has_tr             ? e_tr
+                : et.no_correction ? "n/a (at rest: no correction)"
+                                   : "n/a",
+                et.frames,
+                has_ho             ? e_ho
+                : eh.no_correction ? "n/a (at rest: no correction)"
+                                   : "n/a",
+                eh.frames);
     else
         fprintf(stderr, "             correction error (%s) train %.4f held-out %.4f;\n",
                 err_source, et.correction_error, eh.correction_error);

@@ -27,6 +27,10 @@ sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const doub
                   ? sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
                          (hi[2] - lo[2]) * (hi[2] - lo[2]))
                   : 0;
+    double total_mass = 0;
+    for (int32_t i = 0; i < v->nverts; ++i)
+        total_mass += mass[i];
+    a->den_floor = total_mass * (1e-9 * a->diag) * (1e-9 * a->diag);
     size_t n3 = (size_t)v->nverts * 3 * sizeof(double);
     a->xs = malloc(n3);
     a->xd = malloc(n3);
@@ -68,10 +72,14 @@ void sw_eval_acc_add(sw_eval_acc *a, const sinew_instance *inst, const double *x
 
 void sw_eval_acc_result(const sw_eval_acc *a, sw_eval_result *out) {
     memset(out, 0, sizeof *out);
-    out->correction_error = a->den > 0 ? sqrt(a->num / a->den) : 0;
+    /* frames at rest: the reference and skinning agree to rounding, and a share of that
+       is noise (the bare hand's rest frame read 423484) */
+    int none = !(a->den > a->den_floor * (a->frames > 0 ? a->frames : 1));
+    out->no_correction = none && a->frames > 0;
+    out->correction_error = none ? 0 : sqrt(a->num / a->den);
     out->rel_l2 = a->l2d > 0 ? sqrt(a->l2n / a->l2d) : 0;
     out->frames = a->frames;
-    out->seam = a->den > 0 ? sqrt(a->seam / a->den) : 0;
+    out->seam = none ? 0 : sqrt(a->seam / a->den);
     out->seam_max = a->diag > 0 ? a->seam_max / a->diag : 0;
     for (int32_t b = 0; b < a->nbones && a->num > 0; ++b) { /* the largest shares, in order */
         if (!(a->bone_num[b] > 0)) continue;
@@ -149,8 +157,8 @@ sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mas
         double num = acc.num, den = acc.den;
         sw_eval_acc_add(&acc, inst, x_full + (size_t)(f - o->skip) * 3 * n);
         /* the frame's own share, by the same formula; a frame with no correction to miss
-           (the rest pose) counts 0 */
-        if (fe) *fe = acc.den > den ? sqrt((acc.num - num) / (acc.den - den)) : 0.0;
+           (the rest pose, its correction of rounding) counts 0 */
+        if (fe) *fe = acc.den - den > acc.den_floor ? sqrt((acc.num - num) / (acc.den - den)) : 0.0;
         if (o->on_frame) o->on_frame(o->frame_ctx, f, inst, x_full + (size_t)(f - o->skip) * 3 * n);
     }
     sw_eval_acc_result(&acc, out);

@@ -31,6 +31,10 @@ typedef struct sw_eval_result {
        |x_full - x_dqs|_M (the correction error's denominator), and the largest
        |x_copy - x_mean| of any frame over the rest bounding-box diagonal */
     double seam, seam_max;
+    /* every frame's correction is of rounding (|x_full - x_dqs|_M at most 1e-9 of the rest
+       diagonal, the total mass's worth: frames at rest): a share of nothing, so
+       correction_error and seam are 0, and a caller says the error is not defined */
+    int no_correction;
 } sw_eval_result;
 
 /* The sums behind the correction error, one frame at a time, for a caller that steps
@@ -41,6 +45,7 @@ typedef struct sw_eval_acc {
     int32_t nverts;
     double num, den, l2n, l2d;
     double seam, seam_max, diag; /* sum of m |x_copy - x_mean|^2, largest gap, rest diagonal */
+    double den_floor;            /* a frame's den at most this is rounding (sw_eval_result) */
     int32_t frames;
     double *xs, *cnt, *xd;    /* scratch: subspace, copy counts, DQS (3 nverts each) */
     const int32_t *skin_bone; /* the blob's 4 influences a vertex, strongest first */
