@@ -162,6 +162,30 @@ static int same(double a, double b) {
     return fabs(a - b) <= 1e-12 * fmax(1.0, fabs(b));
 }
 
+/* report.json names the reference's solver and Hessian (null when not given) and the
+ * joint range's frames. */
+static void check_reference_json(const char *dir, const char *solver, const char *hessian,
+                                 int32_t range_frames) {
+    char path[1100];
+    snprintf(path, sizeof path, "%.1000s/report.json", dir);
+    char *text = read_text(path);
+    cJSON *j = text ? cJSON_Parse(text) : NULL;
+    ENSURE(j != NULL);
+    const cJSON *ref = cJSON_GetObjectItemCaseSensitive(j, "reference"),
+                *frames = cJSON_GetObjectItemCaseSensitive(j, "joint_range_frames");
+    if (solver) {
+        const cJSON *s = cJSON_GetObjectItemCaseSensitive(ref, "solver"),
+                    *h = cJSON_GetObjectItemCaseSensitive(ref, "hessian");
+        ENSURE(cJSON_IsString(s) && !strcmp(s->valuestring, solver));
+        ENSURE(cJSON_IsString(h) && !strcmp(h->valuestring, hessian));
+    } else {
+        ENSURE(cJSON_IsNull(ref));
+    }
+    ENSURE(cJSON_IsNumber(frames) && frames->valueint == range_frames);
+    cJSON_Delete(j);
+    free(text);
+}
+
 /* DIR/report.json's ref_spread: the figures given, or null without them. */
 static void check_spread_json(const char *dir, const sw_bake_spread *s) {
     char path[1100];
@@ -295,7 +319,9 @@ TEST(clips_of_their_own_and_the_report) {
                                &eh,
                                NULL,
                                modes,
-                               &spread};
+                               &spread,
+                               "auto",
+                               "adaptive"};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;
@@ -319,6 +345,7 @@ TEST(clips_of_their_own_and_the_report) {
     int flagged[2] = {-1, -1};
     check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes, flagged);
     check_spread_json(dir, &spread);
+    check_reference_json(dir, "auto", "adaptive", 0);
     ENSURE(flagged[0] == 0); /* a training clip never bends beyond itself */
     /* had the training reached half as far, the reversed fold would bend beyond it: the
        report marks those frames (and lists the joints) as the rule says */
@@ -443,12 +470,15 @@ TEST(random_heldout_poses_in_the_report) {
                                &eh,
                                NULL,
                                NULL,
+                               NULL,
+                               NULL,
                                NULL};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
     check_spread_json(dir, NULL); /* not measured: null */
+    check_reference_json(dir, NULL, NULL, 0);
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);

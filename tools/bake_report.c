@@ -30,7 +30,10 @@
  *              train_deg}]: the joints the held-out poses bend further than the training
  *              poses (sw_bake_beyond_training), the largest multiple of the trained bend
  *              first, at most 32
- *   contact_sheet: the PNG's file name, or null */
+ *   contact_sheet: the PNG's file name, or null
+ *   reference {solver, hessian}: what solved the full-space references (null: not given)
+ *   joint_range_frames: the frames of the character's joint range that bound its sweeps
+ *              and random poses (sw_character.range; 0: none, 90 degrees a joint) */
 #include "bake_report.h"
 
 #include <cjson/cJSON.h>
@@ -325,6 +328,14 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     } else {
         cJSON_AddNullToObject(j, "seams");
     }
+    if (in->ref_solver && in->ref_hessian) {
+        cJSON *o = cJSON_AddObjectToObject(j, "reference");
+        cJSON_AddStringToObject(o, "solver", in->ref_solver);
+        cJSON_AddStringToObject(o, "hessian", in->ref_hessian);
+    } else {
+        cJSON_AddNullToObject(j, "reference");
+    }
+    cJSON_AddNumberToObject(j, "joint_range_frames", in->ch->range.nframes);
     cJSON_AddNumberToObject(j, "failed_steps", in->failed_steps);
     cJSON_AddNumberToObject(j, "bake_seconds", in->bake_seconds);
     cJSON_AddNumberToObject(j, "eval_seconds", in->eval_seconds);
@@ -492,6 +503,12 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
             "the physics correction the runtime misses; 0 exact, 1 no better than "
             "skinning)</td></tr>",
             in->err_train, in->err_heldout);
+    if (in->ref_solver && in->ref_hessian)
+        fprintf(f,
+                "<tr><td>reference</td><td>full-space solves by %s, %s element Hessians; "
+                "random poses turn each joint within %s</td></tr>",
+                in->ref_solver, in->ref_hessian,
+                ch->range.nframes > 0 ? "its range (--joint-range)" : "90 degrees");
     if (in->res->model_train_error >= 0)
         fprintf(f,
                 "<tr><td>equilibrium force</td><td>at %d of %d training poses (each pose's "

@@ -51,6 +51,10 @@ typedef struct sw_bake_report_input {
     /* how well the held-out references are defined (sw_bake_reference_spread, sinew-bake
        --reference-spread); NULL: not measured */
     const sw_bake_spread *spread;
+    /* the names of the reference's linear solver and element Hessians (fullsim.h's
+       sw_linear_solver_name, sw_hessian_mode_name): the figures are measured against its
+       solutions; NULL: not shown */
+    const char *ref_solver, *ref_hessian;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

@@ -395,7 +395,9 @@ int main(int argc, char **argv) {
                                    : info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
                                                                           : "lattice",
                                    mode_err,
-                                   spread_every > 0 ? &spread : NULL};
+                                   spread_every > 0 ? &spread : NULL,
+                                   sw_linear_solver_name(reference.solver),
+                                   sw_hessian_mode_name(reference.hessian)};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             goto done;
