@@ -551,7 +551,7 @@ TEST(joint_range_bounds_sweeps_and_random_poses) {
     double keep = range_T[12 * nb + 5];
     range_T[12 * nb + 5] = NAN;
     ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_NOT_FINITE);
-    ENSUREF(strstr(e.msg, "joint range: frame 1") != NULL, "%s", e.msg);
+    ENSUREF(strstr(e.msg, "joint range: motion frame 1") != NULL, "%s", e.msg);
     range_T[12 * nb + 5] = keep;
     ch.range = (sw_clip){nb, 1, 30.0, range_T}; /* the rest frame alone */
     ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);

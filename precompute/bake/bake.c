@@ -346,17 +346,15 @@ static sinew_result bake_begin(sw_bake_state *s, const sw_bake_params *p, const 
                              i < p->ntrain_clips ? i : i - p->ntrain_clips, k->nbones, k->nframes,
                              c->skel.nbones);
     }
-    const sw_clip *range = &c->range;
-    if (r == SINEW_OK && range->nframes != 0 &&
-        (range->nbones != c->skel.nbones || range->nframes < 0 || !range->T))
-        r = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                         "joint range: %d bones x %d frames, the skeleton %d bones", range->nbones,
-                         range->nframes, c->skel.nbones);
-    for (int64_t i = 0; r == SINEW_OK && i < (int64_t)range->nframes * 12 * c->skel.nbones; ++i)
-        if (!isfinite(range->T[i]))
-            r = sw_error_set(err, SINEW_ERROR_NOT_FINITE,
-                             "joint range: frame %lld has a value that is not finite",
-                             (long long)(i / (12 * c->skel.nbones)));
+    if (r == SINEW_OK && c->range.nframes != 0 &&
+        (r = sw_clip_validate(&c->range, c->skel.nbones, err))) {
+        if (r == SINEW_ERROR_PARSE) r = SINEW_ERROR_INVALID_ARGUMENT; /* the caller's, not a file */
+        if (err) { /* the check names the motion: say which */
+            char msg[sizeof err->msg];
+            snprintf(msg, sizeof msg, "%s", err->msg);
+            sw_error_set(err, r, "joint range: %s", msg);
+        }
+    }
     for (int64_t i = 0; r == SINEW_OK && i < (int64_t)p->nextra_poses * 12 * c->skel.nbones; ++i)
         if (!isfinite(p->extra_poses[i]))
             r = sw_error_set(err, SINEW_ERROR_NOT_FINITE,

@@ -175,19 +175,6 @@ static sinew_result load_motion(const char *path, const sw_skeleton *s, int32_t 
     return rc;
 }
 
-/* A motion of the skeleton's bones, every frame finite. */
-static sinew_result check_motion(const sw_clip *c, int32_t nbones, sw_error *err) {
-    if (c->nbones != nbones || c->nframes < 1)
-        return sw_error_set(err, SINEW_ERROR_PARSE,
-                            "motion has %d bones x %d frames, skeleton %d bones", c->nbones,
-                            c->nframes, nbones);
-    for (size_t k = 0; k < (size_t)c->nframes * c->nbones * 12; ++k)
-        if (!isfinite(c->T[k]))
-            return sw_error_set(err, SINEW_ERROR_NOT_FINITE, "motion frame %zu is not finite",
-                                k / (12 * (size_t)c->nbones));
-    return SINEW_OK;
-}
-
 /* Cross-checks what the readers cannot see alone. */
 static sinew_result check_character(const sw_character *c, const char *weights_path,
                                     sw_error *err) {
@@ -209,7 +196,7 @@ static sinew_result check_character(const sw_character *c, const char *weights_p
             return sw_error_set(err, SINEW_ERROR_DEGENERATE,
                                 "weights of vertex %d sum to %.17g, not 1", v, sum);
     }
-    return check_motion(&c->clip, c->skel.nbones, err);
+    return sw_clip_validate(&c->clip, c->skel.nbones, err);
 }
 
 sinew_result sw_character_read_range(const char *path, sw_character *ch, sw_error *err) {
@@ -219,7 +206,7 @@ sinew_result sw_character_read_range(const char *path, sw_character *ch, sw_erro
     memset(&c, 0, sizeof c);
     /* a pose becomes rest, the pose, rest: its middle frame is the pose exactly */
     sinew_result rc = load_motion(path, &ch->skel, has_suffix(path, ".dmat") ? 3 : 0, &c, err);
-    if (!rc && (rc = check_motion(&c, ch->skel.nbones, err)) && err) {
+    if (!rc && (rc = sw_clip_validate(&c, ch->skel.nbones, err)) && err) {
         char msg[sizeof err->msg]; /* the check names the item, not the file */
         snprintf(msg, sizeof msg, "%s", err->msg);
         sw_error_set(err, rc, "%s: %s", path, msg);

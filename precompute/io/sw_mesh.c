@@ -47,6 +47,18 @@ void sw_clip_free(sw_clip *c) {
     memset(c, 0, sizeof *c);
 }
 
+sinew_result sw_clip_validate(const sw_clip *c, int32_t nbones, sw_error *err) {
+    if (!c || c->nbones != nbones || c->nframes < 1 || !c->T)
+        return sw_error_set(err, SINEW_ERROR_PARSE,
+                            "motion has %d bones x %d frames, skeleton %d bones", c ? c->nbones : 0,
+                            c ? c->nframes : 0, nbones);
+    for (size_t k = 0; k < (size_t)c->nframes * c->nbones * 12; ++k)
+        if (!isfinite(c->T[k]))
+            return sw_error_set(err, SINEW_ERROR_NOT_FINITE, "motion frame %zu is not finite",
+                                k / (12 * (size_t)c->nbones));
+    return SINEW_OK;
+}
+
 void sw_character_free(sw_character *c) {
     if (!c) return;
     sw_tetmesh_free(&c->mesh);

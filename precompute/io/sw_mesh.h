@@ -125,6 +125,10 @@ void sw_forward_kinematics(const sw_skeleton *s, const double *local,
  * most SW_MAX_BONES bones. */
 sinew_result sw_skeleton_validate(const sw_skeleton *s, sw_error *err);
 
+/* A motion of nbones bones: at least one frame, every value finite. Errors: PARSE (the
+ * shape, or no frames), NOT_FINITE (naming the frame); the message names "motion". */
+sinew_result sw_clip_validate(const sw_clip *c, int32_t nbones, sw_error *err);
+
 /* Depth of bone b: 0 for a root, its parent's plus 1 otherwise (a validated skeleton). */
 int32_t sw_bone_depth(const sw_skeleton *s, int32_t b);
 
