@@ -582,8 +582,9 @@ TEST(joint_range_bounds_sweeps_and_random_poses) {
     sw_character_free(&ch);
 }
 
-/* Held-out clips need training clips; a clip of another skeleton is named; so is a
- * number of steps to the random held-out poses out of range. */
+/* Held-out clips need training clips; a clip of another skeleton is named, and so is a
+ * clip with a value that is not finite; so is a number of steps to the random held-out
+ * poses out of range. */
 TEST(bad_clip_lists_rejected) {
     sw_character ch;
     sw_error e;
@@ -599,7 +600,29 @@ TEST(bad_clip_lists_rejected) {
     p.train_clips = &wrong;
     p.ntrain_clips = 1;
     ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_INVALID_ARGUMENT);
-    ENSUREF(strstr(e.msg, "training clip 0 has 2 bones"), "%s", e.msg);
+    ENSUREF(strstr(e.msg, "training clip 0: motion has 2 bones"), "%s", e.msg);
+    /* a value that is not finite is named with its clip and frame, in a held-out clip and
+       in the character's own clip (a caller's clips, which no reader checked) */
+    const int32_t nb = ch.skel.nbones;
+    const size_t nT = (size_t)12 * nb * ch.clip.nframes;
+    double *T = malloc(nT * sizeof(double));
+    ENSURE(T && ch.clip.nframes > 3);
+    memcpy(T, ch.clip.T, nT * sizeof(double));
+    T[12 * nb * 3 + 7] = NAN;
+    sw_clip bad = ch.clip;
+    bad.T = T;
+    p.train_clips = &ch.clip;
+    p.heldout_clips = &bad;
+    ENSURE(sw_bake(&ch, &p, &res, &e) == SINEW_ERROR_NOT_FINITE);
+    ENSUREF(strstr(e.msg, "held-out clip 0: motion frame 3 is not finite"), "%s", e.msg);
+    double *own = ch.clip.T;
+    ch.clip.T = T;
+    sw_bake_params d = sw_bake_params_default();
+    sinew_result rd = sw_bake(&ch, &d, &res, &e);
+    ch.clip.T = own;
+    free(T);
+    ENSURE(rd == SINEW_ERROR_NOT_FINITE);
+    ENSUREF(strstr(e.msg, "the character's clip: motion frame 3 is not finite"), "%s", e.msg);
     /* an absurd number of steps to the random held-out poses is named, not baked */
     sw_bake_params q = sw_bake_params_default();
     q.heldout_steps = 0;

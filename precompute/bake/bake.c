@@ -325,6 +325,22 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
     return SINEW_OK;
 }
 
+/* A motion the caller hands the bake (a clip, the joint range): the skeleton's bones and
+ * only finite values (sw_clip_validate), else INVALID_ARGUMENT (NOT_FINITE for a value)
+ * naming it as `what`. */
+static sinew_result check_motion(const sw_clip *k, int32_t nbones, const char *what,
+                                 sw_error *err) {
+    sinew_result r = sw_clip_validate(k, nbones, err);
+    if (r == SINEW_OK) return r;
+    if (r == SINEW_ERROR_PARSE) r = SINEW_ERROR_INVALID_ARGUMENT; /* the caller's, not a file */
+    if (err) { /* the check names the motion: say which */
+        char msg[sizeof err->msg];
+        snprintf(msg, sizeof msg, "%s", err->msg);
+        sw_error_set(err, r, "bake: %s: %s", what, msg);
+    }
+    return r;
+}
+
 /* The start of every bake: the parameters checked, the state prepared (weights by heat
  * diffusion when the character has none) and the worker pool started. On an error the
  * caller frees the state (free_state) as after any stage. */
@@ -336,25 +352,17 @@ static sinew_result bake_begin(sw_bake_state *s, const sw_bake_params *p, const 
     if (!c) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no character");
     sinew_result r = check_params(p, err);
     for (int32_t i = 0; r == SINEW_OK && i < p->ntrain_clips + p->nheldout_clips; ++i) {
-        const sw_clip *k =
-            i < p->ntrain_clips ? &p->train_clips[i] : &p->heldout_clips[i - p->ntrain_clips];
-        if (k->nbones != c->skel.nbones || k->nframes < 1 || !k->T)
-            r = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                             "bake clips: %s clip %d has %d bones x %d frames, the skeleton %d "
-                             "bones",
-                             i < p->ntrain_clips ? "training" : "held-out",
-                             i < p->ntrain_clips ? i : i - p->ntrain_clips, k->nbones, k->nframes,
-                             c->skel.nbones);
+        const int train = i < p->ntrain_clips;
+        char what[48];
+        snprintf(what, sizeof what, "%s clip %d", train ? "training" : "held-out",
+                 train ? i : i - p->ntrain_clips);
+        r = check_motion(train ? &p->train_clips[i] : &p->heldout_clips[i - p->ntrain_clips],
+                         c->skel.nbones, what, err);
     }
-    if (r == SINEW_OK && c->range.nframes != 0 &&
-        (r = sw_clip_validate(&c->range, c->skel.nbones, err))) {
-        if (r == SINEW_ERROR_PARSE) r = SINEW_ERROR_INVALID_ARGUMENT; /* the caller's, not a file */
-        if (err) { /* the check names the motion: say which */
-            char msg[sizeof err->msg];
-            snprintf(msg, sizeof msg, "%s", err->msg);
-            sw_error_set(err, r, "joint range: %s", msg);
-        }
-    }
+    if (r == SINEW_OK && c->clip.nframes != 0)
+        r = check_motion(&c->clip, c->skel.nbones, "the character's clip", err);
+    if (r == SINEW_OK && c->range.nframes != 0)
+        r = check_motion(&c->range, c->skel.nbones, "joint range", err);
     for (int64_t i = 0; r == SINEW_OK && i < (int64_t)p->nextra_poses * 12 * c->skel.nbones; ++i)
         if (!isfinite(p->extra_poses[i]))
             r = sw_error_set(err, SINEW_ERROR_NOT_FINITE,
