@@ -372,6 +372,9 @@ TEST(clips_of_their_own_and_the_report) {
            strstr(html, "Where the error is") &&
            strstr(html, "Held-out error by self-contact mode") &&
            strstr(html, "How well the held-out reference is defined"));
+    /* the reference row names its solver, and no bound of random poses: clips hold out */
+    ENSURE(strstr(html, "full-space solves by auto, adaptive element Hessians</td>") &&
+           !strstr(html, "random poses turn"));
     free(html);
     struct stat st;
     snprintf(path, sizeof path, "%.1000s/heldout_sheet.png", dir);
@@ -506,6 +509,16 @@ TEST(random_heldout_poses_in_the_report) {
     }
     cJSON_Delete(j);
     free(text);
+    /* with its reference named, the page says what bounds the random poses */
+    in.ref_solver = "auto";
+    in.ref_hessian = "adaptive";
+    char dir3[1100], path3[1200];
+    snprintf(dir3, sizeof dir3, "%.1000s_ref", dir);
+    ENSURE(sw_bake_report_write(dir3, &in, &e) == SINEW_OK);
+    snprintf(path3, sizeof path3, "%s/report.html", dir3);
+    char *html = read_text(path3);
+    ENSURE(html && strstr(html, "random poses turn each joint within 90 degrees</td>"));
+    free(html);
     free(fe);
     sinew_blob_destroy(blob);
     free(mem);

@@ -503,12 +503,18 @@ static void html_summary(FILE *f, const sw_bake_report_input *in) {
             "the physics correction the runtime misses; 0 exact, 1 no better than "
             "skinning)</td></tr>",
             in->err_train, in->err_heldout);
-    if (in->ref_solver && in->ref_hessian)
+    if (in->ref_solver && in->ref_hessian) {
+        /* a joint range bounds random held-out poses only: clips need no bound */
+        const char *bound = !heldout_random(in->res) ? ""
+                            : ch->range.nframes > 0  ? "; random poses turn each joint within "
+                                                       "its range (--joint-range)"
+                                                     : "; random poses turn each joint within "
+                                                       "90 degrees";
         fprintf(f,
-                "<tr><td>reference</td><td>full-space solves by %s, %s element Hessians; "
-                "random poses turn each joint within %s</td></tr>",
-                in->ref_solver, in->ref_hessian,
-                ch->range.nframes > 0 ? "its range (--joint-range)" : "90 degrees");
+                "<tr><td>reference</td><td>full-space solves by %s, %s element "
+                "Hessians%s</td></tr>",
+                in->ref_solver, in->ref_hessian, bound);
+    }
     if (in->res->model_train_error >= 0)
         fprintf(f,
                 "<tr><td>equilibrium force</td><td>at %d of %d training poses (each pose's "

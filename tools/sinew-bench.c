@@ -265,6 +265,11 @@ static int parse_rhos(const char *tool, const char *s, sw_cond_bench_params *cp)
     return cp->nrho > 0 || sw_tool_real(tool, "--rho", s, 0, 1, "in (0, 1]", NULL);
 }
 
+/* A clip part's correction error as printed: its figure, or why it has none. */
+static const char *clip_error_text(int has, const char *figure, const sw_eval_result *e) {
+    return has ? figure : e->no_correction ? "n/a (at rest: no correction)" : "n/a";
+}
+
 int main(int argc, char **argv) {
     static const char *tool = "sinew-bench";
     sw_character_args ca;
@@ -679,13 +684,7 @@ int main(int argc, char **argv) {
         fprintf(stderr,
                 "             correction error on clip frames (not the bake's figures): train "
                 "%s (%d frames) held-out %s (%d frames);\n",
-                has_tr             ? e_tr
-                : et.no_correction ? "n/a (at rest: no correction)"
-                                   : "n/a",
-                et.frames,
-                has_ho             ? e_ho
-                : eh.no_correction ? "n/a (at rest: no correction)"
-                                   : "n/a",
+                clip_error_text(has_tr, e_tr, &et), et.frames, clip_error_text(has_ho, e_ho, &eh),
                 eh.frames);
     else
         fprintf(stderr, "             correction error (%s) train %.4f held-out %.4f;\n",
