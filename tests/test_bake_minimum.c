@@ -7,6 +7,7 @@
 #include "sw_test.h"
 
 #include "bake.h"
+#include "mat3.h"
 #include "samples.h"
 
 TEST(min_frames) {
@@ -303,6 +304,65 @@ TEST(pair_sweeps_turn_a_joint_with_its_parent) {
     sw_character_free(&c);
 }
 
+/* The pair sweeps are on by default where a joint range bounds the sweeps (the rig's own
+ * combinations), off at the 90-degree default and whenever the caller says so. The finger
+ * without its clip, its middle and tip joints turned 40 degrees by the range: one joint
+ * with its parent, so one pair sweep. */
+TEST(pair_sweeps_by_default_within_a_joint_range) {
+    sw_character c;
+    sw_error err;
+    ENSURE(sw_sample_make("finger", 1000, 6, &c, &err) == SINEW_OK);
+    c.clip.nframes = 0;
+    int32_t nb = c.skel.nbones;
+    ENSURE(nb == 3);
+    if (nb != 3) {
+        sw_character_free(&c);
+        return;
+    }
+    double local[9 * 3], range_T[2 * 12 * 3];
+    static const double z[3] = {0, 0, 1};
+    for (int f = 0; f < 2; ++f) { /* rest, then bones 1 and 2 at 40 degrees */
+        for (int32_t b = 0; b < nb; ++b)
+            sw_m3_axis_angle(z, f == 1 && b > 0 ? 40 * 0.017453292519943295 : 0, local + 9 * b);
+        sw_forward_kinematics(&c.skel, local, NULL, range_T + (size_t)f * 12 * nb);
+    }
+    sw_bake_params p = quick_params();
+    p.random_poses = 2;
+    p.heldout_steps = 1;
+    const int32_t n = p.sweep_samples;
+    sw_bake_result a, b, d, e;
+    ENSUREF(sw_bake_solutions(&c, &p, &d, &err) == SINEW_OK, "%s", err.msg); /* no range */
+    p.pair_sweeps = 1;
+    ENSUREF(sw_bake_solutions(&c, &p, &e, &err) == SINEW_OK, "%s", err.msg);
+    c.range = (sw_clip){nb, 2, 30.0, range_T};
+    p.pair_sweeps = sw_bake_params_default().pair_sweeps;
+    sinew_result ra = sw_bake_solutions(&c, &p, &a, &err);
+    ENSUREF(ra == SINEW_OK, "%s", err.msg);
+    p.pair_sweeps = 0;
+    sinew_result rb = sw_bake_solutions(&c, &p, &b, &err);
+    ENSUREF(rb == SINEW_OK, "%s", err.msg);
+    c.range = (sw_clip){0, 0, 0, NULL}; /* borrowed: not the character's to free */
+    ENSUREF(d.pair_sweep_poses == 0 && e.pair_sweep_poses == n && e.ntrain == d.ntrain + n,
+            "without a range: %d pair poses of %d by default, %d of %d asked for",
+            d.pair_sweep_poses, d.ntrain, e.pair_sweep_poses, e.ntrain);
+    ENSUREF(a.pair_sweep_poses == n && b.pair_sweep_poses == 0 && a.ntrain == b.ntrain + n,
+            "within the range: %d pair poses of %d by default, %d of %d turned off",
+            a.pair_sweep_poses, a.ntrain, b.pair_sweep_poses, b.ntrain);
+    if (a.ntrain == b.ntrain + n) { /* the pair's last pose turns both joints to the range */
+        const double *T = a.train_T + (size_t)12 * nb * (a.ntrain - 1);
+        double L[9];
+        for (int32_t k = 1; k < nb; ++k) {
+            local_of(&c.skel, T, k, L);
+            ENSURE_NEAR(L[0], cos(40 * 0.017453292519943295), 1e-9);
+        }
+    }
+    sw_bake_result_free(&a);
+    sw_bake_result_free(&b);
+    sw_bake_result_free(&d);
+    sw_bake_result_free(&e);
+    sw_character_free(&c);
+}
+
 /* The sum over joints of the squared angle of a bone in its parent (the bake's bend). */
 static double bend_of(const sw_skeleton *sk, const double *T) {
     double sum = 0, L[9];
@@ -367,6 +427,7 @@ TEST(return_path_goes_home_from_the_last_training_frame) {
 SW_TEST_MAIN(CASE(min_frames), CASE(too_few_frames_rejected), CASE(solutions_match_the_bake),
              CASE(small_bones_fold_into_their_parents), CASE(progress_counts_every_pose_and_domain),
              CASE(pair_sweeps_turn_a_joint_with_its_parent),
+             CASE(pair_sweeps_by_default_within_a_joint_range),
              CASE(sibling_sweeps_turn_two_children_of_one_joint_together),
              CASE(heldout_frames_are_measured_on_the_reference_path),
              CASE(contact_modes_extend_the_basis),

@@ -59,7 +59,7 @@ static void usage(FILE *f) {
                "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
                "                  [--compare-cubature] [--no-self-contact]\n"
                "                  [--return-path|--no-return-path]\n"
-               "                  [--pair-sweeps] [--no-sibling-sweeps]\n"
+               "                  [--pair-sweeps | --no-pair-sweeps] [--no-sibling-sweeps]\n"
                "                  [--adaptive R [--adaptive-add K]\n"
                "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
                "                  [--adaptive-target E]] [--heldout-steps S]\n"
@@ -92,7 +92,8 @@ static void usage(FILE *f) {
             "                   clip (a --clip or a file's one clip split 60/40), off for\n"
             "                   --train-clips; --no-return-path: never\n"
             "  --pair-sweeps    also train on every joint swept together with its parent\n"
-            "                   joint (combinations the single-joint sweeps never show)\n"
+            "                   joint (combinations the single-joint sweeps never show); by\n"
+            "                   default on with --joint-range; --no-pair-sweeps: never\n"
             "  --no-sibling-sweeps  do not train on two sibling joints whose flesh meets\n"
             "                   swept together (by default each such pair is: the flesh\n"
             "                   between them shears with the difference of their bends)\n"
@@ -213,6 +214,8 @@ int main(int argc, char **argv) {
             p.return_path = 0;
         else if (!strcmp(a, "--pair-sweeps"))
             p.pair_sweeps = 1;
+        else if (!strcmp(a, "--no-pair-sweeps"))
+            p.pair_sweeps = 0;
         else if (!strcmp(a, "--no-sibling-sweeps"))
             p.sibling_sweeps = 0;
         else if (!strcmp(a, "--adaptive") && next)
@@ -428,11 +431,15 @@ int main(int argc, char **argv) {
                  res.nheldout / p.heldout_steps, p.heldout_steps,
                  ch.range.nframes > 0 ? "the joints within --joint-range"
                                       : "every joint within 90 degrees");
+    char pair_how[64] = ""; /* on by default only with a range: say when they ran */
+    if (res.pair_sweep_poses > 0)
+        snprintf(pair_how, sizeof pair_how, " (%d of joints swept with their parents)",
+                 res.pair_sweep_poses);
     fprintf(stderr,
-            "  poses: %d training, %d held-out%s; basis projection error train %.4f held-out "
+            "  poses: %d training%s, %d held-out%s; basis projection error train %.4f held-out "
             "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
-            res.ntrain, res.nheldout, held_how, res.train_proj_error, res.heldout_proj_error,
-            res.train_galerkin_error, res.heldout_galerkin_error);
+            res.ntrain, pair_how, res.nheldout, held_how, res.train_proj_error,
+            res.heldout_proj_error, res.train_galerkin_error, res.heldout_galerkin_error);
     fprintf(stderr, "  references solved by: solver %s, %s Hessians, at most %d contact rounds\n",
             sw_linear_solver_name(reference.solver), sw_hessian_mode_name(reference.hessian),
             reference.contact_rounds);
@@ -526,15 +533,15 @@ int main(int argc, char **argv) {
         char gt[32], gh[32];
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
                "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
-               "\"heldout_poses\":%d,"
+               "\"pair_sweep_poses\":%d,\"heldout_poses\":%d,"
                "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
                "heldout\":%.5f,"
                "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
                "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,"
                "%.2f,%.2f]",
                out_path, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones, v->ndomains, v->rank_total,
-               v->ncub, res.cubature_error_max, res.ntrain, res.return_poses, res.nheldout,
-               res.train_proj_error, res.heldout_proj_error, et.correction_error,
+               v->ncub, res.cubature_error_max, res.ntrain, res.return_poses, res.pair_sweep_poses,
+               res.nheldout, res.train_proj_error, res.heldout_proj_error, et.correction_error,
                eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
                eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
                res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);

@@ -26,7 +26,7 @@ sw_bake_params sw_bake_params_default(void) {
     p.cubature_max = 1000;
     p.selector = SW_CUBATURE_NNHTP;
     p.sweep_samples = 6;
-    p.pair_sweeps = 0;
+    p.pair_sweeps = -1;
     p.sibling_sweeps = 1;
     p.max_train_frames = 40;
     p.return_path = -1;
@@ -305,6 +305,7 @@ static sinew_result solve_poses(sw_bake_state *s, sw_bake_result *out, sw_error 
         return r;
     out->simulate_solved = (int32_t)s->solved_poses;
     out->return_poses = s->return_poses;
+    out->pair_sweep_poses = s->pair_sweep_poses;
     size_t na = (size_t)s->nb * 3 * sizeof(double);
     if (!(out->sweep_axis = sw_bake_own(out, malloc(na))) ||
         !(out->sweep_angle = sw_bake_own(out, malloc(na / 3))))

@@ -55,8 +55,10 @@ typedef struct sw_bake_params {
     sw_cubature_selector selector; /* default NN-HTP */
     int32_t sweep_samples;         /* poses per joint sweep (default 6) */
     int pair_sweeps;               /* also sweep every joint together with its parent joint
-                                      (default 0; issue 16: combinations the single sweeps
-                                      never show; docs/accuracy.md) */
+                                      (combinations the single sweeps never show): 1 on, 0
+                                      off, -1 (default) on where the character's joint range
+                                      (sw_character.range) bounds the sweeps (bake_poses.c,
+                                      docs/generalisation.md Joint ranges) */
     int sibling_sweeps;            /* also sweep every two sibling joints whose flesh meets
                                       together (default 1; bake_poses.c, sweep_pairs) */
     int32_t max_train_frames;      /* clip frames used for training at most (default 40) */
@@ -154,6 +156,8 @@ typedef struct sw_bake_result {
     int simulate_cached;       /* the simulate stage read all its solutions from the cache */
     int32_t simulate_solved;   /* poses it solved (the others it read from the cache) */
     int32_t return_poses;      /* training poses on the way home (sw_bake_params.return_path) */
+    int32_t pair_sweep_poses;  /* training poses of the joints swept with their parents
+                                  (sw_bake_params.pair_sweeps) */
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
     /* the same snapshots projected in the reduced model's linearised energy, its domains

@@ -61,8 +61,9 @@ typedef struct sw_bake_state {
     sw_pose_seq *train;
     int32_t ntrain_seq;
     double *sweep_axis, *sweep_angle; /* per bone: each joint's sweep (bake_poses.c) */
-    int64_t solved_poses; /* poses the simulate stage solved (not read from the cache) */
-    int32_t return_poses; /* poses on the way home (bake_poses.c, return_frames) */
+    int64_t solved_poses;     /* poses the simulate stage solved (not read from the cache) */
+    int32_t return_poses;     /* poses on the way home (bake_poses.c, return_frames) */
+    int32_t pair_sweep_poses; /* poses of the joints swept with their parents (sweep_pairs) */
     sw_pose_seq heldout;
     /* basis: per domain 3 n_d x r_d, row-major */
     int32_t *rank;

@@ -376,12 +376,25 @@ static int flesh_meets(const sw_bake_state *s, int32_t a, int32_t b) {
     return 0;
 }
 
+/* Whether every joint is also swept with its parent joint (sw_bake_params.pair_sweeps):
+ * by default where the character's joint range bounds the sweeps. Within the rig's range
+ * the combinations are what the single sweeps miss (the bare hand's default bake 0.100 ->
+ * 0.045, docs/generalisation.md Joint ranges); at the 90-degree default they bend two
+ * joints into flesh no rig reaches and made it worse (at --max-rank 60 0.421 against
+ * 0.379, docs/accuracy.md). */
+static int wants_pair_sweeps(const sw_bake_state *s) {
+    return s->p->pair_sweeps > 0 || (s->p->pair_sweeps < 0 && s->ch.range.nframes > 0);
+}
+
 /* The joints swept in pairs (pairs[2 k], pairs[2 k + 1]; NULL: only counted), returns
  * how many: two sibling joints whose flesh meets (sibling_sweeps: the flesh between two
  * fingers' metacarpals is sheared by the difference of their bends, which neither sweep
- * alone shows), and with pair_sweeps every joint with its parent joint. */
-static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, int32_t *pairs) {
+ * alone shows), and with the pair sweeps every joint with its parent joint (*nparent of
+ * them, the last). */
+static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, int32_t *pairs,
+                           int32_t *nparent) {
     const sw_skeleton *sk = &s->ch.skel;
+    const int parent_pairs = wants_pair_sweeps(s);
     int32_t n = 0;
     for (int32_t a = 0; s->p->sibling_sweeps && a < s->nb; ++a)
         for (int32_t b = a + 1; b < s->nb; ++b)
@@ -390,10 +403,12 @@ static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, in
                 if (pairs) pairs[2 * n] = a, pairs[2 * n + 1] = b;
                 n++;
             }
-    for (int32_t b = 0; s->p->pair_sweeps && b < s->nb; ++b)
+    *nparent = 0;
+    for (int32_t b = 0; parent_pairs && b < s->nb; ++b)
         if (swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b])) {
             if (pairs) pairs[2 * n] = b, pairs[2 * n + 1] = sk->parent[b];
             n++;
+            ++*nparent;
         }
     return n;
 }
@@ -419,7 +434,9 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
     int32_t nb = s->nb, cap = s->p->max_train_frames;
     int32_t n0 = ntr > 0 ? (train[0].count < cap ? train[0].count : cap) : 0;
     int32_t nreturn = wants_return_path(s->p, nheld) && n0 >= 2 ? n0 - 1 : 0;
-    int32_t npair = sweep_pairs(s, sweep_angle, NULL);
+    int32_t nparent;
+    int32_t npair = sweep_pairs(s, sweep_angle, NULL, &nparent);
+    s->pair_sweep_poses = nparent * s->p->sweep_samples;
     int32_t chain = s->p->extra_chain > 0 ? s->p->extra_chain : s->p->nextra_poses;
     int32_t nextra = s->p->nextra_poses > 0 ? (s->p->nextra_poses + chain - 1) / chain : 0;
     s->ntrain_seq = ntr + (nreturn > 0) + njoint + npair + nextra;
@@ -455,7 +472,7 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
     /* a sweep per joint, then the pairs' sweeps, both joints of a pair turned together */
     int32_t *pairs = malloc(sizeof(int32_t) * (2 * (size_t)npair + 1));
     int ok = pairs != NULL;
-    if (ok) sweep_pairs(s, sweep_angle, pairs);
+    if (ok) sweep_pairs(s, sweep_angle, pairs, &nparent);
     for (int32_t b = 0; ok && b < nb; ++b)
         if (swept(sweep_angle, b)) ok = add_sweep(s, &b, 1, sweep_axis, sweep_angle, local, &qi);
     for (int32_t k = 0; ok && k < npair; ++k)
