@@ -314,8 +314,9 @@ static int is_background(const sw_render_params *p, const uint8_t *px) {
     return 1;
 }
 
-/* Pixel of world point q under the renderer's pinhole model (for the shadow test). */
-static void project(const sw_render_params *p, const double q[3], int *px, int *py) {
+/* Where world point q lands under the renderer's pinhole model (pixels from the top
+ * left, not rounded). */
+static void pixel_of(const sw_render_params *p, const double q[3], double px[2]) {
     double f[3], r[3], u[3], d[3];
     for (int k = 0; k < 3; ++k)
         f[k] = p->target[k] - p->eye[k], d[k] = q[k] - p->eye[k];
@@ -336,8 +337,16 @@ static void project(const sw_render_params *p, const double q[3], int *px, int *
     double y = (d[0] * u[0] + d[1] * u[1] + d[2] * u[2]) / z;
     double th = tan(0.5 * p->fov_y_deg * 3.14159265358979323846 / 180.0);
     double aspect = (double)p->width / p->height;
-    *px = (int)floor((x / (th * aspect) + 1) * 0.5 * p->width);
-    *py = (int)floor((1 - y / th) * 0.5 * p->height);
+    px[0] = (x / (th * aspect) + 1) * 0.5 * p->width;
+    px[1] = (1 - y / th) * 0.5 * p->height;
+}
+
+/* The pixel of world point q (for the shadow test). */
+static void project(const sw_render_params *p, const double q[3], int *px, int *py) {
+    double xy[2];
+    pixel_of(p, q, xy);
+    *px = (int)floor(xy[0]);
+    *py = (int)floor(xy[1]);
 }
 
 static double luma(const uint8_t *px) {
@@ -516,6 +525,26 @@ TEST(threads_and_colours) {
     ENSURE(blue);
 }
 
+/* The lit pixels' bounding rectangle (x0, y0, x1, y1) of an image rendered with p, and
+ * whether the border is background everywhere. */
+static long lit_rect(const sw_render_params *p, const uint8_t *img, int w, int h, int rect[4],
+                     int *border_bg) {
+    long lit = 0;
+    rect[0] = w, rect[1] = h, rect[2] = -1, rect[3] = -1;
+    *border_bg = 1;
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x) {
+            if (is_background(p, img + 3 * (y * w + x))) continue;
+            lit++;
+            if (x == 0 || y == 0 || x == w - 1 || y == h - 1) *border_bg = 0;
+            rect[0] = x < rect[0] ? x : rect[0], rect[1] = y < rect[1] ? y : rect[1];
+            rect[2] = x > rect[2] ? x : rect[2], rect[3] = y > rect[3] ? y : rect[3];
+        }
+    return lit;
+}
+
+/* The box's corners fit the image with the 5% margin and reach it, their image centred;
+ * a sphere in it is drawn whole within their image. */
 TEST(frame_camera_fits_an_offset_box) {
     mesh m = icosphere(3);
     for (int32_t v = 0; v < m.nv; ++v) {
@@ -531,26 +560,74 @@ TEST(frame_camera_fits_an_offset_box) {
     uint8_t *img = malloc(160 * 90 * 3);
     if (!rc) rc = sw_render_surface(&p, m.nv, m.X, m.nt, m.T, NULL, img, &err);
     mesh_free(&m);
-    int border_bg = 1;
-    long lit = 0;
-    for (int y = 0; y < 90; ++y)
-        for (int x = 0; x < 160; ++x) {
-            int bg = is_background(&p, img + 3 * (y * 160 + x));
-            lit += !bg;
-            if ((x == 0 || y == 0 || x == 159 || y == 89) && !bg) border_bg = 0;
-        }
-    int centre_lit = !is_background(&p, img + 3 * (45 * 160 + 80));
+    int rect[4], border_bg;
+    long lit = lit_rect(&p, img, 160, 90, rect, &border_bg);
     free(img);
     ENSUREF(rc == SINEW_OK, "%s", err.msg);
-    ENSURE(border_bg && centre_lit);
-    /* The box's bounding sphere (radius 2*sqrt(3)) spans ~95% of the height, so the
-     * sphere's disc has radius ~0.95*45/sqrt(3) ~ 25 px: about 1900 pixels. */
-    ENSUREF(lit > 1500 && lit < 2500, "lit %ld", lit);
+    ENSURE(border_bg);
+    /* the corners' image: within 2.5% of the border on each side at most, and touching
+       it on one axis */
+    double lo[2] = {1e30, 1e30}, hi[2] = {-1e30, -1e30};
+    for (int i = 0; i < 8; ++i) {
+        double c[3], px[2];
+        for (int k = 0; k < 3; ++k)
+            c[k] = (i >> k) & 1 ? bmax[k] : bmin[k];
+        pixel_of(&p, c, px);
+        for (int a = 0; a < 2; ++a)
+            lo[a] = fmin(lo[a], px[a]), hi[a] = fmax(hi[a], px[a]);
+    }
+    ENSUREF(lo[0] >= 0.025 * 160 - 1e-6 && hi[0] <= 0.975 * 160 + 1e-6 &&
+                lo[1] >= 0.025 * 90 - 1e-6 && hi[1] <= 0.975 * 90 + 1e-6,
+            "corners over [%g, %g] x [%g, %g]", lo[0], hi[0], lo[1], hi[1]);
+    ENSUREF(fmin(fmin(lo[0], 160 - hi[0]) - 4, fmin(lo[1], 90 - hi[1]) - 2.25) < 0.25,
+            "corners over [%g, %g] x [%g, %g]: not fitted", lo[0], hi[0], lo[1], hi[1]);
+    ENSURE_NEAR(0.5 * (lo[0] + hi[0]), 80, 1.0); /* centred, within the depth's tilt */
+    ENSURE_NEAR(0.5 * (lo[1] + hi[1]), 45, 1.0);
+    /* the sphere (radius 2 in a box of side 4) drawn whole, within the corners' image */
+    ENSUREF(lit > 1500 && rect[3] - rect[1] > 40, "lit %ld, %d rows", lit, rect[3] - rect[1]);
+    ENSUREF(rect[0] >= lo[0] - 1 && rect[2] <= hi[0] + 1 && rect[1] >= lo[1] - 1 &&
+                rect[3] <= hi[1] + 1,
+            "sphere over [%d, %d] x [%d, %d]", rect[0], rect[2], rect[1], rect[3]);
     ENSURE_NEAR(p.ground_level, 3.0, 1e-12); /* lowest y of the box */
     sw_render_params q = sw_render_params_default(10, 10);
     double nan_box[3] = {NAN, 0, 0};
     ENSURE(sw_render_frame_camera(&q, nan_box, bmax, &err) == SINEW_ERROR_NOT_FINITE);
     ENSURE(sw_render_frame_camera(&q, bmax, bmin, &err) == SINEW_ERROR_INVALID_ARGUMENT);
+}
+
+/* Framed by its own points, a long thin body (a sphere stretched 8 times along x, turned
+ * by the 3/4 view) fills the image along one axis and sits in its middle; framed by its
+ * box's corners it is drawn smaller. A point that is not finite is refused. */
+TEST(frame_points_fills_the_image_with_a_long_body) {
+    mesh m = icosphere(3);
+    for (int32_t v = 0; v < m.nv; ++v) {
+        m.X[3 * v] = 8 * m.X[3 * v] + 3;
+        m.X[3 * v + 2] -= 2;
+    }
+    sw_render_params p = sw_render_params_default(160, 90), q = p;
+    double bmin[3], bmax[3];
+    sw_error err;
+    sinew_result rc = sw_render_frame_points(&p, m.nv, m.X, &err);
+    if (!rc) rc = sw_render_bbox(m.nv, m.X, bmin, bmax, &err);
+    if (!rc) rc = sw_render_frame_camera(&q, bmin, bmax, &err);
+    uint8_t *img = malloc(160 * 90 * 3), *imq = malloc(160 * 90 * 3);
+    if (!rc) rc = sw_render_surface(&p, m.nv, m.X, m.nt, m.T, NULL, img, &err);
+    if (!rc) rc = sw_render_surface(&q, m.nv, m.X, m.nt, m.T, NULL, imq, &err);
+    int rect[4], rq[4], border_bg, border_q;
+    long lit = lit_rect(&p, img, 160, 90, rect, &border_bg);
+    long lit_box = lit_rect(&q, imq, 160, 90, rq, &border_q);
+    free(img);
+    free(imq);
+    ENSUREF(rc == SINEW_OK, "%s", err.msg);
+    ENSURE(border_bg && border_q);
+    int wide = rect[2] - rect[0] + 1, tall = rect[3] - rect[1] + 1;
+    ENSUREF(wide >= 0.9 * 160 || tall >= 0.9 * 90, "%d x %d pixels lit of 160 x 90", wide, tall);
+    ENSUREF(abs(rect[0] + rect[2] - 159) <= 3 && abs(rect[1] + rect[3] - 89) <= 3,
+            "lit over [%d, %d] x [%d, %d]", rect[0], rect[2], rect[1], rect[3]);
+    ENSUREF(lit > 1.1 * lit_box, "lit %ld framed by the points, %ld by the box", lit, lit_box);
+    m.X[3 * 11 + 2] = INFINITY;
+    ENSURE(sw_render_frame_points(&p, m.nv, m.X, &err) == SINEW_ERROR_NOT_FINITE);
+    mesh_free(&m);
 }
 
 TEST(render_input_errors) {
@@ -663,5 +740,6 @@ SW_TEST_MAIN(CASE(checksums_known_vectors), CASE(png_round_trip_small),
              CASE(icosphere_is_closed_and_outward), CASE(sphere_disc_centre_corners_area),
              CASE(key_light_side_is_brighter), CASE(ground_shadow_under_sphere),
              CASE(flipped_winding_renders_the_same), CASE(threads_and_colours),
-             CASE(frame_camera_fits_an_offset_box), CASE(render_input_errors),
+             CASE(frame_camera_fits_an_offset_box),
+             CASE(frame_points_fills_the_image_with_a_long_body), CASE(render_input_errors),
              CASE(timing_20k_triangles_640x480))

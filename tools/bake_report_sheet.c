@@ -112,12 +112,10 @@ sinew_result sw_bake_report_sheet(const char *png_path, const sw_character *ch,
         }
         memcpy(surf.tris, v->render_tris, sizeof(int32_t) * 3 * (size_t)surf.ntris);
     }
-    /* one camera for every tile: the box of all of them */
-    double lo[3], hi[3];
-    if ((r = sw_render_bbox(3 * nv * rows, X, lo, hi, err)) != SINEW_OK) goto done;
+    /* one camera for every tile, fitted to all of them */
     sw_render_params p = sw_render_params_default(TILE_W, TILE_H);
     p.ground = 1;
-    if ((r = sw_render_frame_camera(&p, lo, hi, err)) != SINEW_OK) goto done;
+    if ((r = sw_render_frame_points(&p, 3 * nv * rows, X, err)) != SINEW_OK) goto done;
     for (int32_t row = 0; row < rows && r == SINEW_OK; ++row)
         for (int col = 0; col < 3 && r == SINEW_OK; ++col)
             r = draw_tile(&p, nv, X + ((size_t)row * 3 + col) * 3 * nv, &surf, tile, sheet, W, row,

@@ -78,8 +78,41 @@ static int camera_basis(const sw_render_params *p, double fwd[3], double right[3
     return 1;
 }
 
-sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], const double bmax[3],
-                                    sw_error *err) {
+/* The eye's distance from the target c along dir at which every point o + c lies in the
+ * view: |o . right| <= tx (dist - o . dir) and |o . vup| <= ty (...), with a 5% margin;
+ * at least `least`. */
+static double fit_distance(const double *pts, int64_t n, const double c[3], const double dir[3],
+                           const double right[3], const double vup[3], double tx, double ty,
+                           double least) {
+    double dist = least;
+    for (int64_t i = 0; i < n; ++i) {
+        const double o[3] = {pts[3 * i] - c[0], pts[3 * i + 1] - c[1], pts[3 * i + 2] - c[2]};
+        double depth = sw_v3_dot(o, dir);
+        dist = fmax(dist, depth + fabs(sw_v3_dot(o, right)) / (0.95 * tx));
+        dist = fmax(dist, depth + fabs(sw_v3_dot(o, vup)) / (0.95 * ty));
+    }
+    return dist;
+}
+
+/* The middle of the points' image at distance dist, as the offset along right and vup at
+ * the target's depth that centres it. */
+static void image_middle(const double *pts, int64_t n, const double c[3], const double dir[3],
+                         const double right[3], const double vup[3], double dist, double shift[2]) {
+    double lo[2] = {INFINITY, INFINITY}, hi[2] = {-INFINITY, -INFINITY};
+    for (int64_t i = 0; i < n; ++i) {
+        const double o[3] = {pts[3 * i] - c[0], pts[3 * i + 1] - c[1], pts[3 * i + 2] - c[2]};
+        double depth = dist - sw_v3_dot(o, dir);
+        double a = sw_v3_dot(o, right) / depth, b = sw_v3_dot(o, vup) / depth;
+        lo[0] = fmin(lo[0], a), hi[0] = fmax(hi[0], a);
+        lo[1] = fmin(lo[1], b), hi[1] = fmax(hi[1], b);
+    }
+    shift[0] = 0.5 * (lo[0] + hi[0]) * dist;
+    shift[1] = 0.5 * (lo[1] + hi[1]) * dist;
+}
+
+/* sw_render_frame_camera, the eye fitted to `pts` (n points; NULL: the box's corners). */
+static sinew_result frame(sw_render_params *p, const double bmin[3], const double bmax[3],
+                          const double *pts, int64_t n, sw_error *err) {
     if (!p || !bmin || !bmax)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "render: NULL argument");
     if (!sw_v3_isfinite(bmin) || !sw_v3_isfinite(bmax))
@@ -118,16 +151,37 @@ sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], c
     }
     double r = 0.5 * sw_v3_norm(d);
     if (!(r > 0)) r = 1e-3 * (1.0 + sw_v3_norm(c)); /* a single point: any small frame */
-    /* The bounding sphere fits when its angular radius is below the tighter half fov. */
     double ty = tan(0.5 * p->fov_y_deg * PI / 180.0);
     double tx = ty * (double)p->width / (double)p->height;
-    double half = atan(ty < tx ? ty : tx);
-    double dist = 1.05 * r / sin(half);
     double az = p->view_azimuth_deg * PI / 180.0, el = p->view_elevation_deg * PI / 180.0;
+    double dir[3], right[3], vup[3]; /* from the target to the eye; the image's axes */
+    for (int k = 0; k < 3; ++k)
+        dir[k] = cos(el) * (cos(az) * f[k] + sin(az) * s[k]) + sin(el) * u[k];
+    sw_v3_cross(dir, u, right);
+    sw_v3_normalize(right); /* |el| < 90: dir is never along up */
+    sw_v3_cross(right, dir, vup);
+    double corners[24];
+    if (!pts) {
+        for (int i = 0; i < 8; ++i)
+            for (int k = 0; k < 3; ++k)
+                corners[3 * i + k] = (i >> k) & 1 ? bmax[k] : bmin[k];
+        pts = corners, n = 8;
+    }
+    /* The eye as near as the points allow, never inside the box's bounding sphere, then
+     * the target moved so that their image is centred and the eye fitted again: a long
+     * character (the Fox, a tail and four legs) fills the tile, where the bounding
+     * sphere left it a third of the width. */
+    double t[3] = {c[0], c[1], c[2]}, shift[2];
+    double dist = fit_distance(pts, n, t, dir, right, vup, tx, ty, 1.05 * r);
+    for (int it = 0; it < 4; ++it) { /* the perspective moves the middle as the eye moves */
+        image_middle(pts, n, t, dir, right, vup, dist, shift);
+        for (int k = 0; k < 3; ++k)
+            t[k] += shift[0] * right[k] + shift[1] * vup[k];
+        dist = fit_distance(pts, n, t, dir, right, vup, tx, ty, 1.05 * r);
+    }
     for (int k = 0; k < 3; ++k) {
-        double dir = cos(el) * (cos(az) * f[k] + sin(az) * s[k]) + sin(el) * u[k];
-        p->eye[k] = c[k] + dist * dir;
-        p->target[k] = c[k];
+        p->eye[k] = t[k] + dist * dir[k];
+        p->target[k] = t[k];
     }
     double lo = INFINITY;
     for (int i = 0; i < 8; ++i) {
@@ -140,6 +194,18 @@ sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], c
     p->ground_tile = 0.25 * r;
     p->ground_radius = 4.0 * r;
     return SINEW_OK;
+}
+
+sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], const double bmax[3],
+                                    sw_error *err) {
+    return frame(p, bmin, bmax, NULL, 0, err);
+}
+
+sinew_result sw_render_frame_points(sw_render_params *p, int32_t npts, const double *X,
+                                    sw_error *err) {
+    double lo[3], hi[3];
+    sinew_result r = sw_render_bbox(npts, X, lo, hi, err);
+    return r != SINEW_OK ? r : frame(p, lo, hi, X, npts, err);
 }
 
 static sinew_result validate_params(const sw_render_params *p, sw_error *err) {

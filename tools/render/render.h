@@ -53,11 +53,18 @@ sinew_result sw_render_bbox(int32_t nverts, const double *X, double bmin[3], dou
 /* Frames the box [bmin, bmax] from a 3/4 view: the camera sits in front (+Z, relative to
  * p->up; +X when up is along Z), p->view_azimuth_deg toward the side (up x front, +X
  * for +Y up) and p->view_elevation_deg above the horizon (defaults 35 and 20; the
- * elevation must be within (-90, 90)), looking at the box centre, far enough that the box's
- * bounding sphere fits the image at p->width x p->height with p->fov_y_deg. Also places the ground
- * plane at the box's lowest point along up, with tiles and fade radius scaled to the box (p->ground
- * itself is not changed). Errors: NOT_FINITE / INVALID_ARGUMENT for a bad box, up, fov or size. */
+ * elevation must be within (-90, 90)), looking at the box, as near as lets the box's
+ * corners fit the image at p->width x p->height with p->fov_y_deg (a 5% margin, never
+ * inside the box's bounding sphere), their image centred. Also places the ground plane at
+ * the box's lowest point along up, with tiles and fade radius scaled to the box
+ * (p->ground itself is not changed). Errors: NOT_FINITE / INVALID_ARGUMENT for a bad box,
+ * up, fov or size. */
 sinew_result sw_render_frame_camera(sw_render_params *p, const double bmin[3], const double bmax[3],
+                                    sw_error *err);
+
+/* The same for the points themselves (npts positions X, the bounds of sw_render_bbox): a
+ * character fills the image, where the corners of its box leave it small. */
+sinew_result sw_render_frame_points(sw_render_params *p, int32_t npts, const double *X,
                                     sw_error *err);
 
 /* Renders the surface (nverts positions X, ntris triangles `tris`, 0-based) into
