@@ -9,6 +9,7 @@
 #include "bake.h"
 #include "blob_load.h"
 #include "blob_write.h"
+#include "mat3.h"
 #include "samples.h"
 
 typedef struct {
@@ -75,4 +76,27 @@ static inline void bake_fixture_pose(const bake_fixture *f, int frame, float *ou
     for (int i = 0; i < 12 * f->ch.skel.nbones; ++i)
         out[i] = (float)T[i];
 }
+/* The 3-bone finger at about `tets` tets without its clip, and a joint range of `nframes`
+ * frames written to range_T (12 * 3 doubles a frame) in which bone b turns deg[3 f + b]
+ * degrees about z at frame f. 1 on success (the caller frees the character), 0 with the
+ * character freed. */
+static inline int finger_range_fixture(sw_character *c, int tets, int nframes, const double *deg,
+                                       double *range_T) {
+    sw_error err;
+    if (sw_sample_make("finger", tets, 8, c, &err) != SINEW_OK) return 0;
+    c->clip.nframes = 0;
+    if (c->skel.nbones != 3) {
+        sw_character_free(c);
+        return 0;
+    }
+    static const double z[3] = {0, 0, 1};
+    double local[9 * 3];
+    for (int f = 0; f < nframes; ++f) {
+        for (int32_t b = 0; b < 3; ++b)
+            sw_m3_axis_angle(z, deg[3 * f + b] * 0.017453292519943295, local + 9 * b);
+        sw_forward_kinematics(&c->skel, local, NULL, range_T + (size_t)f * 12 * 3);
+    }
+    return 1;
+}
+
 #endif

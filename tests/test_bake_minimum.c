@@ -7,7 +7,7 @@
 #include "sw_test.h"
 
 #include "bake.h"
-#include "mat3.h"
+#include "bake_fixture.h"
 #include "samples.h"
 
 TEST(min_frames) {
@@ -311,21 +311,12 @@ TEST(pair_sweeps_turn_a_joint_with_its_parent) {
 TEST(pair_sweeps_by_default_within_a_joint_range) {
     sw_character c;
     sw_error err;
-    ENSURE(sw_sample_make("finger", 1000, 6, &c, &err) == SINEW_OK);
-    c.clip.nframes = 0;
-    int32_t nb = c.skel.nbones;
-    ENSURE(nb == 3);
-    if (nb != 3) {
-        sw_character_free(&c);
-        return;
-    }
-    double local[9 * 3], range_T[2 * 12 * 3];
-    static const double z[3] = {0, 0, 1};
-    for (int f = 0; f < 2; ++f) { /* rest, then bones 1 and 2 at 40 degrees */
-        for (int32_t b = 0; b < nb; ++b)
-            sw_m3_axis_angle(z, f == 1 && b > 0 ? 40 * 0.017453292519943295 : 0, local + 9 * b);
-        sw_forward_kinematics(&c.skel, local, NULL, range_T + (size_t)f * 12 * nb);
-    }
+    static const double turn[2 * 3] = {0, 0, 0, 0, 40, 40}; /* rest; bones 1 and 2 at 40 */
+    double range_T[2 * 12 * 3];
+    int made = finger_range_fixture(&c, 1000, 2, turn, range_T);
+    ENSURE(made);
+    if (!made) return;
+    const int32_t nb = 3;
     sw_bake_params p = quick_params();
     p.random_poses = 2;
     p.heldout_steps = 1;

@@ -11,6 +11,7 @@
 #include <sys/stat.h>
 
 #include "bake.h"
+#include "bake_fixture.h"
 #include "mat3.h"
 #include "pose_space.h"
 #include "bake_report.h"
@@ -534,22 +535,13 @@ TEST(random_heldout_poses_in_the_report) {
 TEST(joint_range_bounds_sweeps_and_random_poses) {
     sw_character ch;
     sw_error e;
-    ENSURE(sw_sample_make("finger", 1000, 8, &ch, &e) == SINEW_OK);
-    ch.clip.nframes = 0;
-    int32_t nb = ch.skel.nbones;
-    ENSURE(nb == 3);
-    if (nb != 3) {
-        sw_character_free(&ch);
-        return;
-    }
     /* frames: rest, bone 1 at 40 degrees, at 20 degrees about z; bone 2 always at rest */
-    double local[9 * 3], range_T[3 * 12 * 3], deg = 0.017453292519943295;
-    static const double z[3] = {0, 0, 1}, turn[3] = {0, 40, 20};
-    for (int f = 0; f < 3; ++f) {
-        for (int32_t b = 0; b < nb; ++b)
-            sw_m3_axis_angle(z, b == 1 ? turn[f] * deg : 0, local + 9 * b);
-        sw_forward_kinematics(&ch.skel, local, NULL, range_T + (size_t)f * 12 * nb);
-    }
+    static const double turn[3 * 3] = {0, 0, 0, 0, 40, 0, 0, 20, 0};
+    double range_T[3 * 12 * 3], deg = 0.017453292519943295;
+    int made = finger_range_fixture(&ch, 1000, 3, turn, range_T);
+    ENSURE(made);
+    if (!made) return;
+    const int32_t nb = 3;
     sw_bake_params p = sw_bake_params_default();
     p.threads = 2;
     p.sweep_samples = 3;
