@@ -12,6 +12,7 @@
 #include <dirent.h>
 #include <errno.h>
 #include <math.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -267,10 +268,24 @@ static int render_all(const options *o, const char **paths, int n) {
     p.ground = o->ground;
     p.view_azimuth_deg = o->azimuth;
     p.view_elevation_deg = o->elevation;
-    if (ok && sw_render_frame_camera(&p, bmin, bmax, &err)) {
+    /* one camera for every tile, fitted to the points of all of them */
+    long long npts = 0;
+    for (int i = 0; ok && i < n; ++i)
+        npts += m[i].nverts;
+    double *pts = ok && npts <= INT32_MAX ? malloc(sizeof(double) * 3 * (size_t)npts) : NULL;
+    if (pts) {
+        size_t at = 0;
+        for (int i = 0; i < n; ++i) {
+            memcpy(pts + at, m[i].X, sizeof(double) * 3 * (size_t)m[i].nverts);
+            at += 3 * (size_t)m[i].nverts;
+        }
+    }
+    if (ok && (pts ? sw_render_frame_points(&p, (int32_t)npts, pts, &err)
+                   : sw_render_frame_camera(&p, bmin, bmax, &err))) { /* too many: their box */
         fprintf(stderr, "sinew-render: %s\n", err.msg);
         ok = 0;
     }
+    free(pts);
     if (ok) {
         tile = malloc((size_t)tw * th * 3);
         sheet = malloc((size_t)W * H * 3);
