@@ -102,6 +102,8 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     const cJSON *hreg = cJSON_GetObjectItemCaseSensitive(reg, "heldout");
     ENSURE(cJSON_GetArraySize(hreg) >= 1 &&
            num(cJSON_GetArrayItem(hreg, 0), "err_share") > 0); /* the largest share first */
+    for (int k = 0; k < cJSON_GetArraySize(hreg); ++k) /* the sample's bones have no names */
+        ENSURE(cJSON_IsNull(cJSON_GetObjectItemCaseSensitive(cJSON_GetArrayItem(hreg, k), "name")));
     for (int32_t d = 0; d < v->ndomains && cJSON_GetArraySize(doms) == v->ndomains; ++d) {
         const cJSON *o = cJSON_GetArrayItem(doms, d);
         ENSURE(num(o, "rank") == v->domains[d].rank &&

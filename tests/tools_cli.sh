@@ -360,6 +360,14 @@ if [ -f "$fox" ]; then
     else
         echo "ok   bake_fox_report_files"
     fi
+    # where the error is, by the file's bone names (the Fox's are b_...)
+    if ! grep -Pzq '"name":\s*"b_[^"]*",\s*"err_share"' "$tmp/rep/report.json" ||
+        ! grep -Eq '<tr><td>held-out</td><td>[0-9]+ b_' "$tmp/rep/report.html"; then
+        echo "FAIL bake_fox_report_regions: the regions of the error without the bones' names" >&2
+        fails=$((fails + 1))
+    else
+        echo "ok   bake_fox_report_regions"
+    fi
 fi
 
 [ "$fails" -eq 0 ] || { echo "$fails failures" >&2; exit 1; }

@@ -20,7 +20,7 @@
  *   adaptive [{train_poses, added, rank, err_train, err_heldout, proj_err_train,
  *              proj_err_heldout, picks_error (null: not verified), seconds}]: one per
  *              bake of the adaptive loop (bake_adaptive.h), or null without it
- *   err_regions {train, heldout: [{bone, err_share, correction_share}]}: the bones whose
+ *   err_regions {train, heldout: [{bone, name, err_share, correction_share}]}: the bones whose
  *              vertices (by their strongest bone) hold the largest shares of the squared
  *              error (sw_eval_result's regions), or null
  *   err_heldout_by_mode {pose_space, exhaustive, pose_pairs}: the held-out error in each
@@ -278,12 +278,22 @@ static cJSON *json_adaptive(const sw_adaptive_report *a) {
     return arr;
 }
 
-/* The regions of an evaluation (sw_eval_result): [{bone, err_share, correction_share}]. */
-static cJSON *json_regions(const sw_eval_result *e) {
+/* A bone in the JSON: its index and its name in the file (null: the character has none). */
+static void json_bone(cJSON *o, const sw_character *ch, int32_t bone) {
+    cJSON_AddNumberToObject(o, "bone", bone);
+    if (ch->bone_names)
+        cJSON_AddStringToObject(o, "name", ch->bone_names[bone]);
+    else
+        cJSON_AddNullToObject(o, "name");
+}
+
+/* The regions of an evaluation (sw_eval_result): [{bone, name, err_share,
+ * correction_share}]. */
+static cJSON *json_regions(const sw_eval_result *e, const sw_character *ch) {
     cJSON *arr = cJSON_CreateArray();
     for (int32_t k = 0; k < e->nregions; ++k) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "bone", e->region_bone[k]);
+        json_bone(o, ch, e->region_bone[k]);
         cJSON_AddNumberToObject(o, "err_share", e->region_err[k]);
         cJSON_AddNumberToObject(o, "correction_share", e->region_corr[k]);
         cJSON_AddItemToArray(arr, o);
@@ -354,8 +364,8 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddItemToObject(j, "adaptive", json_adaptive(in->adaptive));
     if (in->eval_train && in->eval_heldout) {
         cJSON *er = cJSON_AddObjectToObject(j, "err_regions");
-        cJSON_AddItemToObject(er, "train", json_regions(in->eval_train));
-        cJSON_AddItemToObject(er, "heldout", json_regions(in->eval_heldout));
+        cJSON_AddItemToObject(er, "train", json_regions(in->eval_train, in->ch));
+        cJSON_AddItemToObject(er, "heldout", json_regions(in->eval_heldout, in->ch));
     } else {
         cJSON_AddNullToObject(j, "err_regions");
     }
@@ -370,11 +380,7 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON *bt = cJSON_AddArrayToObject(j, "heldout_beyond_training");
     for (int32_t k = 0; k < r->nbeyond; ++k) {
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddNumberToObject(o, "bone", r->beyond[k].bone);
-        if (in->ch->bone_names)
-            cJSON_AddStringToObject(o, "name", in->ch->bone_names[r->beyond[k].bone]);
-        else
-            cJSON_AddNullToObject(o, "name");
+        json_bone(o, in->ch, r->beyond[k].bone);
         cJSON_AddNumberToObject(o, "heldout_deg", r->beyond[k].heldout_deg);
         cJSON_AddNumberToObject(o, "train_deg", r->beyond[k].train_deg);
         cJSON_AddItemToArray(bt, o);
@@ -589,6 +595,13 @@ static int html_domains(FILE *f, const sw_bake_report_input *in) {
     return 1;
 }
 
+/* A bone in a table cell: its index and its name in the file, when it has one. */
+static void html_bone(FILE *f, const sw_character *ch, int32_t bone) {
+    fprintf(f, "<td>%d ", bone);
+    if (ch->bone_names) html_text(f, ch->bone_names[bone]);
+    fprintf(f, "</td>");
+}
+
 /* Where the error is: the bones whose vertices hold most of it, training and held-out. */
 static void html_regions(FILE *f, const sw_bake_report_input *in) {
     if (!in->eval_train || !in->eval_heldout) return;
@@ -601,10 +614,11 @@ static void html_regions(FILE *f, const sw_bake_report_input *in) {
                "<th>share of the correction</th></tr>\n");
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *e = set ? in->eval_heldout : in->eval_train;
-        for (int32_t k = 0; k < e->nregions; ++k)
-            fprintf(f, "<tr><td>%s</td><td>%d</td><td>%.3f</td><td>%.3f</td></tr>\n",
-                    set ? "held-out" : "training", e->region_bone[k], e->region_err[k],
-                    e->region_corr[k]);
+        for (int32_t k = 0; k < e->nregions; ++k) {
+            fprintf(f, "<tr><td>%s</td>", set ? "held-out" : "training");
+            html_bone(f, in->ch, e->region_bone[k]);
+            fprintf(f, "<td>%.3f</td><td>%.3f</td></tr>\n", e->region_err[k], e->region_corr[k]);
+        }
     }
     fprintf(f, "</table>\n");
 }
@@ -689,9 +703,9 @@ static void html_beyond(FILE *f, const sw_bake_report_input *in, const report *r
             r->nbeyond_all, r->nbeyond_all == 1 ? "" : "s", r->nbeyond_all == 1 ? "s" : "",
             SW_BEYOND_RATIO, SW_BEYOND_DEG);
     for (int32_t k = 0; k < r->nbeyond; ++k) {
-        fprintf(f, "<tr><td>%d ", r->beyond[k].bone);
-        if (in->ch->bone_names) html_text(f, in->ch->bone_names[r->beyond[k].bone]);
-        fprintf(f, "</td><td>%.1f&deg;</td><td>%.1f&deg;</td></tr>\n", r->beyond[k].heldout_deg,
+        fprintf(f, "<tr>");
+        html_bone(f, in->ch, r->beyond[k].bone);
+        fprintf(f, "<td>%.1f&deg;</td><td>%.1f&deg;</td></tr>\n", r->beyond[k].heldout_deg,
                 r->beyond[k].train_deg);
     }
     fprintf(f, "</table>\n");

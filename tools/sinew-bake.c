@@ -485,8 +485,9 @@ int main(int argc, char **argv) {
                 "correction):",
                 set ? "held-out" : "training");
         for (int32_t k = 0; k < e->nregions; ++k)
-            fprintf(stderr, " bone %d %.3f / %.3f%s", e->region_bone[k], e->region_err[k],
-                    e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
+            fprintf(stderr, " bone %d%s%s %.3f / %.3f%s", e->region_bone[k],
+                    ch.bone_names ? " " : "", ch.bone_names ? ch.bone_names[e->region_bone[k]] : "",
+                    e->region_err[k], e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
     }
     fprintf(stderr, "  held-out error by self-contact mode:");
     for (int k = 0; k < SW_BAKE_MODES; ++k)
