@@ -51,12 +51,15 @@ void sw_pair_space_gather(sw_pose_space *ps, const sw_blob_view *v, const double
         int32_t n0 = -1, n1 = -1;
         sw_pair_space_feature(v, g, T, c);
         const double *F = v->pair_feature + 6 * (int64_t)g * nt;
+        /* Samples within SW_PAIR_SAME of each other share a feature (poses that differ only
+           elsewhere) but not their pairs: of those the first stored is taken, whatever the
+           rounding of the feature, which changes with the character's heading. */
         for (int32_t t = 0; t < nt; ++t) {
             double d = sw_pair_feature_distance(c, F + 6 * (int64_t)t);
-            if (d < d0) {
-                if (!(d0 - d <= SW_PAIR_SAME)) d1 = d0, n1 = n0; /* not the same sample again */
+            if (d < d0 - SW_PAIR_SAME) {
+                d1 = d0, n1 = n0;
                 d0 = d, n0 = t;
-            } else if (d < d1 && d - d0 > SW_PAIR_SAME) {
+            } else if (d - d0 > SW_PAIR_SAME && d < d1 - SW_PAIR_SAME) {
                 d1 = d, n1 = t;
             }
         }

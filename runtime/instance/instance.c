@@ -43,6 +43,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
 #define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
     (void)sw_plan_take(p, 1, sizeof *in);
     TAKE(in->bone_dq, nb);
+    TAKE(in->pose_host, 12 * nb);
     TAKE(in->pose.T_cur, 12 * nb);
     TAKE(in->pose.T_prev, 12 * nb);
     TAKE(in->pose.T_prev2, 12 * nb);
@@ -530,6 +531,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sw_solver_order_blocks(&in->solver, v);
     double share;
     choose_newton_hessian(in, d.newton_hessian, &share);
+    in->logger = d.logger;
+    sw_instance_actor_identity(in);
     sinew_instance_reset(in);
     sw_log(&d.logger, SINEW_LOG_INFO, SINEW_MSG_INSTANCE_CREATED,
            "sinew_instance_create: %zu bytes in one block; %d active vertices, rank %d, %d "
@@ -554,14 +557,9 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     memset(inst->solver.qdot, 0, (size_t)R * sizeof(double));
     inst->solver.pred_valid = 0;
     sw_pose_history *ph = &inst->pose;
-    for (int32_t b = 0; b < nb; ++b) { /* the rest pose: identity transforms */
-        memset(ph->T_cur + 12 * b, 0, 12 * sizeof(double));
-        ph->T_cur[12 * b] = ph->T_cur[12 * b + 4] = ph->T_cur[12 * b + 8] = 1;
-    }
+    sw_instance_rest_pose(inst); /* where the actor stands */
     memcpy(ph->T_prev, ph->T_cur, 12 * (size_t)nb * sizeof(double));
     memcpy(ph->T_prev2, ph->T_cur, 12 * (size_t)nb * sizeof(double));
-    for (int32_t b = 0; b < nb; ++b)
-        sw_dq_from_transform(ph->T_cur + 12 * b, &inst->bone_dq[b]);
     ph->history = 0;
     ph->h_prev = 0;
     ph->declared_jump = 0;

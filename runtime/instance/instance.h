@@ -7,12 +7,17 @@
 #include "blob_view.h"
 #include "sinew/sinew.h"
 
-/* Sets the pose from double transforms (12 per bone, rest -> world). */
+/* Sets the pose from double transforms (12 per bone, rest -> the actor's frame), as
+ * sinew_instance_set_pose. */
 sinew_result sw_instance_set_pose_d(sinew_instance *inst, const double *T);
 
 /* Output surface positions (3 per output vertex, sw_blob_output_verts: the render mesh's
  * when the blob has one) of the last step. */
 const double *sw_instance_surface(const sinew_instance *inst);
+
+/* The output surface of the last step as the host reads it, in the actor's frame
+ * (sinew_instance_set_actor), in double precision (3 per output vertex). */
+void sw_instance_read_surface_d(const sinew_instance *inst, double *x);
 
 /* Reduced coordinates (rank_total) of the last step. */
 const double *sw_instance_q(const sinew_instance *inst);

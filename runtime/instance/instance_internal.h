@@ -14,13 +14,23 @@
 struct sinew_instance {
     const sw_blob_view *v;
     sinew_allocator allocator; /* frees the block */
+    sinew_logger logger;       /* the def's (or the blob's) */
     sinew_step_mode mode;
-    double size;                  /* rest bounding-box diagonal */
-    double *bone_ball;            /* 4 nbones: the ball of the rest vertices each bone skins
-                                     (centre, radius; radius -1: none), sw_pose_jump's */
-    double *q_bound;              /* ndomains: the largest |q_k| a step may leave (step.c) */
-    double *u_max;                /* ndomains: the largest |U_v|_F of a domain's vertex */
-    sw_dualquat *bone_dq;         /* nbones: the current pose */
+    double size;          /* rest bounding-box diagonal */
+    double *bone_ball;    /* 4 nbones: the ball of the rest vertices each bone skins
+                             (centre, radius; radius -1: none), sw_pose_jump's */
+    double *q_bound;      /* ndomains: the largest |q_k| a step may leave (step.c) */
+    double *u_max;        /* ndomains: the largest |U_v|_F of a domain's vertex */
+    sw_dualquat *bone_dq; /* nbones: the current pose */
+    /* Where the actor is (pose.c): the host's bone transforms as given (12 nbones, in the
+     * actor's frame, each a rotation times the pose's uniform scale), the actor's rigid
+     * transform to the world (R row-major, t) and its uniform scale. The step works in
+     * the simulation frame, the world divided by the whole scale s = actor_scale *
+     * pose_scale, so the flesh is the rest-size physics whatever the scale; pose.T_cur
+     * holds the bones there, and the host reads its surface back in the actor's frame. */
+    double *pose_host;
+    double actor[12];
+    double actor_scale, pose_scale, scale;
     sw_pose_history pose;         /* the current pose and the two before */
     sw_reduced red;               /* the subspace map and the evaluation accumulators */
     sw_pose_space ps;             /* training poses near the current one, contact pairs */
@@ -51,6 +61,17 @@ struct sinew_instance {
 /* The contact terms of the instance's step (the world's when it has one); self_seconds
  * as sw_step_contacts. */
 sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds);
+
+/* The actor at the world's origin, unscaled (creation). */
+void sw_instance_actor_identity(sinew_instance *in);
+
+/* The rest pose where the actor stands: the host's bones the identity, composed into
+ * pose.T_cur and bone_dq (reset). */
+void sw_instance_rest_pose(sinew_instance *in);
+
+/* Surface vertex i (position, or with direction set a normal) of the simulation frame
+ * in the actor's frame, as the host reads it. */
+void sw_instance_to_actor(const sinew_instance *in, const double x[3], int direction, double y[3]);
 
 /* The output surface (positions and normals) of the state q (output.c). */
 void sw_instance_write_surface(sinew_instance *in);

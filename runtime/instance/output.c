@@ -66,11 +66,25 @@ SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, f
     if (!inst || (!positions && !normals) ||
         vertex_count != (uint32_t)sw_blob_output_verts(inst->v))
         return SINEW_ERROR_INVALID_ARGUMENT;
-    for (uint32_t i = 0; i < 3 * vertex_count; ++i) {
-        if (positions) positions[i] = (float)inst->surf_x[i];
-        if (normals) normals[i] = (float)inst->surf_n[i];
+    for (uint32_t i = 0; i < vertex_count; ++i) {
+        double y[3];
+        if (positions) {
+            sw_instance_to_actor(inst, inst->surf_x + 3 * i, 0, y);
+            for (int k = 0; k < 3; ++k)
+                positions[3 * i + k] = (float)y[k];
+        }
+        if (normals) {
+            sw_instance_to_actor(inst, inst->surf_n + 3 * i, 1, y);
+            for (int k = 0; k < 3; ++k)
+                normals[3 * i + k] = (float)y[k];
+        }
     }
     return SINEW_OK;
+}
+
+void sw_instance_read_surface_d(const sinew_instance *inst, double *x) {
+    for (int32_t i = 0; i < sw_blob_output_verts(inst->v); ++i)
+        sw_instance_to_actor(inst, inst->surf_x + 3 * i, 0, x + 3 * i);
 }
 
 SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sinew_step_stats *out) {

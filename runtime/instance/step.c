@@ -433,7 +433,12 @@ static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
 }
 
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
-    if (!inst || !(dt > 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (!inst || !(dt >= 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (dt == 0) { /* a paused frame (an engine's pause passes dt = 0): nothing moves */
+        memset(&inst->stats, 0, sizeof inst->stats);
+        inst->stats.struct_size = sizeof inst->stats;
+        return SINEW_OK;
+    }
     sw_step_ctx c;
     phases_to_solve(&c, inst, dt);
     sinew_result r = phase_solve(&c); /* a non-finite state is undone: nothing advances */

@@ -124,14 +124,14 @@ void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int
 }
 
 void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature) {
+    int32_t root = 0; /* the first root: the frame every root is measured in */
+    while (root < nbones - 1 && parent[root] >= 0)
+        ++root;
     for (int32_t b = 0; b < nbones; ++b) {
         const double *Rb = T + 12 * b;
-        double L[12] = {0};
-        if (parent[b] < 0) {
-            for (int i = 0; i < 9; ++i)
-                L[i] = Rb[i];
-        } else { /* L = R_p^T R_b */
-            const double *Rp = T + 12 * parent[b];
+        double L[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+        if (b != root) { /* L = R_p^T R_b, p the parent or (another root) the first root */
+            const double *Rp = T + 12 * (parent[b] >= 0 ? parent[b] : root);
             for (int i = 0; i < 3; ++i)
                 for (int j = 0; j < 3; ++j)
                     L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];

@@ -32,8 +32,10 @@ void sw_dqs_blend(const sw_dualquat *bones, const int32_t *ids, const double *we
 void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int32_t *ids,
                  const double *weights, int k, double *x);
 /* Pose feature of bone transforms T (12 per bone): each bone's rotation relative to its
- * parent's (parent[b] < 0: to the world) as a unit quaternion (w, x, y, z), w >= 0;
- * writes 4 * nbones doubles. Invariant to the character's global placement. */
+ * parent's as a unit quaternion (w, x, y, z), w >= 0; a root's relative to the first
+ * root's, which is the identity: turning the whole pose (a character facing another way)
+ * is rigid motion, not a pose (DESIGN.md §3). Writes 4 * nbones doubles. Invariant to
+ * the character's placement and heading. */
 void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature);
 
 /* The angle (radians, [0, pi]) of the rotation a pose feature's unit quaternion q holds:

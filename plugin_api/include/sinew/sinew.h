@@ -58,12 +58,28 @@ SINEW_API void sinew_instance_destroy(sinew_instance *inst);
 /** Back to rest: zero correction and velocity, rest pose, no pose history. */
 SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst);
 
-/** Sets the pose for the next step: `bone_count` rigid transforms (12 floats each: the
- * 3x3 rotation row-major, then the translation) mapping the bind pose to world space.
- * A non-finite or non-rigid transform is rejected (NOT_FINITE / INVALID_ARGUMENT) and
- * the previous pose kept. Never allocates or locks. */
+/** Sets the pose for the next step: `bone_count` transforms (12 floats each: the 3x3
+ * part row-major, then the translation) mapping the bind pose into the actor's frame
+ * (sinew_instance_set_actor; without one, the world). Each 3x3 part is a rotation times
+ * one uniform scale s shared by every bone (an engine's actor scale): the flesh is then
+ * the rest-size character's, scaled by s. A non-finite transform is NOT_FINITE; a
+ * sheared or mirrored one, a bone scaled unlike bone 0 (squash and stretch of single
+ * bones is not simulated), a scale outside [1e-6, 1e6], or a scale with a collision
+ * world attached is INVALID_ARGUMENT, logged naming the bone (SINEW_MSG_INSTANCE_POSE);
+ * the previous pose is kept. Never allocates or locks. */
 SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float *transforms,
                                                uint32_t bone_count);
+
+/** Places the actor: `transform` (12 doubles: a rotation times a uniform scale, row-major,
+ * then the translation) maps the actor's frame, which the pose's bones and the surface
+ * sinew_instance_read_surface gives are in, to the world, which the collision world and
+ * the inertial forces are in. Doubles, so an actor 10^5 units from the origin keeps its
+ * shape to rounding: hand the bones in relative to the actor (an engine's component
+ * space) and draw the surface with the actor's matrix. Default: the identity. Where the
+ * actor stands and faces does not change the flesh; how it moves does (dynamic mode:
+ * its acceleration). Errors as sinew_instance_set_pose; takes effect at once for the
+ * pose already set. Never allocates or locks. */
+SINEW_API sinew_result sinew_instance_set_actor(sinew_instance *inst, const double transform[12]);
 
 /** Declares the pose of the next step discontinuous with the last step's: a camera cut, a
  * respawn, a switch to another animation, a ragdoll hand-off. The next step treats it as
@@ -75,7 +91,9 @@ SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float
 SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst);
 
 /** Advances the instance by dt seconds (0 < dt <= 1) to the current pose: quasistatic
- * or dynamic per the instance def. Never allocates, locks or blocks; its cost depends
+ * or dynamic per the instance def. dt = 0 is a paused frame: SINEW_OK, nothing changes
+ * (state, surface, pose history), the stats read zero with no flag; the pose set stays
+ * for the next step that runs. Never allocates, locks or blocks; its cost depends
  * on the blob's cubature and surface sizes, not on the tet count. A non-finite result
  * (a non-finite solve, or an output surface beyond float range) is undone and reported
  * as SINEW_ERROR_NOT_FINITE with SINEW_STEP_FAILED: the reduced state goes back to the

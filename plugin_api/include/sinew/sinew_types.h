@@ -68,6 +68,9 @@ static inline sinew_blob_def sinew_blob_def_default(void) {
 #define SINEW_MSG_INSTANCE_UNSUPPORTED                                                             \
     0x0202u /**< error: a def field this version lacks (none today) */
 #define SINEW_MSG_INSTANCE_CREATED 0x0203u /**< info: created, with its memory */
+#define SINEW_MSG_INSTANCE_POSE                                                                    \
+    0x0204u /**< error: a pose or actor transform refused (says                                    \
+                 which bone and why) */
 
 /** A range task of the library: items [begin, end) on the host's worker `worker`. */
 typedef void sinew_task_fn(uint32_t begin, uint32_t end, uint32_t worker, void *task_context);

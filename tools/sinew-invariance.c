@@ -1,0 +1,194 @@
+/* sinew-invariance: does where the character stands, faces or how it is scaled change its
+ * flesh? (DESIGN.md §3, invariance.h)
+ *
+ *   sinew-invariance (FILE.glb [--tets N] ... | --scene NAME [--tets N] [--frames F] |
+ *                     --mesh ... as sinew-bake) --blob FILE [--frames-max K] [--seed S]
+ *                    [--reach D] [--json]
+ *
+ * Plays the character's clip (and a glTF/FBX FILE's held-out clips after it, at most K
+ * frames in all, default 120) in two instances of the blob, the second carried by a
+ * motion of the whole pose, and prints for each case the largest distance of an output
+ * vertex from where it should be, as a share of the character's size:
+ *   rigid_<mode>     quasistatic, one random rigid motion (any axis, up to 180 degrees,
+ *                    a translation up to --reach D units, 10^5 by default) on every bone (double
+ * poses), in each self-contact mode: pose_space, pose_pairs, exhaustive turning quasistatic,
+ * turning 4 degrees a frame about a random axis while walking away dynamic          dynamic mode,
+ * one random rigid motion far_actor        the actor D units from the origin, turned
+ * (sinew_instance_set_actor), float poses in its frame, the float surface read in its frame
+ *   scale_0.01, scale_100  the pose scaled uniformly (float poses and surface)
+ * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
+#include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#define SW_TOOL_CHARACTER_ARGS
+#include "tool_common.h"
+
+#include "invariance.h"
+
+static const char *const TOOL = "sinew-invariance";
+
+static void usage(FILE *f) {
+    fprintf(f,
+            "usage: sinew-invariance (FILE [--tets N] [--train-clips A,B] [--heldout-clips C] |\n"
+            "                         --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+            "                         --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+            "                         [--clip FILE [--frames F]])\n"
+            "                        --blob FILE [--frames-max K] [--seed S] [--json]\n"
+            "character:\n" SW_CHARACTER_USAGE);
+    fprintf(f, "invariance:\n"
+               "  --blob FILE       the blob sinew-bake wrote for this character\n"
+               "  --frames-max K    clip frames played, 1..100000 (default 120)\n"
+               "  --seed S          the random motions' seed, 1..2^31 (default 1)\n"
+               "  --reach D         the rigid motions' and the actor's translation, up to D\n"
+               "                    units on each axis, 0..1e7 (default 1e5)\n"
+               "  --json            the figures as one JSON object on the last line\n");
+}
+
+static unsigned long long rng = 1;
+static double urand(void) { /* xorshift64* */
+    rng ^= rng >> 12;
+    rng ^= rng << 25;
+    rng ^= rng >> 27;
+    return (double)((rng * 0x2545F4914F6CDD1Dull) >> 11) * (1.0 / 9007199254740992.0);
+}
+
+/* A random rigid motion: a uniform axis, a turn in (90, 180] degrees, a translation up to
+ * `reach` on each axis. */
+static sw_move random_rigid(double reach) {
+    sw_move m = {0};
+    m.kind = SW_MOVE_RIGID;
+    double z = 2 * urand() - 1, a = 6.283185307179586 * urand(), r = sqrt(1 - z * z);
+    m.axis[0] = r * cos(a), m.axis[1] = r * sin(a), m.axis[2] = z;
+    m.angle = 3.141592653589793 * (0.5 + 0.5 * urand());
+    for (int k = 0; k < 3; ++k)
+        m.shift[k] = reach * (2 * urand() - 1);
+    return m;
+}
+
+typedef struct {
+    const char *name;
+    sw_invariance_result res;
+} row;
+
+/* The clip the runs play: the character's, then a FILE's held-out clips, at most kmax
+ * frames (malloc'd, *frames set). */
+static double *play_clip(const sw_character *ch, const sw_clip_split *clips, int kmax,
+                         int32_t *frames) {
+    int32_t nb = ch->skel.nbones, n = 0;
+    size_t per = (size_t)12 * nb;
+    double *T = malloc((size_t)kmax * per * sizeof(double));
+    if (!T) return NULL;
+    for (int32_t f = 0; f < ch->clip.nframes && n < kmax; ++f)
+        memcpy(T + per * n++, ch->clip.T + per * f, per * sizeof(double));
+    for (int32_t c = 0; clips && c < clips->nheldout; ++c)
+        for (int32_t f = 0; f < clips->heldout[c].nframes && n < kmax; ++f)
+            memcpy(T + per * n++, clips->heldout[c].T + per * f, per * sizeof(double));
+    *frames = n;
+    return T;
+}
+
+int main(int argc, char **argv) {
+    sw_character_args ca;
+    sw_character_args_init(&ca, TOOL);
+    const char *blob_path = NULL;
+    int kmax = 120, seed = 1, json = 0, ok = 1;
+    double far = 1e5;
+    for (int i = 1; i < argc; ++i) {
+        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
+        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), 0;
+        if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
+            if (!ok) return 2;
+        } else if (!strcmp(a, "--json")) {
+            json = 1;
+        } else if (!strcmp(a, "--blob") && next) {
+            blob_path = argv[++i];
+        } else if (!strcmp(a, "--frames-max") && next) {
+            if (!sw_tool_int(TOOL, a, argv[++i], 1, 100000, &kmax)) return 2;
+        } else if (!strcmp(a, "--reach") && next) {
+            if (!sw_tool_real(TOOL, a, argv[++i], -1e-300, 1e7, "in 0 <= D <= 1e7", &far)) return 2;
+        } else if (!strcmp(a, "--seed") && next) {
+            if (!sw_tool_int(TOOL, a, argv[++i], 1, 2147483647, &seed)) return 2;
+        } else {
+            return sw_tool_bad_arg(TOOL, a, usage);
+        }
+    }
+    if (!sw_character_args_valid(&ca)) return 2;
+    if (!blob_path) {
+        fprintf(stderr, "%s: --blob FILE is needed (bake it with sinew-bake)\n", TOOL);
+        return 2;
+    }
+    rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull | 1;
+    sw_character ch;
+    sw_clip_split clips;
+    sw_error err;
+    sinew_result r = sw_character_args_make(&ca, &ch, &clips, NULL, &err);
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", TOOL);
+    sinew_blob_def bd = sinew_blob_def_default();
+    bd.path = blob_path;
+    sinew_blob *blob = NULL;
+    if (sw_tool_blob_load(TOOL, blob_path, bd, &blob) != SINEW_OK) return 1;
+    int32_t frames = 0, nb = ch.skel.nbones;
+    double *clip = play_clip(&ch, &clips, kmax, &frames);
+    if (!clip || frames < 1) {
+        fprintf(stderr, "%s: the character has no clip to play\n", TOOL);
+        return 1;
+    }
+    float dt = (float)(1.0 / (ch.clip.fps > 0 ? ch.clip.fps : 30));
+    sw_move rigid = random_rigid(far), turning = random_rigid(0), actor = random_rigid(far),
+            s_small = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 0.01, 1, 1},
+            s_big = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 100, 1, 1};
+    turning.kind = SW_MOVE_TURNING;
+    turning.angle = 4 * 3.141592653589793 / 180;
+    for (int k = 0; k < 3; ++k) /* walking away: a tenth of a unit a frame */
+        turning.shift[k] = 0.1 * (2 * urand() - 1);
+    actor.kind = SW_MOVE_ACTOR;
+    actor.float_poses = actor.float_output = 1;
+    struct {
+        const char *name;
+        sinew_step_mode mode;
+        sinew_self_contact sc;
+        const sw_move *m;
+    } cases[] = {
+        {"rigid_pose_space", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_SPACE, &rigid},
+        {"rigid_pose_pairs", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_PAIRS, &rigid},
+        {"rigid_exhaustive", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_EXHAUSTIVE, &rigid},
+        {"turning", SINEW_STEP_QUASISTATIC, 0, &turning},
+        {"dynamic", SINEW_STEP_DYNAMIC, 0, &rigid},
+        {"far_actor", SINEW_STEP_QUASISTATIC, 0, &actor},
+        {"scale_0.01", SINEW_STEP_QUASISTATIC, 0, &s_small},
+        {"scale_100", SINEW_STEP_QUASISTATIC, 0, &s_big},
+    };
+    enum { NCASES = sizeof cases / sizeof cases[0] };
+    row rows[NCASES];
+    double worst = 0;
+    long failed = 0;
+    for (int c = 0; c < NCASES; ++c) {
+        sw_invariance_run run = {cases[c].mode, cases[c].sc, NULL, NULL, dt};
+        rows[c].name = cases[c].name;
+        r = sw_invariance_measure(blob, clip, nb, frames, &run, cases[c].m, &rows[c].res);
+        if (r != SINEW_OK) {
+            fprintf(stderr, "%s: case %s failed: %s\n", TOOL, cases[c].name,
+                    sinew_result_string(r));
+            return 1;
+        }
+        worst = fmax(worst, rows[c].res.err);
+        failed += rows[c].res.failed;
+        fprintf(stderr, "%s: %-18s %.3e of the size (frame %d of %d), %d failed steps\n", TOOL,
+                cases[c].name, rows[c].res.err, rows[c].res.worst_frame, frames,
+                rows[c].res.failed);
+    }
+    if (json) {
+        printf("{\"frames\":%d,\"size\":%.9g,\"worst\":%.4e,\"failed_steps\":%ld", frames,
+               rows[0].res.size, worst, failed);
+        for (int c = 0; c < NCASES; ++c)
+            printf(",\"%s\":%.4e", rows[c].name, rows[c].res.err);
+        printf("}\n");
+    }
+    free(clip);
+    sinew_blob_destroy(blob);
+    sw_clip_split_free(&clips);
+    sw_character_free(&ch);
+    return 0;
+}
