@@ -67,6 +67,7 @@ static sinew_result make_instance(const sinew_blob *blob, const sw_invariance_ru
     sinew_instance_def d = sinew_instance_def_default();
     d.mode = run->mode;
     if (run->self_contact) d.self_contact = run->self_contact;
+    d.max_patch_vertices = run->max_patch_vertices;
     sinew_result r = sinew_instance_create(blob, &d, out);
     if (r == SINEW_OK && world) r = sinew_instance_set_world(*out, world);
     return r;
@@ -138,6 +139,11 @@ sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, i
             goto done;
         out->failed += sinew_instance_step(a, dt) != SINEW_OK;
         out->failed += sinew_instance_step(b, dt) != SINEW_OK;
+        sinew_step_stats st = {.struct_size = sizeof st};
+        sinew_instance_get_stats(a, &st);
+        out->world_contacts += st.world_contacts;
+        out->self_contacts += st.self_contacts;
+        if (st.patch_vertices > out->patch_vertices) out->patch_vertices = st.patch_vertices;
         read_surface(a, ns, m->float_output, fs, xa);
         read_surface(b, ns, m->float_output, fs, xb);
         double worst = 0;

@@ -44,13 +44,17 @@ typedef struct sw_invariance_run {
     const sinew_world *world;        /* the first instance's world (NULL: none) */
     const sinew_world *world_moved;  /* the second's: the same colliders carried by G */
     float dt;                        /* the step (0: 1/30 s) */
+    uint32_t max_patch_vertices;     /* condensation's budget (0: off) */
 } sw_invariance_run;
 
 typedef struct sw_invariance_result {
     double err; /* largest |x_moved - G x| over the frames, / size */
     int32_t worst_frame;
-    double size;    /* the rest bounding-box diagonal */
-    int32_t failed; /* steps that did not return SINEW_OK (either instance) */
+    double size;             /* the rest bounding-box diagonal */
+    int32_t failed;          /* steps that did not return SINEW_OK (either instance) */
+    int64_t world_contacts;  /* the first instance's, summed over the frames */
+    int64_t self_contacts;   /* the same of its self-contact pairs */
+    uint32_t patch_vertices; /* its largest condensation patch */
 } sw_invariance_result;
 
 /* The rigid part of a move at frame f as a transform (12: R row-major, t). */

@@ -165,7 +165,7 @@ int main(int argc, char **argv) {
     double worst = 0;
     long failed = 0;
     for (int c = 0; c < NCASES; ++c) {
-        sw_invariance_run run = {cases[c].mode, cases[c].sc, NULL, NULL, dt};
+        sw_invariance_run run = {cases[c].mode, cases[c].sc, NULL, NULL, dt, 0};
         rows[c].name = cases[c].name;
         r = sw_invariance_measure(blob, clip, nb, frames, &run, cases[c].m, &rows[c].res);
         if (r != SINEW_OK) {

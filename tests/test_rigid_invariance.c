@@ -1,0 +1,326 @@
+/* Where the character is does not change its flesh (DESIGN.md §3): a pose carried by a
+ * rigid motion G gives G applied to the surface, in every step mode and self-contact
+ * mode, with a world whose colliders (every shape: box, sphere, capsule, plane, mesh,
+ * hull) move with G and condensation patches; an actor 10^5 units from the origin keeps
+ * the origin's shape; a uniformly scaled pose gives the scaled shape; dt = 0 is a pause;
+ * a bone scaled unlike the others is refused naming it. The measure is invariance.h's,
+ * the bound 1e-5 of the character's size (issue 55). */
+#include <math.h>
+#include <stdio.h>
+#include <string.h>
+
+#include "bake_fixture.h"
+#include "instance.h"
+#include "invariance.h"
+#include "sinew/sinew_world.h"
+#include "sw_test.h"
+
+#define BOUND 1e-5
+
+static bake_fixture fx;
+static int fx_ok = -1;
+
+/* The finger (along +x from 0 to 3.6), folding into self-contact over 12 frames. */
+static const bake_fixture *finger(void) {
+    if (fx_ok < 0) fx_ok = bake_fixture_make(&fx, "finger", 2000, 12, 0);
+    return fx_ok ? &fx : NULL;
+}
+
+static const double PI = 3.14159265358979323846;
+
+/* Turned 150 degrees about a skew axis and carried far away. */
+static sw_move far_rigid(void) {
+    sw_move m = {SW_MOVE_RIGID, {0.3, -0.8, 0.5}, 150 * PI / 180, {7e4, -3e4, 1e5}, 0, 0, 0};
+    return m;
+}
+
+static sw_invariance_result measure(const sw_invariance_run *run, const sw_move *m) {
+    const bake_fixture *f = finger();
+    sw_invariance_result res = {0};
+    if (!f) return res;
+    sinew_result r = sw_invariance_measure(f->blob, f->ch.clip.T, f->ch.skel.nbones,
+                                           f->ch.clip.nframes, run, m, &res);
+    if (r != SINEW_OK) res.failed = -1;
+    return res;
+}
+
+#define ENSURE_INVARIANT(res, what)                                                                \
+    ENSUREF((res).failed == 0 && (res).size > 0 && (res).err <= BOUND,                             \
+            "%s: %.3e of the size at frame %d (%d failed steps)", what, (res).err,                 \
+            (res).worst_frame, (res).failed)
+
+TEST(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_mode) {
+    ENSURE(finger());
+    const sinew_self_contact modes[] = {SINEW_SELF_CONTACT_POSE_SPACE,
+                                        SINEW_SELF_CONTACT_POSE_PAIRS,
+                                        SINEW_SELF_CONTACT_EXHAUSTIVE};
+    const char *names[] = {"pose-space", "pose-pairs", "exhaustive"};
+    sw_move m = far_rigid();
+    for (int k = 0; k < 3; ++k) {
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, modes[k], NULL, NULL, 0, 0};
+        sw_invariance_result res = measure(&run, &m);
+        ENSURE_INVARIANT(res, names[k]);
+        ENSUREF(res.self_contacts > 0, "%s: the fold never touched", names[k]);
+    }
+}
+
+TEST(a_character_turning_every_frame_deforms_as_one_standing_still) {
+    sw_move m = {SW_MOVE_TURNING, {0.1, 1, 0.2}, 4 * PI / 180, {0.05, 0, 0.08}, 0, 0, 0};
+    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0};
+    sw_invariance_result res = measure(&run, &m);
+    ENSURE_INVARIANT(res, "turning");
+}
+
+TEST(dynamic_flesh_carried_by_a_constant_rigid_motion_is_the_same_motion) {
+    sw_move m = far_rigid();
+    sw_invariance_run run = {SINEW_STEP_DYNAMIC, 0, NULL, NULL, 1.0f / 30, 0};
+    sw_invariance_result res = measure(&run, &m);
+    ENSURE_INVARIANT(res, "dynamic");
+}
+
+TEST(an_actor_far_from_the_origin_keeps_the_origins_shape_in_its_frame) {
+    sw_move m = far_rigid();
+    m.kind = SW_MOVE_ACTOR;
+    m.float_poses = m.float_output = 1; /* as a host hands them in and reads them */
+    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0};
+    sw_invariance_result res = measure(&run, &m);
+    ENSURE_INVARIANT(res, "far actor");
+    m.scale = 0.01; /* an actor scaled as well: its frame holds the unscaled shape */
+    res = measure(&run, &m);
+    ENSURE_INVARIANT(res, "far actor scaled 0.01");
+}
+
+TEST(a_uniformly_scaled_pose_gives_the_scaled_shape) {
+    const double scales[] = {0.01, 100, 1.0005};
+    for (int k = 0; k < 3; ++k) {
+        sw_move m = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, scales[k], 1, 1};
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0};
+        sw_invariance_result res = measure(&run, &m);
+        char what[32];
+        snprintf(what, sizeof what, "scale %g", scales[k]);
+        ENSURE_INVARIANT(res, what);
+    }
+}
+
+/* ---- a world of every collider shape, and the same world carried by G ------------- */
+
+static void carry(const double G[12], const float p[3], float out[3]) {
+    for (int i = 0; i < 3; ++i)
+        out[i] = (float)(G[3 * i] * p[0] + G[3 * i + 1] * p[1] + G[3 * i + 2] * p[2] + G[9 + i]);
+}
+
+/* The quaternion (w, x, y, z) of G's rotation times q. */
+static void carry_rotation(const double G[12], const float q[4], float out[4]) {
+    double tr = G[0] + G[4] + G[8], g[4];
+    g[0] = 0.5 * sqrt(fmax(0, 1 + tr));
+    double s = g[0] > 1e-6 ? 0.25 / g[0] : 0;
+    g[1] = (G[7] - G[5]) * s, g[2] = (G[2] - G[6]) * s, g[3] = (G[3] - G[1]) * s;
+    if (!(g[0] > 1e-6)) { /* (the test's turns are below 180 degrees) */
+        g[0] = 1, g[1] = g[2] = g[3] = 0;
+    }
+    out[0] = (float)(g[0] * q[0] - g[1] * q[1] - g[2] * q[2] - g[3] * q[3]);
+    out[1] = (float)(g[0] * q[1] + g[1] * q[0] + g[2] * q[3] - g[3] * q[2]);
+    out[2] = (float)(g[0] * q[2] - g[1] * q[3] + g[2] * q[0] + g[3] * q[1]);
+    out[3] = (float)(g[0] * q[3] + g[1] * q[2] - g[2] * q[1] + g[3] * q[0]);
+}
+
+static const float hull_pts[] = {-0.3f, -0.3f, -0.3f, 0.3f, -0.3f, -0.3f, -0.3f,
+                                 0.3f,  -0.3f, 0.3f,  0.3f, -0.3f, -0.3f, -0.3f,
+                                 0.3f,  0.3f,  -0.3f, 0.3f, 0.0f,  0.5f,  0.4f};
+static const float mesh_v[] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1, 0, 0.3f, 0};
+static const uint32_t mesh_i[] = {0, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0};
+
+/* Colliders pressing the folding finger from every side, carried by G (NULL: as they
+ * are). Each kind of shape is there once: box (a table), sphere, capsule, a plane, a
+ * triangle mesh (a tent) and a convex hull. */
+static sinew_world *shape_world(const double *G) {
+    sinew_world *w;
+    sinew_world_def wd = sinew_world_def_default();
+    if (sinew_world_create(&wd, &w) != SINEW_OK) return NULL;
+    sinew_collider_def c[6];
+    for (int k = 0; k < 6; ++k)
+        c[k] = sinew_collider_def_default();
+    c[0].shape = SINEW_SHAPE_BOX;
+    c[0].half_extents[0] = 2.5f, c[0].half_extents[1] = 0.2f, c[0].half_extents[2] = 1.0f;
+    c[0].transform.position[0] = 1.8f, c[0].transform.position[1] = -0.59f;
+    c[1].shape = SINEW_SHAPE_SPHERE;
+    c[1].radius = 0.3f;
+    c[1].transform.position[0] = 2.9f, c[1].transform.position[2] = 0.6f;
+    c[2].shape = SINEW_SHAPE_CAPSULE;
+    c[2].radius = 0.2f, c[2].half_height = 0.6f;
+    c[2].transform.position[0] = 1.2f, c[2].transform.position[2] = -0.55f;
+    c[3].shape = SINEW_SHAPE_PLANE; /* a wall at the finger's root: n . x = offset */
+    c[3].normal[0] = 1, c[3].normal[1] = 0, c[3].normal[2] = 0, c[3].offset = -0.05f;
+    c[4].shape = SINEW_SHAPE_MESH;
+    c[4].vertices = mesh_v, c[4].vertex_count = 5;
+    c[4].indices = mesh_i, c[4].triangle_count = 4;
+    c[4].transform.position[0] = 2.2f, c[4].transform.position[1] = 0.65f;
+    c[4].transform.rotation[0] = 0, c[4].transform.rotation[3] = 1; /* upside down: a tent above */
+    c[5].shape = SINEW_SHAPE_HULL;
+    c[5].points = hull_pts, c[5].point_count = 7;
+    c[5].transform.position[0] = 0.6f, c[5].transform.position[2] = 0.6f;
+    for (int k = 0; k < 6 && G; ++k) {
+        if (c[k].shape == SINEW_SHAPE_PLANE) { /* n' = R n, offset' = n' . (G p0) */
+            float n[3] = {c[k].normal[0], c[k].normal[1], c[k].normal[2]}, p0[3];
+            float p[3] = {n[0] * c[k].offset, n[1] * c[k].offset, n[2] * c[k].offset};
+            double Rg[12];
+            memcpy(Rg, G, sizeof Rg);
+            Rg[9] = Rg[10] = Rg[11] = 0;
+            carry(Rg, n, c[k].normal);
+            carry(G, p, p0);
+            c[k].offset = c[k].normal[0] * p0[0] + c[k].normal[1] * p0[1] + c[k].normal[2] * p0[2];
+            continue;
+        }
+        sinew_transform t = c[k].transform;
+        carry(G, t.position, c[k].transform.position);
+        carry_rotation(G, t.rotation, c[k].transform.rotation);
+    }
+    for (int k = 0; k < 6; ++k) {
+        sinew_collider_id id;
+        if (sinew_world_add_collider(w, &c[k], &id) != SINEW_OK) {
+            fprintf(stderr, "  collider %d (shape %d) refused\n", k, (int)c[k].shape);
+            sinew_world_destroy(w);
+            return NULL;
+        }
+    }
+    return w;
+}
+
+TEST(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the_moved_flesh) {
+    ENSURE(finger());
+    /* float collider placements: a modest move keeps their rounding below the bound */
+    sw_move m = {SW_MOVE_RIGID, {0.3, -0.8, 0.5}, 120 * PI / 180, {3, -2, 5}, 0, 0, 0};
+    double G[12];
+    sw_move_transform(&m, 0, G);
+    sinew_world *w = shape_world(NULL), *wg = shape_world(G);
+    ENSURE(w && wg);
+    const uint32_t budgets[] = {0, 400};
+    const sinew_step_mode modes[] = {SINEW_STEP_QUASISTATIC, SINEW_STEP_DYNAMIC};
+    for (int b = 0; b < 2; ++b)
+        for (int k = 0; k < 2; ++k) {
+            sw_invariance_run run = {modes[k], 0, w, wg, 1.0f / 30, budgets[b]};
+            sw_invariance_result res = measure(&run, &m);
+            char what[64];
+            snprintf(what, sizeof what, "world, %s, patch budget %u", k ? "dynamic" : "quasistatic",
+                     budgets[b]);
+            ENSURE_INVARIANT(res, what);
+            /* the colliders do press, and with a budget a patch grows */
+            ENSUREF(res.world_contacts > 0 && res.self_contacts > 0 &&
+                        (budgets[b] == 0 || res.patch_vertices > 0),
+                    "%s: %lld world contacts, %lld self, patch %u", what,
+                    (long long)res.world_contacts, (long long)res.self_contacts,
+                    res.patch_vertices);
+        }
+    sinew_world_destroy(w);
+    sinew_world_destroy(wg);
+}
+
+/* ---- engine inputs ------------------------------------------------------------------ */
+
+typedef struct {
+    char msg[512];
+    uint32_t id;
+} kept_log;
+
+static void keep_log(sinew_log_level level, uint32_t id, const char *message, void *user) {
+    kept_log *k = user;
+    if (level != SINEW_LOG_ERROR) return;
+    k->id = id;
+    snprintf(k->msg, sizeof k->msg, "%s", message);
+}
+
+static sinew_instance *make(const bake_fixture *f, kept_log *log) {
+    sinew_instance_def d = sinew_instance_def_default();
+    d.logger.log = keep_log;
+    d.logger.user = log;
+    d.logger.max_level = SINEW_LOG_ERROR;
+    sinew_instance *in = NULL;
+    return sinew_instance_create(f->blob, &d, &in) == SINEW_OK ? in : NULL;
+}
+
+TEST(dt_zero_is_a_paused_frame) {
+    const bake_fixture *f = finger();
+    ENSURE(f);
+    kept_log log = {{0}, 0};
+    sinew_instance *in = make(f, &log);
+    ENSURE(in);
+    uint32_t nb = f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
+    float pose[12 * 8], before[3 * 4096], after[3 * 4096];
+    ENSURE(nb <= 8 && ns <= 4096);
+    bake_fixture_pose(f, 8, pose);
+    ENSURE(sinew_instance_set_pose(in, pose, nb) == SINEW_OK);
+    ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+    ENSURE(sinew_instance_read_surface(in, before, NULL, ns) == SINEW_OK);
+    bake_fixture_pose(f, 11, pose); /* a new pose, then a pause: nothing moves yet */
+    ENSURE(sinew_instance_set_pose(in, pose, nb) == SINEW_OK);
+    ENSURE(sinew_instance_step(in, 0.0f) == SINEW_OK);
+    ENSURE(sinew_instance_read_surface(in, after, NULL, ns) == SINEW_OK);
+    ENSURE(memcmp(before, after, (size_t)3 * ns * sizeof(float)) == 0);
+    sinew_step_stats st = {.struct_size = sizeof st};
+    ENSURE(sinew_instance_get_stats(in, &st) == SINEW_OK && st.status == 0);
+    ENSURE(sinew_instance_step(in, -1.0f / 30) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK); /* the pose set comes on */
+    ENSURE(sinew_instance_read_surface(in, after, NULL, ns) == SINEW_OK);
+    ENSURE(memcmp(before, after, (size_t)3 * ns * sizeof(float)) != 0);
+    sinew_instance_destroy(in);
+}
+
+TEST(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it) {
+    const bake_fixture *f = finger();
+    ENSURE(f);
+    kept_log log = {{0}, 0};
+    sinew_instance *in = make(f, &log);
+    ENSURE(in);
+    uint32_t nb = f->ch.skel.nbones;
+    float pose[12 * 8], bad[12 * 8];
+    ENSURE(nb >= 2 && nb <= 8);
+    bake_fixture_pose(f, 4, pose);
+    ENSURE(sinew_instance_set_pose(in, pose, nb) == SINEW_OK);
+    memcpy(bad, pose, sizeof pose);
+    for (int i = 0; i < 9; ++i) /* squash and stretch of bone 1 alone */
+        bad[12 + i] *= 1.2f;
+    ENSURE(sinew_instance_set_pose(in, bad, nb) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(log.id == SINEW_MSG_INSTANCE_POSE && strstr(log.msg, "bone 1 is scaled 1.2"), "'%s'",
+            log.msg);
+    memcpy(bad, pose, sizeof pose);
+    bad[12 + 1] += 0.3f; /* a shear */
+    ENSURE(sinew_instance_set_pose(in, bad, nb) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSUREF(strstr(log.msg, "bone 1 is not a rotation times a uniform scale"), "'%s'", log.msg);
+    memcpy(bad, pose, sizeof pose);
+    for (uint32_t b = 0; b < nb; ++b) /* absurd: 10^7 */
+        for (int i = 0; i < 9; ++i)
+            bad[12 * b + i] *= 1e7f;
+    ENSURE(sinew_instance_set_pose(in, bad, nb) == SINEW_ERROR_INVALID_ARGUMENT);
+    double A[12] = {2, 0, 0, 0, 2, 0, 0, 0, 2, 1e5, 0, 0}, S[12] = {1, 0.5, 0, 0, 1, 0, 0, 0, 1};
+    ENSURE(sinew_instance_set_actor(in, A) == SINEW_OK);
+    ENSURE(sinew_instance_set_actor(in, S) == SINEW_ERROR_INVALID_ARGUMENT);
+    A[0] = NAN;
+    ENSURE(sinew_instance_set_actor(in, A) == SINEW_ERROR_NOT_FINITE);
+    /* a scaled actor with a world: refused until the world's queries scale (pose.c) */
+    sinew_world *w;
+    sinew_world_def wd = sinew_world_def_default();
+    ENSURE(sinew_world_create(&wd, &w) == SINEW_OK);
+    double I[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    ENSURE(sinew_instance_set_actor(in, I) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in, w) == SINEW_OK);
+    A[0] = 2;
+    ENSURE(sinew_instance_set_actor(in, A) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sinew_instance_step(in, 1.0f / 30) == SINEW_OK);
+    sinew_instance_destroy(in);
+    sinew_world_destroy(w);
+}
+
+TEST(release_fixture) {
+    if (fx_ok > 0) bake_fixture_free(&fx);
+    fx_ok = -1;
+}
+
+SW_TEST_MAIN(
+    CASE(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_mode),
+    CASE(a_character_turning_every_frame_deforms_as_one_standing_still),
+    CASE(dynamic_flesh_carried_by_a_constant_rigid_motion_is_the_same_motion),
+    CASE(an_actor_far_from_the_origin_keeps_the_origins_shape_in_its_frame),
+    CASE(a_uniformly_scaled_pose_gives_the_scaled_shape),
+    CASE(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the_moved_flesh),
+    CASE(dt_zero_is_a_paused_frame),
+    CASE(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it), CASE(release_fixture))
