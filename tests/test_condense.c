@@ -525,6 +525,14 @@ TEST(patch_def_is_checked_and_sized) {
         d.patch_radius = bad[i];
         ENSURE(sinew_instance_create(f->blob, &d, &in) == SINEW_ERROR_INVALID_ARGUMENT);
     }
+    /* detected self-contact in a patch is refused until the patch evaluates it */
+    d.patch_radius = 0;
+    ENSURE(sinew_instance_create(f->blob, &d, &in) == SINEW_OK);
+    sinew_instance_destroy(in);
+    d.self_contact = SINEW_SELF_CONTACT_EXHAUSTIVE;
+    ENSURE(sinew_instance_create(f->blob, &d, &in) == SINEW_ERROR_INVALID_ARGUMENT);
+    d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS;
+    ENSURE(sinew_instance_create(f->blob, &d, &in) == SINEW_ERROR_INVALID_ARGUMENT);
 }
 
 TEST(release_fixture) {

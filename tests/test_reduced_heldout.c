@@ -252,7 +252,10 @@ TEST(elephant_heldout_matches_the_reference) {
             "%s", err.msg);
     ENSURE(bake(&b));
     check_springs_follow_the_skeleton(b.blob);
-    compare(&b, "elephant-cd", 0.19, 1.32); /* measured 0.147, 1.049 (a known gap) */
+    /* The dynamic bound is above 1, worse than plain skinning: the elephant's dynamic flesh
+       does not follow the reference's yet (docs/notes/placement.md). It guards that gap
+       from widening, and says nothing of quality. */
+    compare(&b, "elephant-cd", 0.19, 1.15);
     baked_free(&b);
 }
 

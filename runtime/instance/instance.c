@@ -333,6 +333,11 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
             ? "exhaustive self-contact needs a blob with the tet mesh (bake it again)"
         : d->self_contact == SINEW_SELF_CONTACT_POSE_PAIRS && v->npair_groups == 0
             ? "pose-pairs self-contact needs a blob with per-pair sections (bake it again)"
+        /* detected pairs are evaluated at subspace positions, a patch's vertices at
+           patch positions: the two would disagree where detected contact meets a patch */
+        : d->max_patch_vertices > 0 && d->self_contact != SINEW_SELF_CONTACT_POSE_SPACE
+            ? "condensation patches (max_patch_vertices) with detected self-contact "
+              "(exhaustive or pose-pairs) are not simulated yet: use pose-space self-contact"
         : d->newton_hessian != SINEW_NEWTON_HESSIAN_AUTO &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_REST_FIRST

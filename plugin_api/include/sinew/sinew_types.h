@@ -171,7 +171,8 @@ typedef struct sinew_instance_def {
      * reserved at creation for this many vertices (sinew_instance_memory_size counts
      * them). A step whose oracle asks for more keeps the vertices nearest the contacts,
      * drops the rest and flags SINEW_STEP_BUDGET with SINEW_BUDGET_PATCH. Needs a blob
-     * with the tet mesh (sinew-bake writes it); INVALID_ARGUMENT otherwise. */
+     * with the tet mesh (sinew-bake writes it) and pose-space self-contact (the default);
+     * INVALID_ARGUMENT otherwise. */
     uint32_t max_patch_vertices;
     /** The patch radius: the breadth-first growth from a contact vertex accepts the
      * vertices within this rest-space distance of it, in units of the rest bounding-box
