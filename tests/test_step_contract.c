@@ -186,12 +186,15 @@ enum {
     P_EXHAUSTIVE,   /* the clip, quasistatic and dynamic, exhaustive self-contact */
     P_POSE_PAIRS,   /* the clip, quasistatic, pose-space self-contact per pair of domains */
     P_REST_FIRST,   /* the clip, quasistatic, Newton starting on the rest Hessian */
+    P_MESH_HULL,    /* quasistatic and dynamic, 10^4 steps against a triangle mesh (Embree)
+                       and a convex hull (libccd) that move every step */
+    P_PATCH,        /* the same world, quasistatic with condensation patches */
     P_COUNT
 };
 static const char *const path_names[P_COUNT] = {
-    "quasistatic",  "dynamic",    "translate jump", "rotation snap", "dt spikes",   "cut",
-    "limited",      "guard",      "failed",         "reset",         "pair budget", "world",
-    "world budget", "exhaustive", "pose pairs",     "rest first"};
+    "quasistatic",  "dynamic",    "translate jump", "rotation snap", "dt spikes",     "cut",
+    "limited",      "guard",      "failed",         "reset",         "pair budget",   "world",
+    "world budget", "exhaustive", "pose pairs",     "rest first",    "mesh and hull", "patch"};
 
 typedef struct {
     int steps, failed;         /* steps made; of them, returning an error */
@@ -201,6 +204,7 @@ typedef struct {
     uint32_t budget_bits;
     uint32_t self_contacts; /* self-contact pairs in the solves, summed */
     uint32_t rest_updates;  /* Newton updates on the rest Hessian, summed */
+    uint32_t patch_max;     /* the largest condensation patch */
 } path_record;
 
 typedef struct {
@@ -245,6 +249,7 @@ static sinew_result step_path(contract_run *cr, int p, sinew_instance *inst, con
     r->budget_bits |= st.budget_exceeded;
     r->self_contacts += st.self_contacts;
     r->rest_updates += st.rest_updates;
+    if (st.patch_vertices > r->patch_max) r->patch_max = st.patch_vertices;
     return res;
 }
 
@@ -293,6 +298,51 @@ static sinew_world *make_world(const float centre[3], const float half[3], float
     return w;
 }
 
+/* A tent of four triangles (a mesh collider, Embree) over the finger and a convex hull
+ * (libccd) under it, each moved every step (tent_at, hull_at). */
+static const float tent_v[] = {-0.6f, 0,     -0.6f, 0.6f, 0, -0.6f,  0.6f, 0,
+                               0.6f,  -0.6f, 0,     0.6f, 0, -0.25f, 0};
+static const uint32_t tent_i[] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+static const float hull_p[] = {-0.3f, 0, -0.3f, 0.3f, 0,     -0.3f, 0.3f, 0,     0.3f,
+                               -0.3f, 0, 0.3f,  0,    0.35f, 0,     0,    -0.2f, 0};
+
+enum { MESH_HULL_STEPS = 10000 };
+
+static sinew_transform tent_at(int s) {
+    sinew_transform t = sinew_transform_identity();
+    t.position[0] = (float)(0.6 + 0.1 * (s % 27));
+    t.position[1] = 0.6f;
+    return t;
+}
+
+static sinew_transform hull_at(int s) {
+    sinew_transform t = sinew_transform_identity();
+    t.position[0] = (float)(0.4 + 0.12 * (s % 23));
+    t.position[1] = -0.55f;
+    return t;
+}
+
+static sinew_world *mesh_hull_world(sinew_collider_id *mesh, sinew_collider_id *hull) {
+    sinew_world *w = NULL;
+    sinew_world_def wd = sinew_world_def_default();
+    if (sinew_world_create(&wd, &w) != SINEW_OK) return NULL;
+    sinew_collider_def c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_MESH;
+    c.vertices = tent_v, c.vertex_count = 5, c.indices = tent_i, c.triangle_count = 4;
+    c.transform = tent_at(0);
+    int ok = sinew_world_add_collider(w, &c, mesh) == SINEW_OK;
+    c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_HULL;
+    c.points = hull_p, c.point_count = 6;
+    c.transform = hull_at(0);
+    ok = ok && sinew_world_add_collider(w, &c, hull) == SINEW_OK;
+    if (!ok) {
+        sinew_world_destroy(w);
+        return NULL;
+    }
+    return w;
+}
+
 static sinew_transform ball_at(int s) {
     sinew_transform t = sinew_transform_identity();
     t.position[0] = (float)(0.5 + 0.1 * (s % 25));
@@ -314,6 +364,9 @@ enum {
     I_XD,
     I_PP,
     I_REST,
+    I_MHQ,
+    I_MHD,
+    I_MHP,
     I_COUNT
 };
 
@@ -330,9 +383,10 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     for (int i = 0; i < I_COUNT; ++i) {
         sinew_instance_def d = sinew_instance_def_default();
         d.allocator = (sinew_allocator){host_alloc, host_free, &heap};
-        d.mode = (i == I_D || i == I_WD || i == I_WBUDGET || i == I_LIMIT || i == I_XD)
-                     ? SINEW_STEP_DYNAMIC
-                     : SINEW_STEP_QUASISTATIC;
+        d.mode =
+            (i == I_D || i == I_WD || i == I_WBUDGET || i == I_LIMIT || i == I_XD || i == I_MHD)
+                ? SINEW_STEP_DYNAMIC
+                : SINEW_STEP_QUASISTATIC;
         if (i == I_XQ || i == I_XD) d.self_contact = SINEW_SELF_CONTACT_EXHAUSTIVE;
         if (i == I_PP) d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS;
         if (i == I_PAIRS) d.max_contact_pairs = 1;
@@ -341,6 +395,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         if (i == I_Q || i == I_FRESH) d.newton_hessian = SINEW_NEWTON_HESSIAN_CURRENT;
         if (i == I_REST) d.newton_hessian = SINEW_NEWTON_HESSIAN_REST_FIRST;
         if (i == I_WBUDGET) d.max_world_contacts = 1;
+        if (i == I_MHP) d.max_patch_vertices = 300;
         size_t bytes = 0;
         int before = heap.allocs;
         ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_OK);
@@ -365,7 +420,12 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     sinew_world *world = make_world(table_at, table_half, 0, &ball),
                 *inside = make_world(inside_at, box_half, 0, NULL),
                 *stiff = make_world(stiff_at, box_half, 1e15f, NULL);
-    ENSURE(world && inside && stiff);
+    sinew_collider_id mesh, hull;
+    sinew_world *mh = mesh_hull_world(&mesh, &hull);
+    ENSURE(world && inside && stiff && mh);
+    ENSURE(sinew_instance_set_world(in[I_MHQ], mh) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in[I_MHD], mh) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(in[I_MHP], mh) == SINEW_OK);
     ENSURE(sinew_instance_set_world(in[I_WQ], world) == SINEW_OK);
     ENSURE(sinew_instance_set_world(in[I_WD], world) == SINEW_OK);
     ENSURE(sinew_instance_set_world(in[I_WBUDGET], world) == SINEW_OK);
@@ -383,6 +443,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     static const float far[3] = {1000, 0, 0}, still[3] = {0, 0, 0};
     int reset_same = 0, failed_kept = 0, failed_results = 0;
     float F[3], M[3];
+    double mesh_push = 0, hull_push = 0; /* the forces on the mesh and the hull, summed */
 #if !defined(SW_CONTRACT_SHARED)
     const int32_t R = sw_blob_get_view(f->blob)->rank_total;
     double *qbig = malloc(sizeof(double) * (size_t)R);
@@ -452,6 +513,20 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         step_path(&cr, P_WORLD_BUDGET, in[I_WBUDGET], clip_pose(f, s), 1.0f / 30);
         if (sinew_instance_collider_force(in[I_WQ], ball, F, M) != SINEW_OK) cr.bad_calls++;
     }
+    /* a mesh and a hull pressing the folding finger, both moving every step */
+    for (int s = 0; s < MESH_HULL_STEPS; ++s) {
+        sinew_transform tm = tent_at(s), th = hull_at(s);
+        if (sinew_world_set_collider_transform(mh, mesh, &tm) != SINEW_OK ||
+            sinew_world_set_collider_transform(mh, hull, &th) != SINEW_OK)
+            cr.bad_calls++;
+        step_path(&cr, P_MESH_HULL, in[s % 2 ? I_MHD : I_MHQ], clip_pose(f, s / 2), 1.0f / 30);
+        /* each shape's own query path pressed the flesh: its collider feels a force */
+        if (sinew_instance_collider_force(in[I_MHQ], mesh, F, M) != SINEW_OK) cr.bad_calls++;
+        mesh_push += fabsf(F[0]) + fabsf(F[1]) + fabsf(F[2]);
+        if (sinew_instance_collider_force(in[I_MHQ], hull, F, M) != SINEW_OK) cr.bad_calls++;
+        hull_push += fabsf(F[0]) + fabsf(F[1]) + fabsf(F[2]);
+        if (s < 4 * frames) step_path(&cr, P_PATCH, in[I_MHP], clip_pose(f, s), 1.0f / 30);
+    }
     sw_rt_counts c = sw_rt_count_end(); /* ================= to here ================= */
 
     fprintf(stderr, "    %s, %d steps: %s; host allocator %d allocs %d frees\n", VARIANT, cr.steps,
@@ -472,6 +547,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     sinew_world_destroy(world);
     sinew_world_destroy(inside);
     sinew_world_destroy(stiff);
+    sinew_world_destroy(mh);
     free(cr.x);
     free(cr.n);
     free(pose);
@@ -505,10 +581,18 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET || p == P_POSE_PAIRS ||
                     p == P_REST_FIRST;
         if (quasi) ENSUREF(r->all & SINEW_STEP_POSE_SPACE, "path %s", path_names[p]);
-        if (!quasi && p != P_RESET && p != P_WORLD && p != P_EXHAUSTIVE)
+        if (!quasi && p != P_RESET && p != P_WORLD && p != P_EXHAUSTIVE && p != P_MESH_HULL &&
+            p != P_PATCH)
             ENSUREF(!(r->any & SINEW_STEP_POSE_SPACE), "path %s", path_names[p]);
     }
     const path_record *rec = cr.rec;
+    ENSUREF(rec[P_MESH_HULL].steps == MESH_HULL_STEPS && rec[P_MESH_HULL].world_contacts > 0,
+            "mesh and hull: %d steps, %u contacts", rec[P_MESH_HULL].steps,
+            rec[P_MESH_HULL].world_contacts);
+    ENSUREF(mesh_push > 0 && hull_push > 0, "the mesh felt %g, the hull %g", mesh_push, hull_push);
+    ENSUREF(rec[P_PATCH].world_contacts > 0 && rec[P_PATCH].patch_max > 0,
+            "patch: %u contacts, largest patch %u", rec[P_PATCH].world_contacts,
+            rec[P_PATCH].patch_max);
     ENSURE(rec[P_QUASISTATIC].any & SINEW_STEP_CONVERGED &&
            rec[P_DYNAMIC].any & SINEW_STEP_CONVERGED);
     ENSURE(!(rec[P_QUASISTATIC].any & ~(SINEW_STEP_CONVERGED | SINEW_STEP_POSE_SPACE)));
