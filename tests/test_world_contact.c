@@ -323,8 +323,8 @@ TEST(reference_pushes_the_flesh_out_of_a_box) {
 /* The shipped world files build their worlds, and the finger's table scene runs in the
  * step and in the reference: contact once the table has risen, no failed step. */
 TEST(sample_worlds_run_in_the_step_and_the_reference) {
-    static const char *names[] = {"finger_table", "capsule_pipe", "hand_handle"};
-    for (int i = 0; i < 3; ++i) {
+    static const char *names[] = {"finger_table", "capsule_pipe", "hand_handle", "finger_props"};
+    for (int i = 0; i < 4; ++i) {
         char path[1024];
         snprintf(path, sizeof path, "%s/samples/worlds/%s.json", SINEW_SOURCE_DIR, names[i]);
         sw_world_scene ws;
@@ -383,6 +383,68 @@ TEST(sample_worlds_run_in_the_step_and_the_reference) {
     sw_world_scene_free(&ws);
 }
 
+/* The sample world of a mesh and a hull (finger_props.json) moving along the finger while
+ * it plays its clip: both colliders press it, with and without a condensation patch, no
+ * step fails, and the patch keeps the tent's apex out of the flesh where the subspace
+ * cannot dent it (thesis §4.3). */
+TEST(a_sample_world_of_a_mesh_and_a_hull_presses_the_finger) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/samples/worlds/finger_props.json", SINEW_SOURCE_DIR);
+    sw_world_scene ws;
+    sw_error err;
+    ENSUREF(sw_world_scene_load(path, &ws, &err) == SINEW_OK, "%s", err.msg);
+    int nf;
+    double *T =
+        sw_world_scene_poses(&ws, f->ch.clip.T, f->ch.clip.nframes, f->ch.skel.nbones, 0, &nf);
+    ENSURE(T && nf > 0); /* the clip's frames, played round while the colliders move */
+    uint32_t ns = sinew_blob_surface_vertex_count(f->blob);
+    double *x = malloc(sizeof(double) * 3 * ns);
+    ENSURE(x);
+    double pen_of[2] = {0, 0};
+    for (int patch = 0; patch < 2; ++patch) {
+        sinew_instance_def d = sinew_instance_def_default();
+        d.max_patch_vertices = patch ? 300 : 0;
+        sinew_instance *inst;
+        ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
+        ENSURE(sinew_instance_set_world(inst, ws.world) == SINEW_OK);
+        double push[2] = {0, 0}, pen = 0;
+        uint32_t largest = 0;
+        for (int k = 0; k < nf; ++k) {
+            ENSURE(sw_world_scene_at(&ws, k, &err) == SINEW_OK);
+            ENSURE(sw_instance_set_pose_d(inst, T + (size_t)k * 12 * f->ch.skel.nbones) ==
+                   SINEW_OK);
+            ENSURE(sinew_instance_step(inst, 1.0f / 30) == SINEW_OK);
+            for (int c = 0; c < 2; ++c) {
+                float F[3], M[3];
+                ENSURE(sinew_instance_collider_force(inst, ws.ids[c], F, M) == SINEW_OK);
+                push[c] += fabsf(F[0]) + fabsf(F[1]) + fabsf(F[2]);
+            }
+            sinew_step_stats st = {.struct_size = sizeof st};
+            ENSURE(sinew_instance_get_stats(inst, &st) == SINEW_OK);
+            if (st.patch_vertices > largest) largest = st.patch_vertices;
+            memcpy(x, sw_instance_surface(inst), sizeof(double) * 3 * ns);
+            pen = fmax(pen, sw_world_max_penetration(ws.world, (int32_t)ns, x, NULL, NULL, NULL));
+        }
+        fprintf(stderr,
+                "  patch budget %d: forces on the tent %g, the wedge %g; deepest %.4f; "
+                "largest patch %u\n",
+                d.max_patch_vertices, push[0], push[1], pen, largest);
+        ENSUREF(push[0] > 0 && push[1] > 0, "the tent felt %g, the wedge %g", push[0], push[1]);
+        pen_of[patch] = pen;
+        ENSURE(!patch || largest > 0);
+        sinew_instance_destroy(inst);
+    }
+    /* the tent's apex dents the flesh where the subspace cannot: the patch holds it to 2%
+       of the finger's thickness, and a third of the subspace's depth at most */
+    ENSUREF(pen_of[1] < 0.018 && pen_of[1] < pen_of[0] / 3,
+            "deepest: %g in the subspace, %g with the patch", pen_of[0], pen_of[1]);
+    free(x);
+    free(T);
+    sw_world_scene_free(&ws);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
     fx_ok = -1;
@@ -393,4 +455,5 @@ SW_TEST_MAIN(CASE(world_penalty_derivatives_match_finite_differences),
              CASE(world_contact_pushes_the_flesh_out_and_readback_sums_the_forces),
              CASE(world_steps_allocate_and_lock_nothing),
              CASE(reference_pushes_the_flesh_out_of_a_box),
-             CASE(sample_worlds_run_in_the_step_and_the_reference), CASE(release_fixture))
+             CASE(sample_worlds_run_in_the_step_and_the_reference),
+             CASE(a_sample_world_of_a_mesh_and_a_hull_presses_the_finger), CASE(release_fixture))

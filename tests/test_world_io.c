@@ -111,9 +111,10 @@ TEST(optional_fields_defaults_and_normalisation) {
 }
 
 TEST(sample_worlds_parse) {
-    static const char *names[] = {"finger_table.json", "capsule_pipe.json", "hand_handle.json"};
-    static const int ncoll[] = {2, 1, 1}, frames[] = {30, 30, 60}, rest[] = {1, 0, 0};
-    for (int i = 0; i < 3; ++i) {
+    static const char *names[] = {"finger_table.json", "capsule_pipe.json", "hand_handle.json",
+                                  "finger_props.json"};
+    static const int ncoll[] = {2, 1, 1, 2}, frames[] = {30, 30, 60, 30}, rest[] = {1, 0, 0, 0};
+    for (int i = 0; i < 4; ++i) {
         char path[1024];
         snprintf(path, sizeof path, "%s/samples/worlds/%s", SINEW_SOURCE_DIR, names[i]);
         sw_world_file w;

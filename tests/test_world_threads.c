@@ -1,6 +1,8 @@
 /* Instances on several threads stepping against one shared world (read-only while they
  * step) give bitwise the output of the same instances stepped one after another; named
- * for the TSan stage (tests/abi.cmake labels "thread" tests). */
+ * for the TSan stage (tests/abi.cmake labels "thread" tests). The world holds every kind
+ * of query: a box, a sphere, a triangle mesh (Embree) and a convex hull (libccd); every
+ * other instance simulates condensation patches. */
 #include <pthread.h>
 #include <stdint.h>
 
@@ -14,7 +16,10 @@ typedef struct {
     const moving_scene *m;
     int offset;
     uint64_t hash;
+    double mesh_push, hull_push; /* the forces on the mesh and the hull, summed */
 } run_arg;
+
+static sinew_collider_id mesh_id, hull_id;
 
 static uint64_t hash_floats(uint64_t h, const float *x, size_t n) {
     return sw_fnv1a(h, x, n * sizeof(float));
@@ -27,7 +32,9 @@ static void *run_instance(void *vp) {
     uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
     sinew_instance *inst;
     a->hash = 0;
-    if (sinew_instance_create(f->blob, NULL, &inst) != SINEW_OK) return NULL;
+    sinew_instance_def d = sinew_instance_def_default();
+    d.max_patch_vertices = a->offset % 2 ? 200 : 0;
+    if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return NULL;
     sinew_instance_set_world(inst, a->m->w);
     float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 3 * ns);
     uint64_t h = SW_FNV_START;
@@ -37,6 +44,11 @@ static void *run_instance(void *vp) {
         sinew_instance_step(inst, 1.0f / 30);
         sinew_instance_read_surface(inst, x, NULL, ns);
         h = hash_floats(h, x, 3 * ns);
+        float F[3], M[3];
+        if (sinew_instance_collider_force(inst, mesh_id, F, M) == SINEW_OK)
+            a->mesh_push += fabsf(F[0]) + fabsf(F[1]) + fabsf(F[2]);
+        if (sinew_instance_collider_force(inst, hull_id, F, M) == SINEW_OK)
+            a->hull_push += fabsf(F[0]) + fabsf(F[1]) + fabsf(F[2]);
     }
     a->hash = h;
     free(pose);
@@ -48,12 +60,28 @@ static void *run_instance(void *vp) {
 TEST(instances_on_threads_sharing_a_world_match_a_sequential_run) {
     moving_scene m;
     ENSURE(moving_scene_make(&m));
+    /* a tent over the finger and a hull under its tip */
+    static const float tent_v[] = {-0.6f, 0,     -0.6f, 0.6f, 0, -0.6f,  0.6f, 0,
+                                   0.6f,  -0.6f, 0,     0.6f, 0, -0.25f, 0};
+    static const uint32_t tent_i[] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
+    static const float hull_p[] = {-0.3f, 0, -0.3f, 0.3f, 0,     -0.3f, 0.3f, 0,     0.3f,
+                                   -0.3f, 0, 0.3f,  0,    0.35f, 0,     0,    -0.2f, 0};
+    sinew_collider_def c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_MESH;
+    c.vertices = tent_v, c.vertex_count = 5, c.indices = tent_i, c.triangle_count = 4;
+    c.transform.position[0] = 1.4f, c.transform.position[1] = 0.6f;
+    ENSURE(sinew_world_add_collider(m.w, &c, &mesh_id) == SINEW_OK);
+    c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_HULL;
+    c.points = hull_p, c.point_count = 6;
+    c.transform.position[0] = 2.9f, c.transform.position[1] = -0.55f;
+    ENSURE(sinew_world_add_collider(m.w, &c, &hull_id) == SINEW_OK);
     run_arg seq[NTHREADS], par[NTHREADS];
     pthread_t th[NTHREADS];
     for (int i = 0; i < NTHREADS; ++i) {
-        seq[i] = (run_arg){&m, 3 * i, 0};
+        seq[i] = (run_arg){&m, 3 * i, 0, 0, 0};
         run_instance(&seq[i]);
-        par[i] = (run_arg){&m, 3 * i, 0};
+        par[i] = (run_arg){&m, 3 * i, 0, 0, 0};
     }
     for (int i = 0; i < NTHREADS; ++i)
         ENSURE(pthread_create(&th[i], NULL, run_instance, &par[i]) == 0);
@@ -64,6 +92,10 @@ TEST(instances_on_threads_sharing_a_world_match_a_sequential_run) {
         ENSURE(par[i].hash == seq[i].hash);
     }
     ENSURE(seq[0].hash != seq[1].hash);
+    double mesh_push = 0, hull_push = 0;
+    for (int i = 0; i < NTHREADS; ++i)
+        mesh_push += seq[i].mesh_push, hull_push += seq[i].hull_push;
+    ENSUREF(mesh_push > 0 && hull_push > 0, "the mesh felt %g, the hull %g", mesh_push, hull_push);
     sinew_world_destroy(m.w);
 }
 
