@@ -435,6 +435,69 @@ TEST(condensed_steps_allocate_and_lock_nothing_while_the_patch_moves) {
     sinew_world_destroy(ms.w);
 }
 
+/* 10^4 steps of a ball that sweeps along the folding finger and in and out of it, dynamic
+ * and quasistatic in turn: the patch grows, moves, shrinks and vanishes again and again;
+ * every step succeeds with a finite surface, and none allocates or locks. */
+enum { SOAK_STEPS = 10000 };
+TEST(a_patch_grows_moves_and_shrinks_for_ten_thousand_steps_allocating_nothing) {
+    moving_scene ms; /* its ball alone: no table to hold a patch when the ball is out */
+    ENSURE((ms.f = fixture()) != NULL);
+    sinew_world_def wd = sinew_world_def_default();
+    ENSURE(sinew_world_create(&wd, &ms.w) == SINEW_OK);
+    sinew_collider_def c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_SPHERE;
+    c.radius = 0.2f;
+    ball_at(0, &c.transform);
+    ENSURE(sinew_world_add_collider(ms.w, &c, &ms.ball) == SINEW_OK);
+    sinew_instance *in[2];
+    for (int k = 0; k < 2; ++k) {
+        sinew_instance_def d = sinew_instance_def_default();
+        d.max_patch_vertices = 800;
+        d.mode = k ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+        ENSURE(sinew_instance_create(ms.f->blob, &d, &in[k]) == SINEW_OK);
+        ENSURE(sinew_instance_set_world(in[k], ms.w) == SINEW_OK);
+    }
+    const int nb = ms.f->ch.skel.nbones, nfr = ms.f->ch.clip.nframes;
+    const uint32_t ns = sinew_blob_surface_vertex_count(ms.f->blob);
+    float *x = malloc(sizeof(float) * 3 * ns);
+    ENSURE(x);
+    unsigned active = sw_rt_interpose_active();
+    uint32_t with = 0, grew = 0, shrank = 0, vanished = 0, last[2] = {0, 0}, failed = 0, bad = 0;
+    sw_rt_count_begin();
+    for (int s = 0; s < SOAK_STEPS; ++s) {
+        sinew_transform t;
+        ball_at(s, &t);
+        t.position[1] = (float)(-0.45 - 0.3 * (1 + sin(0.21 * s))); /* in and out */
+        sinew_world_set_collider_transform(ms.w, ms.ball, &t);
+        sinew_instance *i = in[s % 2];
+        sw_instance_set_pose_d(i, ms.f->ch.clip.T + (size_t)((s / 2) % nfr) * 12 * nb);
+        failed += sinew_instance_step(i, 1.0f / 30) != SINEW_OK;
+        uint32_t n = i->stats.patch_vertices, *l = &last[s % 2];
+        with += n > 0;
+        grew += n > *l;
+        shrank += n < *l && n > 0;
+        vanished += n == 0 && *l > 0;
+        *l = n;
+        sinew_instance_read_surface(i, x, NULL, ns);
+        for (uint32_t v = 0; v < 3 * ns; ++v)
+            bad += !isfinite(x[v]);
+    }
+    sw_rt_counts cnt = sw_rt_count_end();
+    fprintf(stderr,
+            "    %d steps: %u with a patch, grew %u, shrank %u, vanished %u times; %u failed; "
+            "allocs %lu locks %lu\n",
+            SOAK_STEPS, with, grew, shrank, vanished, failed, (unsigned long)cnt.allocs,
+            (unsigned long)cnt.locks);
+    ENSURE(failed == 0 && bad == 0);
+    ENSURE(with > SOAK_STEPS / 10 && grew > 10 && shrank > 10 && vanished > 2);
+    if (active & SW_RT_CAT_ALLOCS) ENSURE(cnt.allocs == 0 && cnt.frees == 0);
+    if (active & SW_RT_CAT_LOCKS) ENSURE(cnt.locks == 0);
+    free(x);
+    sinew_instance_destroy(in[0]);
+    sinew_instance_destroy(in[1]);
+    sinew_world_destroy(ms.w);
+}
+
 TEST(dynamic_patch_gradient_and_the_dynamics_oracle) {
     const bake_fixture *f = fixture();
     ENSURE(f);
@@ -546,4 +609,6 @@ SW_TEST_MAIN(CASE(coupled_gradient_matches_finite_differences_and_its_hessian_is
              CASE(without_contact_a_condensed_instance_is_bitwise_the_subspace),
              CASE(condensed_steps_allocate_and_lock_nothing_while_the_patch_moves),
              CASE(dynamic_patch_gradient_and_the_dynamics_oracle),
-             CASE(patch_def_is_checked_and_sized), CASE(release_fixture))
+             CASE(patch_def_is_checked_and_sized),
+             CASE(a_patch_grows_moves_and_shrinks_for_ten_thousand_steps_allocating_nothing),
+             CASE(release_fixture))
