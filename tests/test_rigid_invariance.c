@@ -12,6 +12,7 @@
 #include "bake_fixture.h"
 #include "instance.h"
 #include "invariance.h"
+#include "props_fixture.h"
 #include "sinew/sinew_world.h"
 #include "sw_test.h"
 
@@ -124,12 +125,6 @@ static void carry_rotation(const double G[12], const float q[4], float out[4]) {
     out[3] = (float)(g[0] * q[3] + g[1] * q[2] - g[2] * q[1] + g[3] * q[0]);
 }
 
-static const float hull_pts[] = {-0.3f, -0.3f, -0.3f, 0.3f, -0.3f, -0.3f, -0.3f,
-                                 0.3f,  -0.3f, 0.3f,  0.3f, -0.3f, -0.3f, -0.3f,
-                                 0.3f,  0.3f,  -0.3f, 0.3f, 0.0f,  0.5f,  0.4f};
-static const float mesh_v[] = {-1, 0, -1, 1, 0, -1, 1, 0, 1, -1, 0, 1, 0, 0.3f, 0};
-static const uint32_t mesh_i[] = {0, 4, 1, 1, 4, 2, 2, 4, 3, 3, 4, 0};
-
 /* Colliders pressing the folding finger from every side, carried by G (NULL: as they
  * are). Each kind of shape is there once: box (a table), sphere, capsule, a plane, a
  * triangle mesh (a tent) and a convex hull. */
@@ -151,14 +146,9 @@ static sinew_world *shape_world(const double *G) {
     c[2].transform.position[0] = 1.2f, c[2].transform.position[2] = -0.55f;
     c[3].shape = SINEW_SHAPE_PLANE; /* a wall at the finger's root: n . x = offset */
     c[3].normal[0] = 1, c[3].normal[1] = 0, c[3].normal[2] = 0, c[3].offset = -0.05f;
-    c[4].shape = SINEW_SHAPE_MESH;
-    c[4].vertices = mesh_v, c[4].vertex_count = 5;
-    c[4].indices = mesh_i, c[4].triangle_count = 4;
-    c[4].transform.position[0] = 2.2f, c[4].transform.position[1] = 0.65f;
-    c[4].transform.rotation[0] = 0, c[4].transform.rotation[3] = 1; /* upside down: a tent above */
-    c[5].shape = SINEW_SHAPE_HULL;
-    c[5].points = hull_pts, c[5].point_count = 7;
-    c[5].transform.position[0] = 0.6f, c[5].transform.position[2] = 0.6f;
+    c[4] = props_def(0, props_at(2.2f, 0.65f)); /* props_fixture.h: the tent */
+    c[5] = props_def(1, props_at(0.6f, 0));     /* and the wedge, beside the root */
+    c[5].transform.position[2] = 0.6f;
     for (int k = 0; k < 6 && G; ++k) {
         if (c[k].shape == SINEW_SHAPE_PLANE) { /* n' = R n, offset' = n' . (G p0) */
             float n[3] = {c[k].normal[0], c[k].normal[1], c[k].normal[2]}, p0[3];

@@ -26,6 +26,7 @@
 #include <stdint.h>
 
 #include "contract_fixture.h"
+#include "props_fixture.h"
 #include "rt_interpose.h"
 #include "sinew/sinew_world.h"
 #include "sw_test.h"
@@ -298,45 +299,25 @@ static sinew_world *make_world(const float centre[3], const float half[3], float
     return w;
 }
 
-/* A tent of four triangles (a mesh collider, Embree) over the finger and a convex hull
- * (libccd) under it, each moved every step (tent_at, hull_at). */
-static const float tent_v[] = {-0.6f, 0,     -0.6f, 0.6f, 0, -0.6f,  0.6f, 0,
-                               0.6f,  -0.6f, 0,     0.6f, 0, -0.25f, 0};
-static const uint32_t tent_i[] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
-static const float hull_p[] = {-0.3f, 0, -0.3f, 0.3f, 0,     -0.3f, 0.3f, 0,     0.3f,
-                               -0.3f, 0, 0.3f,  0,    0.35f, 0,     0,    -0.2f, 0};
-
+/* The tent (a mesh collider, Embree) over the finger and the wedge (a convex hull,
+ * libccd) under it of props_fixture.h, each moved every step (tent_at, hull_at). */
 enum { MESH_HULL_STEPS = 10000 };
 
 static sinew_transform tent_at(int s) {
-    sinew_transform t = sinew_transform_identity();
-    t.position[0] = (float)(0.6 + 0.1 * (s % 27));
-    t.position[1] = 0.6f;
-    return t;
+    return props_at((float)(0.6 + 0.1 * (s % 27)), 0.6f);
 }
 
 static sinew_transform hull_at(int s) {
-    sinew_transform t = sinew_transform_identity();
-    t.position[0] = (float)(0.4 + 0.12 * (s % 23));
-    t.position[1] = -0.55f;
-    return t;
+    return props_at((float)(0.4 + 0.12 * (s % 23)), -0.55f);
 }
 
 static sinew_world *mesh_hull_world(sinew_collider_id *mesh, sinew_collider_id *hull) {
     sinew_world *w = NULL;
     sinew_world_def wd = sinew_world_def_default();
     if (sinew_world_create(&wd, &w) != SINEW_OK) return NULL;
-    sinew_collider_def c = sinew_collider_def_default();
-    c.shape = SINEW_SHAPE_MESH;
-    c.vertices = tent_v, c.vertex_count = 5, c.indices = tent_i, c.triangle_count = 4;
-    c.transform = tent_at(0);
-    int ok = sinew_world_add_collider(w, &c, mesh) == SINEW_OK;
-    c = sinew_collider_def_default();
-    c.shape = SINEW_SHAPE_HULL;
-    c.points = hull_p, c.point_count = 6;
-    c.transform = hull_at(0);
-    ok = ok && sinew_world_add_collider(w, &c, hull) == SINEW_OK;
-    if (!ok) {
+    sinew_collider_def m = props_def(0, tent_at(0)), h = props_def(1, hull_at(0));
+    if (sinew_world_add_collider(w, &m, mesh) != SINEW_OK ||
+        sinew_world_add_collider(w, &h, hull) != SINEW_OK) {
         sinew_world_destroy(w);
         return NULL;
     }

@@ -3,15 +3,19 @@
  * step's for any worker count and any split of the domains: the pool's contiguous
  * chunks on 1, 2 and 4 workers, run at once or deferred to finish, and a host that runs
  * one domain at a time in reverse order on rotating workers. Quasistatic and dynamic,
- * over the clip and a snap. Runs under TSan (the "threads" label). */
+ * over the clip and a snap, and both again against a mesh and a hull with condensation
+ * patches. Runs under TSan (the "threads" label). */
 #include <stdint.h>
 #include <string.h>
 
 #include "bake_fixture.h"
+#include "props_fixture.h"
 #include "sw_test.h"
 #include "thread_pool.h"
 
 enum { STEPS = 24 };
+
+static uint32_t patch_seen; /* the largest patch of the plays since it was zeroed */
 
 /* A test host: a pthread pool, one task at a time. */
 typedef struct {
@@ -60,9 +64,11 @@ static void finish(void *handle, void *user) {
 
 /* The output after each step of the clip (then a 60 degree snap of the last bone held
  * for a few steps) into out (STEPS + 4 surfaces); 1 on success. */
-static int play(const bake_fixture *f, sinew_step_mode mode, host *h, float *out) {
+static int play(const bake_fixture *f, sinew_step_mode mode, const sinew_world *w, host *h,
+                float *out) {
     sinew_instance_def d = sinew_instance_def_default();
     d.mode = mode;
+    d.max_patch_vertices = w ? 400 : 0; /* with a world: condensation patches */
     if (h) {
         d.tasks.enqueue = enqueue;
         d.tasks.finish = finish;
@@ -71,6 +77,7 @@ static int play(const bake_fixture *f, sinew_step_mode mode, host *h, float *out
     }
     sinew_instance *inst;
     if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
+    if (w && sinew_instance_set_world(inst, w) != SINEW_OK) return 0;
     uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
     float pose[12 * 16];
     int ok = nb <= 16;
@@ -87,6 +94,9 @@ static int play(const bake_fixture *f, sinew_step_mode mode, host *h, float *out
         ok = sinew_instance_set_pose(inst, pose, nb) == SINEW_OK &&
              sinew_instance_step(inst, 1.0f / 30) == SINEW_OK &&
              sinew_instance_read_surface(inst, out + (size_t)s * 3 * ns, NULL, ns) == SINEW_OK;
+        sinew_step_stats st = {.struct_size = sizeof st};
+        ok = ok && sinew_instance_get_stats(inst, &st) == SINEW_OK;
+        if (st.patch_vertices > patch_seen) patch_seen = st.patch_vertices;
     }
     sinew_instance_destroy(inst);
     return ok;
@@ -100,9 +110,19 @@ TEST(task_callbacks_give_the_serial_result_for_any_workers) {
     size_t n = (size_t)(STEPS + 4) * 3 * sinew_blob_surface_vertex_count(f.blob);
     float *serial = malloc(n * sizeof(float)), *tasked = malloc(n * sizeof(float));
     ENSURE(serial && tasked);
-    for (int mode = 0; mode < 2; ++mode) {
-        sinew_step_mode m = mode ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
-        ENSURE(play(&f, m, NULL, serial));
+    /* the props of props_fixture.h pressing the finger: patches in modes 2 and 3 */
+    sinew_world *w;
+    sinew_world_def wd = sinew_world_def_default();
+    sinew_collider_id tent, wedge;
+    ENSURE(sinew_world_create(&wd, &w) == SINEW_OK && props_add(w, 2.2f, 1.2f, &tent, &wedge));
+    static const char *const names[] = {"quasistatic", "dynamic", "quasistatic with patches",
+                                        "dynamic with patches"};
+    for (int mode = 0; mode < 4; ++mode) {
+        sinew_step_mode m = mode % 2 ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+        const sinew_world *pw = mode >= 2 ? w : NULL;
+        patch_seen = 0;
+        ENSURE(play(&f, m, pw, NULL, serial));
+        ENSUREF((patch_seen > 0) == (pw != NULL), "%s: largest patch %u", names[mode], patch_seen);
         static const struct {
             int workers, deferred, reverse;
         } hosts[] = {{1, 0, 0}, {2, 0, 0}, {4, 0, 0}, {2, 1, 0}, {3, 0, 1}, {4, 1, 1}};
@@ -113,21 +133,20 @@ TEST(task_callbacks_give_the_serial_result_for_any_workers) {
             h.reverse = hosts[k].reverse;
             h.pool = sw_pool_create(hosts[k].workers);
             ENSURE(h.pool && sw_pool_size(h.pool) == hosts[k].workers);
-            ENSURE(play(&f, m, &h, tasked));
+            ENSURE(play(&f, m, pw, &h, tasked));
             sw_pool_destroy(h.pool);
-            fprintf(stderr, "    %s, %d workers%s%s: %d tasks, %d finished\n",
-                    mode ? "dynamic" : "quasistatic", hosts[k].workers,
-                    h.deferred ? ", deferred" : "", h.reverse ? ", one domain a range" : "",
-                    h.enqueued, h.finished);
+            fprintf(stderr, "    %s, %d workers%s%s: %d tasks, %d finished\n", names[mode],
+                    hosts[k].workers, h.deferred ? ", deferred" : "",
+                    h.reverse ? ", one domain a range" : "", h.enqueued, h.finished);
             ENSURE(h.enqueued > STEPS); /* at least a cubature pass a step */
             ENSURE(h.finished == (h.deferred ? h.enqueued : 0));
             ENSUREF(memcmp(serial, tasked, n * sizeof(float)) == 0,
-                    "%s on %d workers differs from the serial step",
-                    mode ? "dynamic" : "quasistatic", hosts[k].workers);
+                    "%s on %d workers differs from the serial step", names[mode], hosts[k].workers);
         }
     }
     free(serial);
     free(tasked);
+    sinew_world_destroy(w);
     bake_fixture_free(&f);
 }
 

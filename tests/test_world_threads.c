@@ -8,6 +8,7 @@
 
 #include "hash.h"
 #include "sw_test.h"
+#include "props_fixture.h"
 #include "world_fixture.h"
 
 enum { NTHREADS = 4, THREAD_STEPS = 40 };
@@ -60,22 +61,7 @@ static void *run_instance(void *vp) {
 TEST(instances_on_threads_sharing_a_world_match_a_sequential_run) {
     moving_scene m;
     ENSURE(moving_scene_make(&m));
-    /* a tent over the finger and a hull under its tip */
-    static const float tent_v[] = {-0.6f, 0,     -0.6f, 0.6f, 0, -0.6f,  0.6f, 0,
-                                   0.6f,  -0.6f, 0,     0.6f, 0, -0.25f, 0};
-    static const uint32_t tent_i[] = {0, 1, 4, 1, 2, 4, 2, 3, 4, 3, 0, 4};
-    static const float hull_p[] = {-0.3f, 0, -0.3f, 0.3f, 0,     -0.3f, 0.3f, 0,     0.3f,
-                                   -0.3f, 0, 0.3f,  0,    0.35f, 0,     0,    -0.2f, 0};
-    sinew_collider_def c = sinew_collider_def_default();
-    c.shape = SINEW_SHAPE_MESH;
-    c.vertices = tent_v, c.vertex_count = 5, c.indices = tent_i, c.triangle_count = 4;
-    c.transform.position[0] = 1.4f, c.transform.position[1] = 0.6f;
-    ENSURE(sinew_world_add_collider(m.w, &c, &mesh_id) == SINEW_OK);
-    c = sinew_collider_def_default();
-    c.shape = SINEW_SHAPE_HULL;
-    c.points = hull_p, c.point_count = 6;
-    c.transform.position[0] = 2.9f, c.transform.position[1] = -0.55f;
-    ENSURE(sinew_world_add_collider(m.w, &c, &hull_id) == SINEW_OK);
+    ENSURE(props_add(m.w, 1.4f, 2.9f, &mesh_id, &hull_id)); /* a tent over, a wedge under */
     run_arg seq[NTHREADS], par[NTHREADS];
     pthread_t th[NTHREADS];
     for (int i = 0; i < NTHREADS; ++i) {
