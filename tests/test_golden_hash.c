@@ -57,34 +57,83 @@
 #include <pthread.h>
 #include <stdint.h>
 
+#include <math.h>
+#include <string.h>
+
 #include "bake_fixture.h"
+#include "props_fixture.h"
 #include "hash.h"
 #include "sw_test.h"
 
 enum { NINST = 4, STEPS = 24 };
+/* the modes' instances (surface_hash_of_every_mode_is_golden) come after the four */
+enum { MODE_EXHAUSTIVE = NINST, MODE_POSE_PAIRS, MODE_PATCH, MODE_TURNED, NMODES };
 
 /* FNV-1a 64 of the four instances' surfaces, instance after instance. */
 #define GOLDEN_SURFACE_HASH 0x9d38c3e29a0b905full
 
 typedef struct {
     const bake_fixture *f;
-    int first, stride; /* this thread steps instances first, first + stride, ... */
-    uint64_t hash[NINST];
-    int ok[NINST];
+    int begin, end;    /* the instances of the run */
+    int first, stride; /* this thread steps instances begin + first, + stride, ... */
+    uint64_t hash[NMODES];
+    int ok[NMODES];
 } job;
+
+/* The modes' run (surface_hash_of_every_mode_is_golden): instances 4.. of the same
+ * fixture, each with one more of the step's paths. */
+#define GOLDEN_MODES_HASH 0xcb61bb78f7926f1bull
+
+static sinew_world *props_world; /* the patch instance's: the props pressing the finger */
+
+/* Turns pose (12 floats a bone) by 130 degrees about (2, -1, 2) / 3 and moves it by
+ * (40, -25, 70): the turned character's. */
+static void turn_pose(float *pose, uint32_t nb) {
+    const double c = cos(130 * 3.14159265358979 / 180), sn = sin(130 * 3.14159265358979 / 180),
+                 a[3] = {2 / 3.0, -1 / 3.0, 2 / 3.0}, t[3] = {40, -25, 70};
+    double G[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            G[3 * i + j] = (i == j ? c : 0) + (1 - c) * a[i] * a[j] +
+                           sn * (i == 0   ? (j == 1   ? -a[2]
+                                             : j == 2 ? a[1]
+                                                      : 0)
+                                 : i == 1 ? (j == 0   ? a[2]
+                                             : j == 2 ? -a[0]
+                                                      : 0)
+                                          : (j == 0   ? -a[1]
+                                             : j == 1 ? a[0]
+                                                      : 0));
+    for (uint32_t b = 0; b < nb; ++b) {
+        float *T = pose + 12 * b, o[12];
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j)
+                o[3 * i + j] =
+                    (float)(G[3 * i] * T[j] + G[3 * i + 1] * T[3 + j] + G[3 * i + 2] * T[6 + j]);
+            o[9 + i] =
+                (float)(G[3 * i] * T[9] + G[3 * i + 1] * T[10] + G[3 * i + 2] * T[11] + t[i]);
+        }
+        memcpy(T, o, sizeof o);
+    }
+}
 
 /* Steps instance i through STEPS clip frames from offset 3 i, hashing every surface. */
 static int hash_instance(const bake_fixture *f, int i, uint64_t *h) {
     sinew_instance_def d = sinew_instance_def_default();
-    d.mode = i % 2 ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+    d.mode = i % 2 && i < NINST ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+    if (i == MODE_EXHAUSTIVE) d.self_contact = SINEW_SELF_CONTACT_EXHAUSTIVE;
+    if (i == MODE_POSE_PAIRS) d.self_contact = SINEW_SELF_CONTACT_POSE_PAIRS;
+    if (i == MODE_PATCH) d.max_patch_vertices = 400;
     sinew_instance *inst;
     *h = SW_FNV_START;
     if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
+    if (i == MODE_PATCH) sinew_instance_set_world(inst, props_world);
     uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob);
     float *pose = malloc(sizeof(float) * 12 * nb), *x = malloc(sizeof(float) * 6 * ns);
     int ok = pose && x;
     for (int s = 0; s < STEPS && ok; ++s) {
         bake_fixture_pose(f, s + 3 * i, pose);
+        if (i == MODE_TURNED) turn_pose(pose, nb);
         ok = sinew_instance_set_pose(inst, pose, nb) == SINEW_OK &&
              sinew_instance_step(inst, 1.0f / 30) == SINEW_OK &&
              sinew_instance_read_surface(inst, x, x + 3 * ns, ns) == SINEW_OK;
@@ -98,24 +147,25 @@ static int hash_instance(const bake_fixture *f, int i, uint64_t *h) {
 
 static void *run(void *p) {
     job *j = p;
-    for (int i = j->first; i < NINST; i += j->stride)
+    for (int i = j->begin + j->first; i < j->end; i += j->stride)
         j->ok[i] = hash_instance(j->f, i, &j->hash[i]);
     return NULL;
 }
 
-/* The combined hash of all instances stepped on `nthreads` threads (0 on failure). */
-static uint64_t hash_on_threads(const bake_fixture *f, int nthreads) {
+/* The combined hash of instances [begin, end) stepped on `nthreads` threads (0 on
+ * failure). */
+static uint64_t hash_on_threads(const bake_fixture *f, int begin, int end, int nthreads) {
     job jobs[4];
     pthread_t th[4];
     for (int t = 0; t < nthreads; ++t) {
-        jobs[t] = (job){.f = f, .first = t, .stride = nthreads};
+        jobs[t] = (job){.f = f, .begin = begin, .end = end, .first = t, .stride = nthreads};
         if (pthread_create(&th[t], NULL, run, &jobs[t]) != 0) return 0;
     }
     for (int t = 0; t < nthreads; ++t)
         pthread_join(th[t], NULL);
     uint64_t h = SW_FNV_START;
-    for (int i = 0; i < NINST; ++i) {
-        const job *j = &jobs[i % nthreads];
+    for (int i = begin; i < end; ++i) {
+        const job *j = &jobs[(i - begin) % nthreads];
         if (!j->ok[i]) return 0;
         h = sw_fnv1a(h, &j->hash[i], sizeof j->hash[i]);
     }
@@ -131,7 +181,7 @@ TEST(surface_hash_is_golden_on_1_2_4_threads) {
     static const int threads[] = {1, 2, 4};
     uint64_t h[3];
     for (int t = 0; t < 3; ++t) {
-        h[t] = hash_on_threads(&f, threads[t]);
+        h[t] = hash_on_threads(&f, 0, NINST, threads[t]);
         fprintf(stderr, "  %d threads: surface hash 0x%016llx\n", threads[t],
                 (unsigned long long)h[t]);
     }
@@ -142,4 +192,26 @@ TEST(surface_hash_is_golden_on_1_2_4_threads) {
             (unsigned long long)h[0], (unsigned long long)GOLDEN_SURFACE_HASH);
 }
 
-SW_TEST_MAIN(CASE(surface_hash_is_golden_on_1_2_4_threads))
+/* The step's other paths, each an instance: exhaustive and pose-pairs self-contact, a
+ * condensation patch against the props (a mesh and a hull), and the character turned
+ * 130 degrees and carried away (what the pose-space lookups must not notice). */
+TEST(surface_hash_of_every_mode_is_golden) {
+    bake_fixture f;
+    ENSURE(bake_fixture_make(&f, "finger", 2000, 12, 1));
+    sinew_world_def wd = sinew_world_def_default();
+    sinew_collider_id tent, wedge;
+    ENSURE(sinew_world_create(&wd, &props_world) == SINEW_OK &&
+           props_add(props_world, 2.2f, 1.2f, &tent, &wedge));
+    uint64_t h1 = hash_on_threads(&f, NINST, NMODES, 1), h2 = hash_on_threads(&f, NINST, NMODES, 2);
+    fprintf(stderr, "  modes: surface hash 0x%016llx (1 thread), 0x%016llx (2)\n",
+            (unsigned long long)h1, (unsigned long long)h2);
+    sinew_world_destroy(props_world);
+    bake_fixture_free(&f);
+    ENSURE(h1 != 0);
+    ENSUREF(h2 == h1, "the hash depends on the thread count");
+    ENSUREF(h1 == GOLDEN_MODES_HASH, "surface hash 0x%016llx, golden 0x%016llx",
+            (unsigned long long)h1, (unsigned long long)GOLDEN_MODES_HASH);
+}
+
+SW_TEST_MAIN(CASE(surface_hash_is_golden_on_1_2_4_threads),
+             CASE(surface_hash_of_every_mode_is_golden))
