@@ -105,26 +105,6 @@ TEST(a_uniformly_scaled_pose_gives_the_scaled_shape) {
 
 /* ---- a world of every collider shape, and the same world carried by G ------------- */
 
-static void carry(const double G[12], const float p[3], float out[3]) {
-    for (int i = 0; i < 3; ++i)
-        out[i] = (float)(G[3 * i] * p[0] + G[3 * i + 1] * p[1] + G[3 * i + 2] * p[2] + G[9 + i]);
-}
-
-/* The quaternion (w, x, y, z) of G's rotation times q. */
-static void carry_rotation(const double G[12], const float q[4], float out[4]) {
-    double tr = G[0] + G[4] + G[8], g[4];
-    g[0] = 0.5 * sqrt(fmax(0, 1 + tr));
-    double s = g[0] > 1e-6 ? 0.25 / g[0] : 0;
-    g[1] = (G[7] - G[5]) * s, g[2] = (G[2] - G[6]) * s, g[3] = (G[3] - G[1]) * s;
-    if (!(g[0] > 1e-6)) { /* (the test's turns are below 180 degrees) */
-        g[0] = 1, g[1] = g[2] = g[3] = 0;
-    }
-    out[0] = (float)(g[0] * q[0] - g[1] * q[1] - g[2] * q[2] - g[3] * q[3]);
-    out[1] = (float)(g[0] * q[1] + g[1] * q[0] + g[2] * q[3] - g[3] * q[2]);
-    out[2] = (float)(g[0] * q[2] - g[1] * q[3] + g[2] * q[0] + g[3] * q[1]);
-    out[3] = (float)(g[0] * q[3] + g[1] * q[2] - g[2] * q[1] + g[3] * q[0]);
-}
-
 /* Colliders pressing the folding finger from every side, carried by G (NULL: as they
  * are). Each kind of shape is there once: box (a table), sphere, capsule, a plane, a
  * triangle mesh (a tent) and a convex hull. */
@@ -149,22 +129,8 @@ static sinew_world *shape_world(const double *G) {
     c[4] = props_def(0, props_at(2.2f, 0.65f)); /* props_fixture.h: the tent */
     c[5] = props_def(1, props_at(0.6f, 0));     /* and the wedge, beside the root */
     c[5].transform.position[2] = 0.6f;
-    for (int k = 0; k < 6 && G; ++k) {
-        if (c[k].shape == SINEW_SHAPE_PLANE) { /* n' = R n, offset' = n' . (G p0) */
-            float n[3] = {c[k].normal[0], c[k].normal[1], c[k].normal[2]}, p0[3];
-            float p[3] = {n[0] * c[k].offset, n[1] * c[k].offset, n[2] * c[k].offset};
-            double Rg[12];
-            memcpy(Rg, G, sizeof Rg);
-            Rg[9] = Rg[10] = Rg[11] = 0;
-            carry(Rg, n, c[k].normal);
-            carry(G, p, p0);
-            c[k].offset = c[k].normal[0] * p0[0] + c[k].normal[1] * p0[1] + c[k].normal[2] * p0[2];
-            continue;
-        }
-        sinew_transform t = c[k].transform;
-        carry(G, t.position, c[k].transform.position);
-        carry_rotation(G, t.rotation, c[k].transform.rotation);
-    }
+    for (int k = 0; k < 6 && G; ++k)
+        sw_move_collider(G, &c[k]);
     for (int k = 0; k < 6; ++k) {
         sinew_collider_id id;
         if (sinew_world_add_collider(w, &c[k], &id) != SINEW_OK) {

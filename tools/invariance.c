@@ -28,6 +28,49 @@ void sw_move_transform(const sw_move *m, int32_t f, double G[12]) {
     }
 }
 
+/* G (R, t) applied to p: R p, plus t when `point`. */
+static void carry_float(const double G[12], const float p[3], int point, float out[3]) {
+    for (int i = 0; i < 3; ++i)
+        out[i] = (float)(G[3 * i] * p[0] + G[3 * i + 1] * p[1] + G[3 * i + 2] * p[2] +
+                         (point ? G[9 + i] : 0));
+}
+
+void sw_move_collider(const double G[12], sinew_collider_def *c) {
+    if (c->shape == SINEW_SHAPE_PLANE) { /* n' = R n, offset' = n' . (G p0), p0 = offset n */
+        float n[3] = {c->normal[0], c->normal[1], c->normal[2]}, p0[3];
+        float p[3] = {n[0] * c->offset, n[1] * c->offset, n[2] * c->offset};
+        carry_float(G, n, 0, c->normal);
+        carry_float(G, p, 1, p0);
+        c->offset = c->normal[0] * p0[0] + c->normal[1] * p0[1] + c->normal[2] * p0[2];
+        return;
+    }
+    sinew_transform t = c->transform;
+    carry_float(G, t.position, 1, c->transform.position);
+    /* the quaternion of G's rotation (Shepperd: from its largest component), times q */
+    const double tr = G[0] + G[4] + G[8];
+    double g[4];
+    if (tr >= G[0] && tr >= G[4] && tr >= G[8]) {
+        double r = 2 * sqrt(1 + tr);
+        g[0] = r / 4, g[1] = (G[7] - G[5]) / r, g[2] = (G[2] - G[6]) / r, g[3] = (G[3] - G[1]) / r;
+    } else {
+        int k = G[0] >= G[4] && G[0] >= G[8] ? 0
+                : G[4] >= G[8]               ? 1
+                                             : 2,
+            i = (k + 1) % 3, j = (k + 2) % 3;
+        double r = 2 * sqrt(1 + G[4 * k] - G[4 * i] - G[4 * j]);
+        g[1 + k] = r / 4;
+        g[0] = (G[3 * j + i] - G[3 * i + j]) / r;
+        g[1 + i] = (G[3 * i + k] + G[3 * k + i]) / r;
+        g[1 + j] = (G[3 * j + k] + G[3 * k + j]) / r;
+    }
+    const float *q = t.rotation;
+    float *o = c->transform.rotation;
+    o[0] = (float)(g[0] * q[0] - g[1] * q[1] - g[2] * q[2] - g[3] * q[3]);
+    o[1] = (float)(g[0] * q[1] + g[1] * q[0] + g[2] * q[3] - g[3] * q[2]);
+    o[2] = (float)(g[0] * q[2] - g[1] * q[3] + g[2] * q[0] + g[3] * q[1]);
+    o[3] = (float)(g[0] * q[3] + g[1] * q[2] - g[2] * q[1] + g[3] * q[0]);
+}
+
 static double move_scale(const sw_move *m) {
     return (m->kind == SW_MOVE_SCALE || m->kind == SW_MOVE_ACTOR) && m->scale > 0 ? m->scale : 1;
 }
@@ -144,6 +187,7 @@ sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, i
         out->world_contacts += st.world_contacts;
         out->self_contacts += st.self_contacts;
         if (st.patch_vertices > out->patch_vertices) out->patch_vertices = st.patch_vertices;
+        out->unconverged += !(st.status & SINEW_STEP_CONVERGED);
         read_surface(a, ns, m->float_output, fs, xa);
         read_surface(b, ns, m->float_output, fs, xb);
         double worst = 0;

@@ -55,10 +55,16 @@ typedef struct sw_invariance_result {
     int64_t world_contacts;  /* the first instance's, summed over the frames */
     int64_t self_contacts;   /* the same of its self-contact pairs */
     uint32_t patch_vertices; /* its largest condensation patch */
+    int32_t unconverged;     /* its steps that ended short of the solve's tolerance */
 } sw_invariance_result;
 
 /* The rigid part of a move at frame f as a transform (12: R row-major, t). */
 void sw_move_transform(const sw_move *m, int32_t f, double G[12]);
+
+/* Carries collider def c by the rigid transform G (12): its placement, or a plane's normal
+ * and offset (a plane has no placement). Float placements round at 1e-7 of their
+ * distance from the origin. */
+void sw_move_collider(const double G[12], sinew_collider_def *c);
 
 /* Plays frames of `clip` (12 doubles a bone a frame, nb bones) in two instances of blob,
  * the second carried by m, and measures *out. */

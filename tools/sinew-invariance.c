@@ -3,7 +3,7 @@
  *
  *   sinew-invariance (FILE.glb [--tets N] ... | --scene NAME [--tets N] [--frames F] |
  *                     --mesh ... as sinew-bake) --blob FILE [--frames-max K] [--seed S]
- *                    [--reach D] [--json]
+ *                    [--reach D] [--angle A] [--world FILE] [--json]
  *
  * Plays the character's clip (and a glTF/FBX FILE's held-out clips after it, at most K
  * frames in all, default 120) in two instances of the blob, the second carried by a
@@ -16,6 +16,11 @@
  * one random rigid motion far_actor        the actor D units from the origin, turned
  * (sinew_instance_set_actor), float poses in its frame, the float surface read in its frame
  *   scale_0.01, scale_100  the pose scaled uniformly (float poses and surface)
+ * With --world FILE (a world file, samples/worlds) also, its colliders held at their
+ * frame-0 placements and, for the second instance, carried by the motion too (a rigid
+ * motion of the same turn moved by at most 10 units: float collider placements):
+ *   world_quasistatic, world_dynamic, world_patch  quasistatic, dynamic, and quasistatic
+ *                    with condensation patches (a budget of a quarter of the vertices)
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <math.h>
 #include <stdio.h>
@@ -26,6 +31,7 @@
 #include "tool_common.h"
 
 #include "invariance.h"
+#include "world_io.h"
 
 static const char *const TOOL = "sinew-invariance";
 
@@ -43,6 +49,10 @@ static void usage(FILE *f) {
                "  --seed S          the random motions' seed, 1..2^31 (default 1)\n"
                "  --reach D         the rigid motions' and the actor's translation, up to D\n"
                "                    units on each axis, 0..1e7 (default 1e5)\n"
+               "  --angle A         the rigid motions' turn, degrees (default: random in 90..180;\n"
+               "                    a tiny one tells rounding's effect from the heading's)\n"
+               "  --world FILE      also with this world file's colliders (at frame 0), carried\n"
+               "                    by the motion: world_quasistatic, world_dynamic, world_patch\n"
                "  --json            the figures as one JSON object on the last line\n");
 }
 
@@ -72,6 +82,31 @@ typedef struct {
     sw_invariance_result res;
 } row;
 
+/* The world file's colliders at frame 0 into *w, and carried by m's motion into *wm. */
+static int load_worlds(const char *path, const sw_move *m, sinew_world **w, sinew_world **wm) {
+    sw_world_file f;
+    sw_error err;
+    sw_error_clear(&err);
+    if (sw_world_file_read(path, &f, &err) != SINEW_OK) {
+        fprintf(stderr, "%s: %s\n", TOOL, err.msg);
+        return 0;
+    }
+    double G[12];
+    sw_move_transform(m, 0, G);
+    sinew_world_def wd = sinew_world_def_default();
+    int ok = sinew_world_create(&wd, w) == SINEW_OK && sinew_world_create(&wd, wm) == SINEW_OK;
+    for (int32_t c = 0; ok && c < f.ncolliders; ++c) {
+        sinew_collider_def d = f.colliders[c].def;
+        sinew_collider_id id;
+        ok = sinew_world_add_collider(*w, &d, &id) == SINEW_OK;
+        sw_move_collider(G, &d);
+        ok = ok && sinew_world_add_collider(*wm, &d, &id) == SINEW_OK;
+    }
+    sw_world_file_free(&f);
+    if (!ok) fprintf(stderr, "%s: %s: the world's colliders could not be built\n", TOOL, path);
+    return ok;
+}
+
 /* The clip the runs play: the character's, then a FILE's held-out clips, at most kmax
  * frames (malloc'd, *frames set). */
 static double *play_clip(const sw_character *ch, const sw_clip_split *clips, int kmax,
@@ -92,9 +127,9 @@ static double *play_clip(const sw_character *ch, const sw_clip_split *clips, int
 int main(int argc, char **argv) {
     sw_character_args ca;
     sw_character_args_init(&ca, TOOL);
-    const char *blob_path = NULL;
+    const char *blob_path = NULL, *world_path = NULL;
     int kmax = 120, seed = 1, json = 0, ok = 1;
-    double far = 1e5;
+    double far = 1e5, angle = -1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
         if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), 0;
@@ -102,12 +137,17 @@ int main(int argc, char **argv) {
             if (!ok) return 2;
         } else if (!strcmp(a, "--json")) {
             json = 1;
+        } else if (!strcmp(a, "--world") && next) {
+            world_path = argv[++i];
         } else if (!strcmp(a, "--blob") && next) {
             blob_path = argv[++i];
         } else if (!strcmp(a, "--frames-max") && next) {
             if (!sw_tool_int(TOOL, a, argv[++i], 1, 100000, &kmax)) return 2;
         } else if (!strcmp(a, "--reach") && next) {
             if (!sw_tool_real(TOOL, a, argv[++i], -1e-300, 1e7, "in 0 <= D <= 1e7", &far)) return 2;
+        } else if (!strcmp(a, "--angle") && next) {
+            if (!sw_tool_real(TOOL, a, argv[++i], 0, 180.0000001, "in 0 < A <= 180", &angle))
+                return 2;
         } else if (!strcmp(a, "--seed") && next) {
             if (!sw_tool_int(TOOL, a, argv[++i], 1, 2147483647, &seed)) return 2;
         } else {
@@ -139,33 +179,50 @@ int main(int argc, char **argv) {
     sw_move rigid = random_rigid(far), turning = random_rigid(0), actor = random_rigid(far),
             s_small = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 0.01, 1, 1},
             s_big = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 100, 1, 1};
+    if (angle > 0) rigid.angle = actor.angle = angle * 3.141592653589793 / 180;
     turning.kind = SW_MOVE_TURNING;
     turning.angle = 4 * 3.141592653589793 / 180;
     for (int k = 0; k < 3; ++k) /* walking away: a tenth of a unit a frame */
         turning.shift[k] = 0.1 * (2 * urand() - 1);
     actor.kind = SW_MOVE_ACTOR;
     actor.float_poses = actor.float_output = 1;
+    sinew_world *world = NULL, *moved = NULL;
+    sw_move near = rigid;
+    for (int k = 0; k < 3; ++k) /* float collider placements: within 10 units */
+        near.shift[k] = fmax(-10, fmin(10, near.shift[k]));
+    if (world_path && !load_worlds(world_path, &near, &world, &moved)) return 1;
+    uint32_t quarter = sinew_blob_surface_vertex_count(blob) / 4 + 1;
     struct {
         const char *name;
         sinew_step_mode mode;
         sinew_self_contact sc;
         const sw_move *m;
+        const sinew_world *w, *wm;
+        uint32_t patch;
     } cases[] = {
-        {"rigid_pose_space", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_SPACE, &rigid},
-        {"rigid_pose_pairs", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_PAIRS, &rigid},
-        {"rigid_exhaustive", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_EXHAUSTIVE, &rigid},
-        {"turning", SINEW_STEP_QUASISTATIC, 0, &turning},
-        {"dynamic", SINEW_STEP_DYNAMIC, 0, &rigid},
-        {"far_actor", SINEW_STEP_QUASISTATIC, 0, &actor},
-        {"scale_0.01", SINEW_STEP_QUASISTATIC, 0, &s_small},
-        {"scale_100", SINEW_STEP_QUASISTATIC, 0, &s_big},
+        {"rigid_pose_space", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_SPACE, &rigid, NULL,
+         NULL, 0},
+        {"rigid_pose_pairs", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_PAIRS, &rigid, NULL,
+         NULL, 0},
+        {"rigid_exhaustive", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_EXHAUSTIVE, &rigid, NULL,
+         NULL, 0},
+        {"turning", SINEW_STEP_QUASISTATIC, 0, &turning, NULL, NULL, 0},
+        {"dynamic", SINEW_STEP_DYNAMIC, 0, &rigid, NULL, NULL, 0},
+        {"far_actor", SINEW_STEP_QUASISTATIC, 0, &actor, NULL, NULL, 0},
+        {"scale_0.01", SINEW_STEP_QUASISTATIC, 0, &s_small, NULL, NULL, 0},
+        {"scale_100", SINEW_STEP_QUASISTATIC, 0, &s_big, NULL, NULL, 0},
+        {"world_quasistatic", SINEW_STEP_QUASISTATIC, 0, &near, world, moved, 0},
+        {"world_dynamic", SINEW_STEP_DYNAMIC, 0, &near, world, moved, 0},
+        {"world_patch", SINEW_STEP_QUASISTATIC, 0, &near, world, moved, quarter},
     };
     enum { NCASES = sizeof cases / sizeof cases[0] };
     row rows[NCASES];
     double worst = 0;
     long failed = 0;
-    for (int c = 0; c < NCASES; ++c) {
-        sw_invariance_run run = {cases[c].mode, cases[c].sc, NULL, NULL, dt, 0};
+    int ncases = world ? NCASES : NCASES - 3;
+    for (int c = 0; c < ncases; ++c) {
+        sw_invariance_run run = {cases[c].mode, cases[c].sc, cases[c].w,
+                                 cases[c].wm,   dt,          cases[c].patch};
         rows[c].name = cases[c].name;
         r = sw_invariance_measure(blob, clip, nb, frames, &run, cases[c].m, &rows[c].res);
         if (r != SINEW_OK) {
@@ -175,18 +232,23 @@ int main(int argc, char **argv) {
         }
         worst = fmax(worst, rows[c].res.err);
         failed += rows[c].res.failed;
-        fprintf(stderr, "%s: %-18s %.3e of the size (frame %d of %d), %d failed steps\n", TOOL,
-                cases[c].name, rows[c].res.err, rows[c].res.worst_frame, frames,
-                rows[c].res.failed);
+        fprintf(stderr,
+                "%s: %-18s %.3e of the size (frame %d of %d), %d failed steps, %d short of "
+                "tolerance, %lld world contacts, largest patch %u\n",
+                TOOL, cases[c].name, rows[c].res.err, rows[c].res.worst_frame, frames,
+                rows[c].res.failed, rows[c].res.unconverged, (long long)rows[c].res.world_contacts,
+                rows[c].res.patch_vertices);
     }
     if (json) {
         printf("{\"frames\":%d,\"size\":%.9g,\"worst\":%.4e,\"failed_steps\":%ld", frames,
                rows[0].res.size, worst, failed);
-        for (int c = 0; c < NCASES; ++c)
+        for (int c = 0; c < ncases; ++c)
             printf(",\"%s\":%.4e", rows[c].name, rows[c].res.err);
         printf("}\n");
     }
     free(clip);
+    sinew_world_destroy(world);
+    sinew_world_destroy(moved);
     sinew_blob_destroy(blob);
     sw_clip_split_free(&clips);
     sw_character_free(&ch);
