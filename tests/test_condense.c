@@ -378,6 +378,50 @@ TEST(condensation_dents_where_the_subspace_locks_closer_to_the_reference) {
     sinew_world_destroy(w);
 }
 
+/* A patch that covers the whole mesh (radius the whole diagonal, a budget of every vertex)
+ * is the full-space problem: pressed into the table, its solution converges to the
+ * reference's, where the subspace alone misses much of the dent. */
+TEST(a_whole_mesh_patch_converges_to_the_reference) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(0.08, 0.0f, &id);
+    const uint32_t nv = (uint32_t)f->ch.mesh.nverts;
+    sinew_instance *sub = pressed(f, w, 0, 3), *whole = pressed_rho(f, w, nv, 3, 1.0);
+    ENSURE(sub && whole);
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.world = w;
+    sw_fullsim *sim;
+    sw_error err;
+    ENSURE(sw_fullsim_create(&f->ch, &p, &sim, &err) == SINEW_OK);
+    int nb = f->ch.skel.nbones;
+    double *T = calloc((size_t)12 * nb, sizeof(double));
+    ENSURE(T);
+    for (int b = 0; b < nb; ++b)
+        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    sw_fullsim_stats fs;
+    ENSURE(sw_fullsim_step(sim, T, &fs) == SINEW_OK);
+    const double *xr = sw_fullsim_positions(sim), *mass = sw_fullsim_masses(sim);
+    double e_sub = correction_error(sub, xr, mass), e_whole = correction_error(whole, xr, mass);
+    sinew_step_stats st = {.struct_size = sizeof st};
+    sinew_instance_get_stats(whole, &st);
+    int32_t pinned = 0;
+    for (uint32_t v = 0; v < nv; ++v)
+        pinned += f->ch.bone_of_vertex[v] >= 0;
+    fprintf(stderr,
+            "    error vs reference: subspace %.4f, whole-mesh patch %.4f (%u of %u vertices, "
+            "%d pinned to bones; %s)\n",
+            e_sub, e_whole, st.patch_vertices, nv, pinned,
+            st.status & SINEW_STEP_CONVERGED ? "converged" : "not converged");
+    ENSURE(st.patch_vertices + (uint32_t)pinned == nv); /* every free vertex */
+    ENSURE(e_whole < 0.02 && e_whole < 0.1 * e_sub);
+    free(T);
+    sw_fullsim_destroy(sim);
+    sinew_instance_destroy(sub);
+    sinew_instance_destroy(whole);
+    sinew_world_destroy(w);
+}
+
 TEST(without_contact_a_condensed_instance_is_bitwise_the_subspace) {
     const bake_fixture *f = fixture();
     ENSURE(f);
@@ -610,5 +654,6 @@ SW_TEST_MAIN(CASE(coupled_gradient_matches_finite_differences_and_its_hessian_is
              CASE(condensed_steps_allocate_and_lock_nothing_while_the_patch_moves),
              CASE(dynamic_patch_gradient_and_the_dynamics_oracle),
              CASE(patch_def_is_checked_and_sized),
+             CASE(a_whole_mesh_patch_converges_to_the_reference),
              CASE(a_patch_grows_moves_and_shrinks_for_ten_thousand_steps_allocating_nothing),
              CASE(release_fixture))
