@@ -93,7 +93,7 @@
 #include <stdint.h>
 
 #define SINEW_BLOB_MAGIC "SINEWBLB" /* 8 bytes, no terminator in the file */
-#define SINEW_BLOB_VERSION 2u /* 2: pose features measure roots from the first root */
+#define SINEW_BLOB_VERSION 2u       /* 2: pose features measure roots from the first root */
 #define SINEW_BLOB_ALIGN 64u
 #define SINEW_BLOB_ENDIAN_TAG 0x01020304u
 
