@@ -441,6 +441,27 @@ static double correction_error(const sinew_instance *in, const double *xr, const
     return sqrt(num / den);
 }
 
+/* The full-space reference with world w, stepped once at the rest pose (NULL on failure;
+ * *fs its figures). */
+static sw_fullsim *reference_at_rest(const bake_fixture *f, sinew_world *w, sw_fullsim_stats *fs) {
+    sw_fullsim_params p = sw_fullsim_params_default();
+    p.world = w;
+    sw_fullsim *sim;
+    sw_error err;
+    if (sw_fullsim_create(&f->ch, &p, &sim, &err) != SINEW_OK) return NULL;
+    int nb = f->ch.skel.nbones;
+    double *T = calloc((size_t)12 * nb, sizeof(double));
+    for (int b = 0; T && b < nb; ++b)
+        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
+    sinew_result r = T ? sw_fullsim_step(sim, T, fs) : SINEW_ERROR_OUT_OF_MEMORY;
+    free(T);
+    if (r != SINEW_OK) {
+        sw_fullsim_destroy(sim);
+        return NULL;
+    }
+    return sim;
+}
+
 TEST(condensation_dents_where_the_subspace_locks_closer_to_the_reference) {
     const bake_fixture *f = fixture();
     ENSURE(f);
@@ -448,17 +469,9 @@ TEST(condensation_dents_where_the_subspace_locks_closer_to_the_reference) {
     sinew_world *w = table_world(0.08, 0.0f, &id);
     sinew_instance *sub = pressed(f, w, 0, 3), *cond = pressed(f, w, 3000, 3);
     ENSURE(sub && cond);
-    sw_fullsim_params p = sw_fullsim_params_default();
-    p.world = w;
-    sw_fullsim *sim;
-    sw_error err;
-    ENSURE(sw_fullsim_create(&f->ch, &p, &sim, &err) == SINEW_OK);
-    int nb = f->ch.skel.nbones;
-    double *T = calloc((size_t)12 * nb, sizeof(double));
-    for (int b = 0; b < nb; ++b)
-        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
     sw_fullsim_stats fs;
-    ENSURE(sw_fullsim_step(sim, T, &fs) == SINEW_OK);
+    sw_fullsim *sim = reference_at_rest(f, w, &fs);
+    ENSURE(sim);
     const double *xr = sw_fullsim_positions(sim), *mass = sw_fullsim_masses(sim);
     double e_sub = correction_error(sub, xr, mass), e_cond = correction_error(cond, xr, mass);
     int32_t ns = sub->v->nsurf_verts;
@@ -474,7 +487,6 @@ TEST(condensation_dents_where_the_subspace_locks_closer_to_the_reference) {
     ENSURE(st.patch_vertices > 0 && st.pcg_iterations > 0);
     ENSURE(e_cond < 0.6 * e_sub);
     ENSURE(pen_cond < 0.3 * pen_sub);
-    free(T);
     sw_fullsim_destroy(sim);
     sinew_instance_destroy(sub);
     sinew_instance_destroy(cond);
@@ -492,18 +504,9 @@ TEST(a_whole_mesh_patch_converges_to_the_reference) {
     const uint32_t nv = (uint32_t)f->ch.mesh.nverts;
     sinew_instance *sub = pressed(f, w, 0, 3), *whole = pressed_rho(f, w, nv, 3, 1.0);
     ENSURE(sub && whole);
-    sw_fullsim_params p = sw_fullsim_params_default();
-    p.world = w;
-    sw_fullsim *sim;
-    sw_error err;
-    ENSURE(sw_fullsim_create(&f->ch, &p, &sim, &err) == SINEW_OK);
-    int nb = f->ch.skel.nbones;
-    double *T = calloc((size_t)12 * nb, sizeof(double));
-    ENSURE(T);
-    for (int b = 0; b < nb; ++b)
-        T[12 * b] = T[12 * b + 4] = T[12 * b + 8] = 1;
     sw_fullsim_stats fs;
-    ENSURE(sw_fullsim_step(sim, T, &fs) == SINEW_OK);
+    sw_fullsim *sim = reference_at_rest(f, w, &fs);
+    ENSURE(sim);
     const double *xr = sw_fullsim_positions(sim), *mass = sw_fullsim_masses(sim);
     double e_sub = correction_error(sub, xr, mass), e_whole = correction_error(whole, xr, mass);
     sinew_step_stats st = {.struct_size = sizeof st};
@@ -518,7 +521,6 @@ TEST(a_whole_mesh_patch_converges_to_the_reference) {
             st.status & SINEW_STEP_CONVERGED ? "converged" : "not converged");
     ENSURE(st.patch_vertices + (uint32_t)pinned == nv); /* every free vertex */
     ENSURE(e_whole < 0.02 && e_whole < 0.1 * e_sub);
-    free(T);
     sw_fullsim_destroy(sim);
     sinew_instance_destroy(sub);
     sinew_instance_destroy(whole);

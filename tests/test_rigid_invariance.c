@@ -257,6 +257,7 @@ TEST(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it) {
     sinew_world_def wd = sinew_world_def_default();
     ENSURE(sinew_world_create(&wd, &w) == SINEW_OK);
     double I[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    ENSURE(sinew_instance_set_world(in, w) == SINEW_ERROR_INVALID_ARGUMENT); /* scaled 2 */
     ENSURE(sinew_instance_set_actor(in, I) == SINEW_OK);
     ENSURE(sinew_instance_set_world(in, w) == SINEW_OK);
     A[0] = 2;

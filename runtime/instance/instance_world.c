@@ -4,9 +4,17 @@
 
 #include "collision.h"
 #include "instance_internal.h"
+#include "log.h"
 
 SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sinew_world *world) {
     if (!inst) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (world && inst->scale != 1) { /* the world's queries are in its own units (pose.c) */
+        sw_log(&inst->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_POSE,
+               "sinew_instance_set_world: the actor is scaled %.6g; a collision world with a "
+               "scaled actor is not simulated yet",
+               inst->scale);
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    }
     inst->wc.world = world;
     /* the world's contact reads the surface copies (instance.c's active vertices) */
     inst->red.skin_surface = world != NULL || inst->v->nrender_verts == 0;

@@ -146,7 +146,9 @@ SINEW_API sinew_result sinew_world_set_collider_transform(sinew_world *world, si
 SINEW_API uint32_t sinew_world_collider_count(const sinew_world *world);
 
 /** Lets the instance collide with `world` from its next step on (NULL detaches). The
- * world must outlive the attachment. Owner thread of the instance; never while it steps. */
+ * world must outlive the attachment. The world is in world units: an actor scaled by
+ * sinew_instance_set_actor or a scaled pose is refused (INVALID_ARGUMENT) for now. Owner
+ * thread of the instance; never while it steps. */
 SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sinew_world *world);
 
 /** The total force and the torque about the collider's origin (its transform's position)
