@@ -20,13 +20,10 @@ typedef struct {
     sinew_blob *blob;
 } bake_fixture;
 
-/* Bakes `sample` at about `tets` tets with a clip of `frames` frames and bake parameters
- * p, writes and loads the blob. 1 on success. */
-static inline int bake_fixture_make_params(bake_fixture *f, const char *sample, int tets,
-                                           int frames, const sw_bake_params *p) {
+/* Bakes the character f->ch with bake parameters p, writes and loads the blob. 1 on
+ * success. */
+static inline int bake_fixture_bake(bake_fixture *f, const sw_bake_params *p) {
     sw_error err;
-    memset(f, 0, sizeof *f);
-    if (sw_sample_make(sample, tets, frames, &f->ch, &err) != SINEW_OK) return 0;
     if (sw_bake(&f->ch, p, &f->res, &err) != SINEW_OK) {
         fprintf(stderr, "bake failed: %s\n", err.msg);
         return 0;
@@ -36,6 +33,16 @@ static inline int bake_fixture_make_params(bake_fixture *f, const char *sample, 
     d.data = f->data;
     d.data_size = f->size;
     return sinew_blob_load(&d, &f->blob) == SINEW_OK;
+}
+
+/* Bakes `sample` at about `tets` tets with a clip of `frames` frames and bake parameters
+ * p (bake_fixture_bake). 1 on success. */
+static inline int bake_fixture_make_params(bake_fixture *f, const char *sample, int tets,
+                                           int frames, const sw_bake_params *p) {
+    sw_error err;
+    memset(f, 0, sizeof *f);
+    if (sw_sample_make(sample, tets, frames, &f->ch, &err) != SINEW_OK) return 0;
+    return bake_fixture_bake(f, p);
 }
 
 /* The fixture's quick bake parameters: 3 samples a joint sweep, 8 clip frames, `threads`
