@@ -102,7 +102,8 @@ SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst);
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt);
 
 /** Copies the output surface of the last step into host buffers of `vertex_count`
- * (= sinew_blob_surface_vertex_count) xyz triples; either buffer may be NULL. */
+ * (= sinew_blob_surface_vertex_count) xyz triples, in the actor's frame (the world's when
+ * no actor transform was set); either buffer may be NULL. */
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
                                                    float *normals, uint32_t vertex_count);
 
