@@ -269,8 +269,9 @@ TEST(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it) {
 }
 
 /* A real character: the elephant (24 bones, its own clip), baked quickly, turned and carried
- * 10^5 units away, quasistatic and dynamic, as a far actor and scaled. (Its exhaustive and
- * pose-pairs modes amplify rounding itself to 1e-2 of its size: docs/notes/placement.md.) */
+ * 10^5 units away, quasistatic (pose-space and pose-pairs) and dynamic, as a far actor and
+ * scaled. (Its exhaustive mode amplifies rounding itself to 1e-2 of its size:
+ * docs/notes/placement.md.) */
 TEST(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh) {
     NEED_DATA("elephant-cd/elephant.mesh");
     bake_fixture e;
@@ -288,13 +289,15 @@ TEST(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh) {
     const struct {
         const char *name;
         sinew_step_mode mode;
+        sinew_self_contact sc;
         const sw_move *m;
-    } cases[] = {{"quasistatic", SINEW_STEP_QUASISTATIC, &rigid},
-                 {"dynamic", SINEW_STEP_DYNAMIC, &rigid},
-                 {"far actor", SINEW_STEP_QUASISTATIC, &actor},
-                 {"scale 0.01", SINEW_STEP_QUASISTATIC, &scaled}};
-    for (int k = 0; k < 4; ++k) {
-        sw_invariance_run run = {cases[k].mode, 0, NULL, NULL, 0.01f, 0};
+    } cases[] = {{"quasistatic", SINEW_STEP_QUASISTATIC, 0, &rigid},
+                 {"pose-pairs", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_PAIRS, &rigid},
+                 {"dynamic", SINEW_STEP_DYNAMIC, 0, &rigid},
+                 {"far actor", SINEW_STEP_QUASISTATIC, 0, &actor},
+                 {"scale 0.01", SINEW_STEP_QUASISTATIC, 0, &scaled}};
+    for (int k = 0; k < 5; ++k) {
+        sw_invariance_run run = {cases[k].mode, cases[k].sc, NULL, NULL, 0.01f, 0};
         sw_invariance_result res;
         ENSURE(sw_invariance_measure(e.blob, e.ch.clip.T, e.ch.skel.nbones, e.ch.clip.nframes, &run,
                                      cases[k].m, &res) == SINEW_OK);

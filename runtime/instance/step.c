@@ -178,8 +178,13 @@ static void pose_space_start(sinew_instance *in) {
     const double *q1 =
         v->train_q + (size_t)R * (in->ps.blend == 0 ? in->ps.nearest : in->ps.second);
     double b = in->ps.blend;
-    /* the last pose nearer than every training pose (s->q holds q_n) */
-    int offset = s->pred_valid && in->pose.history >= 1 && in->ps.d_last < in->ps.d_nearest;
+    /* the last pose nearer than every training pose (s->q holds q_n). Not where the step
+       detects self-contact (exhaustive, pose-pairs): a vertex on the edge of contact makes
+       the step's answer jump with rounding, and the offset would carry every such jump
+       into all later frames, so that a character turned by 1e-12 degrees ends a clip with
+       another shape; from the prediction alone the shape is the pose's. */
+    int offset = s->pred_valid && in->pose.history >= 1 && in->ps.d_last < in->ps.d_nearest &&
+                 in->self_mode == SINEW_SELF_CONTACT_POSE_SPACE;
     for (int32_t i = 0; i < R; ++i) {
         double p = b == 0 ? q0[i] : (1 - b) * q0[i] + b * q1[i];
         s->q[i] = offset ? p + (s->q[i] - s->q_pred[i]) : p;
