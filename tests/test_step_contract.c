@@ -657,9 +657,61 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
              unseen, VARIANT);
 }
 
+/* Through the library a host links (libsinew.so in test_step_contract_shared): an actor
+ * turned 120 degrees, 10^5 units from the origin and scaled 2, its bones handed in as
+ * floats in its own frame, gives in its frame the surface of an actor at the origin, to
+ * 1e-5 of the character's size; a paused frame (dt = 0) changes nothing. */
+TEST(an_actor_far_turned_and_scaled_reads_the_same_surface_in_its_frame) {
+    const contract_fixture *f = fixture();
+    ENSURE(f);
+    sinew_instance *a = NULL, *b = NULL;
+    ENSURE(sinew_instance_create(f->blob, NULL, &a) == SINEW_OK &&
+           sinew_instance_create(f->blob, NULL, &b) == SINEW_OK);
+    const double c = -0.5, s = 0.8660254037844386; /* 120 degrees about z, scaled 2 */
+    const double actor[12] = {2 * c, -2 * s, 0, 2 * s, 2 * c, 0, 0, 0, 2, 1e5, -7e4, 3e4};
+    ENSURE(sinew_instance_set_actor(b, actor) == SINEW_OK);
+    float *xa = malloc(sizeof(float) * 3 * f->ns), *xb = malloc(sizeof(float) * 3 * f->ns);
+    ENSURE(xa && xb);
+    double worst = 0, size = 0;
+    for (int k = 0; k < f->frames; ++k) {
+        ENSURE(sinew_instance_set_pose(a, clip_pose(f, k), f->nb) == SINEW_OK);
+        ENSURE(sinew_instance_set_pose(b, clip_pose(f, k), f->nb) == SINEW_OK);
+        ENSURE(sinew_instance_step(a, 1.0f / 30) == SINEW_OK);
+        ENSURE(sinew_instance_step(b, 1.0f / 30) == SINEW_OK);
+        ENSURE(sinew_instance_read_surface(a, xa, NULL, f->ns) == SINEW_OK);
+        ENSURE(sinew_instance_read_surface(b, xb, NULL, f->ns) == SINEW_OK);
+        if (k == 0) { /* the size: the first surface's bounding-box diagonal */
+            float lo[3] = {xa[0], xa[1], xa[2]}, hi[3] = {xa[0], xa[1], xa[2]};
+            for (uint32_t i = 0; i < 3 * f->ns; ++i) {
+                lo[i % 3] = fminf(lo[i % 3], xa[i]);
+                hi[i % 3] = fmaxf(hi[i % 3], xa[i]);
+            }
+            size = sqrt((double)(hi[0] - lo[0]) * (hi[0] - lo[0]) +
+                        (double)(hi[1] - lo[1]) * (hi[1] - lo[1]) +
+                        (double)(hi[2] - lo[2]) * (hi[2] - lo[2]));
+        }
+        for (uint32_t i = 0; i < 3 * f->ns; ++i)
+            worst = fmax(worst, fabs((double)xa[i] - xb[i]));
+    }
+    ENSUREF(size > 0 && worst <= 1e-5 * size,
+            "the far actor's surface is %g from the near one's "
+            "(size %g)",
+            worst, size);
+    ENSURE(sinew_instance_set_pose(b, clip_pose(f, 3), f->nb) == SINEW_OK);
+    ENSURE(sinew_instance_step(b, 0.0f) == SINEW_OK); /* paused: the last surface stays */
+    ENSURE(sinew_instance_read_surface(b, xa, NULL, f->ns) == SINEW_OK);
+    ENSURE(memcmp(xa, xb, sizeof(float) * 3 * f->ns) == 0);
+    free(xa);
+    free(xb);
+    sinew_instance_destroy(a);
+    sinew_instance_destroy(b);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) contract_fixture_free(&fx);
 }
 
 SW_TEST_MAIN(CASE(the_interposer_sees_the_librarys_own_calls),
-             CASE(every_path_of_the_step_allocates_and_locks_nothing), CASE(release_fixture))
+             CASE(every_path_of_the_step_allocates_and_locks_nothing),
+             CASE(an_actor_far_turned_and_scaled_reads_the_same_surface_in_its_frame),
+             CASE(release_fixture))
