@@ -120,7 +120,7 @@ static sinew_result make_instance(const sinew_blob *blob, const sw_invariance_ru
 static void read_surface(const sinew_instance *in, uint32_t ns, int as_float, float *fs,
                          double *x) {
     if (!as_float) {
-        memcpy(x, sw_instance_surface(in), (size_t)3 * ns * sizeof(double));
+        sw_instance_read_surface_d(in, x); /* the host's frame, as the float read */
         return;
     }
     sinew_instance_read_surface(in, fs, NULL, ns);
