@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# sinew-bench --dynamic on a tiny finger (issue 15, "Dynamics measured, not assumed"):
+# sinew-bench --dynamic on a tiny finger ("Dynamics measured, not assumed"):
 # the run finishes and its JSON line carries every dynamic figure as a finite number
 # (err_dyn_increment may be null only without the reference's quasistatic clip, which
 # this run has). No thresholds: the figures themselves are measured at full size; and

@@ -1,4 +1,4 @@
-/* The adaptive training loop (precompute/bake/bake_adaptive.h; issue 16, item 1): each
+/* The adaptive training loop (precompute/bake/bake_adaptive.h): each
  * round adds the candidates its proxy scores worst, and the reference confirms they are
  * poses the blob gets wrong (worse than the held-out poses); a round solves only its new
  * poses (the other chains come from the cache), and a re-bake with another cubature none;

@@ -1,4 +1,4 @@
-/* The simulate stage's cache (precompute/bake/sim_cache.h, bake_cache.c; issue 14): a
+/* The simulate stage's cache (precompute/bake/sim_cache.h, bake_cache.c): a
  * re-bake that changes only the cubature reads the solutions back, bitwise the ones it
  * would solve, and writes the very blob a bake without the cache writes; a change of
  * material, pose or simulator misses; a damaged, truncated or forged file is refused with

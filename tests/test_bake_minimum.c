@@ -1,4 +1,4 @@
-/* The bake's least input (issue 15): a clip too short to train on is rejected with the
+/* The bake's least input: a clip too short to train on is rejected with the
  * minimum and the reason, not written as a blob with empty cubature or a useless basis;
  * sw_bake_solutions gives the very poses and solutions sw_bake keeps. Small meshes. */
 #include <math.h>
@@ -155,7 +155,7 @@ static void local_of(const sw_skeleton *sk, const double *T, int32_t b, double L
             L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
 }
 
-/* Pair sweeps (issue 16): the finger's tip joint swept together with its parent joint, a
+/* Pair sweeps: the finger's tip joint swept together with its parent joint, a
  * sequence of sweep_samples poses after the single sweeps, the last of them each joint at
  * its own sweep's end; the held-out poses stay the same. */
 /* Sibling sweeps (default on): the finger with its tip joint hung from the root, so the

@@ -1,4 +1,4 @@
-/* The condensation tet mesh of a blob (issue 12, sinew_blob_format.h ids 35..44): the bake
+/* The condensation tet mesh of a blob (sinew_blob_format.h ids 35..44): the bake
  * writes the whole tet mesh, and it loads as the mesh it was baked from, every tet in its
  * domain, the incidence lists complete, the masses those of the reduced mass, the cubature
  * tets its own; a view without it writes the blob of before; the writer and the loader

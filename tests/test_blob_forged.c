@@ -1,4 +1,4 @@
-/* Forged blobs, field by field (issue 15): every count and index of the training and
+/* Forged blobs, field by field: every count and index of the training and
  * contact sections (TRAIN_Q, TRAIN_POSE, CONTACT_PTR, CONTACT_VERTS, CONTACT_DATA and
  * META's ntrain and ncontacts), and the fields of the other sections that
  * test_blob_hostile.c's forged cases leave out (META's other counts and material, the

@@ -1,4 +1,4 @@
-/* Hostile blobs, stepped (issue 15): a small real bake (a cylinder of 1,000 tets at rank
+/* Hostile blobs, stepped: a small real bake (a cylinder of 1,000 tets at rank
  * 2, with pose-space contact pairs) is mutated a few thousand times from a fixed seed, a
  * few bytes each, anywhere in the file or inside one section picked at random (so that the
  * small index sections, META and the table are hit as often as the large arrays), the

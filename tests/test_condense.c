@@ -1,4 +1,4 @@
-/* Subspace condensation (runtime/condense, issue 12): the coupled potential's gradient
+/* Subspace condensation (runtime/condense): the coupled potential's gradient
  * against finite differences and its Hessian symmetric and PSD; the partition oracle
  * against a brute-force growth; the budget's cut; the flesh denting where the subspace
  * locks, closer to the reference; bitwise the subspace without contact; the real-time

@@ -1,4 +1,4 @@
-/* The bake is deterministic in its thread count (issue 15): a small finger baked on 1, 2
+/* The bake is deterministic in its thread count: a small finger baked on 1, 2
  * and 3 worker threads (sw_bake_params.threads: the training simulations, the cubature
  * and the reduction run on the bake's pool) gives the same blob, byte for byte. Every
  * reduction of the bake has a fixed order; a change that makes one depend on the thread

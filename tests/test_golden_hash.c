@@ -2,56 +2,9 @@
  * Jolt): four instances of one small baked finger, quasistatic and dynamic, each from
  * another clip offset, are stepped on 1, 2 and 4 threads; every run gives the same
  * surfaces (positions and normals of every step), and their FNV-1a hash is the
- * recorded golden value. The value was recorded before the runtime was laid out by
- * subsystem (issue 9); a change that claims to keep behaviour must not move it, and a
+ * recorded golden value. A change that claims to keep behaviour must not move it; a
  * change that means to change the physics records the new value here and says why in
- * its commit. Issue 15 moved it (from 0x019bee093313695e): the old teleport test took the
- * fixture clip's own distal-bone swings (52-65 degrees a frame at 30 Hz) for teleports,
- * because it measured the motion of the world origin under the bone's transform, and
- * dropped their inertia; and a Newton update shorter than a billionth of the size now
- * ends the solve as converged instead of line-searching rounding noise (steps near
- * rest). Issue 15 moved it again (from 0x301362ecd8596037): the bake summed each
- * domain's cubature right-hand side per worker, so the fixture's cubature weights
- * depended on the bake's thread count in their last bits; it now sums fixed chunks of
- * tets in order (bake_cubature.c, test_golden_bake.c), which rounds differently from
- * the old 2-thread split. Issue 10 moved it (from 0xe60e2af2d7fee395) without touching
- * the runtime: the fixture's training solutions come from the reference, whose Newton
- * now ends a contact round once its set would change and keeps truncated PCG answers
- * that made progress (fullsim_step.c, fullsim_system.c), so the baked blob differs.
- * Issue 13 moved it (from 0xdeb5a223c1daed2f): the runtime's Newton takes chord updates
- * on an earlier factor once the iterate converges fast (newton.c), a different path to
- * the same stationary points within the solve's tolerance. Issue 13 moved it again (from
- * 0x88a0a36667517619): the runtime's warm-started SVD ends after a sweep whose pairs were
- * within 1e-8 of orthogonal and rotates with one division fewer, and line-search trials
- * take the element rotation from the polar Newton iteration (svd3.c, fem_corot.c): the
- * same energies and forces to rounding. And once more (from 0x0587738b97849272): the
- * cubature tets' corners are x0 + J q with x0 and J = R U cached once a step, instead of
- * R (X + U q) + t each pass (cubature.c): the same positions to rounding. And again
- * (from 0xffa161049ccd1dcf): the Hessian's mode projections are taken in the element's
- * singular frame (cubature.c, the same products to rounding), and a Newton update below
- * 2% of |q| (was 0.3%) is the step's last (newton.c): an earlier end on the way to the
- * same stationary point. And again (from 0x58402d3f868b7fd0): the corners are R (X + U q)
- * + t each pass again, the projections through U^T R_n and U_n instead of the cached J
- * (cubature.c), and the last update's threshold is 5% of |q| (newton.c). And again (from
- * 0xacf1059c9a39df73): the pose-space pairs' tangential term fades away from the
- * training pose they were found at (pose_space.c). And again (from 0xe9036879522188b8):
- * each training pose's pairs are stored sorted by their pair of domains (bake_pairs.c), so
- * the contact terms are summed in another order. And again (from 0xbf566f059d70d4ae):
- * after a Newton update of at most 20% of |q| the solve evaluates the end point without
- * its Hessian and lets the factor at hand decide whether the next update is the last
- * (newton.c): another path to the same stationary points. And again (from
- * 0x02156e69662599b2): the bake builds the interface springs' Hessian at unit stiffness
- * and scales it by the stiffness it chooses (bake_springs.c; the fixture keeps 20 E h),
- * so the fixture blob's spring Hessian rounds differently. And again (from
- * 0x6b13019a2b7bbe0f): the blob carries the pose-space equilibrium force
- * (bake_equilibrium.c), which every step near a training pose applies. And again (from
- * 0x1bec772129eb29c9): a quasistatic step's Newton starts on the rest Hessian where its
- * factorisation is cheap (SINEW_NEWTON_HESSIAN_AUTO, newton.c), as it is for the
- * fixture: another path to the same stationary points. And again (from
- * 0x246da4bbf774d146): those updates start on the last Hessian a step evaluated, and
- * after a fast one the last update may be as long as Newton's (newton.c): another path.
- * And again (from 0x787d3a8bf600897c): a gradient pass sums its tets' forces on their
- * corners and projects them a corner at a time (cubature.c), which rounds differently.
+ * its commit (the values' history: docs/notes/golden-hashes.md).
  * The thread counts here are instances stepped on several host threads (no task
  * callbacks); instances 1 and 3 are dynamic. */
 #include <pthread.h>

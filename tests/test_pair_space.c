@@ -1,4 +1,4 @@
-/* Pose-space self-contact per pair of domains (issue 16, deliverable 2; bake_pairs.c,
+/* Pose-space self-contact per pair of domains (deliverable 2; bake_pairs.c,
  * pair_space.c): the pair feature ignores a rigid motion of the whole character and
  * is, at every training pose, the feature the bake stored; a pair cubature reproduces the
  * reduced contact force it was fitted to within its tolerance; two identical samples

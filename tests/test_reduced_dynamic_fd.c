@@ -1,4 +1,4 @@
-/* The derivatives of the step's whole potential against central differences (issue 15):
+/* The derivatives of the step's whole potential against central differences:
  * the potential a dynamic step minimises (runtime/solver/potential.c) with every term
  * engaged at once, evaluated through the step's own preparation and coefficients
  * (sw_instance_step_prepare / sw_instance_step_potential, instance.h):

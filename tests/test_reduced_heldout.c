@@ -1,4 +1,4 @@
-/* The runtime against the full-space reference on HELD-OUT poses (issue 15): clip frames
+/* The runtime against the full-space reference on HELD-OUT poses: clip frames
  * the bake did not train on, where no step starts from a stored solution. Two characters:
  * the procedural finger (about 3,000 tets, a fold with self-contact) and the real
  * elephant of ../shared/data/elephant-cd (1,502 tets, 24 bones, its own clip; skipped
@@ -17,7 +17,7 @@
  * Measured: finger quasistatic 0.152 on 5 held-out poses (0.021 on its 19 training
  * poses), dynamic 0.286 on 5 held-out frames (0.171 on its 7 training frames); elephant
  * quasistatic 0.147 on 8 held-out poses (0.007 on 69 training poses), dynamic 1.049 on
- * 24 held-out frames (0.980 on its 36 training frames). Since issue 13's fourth round
+ * 24 held-out frames (0.980 on its 36 training frames). After the tuning of the pose-space pairs and Newton's last update
  * (the pairs' tangential term fading away from their training pose, springs tied to
  * hubs, a 5% last Newton update): finger 0.108 (0.019), dynamic 0.281 (0.255); elephant
  * 0.143 (0.007), dynamic 1.111 (0.983). (Folding the bones under 3% of the volume into

@@ -1,4 +1,4 @@
-/* The render mesh embedded in the tets (issue 14): the embedding reproduces the render
+/* The render mesh embedded in the tets: the embedding reproduces the render
  * mesh at rest; a blob with one outputs it through the public API (counts, triangles,
  * positions, normals), welded duplicates identical under deformation; the loader rejects a
  * damaged render section with a message naming it; the step stays allocation- and

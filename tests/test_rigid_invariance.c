@@ -4,7 +4,7 @@
  * hull) move with G and condensation patches; an actor 10^5 units from the origin keeps
  * the origin's shape; a uniformly scaled pose gives the scaled shape; dt = 0 is a pause;
  * a bone scaled unlike the others is refused naming it. The measure is invariance.h's,
- * the bound 1e-5 of the character's size (issue 55). */
+ * the bound 1e-5 of the character's size. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>

@@ -200,7 +200,7 @@ TEST(fox_character) {
     sw_character_free(&c);
 }
 
-/* TetGen fills the Fox's closed render surface (issue 14, item 2): the tet mesh holds
+/* TetGen fills the Fox's closed render surface: the tet mesh holds
  * exactly the volume the surface encloses and its boundary is that surface, so every render
  * vertex embeds inside a tet (none outside, no barycentric beyond [0, 1]); the robot's
  * render mesh (19 open primitives) is refused, naming the file and the open edges. */

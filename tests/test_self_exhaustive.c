@@ -1,4 +1,4 @@
-/* Exhaustive subspace self-contact (runtime/contact/self_contact.h, issue 16): the
+/* Exhaustive subspace self-contact (runtime/contact/self_contact.h): the
  * runtime detects the very pairs the full-space reference detects at the same positions
  * (the blob's tet boundary, rest measures and area weights against the reference's own,
  * built from the character's mesh); the step's potential with those pairs matches its

@@ -1,4 +1,4 @@
-/* The step cannot blow up (issue 15; sinew_types.h, status flags): one-step rotation
+/* The step cannot blow up ( sinew_types.h, status flags): one-step rotation
  * snaps of a bone (5, 30, 90 degrees) at dt = 1e-9, 1e-6, 1e-3 and 1/60, each followed
  * by 300 steps at that dt, translation jumps and dt spikes leave a finite output within
  * the instance's displacement bound, and every snap that implies a joint spin above

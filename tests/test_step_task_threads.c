@@ -1,4 +1,4 @@
-/* Host task callbacks (sinew_task_callbacks, issue 13): a host's job system runs one
+/* Host task callbacks (sinew_task_callbacks): a host's job system runs one
  * instance's cubature passes on its workers, and the step's output is bitwise the serial
  * step's for any worker count and any split of the domains: the pool's contiguous
  * chunks on 1, 2 and 4 workers, run at once or deferred to finish, and a host that runs

@@ -257,7 +257,7 @@ static void check_shell(const sw_tetmesh *t, const sw_lattice_report *rep, doubl
             "shell volume %g for area %g and thickness %g", vol, area, rep->shell);
 }
 
-/* A surface with no inside (issue 14: SimpleSkin is a flat strip) is meshed as a shell:
+/* A surface with no inside (SimpleSkin is a flat strip) is meshed as a shell:
  * a flat sheet (the unit box squashed to z = 0) and one tilted triangle. */
 TEST(a_surface_without_inside_becomes_a_shell) {
     double lo[1][3] = {{0, 0, 0}};

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# The tools never mislead (issue 15): every error exits non-zero with a message that
+# The tools never mislead: every error exits non-zero with a message that
 # names what is wrong; flags that do not apply to the input, values out of range and
 # files of the wrong format are rejected; the bake and the bench --blob --bake-errors
 # report the same training and held-out error for the same blob, and the bench --blob
@@ -315,7 +315,7 @@ fi
 expect inspect_mesher_name 2 "--mesher takes lattice or tetgen, not 'gmsh'" \
     "$inspect" x.glb --mesher gmsh
 
-# a glTF/FBX FILE (issue 14): its format, the options that do not apply to it or that
+# a glTF/FBX FILE: its format, the options that do not apply to it or that
 # apply only to it, an unwritable report folder; with the fox, unknown clip names are
 # an error listing the file's clips, and a small bake writes its report
 expect bake_file_format 2 "FILE 'x\.dae': not a format it reads; accepted: \.glb, \.gltf" \
@@ -342,7 +342,7 @@ expect bench_self_contact_mode 2 "--self-contact: pose-space, exhaustive or pose
     "$bench" "${small[@]}" --self-contact brute
 expect bench_gap_needs_poses 2 "--error-gap needs the bake's poses" \
     "$bench" "${small[@]}" --blob "$tmp/a.blob" --error-gap
-# issue 16's figures on a small bake: both self-contact modes timed in one run, the
+# the self-contact figures on a small bake: both self-contact modes timed in one run, the
 # runtime against its basis's projection (every figure present, no step failed)
 want=('"sc_speedup_max":[0-9.]+,' '"sc_frame_share":0\.[0-9]+,' '"sc_exh_pairs":[0-9.]+,'
     '"gap_poses":[1-9][0-9]*,' '"gap_err_projection":[0-9.]+,' '"failed_steps":0,')

@@ -313,8 +313,8 @@ sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets
         sw_error_set(err, rc, "%s: %s", obj_path, msg);
         return rc;
     }
-    /* the artist's surface is what the runtime outputs, carried by the generated tets
-       (issue 14); finish_character frees it with the character on an error */
+    /* the artist's surface is what the runtime outputs, carried by the generated tets;
+       finish_character frees it with the character on an error */
     out->render = surf;
     return finish_character(obj_path, tgf_path, NULL, motion_path, nframes, out, err);
 }

@@ -30,7 +30,7 @@ sinew_result sw_character_read_range(const char *path, sw_character *ch, sw_erro
  * with about target_tets tets by `mesher` (mesher.h; report may be NULL), a .tgf
  * skeleton and optional motion as in sw_character_from_files; inverse-distance weights
  * (a caller may compute heat-diffusion weights instead, as sinew-bake does). out->render
- * is the surface itself: a bake embeds it and the blob outputs it (issue 14). */
+ * is the surface itself: a bake embeds it and the blob outputs it. */
 sinew_result sw_character_from_surface(const char *obj_path, int32_t target_tets, sw_mesher mesher,
                                        const char *tgf_path, const char *motion_path,
                                        int32_t nframes, sw_character *out, sw_mesher_report *report,

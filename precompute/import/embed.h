@@ -1,4 +1,4 @@
-/* The render mesh embedded in the simulation tets (DESIGN.md §4, issue 14): every render
+/* The render mesh embedded in the simulation tets (DESIGN.md §4): every render
  * vertex gets a tet and 4 barycentrics that reproduce its rest position exactly, so the
  * runtime can carry the render mesh on the deformed tets; and a weld map that joins the
  * render vertices at one rest position (UV seams, hard edges) so they move and shade as

@@ -2,7 +2,7 @@
  * 5.2.5 (Debian 12) dereferences NULL or reads past arrays on some malformed skins and
  * node graphs instead of rejecting them; fuzz_scene_import found these, and upstream
  * fixed them only in later releases:
- *  - a skin without inverseBindMatrices (optional in glTF 2.0; assimp issue #3465),
+ *  - a skin without inverseBindMatrices (optional in glTF 2.0; assimp's issue tracker, #3465),
  *  - an inverseBindMatrices accessor that is not MAT4 floats, one per joint (#6612),
  *  - a node graph that is not a forest (a node that is a child twice, a child and a scene
  *    root, or its own ancestor),

@@ -1,4 +1,4 @@
-/* A simulation character from a rigged glTF 2.0 / FBX file (issue 14): the assimp import
+/* A simulation character from a rigged glTF 2.0 / FBX file: the assimp import
  * (scene_import.h), a tet mesh the lattice mesher (tet_lattice.h) or TetGen (tetgen_run.h,
  * closed surfaces only) fills the render surface with, skin weights transferred from the artist's
  * render weights (sw_weights_from_surface), bone-driven vertices, a material relative to the

@@ -1,4 +1,4 @@
-/* What fills a render surface with simulation tets (issue 14, item 2): the lattice cut by
+/* What fills a render surface with simulation tets: the lattice cut by
  * the winding number (tet_lattice.h; any surface, the default) or TetGen run as a separate
  * program (tetgen_run.h; closed surfaces, boundary-conforming). docs/game-assets.md ("The
  * lattice or TetGen") compares them. */

@@ -79,8 +79,8 @@ typedef struct sw_character {
     double poisson; /* Poisson ratio nu */
     double density; /* mass per unit rest volume */
     /* Optional render mesh (render.nverts 0: none). When set, the bake embeds it in the
-     * tets and the runtime's output surface is this mesh in its own vertex order
-     * (issue 14); otherwise the output surface is the tet mesh's boundary. */
+     * tets and the runtime's output surface is this mesh in its own vertex order;
+     * otherwise the output surface is the tet mesh's boundary. */
     sw_trimesh render;
     char (*bone_names)[64]; /* skel.nbones names from the file (glTF/FBX nodes), or NULL */
 } sw_character;

@@ -1,5 +1,5 @@
 /* A simulation tet mesh generated from a render surface that need not be closed or
- * manifold (issue 14: game characters' render meshes have holes, several primitives and
+ * manifold (game characters' render meshes have holes, several primitives and
  * self-intersections). A cubic lattice over the surface's bounding box, each cube split
  * into the six Freudenthal tets that share its main diagonal (a conforming mesh: every
  * cube is split the same way); a cube is inside when the generalised winding number of

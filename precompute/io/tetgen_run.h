@@ -1,4 +1,4 @@
-/* A simulation tet mesh from a closed render surface by TetGen (issue 14, item 2).
+/* A simulation tet mesh from a closed render surface by TetGen.
  *
  * TetGen is AGPL-3 (Debian `tetgen`): it is only ever run as a separate program, never
  * linked. The surface is welded (render meshes split their vertices at UV seams), checked

@@ -1,4 +1,4 @@
-/* Skin weights of a simulation mesh transferred from an artist's render mesh (issue 14):
+/* Skin weights of a simulation mesh transferred from an artist's render mesh:
  * each simulation vertex takes the weights at its closest point on the render surface,
  * interpolated barycentrically over that triangle. This follows the artist's intent
  * (joint blends, props bound to one joint) where heat diffusion over the generated tets

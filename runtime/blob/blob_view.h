@@ -128,7 +128,7 @@ typedef struct sw_blob_view {
     const int32_t *contact_verts;
     const double *contact_data;
 
-    /* the optional render mesh embedded in the tets (issue 14; nrender_verts 0: none, and
+    /* the optional render mesh embedded in the tets (nrender_verts 0: none, and
      * every field below is 0 / NULL). Render vertex i sits at
      *     sum_k render_bary[4i+k] node(render_tets[4 render_tet[i] + k]),
      * a node the mean of its copies render_node_copies[render_node_ptr[n] ..] (domain,
@@ -144,7 +144,7 @@ typedef struct sw_blob_view {
     const int32_t *render_node_ptr;    /* nrender_nodes + 1, increasing, starts at 0 */
     const int32_t *render_node_copies; /* 2 * nrender_copies: (domain, local vertex) */
 
-    /* the whole tet mesh for condensation's full-space patches (issue 12; ntets 0: none,
+    /* the whole tet mesh for condensation's full-space patches (ntets 0: none,
      * every field below 0 / NULL). Tet t lies in domain tet_domain[t]: its corner k is
      * domain_verts[domains[tet_domain[t]].vert_begin + tet_local[4t+k]] == tets[4t+k]. */
     int32_t ntets, nvert_tets;

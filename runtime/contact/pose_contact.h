@@ -46,13 +46,10 @@ double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const doub
  * point than this many triangle edges (the longest), over 1 - s where s is the pair's
  * locality share (pair_tan: 1 at its own training pose, 0 at the nearest other one), is
  * not the reference's contact there; at its own pose a pair always stays, so the step
- * applies the reference's contact set where the bake solved it. Measured (the bakes'
- * held-out errors): the Fox trained on Survey and Run with Walk held out (a gait whose
- * legs swing less than the training's) 0.425 -> 0.151, its Galerkin error 0.156; with Run
- * held out 0.283 -> 0.268; elephant 0.0909 -> 0.0868; the robot in the pose-pairs mode
- * 0.169 -> 0.070; finger 50K, hand, robot unchanged, bare hand 0.400 -> 0.402. (1.0 and
- * 1.5 edges within 0.002 of each other on the Fox; without the share, the bare hand's
- * training poses lost pairs and its springs' choice moved: 0.410.) */
+ * applies the reference's contact set where the bake solved it. Without the drop, a gait
+ * that swings less than the training's is pulled across surfaces it does not touch; the
+ * threshold is not sensitive between one and one and a half edges (figures:
+ * docs/notes/runtime-constants.md). */
 #define SW_PAIR_APART 1.0
 
 /* Drops from ps->pairs (with pair_w, pair_tan) every pair that has come apart at q

@@ -12,13 +12,9 @@
  * reference would have found elsewhere, and (eq. 3.12's Heaviside) it jumps into the
  * energy wherever a pair starts to collide with |d_t| > 0, which the energy guard
  * cannot descend through. With the whole term off everywhere (alpha 0) the held-out
- * errors fell (elephant 0.129 -> 0.085) but the training errors rose (elephant 0.0196 ->
- * 0.0296, finger 50K 0.0194 -> 0.0247): at its own pose the term is the reference's. So
- * it fades from 1 there to 0 at the nearest other sample, where that sample's pairs
- * take over. Measured (sinew-bake, train / held-out, alpha whole -> faded): elephant
- * 0.0196 / 0.1286 -> 0.0196 / 0.0888, finger 50K 0.0194 / 0.1361 -> 0.0194 / 0.1358,
- * 20K 0.0236 / 0.1817 -> 0.0236 / 0.1823, hand 0.0200 / 0.0448 -> 0.0200 / 0.0448;
- * elephant evaluations a step 4.65 -> 4.13 (fewer energy-guard stops). */
+ * errors fall but the training errors rise: at its own pose the term is the reference's.
+ * So it fades from 1 there to 0 at the nearest other sample, where that sample's pairs
+ * take over (figures: docs/notes/runtime-constants.md). */
 double sw_pose_space_tangent_share(double s, double reach) {
     return s >= reach ? 0.0 : 1.0 - s / reach; /* reach INFINITY: 1 */
 }

@@ -1,4 +1,4 @@
-/* Exhaustive subspace self-contact (issue 16's baseline, thesis Table 3.2's "exhaustive"
+/* Exhaustive subspace self-contact (the baseline of thesis Table 3.2's "exhaustive"
  * column): every surface vertex of the tet boundary tested against the whole deformed
  * mesh at each detection, with the reference's own rule (self_detect.h), and the pairs
  * found applied with the contact law of eqs. 3.4-3.6 (penalty.h) through the subspace

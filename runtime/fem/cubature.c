@@ -11,9 +11,8 @@
 /* A cubature tet's corners in the subspace map (reduced_map.h): corner n's rows of the
  * domain's basis U_n (3 x r) and its skinning rotation R_n, so that its Jacobian is
  * J_n = R_n U_n without being formed. (A per-step cache of x0 and J = R U, 12 (r + 1)
- * doubles a tet, cost more to fill than it saved: W_n = U^T R_n costs a pass what J costs
- * a column, and most steps make one or two passes. Without it, callgrind over 4 finger 50K
- * instances' steps: 2.316G -> 2.206G instructions, the elephant's instance 7.18 -> 5.89 MB.) */
+ * doubles a tet, costs more to fill than it saves: W_n = U^T R_n costs a pass what J costs
+ * a column, and most steps make one or two passes; see docs/notes/runtime-constants.md.) */
 typedef struct {
     const double *U[4];
     const double *R[4];
@@ -53,10 +52,8 @@ static void add_mode_products(double *H, int32_t R, int32_t r, const double *hm,
 
 /* Columns j0 .. j0 + nl - 1 (nl <= SW_CUB_COLS) of singular_frame_projections side by
  * side: each column's sums in the order of a one-column loop, the columns in lanes that
- * a vectorising compiler fills when nl is the constant SW_CUB_COLS (SSE2 pairs).
- * Measured (callgrind over sinew-bench's clips, bitwise the same steps): Fox 1.99G ->
- * 1.90G instructions, elephant 24.5G -> 23.6G, hand 1.25G -> 1.21G. (Compiling the pass for AVX2
- * too, target_clones, made those steps slower here: 3.9 -> 7.2 ms.) */
+ * a vectorising compiler fills when nl is the constant SW_CUB_COLS (SSE2 pairs). The sums
+ * are bitwise those of the one-column loop. (An AVX2 clone of the pass was slower.) */
 #define SW_CUB_COLS 4
 static void column_projections(const tet_map *tm, int32_t r, int32_t j0, int nl, double W[4][9],
                                const double b[12], const double dpsi[3], double fscale,

@@ -1,4 +1,4 @@
-/* The render mesh as output surface (blob_view.h, issue 14): each representative render
+/* The render mesh as output surface (blob_view.h): each representative render
  * vertex the barycentric sum of its tet's render nodes, each duplicate a copy of its
  * representative; normals area-weighted over the welded triangles, so a UV seam's
  * duplicates shade as one vertex. Used by the step's output (output.c) and, over other

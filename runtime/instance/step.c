@@ -156,20 +156,14 @@ static void phase_self(sw_step_ctx *c) {
  * that step's solution ended from its own prediction: q = p + (q_n - p_n) (after a pose
  * jump, a reset, a failed step or one the energy guard stopped: p alone). The reduced
  * energy has several minima once a fold buckles or a contact engages, and a warm start
- * from the previous frame can converge to one the full-space solution does not take
- * (measured on a folding finger: the previous frame's q converged to energy 80.8 and 46%
- * correction error where the training solution's minimum at 83.0 is within 2.5%; bakes
- * started at q_n: finger 50K train error 0.0087 -> 0.039, elephant held-out 0.092 ->
- * 0.122). The prediction picks the minimum, so the shape is a function of the pose (no
- * drift); the last step's offset from its prediction is what the training poses do not
- * predict and changes little from frame to frame, so it starts Newton nearer: the Fox's
- * Run (held out) took 2.86 cubature passes a step instead of 3.57 (callgrind 1.24G ->
- * 1.01G instructions); the bakes' errors train / held-out: Fox 0.0079 / 0.2818 -> 0.0079
- * / 0.2829, elephant 0.0085 / 0.0919 -> 0.0085 / 0.0885, bare hand 0.0289 / 0.3867 ->
- * 0.0289 / 0.3836, robot held-out 0.0705 -> 0.0704, the finger and the hand unchanged (at
- * a training pose the offset is never taken). The shape depends on the frames before
- * within the solve's tolerance: a step ends within its last update, SW_NEWTON_LAST_UPDATE
- * |q|, of the stationary point (test_reduced_model). O(R). */
+ * from the previous frame can converge to one the full-space solution does not take (on
+ * a folding finger, a minimum with half the correction wrong). The prediction picks the
+ * minimum, so the shape is a function of the pose (no drift); the last step's offset
+ * from its prediction is what the training poses do not predict and changes little from
+ * frame to frame, so it starts Newton nearer, saving cubature passes (at a training pose
+ * the offset is never taken; figures: docs/notes/runtime-constants.md). The shape depends on the
+ * frames before within the solve's tolerance: a step ends within its last update,
+ * SW_NEWTON_LAST_UPDATE |q|, of the stationary point (test_reduced_model). O(R). */
 static void pose_space_start(sinew_instance *in) {
     const sw_blob_view *v = in->v;
     sw_solver *s = &in->solver;

@@ -127,58 +127,42 @@ static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_sol
     return phi;
 }
 
-/* A chord update (on a Hessian factored at an earlier iterate of the step) that shrinks
- * the gradient by less than this is followed by a fresh factorisation. */
 /* Chord updates (on the factor of an earlier iterate's Hessian) follow a Newton update
  * that shrank the gradient to SW_CHORD_ENTER of its value or less, and go on while each
- * shrinks it to SW_CHORD_KEEP or less. Measured (callgrind, instructions of the steps
- * over the clip): finger 20K 0.273G -> 0.230G at 0.1 (0.206G at 0.3), elephant 69.7G ->
- * 63.1G at 0.1 (56.3G at 0.3, but there the bake's held-out error went 0.129 -> 0.159:
- * a slower path through its several minima); errors at 0.1 unchanged or lower. */
+ * shrinks it to SW_CHORD_KEEP or less; a slower one is followed by a fresh factorisation.
+ * Near the stationary point Newton converges quadratically and the Hessian changes
+ * little, so a chord update costs a solve where Newton costs a Hessian pass and a
+ * factorisation. A looser entry saves more but takes a slower path through the several
+ * minima of a buckled fold (§3.2.3). Figures: docs/notes/runtime-constants.md. */
 #define SW_CHORD_ENTER 0.1
 #define SW_CHORD_KEEP 0.5
 /* A Newton update of at most this share of |q| is near the stationary point: its end
  * point is evaluated without H, and when the gradient there is too large for chord
  * updates, the factor at hand first tells whether the update from there is the last one
  * (SW_NEWTON_LAST_UPDATE), taken then without a new Hessian. Newton's next update is
- * quadratically smaller (the Fox's held-out run: updates of 0.13-0.29 |q| were followed by
- * 0.005-0.043 |q|), so the Hessian pass and factorisation that only confirmed the last
- * update are saved. Measured against Newton to the end (callgrind over sinew-bench's
- * clips): Fox 2.51G -> 1.99G instructions, factorisations a step 2.77 -> 1.94, elephant
- * 30.3G -> 24.5G; the bakes' errors train / held-out unchanged on the finger (20K, 50K), the hand
- * and the Fox (0.3358 -> 0.3363 held-out), the elephant's held-out 0.0886 -> 0.0891. At
- * 0.3 the Fox took 1.89 factorisations a step but the elephant's held-out error went to
- * 0.0922 (its several minima); at 0.15 the Fox took 2.29. */
+ * quadratically smaller, so the Hessian pass and factorisation that would only confirm
+ * the last update are saved. A larger share saves more factorisations but lets a step
+ * settle in another of a buckled fold's minima. Figures: docs/notes/runtime-constants.md. */
 #define SW_NEWTON_NEAR 0.2
 
 /* Rest-first updates (SINEW_NEWTON_HESSIAN_REST_FIRST) go on while each shrinks the
  * gradient to this share of its value or less; a slower one hands the step to the current
- * Hessian. Measured on the Fox's Run (callgrind, instructions of the steps over the clip,
- * 2.20G with the current Hessian): 2.05G at 0.3 (1.71 rest updates a step), 2.15G at
- * 0.5, 1.68G at 0.9, but there 4.6 of the 5 updates a step allowed are rest updates and
- * the step ends at the cap, not at its last-update test. The hand and the finger end
- * in one update at any of these. */
+ * Hessian. Much looser, a step spends its whole update cap on slow reference updates and
+ * ends at the cap instead of at its last-update test. */
 #define SW_REST_KEEP 0.3
 /* A reference update's error is not quadratic in its length, as a Newton update's is: the
- * step's first must be shorter to be its last. At SW_NEWTON_LAST_UPDATE a step of the test
- * fixture ended where a Newton update from its solution still moved 5.8% of |q|
- * (test_reduced_model's bound is 5%); at half of it every step ends within the bound, and
- * the hand and the finger still take one update a step. After an update that shrank the
- * gradient to SW_REST_KEEP or less, the factor at hand models the potential as well as
- * Newton's last ones do, and Newton's SW_NEWTON_LAST_UPDATE holds: the Fox's Run took 3.57
- * cubature passes and 3.0 factorisations a step instead of 4.06 and 3.4 (callgrind over
- * its steps 1.42G -> 1.24G instructions). (Reusing the factor after a fast update instead
- * took more passes: 1.28G at a shrink to 0.15, 1.45G at 0.3.) */
+ * step's first must be shorter to be its last (at SW_NEWTON_LAST_UPDATE itself a step can
+ * end farther from its stationary point than test_reduced_model's bound). After an update
+ * that shrank the gradient to SW_REST_KEEP or less, the factor at hand models the
+ * potential as well as Newton's last ones do, and Newton's SW_NEWTON_LAST_UPDATE holds. */
 #define SW_REST_LAST_UPDATE (0.5 * SW_NEWTON_LAST_UPDATE)
 
 /* After a fast reference update the factor at hand is the last iterate's, whose matrix
  * differs from the new one only in the contact pairs' Hessian (the reference and the
  * springs do not change within the updates): it first tells whether the update from
  * here is the last (SW_NEWTON_LAST_UPDATE), taken then without a new factorisation; if
- * not, the iterate's own factor gives the update as before, so no pass is added. The
- * Fox's Run (callgrind over its steps): 0.911G -> 0.844G instructions, factorisations a
- * step 2.46 -> 1.8. (Taking the chord update and evaluating its end point instead, tried
- * before, took more passes.) */
+ * not, the iterate's own factor gives the update as before, so no pass is added. (Taking
+ * the chord update and evaluating its end point instead takes more passes.) */
 
 /* An update s->dq shorter than `share` of |q| (or than dq_tiny) is the step's last: taken
  * without evaluating its end point, counted, the step CONVERGED; returns 1 then. */
@@ -214,14 +198,9 @@ enum rest_outcome { REST_DONE, REST_HAND_OVER, REST_NOT_FINITE };
  * update or one that shrinks the gradient by less than SW_REST_KEEP hands the step to the
  * current Hessian's iteration at the best iterate, whose Hessian passes then become the
  * reference of the next steps: the pose of the last hand-over is nearer than the rest
- * pose. Measured on the Fox's Run (callgrind over its steps): 2.09G -> 1.42G instructions
- * (passes a step 5.2 -> 4.06, reference updates 1.71 -> 3.06); the bakes' errors train /
- * held-out: Fox 0.0079 / 0.2819 -> 0.0079 / 0.2818, bare hand 0.0289 / 0.3859 -> 0.0289 /
- * 0.3867, robot 0.0079 / 0.0706 -> 0.0079 / 0.0705; the hand and the finger never hand
- * over and are unchanged, and the elephant keeps the current Hessian. (The reference
- * factored once for the whole step missed the contact pairs that start to touch during
- * it: 15 of the Fox's 35 steps rejected an update.) On entry phi, red->g and red->H are
- * the start point's; *gn is |g| there, g0 the step's first. */
+ * pose. The reference is factored at each iterate, not once a step: a factor kept for the
+ * whole step misses the contact pairs that start to touch during it. On entry phi,
+ * red->g and red->H are the start point's; *gn is |g| there, g0 the step's first. */
 static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_contacts *ct,
                                             sw_solver *s, const sw_dyn_coef *dc,
                                             sinew_step_stats *st, double *phi, double *gn,
@@ -327,19 +306,10 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
         factored_direction(red, s);
         /* An update that moves the shape by less than 5% of its correction (the basis
          * columns are orthonormal, so |dq| is the displacement's norm) is the last one,
-         * taken without evaluating its end point (a cubature pass). Measured on the
-         * finger: the correction error did not change from the 1e-5 gradient criterion
-         * alone (0.0279 / 0.1679 train / held-out at 5K) while the step took 0.7 ms
-         * instead of 1.6 ms at 20K (at 0.3%). From 0.3% to 2% (issue 13): potential
-         * evaluations a step finger 50K 3.23 -> 1.53, elephant 7.19 -> 5.86, hand 2.15 ->
-         * 1.44, and the bakes' errors train / held-out no worse (finger 20K 0.0271 /
-         * 0.1822 -> 0.0250 / 0.1815, 50K 0.0218 / 0.1402 -> 0.0200 / 0.1390, hand 0.0210 /
-         * 0.0451 -> 0.0203 / 0.0448, elephant 0.0200 / 0.1290 -> 0.0199 / 0.1285): the
-         * subspace's own error is ten times what the last updates move. From 2% to 5%:
-         * evaluations finger 50K 1.53 -> 1.10, hand 1.44 -> 1.23, elephant 5.86 -> 4.65;
-         * errors finger 20K 0.0236 / 0.1817, 50K 0.0194 / 0.1361, hand 0.0200 / 0.0448,
-         * elephant 0.0196 / 0.1286 (a Newton update's own error is quadratic in its
-         * length: the last one leaves far less than the 5% it moves).
+         * taken without evaluating its end point (a cubature pass). A Newton update's own
+         * error is quadratic in its length, so the last one leaves far less than the 5% it
+         * moves, and the subspace's own error is larger still (figures:
+         * docs/notes/runtime-constants.md).
          * An update below dq_tiny (a billionth of the character's size: no vertex moves by
          * more, the basis columns being orthonormal; the float output cannot show it) is
          * convergence too: at rest the gradient is rounding noise that no line search can

@@ -46,7 +46,7 @@
  *   RENDER_NODE_COPIES (domain, local vertex) of each copy; a node is the mean of them
  *
  * Optional sections (SINEW_BLOB_COND_SECTIONS, ids 35..44): the whole simulation tet mesh,
- * for subspace condensation's full-space patches (issue 12), all ten present or none. A
+ * for subspace condensation's full-space patches, all ten present or none. A
  * blob without them is byte for byte what it was before they existed; a runtime that
  * predates them skips them as unknown ids. Every tet lies in one domain (the domain the
  * bake gave it: all four corners have copies there), as a cubature tet does. Their counts
