@@ -17,10 +17,10 @@
  * Measured: finger quasistatic 0.152 on 5 held-out poses (0.021 on its 19 training
  * poses), dynamic 0.286 on 5 held-out frames (0.171 on its 7 training frames); elephant
  * quasistatic 0.147 on 8 held-out poses (0.007 on 69 training poses), dynamic 1.049 on
- * 24 held-out frames (0.980 on its 36 training frames). After the tuning of the pose-space pairs and Newton's last update
- * (the pairs' tangential term fading away from their training pose, springs tied to
- * hubs, a 5% last Newton update): finger 0.108 (0.019), dynamic 0.281 (0.255); elephant
- * 0.143 (0.007), dynamic 1.111 (0.983). (Folding the bones under 3% of the volume into
+ * 24 held-out frames (0.980 on its 36 training frames). After the tuning of the pose-space pairs
+ * and Newton's last update (the pairs' tangential term fading away from their training pose,
+ * springs tied to hubs, a 5% last Newton update): finger 0.108 (0.019), dynamic 0.281 (0.255);
+ * elephant 0.143 (0.007), dynamic 1.111 (0.983). (Folding the bones under 3% of the volume into
  * their parents, sw_bake_params.fold_share, costs this sparse training set accuracy:
  * 0.171 with 11 domains instead of 24; 0.155 at a 1% share, 0.168 at 2%; the default
  * training set loses almost none: sinew-bake 0.0886 -> 0.0900 held-out.) The elephant's
