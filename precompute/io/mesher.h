@@ -1,6 +1,6 @@
 /* What fills a render surface with simulation tets: the lattice cut by
  * the winding number (tet_lattice.h; any surface, the default) or TetGen run as a separate
- * program (tetgen_run.h; closed surfaces, boundary-conforming). docs/game-assets.md ("The
+ * program (tetgen_run.h; closed surfaces, boundary-conforming). docs/notes/game-assets.md ("The
  * lattice or TetGen") compares them. */
 #ifndef SW_MESHER_H
 #define SW_MESHER_H

@@ -73,7 +73,7 @@ typedef struct sw_character {
     /* Each joint's range of motion (nframes 0: none given): its largest turn over these
      * frames bounds the bake's joint sweeps and random combined poses where the bake has
      * no clip to train on; without it they turn every joint 90 degrees across its bone,
-     * the palm's metacarpals too (docs/generalisation.md, "Joint ranges"). */
+     * the palm's metacarpals too (docs/notes/generalisation.md, "Joint ranges"). */
     sw_clip range;
     double youngs;  /* Young's modulus E */
     double poisson; /* Poisson ratio nu */

@@ -13,7 +13,7 @@
  * The boundary is the lattice's staircase: the render mesh is embedded in the result
  * (each render vertex in its nearest tet), not the other way round. TetGen gives a
  * boundary-conforming mesh of closed surfaces only (tetgen_run.h, `--mesher tetgen`;
- * docs/game-assets.md compares the two on the shared assets). */
+ * docs/notes/game-assets.md compares the two on the shared assets). */
 #ifndef SW_TET_LATTICE_H
 #define SW_TET_LATTICE_H
 

@@ -57,7 +57,7 @@ typedef enum sw_linear_solver {
     /* PCG: measured on the finger's 40-frame fold at 20K tets (3,984 vertices, 2 cores),
      * a CHOLMOD factorisation costs 140-270 ms, more than a whole PCG solve of the same
      * Newton system, and the exact co-rotational Hessian of the fold is indefinite in
-     * most iterations, so adaptive Newton factors twice (docs/reference.md) */
+     * most iterations, so adaptive Newton factors twice (docs/notes/reference.md) */
     SW_SOLVER_AUTO = 0,
     SW_SOLVER_CHOLMOD = 1, /* sparse direct, supernodal Cholesky (sparse_chol.h) */
     SW_SOLVER_PCG = 2      /* block-Jacobi PCG */

@@ -20,7 +20,7 @@
  * renormalising the rest (the first rule tried) fails once the patch holds the place
  * the cubature was fitted for: on the 100K capsule at rho 0.236 the patch held 78% of
  * the bent domain's volume but 97% of its cubature weight, and the 2 tets left, scaled
- * 7.8x, stood for the rest (err_world_cond 0.201; 0.144 with this rule, docs/world.md). The
+ * 7.8x, stood for the rest (err_world_cond 0.201; 0.144 with this rule, docs/notes/world.md). The
  * cached cubature Jacobians of those domains are refilled by the next gradient pass. */
 void sw_cond_weights_apply(sw_cond *c) {
     const sw_blob_view *v = c->v;
