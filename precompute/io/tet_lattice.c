@@ -58,7 +58,7 @@ static int64_t classify(lattice *L, const double lo[3], const double hi[3], doub
     return k;
 }
 
-/* The six Freudenthal tets of a cube, corners numbered x + 2y + 4z: the paths 0 -> 7
+/* The six Freudenthal tets of a cube, corners numbered x + 2y + 4z: the paths from 0 to 7
  * along the three axes in each order, each ordered to be positively oriented (checked
  * on the unit cube; every cube of the lattice is a translate of it). */
 static void freudenthal_tets(int32_t T[6][4]) {

@@ -442,13 +442,11 @@ static void state_bounds(sinew_instance *in) {
 /* Where a factorisation costs at least this share of the multiply-adds the rest Hessian
  * saves a cubature pass, SINEW_NEWTON_HESSIAN_AUTO keeps the current Hessian: every
  * rest-first update costs a factorisation, and one the energy rejects also a gradient
- * pass before the step goes on as before. Measured shares (sw_solver_factor_madds over
- * sw_cubature_hessian_madds; the same ratio of a factorisation's time to a Hessian
- * pass's extra time within 0.1) and the instructions of the steps over sinew-bench's clip
- * with the current Hessian -> rest-first (callgrind): finger 50K 0.013, 0.230G -> 0.145G;
- * hand 0.095, 1.244G -> 0.689G; Fox 0.10, 2.20G -> 2.05G; elephant 0.62, 24.7G -> 29.9G
- * (its factor keeps 68 blocks for the springs' cross-body ties, and most of its
- * rest-first updates are rejected: its stretched flesh stiffens in rotation). */
+ * pass before the step goes on as before. The share is sw_solver_factor_madds over
+ * sw_cubature_hessian_madds (it tracks the ratio of the times). Characters whose factor
+ * is sparse gain from the rest Hessian; one whose springs tie the whole body into a
+ * dense factor, and whose stretched flesh stiffens in rotation so that most rest-first
+ * updates are rejected, loses (figures: docs/notes/runtime-constants.md). */
 #define SW_REST_FACTOR_SHARE 0.3
 
 /* The def's newton_hessian made concrete: with the rest Hessian, its blocks computed

@@ -85,10 +85,8 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
 /* Phi, g and H at the step's start s->q, as sw_potential: a dynamic step's material part at
  * q_n is already known (phase_dynamics evaluates it for the damping Hessian), so while s->q
  * is still q_n only the rest is added, without a second cubature pass at the same point
- * (*cubature_pass 0; it is used once a step). Measured (callgrind, dynamic steps over
- * sinew-bench's clips): Fox 2.09G -> 1.51G instructions, hand 2.38G -> 1.79G, finger 50K
- * 0.397G -> 0.313G, elephant 31.8G -> 27.0G, and the golden hash's dynamic instances
- * unchanged (the second pass at q_n had given bitwise the same part). */
+ * (*cubature_pass 0; it is used once a step). The second pass at q_n gave bitwise the
+ * same part, so the saving changes no result. */
 double sw_potential_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
                           const sw_dyn_coef *dc, int *cubature_pass);
 
