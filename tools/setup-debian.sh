@@ -18,6 +18,7 @@ packages=(
     tetgen           # sinew-bake --mesher tetgen: run as a separate program, never linked (AGPL)
     abigail-tools    # abidw/abidiff: the ABI baseline test (tests/abi/abi_check.sh)
     clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
+    python3          # docs/status.md from the benchmarks' JSON (tools/scripts/status_table.py)
 )
 
 installed() {
