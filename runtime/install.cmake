@@ -1,10 +1,13 @@
-# `cmake --install`: libsinew as a library package (README.md "Linking").
-#   <libdir>/libsinew.so.<major>.<minor>.<patch>, libsinew.so.<major>, libsinew.so
-#   <libdir>/libsinew.a
-#   <includedir>/sinew/*.h                 the public headers (plugin_api/include/sinew)
-#   <libdir>/pkgconfig/sinew.pc            Libs.private/Requires.private: the static link
-#   <libdir>/cmake/sinew/                  find_package(sinew CONFIG): sinew::sinew (shared),
-#                                          sinew::sinew_static (when its deps are found)
+# `cmake --install`: libsinew as a library package (README.md "Linking"), in two install
+# components (`cmake --install <build> --component <name>`; the tools are a third,
+# cmake/install_tools.cmake):
+#   runtime      <libdir>/libsinew.so.<major>.<minor>.<patch>, libsinew.so.<major>
+#   development  <libdir>/libsinew.so (the link-time name), <libdir>/libsinew.a
+#                <includedir>/sinew/*.h      the public headers (plugin_api/include/sinew)
+#                <libdir>/pkgconfig/sinew.pc Libs.private/Requires.private: the static link
+#                <libdir>/cmake/sinew/       find_package(sinew CONFIG): sinew::sinew
+#                                            (shared), sinew::sinew_static (when its deps
+#                                            are found)
 # Only the runtime and its headers: nothing of precompute/ (LAPACKE, OpenBLAS, CHOLMOD,
 # assimp, cJSON) is needed to use the package. tests/install.cmake checks all of this
 # from an install into a scratch prefix.
@@ -14,25 +17,25 @@ include(CMakePackageConfigHelpers)
 set(SINEW_CMAKE_DIR ${CMAKE_INSTALL_LIBDIR}/cmake/sinew)
 
 install(TARGETS sinew EXPORT sinewTargets
-  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT sinew_runtime
-          NAMELINK_COMPONENT sinew_devel
-  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT sinew_runtime
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT sinew_devel
+  LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT runtime
+          NAMELINK_COMPONENT development
+  RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR} COMPONENT runtime
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 # A separate export set: its link dependencies (embree, libccd) are looked for only by
 # the static part of sinewConfig.cmake, so a shared-only host needs none of their
 # development files.
 install(TARGETS sinew_static EXPORT sinewStaticTargets
-  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT sinew_devel
+  ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR} COMPONENT development
   INCLUDES DESTINATION ${CMAKE_INSTALL_INCLUDEDIR})
 install(DIRECTORY ${CMAKE_SOURCE_DIR}/plugin_api/include/sinew
-  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT sinew_devel
+  DESTINATION ${CMAKE_INSTALL_INCLUDEDIR} COMPONENT development
   FILES_MATCHING PATTERN "*.h")
 
 install(EXPORT sinewTargets NAMESPACE sinew:: DESTINATION ${SINEW_CMAKE_DIR}
-  COMPONENT sinew_devel)
+  COMPONENT development)
 install(EXPORT sinewStaticTargets NAMESPACE sinew:: DESTINATION ${SINEW_CMAKE_DIR}
-  COMPONENT sinew_devel)
+  COMPONENT development)
 configure_package_config_file(${CMAKE_CURRENT_SOURCE_DIR}/sinewConfig.cmake.in
   ${CMAKE_CURRENT_BINARY_DIR}/sinewConfig.cmake INSTALL_DESTINATION ${SINEW_CMAKE_DIR})
 # The ABI changes only with the major version (sinew_base.h, the SONAME).
@@ -40,7 +43,7 @@ write_basic_package_version_file(${CMAKE_CURRENT_BINARY_DIR}/sinewConfigVersion.
   VERSION ${PROJECT_VERSION} COMPATIBILITY SameMajorVersion)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/sinewConfig.cmake
   ${CMAKE_CURRENT_BINARY_DIR}/sinewConfigVersion.cmake
-  DESTINATION ${SINEW_CMAKE_DIR} COMPONENT sinew_devel)
+  DESTINATION ${SINEW_CMAKE_DIR} COMPONENT development)
 
 # sinew.pc, relocatable: prefix is found from the .pc file's own folder (${pcfiledir},
 # understood by pkg-config and pkgconf), so `cmake --install --prefix P` and DESTDIR work.
@@ -78,4 +81,4 @@ foreach(c ${cfgs} NOCONFIG)
 endforeach()
 configure_file(${CMAKE_CURRENT_SOURCE_DIR}/sinew.pc.in ${CMAKE_CURRENT_BINARY_DIR}/sinew.pc @ONLY)
 install(FILES ${CMAKE_CURRENT_BINARY_DIR}/sinew.pc DESTINATION ${SINEW_PC_DIR}
-  COMPONENT sinew_devel)
+  COMPONENT development)
