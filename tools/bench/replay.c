@@ -6,6 +6,7 @@
 void sw_replay_run(sw_replay *r) {
     const size_t pose = (size_t)12 * r->nbones;
     r->warmup_failed = r->failed = 0;
+    r->result = SINEW_OK;
     for (int f = 0; f < r->warmup; ++f) {
         sw_instance_set_pose_d(r->inst, r->T + (size_t)(f % r->nframes) * pose);
         r->warmup_failed +=
@@ -14,6 +15,7 @@ void sw_replay_run(sw_replay *r) {
     if (r->count_rt) sw_rt_count_begin();
     for (int s = 0; s < r->steps; ++s) {
         int f = s % r->nframes;
+        if (r->before && (r->result = r->before(r->user, s, f)) != SINEW_OK) break;
         double t0 = sw_now_seconds();
         if (r->post_null) sinew_instance_set_pose(r->inst, NULL, 0);
         sw_instance_set_pose_d(r->inst, r->T + (size_t)f * pose);

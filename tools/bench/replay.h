@@ -1,7 +1,8 @@
 /* The bench's one replay loop: an instance steps a clip, first untimed (it settles), then
  * timed, optionally reading its surface and counting allocation and lock calls, and hands
- * each timed step's figures to the mode. sinew-bench's timing, its contract count and the
- * --sc-compare and --newton-compare modes replay through it. */
+ * each timed step's figures to the mode. sinew-bench's timing and contract count, the
+ * --sc-compare and --newton-compare modes and the --world mode's timing and contract count
+ * replay through it. */
 #ifndef SW_BENCH_REPLAY_H
 #define SW_BENCH_REPLAY_H
 
@@ -22,6 +23,10 @@ typedef struct sw_replay {
     int post_null;    /* before each timed pose, a rejected empty pose (must not allocate) */
     float *pos, *nrm; /* when pos is set: read ns surface vertices after each timed step */
     uint32_t ns;
+    /* before each timed step's pose (outside its wall time, inside the count): e.g. the
+     * colliders moved to the frame; a result other than SINEW_OK ends the replay there
+     * (NULL: nothing) */
+    sinew_result (*before)(void *user, int step, int frame);
     /* each timed step: its index, its clip frame, its wall ms (pose, step and read) and its
      * stats (NULL: the mode needs none; then no stats are read) */
     void (*on_step)(void *user, int step, int frame, double ms, const sinew_step_stats *st);
@@ -29,6 +34,7 @@ typedef struct sw_replay {
     /* out */
     long warmup_failed, failed; /* steps that did not return SINEW_OK */
     sw_rt_counts counts;        /* with count_rt */
+    sinew_result result;        /* SINEW_OK, or what ended the replay (before) */
 } sw_replay;
 
 /* Runs r's untimed then timed steps. */
