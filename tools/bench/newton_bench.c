@@ -47,16 +47,12 @@ static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int
                             k ? "rest-first" : "current-Hessian", sinew_result_string(r));
     newton_sums m = {out, k, nframes, reps, inst, sinew_blob_surface_vertex_count(blob), surf, ms};
     /* an untimed pass first */
-    sw_replay rp = {.inst = inst,
-                    .T = T,
-                    .nframes = nframes,
-                    .nbones = (int)sinew_blob_bone_count(blob),
-                    .dt = dt,
-                    .warmup = nframes,
-                    .steps = reps * nframes,
-                    .count_rt = k,
-                    .on_step = newton_step,
-                    .user = &m};
+    sw_replay rp = sw_replay_clip(inst, T, nframes, (int)sinew_blob_bone_count(blob), dt);
+    rp.warmup = nframes;
+    rp.steps = reps * nframes;
+    rp.count_rt = k;
+    rp.on_step = newton_step;
+    rp.user = &m;
     sw_replay_run(&rp);
     out->failed += rp.warmup_failed + rp.failed;
     if (k) sw_rt_counts_report(&rp.counts, &out->allocs, &out->locks);

@@ -3,6 +3,10 @@
 #include "clock.h"
 #include "instance.h"
 
+sw_replay sw_replay_clip(sinew_instance *inst, const double *T, int nframes, int nbones, float dt) {
+    return (sw_replay){.inst = inst, .T = T, .nframes = nframes, .nbones = nbones, .dt = dt};
+}
+
 void sw_replay_run(sw_replay *r) {
     const size_t pose = (size_t)12 * r->nbones;
     r->warmup_failed = r->failed = 0;

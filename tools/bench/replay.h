@@ -37,6 +37,10 @@ typedef struct sw_replay {
     sinew_result result;        /* SINEW_OK, or what ended the replay (before) */
 } sw_replay;
 
+/* A replay of the clip T (nframes frames of nbones bones) on inst at dt, nothing else
+ * set: no untimed and no timed steps yet, no count, no read, no hooks. */
+sw_replay sw_replay_clip(sinew_instance *inst, const double *T, int nframes, int nbones, float dt);
+
 /* Runs r's untimed then timed steps. */
 void sw_replay_run(sw_replay *r);
 

@@ -47,16 +47,12 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
     out->ms_mean[k] = out->ms_max[k] = out->tests_mean[k] = out->pairs_mean[k] = 0;
     sc_sums m = {out, k, 0, 0};
     /* an untimed pass first: the instance settles on the clip */
-    sw_replay rp = {.inst = inst,
-                    .T = T,
-                    .nframes = nframes,
-                    .nbones = (int)sinew_blob_bone_count(blob),
-                    .dt = dt,
-                    .warmup = nframes,
-                    .steps = reps * nframes,
-                    .count_rt = count_rt,
-                    .on_step = sc_step,
-                    .user = &m};
+    sw_replay rp = sw_replay_clip(inst, T, nframes, (int)sinew_blob_bone_count(blob), dt);
+    rp.warmup = nframes;
+    rp.steps = reps * nframes;
+    rp.count_rt = count_rt;
+    rp.on_step = sc_step;
+    rp.user = &m;
     sw_replay_run(&rp);
     out->failed += rp.warmup_failed + rp.failed;
     if (count_rt) sw_rt_counts_report(&rp.counts, &out->allocs[k], &out->locks[k]);

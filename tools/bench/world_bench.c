@@ -92,18 +92,14 @@ static void time_subspace(sinew_instance *inst, sw_world_scene *ws, const double
     world_pass w = {inst, ws, err, malloc(sizeof(double) * n), malloc(sizeof(double) * n), n, out};
     float *pos = malloc(sizeof(float) * 3 * ns), *nrm = malloc(sizeof(float) * 3 * ns);
     if (w.qms && w.sms && pos && nrm) {
-        sw_replay rp = {.inst = inst,
-                        .T = T,
-                        .nframes = nf,
-                        .nbones = nbones,
-                        .dt = 1.0f / 30,
-                        .steps = n,
-                        .pos = pos,
-                        .nrm = nrm,
-                        .ns = ns,
-                        .before = world_before,
-                        .on_step = world_step,
-                        .user = &w};
+        sw_replay rp = sw_replay_clip(inst, T, nf, nbones, 1.0f / 30);
+        rp.steps = n;
+        rp.pos = pos;
+        rp.nrm = nrm;
+        rp.ns = ns;
+        rp.before = world_before;
+        rp.on_step = world_step;
+        rp.user = &w;
         sw_replay_run(&rp);
         out->sub_failed += rp.failed;
     }
@@ -161,15 +157,11 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
     if (out->contract_steps > 0 && r == SINEW_OK) {
         /* the colliders at each frame: inside the count (world_before, no reset past n) */
         world_pass w = {inst, ws, err, NULL, NULL, 0, out};
-        sw_replay rp = {.inst = inst,
-                        .T = T,
-                        .nframes = nf,
-                        .nbones = v->nbones,
-                        .dt = 1.0f / 30,
-                        .steps = out->contract_steps,
-                        .count_rt = 1,
-                        .before = world_before,
-                        .user = &w};
+        sw_replay rp = sw_replay_clip(inst, T, nf, v->nbones, 1.0f / 30);
+        rp.steps = out->contract_steps;
+        rp.count_rt = 1;
+        rp.before = world_before;
+        rp.user = &w;
         sw_replay_run(&rp);
         out->sub_failed += rp.failed;
         sw_rt_counts_report(&rp.counts, &out->allocs, &out->locks);

@@ -544,17 +544,14 @@ static int run_subspace(bench *b, sw_error *err) {
     b->sub = malloc((size_t)nf * sizeof(double));
     b->phase = malloc((size_t)nf * NPHASES * sizeof(double));
     b->beyond_bone = -1; /* frames bent beyond the bake's training */
-    sw_replay rp = {.inst = b->inst,
-                    .T = b->ch.clip.T,
-                    .nframes = nf,
-                    .nbones = b->ch.skel.nbones,
-                    .dt = 1.0f / (float)(b->ch.clip.fps > 0 ? b->ch.clip.fps : 30),
-                    .steps = b->o.timing_passes * nf,
-                    .pos = b->pos,
-                    .nrm = b->nrm,
-                    .ns = b->ns,
-                    .on_step = sub_step,
-                    .user = b};
+    sw_replay rp = sw_replay_clip(b->inst, b->ch.clip.T, nf, b->ch.skel.nbones,
+                                  1.0f / (float)(b->ch.clip.fps > 0 ? b->ch.clip.fps : 30));
+    rp.steps = b->o.timing_passes * nf;
+    rp.pos = b->pos;
+    rp.nrm = b->nrm;
+    rp.ns = b->ns;
+    rp.on_step = sub_step;
+    rp.user = b;
     sw_replay_run(&rp);
     b->failed_steps += rp.failed; /* steps that did not return SINEW_OK (a non-finite state) */
     b->sub_ms = sw_median(b->sub, nf);
@@ -617,18 +614,14 @@ static void run_contract(bench *b) {
     b->allocs = b->locks = -1;
     (void)sw_rt_interpose_active(); /* its self-check counts: outside the counted steps */
     if (b->o.contract_steps > 0) {
-        sw_replay rp = {.inst = b->inst,
-                        .T = b->ch.clip.T,
-                        .nframes = b->nf,
-                        .nbones = b->ch.skel.nbones,
-                        .dt = 1.0f / 30,
-                        .warmup = 10,
-                        .steps = b->o.contract_steps,
-                        .count_rt = 1,
-                        .post_null = 1,
-                        .pos = b->pos,
-                        .nrm = b->nrm,
-                        .ns = b->ns};
+        sw_replay rp = sw_replay_clip(b->inst, b->ch.clip.T, b->nf, b->ch.skel.nbones, 1.0f / 30);
+        rp.warmup = 10;
+        rp.steps = b->o.contract_steps;
+        rp.count_rt = 1;
+        rp.post_null = 1;
+        rp.pos = b->pos;
+        rp.nrm = b->nrm;
+        rp.ns = b->ns;
         sw_replay_run(&rp);
         b->failed_steps += rp.failed;
         sw_rt_counts_report(&rp.counts, &b->allocs, &b->locks);
