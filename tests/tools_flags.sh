@@ -21,6 +21,7 @@ fail() {
 # The Flags line of a tool: its --help's flags (the first word of each flag line), in order.
 flags_line() {
     local list
+    # shellcheck disable=SC2016 # the backquotes are markdown's, not the shell's
     list=$(grep -oE '^  --[a-z0-9-]+' <<<"$1" | sed 's/^  //' | awk '!seen[$0]++' |
         sed 's/.*/`&`/' | paste -sd, - | sed 's/,/, /g')
     echo "Flags (\`$2 --help\` says what each takes): $list"
