@@ -38,6 +38,7 @@
 #include "character_io.h"
 #include "samples.h"
 #include "subspace_eval.h"
+#include "bake_cli.h"
 
 static const char *const tool = "sinew-bake";
 
@@ -50,230 +51,10 @@ static const char *json_number(double v, char *buf) {
     return buf;
 }
 
-#define TEXT_(x) #x
-#define TEXT(x) TEXT_(x)
-
-/* The command line. */
+/* Everything the bake made and measured. The steps that read it (write_outputs,
+ * print_summary, print_json) take its members by value under main's names. */
 typedef struct {
-    sw_character_args ca;
-    const char *out_path, *report_dir;
-    int json, force, spread_every, seed, seed_given, eval_pairs;
-    sw_bake_params p;
-    sw_fullsim_params reference; /* its solver options */
-    sw_adaptive_params ad;
-} options;
-
-static const char *const SYNOPSIS =
-    "sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
-    "                   [--fps F] [--height H] |\n"
-    "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-    "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-    "                   [--clip FILE [--frames F] | --joint-range FILE])\n"
-    "                  --out FILE.blob [--report DIR]\n"
-    "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
-    "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
-    "                  [--compare-cubature] [--no-self-contact]\n"
-    "                  [--return-path|--no-return-path]\n"
-    "                  [--pair-sweeps | --no-pair-sweeps] [--no-sibling-sweeps]\n"
-    "                  [--adaptive R [--adaptive-add K]\n"
-    "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
-    "                  [--adaptive-target E]] [--heldout-steps S]\n"
-    "                  [--random-poses N] [--seed S]\n"
-    "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
-    "                  [--no-pose-force]\n"
-    "                  [--eval-self-contact pose-space|pose-pairs]\n"
-    "                  [--reference-spread K] [reference options]\n"
-    "                  [--cache DIR] [--threads T] [--force]\n"
-    "                  [--json]\n";
-
-/* --selector greedy | importance | nnhtp */
-static int take_selector(const char *tool, const char *flag, const char *v, void *target) {
-    static const char *const names[] = {"greedy", "importance", "nnhtp", NULL};
-    static const sw_cubature_selector selectors[] = {SW_CUBATURE_GREEDY, SW_CUBATURE_IMPORTANCE,
-                                                     SW_CUBATURE_NNHTP};
-    int k = sw_tool_choice(v, names);
-    if (k < 0) {
-        fprintf(stderr, "%s: %s wants greedy | importance | nnhtp, got '%s'\n", tool, flag, v);
-        return 0;
-    }
-    *(sw_cubature_selector *)target = selectors[k];
-    return 1;
-}
-
-/* --fold-share S, 0 <= S < 0.5 */
-static int take_fold_share(const char *tool, const char *flag, const char *v, void *target) {
-    double *s = target;
-    int ok = sw_tool_real(tool, flag, v, -1, 0.5, "in 0..0.5", s);
-    if (ok && *s < 0) {
-        fprintf(stderr, "%s: %s wants a number in 0..0.5, got '%s'\n", tool, flag, v);
-        ok = 0;
-    }
-    return ok;
-}
-
-/* The bake's own flags, bound to o, into f; returns their count. */
-static size_t bake_flags(options *o, sw_flag *f) {
-    static const char *const eval_modes[] = {"pose-space", "pose-pairs", NULL};
-    sw_bake_params *p = &o->p;
-    sw_adaptive_params *ad = &o->ad;
-    const sw_flag flags[] = {
-        {SW_STR("--out", &o->out_path, "FILE",
-                "the blob to write (atomically: FILE.tmp, then renamed)")},
-        {SW_STR("--report", &o->report_dir, "DIR",
-                "write the bake report: DIR/report.html (plots of every clip\n"
-                "frame's error, ranks, cubature, stage times, a contact sheet of\n"
-                "held-out frames) and DIR/report.json (the same figures)")},
-        {SW_CALL("--selector", take_selector, &p->selector, "S",
-                 "cubature selector: greedy | importance | nnhtp (default)")},
-        {SW_REAL("--tol", &p->cubature_tol, 0, 1, "in the open range 0..1", "T",
-                 "cubature fit tolerance, 0 < T < 1 (default 0.05)")},
-        {SW_INT("--max-rank", &p->max_rank, 1, 1024, "R",
-                "basis rank per domain, 1..1024 (default 30)")},
-        {SW_REAL("--pca-strain", &p->pca_strain, -1e-300, nextafter(1.0, 2.0), "in 0..1", "S",
-                 "the basis's PCA in an inner product that is the share S of the\n"
-                 "snapshots' rest strain energy, 0..1 (default 0: the plain PCA)")},
-        {SW_CALL("--fold-share", take_fold_share, &p->fold_share, "S",
-                 "a bone whose tets hold less than S of the mesh's volume\n"
-                 "joins its parent's domain, 0..0.5 (default 0: off; 0.03\n"
-                 "folds the elephant's 24 bones into 11 domains)")},
-        {SW_REAL("--spring-k", &p->spring_k, 0, INFINITY, "above 0", "K",
-                 "interface spring stiffness, K > 0 (default: of 20, 10, 5 and\n"
-                 "2.5 E h the one with the lowest training error)")},
-        {SW_SET("--compare-cubature", &p->compare_selectors, 1,
-                "also train the other two selectors on the same data and\n"
-                "report each one's tets, seconds and worst fit")},
-        {SW_SET("--no-self-contact", &p->self_contact, 0,
-                "no self-contact in the training simulations")},
-        {SW_SET("--return-path", &p->return_path, 1,
-                "also train on the way home: from the first training clip's\n"
-                "last frame, its earlier frames backwards, each bent less than\n"
-                "the one before (a fold keeps its branch on the way out); by\n"
-                "default on where the held-out frames continue the training\n"
-                "clip (a --clip or a file's one clip split 60/40), off for\n"
-                "--train-clips")},
-        {SW_SET("--no-return-path", &p->return_path, 0, "never train on the way home")},
-        {SW_SET("--pair-sweeps", &p->pair_sweeps, 1,
-                "also train on every joint swept together with its parent\n"
-                "joint (combinations the single-joint sweeps never show); by\n"
-                "default on with --joint-range")},
-        {SW_SET("--no-pair-sweeps", &p->pair_sweeps, 0, "never the pair sweeps")},
-        {SW_SET("--no-sibling-sweeps", &p->sibling_sweeps, 0,
-                "do not train on two sibling joints whose flesh meets\n"
-                "swept together (by default each such pair is: the flesh\n"
-                "between them shears with the difference of their bends)")},
-        {SW_INT("--adaptive", &ad->rounds, 0, SW_ADAPTIVE_MAX_ROUNDS, "R",
-                "then up to R rounds that each add the K (default 8) of C\n"
-                "(default 64) random combined poses the blob steps worst (the\n"
-                "full-space force its state leaves over plain skinning's) to\n"
-                "the training poses and bake again, until B poses (default 32)\n"
-                "are added or the held-out error is at most E")},
-        {SW_INT("--adaptive-add", &ad->add, 1, 100000, "K", "poses added a round, 1..100000")},
-        {SW_INT("--adaptive-candidates", &ad->candidates, 1, 100000, "C",
-                "candidate poses scored a round, 1..100000")},
-        {SW_INT("--adaptive-budget", &ad->budget, 0, 1000000, "B",
-                "poses added in all at most, 0..1000000")},
-        {SW_REAL("--adaptive-target", &ad->target, 0, 1, "in 0..1", "E",
-                 "stop once the held-out error is at most E, 0 < E < 1")},
-        {SW_INT("--heldout-steps", &p->heldout_steps, 1, 64, "S",
-                "without a clip, the 10 random held-out poses are each\n"
-                "reached from the one before in S held-out poses, 1..64\n"
-                "(default 4; the reference depends on the path)")},
-        {SW_INT("--random-poses", &p->random_poses, 1, 10000, "N",
-                "without a clip, N random held-out poses, 1..10000\n"
-                "(default 10; more define the held-out figure better)")},
-        {SW_INT("--seed", &o->seed, 0, 2147483647, "S",
-                "the bake's random draws (held-out poses, adaptive candidates,\n"
-                "cubature candidates), 0..2147483647 (default 1592614637)"),
-         .given = &o->seed_given},
-        {SW_SET("--contact-modes", &p->contact_modes, 1,
-                "also the static responses to the training poses' self-contact\n"
-                "forces in the basis (thesis 3.3.1; a higher rank)")},
-        {SW_REAL("--contact-tol", &p->contact_cubature_tol, -1e-300, 1, "in 0 <= T < 1", "T",
-                 "per pair of domains, each training pose's contact pairs are\n"
-                 "cut to a cubature that keeps their reduced force to T,\n"
-                 "0 <= T < 1 (default 0.05; 0: every pair kept)")},
-        {SW_SET("--no-pose-force", &p->pose_force, 0,
-                "no pose-space equilibrium force in the blob (by default each\n"
-                "training pose carries the reduced force that makes its\n"
-                "projected solution the runtime's equilibrium there,\n"
-                "interpolated between poses)")},
-        {SW_CHOICE("--eval-self-contact", &o->eval_pairs, eval_modes, "M",
-                   "the runtime's self-contact mode the bake's errors are\n"
-                   "measured in: pose-space (default) or pose-pairs")},
-        {SW_INT("--reference-spread", &o->spread_every, 1, 1000000, "K",
-                "at every K-th held-out pose, three more full-space\n"
-                "solves: from plain skinning, from the reference and from the\n"
-                "runtime's state; how far they land from the reference says\n"
-                "how well the reference is defined, and whether the runtime\n"
-                "sits by another equilibrium")},
-        {SW_SET("--inertia-modes", &p->inertia_modes, 1,
-                "for the dynamic step: basis modes for the inertia of the\n"
-                "bones' accelerations (static responses to them), so that the\n"
-                "flesh lags and overshoots as the reference does; a higher rank")},
-        {SW_STR("--cache", &p->cache_dir, "DIR",
-                "keep the full-space solutions in DIR and reuse them when a\n"
-                "later bake solves the same poses of the same character (a\n"
-                "re-bake that changes the cubature, rank or report only)")},
-        {SW_INT("--threads", &p->threads, 0, 256, "T", "0..256 (default 0: all cores)")},
-        {SW_SET("--force", &o->force, 1,
-                "write the blob even when its training error is " TEXT(
-                    SW_BAKE_MAX_TRAIN_ERROR) " or more\n"
-                                             "(the share of the physics correction it misses "
-                                             "on its own\n"
-                                             "training poses; without --force that is an error)")},
-        {SW_SET("--json", &o->json, 1, "one JSON object with the figures as the last stdout line")},
-    };
-    memcpy(f, flags, sizeof flags);
-    return SW_FLAGS_N(flags);
-}
-
-/* Parses argv into *o: 0, or the exit status after a message. */
-static int parse_args(int argc, char **argv, options *o) {
-    memset(o, 0, sizeof *o);
-    sw_character_args_init(&o->ca, tool);
-    o->p = sw_bake_params_default();
-    o->reference = sw_fullsim_params_default();
-    o->p.reference = &o->reference;
-    o->ad = sw_adaptive_params_default();
-    o->ad.rounds = 0;
-    o->p.progress = 1;
-    sw_flag character[SW_CHARACTER_NFLAGS], bake[48], reference[SW_REFERENCE_NFLAGS];
-    const sw_flag_group groups[] = {
-        {"character:\n" SW_CHARACTER_FILE_USAGE, character, sw_character_flags(&o->ca, character)},
-        {"bake:", bake, bake_flags(o, bake)},
-        {"reference options (every full-space solve of the bake; a change of them\n"
-         "solves the poses again instead of reading the cache):",
-         reference, sw_reference_flags(&o->reference, reference)}};
-    const sw_tool_cli cli = {tool,
-                             SYNOPSIS,
-                             groups,
-                             SW_FLAGS_N(groups),
-                             "exit status: 0 blob written, 1 failed, 2 bad arguments\n",
-                             &o->ca.file,
-                             1};
-    int status = sw_flags_parse(&cli, argc, argv);
-    if (status) return status;
-    if (o->seed_given) o->p.seed = (uint64_t)o->seed;
-    if (!o->out_path) {
-        fprintf(stderr, "%s: give --out FILE.blob\n", tool);
-        sw_flags_usage(&cli, stderr);
-        return 2;
-    }
-    if (!sw_character_args_valid(&o->ca)) return 2;
-    /* the report's folder before the long run: an unwritable one is an error now */
-    const char *dirs[2][2] = {{"--report", o->report_dir}, {"--cache", o->p.cache_dir}};
-    for (int k = 0; k < 2; ++k)
-        if (dirs[k][1] && !sw_tool_make_dirs(dirs[k][1])) {
-            fprintf(stderr, "%s: %s '%s': cannot create or write the folder: %s\n", tool,
-                    dirs[k][0], dirs[k][1], strerror(errno ? errno : EACCES));
-            return 1;
-        }
-    return 0;
-}
-
-/* Everything the bake made and measured. */
-typedef struct {
-    options o;
+    bake_options o;
     sw_tool_progress bar;
     sw_character ch;
     sw_clip_split clips;
@@ -316,7 +97,7 @@ static int load_character(bake *b, sw_error *err) {
 
 /* The bake (with --adaptive, its rounds). */
 static int run_bake(bake *b, sw_error *err) {
-    options *o = &b->o;
+    bake_options *o = &b->o;
     sw_tool_progress_init(&b->bar, tool);
     o->p.on_progress = sw_tool_progress_print;
     o->p.progress_user = &b->bar;
@@ -332,7 +113,7 @@ static int run_bake(bake *b, sw_error *err) {
 /* The blob measured before it goes to the file: its errors on the bake's poses, in each
  * self-contact mode, and with --reference-spread the reference's spread. */
 static int measure(bake *b, sw_error *err) {
-    const options *o = &b->o;
+    const bake_options *o = &b->o;
     sw_bake_result *res = &b->res;
     sinew_self_contact eval_mode =
         o->eval_pairs ? SINEW_SELF_CONTACT_POSE_PAIRS : SINEW_SELF_CONTACT_POSE_SPACE;
@@ -369,164 +150,192 @@ static int measure(bake *b, sw_error *err) {
        poses' errors their projections' whatever the model (bake_equilibrium.c) */
     b->model_err = res->model_train_error >= 0 ? res->model_train_error : b->et.correction_error;
     b->absurd = !(b->model_err < SW_BAKE_MAX_TRAIN_ERROR) || b->et.failed > 0;
+    /* what the summary and the JSON line both list */
+    const sw_blob_view *v = &res->view;
+    for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
+        b->kept += v->pair_weight[c] > 0;
+    b->nbeyond_all = sw_bake_beyond_training(res, &b->ch.skel, b->beyond, BAKE_BEYOND);
+    b->nbeyond = b->nbeyond_all < BAKE_BEYOND ? b->nbeyond_all : BAKE_BEYOND;
     return 0;
 }
 
 /* The blob written (unless absurd without --force) and with --report the report. */
-static int write_outputs(bake *b, sw_error *err) {
-    const options *o = &b->o;
-    const sw_bake_result *res = &b->res;
-    const char *out_path = o->out_path;
+static int write_outputs(const bake *b) {
+    /* by value, under main's names */
+    const char *out_path = b->o.out_path;
+    const char *report_dir = b->o.report_dir;
+    const char *source = b->source;
+    const sw_character_args ca = b->o.ca;
+    const sw_bake_params p = b->o.p;
+    const sw_fullsim_params reference = b->o.reference;
+    const sw_adaptive_params ad = b->o.ad;
+    const sw_adaptive_report arep = b->arep;
+    const sw_character ch = b->ch;
+    const sw_clip_split clips = b->clips;
+    const sw_scene_character_info info = b->info;
+    const sw_bake_result res = b->res;
+    const sinew_blob *blob = b->blob;
+    const sw_eval_result et = b->et;
+    const sw_eval_result eh = b->eh;
+    const sw_bake_spread spread = b->spread;
+    const double *frame_err = b->frame_err;
+    const double *mode_err = b->mode_err;
+    const double bake_seconds = b->bake_seconds;
+    const double eval_seconds = b->eval_seconds;
+    const double model_err = b->model_err;
+    const int force = b->o.force;
+    const int spread_every = b->o.spread_every;
+    const int absurd = b->absurd;
+    sw_error err;
     sinew_result r;
-    if (b->absurd && !o->force && b->et.failed > 0) {
+    if (absurd && !force && et.failed > 0) {
         fprintf(stderr,
                 "%s: error: %d of the blob's steps through its own %d training poses failed (a "
                 "non-finite state: check the material and --spring-k); %s not written, or "
                 "--force to write it anyway\n",
-                tool, b->et.failed, res->ntrain, out_path);
+                tool, et.failed, res.ntrain, out_path);
         return 1;
     }
-    if (b->absurd && !o->force) {
+    if (absurd && !force) {
         fprintf(stderr,
                 "%s: error: the bake's training error is %.4f (at least %.2f: the subspace misses "
                 "that share of the physics correction on its own training poses without the "
                 "equilibrium force; a sound bake misses a few percent); %s not written. Give a "
                 "clip with more frames or joint motion or a higher --max-rank, or --force to "
                 "write it anyway\n",
-                tool, b->model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
+                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
         return 1;
     }
-    if ((r = sw_blob_write(out_path, &res->view, err)) != SINEW_OK)
-        return sw_tool_failed(r, err, "%s: cannot write %s: ", tool, out_path);
-    if (!o->report_dir) return 0;
-    int scene_clips = o->p.ntrain_clips > 0;
-    const sw_clip_split *clips = &b->clips;
-    sw_bake_report_input ri = {b->source,
-                               &b->ch,
-                               res,
-                               b->blob,
-                               scene_clips ? (const char(*)[64])clips->train_names : NULL,
-                               scene_clips ? clips->ntrain : 0,
-                               scene_clips ? (const char(*)[64])clips->heldout_names : NULL,
-                               scene_clips ? clips->nheldout : 0,
-                               b->frame_err,
-                               b->frame_err + res->ntrain,
-                               b->et.correction_error,
-                               b->eh.correction_error,
-                               b->et.failed + b->eh.failed,
-                               b->bake_seconds,
-                               b->eval_seconds,
-                               1,
-                               o->ad.rounds > 0 ? &b->arep : NULL,
-                               &b->et,
-                               &b->eh,
-                               !o->ca.file                               ? NULL
-                               : b->info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
-                                                                         : "lattice",
-                               b->mode_err,
-                               o->spread_every > 0 ? &b->spread : NULL,
-                               sw_linear_solver_name(o->reference.solver),
-                               sw_hessian_mode_name(o->reference.hessian)};
-    if ((r = sw_bake_report_write(o->report_dir, &ri, err)) != SINEW_OK)
-        return sw_tool_failed(r, err, "%s: --report %s: ", tool, o->report_dir);
-    fprintf(stderr, "%s: wrote the report %s/report.html and %s/report.json\n", tool, o->report_dir,
-            o->report_dir);
+    if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
+        sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
+        return 1;
+    }
+    if (report_dir) {
+        int scene_clips = p.ntrain_clips > 0;
+        sw_bake_report_input ri = {source,
+                                   &ch,
+                                   &res,
+                                   blob,
+                                   scene_clips ? (const char(*)[64])clips.train_names : NULL,
+                                   scene_clips ? clips.ntrain : 0,
+                                   scene_clips ? (const char(*)[64])clips.heldout_names : NULL,
+                                   scene_clips ? clips.nheldout : 0,
+                                   frame_err,
+                                   frame_err + res.ntrain,
+                                   et.correction_error,
+                                   eh.correction_error,
+                                   et.failed + eh.failed,
+                                   bake_seconds,
+                                   eval_seconds,
+                                   1,
+                                   ad.rounds > 0 ? &arep : NULL,
+                                   &et,
+                                   &eh,
+                                   !ca.file                               ? NULL
+                                   : info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
+                                                                          : "lattice",
+                                   mode_err,
+                                   spread_every > 0 ? &spread : NULL,
+                                   sw_linear_solver_name(reference.solver),
+                                   sw_hessian_mode_name(reference.hessian)};
+        if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
+            sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
+            return 1;
+        }
+        fprintf(stderr, "%s: wrote the report %s/report.html and %s/report.json\n", tool,
+                report_dir, report_dir);
+    }
     return 0;
-}
-
-/* What the summary and the JSON line both list: the pairs the per-pair cubature keeps,
- * the joints the held-out poses bend beyond training. */
-static void tally(bake *b) {
-    const sw_blob_view *v = &b->res.view;
-    b->kept = 0;
-    for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
-        b->kept += v->pair_weight[c] > 0;
-    b->nbeyond_all = sw_bake_beyond_training(&b->res, &b->ch.skel, b->beyond, BAKE_BEYOND);
-    b->nbeyond = b->nbeyond_all < BAKE_BEYOND ? b->nbeyond_all : BAKE_BEYOND;
 }
 
 /* The bake's summary on stderr. */
 static void print_summary(const bake *b) {
-    const options *o = &b->o;
-    const sw_bake_params *p = &o->p;
-    const sw_fullsim_params *reference = &o->reference;
-    const sw_bake_result *res = &b->res;
-    const sw_character *ch = &b->ch;
-    const sw_eval_result *et = &b->et, *eh = &b->eh;
-    const sw_bake_spread *spread = &b->spread;
+    /* by value, under main's names */
+    const char *out_path = b->o.out_path;
+    const sw_bake_params p = b->o.p;
+    const sw_fullsim_params reference = b->o.reference;
+    const sw_character ch = b->ch;
+    const sw_bake_result res = b->res;
+    const sw_eval_result et = b->et;
+    const sw_eval_result eh = b->eh;
+    const sw_bake_spread spread = b->spread;
+    const double *mode_err = b->mode_err;
+    const double bake_seconds = b->bake_seconds;
+    const double model_err = b->model_err;
+    const int spread_every = b->o.spread_every;
+    const int absurd = b->absurd;
+    const int32_t kept = b->kept;
+    const int32_t nbeyond = b->nbeyond;
+    const int32_t nbeyond_all = b->nbeyond_all;
     const sw_joint_reach *beyond = b->beyond;
-    const char *out_path = o->out_path;
-    const double *mode_err = b->mode_err, bake_seconds = b->bake_seconds, model_err = b->model_err;
-    const int spread_every = o->spread_every, absurd = b->absurd;
-    const int32_t kept = b->kept, nbeyond = b->nbeyond, nbeyond_all = b->nbeyond_all;
     char num[32];
-    const sw_blob_view *v = &res->view;
+    const sw_blob_view *v = &res.view;
     fprintf(stderr, "%s: wrote %s\n", tool, out_path);
     fprintf(stderr,
             "  stages (s): prepare %.2f, domains %.2f, simulate %.2f, basis %.2f, cubature %.2f, "
             "reduce %.2f; total %.2f\n",
-            res->stage_seconds[0], res->stage_seconds[1], res->stage_seconds[2],
-            res->stage_seconds[3], res->stage_seconds[4], res->stage_seconds[5], bake_seconds);
+            res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2], res.stage_seconds[3],
+            res.stage_seconds[4], res.stage_seconds[5], bake_seconds);
     fprintf(stderr, "  domains %d, total rank %d (", v->ndomains, v->rank_total);
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].rank);
     fprintf(stderr, "), cubature tets %d (", v->ncub);
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].cub_count);
-    fprintf(stderr, "), worst cubature fit %.4f\n", res->cubature_error_max);
+    fprintf(stderr, "), worst cubature fit %.4f\n", res.cubature_error_max);
     /* random held-out poses (no clip) come on a path: say what the count is made of */
     char held_how[128] = "";
-    if (res->nheldout > 0 && res->heldout_clip[0] < 0)
+    if (res.nheldout > 0 && res.heldout_clip[0] < 0)
         snprintf(held_how, sizeof held_how,
                  " (%d random combined poses, each reached in %d steps, %s)",
-                 res->nheldout / p->heldout_steps, p->heldout_steps,
-                 ch->range.nframes > 0 ? "the joints within --joint-range"
-                                       : "every joint within 90 degrees");
+                 res.nheldout / p.heldout_steps, p.heldout_steps,
+                 ch.range.nframes > 0 ? "the joints within --joint-range"
+                                      : "every joint within 90 degrees");
     char pair_how[64] = ""; /* on by default only with a range: say when they ran */
-    if (res->pair_sweep_poses > 0)
+    if (res.pair_sweep_poses > 0)
         snprintf(pair_how, sizeof pair_how, " (%d of joints swept with their parents)",
-                 res->pair_sweep_poses);
+                 res.pair_sweep_poses);
     fprintf(stderr,
             "  poses: %d training%s, %d held-out%s; basis projection error train %.4f held-out "
             "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
-            res->ntrain, pair_how, res->nheldout, held_how, res->train_proj_error,
-            res->heldout_proj_error, res->train_galerkin_error, res->heldout_galerkin_error);
+            res.ntrain, pair_how, res.nheldout, held_how, res.train_proj_error,
+            res.heldout_proj_error, res.train_galerkin_error, res.heldout_galerkin_error);
     fprintf(stderr, "  references solved by: solver %s, %s Hessians, at most %d contact rounds\n",
-            sw_linear_solver_name(reference->solver), sw_hessian_mode_name(reference->hessian),
-            reference->contact_rounds);
+            sw_linear_solver_name(reference.solver), sw_hessian_mode_name(reference.hessian),
+            reference.contact_rounds);
     fprintf(stderr,
             "  self-contact: %d contact pairs over the training poses in %d pairs of domains; "
             "the per-pair cubature keeps %d (--contact-tol %g)\n",
-            v->ncontacts, v->npair_groups, kept, p->contact_cubature_tol);
+            v->ncontacts, v->npair_groups, kept, p.contact_cubature_tol);
     if (v->nrender_verts > 0)
         fprintf(stderr,
                 "  output: the render mesh, %d vertices (%d welded duplicates), %d triangles, "
                 "embedded in %d tets in %.1f ms; %d vertices outside the tets, by %.4g at most; "
                 "|barycentric| <= %.3g\n",
-                v->nrender_verts, res->render_welded, v->nrender_tris, v->nembed_tets,
-                1e3 * res->embed_seconds, res->render_outside, res->render_max_outside,
-                res->render_max_bary);
-    if (res->train_unsettled + res->heldout_unsettled > 0)
+                v->nrender_verts, res.render_welded, v->nrender_tris, v->nembed_tets,
+                1e3 * res.embed_seconds, res.render_outside, res.render_max_outside,
+                res.render_max_bary);
+    if (res.train_unsettled + res.heldout_unsettled > 0)
         fprintf(
             stderr,
             "  reference: the contact round cap left the contact set unsettled in %d training and "
             "%d held-out solutions (their fold depends on the cap)\n",
-            res->train_unsettled, res->heldout_unsettled);
+            res.train_unsettled, res.heldout_unsettled);
     fprintf(stderr,
             "  correction error (subspace vs full, share of the correction missed, on the bake's "
             "poses): train %.4f, held-out %.4f (%d failed steps)\n",
-            et->correction_error, eh->correction_error, et->failed + eh->failed);
-    if (res->model_train_error >= 0)
+            et.correction_error, eh.correction_error, et.failed + eh.failed);
+    if (res.model_train_error >= 0)
         fprintf(stderr,
                 "  equilibrium force at %d of %d training poses; the training error without it "
                 "%.4f\n",
-                res->force_poses, res->ntrain, res->model_train_error);
+                res.force_poses, res.ntrain, res.model_train_error);
     fprintf(stderr,
             "  seams (the domains' copies of a vertex apart, share of the correction; largest "
             "gap over the rest diagonal): train %.4f, %.2e; held-out %.4f, %.2e\n",
-            et->seam, et->seam_max, eh->seam, eh->seam_max);
+            et.seam, et.seam_max, eh.seam, eh.seam_max);
     for (int set = 0; set < 2; ++set) {
-        const sw_eval_result *e = set ? eh : et;
+        const sw_eval_result *e = set ? &eh : &et;
         if (e->nregions < 1) continue;
         fprintf(stderr,
                 "  %s error by region (strongest bone: share of the error / of the "
@@ -534,9 +343,8 @@ static void print_summary(const bake *b) {
                 set ? "held-out" : "training");
         for (int32_t k = 0; k < e->nregions; ++k)
             fprintf(stderr, " bone %d%s%s %.3f / %.3f%s", e->region_bone[k],
-                    ch->bone_names ? " " : "",
-                    ch->bone_names ? ch->bone_names[e->region_bone[k]] : "", e->region_err[k],
-                    e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
+                    ch.bone_names ? " " : "", ch.bone_names ? ch.bone_names[e->region_bone[k]] : "",
+                    e->region_err[k], e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
     }
     fprintf(stderr, "  held-out error by self-contact mode:");
     for (int k = 0; k < SW_BAKE_MODES; ++k)
@@ -548,9 +356,8 @@ static void print_summary(const bake *b) {
                 "  reference spread at %d held-out poses (every %d-th): runtime %.4f; full-space "
                 "solves from plain skinning %.4f, from the reference %.4f, from the runtime's "
                 "state %.4f (moved it %.4f); %d unconverged, %d left out\n",
-                spread->poses, spread_every, spread->runtime, spread->from_skin,
-                spread->from_reference, spread->polished, spread->polish_move, spread->unconverged,
-                spread->failed);
+                spread.poses, spread_every, spread.runtime, spread.from_skin, spread.from_reference,
+                spread.polished, spread.polish_move, spread.unconverged, spread.failed);
     if (nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
         int32_t shown = nbeyond < 8 ? nbeyond : 8;
         fprintf(stderr,
@@ -559,7 +366,7 @@ static void print_summary(const bake *b) {
                 nbeyond_all, nbeyond_all == 1 ? "" : "s");
         for (int32_t k = 0; k < shown; ++k) {
             fprintf(stderr, " bone %d", beyond[k].bone);
-            if (ch->bone_names) fprintf(stderr, " %s", ch->bone_names[beyond[k].bone]);
+            if (ch.bone_names) fprintf(stderr, " %s", ch.bone_names[beyond[k].bone]);
             fprintf(stderr, " %.1f / %.1f%s", beyond[k].heldout_deg, beyond[k].train_deg,
                     k + 1 < shown     ? ","
                     : nbeyond > shown ? ", ...\n"
@@ -570,135 +377,145 @@ static void print_summary(const bake *b) {
         fprintf(stderr,
                 "%s: WARNING: written with --force although its training error is %.4f (refused "
                 "at %.2f) with %d failed steps: this blob misses most of the physics correction\n",
-                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, et->failed);
-    if (p->compare_selectors) {
+                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, et.failed);
+    if (p.compare_selectors) {
         static const char *names[3] = {"greedy", "importance", "nnhtp"};
         for (int s = 0; s < 3; ++s)
             fprintf(stderr, "  selector %-10s %6d tets  %8.2f s  worst fit %.4f\n", names[s],
-                    res->selector_points[s], res->selector_seconds[s], res->selector_error[s]);
+                    res.selector_points[s], res.selector_seconds[s], res.selector_error[s]);
     }
 }
 
-/* The JSON line. */
+/* The JSON line, with --json. */
 static void print_json(const bake *b) {
-    const options *o = &b->o;
-    const sw_bake_params *p = &o->p;
-    const sw_fullsim_params *reference = &o->reference;
-    const sw_adaptive_params *ad = &o->ad;
-    const sw_character_args *ca = &o->ca;
-    const sw_bake_result *res = &b->res;
-    const sw_blob_view *v = &res->view;
-    const sw_character *ch = &b->ch;
-    const sw_eval_result *et = &b->et, *eh = &b->eh;
-    const sw_bake_spread *spread = &b->spread;
-    const sw_adaptive_report *arep = &b->arep;
-    const sw_scene_character_info *info = &b->info;
-    const sw_quality *quality = &b->quality;
+    /* by value, under main's names */
+    const char *out_path = b->o.out_path;
+    const sw_character_args ca = b->o.ca;
+    const sw_bake_params p = b->o.p;
+    const sw_fullsim_params reference = b->o.reference;
+    const sw_adaptive_params ad = b->o.ad;
+    const sw_adaptive_report arep = b->arep;
+    const sw_character ch = b->ch;
+    const sw_scene_character_info info = b->info;
+    const sw_quality quality = b->quality;
+    const sw_bake_result res = b->res;
+    const sw_eval_result et = b->et;
+    const sw_eval_result eh = b->eh;
+    const sw_bake_spread spread = b->spread;
+    const double *mode_err = b->mode_err;
+    const double bake_seconds = b->bake_seconds;
+    const double eval_seconds = b->eval_seconds;
+    const double model_err = b->model_err;
+    const int json = b->o.json;
+    const int spread_every = b->o.spread_every;
+    const int absurd = b->absurd;
+    const int32_t kept = b->kept;
+    const int32_t nbeyond = b->nbeyond;
     const sw_joint_reach *beyond = b->beyond;
-    const char *out_path = o->out_path;
-    const double *mode_err = b->mode_err, bake_seconds = b->bake_seconds,
-                 eval_seconds = b->eval_seconds, model_err = b->model_err;
-    const int spread_every = o->spread_every, absurd = b->absurd;
-    const int32_t kept = b->kept, nbeyond = b->nbeyond;
+    const sw_blob_view *v = &b->res.view;
     char num[32];
-    char gt[32], gh[32];
-    printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
-           "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
-           "\"pair_sweep_poses\":%d,\"heldout_poses\":%d,"
-           "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
-           "heldout\":%.5f,"
-           "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
-           "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,"
-           "%.2f,%.2f]",
-           out_path, ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones, v->ndomains, v->rank_total,
-           v->ncub, res->cubature_error_max, res->ntrain, res->return_poses, res->pair_sweep_poses,
-           res->nheldout, res->train_proj_error, res->heldout_proj_error, et->correction_error,
-           eh->correction_error, res->train_unsettled, res->heldout_unsettled, bake_seconds,
-           eval_seconds, res->stage_seconds[0], res->stage_seconds[1], res->stage_seconds[2],
-           res->stage_seconds[3], res->stage_seconds[4], res->stage_seconds[5]);
-    printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
-           "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
-           res->force_poses, model_err, sw_linear_solver_name(reference->solver),
-           sw_hessian_mode_name(reference->hessian), ch->range.nframes,
-           (unsigned long long)p->seed);
-    printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
-           json_number(res->train_galerkin_error, gt),
-           json_number(res->heldout_galerkin_error, gh));
-    printf(",\"spring_k\":%.6g,\"spring_tried\":[", res->spring_k);
-    for (int32_t k = 0; k < res->nspring_tried; ++k)
-        printf("%s[%.4g,%.5f]", k ? "," : "", res->spring_tried_mult[k], res->spring_tried_err[k]);
-    printf("]");
-    printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
-           "\"seam_max_heldout\":%.3e",
-           et->seam, eh->seam, et->seam_max, eh->seam_max);
-    printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
-           "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
-           "\"embed_seconds\":%.4f",
-           sw_blob_output_verts(v), sw_blob_output_ntris(v),
-           v->nrender_verts > 0 ? "true" : "false", res->render_outside, res->render_max_outside,
-           res->render_max_bary, res->embed_seconds);
-    if (ca->file)
-        printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
-               info->mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
-               quality->min_dihedral_deg, quality->slivers);
-    if (p->compare_selectors)
-        printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
-               "\"nnhtp\":[%d,%.3f,%.4f]}",
-               res->selector_points[0], res->selector_seconds[0], res->selector_error[0],
-               res->selector_points[1], res->selector_seconds[1], res->selector_error[1],
-               res->selector_points[2], res->selector_seconds[2], res->selector_error[2]);
-    for (int k = 0; ad->rounds > 0 && k < arep->nrounds; ++k) {
-        const sw_adaptive_round *a = &arep->round[k];
-        printf("%s{\"train_poses\":%d,\"added\":%d,\"rank\":%d,\"err_train\":%.5f,"
-               "\"err_heldout\":%.5f,\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,"
-               "\"score_mean\":%.4f,\"score_max\":%.4f,\"picks_score\":%.4f,"
-               "\"picks_error\":%.5f,\"solved\":%d,\"seconds\":%.2f}%s",
-               k == 0 ? ",\"adaptive\":[" : ",", a->ntrain, a->added, a->rank_total, a->err_train,
-               a->err_heldout, a->proj_train, a->proj_heldout, a->score_mean, a->score_max,
-               a->picks_score, a->picks_error, a->solved, a->seconds,
-               k + 1 == arep->nrounds ? "]" : "");
-    }
-    printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d", v->ncontacts,
-           v->npair_groups, kept);
-    for (int set = 0; set < 2; ++set) { /* [bone, share of the error, of the correction] */
-        const sw_eval_result *e = set ? eh : et;
-        printf(",\"err_regions_%s\":[", set ? "heldout" : "train");
-        for (int32_t k = 0; k < e->nregions; ++k)
-            printf("%s[%d,%.4f,%.4f]", k ? "," : "", e->region_bone[k], e->region_err[k],
-                   e->region_corr[k]);
+    if (json) {
+        char gt[32], gh[32];
+        printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
+               "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
+               "\"pair_sweep_poses\":%d,\"heldout_poses\":%d,"
+               "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
+               "heldout\":%.5f,"
+               "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
+               "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,"
+               "%.2f,%.2f]",
+               out_path, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones, v->ndomains, v->rank_total,
+               v->ncub, res.cubature_error_max, res.ntrain, res.return_poses, res.pair_sweep_poses,
+               res.nheldout, res.train_proj_error, res.heldout_proj_error, et.correction_error,
+               eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
+               eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
+               res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
+               "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
+               res.force_poses, model_err, sw_linear_solver_name(reference.solver),
+               sw_hessian_mode_name(reference.hessian), ch.range.nframes,
+               (unsigned long long)p.seed);
+        printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
+               json_number(res.train_galerkin_error, gt),
+               json_number(res.heldout_galerkin_error, gh));
+        printf(",\"spring_k\":%.6g,\"spring_tried\":[", res.spring_k);
+        for (int32_t k = 0; k < res.nspring_tried; ++k)
+            printf("%s[%.4g,%.5f]", k ? "," : "", res.spring_tried_mult[k],
+                   res.spring_tried_err[k]);
         printf("]");
+        printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
+               "\"seam_max_heldout\":%.3e",
+               et.seam, eh.seam, et.seam_max, eh.seam_max);
+        printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
+               "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
+               "\"embed_seconds\":%.4f",
+               sw_blob_output_verts(v), sw_blob_output_ntris(v),
+               v->nrender_verts > 0 ? "true" : "false", res.render_outside, res.render_max_outside,
+               res.render_max_bary, res.embed_seconds);
+        if (ca.file)
+            printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
+                   info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
+                   quality.min_dihedral_deg, quality.slivers);
+        if (p.compare_selectors)
+            printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
+                   "\"nnhtp\":[%d,%.3f,%.4f]}",
+                   res.selector_points[0], res.selector_seconds[0], res.selector_error[0],
+                   res.selector_points[1], res.selector_seconds[1], res.selector_error[1],
+                   res.selector_points[2], res.selector_seconds[2], res.selector_error[2]);
+        for (int k = 0; ad.rounds > 0 && k < arep.nrounds; ++k) {
+            const sw_adaptive_round *a = &arep.round[k];
+            printf("%s{\"train_poses\":%d,\"added\":%d,\"rank\":%d,\"err_train\":%.5f,"
+                   "\"err_heldout\":%.5f,\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,"
+                   "\"score_mean\":%.4f,\"score_max\":%.4f,\"picks_score\":%.4f,"
+                   "\"picks_error\":%.5f,\"solved\":%d,\"seconds\":%.2f}%s",
+                   k == 0 ? ",\"adaptive\":[" : ",", a->ntrain, a->added, a->rank_total,
+                   a->err_train, a->err_heldout, a->proj_train, a->proj_heldout, a->score_mean,
+                   a->score_max, a->picks_score, a->picks_error, a->solved, a->seconds,
+                   k + 1 == arep.nrounds ? "]" : "");
+        }
+        printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d", v->ncontacts,
+               v->npair_groups, kept);
+        for (int set = 0; set < 2; ++set) { /* [bone, share of the error, of the correction] */
+            const sw_eval_result *e = set ? &eh : &et;
+            printf(",\"err_regions_%s\":[", set ? "heldout" : "train");
+            for (int32_t k = 0; k < e->nregions; ++k)
+                printf("%s[%d,%.4f,%.4f]", k ? "," : "", e->region_bone[k], e->region_err[k],
+                       e->region_corr[k]);
+            printf("]");
+        }
+        printf(",\"err_heldout_by_mode\":{");
+        for (int k = 0; k < SW_BAKE_MODES; ++k)
+            printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k],
+                   json_number(mode_err[k], num));
+        printf("}");
+        if (spread_every > 0)
+            printf(",\"ref_spread\":{\"every\":%d,\"poses\":%d,\"runtime\":%.5f,"
+                   "\"from_skin\":%.5f,\"from_reference\":%.5f,\"polished\":%.5f,"
+                   "\"polish_move\":%.5f,\"unconverged\":%d,\"failed\":%d}",
+                   spread_every, spread.poses, spread.runtime, spread.from_skin,
+                   spread.from_reference, spread.polished, spread.polish_move, spread.unconverged,
+                   spread.failed);
+        for (int32_t k = 0; spread_every > 0 && k < spread.poses; ++k) {
+            /* [held-out pose, runtime, from_skin, from_reference, polished, correction] */
+            const sw_bake_spread_pose *q = &spread.per_pose[k];
+            printf("%s[%d,%.5f,%.5f,%.5f,%.5f,%.4g]%s", k ? "," : ",\"ref_spread_poses\":[",
+                   q->heldout, q->runtime, q->from_skin, q->from_reference, q->polished,
+                   q->correction, k + 1 == spread.poses ? "]" : "");
+        }
+        printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
+        for (int32_t k = 0; k < nbeyond; ++k) {
+            printf("%s[%d,", k ? "," : "", beyond[k].bone);
+            if (ch.bone_names)
+                sw_tool_json_string(ch.bone_names[beyond[k].bone]);
+            else
+                printf("null");
+            printf(",%.2f,%.2f]", beyond[k].heldout_deg, beyond[k].train_deg);
+        }
+        printf("]");
+        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
+               res.simulate_cached ? "true" : "false", res.simulate_solved,
+               absurd ? "true" : "false");
     }
-    printf(",\"err_heldout_by_mode\":{");
-    for (int k = 0; k < SW_BAKE_MODES; ++k)
-        printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k], json_number(mode_err[k], num));
-    printf("}");
-    if (spread_every > 0)
-        printf(",\"ref_spread\":{\"every\":%d,\"poses\":%d,\"runtime\":%.5f,"
-               "\"from_skin\":%.5f,\"from_reference\":%.5f,\"polished\":%.5f,"
-               "\"polish_move\":%.5f,\"unconverged\":%d,\"failed\":%d}",
-               spread_every, spread->poses, spread->runtime, spread->from_skin,
-               spread->from_reference, spread->polished, spread->polish_move, spread->unconverged,
-               spread->failed);
-    for (int32_t k = 0; spread_every > 0 && k < spread->poses; ++k) {
-        /* [held-out pose, runtime, from_skin, from_reference, polished, correction] */
-        const sw_bake_spread_pose *q = &spread->per_pose[k];
-        printf("%s[%d,%.5f,%.5f,%.5f,%.5f,%.4g]%s", k ? "," : ",\"ref_spread_poses\":[", q->heldout,
-               q->runtime, q->from_skin, q->from_reference, q->polished, q->correction,
-               k + 1 == spread->poses ? "]" : "");
-    }
-    printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
-    for (int32_t k = 0; k < nbeyond; ++k) {
-        printf("%s[%d,", k ? "," : "", beyond[k].bone);
-        if (ch->bone_names)
-            sw_tool_json_string(ch->bone_names[beyond[k].bone]);
-        else
-            printf("null");
-        printf(",%.2f,%.2f]", beyond[k].heldout_deg, beyond[k].train_deg);
-    }
-    printf("]");
-    printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
-           res->simulate_cached ? "true" : "false", res->simulate_solved,
-           absurd ? "true" : "false");
 }
 
 static void bake_free(bake *b) {
@@ -714,17 +531,16 @@ static void bake_free(bake *b) {
 int main(int argc, char **argv) {
     static bake b;
     sw_error err;
-    int status = parse_args(argc, argv, &b.o);
+    int status = bake_parse_args(argc, argv, &b.o);
     if (status || (status = load_character(&b, &err))) return status;
     if ((status = run_bake(&b, &err))) {
         sw_character_free(&b.ch);
         sw_clip_split_free(&b.clips);
         return status;
     }
-    if (!(status = measure(&b, &err)) && !(status = write_outputs(&b, &err))) {
-        tally(&b);
+    if (!(status = measure(&b, &err)) && !(status = write_outputs(&b))) {
         print_summary(&b);
-        if (b.o.json) print_json(&b);
+        print_json(&b);
     }
     bake_free(&b);
     return status;
