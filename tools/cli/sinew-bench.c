@@ -14,7 +14,7 @@
  *             (machine noise only adds time), and dqs_ms's likewise (timing_passes);
  *             failed_steps counts the steps of every play
  *   dqs_ms    median ms/frame of DQS of the output surface (positions and normals): the
- *             render mesh's own vertices when the blob embeds one (issue 14), so
+ *             render mesh's own vertices when the blob embeds one, so
  *             cost_vs_dqs is the cost against skinning the very mesh a host draws
  *   correction error |x_sub - x_full|_M / |x_full - x_dqs|_M, always through
  *             sw_bake_errors (one definition), on one of three pose sets (err_source):
@@ -99,6 +99,9 @@
  *                     after a warm-up)
  * Always: instance_bytes (sinew_instance_memory_size with the default def) and
  * blob_bytes (the blob file's size with --blob, else the size of the blob just baked).
+ * The optional runs (--instances, --sc-compare, --newton-compare, --error-gap, --world,
+ * --dynamic) are the modes of bench/bench_mode.h, run in its table's order after the contract
+ * count, each adding its members to the JSON line after the bench's own.
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
