@@ -1,5 +1,5 @@
 /* Clips of their own in the bake (sw_bake_params.train_clips / heldout_clips) and the bake
- * report (tools/bake_report.h): training poses come only from training clips (and joint
+ * report (tools/report/bake_report.h): training poses come only from training clips (and joint
  * sweeps), held-out poses only from held-out clips, each labelled with its clip and frame;
  * the report's JSON parses back (cJSON) with the bake's figures, and the page and the
  * contact sheet are written. A 1,000-tet finger: a few seconds. */

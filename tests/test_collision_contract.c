@@ -1,6 +1,6 @@
 /* The query's real-time contract (collision.h): 10,000 queries of every shape (plane,
  * sphere, capsule, box, libccd MPR hull, Embree mesh) allocate nothing and lock nothing,
- * counted by the interposer (tools/rt_interpose.h) after a warm-up. */
+ * counted by the interposer (tools/testkit/rt_interpose.h) after a warm-up. */
 #include "sw_test.h"
 
 #include "collision_ref.h"

@@ -1,4 +1,4 @@
-/* The allocation/lock call counter (tools/rt_interpose.h) that proves the frame step
+/* The allocation/lock call counter (tools/testkit/rt_interpose.h) that proves the frame step
  * allocation-free and lock-free (DESIGN.md §3): it must see each call made directly,
  * from our static libraries and from inside libc.so, must see nothing while off or on
  * other threads, and must count exactly zero for code that neither allocates nor

@@ -6,8 +6,8 @@
  * translation and by a rotation snap, the state bounds (LIMITED), the energy guard (GUARD), a
  * failed step (FAILED), the contact pair and world contact budgets (BUDGET), a reset between steps,
  * and a collision world whose collider moves every step. Every return code is checked; the
- * interposer (tools/rt_interpose.h) counts allocations, frees, mappings and locks over all of it,
- * and the host allocator counts its own calls.
+ * interposer (tools/testkit/rt_interpose.h) counts allocations, frees, mappings and locks over
+ * all of it, and the host allocator counts its own calls.
  *
  * Built twice from this source: test_step_contract against the static library, and
  * test_step_contract_shared (SW_CONTRACT_SHARED) against libsinew.so, whose executable

@@ -312,7 +312,7 @@ if have_fox inspect_fox; then
         '"sim_mesher": "tetgen"' 'by tetgen')
     expect_stdout inspect_fox_tetgen "$inspect" "$fox" --tets 5000 --mesher tetgen --json
 fi
-expect inspect_mesher_name 2 "--mesher takes lattice or tetgen, not 'gmsh'" \
+expect inspect_mesher_name 2 "--mesher wants lattice or tetgen, got 'gmsh'" \
     "$inspect" x.glb --mesher gmsh
 
 # a glTF/FBX FILE: its format, the options that do not apply to it or that
@@ -329,7 +329,7 @@ expect bench_frames_with_file 2 "--frames does not apply to a glTF/FBX FILE" \
 expect bake_clips_without_file 2 "--train-clips applies only to a glTF/FBX FILE" \
     "$bake" "${small[@]}" --train-clips A --out "$tmp/a.blob"
 expect bench_fps_range 2 "--fps wants a number in 0 < F <= 1000, got '0'" "$bench" x.glb --fps 0
-expect bake_mesher_name 2 "--mesher takes lattice or tetgen, not 'gmsh'" \
+expect bake_mesher_name 2 "--mesher wants lattice or tetgen, got 'gmsh'" \
     "$bake" x.glb --mesher gmsh --out "$tmp/a.blob"
 expect bake_mesher_without_file 2 "--mesher applies only to a render surface to fill" \
     "$bake" "${small[@]}" --mesher tetgen --out "$tmp/a.blob"
@@ -338,7 +338,7 @@ expect bake_mesher_with_tet_mesh 2 "--mesher applies only to a render surface to
 touch "$tmp/plain"
 expect bake_report_unwritable 1 "--report '$tmp/plain/r': cannot create or write the folder" \
     "$bake" "${small[@]}" --out "$tmp/a.blob" --report "$tmp/plain/r"
-expect bench_self_contact_mode 2 "--self-contact: pose-space, exhaustive or pose-pairs" \
+expect bench_self_contact_mode 2 "--self-contact wants pose-space, exhaustive or pose-pairs, got 'brute'" \
     "$bench" "${small[@]}" --self-contact brute
 expect bench_gap_needs_poses 2 "--error-gap needs the bake's poses" \
     "$bench" "${small[@]}" --blob "$tmp/a.blob" --error-gap

@@ -103,7 +103,7 @@ typedef struct sw_fullsim_params {
 
 sw_fullsim_params sw_fullsim_params_default(void);
 
-/* The solver options the tools take for the reference (tool_common.h, SW_REFERENCE_USAGE):
+/* The solver options the tools take for the reference (tools/common/reference_args.h):
  * from's solver, hessian, contact_rounds and contact_set_check into *to, which keeps the
  * rest (the physics, the tolerances, the threads). */
 void sw_fullsim_params_take_solver(sw_fullsim_params *to, const sw_fullsim_params *from);

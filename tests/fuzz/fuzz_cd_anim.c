@@ -1,7 +1,7 @@
 /* libFuzzer harness for the complementary-dynamics bone animation reader
  * (sw_parse_cd_anim; STYLE.md §9: a fuzz harness for every loader). tests/CMakeLists.txt
  * builds it with clang when clang has libFuzzer and runs it for a few seconds on
- * tests/fuzz/corpus/cd_anim as the test fuzz_cd_anim; tools/run-fuzz.sh runs it for
+ * tests/fuzz/corpus/cd_anim as the test fuzz_cd_anim; tools/scripts/run-fuzz.sh runs it for
  * longer. By hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \

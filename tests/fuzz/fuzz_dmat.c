@@ -1,7 +1,7 @@
 /* libFuzzer harness for the libigl .dmat reader, ASCII and binary (sw_parse_dmat), and the
  * skin-weight reader built on it (sw_parse_weights; STYLE.md §9: a fuzz harness for every
  * loader). tests/CMakeLists.txt builds it with clang when clang has libFuzzer and runs it
- * for a few seconds on tests/fuzz/corpus/dmat as the test fuzz_dmat; tools/run-fuzz.sh
+ * for a few seconds on tests/fuzz/corpus/dmat as the test fuzz_dmat; tools/scripts/run-fuzz.sh
  * runs it for longer. By hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \

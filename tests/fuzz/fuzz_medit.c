@@ -1,7 +1,7 @@
 /* libFuzzer harness for the Medit .mesh reader (sw_parse_medit; STYLE.md §9: a fuzz
  * harness for every loader). tests/CMakeLists.txt builds it with clang when clang has
  * libFuzzer and runs it for a few seconds on tests/fuzz/corpus/medit as the test
- * fuzz_medit; tools/run-fuzz.sh runs it for longer. By hand:
+ * fuzz_medit; tools/scripts/run-fuzz.sh runs it for longer. By hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/core -Iruntime/math -Iprecompute/io \

@@ -32,7 +32,8 @@ const char *__lsan_default_suppressions(void);
  * libassimp are suppressed; a leak of the importer's own malloc calls is still found. assimp
  * is built without frame pointers, so the fast unwinder stops at operator new and the stack
  * never shows libassimp (CI found such a leak reported as ours): unwind slowly instead. Both
- * live here, not in the environment, so ctest and tools/run-fuzz.sh run the harness alike. */
+ * live here, not in the environment, so ctest and tools/scripts/run-fuzz.sh run the harness
+ * alike. */
 const char *__asan_default_options(void) {
     return "fast_unwind_on_malloc=0";
 }

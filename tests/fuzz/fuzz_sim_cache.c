@@ -3,7 +3,7 @@
  * so it is outside data. tests/CMakeLists.txt builds it with clang when clang has
  * libFuzzer and runs it for a few seconds on tests/fuzz/corpus/sim_cache (the seed is
  * test_bake_cache's tiny file, SINEW_WRITE_SEEDS=1 rewrites it) as the test
- * fuzz_sim_cache; tools/run-fuzz.sh runs it for longer.
+ * fuzz_sim_cache; tools/scripts/run-fuzz.sh runs it for longer.
  *
  * Each input is read twice against the seed's shape (key 0x1234, 4 vertices, sequences of
  * 2 and 1 poses): as it is, and with its checksum fixed up (random bytes rarely pass it,

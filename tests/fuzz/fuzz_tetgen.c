@@ -1,7 +1,7 @@
 /* libFuzzer harness for the TetGen .node/.ele reader (sw_parse_tetgen; STYLE.md §9: a
  * fuzz harness for every loader). tests/CMakeLists.txt builds it with clang when clang has
  * libFuzzer and runs it for a few seconds on tests/fuzz/corpus/tetgen as the test
- * fuzz_tetgen; tools/run-fuzz.sh runs it for longer. By hand:
+ * fuzz_tetgen; tools/scripts/run-fuzz.sh runs it for longer. By hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/core -Iprecompute/io tests/fuzz/fuzz_tetgen.c \

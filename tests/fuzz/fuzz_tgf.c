@@ -1,7 +1,7 @@
 /* libFuzzer harness for the libigl .tgf skeleton reader (sw_parse_tgf; STYLE.md §9: a
  * fuzz harness for every loader). tests/CMakeLists.txt builds it with clang when clang has
  * libFuzzer and runs it for a few seconds on tests/fuzz/corpus/tgf as the test fuzz_tgf;
- * tools/run-fuzz.sh runs it for longer. By hand:
+ * tools/scripts/run-fuzz.sh runs it for longer. By hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/core -Iprecompute/io tests/fuzz/fuzz_tgf.c \

@@ -38,6 +38,9 @@
 #include "character_io.h"
 #include "samples.h"
 #include "subspace_eval.h"
+#include "bake_cli.h"
+
+static const char *const tool = "sinew-bake";
 
 #define BAKE_BEYOND 32 /* joints listed beyond training, at most (8 in the summary) */
 
@@ -48,316 +51,150 @@ static const char *json_number(double v, char *buf) {
     return buf;
 }
 
-static void usage(FILE *f) {
-    fprintf(f, "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
-               "                   [--fps F] [--height H] |\n"
-               "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-               "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-               "                   [--clip FILE [--frames F] | --joint-range FILE])\n"
-               "                  --out FILE.blob [--report DIR]\n"
-               "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
-               "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
-               "                  [--compare-cubature] [--no-self-contact]\n"
-               "                  [--return-path|--no-return-path]\n"
-               "                  [--pair-sweeps | --no-pair-sweeps] [--no-sibling-sweeps]\n"
-               "                  [--adaptive R [--adaptive-add K]\n"
-               "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
-               "                  [--adaptive-target E]] [--heldout-steps S]\n"
-               "                  [--random-poses N] [--seed S]\n"
-               "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
-               "                  [--no-pose-force]\n"
-               "                  [--eval-self-contact pose-space|pose-pairs]\n"
-               "                  [--reference-spread K] [reference options]\n"
-               "                  [--cache DIR] [--threads T] [--force]\n"
-               "                  [--json]\n"
-               "character:\n" SW_CHARACTER_USAGE);
-    fprintf(f,
-            "bake:\n"
-            "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
-            "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
-            "                   frame's error, ranks, cubature, stage times, a contact sheet of\n"
-            "                   held-out frames) and DIR/report.json (the same figures)\n"
-            "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
-            "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
-            "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
-            "  --fold-share S   a bone whose tets hold less than S of the mesh's volume\n"
-            "                   joins its parent's domain, 0..0.5 (default 0: off; 0.03\n"
-            "                   folds the elephant's 24 bones into 11 domains)\n"
-            "  --spring-k K     interface spring stiffness, K > 0 (default: of 20, 10, 5 and\n"
-            "                   2.5 E h the one with the lowest training error)\n"
-            "  --return-path    also train on the way home: from the first training clip's\n"
-            "                   last frame, its earlier frames backwards, each bent less than\n"
-            "                   the one before (a fold keeps its branch on the way out); by\n"
-            "                   default on where the held-out frames continue the training\n"
-            "                   clip (a --clip or a file's one clip split 60/40), off for\n"
-            "                   --train-clips; --no-return-path: never\n"
-            "  --pair-sweeps    also train on every joint swept together with its parent\n"
-            "                   joint (combinations the single-joint sweeps never show); by\n"
-            "                   default on with --joint-range; --no-pair-sweeps: never\n"
-            "  --no-sibling-sweeps  do not train on two sibling joints whose flesh meets\n"
-            "                   swept together (by default each such pair is: the flesh\n"
-            "                   between them shears with the difference of their bends)\n"
-            "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
-            "                   (default 64) random combined poses the blob steps worst (the\n"
-            "                   full-space force its state leaves over plain skinning's) to\n"
-            "                   the training poses and bake again, until B poses (default 32)\n"
-            "                   are added or the held-out error is at most E\n"
-            "  --heldout-steps S  without a clip, the 10 random held-out poses are each\n"
-            "                   reached from the one before in S held-out poses, 1..64\n"
-            "                   (default 4; the reference depends on the path)\n"
-            "  --random-poses N  without a clip, N random held-out poses, 1..10000\n"
-            "                   (default 10; more define the held-out figure better)\n"
-            "  --seed S         the bake's random draws (held-out poses, adaptive candidates,\n"
-            "                   cubature candidates), 0..2147483647 (default 1592614637)\n"
-            "  --contact-modes  also the static responses to the training poses' self-contact\n"
-            "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
-            "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
-            "                   cut to a cubature that keeps their reduced force to T,\n"
-            "                   0 <= T < 1 (default 0.05; 0: every pair kept)\n"
-            "  --no-pose-force  no pose-space equilibrium force in the blob (by default each\n"
-            "                   training pose carries the reduced force that makes its\n"
-            "                   projected solution the runtime's equilibrium there,\n"
-            "                   interpolated between poses)\n"
-            "  --eval-self-contact M  the runtime's self-contact mode the bake's errors are\n"
-            "                   measured in: pose-space (default) or pose-pairs\n");
-    fprintf(f,
-            "  --reference-spread K  at every K-th held-out pose, three more full-space\n"
-            "                   solves: from plain skinning, from the reference and from the\n"
-            "                   runtime's state; how far they land from the reference says\n"
-            "                   how well the reference is defined, and whether the runtime\n"
-            "                   sits by another equilibrium\n"
-            "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
-            "                   bones' accelerations (static responses to them), so that the\n"
-            "                   flesh lags and overshoots as the reference does; a higher rank\n"
-            "  --cache DIR      keep the full-space solutions in DIR and reuse them when a\n"
-            "                   later bake solves the same poses of the same character (a\n"
-            "                   re-bake that changes the cubature, rank or report only)\n"
-            "  --threads T      0..256 (default 0: all cores)\n"
-            "  --force          write the blob even when its training error is %.2f or more\n"
-            "                   (the share of the physics correction it misses on its own\n"
-            "                   training poses; without --force that is an error)\n"
-            "  --json           one JSON object with the figures as the last stdout line\n",
-            SW_BAKE_MAX_TRAIN_ERROR);
-    fprintf(f, "reference options (every full-space solve of the bake; a change of them\n"
-               "solves the poses again instead of reading the cache):\n" SW_REFERENCE_USAGE
-               "exit status: 0 blob written, 1 failed, 2 bad arguments\n");
-}
-
-int main(int argc, char **argv) {
-    static const char *tool = "sinew-bake";
-    sw_character_args ca;
-    sw_character_args_init(&ca, tool);
-    const char *out_path = NULL, *report_dir = NULL;
-    int json = 0, force = 0, spread_every = 0;
-    sinew_self_contact eval_mode = SINEW_SELF_CONTACT_POSE_SPACE;
-    sw_bake_params p = sw_bake_params_default();
-    sw_fullsim_params reference = sw_fullsim_params_default(); /* its solver options */
-    p.reference = &reference;
-    sw_adaptive_params ad = sw_adaptive_params_default();
-    sw_adaptive_report arep;
-    ad.rounds = 0;
-    p.progress = 1;
+/* Everything the bake made and measured. The steps that read it (write_outputs,
+ * print_summary, print_json) take its members by value under main's names. */
+typedef struct {
+    bake_options o;
     sw_tool_progress bar;
-    sw_tool_progress_init(&bar, tool);
-    p.on_progress = sw_tool_progress_print;
-    p.progress_user = &bar;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        int ok = 1;
-        if (sw_character_args_take(&ca, argc, argv, &i, &ok) ||
-            sw_reference_args_take(&reference, argc, argv, &i, &ok)) {
-            /* a character or reference option, consumed */
-        } else if (!strcmp(a, "--out") && next)
-            out_path = argv[++i];
-        else if (!strcmp(a, "--report") && next)
-            report_dir = argv[++i];
-        else if (!strcmp(a, "--threads") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 0, 256, &p.threads);
-        else if (!strcmp(a, "--max-rank") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 1, 1024, &p.max_rank);
-        else if (!strcmp(a, "--pca-strain") && next)
-            ok = sw_tool_real(tool, a, argv[++i], -1e-300, nextafter(1.0, 2.0), "in 0..1",
-                              &p.pca_strain);
-        else if (!strcmp(a, "--tol") && next)
-            ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in the open range 0..1", &p.cubature_tol);
-        else if (!strcmp(a, "--selector") && next) {
-            const char *s = argv[++i];
-            if (!strcmp(s, "greedy"))
-                p.selector = SW_CUBATURE_GREEDY;
-            else if (!strcmp(s, "importance"))
-                p.selector = SW_CUBATURE_IMPORTANCE;
-            else if (!strcmp(s, "nnhtp"))
-                p.selector = SW_CUBATURE_NNHTP;
-            else {
-                fprintf(stderr, "%s: --selector wants greedy | importance | nnhtp, got '%s'\n",
-                        tool, s);
-                ok = 0;
-            }
-        } else if (!strcmp(a, "--fold-share") && next) {
-            ok = sw_tool_real(tool, a, argv[++i], -1, 0.5, "in 0..0.5", &p.fold_share);
-            if (ok && p.fold_share < 0) {
-                fprintf(stderr, "%s: --fold-share wants a number in 0..0.5, got '%s'\n", tool,
-                        argv[i]);
-                ok = 0;
-            }
-        } else if (!strcmp(a, "--spring-k") && next)
-            ok = sw_tool_real(tool, a, argv[++i], 0, INFINITY, "above 0", &p.spring_k);
-        else if (!strcmp(a, "--cache") && next)
-            p.cache_dir = argv[++i];
-        else if (!strcmp(a, "--compare-cubature"))
-            p.compare_selectors = 1;
-        else if (!strcmp(a, "--no-self-contact"))
-            p.self_contact = 0;
-        else if (!strcmp(a, "--return-path"))
-            p.return_path = 1;
-        else if (!strcmp(a, "--no-return-path"))
-            p.return_path = 0;
-        else if (!strcmp(a, "--pair-sweeps"))
-            p.pair_sweeps = 1;
-        else if (!strcmp(a, "--no-pair-sweeps"))
-            p.pair_sweeps = 0;
-        else if (!strcmp(a, "--no-sibling-sweeps"))
-            p.sibling_sweeps = 0;
-        else if (!strcmp(a, "--adaptive") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 0, SW_ADAPTIVE_MAX_ROUNDS, &ad.rounds);
-        else if (!strcmp(a, "--adaptive-add") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &ad.add);
-        else if (!strcmp(a, "--adaptive-candidates") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 1, 100000, &ad.candidates);
-        else if (!strcmp(a, "--adaptive-budget") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 0, 1000000, &ad.budget);
-        else if (!strcmp(a, "--reference-spread") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 1, 1000000, &spread_every);
-        else if (!strcmp(a, "--heldout-steps") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 1, 64, &p.heldout_steps);
-        else if (!strcmp(a, "--random-poses") && next)
-            ok = sw_tool_int(tool, a, argv[++i], 1, 10000, &p.random_poses);
-        else if (!strcmp(a, "--seed") && next) {
-            int seed = 0;
-            ok = sw_tool_int(tool, a, argv[++i], 0, 2147483647, &seed);
-            p.seed = (uint64_t)seed;
-        } else if (!strcmp(a, "--adaptive-target") && next)
-            ok = sw_tool_real(tool, a, argv[++i], 0, 1, "in 0..1", &ad.target);
-        else if (!strcmp(a, "--inertia-modes"))
-            p.inertia_modes = 1;
-        else if (!strcmp(a, "--contact-modes"))
-            p.contact_modes = 1;
-        else if (!strcmp(a, "--no-pose-force"))
-            p.pose_force = 0;
-        else if (!strcmp(a, "--contact-tol") && next)
-            ok = sw_tool_real(tool, a, argv[++i], -1e-300, 1, "in 0 <= T < 1",
-                              &p.contact_cubature_tol);
-        else if (!strcmp(a, "--eval-self-contact") && next) {
-            int k = sw_tool_choice(argv[++i], (const char *const[]){"pose-space", "pose-pairs", 0});
-            if (!(ok = k >= 0))
-                fprintf(stderr, "%s: --eval-self-contact: pose-space or pose-pairs\n", tool);
-            eval_mode = k == 1 ? SINEW_SELF_CONTACT_POSE_PAIRS : SINEW_SELF_CONTACT_POSE_SPACE;
-        } else if (!strcmp(a, "--force"))
-            force = 1;
-        else if (!strcmp(a, "--json"))
-            json = 1;
-        else if (!sw_tool_help(a, usage))
-            return sw_tool_bad_arg(tool, a, usage);
-        if (!ok) return 2; /* the value's message is out */
-    }
-    if (!out_path) {
-        fprintf(stderr, "%s: give --out FILE.blob\n", tool);
-        usage(stderr);
-        return 2;
-    }
-    if (!sw_character_args_valid(&ca)) return 2;
-    /* the report's folder before the long run: an unwritable one is an error now */
-    const char *dirs[2][2] = {{"--report", report_dir}, {"--cache", p.cache_dir}};
-    for (int k = 0; k < 2; ++k)
-        if (dirs[k][1] && !sw_tool_make_dirs(dirs[k][1])) {
-            fprintf(stderr, "%s: %s '%s': cannot create or write the folder: %s\n", tool,
-                    dirs[k][0], dirs[k][1], strerror(errno ? errno : EACCES));
-            return 1;
-        }
-    sw_error err;
     sw_character ch;
     sw_clip_split clips;
     sw_scene_character_info info;
-    double t0 = sw_now_seconds();
-    sinew_result r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
-    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
-    const char *source = ca.file ? ca.file : ca.scene ? ca.scene : ca.mesh;
-    fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
-            ch.name[0] ? ch.name : source, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones,
-            ch.clip.nframes);
-    sw_quality quality = {0};
-    if (ca.file) {
-        sw_tetmesh_quality(&ch.mesh, 0, &quality);
-        sw_tool_print_scene(tool, &ch, &clips, &info, &quality);
-    }
-    sw_tool_bake_clips(&ca, &clips, &p);
+    sw_quality quality;
+    const char *source;
+    double t0, bake_seconds, eval_seconds;
     sw_bake_result res;
-    r = ad.rounds > 0 ? sw_bake_adaptive(&ch, &p, &ad, &res, &arep, &err)
-                      : sw_bake(&ch, &p, &res, &err);
-    if (r != SINEW_OK) {
-        sw_character_free(&ch);
-        sw_clip_split_free(&clips);
-        return sw_tool_failed(r, &err, "%s: ", tool);
-    }
-    /* measure the blob's bytes before they go to the file */
-    void *mem = NULL;
-    size_t size = 0;
-    sinew_blob *blob = NULL;
+    sw_adaptive_report arep;
+    void *mem;
+    sinew_blob *blob;
     sw_eval_result et, eh;
-    memset(&et, 0, sizeof et);
-    memset(&eh, 0, sizeof eh);
-    double bake_seconds = sw_now_seconds() - t0, t1 = sw_now_seconds();
+    double *frame_err;     /* every training pose's error, then every held-out one's */
+    sw_bake_spread spread; /* --reference-spread */
+    double mode_err[SW_BAKE_MODES];
+    double model_err; /* the reduced model's own training error */
+    int absurd;
+    int32_t kept; /* the pose-space pairs the per-pair cubature keeps */
+    sw_joint_reach beyond[BAKE_BEYOND];
+    int32_t nbeyond_all, nbeyond;
+} bake;
+
+/* The character from the command line, its summary on stderr. */
+static int load_character(bake *b, sw_error *err) {
+    const sw_character_args *ca = &b->o.ca;
+    sw_character *ch = &b->ch;
+    b->t0 = sw_now_seconds();
+    sinew_result r = sw_character_args_make(ca, ch, &b->clips, &b->info, err);
+    if (r != SINEW_OK) return sw_tool_failed(r, err, "%s: ", tool);
+    b->source = ca->file ? ca->file : ca->scene ? ca->scene : ca->mesh;
+    fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
+            ch->name[0] ? ch->name : b->source, ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones,
+            ch->clip.nframes);
+    if (ca->file) {
+        sw_tetmesh_quality(&ch->mesh, 0, &b->quality);
+        sw_tool_print_scene(tool, ch, &b->clips, &b->info, &b->quality);
+    }
+    return 0;
+}
+
+/* The bake (with --adaptive, its rounds). */
+static int run_bake(bake *b, sw_error *err) {
+    bake_options *o = &b->o;
+    sw_tool_progress_init(&b->bar, tool);
+    o->p.on_progress = sw_tool_progress_print;
+    o->p.progress_user = &b->bar;
+    sw_tool_bake_clips(&o->ca, &b->clips, &o->p);
+    sinew_result r = o->ad.rounds > 0
+                         ? sw_bake_adaptive(&b->ch, &o->p, &o->ad, &b->res, &b->arep, err)
+                         : sw_bake(&b->ch, &o->p, &b->res, err);
+    if (r != SINEW_OK) return sw_tool_failed(r, err, "%s: ", tool);
+    b->bake_seconds = sw_now_seconds() - b->t0;
+    return 0;
+}
+
+/* The blob measured before it goes to the file: its errors on the bake's poses, in each
+ * self-contact mode, and with --reference-spread the reference's spread. */
+static int measure(bake *b, sw_error *err) {
+    const bake_options *o = &b->o;
+    sw_bake_result *res = &b->res;
+    sinew_self_contact eval_mode =
+        o->eval_pairs ? SINEW_SELF_CONTACT_POSE_PAIRS : SINEW_SELF_CONTACT_POSE_SPACE;
+    double t1 = sw_now_seconds();
+    size_t size = 0;
+    sinew_result r;
+    if ((r = sw_blob_write_memory(&res->view, &b->mem, &size, err)) != SINEW_OK)
+        return sw_tool_failed(r, err, "%s: cannot serialise the blob: ", tool);
     sinew_blob_def bd = sinew_blob_def_default();
-    int status = 1;
-    double *frame_err = NULL; /* every training pose's error, then every held-out one's */
-    sw_bake_spread spread;    /* --reference-spread */
-    memset(&spread, 0, sizeof spread);
-    if ((r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
-        sw_tool_failed(r, &err, "%s: cannot serialise the blob: ", tool);
-        goto done;
-    }
-    bd.data = mem;
+    bd.data = b->mem;
     bd.data_size = size;
-    if (sw_tool_blob_load(tool, "just baked", bd, &blob) != SINEW_OK) goto done;
-    frame_err = malloc(sizeof(double) * ((size_t)res.ntrain + (size_t)res.nheldout + 1));
-    if (!frame_err) {
+    if (sw_tool_blob_load(tool, "just baked", bd, &b->blob) != SINEW_OK) return 1;
+    b->frame_err = malloc(sizeof(double) * ((size_t)res->ntrain + (size_t)res->nheldout + 1));
+    if (!b->frame_err) {
         fprintf(stderr, "%s: out of memory\n", tool);
-        goto done;
+        return 1;
     }
-    if ((r = sw_bake_errors_frames(blob, &res, eval_mode, &et, &eh, frame_err,
-                                   frame_err + res.ntrain, &err)) != SINEW_OK) {
-        sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
-        goto done;
-    }
+    if ((r = sw_bake_errors_frames(b->blob, res, eval_mode, &b->et, &b->eh, b->frame_err,
+                                   b->frame_err + res->ntrain, err)) != SINEW_OK)
+        return sw_tool_failed(r, err, "%s: cannot evaluate the blob: ", tool);
     /* the held-out error in each self-contact mode an instance can take
        (sinew_instance_def.self_contact): which suits this character's motion */
-    double mode_err[SW_BAKE_MODES];
-    char num[32];
-    if ((r = sw_bake_mode_errors(blob, &res, eval_mode, eh.correction_error, mode_err, &err))) {
-        sw_tool_failed(r, &err, "%s: cannot evaluate the blob: ", tool);
-        goto done;
-    }
-    if (spread_every > 0 &&
-        (r = sw_bake_reference_spread(&ch, &p, blob, &res, eval_mode, spread_every, &spread,
-                                      &err)) != SINEW_OK) {
-        sw_tool_failed(r, &err, "%s: --reference-spread: ", tool);
-        goto done;
-    }
-    double eval_seconds = sw_now_seconds() - t1;
+    if ((r = sw_bake_mode_errors(b->blob, res, eval_mode, b->eh.correction_error, b->mode_err,
+                                 err)))
+        return sw_tool_failed(r, err, "%s: cannot evaluate the blob: ", tool);
+    if (o->spread_every > 0 &&
+        (r = sw_bake_reference_spread(&b->ch, &o->p, b->blob, res, eval_mode, o->spread_every,
+                                      &b->spread, err)) != SINEW_OK)
+        return sw_tool_failed(r, err, "%s: --reference-spread: ", tool);
+    b->eval_seconds = sw_now_seconds() - t1;
     /* a blob that cannot step its own training poses is no bake either (its error,
        measured on the steps that did not fail, would say nothing) */
     /* the reduced model's own training error: the equilibrium force makes the training
        poses' errors their projections' whatever the model (bake_equilibrium.c) */
-    const double model_err =
-        res.model_train_error >= 0 ? res.model_train_error : et.correction_error;
-    int absurd = !(model_err < SW_BAKE_MAX_TRAIN_ERROR) || et.failed > 0;
+    b->model_err = res->model_train_error >= 0 ? res->model_train_error : b->et.correction_error;
+    b->absurd = !(b->model_err < SW_BAKE_MAX_TRAIN_ERROR) || b->et.failed > 0;
+    /* what the summary and the JSON line both list */
+    const sw_blob_view *v = &res->view;
+    for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
+        b->kept += v->pair_weight[c] > 0;
+    b->nbeyond_all = sw_bake_beyond_training(res, &b->ch.skel, b->beyond, BAKE_BEYOND);
+    b->nbeyond = b->nbeyond_all < BAKE_BEYOND ? b->nbeyond_all : BAKE_BEYOND;
+    return 0;
+}
+
+/* The blob written (unless absurd without --force) and with --report the report. */
+static int write_outputs(const bake *b) {
+    /* by value, under main's names */
+    const char *out_path = b->o.out_path;
+    const char *report_dir = b->o.report_dir;
+    const char *source = b->source;
+    const sw_character_args ca = b->o.ca;
+    const sw_bake_params p = b->o.p;
+    const sw_fullsim_params reference = b->o.reference;
+    const sw_adaptive_params ad = b->o.ad;
+    const sw_adaptive_report arep = b->arep;
+    const sw_character ch = b->ch;
+    const sw_clip_split clips = b->clips;
+    const sw_scene_character_info info = b->info;
+    const sw_bake_result res = b->res;
+    const sinew_blob *blob = b->blob;
+    const sw_eval_result et = b->et;
+    const sw_eval_result eh = b->eh;
+    const sw_bake_spread spread = b->spread;
+    const double *frame_err = b->frame_err;
+    const double *mode_err = b->mode_err;
+    const double bake_seconds = b->bake_seconds;
+    const double eval_seconds = b->eval_seconds;
+    const double model_err = b->model_err;
+    const int force = b->o.force;
+    const int spread_every = b->o.spread_every;
+    const int absurd = b->absurd;
+    sw_error err;
+    sinew_result r;
     if (absurd && !force && et.failed > 0) {
         fprintf(stderr,
                 "%s: error: %d of the blob's steps through its own %d training poses failed (a "
                 "non-finite state: check the material and --spring-k); %s not written, or "
                 "--force to write it anyway\n",
                 tool, et.failed, res.ntrain, out_path);
-        goto done;
+        return 1;
     }
     if (absurd && !force) {
         fprintf(stderr,
@@ -367,11 +204,11 @@ int main(int argc, char **argv) {
                 "clip with more frames or joint motion or a higher --max-rank, or --force to "
                 "write it anyway\n",
                 tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
-        goto done;
+        return 1;
     }
     if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
-        goto done;
+        return 1;
     }
     if (report_dir) {
         int scene_clips = p.ntrain_clips > 0;
@@ -403,12 +240,35 @@ int main(int argc, char **argv) {
                                    sw_hessian_mode_name(reference.hessian)};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
-            goto done;
+            return 1;
         }
         fprintf(stderr, "%s: wrote the report %s/report.html and %s/report.json\n", tool,
                 report_dir, report_dir);
     }
-    status = 0;
+    return 0;
+}
+
+/* The bake's summary on stderr. */
+static void print_summary(const bake *b) {
+    /* by value, under main's names */
+    const char *out_path = b->o.out_path;
+    const sw_bake_params p = b->o.p;
+    const sw_fullsim_params reference = b->o.reference;
+    const sw_character ch = b->ch;
+    const sw_bake_result res = b->res;
+    const sw_eval_result et = b->et;
+    const sw_eval_result eh = b->eh;
+    const sw_bake_spread spread = b->spread;
+    const double *mode_err = b->mode_err;
+    const double bake_seconds = b->bake_seconds;
+    const double model_err = b->model_err;
+    const int spread_every = b->o.spread_every;
+    const int absurd = b->absurd;
+    const int32_t kept = b->kept;
+    const int32_t nbeyond = b->nbeyond;
+    const int32_t nbeyond_all = b->nbeyond_all;
+    const sw_joint_reach *beyond = b->beyond;
+    char num[32];
     const sw_blob_view *v = &res.view;
     fprintf(stderr, "%s: wrote %s\n", tool, out_path);
     fprintf(stderr,
@@ -443,9 +303,6 @@ int main(int argc, char **argv) {
     fprintf(stderr, "  references solved by: solver %s, %s Hessians, at most %d contact rounds\n",
             sw_linear_solver_name(reference.solver), sw_hessian_mode_name(reference.hessian),
             reference.contact_rounds);
-    int32_t kept = 0; /* the pose-space pairs the per-pair cubature keeps */
-    for (int32_t c = 0; c < v->ncontacts && v->npair_groups > 0; ++c)
-        kept += v->pair_weight[c] > 0;
     fprintf(stderr,
             "  self-contact: %d contact pairs over the training poses in %d pairs of domains; "
             "the per-pair cubature keeps %d (--contact-tol %g)\n",
@@ -501,9 +358,6 @@ int main(int argc, char **argv) {
                 "state %.4f (moved it %.4f); %d unconverged, %d left out\n",
                 spread.poses, spread_every, spread.runtime, spread.from_skin, spread.from_reference,
                 spread.polished, spread.polish_move, spread.unconverged, spread.failed);
-    sw_joint_reach beyond[BAKE_BEYOND];
-    int32_t nbeyond_all = sw_bake_beyond_training(&res, &ch.skel, beyond, BAKE_BEYOND);
-    int32_t nbeyond = nbeyond_all < BAKE_BEYOND ? nbeyond_all : BAKE_BEYOND;
     if (nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
         int32_t shown = nbeyond < 8 ? nbeyond : 8;
         fprintf(stderr,
@@ -530,6 +384,36 @@ int main(int argc, char **argv) {
             fprintf(stderr, "  selector %-10s %6d tets  %8.2f s  worst fit %.4f\n", names[s],
                     res.selector_points[s], res.selector_seconds[s], res.selector_error[s]);
     }
+}
+
+/* The JSON line, with --json. */
+static void print_json(const bake *b) {
+    /* by value, under main's names */
+    const char *out_path = b->o.out_path;
+    const sw_character_args ca = b->o.ca;
+    const sw_bake_params p = b->o.p;
+    const sw_fullsim_params reference = b->o.reference;
+    const sw_adaptive_params ad = b->o.ad;
+    const sw_adaptive_report arep = b->arep;
+    const sw_character ch = b->ch;
+    const sw_scene_character_info info = b->info;
+    const sw_quality quality = b->quality;
+    const sw_bake_result res = b->res;
+    const sw_eval_result et = b->et;
+    const sw_eval_result eh = b->eh;
+    const sw_bake_spread spread = b->spread;
+    const double *mode_err = b->mode_err;
+    const double bake_seconds = b->bake_seconds;
+    const double eval_seconds = b->eval_seconds;
+    const double model_err = b->model_err;
+    const int json = b->o.json;
+    const int spread_every = b->o.spread_every;
+    const int absurd = b->absurd;
+    const int32_t kept = b->kept;
+    const int32_t nbeyond = b->nbeyond;
+    const sw_joint_reach *beyond = b->beyond;
+    const sw_blob_view *v = &b->res.view;
+    char num[32];
     if (json) {
         char gt[32], gh[32];
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
@@ -632,13 +516,32 @@ int main(int argc, char **argv) {
                res.simulate_cached ? "true" : "false", res.simulate_solved,
                absurd ? "true" : "false");
     }
-done:
-    sw_bake_spread_free(&spread);
-    sinew_blob_destroy(blob);
-    free(mem);
-    free(frame_err);
-    sw_bake_result_free(&res);
-    sw_character_free(&ch);
-    sw_clip_split_free(&clips);
+}
+
+static void bake_free(bake *b) {
+    sw_bake_spread_free(&b->spread);
+    sinew_blob_destroy(b->blob);
+    free(b->mem);
+    free(b->frame_err);
+    sw_bake_result_free(&b->res);
+    sw_character_free(&b->ch);
+    sw_clip_split_free(&b->clips);
+}
+
+int main(int argc, char **argv) {
+    static bake b;
+    sw_error err;
+    int status = bake_parse_args(argc, argv, &b.o);
+    if (status || (status = load_character(&b, &err))) return status;
+    if ((status = run_bake(&b, &err))) {
+        sw_character_free(&b.ch);
+        sw_clip_split_free(&b.clips);
+        return status;
+    }
+    if (!(status = measure(&b, &err)) && !(status = write_outputs(&b))) {
+        print_summary(&b);
+        print_json(&b);
+    }
+    bake_free(&b);
     return status;
 }

@@ -35,25 +35,50 @@
 
 static const char *const TOOL = "sinew-invariance";
 
-static void usage(FILE *f) {
-    fprintf(f,
-            "usage: sinew-invariance (FILE [--tets N] [--train-clips A,B] [--heldout-clips C] |\n"
-            "                         --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-            "                         --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-            "                         [--clip FILE [--frames F]])\n"
-            "                        --blob FILE [--frames-max K] [--seed S] [--json]\n"
-            "character:\n" SW_CHARACTER_USAGE);
-    fprintf(f, "invariance:\n"
-               "  --blob FILE       the blob sinew-bake wrote for this character\n"
-               "  --frames-max K    clip frames played, 1..100000 (default 120)\n"
-               "  --seed S          the random motions' seed, 1..2^31 (default 1)\n"
-               "  --reach D         the rigid motions' and the actor's translation, up to D\n"
-               "                    units on each axis, 0..1e7 (default 1e5)\n"
-               "  --angle A         the rigid motions' turn, degrees (default: random in 90..180;\n"
-               "                    a tiny one tells rounding's effect from the heading's)\n"
-               "  --world FILE      also with this world file's colliders (at frame 0), carried\n"
-               "                    by the motion: world_quasistatic, world_dynamic, world_patch\n"
-               "  --json            the figures as one JSON object on the last line\n");
+typedef struct {
+    const char *blob_path, *world_path;
+    int kmax, seed, json;
+    double far, angle;
+} options;
+
+static const char *const SYNOPSIS =
+    "sinew-invariance (FILE [--tets N] [--train-clips A,B] [--heldout-clips C] |\n"
+    "                         --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
+    "                         --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
+    "                         [--clip FILE [--frames F]])\n"
+    "                        --blob FILE [--frames-max K] [--seed S] [--json]\n";
+
+static int parse_args(int argc, char **argv, sw_character_args *ca, options *o) {
+    *o = (options){.kmax = 120, .seed = 1, .far = 1e5, .angle = -1};
+    const sw_flag flags[] = {
+        {SW_STR("--blob", &o->blob_path, "FILE", "the blob sinew-bake wrote for this character")},
+        {SW_INT("--frames-max", &o->kmax, 1, 100000, "K",
+                "clip frames played, 1..100000 (default 120)")},
+        {SW_INT("--seed", &o->seed, 1, 2147483647, "S",
+                "the random motions' seed, 1..2^31 (default 1)")},
+        {SW_REAL("--reach", &o->far, -1e-300, 1e7, "in 0 <= D <= 1e7", "D",
+                 "the rigid motions' and the actor's translation, up to D\n"
+                 "units on each axis, 0..1e7 (default 1e5)")},
+        {SW_REAL("--angle", &o->angle, 0, 180.0000001, "in 0 < A <= 180", "A",
+                 "the rigid motions' turn, degrees (default: random in 90..180;\n"
+                 "a tiny one tells rounding's effect from the heading's)")},
+        {SW_STR("--world", &o->world_path, "FILE",
+                "also with this world file's colliders (at frame 0), carried\n"
+                "by the motion: world_quasistatic, world_dynamic, world_patch")},
+        {SW_SET("--json", &o->json, 1, "the figures as one JSON object on the last line")},
+    };
+    sw_flag character[SW_CHARACTER_NFLAGS];
+    const sw_flag_group groups[] = {
+        {"character:\n" SW_CHARACTER_FILE_USAGE, character, sw_character_flags(ca, character)},
+        {"invariance:", flags, SW_FLAGS_N(flags)}};
+    const sw_tool_cli cli = {TOOL, SYNOPSIS, groups, SW_FLAGS_N(groups), NULL, &ca->file, 1};
+    if (sw_flags_parse(&cli, argc, argv)) return 2;
+    if (!sw_character_args_valid(ca)) return 2;
+    if (!o->blob_path) {
+        fprintf(stderr, "%s: --blob FILE is needed (bake it with sinew-bake)\n", TOOL);
+        return 2;
+    }
+    return 0;
 }
 
 static unsigned long long rng = 1;
@@ -127,59 +152,29 @@ static double *play_clip(const sw_character *ch, const sw_clip_split *clips, int
 int main(int argc, char **argv) {
     sw_character_args ca;
     sw_character_args_init(&ca, TOOL);
-    const char *blob_path = NULL, *world_path = NULL;
-    int kmax = 120, seed = 1, json = 0, ok = 1;
-    double far = 1e5, angle = -1;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        if (!strcmp(a, "--help") || !strcmp(a, "-h")) return usage(stdout), 0;
-        if (sw_character_args_take(&ca, argc, argv, &i, &ok)) {
-            if (!ok) return 2;
-        } else if (!strcmp(a, "--json")) {
-            json = 1;
-        } else if (!strcmp(a, "--world") && next) {
-            world_path = argv[++i];
-        } else if (!strcmp(a, "--blob") && next) {
-            blob_path = argv[++i];
-        } else if (!strcmp(a, "--frames-max") && next) {
-            if (!sw_tool_int(TOOL, a, argv[++i], 1, 100000, &kmax)) return 2;
-        } else if (!strcmp(a, "--reach") && next) {
-            if (!sw_tool_real(TOOL, a, argv[++i], -1e-300, 1e7, "in 0 <= D <= 1e7", &far)) return 2;
-        } else if (!strcmp(a, "--angle") && next) {
-            if (!sw_tool_real(TOOL, a, argv[++i], 0, 180.0000001, "in 0 < A <= 180", &angle))
-                return 2;
-        } else if (!strcmp(a, "--seed") && next) {
-            if (!sw_tool_int(TOOL, a, argv[++i], 1, 2147483647, &seed)) return 2;
-        } else {
-            return sw_tool_bad_arg(TOOL, a, usage);
-        }
-    }
-    if (!sw_character_args_valid(&ca)) return 2;
-    if (!blob_path) {
-        fprintf(stderr, "%s: --blob FILE is needed (bake it with sinew-bake)\n", TOOL);
-        return 2;
-    }
-    rng = (unsigned long long)seed * 0x9E3779B97F4A7C15ull | 1;
+    options o;
+    if (parse_args(argc, argv, &ca, &o)) return 2;
+    rng = (unsigned long long)o.seed * 0x9E3779B97F4A7C15ull | 1;
     sw_character ch;
     sw_clip_split clips;
     sw_error err;
     sinew_result r = sw_character_args_make(&ca, &ch, &clips, NULL, &err);
     if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", TOOL);
     sinew_blob_def bd = sinew_blob_def_default();
-    bd.path = blob_path;
+    bd.path = o.blob_path;
     sinew_blob *blob = NULL;
-    if (sw_tool_blob_load(TOOL, blob_path, bd, &blob) != SINEW_OK) return 1;
+    if (sw_tool_blob_load(TOOL, o.blob_path, bd, &blob) != SINEW_OK) return 1;
     int32_t frames = 0, nb = ch.skel.nbones;
-    double *clip = play_clip(&ch, &clips, kmax, &frames);
+    double *clip = play_clip(&ch, &clips, o.kmax, &frames);
     if (!clip || frames < 1) {
         fprintf(stderr, "%s: the character has no clip to play\n", TOOL);
         return 1;
     }
     float dt = (float)(1.0 / (ch.clip.fps > 0 ? ch.clip.fps : 30));
-    sw_move rigid = random_rigid(far), turning = random_rigid(0), actor = random_rigid(far),
+    sw_move rigid = random_rigid(o.far), turning = random_rigid(0), actor = random_rigid(o.far),
             s_small = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 0.01, 1, 1},
             s_big = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 100, 1, 1};
-    if (angle > 0) rigid.angle = actor.angle = angle * 3.141592653589793 / 180;
+    if (o.angle > 0) rigid.angle = actor.angle = o.angle * 3.141592653589793 / 180;
     turning.kind = SW_MOVE_TURNING;
     turning.angle = 4 * 3.141592653589793 / 180;
     for (int k = 0; k < 3; ++k) /* walking away: a tenth of a unit a frame */
@@ -190,7 +185,7 @@ int main(int argc, char **argv) {
     sw_move near = rigid;
     for (int k = 0; k < 3; ++k) /* float collider placements: within 10 units */
         near.shift[k] = fmax(-10, fmin(10, near.shift[k]));
-    if (world_path && !load_worlds(world_path, &near, &world, &moved)) return 1;
+    if (o.world_path && !load_worlds(o.world_path, &near, &world, &moved)) return 1;
     uint32_t quarter = sinew_blob_surface_vertex_count(blob) / 4 + 1;
     struct {
         const char *name;
@@ -239,7 +234,7 @@ int main(int argc, char **argv) {
                 rows[c].res.failed, rows[c].res.unconverged, (long long)rows[c].res.world_contacts,
                 rows[c].res.patch_vertices);
     }
-    if (json) {
+    if (o.json) {
         printf("{\"frames\":%d,\"size\":%.9g,\"worst\":%.4e,\"failed_steps\":%ld", frames,
                rows[0].res.size, worst, failed);
         for (int c = 0; c < ncases; ++c)

@@ -34,30 +34,19 @@ typedef struct {
     int azimuth, elevation;
 } options;
 
-static void usage(FILE *f) {
-    fprintf(f,
-            "usage: sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [options]\n"
-            "       sinew-render --frames DIR --out IMAGE.png [--grid N] [options]\n"
-            "  --obj FILE      a Wavefront OBJ surface; several make a contact sheet (vertex\n"
-            "                  colours, v x y z r g b, colour its triangles: sinew-bench\n"
-            "                  --world --out marks the full-space patch so)\n"
-            "  --frames DIR    every DIR/frame_NNNN.obj (as written by sinew-fullsim --out)\n"
-            "  --grid N        with --frames: at most N x N evenly spaced frames, 1..64\n"
-            "                  (default 4)\n"
-            "  --out FILE      the PNG to write (written to FILE.tmp, then renamed)\n"
-            "  --width W       image width in pixels, 1..%d (default 640, contact sheet 1280)\n"
-            "  --height H      image height in pixels, 1..%d (default 480, contact sheet 960)\n"
-            "  --supersample S S x S rays a pixel, 1..4 (default 2)\n"
-            "  --azimuth DEG   camera turned from the front (+Z, Y up) toward +X, -360..360\n"
-            "                  (default 35)\n"
-            "  --elevation DEG camera height above the horizon, -89..89 (default 20)\n"
-            "  --threads T     render threads, 1..64 (default: all cores)\n"
-            "  --no-ground     no checkered ground plane\n"
-            "  --quiet         no summary line on stderr\n"
-            "exit status: 0 written, 1 failed, 2 bad arguments\n",
-            SW_PNG_MAX_DIM, SW_PNG_MAX_DIM);
+#define TEXT_(x) #x
+#define TEXT(x) TEXT_(x)
+
+/* --obj FILE, any number of times */
+static int take_obj(const char *tool, const char *flag, const char *v, void *target) {
+    (void)tool, (void)flag;
+    options *o = target;
+    o->objs[o->nobjs++] = v;
+    return 1;
 }
 
+/* Parses argv into *o; 0 for a usable command line, else the exit status 2 (the message
+ * is out). */
 static int parse_args(int argc, char **argv, options *o) {
     memset(o, 0, sizeof *o);
     o->grid = 4;
@@ -70,58 +59,60 @@ static int parse_args(int argc, char **argv, options *o) {
     o->objs = calloc((size_t)argc, sizeof *o->objs);
     if (!o->objs) {
         fprintf(stderr, "sinew-render: out of memory\n");
-        return 0;
+        return 2;
     }
-    struct {
-        const char *flag;
-        int lo, hi, *dst;
-    } ints[] = {{"--width", 1, SW_PNG_MAX_DIM, &o->width},
-                {"--height", 1, SW_PNG_MAX_DIM, &o->height},
-                {"--grid", 1, 64, &o->grid},
-                {"--supersample", 1, 4, &o->supersample},
-                {"--threads", 1, 64, &o->threads},
-                {"--azimuth", -360, 360, &o->azimuth},
-                {"--elevation", -89, 89, &o->elevation}};
-    const sw_tool_opt opts[] = {{"--frames", &o->frames_dir, NULL, 0},
-                                {"--out", &o->out, NULL, 0},
-                                {"--no-ground", NULL, &o->ground, 0},
-                                {"--quiet", NULL, &o->quiet, 1}};
     int grid_given = 0;
-    for (int i = 1; i < argc; ++i) {
-        const char *a = argv[i], *next = i + 1 < argc ? argv[i + 1] : NULL;
-        int matched = 0;
-        grid_given |= !strcmp(a, "--grid");
-        for (size_t k = 0; k < sizeof ints / sizeof ints[0]; ++k) {
-            if (strcmp(a, ints[k].flag)) continue;
-            matched = 1;
-            if (!next || !sw_parse_int(next, ints[k].lo, ints[k].hi, ints[k].dst)) {
-                fprintf(stderr, "sinew-render: %s wants an integer in %d..%d, got '%s'\n", a,
-                        ints[k].lo, ints[k].hi, next ? next : "(nothing)");
-                return 0;
-            }
-            ++i;
-        }
-        if (matched) continue;
-        if (!strcmp(a, "--obj") && next) {
-            o->objs[o->nobjs++] = argv[++i];
-        } else if (sw_tool_take(opts, sizeof opts / sizeof opts[0], argc, argv, &i)) {
-            /* taken */
-        } else if (!sw_tool_help(a, usage)) {
-            return sw_tool_unknown_arg("sinew-render", a);
-        }
-    }
+    const sw_flag flags[] = {
+        {SW_CALL("--obj", take_obj, o, "FILE",
+                 "a Wavefront OBJ surface; several make a contact sheet (vertex\n"
+                 "colours, v x y z r g b, colour its triangles: sinew-bench\n"
+                 "--world --out marks the full-space patch so)")},
+        {SW_STR("--frames", &o->frames_dir, "DIR",
+                "every DIR/frame_NNNN.obj (as written by sinew-fullsim --out)")},
+        {SW_INT("--grid", &o->grid, 1, 64, "N",
+                "with --frames: at most N x N evenly spaced frames, 1..64\n(default 4)"),
+         .given = &grid_given},
+        {SW_STR("--out", &o->out, "FILE", "the PNG to write (written to FILE.tmp, then renamed)")},
+        {SW_INT("--width", &o->width, 1, SW_PNG_MAX_DIM, "W",
+                "image width in pixels, 1.." TEXT(SW_PNG_MAX_DIM) " (default 640, contact\n"
+                                                                  "sheet 1280)")},
+        {SW_INT("--height", &o->height, 1, SW_PNG_MAX_DIM, "H",
+                "image height in pixels, 1.." TEXT(SW_PNG_MAX_DIM) " (default 480, contact\n"
+                                                                   "sheet 960)")},
+        {SW_INT("--supersample", &o->supersample, 1, 4, "S",
+                "S x S rays a pixel, 1..4 (default 2)")},
+        {SW_INT("--azimuth", &o->azimuth, -360, 360, "DEG",
+                "camera turned from the front (+Z, Y up) toward +X, -360..360\n(default 35)")},
+        {SW_INT("--elevation", &o->elevation, -89, 89, "DEG",
+                "camera height above the horizon, -89..89 (default 20)")},
+        {SW_INT("--threads", &o->threads, 1, 64, "T",
+                "render threads, 1..64 (default: all cores)")},
+        {SW_SET("--no-ground", &o->ground, 0, "no checkered ground plane")},
+        {SW_SET("--quiet", &o->quiet, 1, "no summary line on stderr")},
+    };
+    const sw_flag_group groups[] = {{NULL, flags, SW_FLAGS_N(flags)}};
+    const sw_tool_cli cli = {
+        "sinew-render",
+        "sinew-render --obj FILE [--obj FILE ...] --out IMAGE.png [options]\n"
+        "       sinew-render --frames DIR --out IMAGE.png [--grid N] [options]\n",
+        groups,
+        1,
+        "exit status: 0 written, 1 failed, 2 bad arguments\n",
+        NULL,
+        0};
+    if (sw_flags_parse(&cli, argc, argv)) return 2;
     if (!o->out || (o->nobjs == 0) == (o->frames_dir == NULL)) {
         fprintf(stderr, "sinew-render: need --out and either --obj (one or more) or --frames\n");
-        return 0;
+        return 2;
     }
     if (grid_given && !o->frames_dir) {
         fprintf(stderr, "sinew-render: --grid does not apply to --obj (it thins --frames)\n");
-        return 0;
+        return 2;
     }
     for (int k = 0; k < o->nobjs; ++k)
         if (!sw_tool_format("sinew-render", "--obj", o->objs[k], "obj", ".obj (Wavefront)"))
-            return 0;
-    return sw_tool_format("sinew-render", "--out", o->out, "png", ".png");
+            return 2;
+    return sw_tool_format("sinew-render", "--out", o->out, "png", ".png") ? 0 : 2;
 }
 
 /* ---- --frames: frame_NNNN.obj files, sorted by number, evenly thinned --------------- */
@@ -336,8 +327,7 @@ static int render_all(const options *o, const char **paths, int n) {
 
 int main(int argc, char **argv) {
     options o;
-    if (!parse_args(argc, argv, &o)) {
-        usage(stderr);
+    if (parse_args(argc, argv, &o)) {
         free(o.objs);
         return 2;
     }

@@ -8,8 +8,30 @@
 #include "bbox.h"
 #include "blob_load.h"
 #include "instance.h"
+#include "replay.h"
 #include "rt_interpose.h"
 #include "tool_common.h"
+
+/* Mode k's sums over its timed steps. */
+typedef struct {
+    sw_newton_bench *out;
+    int k, nframes, reps;
+    sinew_instance *inst;
+    uint32_t ns;
+    float *surf;
+    double *ms;
+} newton_sums;
+
+static void newton_step(void *user, int step, int frame, double ms, const sinew_step_stats *st) {
+    (void)ms;
+    newton_sums *m = user;
+    m->ms[step] = sw_step_ms(st);
+    m->out->evals[m->k] += st->potential_evals;
+    m->out->factors[m->k] += st->factorizations;
+    m->out->rest[m->k] += st->rest_updates;
+    if (step / m->nframes == m->reps - 1)
+        sinew_instance_read_surface(m->inst, m->surf + (size_t)frame * 3 * m->ns, NULL, m->ns);
+}
 
 /* Mode k's instance (0 current, 1 rest-first) over the clip: the timed steps' figures,
  * and each frame's output surface of the last pass in surf (3 ns floats a frame). */
@@ -23,31 +45,18 @@ static sinew_result run_mode(const sinew_blob *blob, int k, const double *T, int
     if (r != SINEW_OK)
         return sw_error_set(err, r, "cannot create a %s instance: %s",
                             k ? "rest-first" : "current-Hessian", sinew_result_string(r));
-    int nb = (int)sinew_blob_bone_count(blob);
-    uint32_t ns = sinew_blob_surface_vertex_count(blob);
-    for (int f = 0; f < nframes; ++f) { /* untimed pass */
-        sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
-        out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
-    }
-    if (k) sw_rt_count_begin();
-    int steps = 0;
-    for (int rep = 0; rep < reps; ++rep)
-        for (int f = 0; f < nframes; ++f, ++steps) {
-            sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
-            out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
-            sinew_step_stats st = {.struct_size = sizeof st};
-            sinew_instance_get_stats(inst, &st);
-            ms[steps] = sw_step_ms(&st);
-            out->evals[k] += st.potential_evals;
-            out->factors[k] += st.factorizations;
-            out->rest[k] += st.rest_updates;
-            if (rep == reps - 1)
-                sinew_instance_read_surface(inst, surf + (size_t)f * 3 * ns, NULL, ns);
-        }
-    if (k) {
-        sw_rt_counts c = sw_rt_count_end();
-        sw_rt_counts_report(&c, &out->allocs, &out->locks);
-    }
+    newton_sums m = {out, k, nframes, reps, inst, sinew_blob_surface_vertex_count(blob), surf, ms};
+    /* an untimed pass first */
+    sw_replay rp = sw_replay_clip(inst, T, nframes, (int)sinew_blob_bone_count(blob), dt);
+    rp.warmup = nframes;
+    rp.steps = reps * nframes;
+    rp.count_rt = k;
+    rp.on_step = newton_step;
+    rp.user = &m;
+    sw_replay_run(&rp);
+    out->failed += rp.warmup_failed + rp.failed;
+    if (k) sw_rt_counts_report(&rp.counts, &out->allocs, &out->locks);
+    const int steps = rp.steps;
     out->steps = steps;
     out->step_ms[k] = sw_median(ms, steps);
     out->evals[k] /= steps;

@@ -8,6 +8,7 @@
 #include "clock.h"
 #include "collision.h"
 #include "instance.h"
+#include "replay.h"
 #include "rt_interpose.h"
 #include "tool_common.h"
 
@@ -55,32 +56,56 @@ static sinew_result run_reference(const sw_character *ch, sw_world_scene *ws,
  * of 30 steps moved by 1.6x between two runs on this machine). */
 #define TIMED_PASSES 5
 
+/* The timed pass's state: the scene and the figures of its steps. */
+typedef struct {
+    sinew_instance *inst;
+    sw_world_scene *ws;
+    sw_error *err;
+    double *qms, *sms;
+    int n;
+    sw_world_bench *out;
+} world_pass;
+
+/* Each pass from rest, the colliders at the frame (a failure is counted by the step). */
+static sinew_result world_before(void *user, int step, int frame) {
+    world_pass *w = user;
+    if (frame == 0 && step < w->n) sinew_instance_reset(w->inst);
+    sw_world_scene_at(w->ws, frame, w->err);
+    return SINEW_OK;
+}
+
+static void world_step(void *user, int step, int frame, double ms, const sinew_step_stats *st) {
+    (void)frame;
+    world_pass *w = user;
+    w->sms[step] = ms;
+    w->qms[step] = st->ms_world;
+    w->out->world_queries += st->world_queries / (double)w->n;
+    w->out->world_contacts += st->world_contacts / (double)w->n;
+}
+
 /* The timed pass: the scene's frames stepped and read back to back, as sub_ms is timed
  * (nothing else between steps evicting the caches): the median step and the median of
  * the step's own world detection time (ms_world), over TIMED_PASSES passes. */
 static void time_subspace(sinew_instance *inst, sw_world_scene *ws, const double *T, int nf,
                           int32_t nbones, uint32_t ns, sw_world_bench *out, sw_error *err) {
     int n = TIMED_PASSES * nf;
-    double *qms = malloc(sizeof(double) * n), *sms = malloc(sizeof(double) * n);
+    world_pass w = {inst, ws, err, malloc(sizeof(double) * n), malloc(sizeof(double) * n), n, out};
     float *pos = malloc(sizeof(float) * 3 * ns), *nrm = malloc(sizeof(float) * 3 * ns);
-    for (int k = 0; k < n && qms && sms && pos && nrm; ++k) {
-        int f = k % nf;
-        if (f == 0) sinew_instance_reset(inst);
-        sw_world_scene_at(ws, f, err);
-        double t0 = sw_now_seconds();
-        sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nbones);
-        out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
-        sinew_instance_read_surface(inst, pos, nrm, ns);
-        sms[k] = 1e3 * (sw_now_seconds() - t0);
-        sinew_step_stats st = {.struct_size = sizeof st};
-        sinew_instance_get_stats(inst, &st);
-        qms[k] = st.ms_world;
-        out->world_queries += st.world_queries / (double)n;
-        out->world_contacts += st.world_contacts / (double)n;
+    if (w.qms && w.sms && pos && nrm) {
+        sw_replay rp = sw_replay_clip(inst, T, nf, nbones, 1.0f / 30);
+        rp.steps = n;
+        rp.pos = pos;
+        rp.nrm = nrm;
+        rp.ns = ns;
+        rp.before = world_before;
+        rp.on_step = world_step;
+        rp.user = &w;
+        sw_replay_run(&rp);
+        out->sub_failed += rp.failed;
     }
-    out->world_query_ms = qms ? sw_median(qms, n) : 0;
-    out->sub_ms = sms ? sw_median(sms, n) : 0;
-    free(qms), free(sms), free(pos), free(nrm);
+    out->world_query_ms = w.qms ? sw_median(w.qms, n) : 0;
+    out->sub_ms = w.sms ? sw_median(w.sms, n) : 0;
+    free(w.qms), free(w.sms), free(pos), free(nrm);
     sinew_instance_reset(inst);
 }
 
@@ -130,14 +155,16 @@ static sinew_result run_subspace(const sinew_blob *blob, sw_world_scene *ws, con
     out->allocs = out->locks = -1;
     (void)sw_rt_interpose_active(); /* its self-check counts: outside the counted steps */
     if (out->contract_steps > 0 && r == SINEW_OK) {
-        sw_rt_count_begin();
-        for (int s = 0; s < out->contract_steps; ++s) {
-            sw_world_scene_at(ws, s % nf, err);
-            sw_instance_set_pose_d(inst, T + (size_t)(s % nf) * 12 * v->nbones);
-            out->sub_failed += sinew_instance_step(inst, 1.0f / 30) != SINEW_OK;
-        }
-        sw_rt_counts c = sw_rt_count_end();
-        sw_rt_counts_report(&c, &out->allocs, &out->locks);
+        /* the colliders at each frame: inside the count (world_before, no reset past n) */
+        world_pass w = {inst, ws, err, NULL, NULL, 0, out};
+        sw_replay rp = sw_replay_clip(inst, T, nf, v->nbones, 1.0f / 30);
+        rp.steps = out->contract_steps;
+        rp.count_rt = 1;
+        rp.before = world_before;
+        rp.user = &w;
+        sw_replay_run(&rp);
+        out->sub_failed += rp.failed;
+        sw_rt_counts_report(&rp.counts, &out->allocs, &out->locks);
     }
     free(xs), free(cnt), free(xd), free(xo);
     sinew_instance_destroy(inst);

@@ -8,12 +8,12 @@
 # when any harness crashed (ASan, UBSan, a leak, a broken reader promise = abort) or did
 # not run; the crashing inputs are kept in BUILD/fuzz-artifacts/<name>/.
 #
-# usage: bash tools/run-fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]   (default 60, all)
+# usage: bash tools/scripts/run-fuzz.sh [SECONDS_PER_HARNESS] [HARNESS...]   (default 60, all)
 # env:   SINEW_FUZZ_BUILD (build folder, default build), SINEW_JOBS (default 2),
 #        SINEW_FUZZ_KEEP=1 keeps the scratch corpora (their paths are printed)
 set -uo pipefail
 
-cd "$(dirname "${BASH_SOURCE[0]}")/.." || exit 1
+cd "$(dirname "${BASH_SOURCE[0]}")/../.." || exit 1
 root=$(pwd)
 secs=${1:-60}
 [ $# -gt 0 ] && shift

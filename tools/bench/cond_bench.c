@@ -54,6 +54,38 @@ static double max_jump(const double *a, const double *b, int32_t n) {
     return m;
 }
 
+/* The run's times against the reference's, and its patches' means over the frames that
+ * had one; sorted: scratch of nf. */
+static void summarise(int nf, const double *ms, const double *ref_ms, const double *patch_size,
+                      double *sorted, sw_cond_bench *out) {
+    out->speedup_worst = INFINITY;
+    for (int f = 0; f < nf; ++f) {
+        double s = ref_ms[f] / ms[f];
+        if (getenv("SW_COND_DEBUG") && s < 50)
+            fprintf(stderr, "frame %d: %.1f ms, reference %.1f ms: %.1fx\n", f, ms[f], ref_ms[f],
+                    s);
+        out->speedup_mean += s / nf;
+        out->speedup_worst = fmin(out->speedup_worst, s);
+        out->ms_max = fmax(out->ms_max, ms[f]);
+        sorted[f] = ms[f];
+    }
+    int patch_frames = 0;
+    for (int f = 0; f < nf; ++f) {
+        if (patch_size[2 * f] == 0) continue;
+        patch_frames++;
+        out->patch_ms_mean += ms[f];
+        out->patch_verts_mean += patch_size[2 * f];
+        out->patch_tets_mean += patch_size[2 * f + 1];
+    }
+    if (patch_frames > 0) {
+        out->patch_ms_mean /= patch_frames;
+        out->patch_verts_mean /= patch_frames;
+        out->patch_tets_mean /= patch_frames;
+    }
+    out->ms_median = sw_median(sorted, nf);
+    out->p100_over_p50 = out->ms_median > 0 ? out->ms_max / out->ms_median : 0;
+}
+
 sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const double *T, int nf,
                                const double *x_full, const double *ref_ms,
                                const unsigned char *touch, const double *mass,
@@ -172,32 +204,7 @@ sinew_result sw_cond_bench_run(const sinew_blob *blob, sw_world_scene *ws, const
         }
     }
     out->err_world_cond = den > 0 ? sqrt(num / den) : 0;
-    out->speedup_worst = INFINITY;
-    for (int f = 0; f < nf; ++f) {
-        double s = ref_ms[f] / ms[f];
-        if (getenv("SW_COND_DEBUG") && s < 50)
-            fprintf(stderr, "frame %d: %.1f ms, reference %.1f ms: %.1fx\n", f, ms[f], ref_ms[f],
-                    s);
-        out->speedup_mean += s / nf;
-        out->speedup_worst = fmin(out->speedup_worst, s);
-        out->ms_max = fmax(out->ms_max, ms[f]);
-        sorted[f] = ms[f];
-    }
-    int patch_frames = 0;
-    for (int f = 0; f < nf; ++f) {
-        if (patch_size[2 * f] == 0) continue;
-        patch_frames++;
-        out->patch_ms_mean += ms[f];
-        out->patch_verts_mean += patch_size[2 * f];
-        out->patch_tets_mean += patch_size[2 * f + 1];
-    }
-    if (patch_frames > 0) {
-        out->patch_ms_mean /= patch_frames;
-        out->patch_verts_mean /= patch_frames;
-        out->patch_tets_mean /= patch_frames;
-    }
-    out->ms_median = sw_median(sorted, nf);
-    out->p100_over_p50 = out->ms_median > 0 ? out->ms_max / out->ms_median : 0;
+    summarise(nf, ms, ref_ms, patch_size, sorted, out);
 done:
     free(ms), free(sorted), free(xs), free(cnt), free(xd), free(prev), free(ref_prev);
     free(ref_out), free(pos), free(nrm), free(col), free(patch_size);

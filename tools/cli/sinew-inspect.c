@@ -16,19 +16,12 @@
 
 static const char *tool = "sinew-inspect";
 
-static int usage(FILE *f) {
-    fprintf(f,
-            "usage: %s FILE [--fps F] [--height H] [--tets N] [--mesher M] [--json]\n"
-            "  FILE      a rigged glTF 2.0 (.gltf/.glb) or FBX character\n"
-            "  --fps F   clip sampling rate (default 30)\n"
-            "  --height H  scale the render mesh to H metres tall (default: file units)\n"
-            "  --tets N  also fill the render surface with a simulation tet mesh of about N\n"
-            "            tets (100..5000000) and report it\n"
-            "  --mesher M  lattice (default: a lattice cut by the winding number, any\n"
-            "            surface) or tetgen (the Debian program, closed surfaces only)\n"
-            "  --json    print one JSON object as the last line\n",
-            tool);
-    return f == stdout ? 0 : 2;
+/* --mesher lattice | tetgen: *(int *)target = 1 for tetgen */
+static int take_mesher(const char *t, const char *flag, const char *v, void *target) {
+    static const char *const meshers[] = {"lattice", "tetgen", NULL};
+    int k = sw_flags_choice(t, flag, v, meshers);
+    if (k >= 0) *(int *)target = k;
+    return k >= 0;
 }
 
 static void bbox(const sw_trimesh *m, double *size) {
@@ -128,36 +121,34 @@ int main(int argc, char **argv) {
     const char *path = NULL;
     sw_import_options o = {0};
     int json = 0, tets = 0, tetgen = 0;
-    for (int i = 1; i < argc; ++i) {
-        if (!strcmp(argv[i], "--help") || !strcmp(argv[i], "-h")) return usage(stdout);
-        if (!strcmp(argv[i], "--json")) {
-            json = 1;
-        } else if (!strcmp(argv[i], "--fps")) {
-            if (!sw_tool_real(tool, "--fps", i + 1 < argc ? argv[++i] : NULL, 0, 10000.0001,
-                              "in (0, 10000]", &o.fps))
-                return 2;
-        } else if (!strcmp(argv[i], "--height")) {
-            if (!sw_tool_real(tool, "--height", i + 1 < argc ? argv[++i] : NULL, 0, 1e6,
-                              "in (0, 1e6)", &o.target_height))
-                return 2;
-        } else if (!strcmp(argv[i], "--tets")) {
-            if (!sw_tool_int(tool, "--tets", i + 1 < argc ? argv[++i] : NULL, 100, 5000000, &tets))
-                return 2;
-        } else if (!strcmp(argv[i], "--mesher")) {
-            const char *m = i + 1 < argc ? argv[++i] : "";
-            if (strcmp(m, "lattice") && strcmp(m, "tetgen")) {
-                fprintf(stderr, "%s: --mesher takes lattice or tetgen, not '%s'\n", tool, m);
-                return 2;
-            }
-            tetgen = !strcmp(m, "tetgen");
-        } else if (argv[i][0] == '-' || path) {
-            fprintf(stderr, "%s: unexpected argument '%s'\n", tool, argv[i]);
-            return usage(stderr);
-        } else {
-            path = argv[i];
-        }
+    const sw_flag flags[] = {
+        {SW_REAL("--fps", &o.fps, 0, 10000.0001, "in (0, 10000]", "F",
+                 "clip sampling rate, in (0, 10000] (default 30)")},
+        {SW_REAL("--height", &o.target_height, 0, 1e6, "in (0, 1e6)", "H",
+                 "scale the render mesh to H metres tall (default: file units)")},
+        {SW_INT("--tets", &tets, 100, 5000000, "N",
+                "also fill the render surface with a simulation tet mesh of about N\n"
+                "tets (100..5000000) and report it")},
+        {SW_CALL("--mesher", take_mesher, &tetgen, "M",
+                 "lattice (default: a lattice cut by the winding number, any\n"
+                 "surface) or tetgen (the Debian program, closed surfaces only)")},
+        {SW_SET("--json", &json, 1, "print one JSON object as the last line")},
+    };
+    const sw_flag_group groups[] = {{NULL, flags, SW_FLAGS_N(flags)}};
+    const sw_tool_cli cli = {tool,
+                             "sinew-inspect FILE [--fps F] [--height H] [--tets N] [--mesher M] "
+                             "[--json]\n"
+                             "  FILE             a rigged glTF 2.0 (.gltf/.glb) or FBX character\n",
+                             groups,
+                             1,
+                             "exit status: 0 done, 1 failed, 2 bad arguments\n",
+                             &path,
+                             1};
+    if (sw_flags_parse(&cli, argc, argv)) return 2;
+    if (!path) {
+        sw_flags_usage(&cli, stderr);
+        return 2;
     }
-    if (!path) return usage(stderr);
     sw_imported_character c;
     sw_error err;
     sw_error_clear(&err);

@@ -7,8 +7,30 @@
 #include "bake.h"
 #include "blob_load.h"
 #include "instance.h"
+#include "replay.h"
 #include "rt_interpose.h"
 #include "tool_common.h"
+
+/* Mode k's sums over its timed steps. */
+typedef struct {
+    sw_sc_bench *out;
+    int k;
+    double sc_sum, step_sum;
+} sc_sums;
+
+static void sc_step(void *user, int step, int frame, double ms, const sinew_step_stats *st) {
+    (void)step, (void)frame, (void)ms;
+    sc_sums *m = user;
+    sw_sc_bench *out = m->out;
+    const int k = m->k;
+    m->sc_sum += st->ms_self_contact;
+    m->step_sum += sw_step_ms(st);
+    out->ms_max[k] = fmax(out->ms_max[k], st->ms_self_contact);
+    out->tests_mean[k] += st->self_contact_tests;
+    out->pairs_mean[k] += st->self_contacts;
+    out->novel_mean[k] += st->self_contact_novel;
+    out->apart_mean[k] += st->self_contacts_apart;
+}
 
 /* One mode's pass: the figures of its timed steps. */
 static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, const double *T,
@@ -22,43 +44,28 @@ static sinew_result run_mode(const sinew_blob *blob, sinew_self_contact mode, co
     if (r != SINEW_OK)
         return sw_error_set(err, r, "cannot create a %s instance: %s", sw_self_contact_names[k],
                             sinew_result_string(r));
-    int nb = (int)sinew_blob_bone_count(blob);
-    double sc_sum = 0, step_sum = 0;
     out->ms_mean[k] = out->ms_max[k] = out->tests_mean[k] = out->pairs_mean[k] = 0;
-    for (int f = 0; f < nframes; ++f) { /* untimed pass: the instance settles on the clip */
-        sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
-        out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
-    }
-    if (count_rt) sw_rt_count_begin();
-    int steps = 0;
-    for (int rep = 0; rep < reps; ++rep)
-        for (int f = 0; f < nframes; ++f, ++steps) {
-            sw_instance_set_pose_d(inst, T + (size_t)f * 12 * nb);
-            out->failed += sinew_instance_step(inst, dt) != SINEW_OK;
-            sinew_step_stats st = {.struct_size = sizeof st};
-            sinew_instance_get_stats(inst, &st);
-            double step = sw_step_ms(&st);
-            sc_sum += st.ms_self_contact;
-            step_sum += step;
-            out->ms_max[k] = fmax(out->ms_max[k], st.ms_self_contact);
-            out->tests_mean[k] += st.self_contact_tests;
-            out->pairs_mean[k] += st.self_contacts;
-            out->novel_mean[k] += st.self_contact_novel;
-            out->apart_mean[k] += st.self_contacts_apart;
-        }
-    if (count_rt) {
-        sw_rt_counts c = sw_rt_count_end();
-        sw_rt_counts_report(&c, &out->allocs[k], &out->locks[k]);
-    }
+    sc_sums m = {out, k, 0, 0};
+    /* an untimed pass first: the instance settles on the clip */
+    sw_replay rp = sw_replay_clip(inst, T, nframes, (int)sinew_blob_bone_count(blob), dt);
+    rp.warmup = nframes;
+    rp.steps = reps * nframes;
+    rp.count_rt = count_rt;
+    rp.on_step = sc_step;
+    rp.user = &m;
+    sw_replay_run(&rp);
+    out->failed += rp.warmup_failed + rp.failed;
+    if (count_rt) sw_rt_counts_report(&rp.counts, &out->allocs[k], &out->locks[k]);
+    const int steps = rp.steps;
     out->steps = steps;
-    out->ms_mean[k] = sc_sum / steps;
-    out->step_mean[k] = step_sum / steps;
+    out->ms_mean[k] = m.sc_sum / steps;
+    out->step_mean[k] = m.step_sum / steps;
     out->tests_mean[k] /= steps;
     out->pairs_mean[k] /= steps;
     out->novel_mean[k] /= steps;
     out->apart_mean[k] /= steps;
-    if (k == 0) out->frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
-    if (k == 2) out->pp_frame_share = step_sum > 0 ? sc_sum / step_sum : 0;
+    if (k == 0) out->frame_share = m.step_sum > 0 ? m.sc_sum / m.step_sum : 0;
+    if (k == 2) out->pp_frame_share = m.step_sum > 0 ? m.sc_sum / m.step_sum : 0;
     sinew_instance_destroy(inst);
     return SINEW_OK;
 }
