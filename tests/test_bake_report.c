@@ -324,7 +324,8 @@ TEST(clips_of_their_own_and_the_report) {
                                modes,
                                &spread,
                                "auto",
-                               "adaptive"};
+                               "adaptive",
+                               0};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;
@@ -478,7 +479,8 @@ TEST(random_heldout_poses_in_the_report) {
                                NULL,
                                NULL,
                                NULL,
-                               NULL};
+                               NULL,
+                               0};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
