@@ -46,7 +46,7 @@ typedef struct sw_bake_report_input {
     double err_train, err_heldout;
     int32_t failed_steps;
     double bake_seconds, eval_seconds;
-    int contact_sheet; /* render DIR/heldout_sheet.png (Embree; a few seconds) */
+    int contact_sheet; /* render DIR/heldout_sheet.png and its tiles (Embree; a few seconds) */
     /* the adaptive loop's rounds (sinew-bake --adaptive; NULL or 0 rounds: none) */
     const sw_adaptive_report *adaptive;
     /* where the error is (sw_eval_result's regions) on the training and the held-out poses;

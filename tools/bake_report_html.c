@@ -391,6 +391,8 @@ static void html_sheet(FILE *f, const sw_bake_report_input *in, const report *r)
             html_text(f, in->heldout_names[clip]);
         } else if (clip < 0) {
             fprintf(f, "<br>(random pose %d)", k);
+        } else {
+            fprintf(f, "<br>of the held-out part");
         }
         fprintf(f, "</th>");
         for (int c = 0; c < SW_SHEET_COLS; ++c) {
