@@ -15,6 +15,7 @@
 
 #include "bake_report.h"
 #include "sw_test.h"
+#include "text5x7.h"
 
 /* DIR/name parsed (NULL when it cannot be read or parsed). */
 static cJSON *report_load_json(const char *dir) {
@@ -165,6 +166,21 @@ static void check_ramp(void) {
     sw_bake_report_diff_colors(4, X, ref, 2, tris, 1.0, rgb);
     ENSURE(fabsf(rgb[0] - rgb[2]) < 0.1f); /* on the reference: pale */
     ENSUREF(rgb[3] - rgb[5] > 0.3f, "%g %g %g", rgb[3], rgb[4], rgb[5]); /* off it: warm */
+}
+
+/* The sheet's own labels (text5x7.h): a glyph's pixels where its bits are, at its scale,
+ * clipped at the image's edge, and widths of 6 font pixels a character less the last gap. */
+static void check_font(void) {
+    uint8_t img[3 * 20 * 20];
+    memset(img, 255, sizeof img);
+    static const uint8_t ink[3] = {0, 0, 0};
+    sw_draw_text(img, 20, 20, 1, 1, 2, "0", ink); /* 19 set bits in the 0 glyph */
+    int dark = 0;
+    for (int p = 0; p < 20 * 20; ++p)
+        dark += img[3 * p] == 0;
+    ENSUREF(dark == 4 * 19, "%d pixels", dark);
+    sw_draw_text(img, 20, 20, 15, 15, 2, "0", ink); /* mostly off the image: no write past it */
+    ENSURE(sw_text_width("AB", 2) == 22 && sw_text_width("", 3) == 0);
 }
 
 /* The contact sheet: the figures in the JSON (a row a held-out pose, the reference column

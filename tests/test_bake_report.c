@@ -538,6 +538,7 @@ TEST(random_heldout_poses_in_the_report) {
     ENSURE(html && strstr(html, "random poses turn each joint within 90 degrees</td>"));
     free(html);
     check_ramp();
+    check_font();
     char verdict[16];
     /* nothing beyond training: a miss names the bones whose flesh holds the error */
     in.target = 1e-9;

@@ -8,7 +8,8 @@
  *
  *   DIR/report.html   the page (shows the tiles below when they were rendered)
  *   DIR/report.json   {"sinew_bake_report": 1, ...}: the figures (schema in bake_report.c)
- *   DIR/heldout_sheet.png  the contact sheet in one image (rows: frames; columns as below)
+ *   DIR/heldout_sheet.png  the contact sheet in one image, labelled (columns named, frames
+ *                     numbered, the colour legend)
  *   DIR/heldout_<row>_<column>.png  its tiles, one a frame and column, which the page
  *                     lays out under named columns and numbered frames */
 #ifndef SW_BAKE_REPORT_H

@@ -17,10 +17,16 @@
 #include "mesh_io.h"
 #include "png_write.h"
 #include "render.h"
+#include "text5x7.h"
 
 #define TILE_W 320
 #define TILE_H 240
 #define GAP 4
+/* the sheet's margins for its labels (text5x7.h), so the one image reads on its own:
+   column names above, frame numbers left, the colour legend below */
+#define HEAD_H 28
+#define LEFT_W 76
+#define FOOT_H 52
 
 const char *const sw_bake_report_sheet_keys[SW_SHEET_COLS] = {"reference", "sinew", "skinning"};
 
@@ -152,13 +158,52 @@ static sinew_result draw_tile(const sw_render_params *p, int32_t nv, const doubl
     sw_bake_report_diff_colors(nv, X, ref, s->ntris, s->tris, scale, colors);
     sinew_result r = sw_render_surface(p, nv, X, s->ntris, s->tris, colors, tile, err);
     if (r != SINEW_OK) return r;
-    int x0 = col * (TILE_W + GAP), y0 = row * (TILE_H + GAP);
+    int x0 = LEFT_W + col * (TILE_W + GAP), y0 = HEAD_H + row * (TILE_H + GAP);
     for (int y = 0; y < TILE_H; ++y)
         memcpy(sheet + 3 * ((size_t)(y0 + y) * W + x0), tile + 3 * (size_t)y * TILE_W, 3 * TILE_W);
     char name[64], path[4200];
     sw_bake_report_tile_name(name, sizeof name, row, col);
     snprintf(path, sizeof path, "%s/%s", dir, name);
     return sw_write_png(path, TILE_W, TILE_H, tile, err);
+}
+
+/* The sheet's labels: the columns' names, each row's frame (or random pose), and the
+ * colour legend with its scale in length units and as a share of the character's size. */
+static void draw_labels(uint8_t *sheet, int W, int H, const sw_bake_result *res,
+                        const sw_bake_report_sheet_info *info) {
+    static const uint8_t ink[3] = {40, 40, 40};
+    static const char *const head[SW_SHEET_COLS] = {"REFERENCE", "SINEW", "SKINNING"};
+    char text[96];
+    for (int c = 0; c < SW_SHEET_COLS; ++c)
+        sw_draw_text(sheet, W, H,
+                     LEFT_W + c * (TILE_W + GAP) + (TILE_W - sw_text_width(head[c], 2)) / 2, 7, 2,
+                     head[c], ink);
+    for (int32_t row = 0; row < info->rows; ++row) {
+        int32_t k = info->pose[row];
+        int y = HEAD_H + row * (TILE_H + GAP) + TILE_H / 2 - 16;
+        sw_draw_text(sheet, W, H, 8, y, 2, res->heldout_clip[k] < 0 ? "POSE" : "FRAME", ink);
+        snprintf(text, sizeof text, "%d", res->heldout_clip[k] < 0 ? k : res->heldout_frame[k]);
+        sw_draw_text(sheet, W, H, 8, y + 20, 2, text, ink);
+    }
+    int y0 = H - FOOT_H + 8, x0 = LEFT_W, bar = 3 * TILE_W + 2 * GAP;
+    sw_draw_text(sheet, W, H, x0, y0, 1,
+                 "DISTANCE FROM THE REFERENCE, IN LENGTH UNITS (SHARE OF "
+                 "THE CHARACTER'S SIZE)",
+                 ink);
+    for (int x = 0; x < bar; ++x) {
+        float c[3];
+        sw_bake_report_ramp((double)x / (bar - 1), c);
+        for (int y = y0 + 11; y < y0 + 23; ++y)
+            for (int a = 0; a < 3; ++a)
+                sheet[3 * ((size_t)y * W + x0 + x) + a] = (uint8_t)(255 * c[a] + 0.5f);
+    }
+    for (int t = 0; t <= 4; ++t) {
+        double d = info->scale * t / 4;
+        snprintf(text, sizeof text, "%s%.3g (%.2g%%)", t == 4 ? ">=" : "", d,
+                 info->size > 0 ? 100 * d / info->size : 0);
+        int w = sw_text_width(text, 1), x = x0 + bar * t / 4 - (t == 0 ? 0 : t == 4 ? w : w / 2);
+        sw_draw_text(sheet, W, H, x, y0 + 28, 1, text, ink);
+    }
 }
 
 /* The surfaces X (3 * rows tiles of the simulation mesh's nv vertices) carried onto the
@@ -196,7 +241,7 @@ sinew_result sw_bake_report_sheet(const char *dir, const sw_character *ch,
     sw_surface surf = {0};
     sinew_result r = sw_tetmesh_surface(&ch->mesh, &surf, err);
     if (r != SINEW_OK) return r;
-    int W = 3 * TILE_W + 2 * GAP, H = rows * TILE_H + (rows - 1) * GAP;
+    int W = LEFT_W + 3 * TILE_W + 2 * GAP, H = HEAD_H + rows * TILE_H + (rows - 1) * GAP + FOOT_H;
     double *X = malloc(sizeof(double) * 9 * (size_t)nv * (size_t)rows);
     uint8_t *tile = malloc(3 * (size_t)TILE_W * TILE_H), *sheet = malloc(3 * (size_t)W * H);
     float *colors = NULL;
@@ -204,7 +249,7 @@ sinew_result sw_bake_report_sheet(const char *dir, const sw_character *ch,
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "contact sheet: out of memory");
         goto done;
     }
-    memset(sheet, 64, 3 * (size_t)W * H); /* dark grey gutters */
+    memset(sheet, 255, 3 * (size_t)W * H); /* white margins and gutters */
     if ((r = capture(res, blob, nv, rows, X, info->pose, err)) != SINEW_OK) goto done;
     const sw_blob_view *v = sw_blob_get_view(blob);
     if (v->nrender_verts > 0 && (r = to_render_mesh(v, rows, &X, &nv, &surf, err)) != SINEW_OK)
@@ -224,6 +269,7 @@ sinew_result sw_bake_report_sheet(const char *dir, const sw_character *ch,
             r = draw_tile(&p, nv, X + ((size_t)row * SW_SHEET_COLS + col) * n3,
                           X + ((size_t)row * SW_SHEET_COLS + SW_SHEET_REFERENCE) * n3, info->scale,
                           &surf, colors, tile, sheet, W, row, col, dir, err);
+    if (r == SINEW_OK) draw_labels(sheet, W, H, res, info);
     char path[4200];
     snprintf(path, sizeof path, "%s/heldout_sheet.png", dir);
     if (r == SINEW_OK) r = sw_write_png(path, W, H, sheet, err);
