@@ -293,7 +293,7 @@ static void html_beyond(FILE *f, const sw_bake_report_input *in, const report *r
     if (r->nbeyond < 1) return;
     fprintf(
         f,
-        "<h2>Motion beyond training</h2><p>%d joint%s turn%s further in the "
+        "<h2>Held-out motion beyond training</h2><p>%d joint%s turn%s further in the "
         "held-out poses than in any training pose (more than %.2f times and %.0f degrees "
         "beyond). The runtime learnt the flesh of the bends it was shown: there it "
         "has to guess (extrapolate), and the held-out error says how well. Training clips "

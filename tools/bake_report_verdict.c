@@ -56,7 +56,8 @@ static void advise_miss(const sw_bake_report_input *in, report *r) {
                    name, r->beyond[k].heldout_deg, r->beyond[k].train_deg);
         }
         if (r->nbeyond_all > shown)
-            APPEND(v->advice, " and %d more (see Motion beyond training)", r->nbeyond_all - shown);
+            APPEND(v->advice, " and %d more (see Held-out motion beyond training)",
+                   r->nbeyond_all - shown);
         APPEND(v->advice,
                ". Add training motion that bends %s as far as the held-out motion "
                "does (for example a clip like the held-out one), then bake again.",
