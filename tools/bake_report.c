@@ -60,6 +60,7 @@
 /* The one place the report reads the bake's stage list: the names of the first
  * SW_BAKE_REPORT_STAGES slots of sw_bake_result.stage_seconds. */
 int32_t report_stage_times(const sw_bake_result *res, const char **names, double *seconds) {
+    _Static_assert(SW_BAKE_REPORT_STAGES <= REPORT_MAX_STAGES, "room for the stages");
     static const char *const stage_names[SW_BAKE_REPORT_STAGES] = {
         "prepare", "domains", "simulate", "basis", "cubature", "reduce"};
     for (int32_t k = 0; k < SW_BAKE_REPORT_STAGES; ++k) {
@@ -383,8 +384,8 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
     cJSON_AddNumberToObject(j, "bake_seconds", in->bake_seconds);
     cJSON_AddNumberToObject(j, "eval_seconds", in->eval_seconds);
     cJSON *st = cJSON_AddArrayToObject(j, "stages");
-    const char *names[SW_BAKE_REPORT_STAGES];
-    double seconds[SW_BAKE_REPORT_STAGES];
+    const char *names[REPORT_MAX_STAGES];
+    double seconds[REPORT_MAX_STAGES];
     for (int32_t k = 0, n = report_stage_times(res, names, seconds); k < n; ++k) {
         cJSON *o = cJSON_CreateObject();
         cJSON_AddStringToObject(o, "name", names[k]);

@@ -345,17 +345,26 @@ static void html_adaptive(FILE *f, const sw_adaptive_report *a, double target) {
 
 /* The stage times as a horizontal bar chart, read through report_stage_times. */
 static void html_stages(FILE *f, const sw_bake_result *res) {
-    const char *names[SW_BAKE_REPORT_STAGES];
-    double seconds[SW_BAKE_REPORT_STAGES];
+    const char *names[REPORT_MAX_STAGES], *tips[REPORT_MAX_STAGES];
+    double seconds[REPORT_MAX_STAGES];
     int32_t n = report_stage_times(res, names, seconds);
-    const char *tips[SW_BAKE_REPORT_STAGES];
+    /* what each stage does, by name, for the tooltips (a stage not listed shows its name) */
     static const char *const known[][2] = {
-        {"prepare", "read the character, build its meshes and weights"},
+        {"prepare", "read the character, build its weights and masses"},
+        {"embed", "place the render mesh in the simulation mesh's tets"},
         {"domains", "split the flesh into body parts, one per bone"},
-        {"simulate", "solve the full simulation at every training pose"},
+        {"poses", "choose the training and held-out poses"},
+        {"simulate", "solve the full simulation at every training and held-out pose"},
         {"basis", "learn each body part's flesh shapes from the solutions (PCA)"},
         {"cubature", "pick the sample tets whose forces stand for the whole mesh"},
-        {"reduce", "precompute the runtime's small matrices and write the blob"}};
+        {"contacts", "collect the training poses' self-contacts"},
+        {"reduce", "precompute the runtime's small matrices"},
+        {"render", "carry the render mesh's embedding into the blob"},
+        {"cond", "measure the tet mesh's conditioning for the blob"},
+        {"pairs", "per pair of body parts, the contact samples"},
+        {"springs", "choose the glue's stiffness between body parts"},
+        {"galerkin", "measure the best the runtime's solver can reach"},
+        {"equilibrium", "the pose correction of every training pose"}};
     for (int32_t k = 0; k < n; ++k) {
         tips[k] = NULL;
         for (size_t i = 0; i < sizeof known / sizeof known[0]; ++i)

@@ -55,8 +55,10 @@ typedef struct report {
     report_verdict verdict;
 } report;
 
+#define REPORT_MAX_STAGES 32 /* room for the bake's stages */
+
 /* The bake's stages as the report shows them: their names and seconds into names and
- * seconds (room for SW_BAKE_REPORT_STAGES); returns how many (bake_report.c). */
+ * seconds (room for REPORT_MAX_STAGES); returns how many (bake_report.c). */
 int32_t report_stage_times(const sw_bake_result *res, const char **names, double *seconds);
 
 /* Whether the held-out poses are random combined poses (no clip to hold out). */
