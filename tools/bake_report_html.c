@@ -365,14 +365,18 @@ static void html_stages(FILE *f, const sw_bake_result *res) {
         {"springs", "choose the glue's stiffness between body parts"},
         {"galerkin", "measure the best the runtime's solver can reach"},
         {"equilibrium", "the pose correction of every training pose"}};
+    double total = 0;
     for (int32_t k = 0; k < n; ++k) {
         tips[k] = NULL;
         for (size_t i = 0; i < sizeof known / sizeof known[0]; ++i)
             if (!strcmp(names[k], known[i][0])) tips[k] = known[i][1];
+        total += isfinite(seconds[k]) ? seconds[k] : 0;
     }
+    char title[96];
+    snprintf(title, sizeof title,
+             "seconds per stage, %.1f s in all (hover a stage for what it does)", total);
     fprintf(f, "<h2>Where the bake's time went</h2>");
-    svg_hbars(f, "seconds per stage (hover a stage for what it does)", seconds, n, names, tips, "s",
-              "#7f7f7f");
+    svg_hbars(f, title, seconds, n, names, tips, "s", "#7f7f7f");
 }
 
 /* The contact sheet as a table: named columns, numbered frames, each tile with its
