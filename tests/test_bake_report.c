@@ -12,6 +12,7 @@
 
 #include "bake.h"
 #include "bake_fixture.h"
+#include "bake_report_checks.h"
 #include "mat3.h"
 #include "pose_space.h"
 #include "bake_report.h"
@@ -324,7 +325,8 @@ TEST(clips_of_their_own_and_the_report) {
                                modes,
                                &spread,
                                "auto",
-                               "adaptive"};
+                               "adaptive",
+                               0};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;
@@ -350,16 +352,28 @@ TEST(clips_of_their_own_and_the_report) {
     check_spread_json(dir, &spread);
     check_reference_json(dir, "auto", "adaptive", 0);
     ENSURE(flagged[0] == 0); /* a training clip never bends beyond itself */
+    char verdict[16];
+    check_verdict(dir, eh.correction_error, 0, &eh, verdict);
+    check_sheet(dir, &res);
+    check_plots(dir);
     /* had the training reached half as far, the reversed fold would bend beyond it: the
        report marks those frames (and lists the joints) as the rule says */
     for (int32_t b = 0; b < ch.skel.nbones; ++b)
         res.sweep_angle[b] *= 0.5;
     char dir2[1100];
     snprintf(dir2, sizeof dir2, "%.1000s_half", dir);
+    in.target = 1e-9; /* a miss: the verdict names the joints beyond training */
     ENSURE(sw_bake_report_write(dir2, &in, &e) == SINEW_OK);
     flagged[1] = -1;
     check_json(dir2, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes, flagged);
     ENSUREF(flagged[1] > 0, "%d held-out frames beyond half the training's bends", flagged[1]);
+    check_verdict(dir2, eh.correction_error, in.target, &eh, verdict);
+    ENSURE(!strcmp(verdict, "miss"));
+    in.target = 0.999; /* a pass, whatever the error */
+    ENSURE(sw_bake_report_write(dir2, &in, &e) == SINEW_OK);
+    check_verdict(dir2, eh.correction_error, in.target, &eh, verdict);
+    ENSURE(!strcmp(verdict, "pass"));
+    in.target = 0;
     char path2[1200];
     snprintf(path2, sizeof path2, "%s/report.html", dir2);
     char *html2 = read_text(path2);
@@ -478,7 +492,8 @@ TEST(random_heldout_poses_in_the_report) {
                                NULL,
                                NULL,
                                NULL,
-                               NULL};
+                               NULL,
+                               0};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
@@ -522,6 +537,20 @@ TEST(random_heldout_poses_in_the_report) {
     char *html = read_text(path3);
     ENSURE(html && strstr(html, "random poses turn each joint within 90 degrees</td>"));
     free(html);
+    check_ramp();
+    check_font();
+    char verdict[16];
+    /* nothing beyond training: a miss names the bones whose flesh holds the error */
+    in.target = 1e-9;
+    in.contact_sheet = 1;
+    ENSURE(sw_bake_report_write(dir3, &in, &e) == SINEW_OK);
+    check_verdict(dir3, eh.correction_error, in.target, &eh, verdict);
+    ENSURE(!strcmp(verdict, "miss"));
+    check_sheet(dir3, &res);
+    in.err_heldout = NAN; /* no held-out figure: no verdict either way */
+    ENSURE(sw_bake_report_write(dir3, &in, &e) == SINEW_OK);
+    check_verdict(dir3, NAN, in.target, &eh, verdict);
+    ENSURE(!strcmp(verdict, "not_measured"));
     free(fe);
     sinew_blob_destroy(blob);
     free(mem);

@@ -365,12 +365,17 @@ if have_fox bake_fox; then
     want=('"heldout_poses":35,')
     expect_stdout bake_fox_report "$bake" "$fox" --tets 2000 --train-clips Survey,Walk \
         --heldout-clips Run --out "$tmp/fox.blob" --report "$tmp/rep" --json
-    # the clips by name; where the error is, by the file's bone names (the Fox's are b_...)
+    # the clips by name; where the error is, by the file's bone names (the Fox's are b_...);
+    # a verdict, and the contact sheet's tiles under named columns
     if ! grep -Eq '"name":[[:space:]]*"Run"' "$tmp/rep/report.json" ||
+        ! grep -Eq '"status":[[:space:]]*"(pass|miss)"' "$tmp/rep/report.json" ||
+        ! grep -q 'class="verdict ' "$tmp/rep/report.html" ||
+        ! grep -q '<th>sinew (the runtime)</th>' "$tmp/rep/report.html" ||
+        ! [ -s "$tmp/rep/heldout_0_skinning.png" ] ||
         ! grep -q "<svg" "$tmp/rep/report.html" ||
         ! grep -Pzq '"name":\s*"b_[^"]*",\s*"err_share"' "$tmp/rep/report.json" ||
         ! grep -Eq '<tr><td>held-out</td><td>[0-9]+ b_' "$tmp/rep/report.html"; then
-        echo "FAIL bake_fox_report_files: report.json without Run, report.html without a plot, or the regions of the error without the bones' names" >&2
+        echo "FAIL bake_fox_report_files: report.json without Run or a verdict, report.html without a plot, a verdict or the contact sheet, or the regions of the error without the bones' names" >&2
         fails=$((fails + 1))
     else
         echo "ok   bake_fox_report_files"

@@ -237,7 +237,8 @@ static int write_outputs(const bake *b) {
                                    mode_err,
                                    spread_every > 0 ? &spread : NULL,
                                    sw_linear_solver_name(reference.solver),
-                                   sw_hessian_mode_name(reference.hessian)};
+                                   sw_hessian_mode_name(reference.hessian),
+                                   ad.rounds > 0 ? ad.target : 0};
         if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
             return 1;

@@ -1,15 +1,21 @@
-/* The bake report (issue 14, sinew-bake --report DIR): one self-contained HTML page a
- * technical artist opens (inline SVG plots: the correction error of every clip frame,
- * training and held-out; the basis rank and energy and the cubature size of every
- * domain; the stage times) and the same figures as JSON (libcjson), plus contact sheets
- * of held-out frames (runtime, full-space reference and plain skinning side by side)
- * as PNG files the page shows.
+/* The bake report (sinew-bake --report DIR): one self-contained HTML page a technical
+ * artist opens, its verdict first (the held-out error against a target, and what motion
+ * to add when it misses), then inline SVG plots (the correction error of every clip
+ * frame, training and held-out; the basis rank and energy and the cubature size of every
+ * domain; the stage times), and the same figures as JSON (libcjson), plus a contact sheet
+ * of held-out frames (full-space reference, runtime and plain skinning side by side, each
+ * surface coloured by its distance from the reference) as PNG files the page shows.
  *
- *   DIR/report.html   the page (references heldout_sheet.png when it was rendered)
+ *   DIR/report.html   the page (shows the tiles below when they were rendered)
  *   DIR/report.json   {"sinew_bake_report": 1, ...}: the figures (schema in bake_report.c)
- *   DIR/heldout_sheet.png  the contact sheet */
+ *   DIR/heldout_sheet.png  the contact sheet in one image, labelled (columns named, frames
+ *                     numbered, the colour legend)
+ *   DIR/heldout_<row>_<column>.png  its tiles, one a frame and column, which the page
+ *                     lays out under named columns and numbered frames */
 #ifndef SW_BAKE_REPORT_H
 #define SW_BAKE_REPORT_H
+
+#include <stddef.h>
 
 #include "bake.h"
 #include "bake_adaptive.h"
@@ -18,6 +24,11 @@
 
 #define SW_BAKE_REPORT_VERSION 1
 #define SW_BAKE_REPORT_STAGES 6
+
+/* The held-out error the verdict measures against when none is given: sinew's acceptance
+ * limit for a character's held-out clip (the runtime misses at most a fifth of the
+ * physics correction on motion it never trained on). */
+#define SW_BAKE_REPORT_TARGET 0.2
 
 /* Everything the report shows; the pointers are borrowed. */
 typedef struct sw_bake_report_input {
@@ -36,7 +47,7 @@ typedef struct sw_bake_report_input {
     double err_train, err_heldout;
     int32_t failed_steps;
     double bake_seconds, eval_seconds;
-    int contact_sheet; /* render DIR/heldout_sheet.png (Embree; a few seconds) */
+    int contact_sheet; /* render DIR/heldout_sheet.png and its tiles (Embree; a few seconds) */
     /* the adaptive loop's rounds (sinew-bake --adaptive; NULL or 0 rounds: none) */
     const sw_adaptive_report *adaptive;
     /* where the error is (sw_eval_result's regions) on the training and the held-out poses;
@@ -55,18 +66,55 @@ typedef struct sw_bake_report_input {
        sw_linear_solver_name, sw_hessian_mode_name): the figures are measured against its
        solutions; NULL: not shown */
     const char *ref_solver, *ref_hessian;
+    /* the held-out error the verdict measures against, in (0, 1); 0: SW_BAKE_REPORT_TARGET */
+    double target;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create
  * or write), OUT_OF_MEMORY, and the renderer's for the contact sheet. */
 sinew_result sw_bake_report_write(const char *dir, const sw_bake_report_input *in, sw_error *err);
 
-/* The contact sheet of up to `frames` held-out poses of res, one row each: the runtime
- * (a quasistatic instance of blob stepped through the held-out poses), the full-space
- * reference and plain dual-quaternion skinning, the simulation mesh's boundary each
- * (bake_report_sheet.c). */
-sinew_result sw_bake_report_sheet(const char *png_path, const sw_character *ch,
+/* The contact sheet's columns, left to right, and their keys in the tiles' file names. */
+enum { SW_SHEET_REFERENCE, SW_SHEET_SINEW, SW_SHEET_SKINNING, SW_SHEET_COLS };
+extern const char *const sw_bake_report_sheet_keys[SW_SHEET_COLS];
+
+#define SW_BAKE_REPORT_SHEET_ROWS 4 /* held-out frames on the sheet, at most */
+
+/* What the contact sheet shows, for the page's labels and legend. Distances are in the
+ * character's length units. */
+typedef struct sw_bake_report_sheet_info {
+    int32_t rows;
+    int32_t pose[SW_BAKE_REPORT_SHEET_ROWS]; /* the held-out pose (index) of each row */
+    double scale; /* the colour ramp's top: a vertex this far from the reference, or further */
+    double size;  /* the character's size: the largest side of the reference frames' box */
+    /* per row and column: the largest and the mean vertex distance from the reference */
+    double max_dist[SW_BAKE_REPORT_SHEET_ROWS][SW_SHEET_COLS];
+    double mean_dist[SW_BAKE_REPORT_SHEET_ROWS][SW_SHEET_COLS];
+} sw_bake_report_sheet_info;
+
+/* The tile of (row, col) as a file name in the report's folder. */
+void sw_bake_report_tile_name(char *buf, size_t n, int32_t row, int col);
+
+/* The contact sheet of up to `frames` (at most SW_BAKE_REPORT_SHEET_ROWS) held-out poses
+ * of res, one row each: the full-space reference, the runtime (a quasistatic instance of
+ * blob stepped through the held-out poses) and plain dual-quaternion skinning, each
+ * coloured by its vertices' distance from the reference (sw_bake_report_ramp), written as
+ * DIR/heldout_sheet.png and one PNG a tile (bake_report_sheet.c). */
+sinew_result sw_bake_report_sheet(const char *dir, const sw_character *ch,
                                   const sw_bake_result *res, const sinew_blob *blob, int32_t frames,
-                                  sw_error *err);
+                                  sw_bake_report_sheet_info *info, sw_error *err);
+
+/* The colour ramp of the distance from the reference, t = distance / scale clamped to
+ * [0, 1]: pale grey (0), yellow, orange, red (1), as sRGB in [0, 1], evenly spaced. The
+ * page's legend draws the same stops (sw_bake_report_ramp_stops). */
+#define SW_BAKE_REPORT_RAMP_STOPS 4
+extern const float sw_bake_report_ramp_stops[SW_BAKE_REPORT_RAMP_STOPS][3];
+void sw_bake_report_ramp(double t, float srgb[3]);
+
+/* Per-triangle linear RGB albedo (3 floats a triangle, for sw_render_surface) of the
+ * surface X against the reference surface ref (nv vertices each): the ramp at each
+ * triangle's mean vertex distance over scale (> 0). */
+void sw_bake_report_diff_colors(int32_t nv, const double *X, const double *ref, int32_t ntris,
+                                const int32_t *tris, double scale, float *rgb);
 
 #endif
