@@ -49,9 +49,6 @@
 #include "pose_space.h"
 #include "tool_common.h"
 
-static const char *const stage_names[SW_BAKE_REPORT_STAGES] = {"prepare", "domains",  "simulate",
-                                                               "basis",   "cubature", "reduce"};
-
 #define SHEET_NAME "heldout_sheet.png"
 
 /* One clip's frames in the report: the poses of `split` labelled `label`. */
@@ -350,9 +347,9 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
     cJSON_AddNumberToObject(j, "bake_seconds", in->bake_seconds);
     cJSON_AddNumberToObject(j, "eval_seconds", in->eval_seconds);
     cJSON *st = cJSON_AddArrayToObject(j, "stages");
-    for (int k = 0; k < SW_BAKE_REPORT_STAGES; ++k) {
+    for (int k = 0; k < SW_BAKE_NSTAGES; ++k) { /* the bake's table (bake.h) */
         cJSON *o = cJSON_CreateObject();
-        cJSON_AddStringToObject(o, "name", stage_names[k]);
+        cJSON_AddStringToObject(o, "name", sw_bake_stages[k].name);
         cJSON_AddNumberToObject(o, "seconds", res->stage_seconds[k]);
         cJSON_AddItemToArray(st, o);
     }
@@ -761,7 +758,10 @@ static int write_html(const char *path, const sw_bake_report_input *in, const re
     int ok = html_domains(f, in);
     html_adaptive(f, in->adaptive);
     fprintf(f, "<h2>Stage times</h2>");
-    svg_bars(f, "seconds per stage", in->res->stage_seconds, SW_BAKE_REPORT_STAGES, stage_names,
+    const char *stage_names[SW_BAKE_NSTAGES]; /* the bake's table (bake.h) */
+    for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
+        stage_names[k] = sw_bake_stages[k].name;
+    svg_bars(f, "seconds per stage", in->res->stage_seconds, SW_BAKE_NSTAGES, stage_names,
              "#7f7f7f");
     if (sheet)
         fprintf(f, "<h2>Held-out frames</h2><p>Each row one held-out frame: the runtime, the "

@@ -17,7 +17,6 @@
 #include "sw_mesh.h"
 
 #define SW_BAKE_REPORT_VERSION 1
-#define SW_BAKE_REPORT_STAGES 6
 
 /* Everything the report shows; the pointers are borrowed. */
 typedef struct sw_bake_report_input {

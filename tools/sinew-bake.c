@@ -411,11 +411,10 @@ int main(int argc, char **argv) {
     status = 0;
     const sw_blob_view *v = &res.view;
     fprintf(stderr, "%s: wrote %s\n", tool, out_path);
-    fprintf(stderr,
-            "  stages (s): prepare %.2f, domains %.2f, simulate %.2f, basis %.2f, cubature %.2f, "
-            "reduce %.2f; total %.2f\n",
-            res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2], res.stage_seconds[3],
-            res.stage_seconds[4], res.stage_seconds[5], bake_seconds);
+    fprintf(stderr, "  stages (s):");
+    for (int k = 0; k < SW_BAKE_NSTAGES; ++k) /* the bake's table (bake.h) */
+        fprintf(stderr, "%s %s %.2f", k ? "," : "", sw_bake_stages[k].name, res.stage_seconds[k]);
+    fprintf(stderr, "; total %.2f\n", bake_seconds);
     fprintf(stderr, "  domains %d, total rank %d (", v->ndomains, v->rank_total);
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].rank);
@@ -538,14 +537,16 @@ int main(int argc, char **argv) {
                "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
                "heldout\":%.5f,"
                "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
-               "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,"
-               "%.2f,%.2f]",
+               "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f",
                out_path, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones, v->ndomains, v->rank_total,
                v->ncub, res.cubature_error_max, res.ntrain, res.return_poses, res.pair_sweep_poses,
                res.nheldout, res.train_proj_error, res.heldout_proj_error, et.correction_error,
                eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
-               eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
-               res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+               eval_seconds);
+        printf(",\"stage_seconds\":{"); /* the bake's table (bake.h) */
+        for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
+            printf("%s\"%s\":%.2f", k ? "," : "", sw_bake_stages[k].name, res.stage_seconds[k]);
+        printf("}");
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
                "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
                res.force_poses, model_err, sw_linear_solver_name(reference.solver),

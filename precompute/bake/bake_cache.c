@@ -8,7 +8,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "blob_write.h"
 #include "sim_cache.h"
 
@@ -38,18 +38,19 @@ static uint64_t character_key(sw_bake_state *s) {
     uint64_t h = SW_FNV_START;
     const char tag[] = "sinew simulate cache";
     h = sw_fnv1a(h, tag, sizeof tag);
-    int32_t version = SW_SIM_CACHE_VERSION, nv = s->nv, nt = s->ch.mesh.ntets, nb = s->nb;
+    int32_t version = SW_SIM_CACHE_VERSION, nv = s->rig.nv, nt = s->rig.ch.mesh.ntets,
+            nb = s->rig.nb;
     MIX(h, version);
     MIX(h, nv);
     MIX(h, nt);
     MIX(h, nb);
-    h = sw_fnv1a(h, s->ch.mesh.X, (size_t)nv * 3 * sizeof(double));
-    h = sw_fnv1a(h, s->ch.mesh.tets, (size_t)nt * 4 * sizeof(int32_t));
-    h = sw_fnv1a(h, s->ch.bone_of_vertex, (size_t)nv * sizeof(int32_t));
-    h = sw_fnv1a(h, s->ch.weights.w, (size_t)nv * nb * sizeof(double));
-    MIX(h, s->ch.youngs);
-    MIX(h, s->ch.poisson);
-    MIX(h, s->ch.density);
+    h = sw_fnv1a(h, s->rig.ch.mesh.X, (size_t)nv * 3 * sizeof(double));
+    h = sw_fnv1a(h, s->rig.ch.mesh.tets, (size_t)nt * 4 * sizeof(int32_t));
+    h = sw_fnv1a(h, s->rig.ch.bone_of_vertex, (size_t)nv * sizeof(int32_t));
+    h = sw_fnv1a(h, s->rig.ch.weights.w, (size_t)nv * nb * sizeof(double));
+    MIX(h, s->rig.ch.youngs);
+    MIX(h, s->rig.ch.poisson);
+    MIX(h, s->rig.ch.density);
     sw_fullsim_params fp = sw_bake_sim_params(s->p); /* field by field: no padding bytes */
     int32_t ints[] = {(int32_t)fp.integrator, fp.self_contact,    fp.ground,
                       (int32_t)fp.hessian,    (int32_t)fp.solver, fp.contact_rounds,
@@ -72,7 +73,7 @@ static uint64_t chain_key(const sw_bake_state *s, uint64_t character, const chai
         const sw_pose_seq *q = c->seq[i];
         int32_t links[3] = {q->npose, q->then[0] != NULL, q->then[1] != NULL};
         h = sw_fnv1a(h, links, sizeof links);
-        h = sw_fnv1a(h, q->T, (size_t)q->npose * 12 * s->nb * sizeof(double));
+        h = sw_fnv1a(h, q->T, (size_t)q->npose * 12 * s->rig.nb * sizeof(double));
     }
     return h;
 }
@@ -98,7 +99,7 @@ static sinew_result adopt(sw_bake_state *s, const chain *ch, sw_sim_cache *c, sw
     for (int32_t i = 0; i < c->nseq; ++i) {
         sw_pose_seq *q = ch->seq[i];
         sw_sim_cache_seq *e = &c->seq[i];
-        memcpy(q->x, e->x, (size_t)q->npose * 3 * s->nv * sizeof(double));
+        memcpy(q->x, e->x, (size_t)q->npose * 3 * s->rig.nv * sizeof(double));
         memcpy(q->contact_ptr, e->contact_ptr, (size_t)(q->npose + 1) * sizeof(int32_t));
         free(q->contacts);
         q->contacts = e->contacts;
@@ -118,7 +119,7 @@ static sinew_result adopt(sw_bake_state *s, const chain *ch, sw_sim_cache *c, sw
  * has what it needs). */
 static void store(sw_bake_state *s, const chain *ch, uint64_t key, const char *path) {
     sw_sim_cache_seq seq[3];
-    sw_sim_cache c = {key, s->nv, ch->n, seq};
+    sw_sim_cache c = {key, s->rig.nv, ch->n, seq};
     sw_error e;
     uint8_t *b = NULL;
     size_t n = 0;
@@ -145,7 +146,7 @@ static int lookup(sw_bake_state *s, const chain *ch, uint64_t key, const char *p
         npose[i] = ch->seq[i]->npose;
     sw_sim_cache c;
     sw_error e;
-    sinew_result pr = sw_sim_cache_parse(b, n, path, key, s->nv, ch->n, npose, &c, &e);
+    sinew_result pr = sw_sim_cache_parse(b, n, path, key, s->rig.nv, ch->n, npose, &c, &e);
     free(b);
     if (pr != SINEW_OK) {
         if (s->p->progress) fprintf(stderr, "sinew-bake: simulate cache unused: %s\n", e.msg);
@@ -160,7 +161,7 @@ static int lookup(sw_bake_state *s, const chain *ch, uint64_t key, const char *p
  * chain, its key and its file under dir (0: it continues another, or is empty). */
 static int chain_file(sw_bake_state *s, int32_t i, uint64_t character, const char *dir, chain *ch,
                       uint64_t *key, char *path, size_t size) {
-    sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
+    sw_pose_seq *q = i < s->poses.ntrain_seq ? &s->poses.train[i] : &s->poses.heldout;
     if (q->continues || q->npose == 0) return 0;
     *ch = chain_of(q);
     *key = chain_key(s, character, ch);
@@ -168,10 +169,10 @@ static int chain_file(sw_bake_state *s, int32_t i, uint64_t character, const cha
     return 1;
 }
 
-sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err) {
+static sinew_result simulate_cached(sw_bake_state *s, int *cached, sw_error *err) {
     *cached = 0;
     const char *dir = s->p->cache_dir;
-    if (!dir || !dir[0]) return sw_bake_simulate(s, err);
+    if (!dir || !dir[0]) return sw_bake_simulate_solve(s, err);
     struct stat st;
     if (mkdir(dir, 0755) != 0 && errno != EEXIST)
         return sw_error_set(err, SINEW_ERROR_IO, "cache folder '%s': cannot create it: %s", dir,
@@ -183,17 +184,78 @@ sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *er
     sinew_result r = SINEW_OK;
     char path[4200];
     chain ch;
-    for (int32_t i = 0; i <= s->ntrain_seq && r == SINEW_OK; ++i)
+    for (int32_t i = 0; i <= s->poses.ntrain_seq && r == SINEW_OK; ++i)
         if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path)) {
             nroot++;
             hits += lookup(s, &ch, key, path, &r, err);
         }
     if (r != SINEW_OK) return r;
-    if ((r = sw_bake_simulate(s, err)) != SINEW_OK) return r; /* the chains not found */
-    for (int32_t i = 0; i <= s->ntrain_seq; ++i)
+    if ((r = sw_bake_simulate_solve(s, err)) != SINEW_OK) return r; /* the chains not found */
+    for (int32_t i = 0; i <= s->poses.ntrain_seq; ++i)
         if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path) &&
             !ch.seq[0]->from_cache)
             store(s, &ch, key, path);
     *cached = hits == nroot;
+    return SINEW_OK;
+}
+
+/* Keeps the poses and full-space solutions for evaluation (sinew-bench, the report). */
+static sinew_result keep_solutions(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    size_t pt = (size_t)12 * s->rig.nb * sizeof(double),
+           px = (size_t)3 * s->rig.nv * sizeof(double);
+    out->train_T = malloc((size_t)out->ntrain * pt + 1);
+    out->train_x = malloc((size_t)out->ntrain * px + 1);
+    out->heldout_T = malloc((size_t)out->nheldout * pt + 1);
+    out->heldout_x = malloc((size_t)out->nheldout * px + 1);
+    size_t pl = sizeof(int32_t);
+    out->train_clip = malloc((size_t)out->ntrain * pl + 1);
+    out->train_frame = malloc((size_t)out->ntrain * pl + 1);
+    out->heldout_clip = malloc((size_t)out->nheldout * pl + 1);
+    out->heldout_frame = malloc((size_t)out->nheldout * pl + 1);
+    if (!out->train_T || !out->train_x || !out->heldout_T || !out->heldout_x || !out->train_clip ||
+        !out->train_frame || !out->heldout_clip || !out->heldout_frame)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for solutions");
+    int32_t k = 0;
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k) {
+            memcpy((char *)out->train_T + k * pt, (const char *)s->poses.train[i].T + j * pt, pt);
+            memcpy((char *)out->train_x + k * px, (const char *)s->poses.train[i].x + j * px, px);
+            out->train_clip[k] = s->poses.train[i].clip[j];
+            out->train_frame[k] = s->poses.train[i].frame[j];
+        }
+    if (out->nheldout) {
+        memcpy(out->heldout_T, s->poses.heldout.T, (size_t)out->nheldout * pt);
+        memcpy(out->heldout_x, s->poses.heldout.x, (size_t)out->nheldout * px);
+        memcpy(out->heldout_clip, s->poses.heldout.clip, (size_t)out->nheldout * pl);
+        memcpy(out->heldout_frame, s->poses.heldout.frame, (size_t)out->nheldout * pl);
+    }
+    return SINEW_OK;
+}
+
+/* simulate: the poses' full-space solutions (through the cache), and what the result keeps
+ * of them for evaluation (sinew-bench, the report). */
+sinew_result sw_bake_simulate(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sinew_result r = simulate_cached(s, &out->simulate_cached, err);
+    if (r != SINEW_OK) return r;
+    out->simulate_solved = (int32_t)s->poses.solved_poses;
+    out->return_poses = s->poses.return_poses;
+    out->pair_sweep_poses = s->poses.pair_sweep_poses;
+    size_t na = (size_t)s->rig.nb * 3 * sizeof(double);
+    if (!(out->sweep_axis = sw_bake_own(out, malloc(na))) ||
+        !(out->sweep_angle = sw_bake_own(out, malloc(na / 3))))
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    memcpy(out->sweep_axis, s->poses.sweep_axis, na);
+    memcpy(out->sweep_angle, s->poses.sweep_angle, na / 3);
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i) {
+        out->ntrain += s->poses.train[i].npose;
+        out->train_unsettled += s->poses.train[i].unsettled;
+    }
+    out->nheldout = s->poses.heldout.npose;
+    out->heldout_after = s->poses.heldout.continues ? s->poses.train[0].npose : 0;
+    out->heldout_unsettled = s->poses.heldout.unsettled;
+    if ((r = keep_solutions(s, out, err)) != SINEW_OK) return r;
+    if (!(out->mass = malloc((size_t)s->rig.nv * sizeof(double))))
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    memcpy(out->mass, s->rig.mass, (size_t)s->rig.nv * sizeof(double));
     return SINEW_OK;
 }

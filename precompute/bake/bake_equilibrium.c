@@ -17,7 +17,7 @@
 #include <math.h>
 #include <stdlib.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "instance.h"
 
 /* The training error of the blob without the force: the springs' choice measured it
