@@ -543,10 +543,11 @@ int main(int argc, char **argv) {
                res.nheldout, res.train_proj_error, res.heldout_proj_error, et.correction_error,
                eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
                eval_seconds);
-        printf(",\"stage_seconds\":{"); /* the bake's table (bake.h) */
+        printf(",\"stages\":["); /* the bake's table (bake.h), as the report's JSON */
         for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
-            printf("%s\"%s\":%.2f", k ? "," : "", sw_bake_stages[k].name, res.stage_seconds[k]);
-        printf("}");
+            printf("%s{\"name\":\"%s\",\"seconds\":%.2f}", k ? "," : "", sw_bake_stages[k].name,
+                   res.stage_seconds[k]);
+        printf("]");
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
                "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
                res.force_poses, model_err, sw_linear_solver_name(reference.solver),

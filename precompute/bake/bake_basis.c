@@ -1,3 +1,5 @@
+/* Stage "basis" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->poses; writes s->basis, the
+ * result's *_proj_error and basis_energy. */
 /* Skinning-correction basis (thesis §4.4.1, eq. 4.13): each full-space solution x is
  * pulled back through the skinning transform, d_v = R_v^T (x_v - t_v) - rest_v, and
  * each domain gets the uncentred PCA of its vertices' d over the training poses:

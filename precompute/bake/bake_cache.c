@@ -1,3 +1,5 @@
+/* Stage "simulate" (bake.c, sw_bake_stages): reads s->rig, s->poses; writes the sequences'
+ * solutions and contact sets in s->poses, the result's train_*, heldout_*, mass, sweeps. */
 /* The simulate stage through its cache (sim_cache.h, sw_bake_params.cache_dir): the key
  * hashes every input of the full-space solves, so a file found under it holds exactly
  * the solutions this bake would compute (the reference's results do not depend on its

@@ -1,4 +1,6 @@
-/* The condensation tet mesh's blob sections (issue 12): the whole simulation tet mesh, for
+/* Stage "cond" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->cubature, the view; writes
+ * the view's tet mesh sections. */
+/* The condensation tet mesh's blob sections : the whole simulation tet mesh, for
  * the runtime's full-space patches. Each tet is stored with the domain the bake gave it
  * (bake_domains.c: its corners all have copies there) and its corners' local indices in
  * that domain, as the cubature tets are (bake_reduce.c); its rest Dm^-1 and volume come from

@@ -1,3 +1,5 @@
+/* Stage "contacts" (bake.c, sw_bake_stages): reads s->rig, s->poses, s->basis; writes s->contacts.
+ */
 /* Pose-space self-contact data (thesis §3.2.3): the self-contact set the reference
  * simulator converged with at every training pose (every pair its contact rounds
  * gathered, eqs. 3.4-3.6 with n and beta frozen), so that at a training pose the

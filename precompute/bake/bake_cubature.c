@@ -1,3 +1,5 @@
+/* Stage "cubature" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->poses, s->basis; writes
+ * s->cubature, the result's cubature_error_max and selector_*. */
 /* Material cubature per domain (thesis eqs. 2.11-2.14). Training samples are the
  * reduced coordinates of the training snapshots, q = U^T d, and as many perturbed
  * copies (q + 0.5 * rms(q) * gaussian): at the snapshots themselves the reduced force
@@ -196,8 +198,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     if (sets == 3) {
         /* inertia modes (bake_basis.c) are barely in the snapshots, so the perturbations
            above hardly move them, and a fit blind to their force leaves them wrongly stiff
-           or soft (finger 3K: training error 0.028 -> 0.21-0.30 with them): a third set
-           perturbs every mode at the largest mode's amplitude (training error 0.062) */
+           or soft: a third set perturbs every mode at the largest mode's amplitude */
         double rmax = 0;
         for (int32_t j = 0; j < r; ++j)
             rmax = fmax(rmax, sqrt(rms[j]));
@@ -210,8 +211,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
         inv_norm[smp] = 1.0;
     cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, NULL, 0, 0};
     sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &c.mu, &c.lambda);
-    if (s->p->inertia_modes) { /* measured with them only (finger 20K: training error
-                                   0.24 without the weights, 0.059 with) */
+    if (s->p->inertia_modes) { /* the inertia modes' force weighted (mode_weights) */
         if (!(mode_w = malloc((size_t)r * sizeof(double)))) goto done;
         mode_weights(&c, ntd, mode_w);
         c.mode_w = mode_w;

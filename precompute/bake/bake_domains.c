@@ -1,3 +1,4 @@
+/* Stage "domains" (bake.c, sw_bake_stages): reads s->rig; writes s->domains. */
 /* Skeletal domains (thesis §2.3, §4.4.1; DESIGN.md §8): a tet goes to the strongest
  * bone of the majority of its vertices; a bone whose tets hold less than fold_share of
  * the mesh's volume passes them to its parent (fold_bones); bones that own no tet get no
@@ -49,13 +50,9 @@ static int32_t tet_bone(const sw_bake_state *s, const int32_t *tet) {
  * with enough of its own and theirs: bone_of_tet maps bones to bones in place. A domain
  * costs a block of the reduced Hessian, its springs to its neighbours and a cubature of
  * its own however little it holds, and its rank is bounded by its shapes, not its size.
- * Measured on the elephant (24 bones, 1,502 tets): at 3% of the volume 24 -> 11 domains,
- * rank 483 -> 296, instance 5.9 -> 2.4 MB, cost_vs_dqs 234 -> 195, bake errors train /
- * held-out 0.0196 / 0.0886 -> 0.0196 / 0.0900 (by tet count instead of volume: 5% gave 8
- * domains and 0.102, 8% gave 5 and 0.110); the hand 20 -> 10 domains, rank 229 -> 155,
- * 0.0193 / 0.0448 -> 0.0182 / 0.0451, its cost unchanged (at 1.5%: 15 domains, 0.0450; at
- * 2%: 11, 0.0455). Off by default: it never lowered a held-out error, and with few training
- * poses it costs accuracy (test_reduced_heldout.c). Returns 0 when out of memory. */
+ * Folding by volume, not by tet count, keeps the errors (docs/notes). Off by default: it never
+ * lowered a held-out error, and with few training poses it costs accuracy (test_reduced_heldout.c).
+ * Returns 0 when out of memory. */
 static int fold_bones(const sw_bake_state *s, int32_t *bone_of_tet) {
     const sw_skeleton *sk = &s->rig.ch.skel;
     int32_t nb = s->rig.nb, maxdepth = 0;

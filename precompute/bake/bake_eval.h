@@ -14,9 +14,8 @@
  * its held-out poses, the instance in self-contact mode `sc` (the pose-space mode is the
  * bake's figure) and otherwise as an engine creates it: SW_BAKE_EVAL_NEWTON is the
  * instance's default Newton cap (0: DESIGN.md's 5 a frame), so the bake reports what the
- * shipped step does, not what a step run to convergence would (held-out: the bare hand's
- * random poses 0.400 against 0.384 at 20 iterations, the elephant 0.091 against 0.089;
- * the Fox's, robot's, hand's and finger's figures are the same to four digits). */
+ * shipped step does, not what a step run to convergence would (the two differ little:
+ * docs/notes). */
 #define SW_BAKE_EVAL_NEWTON 0
 sinew_result sw_bake_errors(const sinew_blob *blob, const sw_bake_result *res,
                             sinew_self_contact sc, sw_eval_result *train, sw_eval_result *heldout,

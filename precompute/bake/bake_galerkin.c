@@ -1,5 +1,6 @@
-/* The Galerkin errors (issue 16, item 4: why the runtime misses more than the basis's
- * projection). The step finds the reduced energy's minimum; for the linearised model,
+/* The galerkin stage: reads rig, domains, poses, basis and the view with its springs;
+ * writes the result's *_galerkin_error. Why the runtime misses more than the basis's
+ * projection: The step finds the reduced energy's minimum; for the linearised model,
  * rest stiffness K in the skinned frames and the interface springs S at the blob's
  * stiffness k, that minimum for a reference displacement d is
  *   (blockdiag(U_d^T K_d U_d) + k S) q = (U_d^T K_d d_d)_d,

@@ -1,3 +1,5 @@
+/* Stage "pairs" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->basis, s->poses, the view;
+ * writes the view's per-pair contact sections. */
 /* Pose-space self-contact per pair of domains (thesis §3.2.3, DESIGN.md §4.4 and §8): the
  * training poses' contacts grouped by the ordered pair of domains (a, b) holding the
  * contact's vertex and its triangle, a pose feature per group, and a cubature of each

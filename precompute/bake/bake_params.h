@@ -48,8 +48,8 @@ typedef struct sw_bake_params {
                                       clip (a character's own clip split by
                                       heldout_fraction: what plays after the training part
                                       starts from its last frame), off for training clips
-                                      named in train_clips (finger 50K held-out 0.1358 ->
-                                      0.0781, docs/accuracy.md The way home) */
+                                      named in train_clips (docs/accuracy.md The way
+                                      home) */
     int pose_force;                /* the pose-space equilibrium force (bake_equilibrium.c:
                                       the training poses' projected solutions made the
                                       runtime's equilibria there; default 1) */
@@ -63,8 +63,8 @@ typedef struct sw_bake_params {
                                       weight 1) */
     int inertia_modes;             /* for the dynamic step: basis modes for the inertia of the
                                       bones' accelerations and the cubature trained on them
-                                      (bake_basis.c; default 0: they raise the rank, 33 -> 73
-                                      on the 3K finger) */
+                                      (bake_basis.c; default 0: they more than double the
+                                      rank) */
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
     int32_t random_poses;          /* held-out poses when there is no clip (default 10) */
     int32_t heldout_steps;         /* ... each reached from the one before in this many
@@ -97,13 +97,13 @@ typedef struct sw_bake_params {
        serialises them), with `done` rising to `total`; NULL: none. */
     void (*on_progress)(void *user, const char *stage, int64_t done, int64_t total, double elapsed);
     void *progress_user;
-    /* Training and held-out clips of their own (issue 14: a glTF/FBX file's clips, by
-       name): with ntrain_clips > 0 the training poses are frames of train_clips (each its
-       own path from rest, at most max_train_frames of it) and the joint sweeps, the
-       held-out poses frames of heldout_clips (one path from rest, clip after clip, at most
-       max_train_frames of each), and the character's clip and heldout_fraction are not
-       used for poses. The clips must have the skeleton's bones; held-out clips need
-       training clips. NULL/0 (default): the character's clip, split as above. */
+    /* Training and held-out clips of their own (a glTF/FBX file's clips, by name): with
+       ntrain_clips > 0 the training poses are frames of train_clips (each its own path from rest,
+       at most max_train_frames of it) and the joint sweeps, the held-out poses frames of
+       heldout_clips (one path from rest, clip after clip, at most max_train_frames of each), and
+       the character's clip and heldout_fraction are not used for poses. The clips must have the
+       skeleton's bones; held-out clips need training clips. NULL/0 (default): the character's clip,
+       split as above. */
     const sw_clip *train_clips;
     int32_t ntrain_clips;
     const sw_clip *heldout_clips;

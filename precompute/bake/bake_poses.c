@@ -1,3 +1,5 @@
+/* Stage "poses" (bake.c, sw_bake_stages): reads s->rig, s->domains and the clips; writes s->poses
+ * (the pose sequences; the simulate stage solves them, sw_bake_simulate_solve here). */
 /* Training and held-out poses, and their full-space solutions (DESIGN.md §5).
  * Training: the first (1 - heldout) frames of the clip (evenly subsampled), or with
  * training clips of their own (sw_bake_params.train_clips: a glTF file's clips) each of
@@ -304,7 +306,7 @@ static void sweep_pose(const sw_bake_state *s, const int32_t *bones, int nsw, in
 }
 
 /* Whether the sweeps bend bone b's joint (b >= 0). A pair sweep turns a joint and its
- * parent's together when both are (issue 16: the flesh between two domain boundaries
+ * parent's together when both are (the flesh between two domain boundaries
  * depends on both joints, and the single sweeps never show them combined). */
 static int swept(const double *sweep_angle, int32_t b) {
     return b >= 0 && sweep_angle[b] > 1e-3;

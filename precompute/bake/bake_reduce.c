@@ -1,3 +1,5 @@
+/* Stage "reduce" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->basis, s->cubature,
+ * s->contacts; writes s->reduce and the view's reduced sections. */
 /* The constant reduced matrices and the blob view (bake.h "reduce").
  *   springs (eqs. 4.17-4.20): a vertex in domains i and j has copies that skinning
  *     moves with the same (R_v, t_v), so its spring energy k/2 |U_i q_i - U_j q_j|^2
@@ -35,11 +37,8 @@ static double mean_edge(const sw_tetmesh *m) {
  * skeleton's root (the lower domain on a tie), by k/2 |U_i q_i - U_j q_j|^2. Every pair
  * of copies tied instead (k(k-1)/2 springs, not k - 1) coupled sibling domains that
  * meet only at their parent's vertices, and the reduced Hessian's block graph then
- * follows the mesh's corners, not the skeleton. Measured on the elephant (24 domains):
- * lower blocks of the factor in use 89 -> 68 of 276, 4.5 -> 2.9 million multiply-adds a
- * factorisation, cost_vs_dqs 295-305 -> 245-252; bake errors train / held-out elephant
- * 0.0196 / 0.0888 -> 0.0196 / 0.0886, hand 0.0200 / 0.0448 -> 0.0193 / 0.0448, finger
- * 20K and 50K unchanged (no vertex of theirs has three copies). */
+ * follows the mesh's corners, not the skeleton: the hub ties keep the factor's blocks to
+ * the skeleton's graph, at the same errors (docs/notes). */
 static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *doms,
                                   const int32_t *copy_ptr_v, const int32_t *copy_list,
                                   double *spring) {
@@ -273,7 +272,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->cub_weight = cub_weight;
     v->cub_dminv = cub_dminv;
     v->cub_vol = cub_vol;
-    v->spring_hessian = spring;
+    v->spring_hessian = s->reduce.spring = spring; /* the springs stage scales it */
     v->mass = mass;
     v->inertia_s = ins;
     v->inertia_x = inx;

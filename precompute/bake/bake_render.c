@@ -1,3 +1,5 @@
+/* Stage "render" (bake.c, sw_bake_stages): reads s->embed, s->domains, s->basis; writes the view's
+ * render sections. */
 /* The render mesh's blob sections (bake.h "embed" and "reduce"): the embedding computed in
  * prepare (precompute/import/embed.h) turned into the runtime's terms. Only the tets that
  * hold a render vertex are stored (RENDER_TETS), over the simulation vertices at their

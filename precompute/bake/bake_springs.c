@@ -1,3 +1,5 @@
+/* Stage "springs" (bake.c, sw_bake_stages): reads s->reduce, the view, the training poses; writes
+ * the view's spring Hessian (through s->reduce.spring) and the result's spring_*. */
 /* The interface springs' stiffness (thesis eq. 4.20): k/2 |x_c - x_hub|^2 ties every copy
  * of a vertex to its hub copy (bake_reduce.c). Too stiff, and the domains' bases, which
  * cannot match exactly at an interface, lock each other: the reduced model holds only
@@ -5,7 +7,7 @@
  * their mean, but each side of the seam follows its own domain: a crease) and the
  * domains drift apart. Where between depends on the character: the
  * training error is lowest at 10 E h on the hand, the fingers, the elephant and the
- * robot, at 2.5-5 E h on the Fox (measured 2026-12-03, docs/game-assets.md).
+ * robot, at 2.5-5 E h on the Fox (docs/game-assets.md).
  *
  * So, unless the caller gives k, the bake measures the training error (the bake's own
  * figure: pose-space self-contact, sw_bake_train_error) of the blob at each of
@@ -39,7 +41,7 @@ double sw_bake_spring_mult(int i) {
  * (above SW_SPRING_MAX_EH E h, or springs that overflow). */
 static sinew_result set_springs(const sw_bake_state *s, sw_bake_result *out, double k,
                                 sw_error *err) {
-    double *spring = (double *)out->view.spring_hessian; /* owned by out (bake_reduce.c) */
+    double *spring = s->reduce.spring; /* the view's, owned by out (bake_reduce.c) */
     int finite = 1;
     for (int64_t i = 0; i < (int64_t)s->basis.rank_total * s->basis.rank_total; ++i) {
         spring[i] = k * s->reduce.spring_unit[i];
