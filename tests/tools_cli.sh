@@ -142,9 +142,10 @@ expect bench_bake_errors_without_blob 2 "--bake-errors applies only with --blob"
 
 # one definition of the training and held-out error: the bake and the bench
 # --blob --bake-errors (the bake's poses solved anew) agree (--reference-spread measures
-# beside the errors, never changes them)
+# beside the errors, never changes them). --ship-split: the blob the figures measure (by
+# default the finger's only clip ships re-baked on all its frames, sw_bake_ships_whole_clip)
 key() { tail -n 1 "$1" | grep -oE "\"$2\":(\"[a-z_]*\"|[0-9.]+|null)" | cut -d: -f2; }
-if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference-spread 1 \
+if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference-spread 1 --ship-split \
     --json >"$tmp/bake.json" 2>"$tmp/bake.err" &&
     "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --bake-errors \
         --contract-steps 10 --json >"$tmp/bench.json" 2>"$tmp/bench.err"; then

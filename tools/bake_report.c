@@ -14,6 +14,8 @@
  *   seams {train, heldout, max_train, max_heldout}: the domains' copies of a vertex apart
  *              (sw_eval_result's seam, seam_max), or null
  *   bake_seconds, eval_seconds, stages [{name, seconds}]
+ *   render {verts, outside, max_outside}: the render mesh's vertices, those embedded
+ *              outside the tets (they follow the nearest tet, extrapolated), or null
  *   clips [{name, split "train" | "heldout", frames [clip frame], error [per frame]}]
  *   sweeps {poses, mean_error}: the training poses of no clip (joint sweeps, return path)
  *   domains [{bone, rank, energy, cubature}]
@@ -353,6 +355,13 @@ static char *report_json(const sw_bake_report_input *in, const report *r, int sh
         cJSON_AddNumberToObject(o, "seconds", res->stage_seconds[k]);
         cJSON_AddItemToArray(st, o);
     }
+    if (in->ch->render.nverts > 0) { /* the bake's log warns of vertices outside */
+        cJSON *rd = cJSON_AddObjectToObject(j, "render");
+        cJSON_AddNumberToObject(rd, "verts", in->ch->render.nverts);
+        cJSON_AddNumberToObject(rd, "outside", res->render_outside);
+        cJSON_AddNumberToObject(rd, "max_outside", res->render_max_outside);
+    } else
+        cJSON_AddNullToObject(j, "render");
     cJSON_AddItemToObject(j, "clips", json_clips(r));
     cJSON *sw = cJSON_AddObjectToObject(j, "sweeps");
     cJSON_AddNumberToObject(sw, "poses", r->sweep_poses);

@@ -49,77 +49,84 @@ static const char *json_number(double v, char *buf) {
 }
 
 static void usage(FILE *f) {
-    fprintf(f, "usage: sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
-               "                   [--fps F] [--height H] |\n"
-               "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-               "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-               "                   [--clip FILE [--frames F] | --joint-range FILE])\n"
-               "                  --out FILE.blob [--report DIR]\n"
-               "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
-               "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
-               "                  [--compare-cubature] [--no-self-contact]\n"
-               "                  [--return-path|--no-return-path]\n"
-               "                  [--pair-sweeps | --no-pair-sweeps] [--no-sibling-sweeps]\n"
-               "                  [--adaptive R [--adaptive-add K]\n"
-               "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
-               "                  [--adaptive-target E]] [--heldout-steps S]\n"
-               "                  [--random-poses N] [--seed S]\n"
-               "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
-               "                  [--no-pose-force]\n"
-               "                  [--eval-self-contact pose-space|pose-pairs]\n"
-               "                  [--reference-spread K] [reference options]\n"
-               "                  [--cache DIR] [--threads T] [--force]\n"
-               "                  [--json]\n"
-               "character:\n" SW_CHARACTER_USAGE);
     fprintf(f,
-            "bake:\n"
-            "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed)\n"
+            "usage: sinew-bake FILE --out FILE.blob [--report DIR] [--tets N]\n"
+            "                  [--train-clips A,B] [--heldout-clips C]\n"
+            "       sinew-bake (FILE | --scene NAME | --mesh FILE --skeleton FILE.tgf)\n"
+            "                  --out FILE.blob [character options] [bake options]\n"
+            "                  [research options] [reference options]\n"
+            "what an artist's bake needs (the rest has defaults that suit a character):\n"
+            "  FILE             the rigged glTF 2.0 (.gltf, .glb) or FBX character\n"
+            "  --out FILE       the blob to write (atomically: FILE.tmp, then renamed); a\n"
+            "                   FILE that cannot be written is an error before the bake\n"
             "  --report DIR     write the bake report: DIR/report.html (plots of every clip\n"
             "                   frame's error, ranks, cubature, stage times, a contact sheet of\n"
             "                   held-out frames) and DIR/report.json (the same figures)\n"
-            "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
-            "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
-            "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
-            "  --fold-share S   a bone whose tets hold less than S of the mesh's volume\n"
-            "                   joins its parent's domain, 0..0.5 (default 0: off; 0.03\n"
-            "                   folds the elephant's 24 bones into 11 domains)\n"
-            "  --spring-k K     interface spring stiffness, K > 0 (default: of 20, 10, 5 and\n"
-            "                   2.5 E h the one with the lowest training error)\n"
-            "  --return-path    also train on the way home: from the first training clip's\n"
-            "                   last frame, its earlier frames backwards, each bent less than\n"
-            "                   the one before (a fold keeps its branch on the way out); by\n"
-            "                   default on where the held-out frames continue the training\n"
-            "                   clip (a --clip or a file's one clip split 60/40), off for\n"
-            "                   --train-clips; --no-return-path: never\n"
-            "  --pair-sweeps    also train on every joint swept together with its parent\n"
-            "                   joint (combinations the single-joint sweeps never show); by\n"
-            "                   default on with --joint-range; --no-pair-sweeps: never\n"
-            "  --no-sibling-sweeps  do not train on two sibling joints whose flesh meets\n"
-            "                   swept together (by default each such pair is: the flesh\n"
-            "                   between them shears with the difference of their bends)\n"
-            "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
-            "                   (default 64) random combined poses the blob steps worst (the\n"
-            "                   full-space force its state leaves over plain skinning's) to\n"
-            "                   the training poses and bake again, until B poses (default 32)\n"
-            "                   are added or the held-out error is at most E\n"
-            "  --heldout-steps S  without a clip, the 10 random held-out poses are each\n"
-            "                   reached from the one before in S held-out poses, 1..64\n"
-            "                   (default 4; the reference depends on the path)\n"
-            "  --random-poses N  without a clip, N random held-out poses, 1..10000\n"
-            "                   (default 10; more define the held-out figure better)\n"
-            "  --seed S         the bake's random draws (held-out poses, adaptive candidates,\n"
-            "                   cubature candidates), 0..2147483647 (default 1592614637)\n"
-            "  --contact-modes  also the static responses to the training poses' self-contact\n"
-            "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
-            "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
-            "                   cut to a cubature that keeps their reduced force to T,\n"
-            "                   0 <= T < 1 (default 0.05; 0: every pair kept)\n"
-            "  --no-pose-force  no pose-space equilibrium force in the blob (by default each\n"
-            "                   training pose carries the reduced force that makes its\n"
-            "                   projected solution the runtime's equilibrium there,\n"
-            "                   interpolated between poses)\n"
-            "  --eval-self-contact M  the runtime's self-contact mode the bake's errors are\n"
-            "                   measured in: pose-space (default) or pose-pairs\n");
+            "  --tets N         how finely the simulation fills the character (below)\n"
+            "  --train-clips A,B  --heldout-clips C  the clips it learns from and those it\n"
+            "                   is measured on (below); a character's only clip is split:\n"
+            "                   the figures are measured on its last 40%%, then the blob\n"
+            "                   ships trained on all of it (--ship-split: the split's)\n"
+            "character:\n" SW_CHARACTER_USAGE);
+    fprintf(f,
+            "bake:\n"
+            "  --cache DIR      keep the full-space solutions in DIR and reuse them when a\n"
+            "                   later bake solves the same poses of the same character (a\n"
+            "                   re-bake that changes the cubature, rank or report only)\n"
+            "  --ship-split     ship the blob trained on the split of a character's only\n"
+            "                   clip, the one the held-out figures measure (default: baked\n"
+            "                   again on the whole clip once measured)\n"
+            "  --threads T      0..256 (default 0: all cores)\n"
+            "  --force          write the blob even when its training error is %.2f or more\n"
+            "                   (the share of the physics correction it misses on its own\n"
+            "                   training poses; without --force that is an error)\n"
+            "  --json           one JSON object with the figures as the last stdout line\n",
+            SW_BAKE_MAX_TRAIN_ERROR);
+    fprintf(f, "research (the model's knobs, for studying the method; [--compare-cubature]\n"
+               "[--no-self-contact] too):\n"
+               "  --selector S     cubature selector: greedy | importance | nnhtp (default)\n"
+               "  --tol T          cubature fit tolerance, 0 < T < 1 (default 0.05)\n"
+               "  --max-rank R     basis rank per domain, 1..1024 (default 30)\n"
+               "  --fold-share S   a bone whose tets hold less than S of the mesh's volume\n"
+               "                   joins its parent's domain, 0..0.5 (default 0: off; 0.03\n"
+               "                   folds the elephant's 24 bones into 11 domains)\n"
+               "  --spring-k K     interface spring stiffness, K > 0 (default: of 20, 10, 5 and\n"
+               "                   2.5 E h the one with the lowest training error)\n"
+               "  --return-path    also train on the way home: from the first training clip's\n"
+               "                   last frame, its earlier frames backwards, each bent less than\n"
+               "                   the one before (a fold keeps its branch on the way out); by\n"
+               "                   default on where the held-out frames continue the training\n"
+               "                   clip (a --clip or a file's one clip split 60/40), off for\n"
+               "                   --train-clips; --no-return-path: never\n"
+               "  --pair-sweeps    also train on every joint swept together with its parent\n"
+               "                   joint (combinations the single-joint sweeps never show); by\n"
+               "                   default on with --joint-range; --no-pair-sweeps: never\n"
+               "  --no-sibling-sweeps  do not train on two sibling joints whose flesh meets\n"
+               "                   swept together (by default each such pair is: the flesh\n"
+               "                   between them shears with the difference of their bends)\n"
+               "  --adaptive R     then up to R rounds that each add the K (default 8) of C\n"
+               "                   (default 64) random combined poses the blob steps worst (the\n"
+               "                   full-space force its state leaves over plain skinning's) to\n"
+               "                   the training poses and bake again, until B poses (default 32)\n"
+               "                   are added or the held-out error is at most E\n"
+               "  --heldout-steps S  without a clip, the 10 random held-out poses are each\n"
+               "                   reached from the one before in S held-out poses, 1..64\n"
+               "                   (default 4; the reference depends on the path)\n"
+               "  --random-poses N  without a clip, N random held-out poses, 1..10000\n"
+               "                   (default 10; more define the held-out figure better)\n"
+               "  --seed S         the bake's random draws (held-out poses, adaptive candidates,\n"
+               "                   cubature candidates), 0..2147483647 (default 1592614637)\n"
+               "  --contact-modes  also the static responses to the training poses' self-contact\n"
+               "                   forces in the basis (thesis 3.3.1; a higher rank)\n"
+               "  --contact-tol T  per pair of domains, each training pose's contact pairs are\n"
+               "                   cut to a cubature that keeps their reduced force to T,\n"
+               "                   0 <= T < 1 (default 0.05; 0: every pair kept)\n"
+               "  --no-pose-force  no pose-space equilibrium force in the blob (by default each\n"
+               "                   training pose carries the reduced force that makes its\n"
+               "                   projected solution the runtime's equilibrium there,\n"
+               "                   interpolated between poses)\n"
+               "  --eval-self-contact M  the runtime's self-contact mode the bake's errors are\n"
+               "                   measured in: pose-space (default) or pose-pairs\n");
     fprintf(f,
             "  --reference-spread K  at every K-th held-out pose, three more full-space\n"
             "                   solves: from plain skinning, from the reference and from the\n"
@@ -128,16 +135,7 @@ static void usage(FILE *f) {
             "                   sits by another equilibrium\n"
             "  --inertia-modes  for the dynamic step: basis modes for the inertia of the\n"
             "                   bones' accelerations (static responses to them), so that the\n"
-            "                   flesh lags and overshoots as the reference does; a higher rank\n"
-            "  --cache DIR      keep the full-space solutions in DIR and reuse them when a\n"
-            "                   later bake solves the same poses of the same character (a\n"
-            "                   re-bake that changes the cubature, rank or report only)\n"
-            "  --threads T      0..256 (default 0: all cores)\n"
-            "  --force          write the blob even when its training error is %.2f or more\n"
-            "                   (the share of the physics correction it misses on its own\n"
-            "                   training poses; without --force that is an error)\n"
-            "  --json           one JSON object with the figures as the last stdout line\n",
-            SW_BAKE_MAX_TRAIN_ERROR);
+            "                   flesh lags and overshoots as the reference does; a higher rank\n");
     fprintf(f, "reference options (every full-space solve of the bake; a change of them\n"
                "solves the poses again instead of reading the cache):\n" SW_REFERENCE_USAGE
                "exit status: 0 blob written, 1 failed, 2 bad arguments\n");
@@ -244,6 +242,8 @@ int main(int argc, char **argv) {
             p.contact_modes = 1;
         else if (!strcmp(a, "--no-pose-force"))
             p.pose_force = 0;
+        else if (!strcmp(a, "--ship-split"))
+            p.ship_split = 1;
         else if (!strcmp(a, "--contact-tol") && next)
             ok = sw_tool_real(tool, a, argv[++i], -1e-300, 1, "in 0 <= T < 1",
                               &p.contact_cubature_tol);
@@ -275,11 +275,13 @@ int main(int argc, char **argv) {
             return 1;
         }
     sw_error err;
+    sinew_result r = sw_write_file_check(out_path, &err); /* before the long run, as the folders */
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: --out: ", tool);
     sw_character ch;
     sw_clip_split clips;
     sw_scene_character_info info;
     double t0 = sw_now_seconds();
-    sinew_result r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
+    r = sw_character_args_make(&ca, &ch, &clips, &info, &err);
     if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: ", tool);
     const char *source = ca.file ? ca.file : ca.scene ? ca.scene : ca.mesh;
     fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
@@ -312,6 +314,8 @@ int main(int argc, char **argv) {
     double *frame_err = NULL; /* every training pose's error, then every held-out one's */
     sw_bake_spread spread;    /* --reference-spread */
     memset(&spread, 0, sizeof spread);
+    sw_bake_result whole; /* the blob shipped when baked on the whole clip */
+    memset(&whole, 0, sizeof whole);
     if ((r = sw_blob_write_memory(&res.view, &mem, &size, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot serialise the blob: ", tool);
         goto done;
@@ -369,7 +373,20 @@ int main(int argc, char **argv) {
                 tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
         goto done;
     }
-    if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
+    /* the figures above are the split's; the blob ships trained on the whole clip
+       (sw_bake_ships_whole_clip) unless --ship-split or adaptive rounds */
+    const int ship_whole = ad.rounds == 0 && sw_bake_ships_whole_clip(&ch, &p);
+    if (ship_whole) {
+        fprintf(stderr,
+                "%s: the figures are of the split (held-out: the clip's last %.0f%%); the blob "
+                "ships baked on all %d frames of the clip (--ship-split: the split's)\n",
+                tool, 100 * p.heldout_fraction, ch.clip.nframes);
+        if ((r = sw_bake_whole_clip(&ch, &p, &whole, &err)) != SINEW_OK) {
+            sw_tool_failed(r, &err, "%s: the whole clip's bake: ", tool);
+            goto done;
+        }
+    }
+    if ((r = sw_blob_write(out_path, ship_whole ? &whole.view : &res.view, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
         goto done;
     }
@@ -630,9 +647,10 @@ int main(int argc, char **argv) {
             printf(",%.2f,%.2f]", beyond[k].heldout_deg, beyond[k].train_deg);
         }
         printf("]");
-        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
+        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s,"
+               "\"shipped\":\"%s\"}\n",
                res.simulate_cached ? "true" : "false", res.simulate_solved,
-               absurd ? "true" : "false");
+               absurd ? "true" : "false", ship_whole ? "whole_clip" : "as_measured");
     }
 done:
     sw_bake_spread_free(&spread);
@@ -640,6 +658,7 @@ done:
     free(mem);
     free(frame_err);
     sw_bake_result_free(&res);
+    sw_bake_result_free(&whole);
     sw_character_free(&ch);
     sw_clip_split_free(&clips);
     return status;

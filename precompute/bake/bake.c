@@ -304,3 +304,19 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     if (r != SINEW_OK) sw_bake_result_free(out);
     return r;
 }
+
+int sw_bake_ships_whole_clip(const sw_character *c, const sw_bake_params *p) {
+    return c && p && !p->ship_split && p->ntrain_clips == 0 && p->nextra_poses == 0 &&
+           c->clip.nframes >= 2 && p->heldout_fraction > 0;
+}
+
+sinew_result sw_bake_whole_clip(const sw_character *c, const sw_bake_params *params,
+                                sw_bake_result *out, sw_error *err) {
+    sw_bake_params p = params ? *params : sw_bake_params_default();
+    p.heldout_fraction = 0;
+    /* the split trains on the way home by default (its held-out frames continue the
+       clip): so does the whole clip */
+    if (p.return_path < 0) p.return_path = 1;
+    p.random_poses = 0;
+    return sw_bake(c, &p, out, err);
+}

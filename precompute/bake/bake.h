@@ -36,4 +36,20 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *p, sw_bake_res
 sinew_result sw_bake_solutions(const sw_character *c, const sw_bake_params *p, sw_bake_result *out,
                                sw_error *err);
 
+/* Whether the blob to ship is baked again on all the motion given (sw_bake_whole_clip):
+ * when the bake's motion is the character's own clip, split by heldout_fraction into the
+ * frames it trains on and those its held-out figures are measured on, and ship_split is
+ * 0. The split measures how the blob does on motion it has not seen; the blob a game
+ * ships has then no reason to leave the clip's last part out. Training clips of their
+ * own (train_clips), a joint range and random poses are not split: their blob ships as
+ * baked. */
+int sw_bake_ships_whole_clip(const sw_character *c, const sw_bake_params *p);
+
+/* The bake of the whole clip: sw_bake with p's parameters, but every frame of the
+ * character's clip a training frame (heldout_fraction 0), the way home trained as the
+ * split's default trains it (return_path), and no held-out poses to solve (its figures
+ * are the split's). */
+sinew_result sw_bake_whole_clip(const sw_character *c, const sw_bake_params *p, sw_bake_result *out,
+                                sw_error *err);
+
 #endif

@@ -66,6 +66,12 @@ typedef struct sw_bake_params {
                                       (bake_basis.c; default 0: they more than double the
                                       rank) */
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
+    int ship_split;                /* the blob a tool ships from a character's own clip split
+                                      by heldout_fraction: 0 (default) re-baked on the whole
+                                      clip once the split has been measured
+                                      (sw_bake_ships_whole_clip), 1 the split's own blob, the
+                                      one the held-out figures measure. sw_bake itself always
+                                      bakes the split. */
     int32_t random_poses;          /* held-out poses when there is no clip (default 10) */
     int32_t heldout_steps;         /* ... each reached from the one before in this many
                                       held-out poses, 1..64 (default 4): the reference is
