@@ -80,6 +80,103 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
     }
 }
 
+/* The view's domains, basis, cubature tets, reduced mass and inertial projections, per
+ * domain (blob_view.h); local_of: nverts ints of scratch. */
+static void fill_domains(const sw_bake_state *s, sw_blob_domain *doms, double *basis,
+                         int32_t *cub_tets, double *cub_weight, double *cub_dminv, double *cub_vol,
+                         double *mass, double *ins, double *inx, double *inu, int32_t *local_of) {
+    const int32_t R = s->basis.rank_total, nd = s->domains.nd;
+    int32_t qoff = 0, cub = 0;
+    int64_t boff = 0, ioff = 0;
+    for (int32_t d = 0; d < nd; ++d) {
+        int32_t base = s->domains.dom_vert_ptr[d], n = s->domains.dom_vert_ptr[d + 1] - base,
+                r_d = s->basis.rank[d];
+        sw_blob_domain *D = &doms[d];
+        memset(D, 0, sizeof *D);
+        D->bone = s->domains.domain_bone[d];
+        D->vert_begin = base;
+        D->vert_count = n;
+        D->rank = r_d;
+        D->q_offset = qoff;
+        D->cub_begin = cub;
+        D->cub_count = s->cubature.n[d];
+        D->basis_offset = boff;
+        D->inertia_offset = ioff;
+        const double *U = s->basis.U[d];
+        memcpy(basis + boff, U, (size_t)n * 3 * r_d * sizeof(double));
+        for (int32_t k = 0; k < n; ++k)
+            local_of[s->domains.dom_verts[base + k]] = k;
+        for (int32_t i = 0; i < s->cubature.n[d]; ++i, ++cub) {
+            int32_t tet = s->domains.dom_tets[s->domains.dom_tet_ptr[d] + s->cubature.local[d][i]];
+            double Xe[12];
+            for (int k = 0; k < 4; ++k) {
+                int32_t gv = s->rig.ch.mesh.tets[4 * (int64_t)tet + k];
+                cub_tets[4 * cub + k] = local_of[gv];
+                memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)gv, 24);
+            }
+            sw_tet_rest(Xe, cub_dminv + 9 * cub, cub_vol + cub);
+            cub_weight[cub] = s->cubature.w[d][i];
+        }
+        for (int32_t k = 0; k < n; ++k) {
+            double m = s->domains.copy_mass[base + k];
+            const double *Uk = U + (size_t)3 * k * r_d,
+                         *X = s->rig.ch.mesh.X + 3 * (int64_t)s->domains.dom_verts[base + k];
+            for (int32_t i = 0; i < r_d; ++i) {
+                for (int a = 0; a < 3; ++a) {
+                    double u = m * Uk[a * r_d + i];
+                    if (u == 0) continue;
+                    ins[3 * (qoff + i) + a] += u;
+                    for (int bb = 0; bb < 3; ++bb)
+                        inx[9 * (qoff + i) + 3 * a + bb] += u * X[bb];
+                    for (int bb = 0; bb < 3; ++bb)
+                        for (int32_t j = 0; j < r_d; ++j)
+                            inu[ioff + (int64_t)(3 * a + bb) * r_d * r_d + (int64_t)i * r_d + j] +=
+                                u * Uk[bb * r_d + j];
+                    for (int32_t j = 0; j < r_d; ++j)
+                        mass[(int64_t)(qoff + i) * R + qoff + j] += u * Uk[a * r_d + j];
+                }
+            }
+        }
+        qoff += r_d;
+        boff += (int64_t)n * 3 * r_d;
+        ioff += 9 * (int64_t)r_d * r_d;
+    }
+}
+
+/* The pose-space sections of the view: the training poses' projections and pose
+ * features (the pose-space interpolation's samples) and their self-contact pairs. */
+static sinew_result pose_sections(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    const int32_t R = s->basis.rank_total;
+    double *tq, *tp;
+    OWN(tq, (int64_t)s->basis.ntrain * R, double);
+    OWN(tp, (int64_t)s->basis.ntrain * 4 * s->rig.nb, double);
+    if (!tq || !tp) {
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    }
+    memcpy(tq, s->basis.train_q, (size_t)s->basis.ntrain * R * sizeof(double));
+    memcpy(tp, s->basis.train_pose, (size_t)s->basis.ntrain * 4 * s->rig.nb * sizeof(double));
+    v->ntrain = s->basis.ntrain;
+    v->train_q = tq;
+    v->train_pose = tp;
+    int32_t *cp, *cv;
+    double *cd;
+    OWN(cp, s->basis.ntrain + 1, int32_t);
+    OWN(cv, 8 * (int64_t)s->contacts.ncontacts, int32_t);
+    OWN(cd, 7 * (int64_t)s->contacts.ncontacts, double);
+    if (!cp || !cv || !cd) {
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    }
+    memcpy(cp, s->contacts.contact_ptr, (size_t)(s->basis.ntrain + 1) * sizeof(int32_t));
+    memcpy(cv, s->contacts.contact_verts, (size_t)s->contacts.ncontacts * 8 * sizeof(int32_t));
+    memcpy(cd, s->contacts.contact_data, (size_t)s->contacts.ncontacts * 7 * sizeof(double));
+    v->ncontacts = s->contacts.ncontacts;
+    v->contact_ptr = cp;
+    v->contact_verts = cv;
+    v->contact_data = cd;
+    return SINEW_OK;
+}
+
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sw_blob_view *v = &out->view;
     int32_t R = s->basis.rank_total, nd = s->domains.nd, ncopies = s->domains.dom_vert_ptr[nd];
@@ -144,63 +241,8 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     }
     memcpy(dverts, s->domains.dom_verts, (size_t)ncopies * sizeof(int32_t));
 
-    /* domains, basis, cubature, mass and inertia per domain */
-    int32_t qoff = 0, cub = 0;
-    int64_t boff = 0, ioff = 0;
-    for (int32_t d = 0; d < nd; ++d) {
-        int32_t base = s->domains.dom_vert_ptr[d], n = s->domains.dom_vert_ptr[d + 1] - base,
-                r_d = s->basis.rank[d];
-        sw_blob_domain *D = &doms[d];
-        memset(D, 0, sizeof *D);
-        D->bone = s->domains.domain_bone[d];
-        D->vert_begin = base;
-        D->vert_count = n;
-        D->rank = r_d;
-        D->q_offset = qoff;
-        D->cub_begin = cub;
-        D->cub_count = s->cubature.n[d];
-        D->basis_offset = boff;
-        D->inertia_offset = ioff;
-        const double *U = s->basis.U[d];
-        memcpy(basis + boff, U, (size_t)n * 3 * r_d * sizeof(double));
-        int32_t *local_of = surf_index; /* scratch: global -> local for this domain */
-        for (int32_t k = 0; k < n; ++k)
-            local_of[s->domains.dom_verts[base + k]] = k;
-        for (int32_t i = 0; i < s->cubature.n[d]; ++i, ++cub) {
-            int32_t tet = s->domains.dom_tets[s->domains.dom_tet_ptr[d] + s->cubature.local[d][i]];
-            double Xe[12];
-            for (int k = 0; k < 4; ++k) {
-                int32_t gv = s->rig.ch.mesh.tets[4 * (int64_t)tet + k];
-                cub_tets[4 * cub + k] = local_of[gv];
-                memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)gv, 24);
-            }
-            sw_tet_rest(Xe, cub_dminv + 9 * cub, cub_vol + cub);
-            cub_weight[cub] = s->cubature.w[d][i];
-        }
-        for (int32_t k = 0; k < n; ++k) {
-            double m = s->domains.copy_mass[base + k];
-            const double *Uk = U + (size_t)3 * k * r_d,
-                         *X = s->rig.ch.mesh.X + 3 * (int64_t)s->domains.dom_verts[base + k];
-            for (int32_t i = 0; i < r_d; ++i) {
-                for (int a = 0; a < 3; ++a) {
-                    double u = m * Uk[a * r_d + i];
-                    if (u == 0) continue;
-                    ins[3 * (qoff + i) + a] += u;
-                    for (int bb = 0; bb < 3; ++bb)
-                        inx[9 * (qoff + i) + 3 * a + bb] += u * X[bb];
-                    for (int bb = 0; bb < 3; ++bb)
-                        for (int32_t j = 0; j < r_d; ++j)
-                            inu[ioff + (int64_t)(3 * a + bb) * r_d * r_d + (int64_t)i * r_d + j] +=
-                                u * Uk[bb * r_d + j];
-                    for (int32_t j = 0; j < r_d; ++j)
-                        mass[(int64_t)(qoff + i) * R + qoff + j] += u * Uk[a * r_d + j];
-                }
-            }
-        }
-        qoff += r_d;
-        boff += (int64_t)n * 3 * r_d;
-        ioff += 9 * (int64_t)r_d * r_d;
-    }
+    fill_domains(s, doms, basis, cub_tets, cub_weight, cub_dminv, cub_vol, mass, ins, inx, inu,
+                 surf_index);
     /* copies of each vertex: (domain, local) */
     for (int32_t d = 0; d < nd; ++d)
         for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k)
@@ -282,35 +324,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->surf_copy_ptr = copy_ptr;
     v->surf_copies = copies;
     v->nsurf_copies = nsc;
-    double *tq, *tp;
-    OWN(tq, (int64_t)s->basis.ntrain * R, double);
-    OWN(tp, (int64_t)s->basis.ntrain * 4 * s->rig.nb, double);
-    if (!tq || !tp) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-        goto done;
-    }
-    memcpy(tq, s->basis.train_q, (size_t)s->basis.ntrain * R * sizeof(double));
-    memcpy(tp, s->basis.train_pose, (size_t)s->basis.ntrain * 4 * s->rig.nb * sizeof(double));
-    v->ntrain = s->basis.ntrain;
-    v->train_q = tq;
-    v->train_pose = tp;
-    int32_t *cp, *cv;
-    double *cd;
-    OWN(cp, s->basis.ntrain + 1, int32_t);
-    OWN(cv, 8 * (int64_t)s->contacts.ncontacts, int32_t);
-    OWN(cd, 7 * (int64_t)s->contacts.ncontacts, double);
-    if (!cp || !cv || !cd) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-        goto done;
-    }
-    memcpy(cp, s->contacts.contact_ptr, (size_t)(s->basis.ntrain + 1) * sizeof(int32_t));
-    memcpy(cv, s->contacts.contact_verts, (size_t)s->contacts.ncontacts * 8 * sizeof(int32_t));
-    memcpy(cd, s->contacts.contact_data, (size_t)s->contacts.ncontacts * 7 * sizeof(double));
-    v->ncontacts = s->contacts.ncontacts;
-    v->contact_ptr = cp;
-    v->contact_verts = cv;
-    v->contact_data = cd;
-    r = SINEW_OK;
+    r = pose_sections(s, out, err);
 done:
     free(copy_ptr_v);
     free(copy_list);
