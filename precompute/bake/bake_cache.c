@@ -1,5 +1,5 @@
-/* Stage "simulate" (bake.c, sw_bake_stages): reads s->rig, s->poses; writes the sequences'
- * solutions and contact sets in s->poses, the result's train_*, heldout_*, mass, sweeps. */
+/* A helper of the simulate stage (bake_simulate.c), below it: the chains of poses it
+ * would solve, read from and stored to the cache folder. */
 /* The simulate stage through its cache (sim_cache.h, sw_bake_params.cache_dir): the key
  * hashes every input of the full-space solves, so a file found under it holds exactly
  * the solutions this bake would compute (the reference's results do not depend on its
@@ -171,10 +171,10 @@ static int chain_file(sw_bake_state *s, int32_t i, uint64_t character, const cha
     return 1;
 }
 
-static sinew_result simulate_cached(sw_bake_state *s, int *cached, sw_error *err) {
-    *cached = 0;
+sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err) {
+    *all = 0;
     const char *dir = s->p->cache_dir;
-    if (!dir || !dir[0]) return sw_bake_simulate_solve(s, err);
+    if (!dir || !dir[0]) return SINEW_OK;
     struct stat st;
     if (mkdir(dir, 0755) != 0 && errno != EEXIST)
         return sw_error_set(err, SINEW_ERROR_IO, "cache folder '%s': cannot create it: %s", dir,
@@ -191,73 +191,18 @@ static sinew_result simulate_cached(sw_bake_state *s, int *cached, sw_error *err
             nroot++;
             hits += lookup(s, &ch, key, path, &r, err);
         }
-    if (r != SINEW_OK) return r;
-    if ((r = sw_bake_simulate_solve(s, err)) != SINEW_OK) return r; /* the chains not found */
+    *all = r == SINEW_OK && hits == nroot;
+    return r;
+}
+
+void sw_bake_cache_store(sw_bake_state *s) {
+    const char *dir = s->p->cache_dir;
+    if (!dir || !dir[0]) return;
+    uint64_t character = character_key(s), key;
+    char path[4200];
+    chain ch;
     for (int32_t i = 0; i <= s->poses.ntrain_seq; ++i)
         if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path) &&
             !ch.seq[0]->from_cache)
             store(s, &ch, key, path);
-    *cached = hits == nroot;
-    return SINEW_OK;
-}
-
-/* Keeps the poses and full-space solutions for evaluation (sinew-bench, the report). */
-static sinew_result keep_solutions(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    size_t pt = (size_t)12 * s->rig.nb * sizeof(double),
-           px = (size_t)3 * s->rig.nv * sizeof(double);
-    out->train_T = malloc((size_t)out->ntrain * pt + 1);
-    out->train_x = malloc((size_t)out->ntrain * px + 1);
-    out->heldout_T = malloc((size_t)out->nheldout * pt + 1);
-    out->heldout_x = malloc((size_t)out->nheldout * px + 1);
-    size_t pl = sizeof(int32_t);
-    out->train_clip = malloc((size_t)out->ntrain * pl + 1);
-    out->train_frame = malloc((size_t)out->ntrain * pl + 1);
-    out->heldout_clip = malloc((size_t)out->nheldout * pl + 1);
-    out->heldout_frame = malloc((size_t)out->nheldout * pl + 1);
-    if (!out->train_T || !out->train_x || !out->heldout_T || !out->heldout_x || !out->train_clip ||
-        !out->train_frame || !out->heldout_clip || !out->heldout_frame)
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for solutions");
-    int32_t k = 0;
-    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
-        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k) {
-            memcpy((char *)out->train_T + k * pt, (const char *)s->poses.train[i].T + j * pt, pt);
-            memcpy((char *)out->train_x + k * px, (const char *)s->poses.train[i].x + j * px, px);
-            out->train_clip[k] = s->poses.train[i].clip[j];
-            out->train_frame[k] = s->poses.train[i].frame[j];
-        }
-    if (out->nheldout) {
-        memcpy(out->heldout_T, s->poses.heldout.T, (size_t)out->nheldout * pt);
-        memcpy(out->heldout_x, s->poses.heldout.x, (size_t)out->nheldout * px);
-        memcpy(out->heldout_clip, s->poses.heldout.clip, (size_t)out->nheldout * pl);
-        memcpy(out->heldout_frame, s->poses.heldout.frame, (size_t)out->nheldout * pl);
-    }
-    return SINEW_OK;
-}
-
-/* simulate: the poses' full-space solutions (through the cache), and what the result keeps
- * of them for evaluation (sinew-bench, the report). */
-sinew_result sw_bake_simulate(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    sinew_result r = simulate_cached(s, &out->simulate_cached, err);
-    if (r != SINEW_OK) return r;
-    out->simulate_solved = (int32_t)s->poses.solved_poses;
-    out->return_poses = s->poses.return_poses;
-    out->pair_sweep_poses = s->poses.pair_sweep_poses;
-    size_t na = (size_t)s->rig.nb * 3 * sizeof(double);
-    if (!(out->sweep_axis = sw_bake_own(out, malloc(na))) ||
-        !(out->sweep_angle = sw_bake_own(out, malloc(na / 3))))
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-    memcpy(out->sweep_axis, s->poses.sweep_axis, na);
-    memcpy(out->sweep_angle, s->poses.sweep_angle, na / 3);
-    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i) {
-        out->ntrain += s->poses.train[i].npose;
-        out->train_unsettled += s->poses.train[i].unsettled;
-    }
-    out->nheldout = s->poses.heldout.npose;
-    out->heldout_after = s->poses.heldout.continues ? s->poses.train[0].npose : 0;
-    out->heldout_unsettled = s->poses.heldout.unsettled;
-    if ((r = keep_solutions(s, out, err)) != SINEW_OK) return r;
-    if (!(out->mass = malloc((size_t)s->rig.nv * sizeof(double))))
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-    memcpy(out->mass, s->rig.mass, (size_t)s->rig.nv * sizeof(double));
-    return SINEW_OK;
 }

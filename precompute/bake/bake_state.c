@@ -83,3 +83,10 @@ void sw_bake_state_free(sw_bake_state *s) {
     sw_embedding_free(&s->embed);
     sw_pool_destroy(s->pool);
 }
+
+sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p) {
+    sw_fullsim_params fp = sw_fullsim_params_default();
+    if (p->reference) sw_fullsim_params_take_solver(&fp, p->reference);
+    fp.self_contact = p->self_contact;
+    return fp;
+}

@@ -147,8 +147,11 @@ void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, 
                          double *dminv, double *vol);
 /* The reference simulator's parameters of the simulate stage (threads aside). */
 sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p);
-/* The full-space solves of the simulate stage, without the cache (bake_poses.c). */
-sinew_result sw_bake_simulate_solve(sw_bake_state *s, sw_error *err);
+/* The simulate stage's cache (bake_cache.c; sw_bake_params.cache_dir, nothing without
+ * one): read marks the pose chains the cache holds as solved (sw_pose_seq.from_cache),
+ * *all when it holds every one; store writes the chains that were solved. */
+sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err);
+void sw_bake_cache_store(sw_bake_state *s);
 /* The un-skinned displacements of one pose (bake_basis.c, thesis eq. 4.13): d (3 nv) from
  * positions x and bone transforms T, d_v = R_v^T (x_v - t_v) - rest_v (0 at bone-driven
  * vertices); R (9 nv) and t (3 nv) are scratch for the skinning transforms. */
