@@ -195,23 +195,3 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *er
     free(mark);
     return SINEW_OK;
 }
-
-void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
-                         double *dminv, double *vol) {
-    int32_t base = s->domains.dom_vert_ptr[dm], t0 = s->domains.dom_tet_ptr[dm],
-            ntd = s->domains.dom_tet_ptr[dm + 1] - t0;
-    for (int32_t k = base; k < s->domains.dom_vert_ptr[dm + 1]; ++k)
-        local_of[s->domains.dom_verts[k]] = k - base;
-    for (int32_t i = 0; i < ntd; ++i) {
-        const int32_t *tet = s->rig.ch.mesh.tets + 4 * (int64_t)s->domains.dom_tets[t0 + i];
-        double Xe[12];
-        for (int k = 0; k < 4; ++k) {
-            tet_local[4 * i + k] = local_of[tet[k]];
-            memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)tet[k], 24);
-        }
-        if (!sw_tet_rest(Xe, dminv + 9 * i, vol + i)) { /* a degenerate tet weighs nothing */
-            memset(dminv + 9 * i, 0, 9 * sizeof(double));
-            vol[i] = 0;
-        }
-    }
-}

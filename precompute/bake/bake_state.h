@@ -139,10 +139,10 @@ void sw_bake_progress(sw_bake_state *s, int64_t units);
 void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R /* 9 nv */,
                              double *t /* 3 nv */);
 
-/* Helpers of one stage that later stages take too. */
+/* Helpers of the stages after domains and basis (bake_shapes.c). */
 /* Rest data of domain dm's tets in dom_tets order: each corner's copy in the domain
  * (tet_local, 4 a tet), Dm^-1 (9 a tet; zero for a degenerate tet) and rest volume (0 for
- * a degenerate tet). local_of: nverts ints of scratch (bake_domains.c). */
+ * a degenerate tet). local_of: nverts ints of scratch. */
 void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
                          double *dminv, double *vol);
 /* The reference simulator's parameters of the simulate stage (threads aside). */
@@ -152,14 +152,14 @@ sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p);
  * *all when it holds every one; store writes the chains that were solved. */
 sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err);
 void sw_bake_cache_store(sw_bake_state *s);
-/* The un-skinned displacements of one pose (bake_basis.c, thesis eq. 4.13): d (3 nv) from
+/* The un-skinned displacements of one pose (thesis eq. 4.13): d (3 nv) from
  * positions x and bone transforms T, d_v = R_v^T (x_v - t_v) - rest_v (0 at bone-driven
  * vertices); R (9 nv) and t (3 nv) are scratch for the skinning transforms. */
 void sw_bake_unskin(const sw_bake_state *s, const double *T, const double *x, double *R, double *t,
                     double *d);
 /* G (na x nb) = A K B^T: the products of the rows of A and B (na and nb rows of domain dm's
  * 3 n copies' displacements) in the rest linear-elastic energy of the domain's tets, K
- * the stiffness of the co-rotational energy (eq. 2.3) at rest (bake_basis.c). B NULL: the
+ * the stiffness of the co-rotational energy (eq. 2.3) at rest. B NULL: the
  * Gram matrix of A (na x na). 0 when out of memory. The PCA's strain share
  * (sw_bake_params.pca_strain) and the Galerkin errors (bake_galerkin.c) take them. */
 int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A, int32_t na,
