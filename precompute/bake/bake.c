@@ -1,6 +1,7 @@
 /* The bake's orchestrator (bake.h): its stages as one table, and the loop that runs,
  * times and reports them. Each stage is a file of its own (bake_state.h lists them); what
- * they share lives below them (bake_state.c, bake_params.c, bake_eval.c). */
+ * they share lives below them (bake_state.c, bake_params.c, bake_eval.c, bake_shapes.c,
+ * bake_cache.c); no stage includes bake.h (tests/bake_includes.cmake). */
 #include "bake.h"
 
 #include <math.h>
@@ -219,8 +220,8 @@ static int sum_equilibrium(const sw_bake_state *s, const sw_bake_result *o, char
  * (bake_state.h) and writes its own group and its part of the result; "view" is the blob
  * view in sw_bake_result, whose sections reduce, render, cond and pairs assemble, and
  * springs and equilibrium complete from their own state (sw_reduce_state.spring,
- * sw_bake_result.view.train_force). The first four (`solutions`) are what
- * sw_bake_solutions runs. */
+ * sw_bake_result.view.train_force). Those marked `solutions` (prepare, domains, poses,
+ * simulate) are what sw_bake_solutions runs. */
 const sw_bake_stage sw_bake_stages[SW_BAKE_NSTAGES] = {
     /* weights (heat diffusion when the asset has none), bone-driven vertices rigid,
        top-4 influences, lumped masses */
