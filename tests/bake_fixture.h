@@ -21,7 +21,10 @@ typedef struct {
 } bake_fixture;
 
 /* Bakes the character f->ch with bake parameters p, writes and loads the blob. 1 on
- * success. */
+ * success. sw_bake bakes a character's only clip split by heldout_fraction, as it always
+ * has: the fixtures' and the golden tests' blobs are the split's, bit for bit (the blob
+ * sinew-bake ships from such a clip is baked again on the whole clip,
+ * sw_bake_ships_whole_clip; --ship-split is this one). */
 static inline int bake_fixture_bake(bake_fixture *f, const sw_bake_params *p) {
     sw_error err;
     if (sw_bake(&f->ch, p, &f->res, &err) != SINEW_OK) {

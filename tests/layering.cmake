@@ -26,3 +26,9 @@ sinew_layering_test(runtime_cannot_see_precompute sinew_instance fullsim.h hidde
 sinew_layering_test(io_cannot_see_reference sinew_pc_io fullsim.h hidden)
 sinew_layering_test(reference_cannot_see_bake sinew_pc_reference bake.h hidden)
 sinew_layering_test(bake_sees_reference sinew_pc_bake fullsim.h visible)
+
+# No stage of the bake includes its orchestrator (tests/bake_includes.cmake).
+add_test(NAME layering_bake_includes
+  COMMAND ${CMAKE_COMMAND} -DDIR=${CMAKE_CURRENT_LIST_DIR}/../precompute/bake
+          -P ${CMAKE_CURRENT_LIST_DIR}/bake_includes.cmake)
+set_tests_properties(layering_bake_includes PROPERTIES LABELS layering)

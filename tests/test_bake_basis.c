@@ -7,7 +7,8 @@
 #include <stdint.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake.h"
+#include "bake_state.h"
 #include "fem_corot.h"
 #include "samples.h"
 #include "sw_test.h"
@@ -32,12 +33,12 @@ static void cube_make(cube_state *c) {
         cube_X[3 * v + 1] = xy[v % 4][1] * 0.9;
         cube_X[3 * v + 2] = (v / 4) * 1.1;
     }
-    c->s.ch.mesh.X = cube_X;
-    c->s.ch.mesh.tets = cube_tets;
-    c->s.ch.mesh.nverts = c->s.nv = 8;
-    c->s.ch.mesh.ntets = c->s.nt = 5;
-    c->s.ch.youngs = 3e4;
-    c->s.ch.poisson = 0.3;
+    c->s.rig.ch.mesh.X = cube_X;
+    c->s.rig.ch.mesh.tets = cube_tets;
+    c->s.rig.ch.mesh.nverts = c->s.rig.nv = 8;
+    c->s.rig.ch.mesh.ntets = c->s.rig.nt = 5;
+    c->s.rig.ch.youngs = 3e4;
+    c->s.rig.ch.poisson = 0.3;
     static const int32_t tets0[] = {0, 1, 4}, tets1[] = {2, 3};
     int32_t nt = 0, nvc = 0;
     c->tet_ptr[0] = c->vert_ptr[0] = 0;
@@ -54,17 +55,17 @@ static void cube_make(cube_state *c) {
         c->tet_ptr[d + 1] = nt;
         c->vert_ptr[d + 1] = nvc;
     }
-    c->s.nd = 2;
-    c->s.dom_tet_ptr = c->tet_ptr;
-    c->s.dom_tets = c->tets;
-    c->s.dom_vert_ptr = c->vert_ptr;
-    c->s.dom_verts = c->verts;
+    c->s.domains.nd = 2;
+    c->s.domains.dom_tet_ptr = c->tet_ptr;
+    c->s.domains.dom_tets = c->tets;
+    c->s.domains.dom_vert_ptr = c->vert_ptr;
+    c->s.domains.dom_verts = c->verts;
 }
 
 /* d^T K e over domain dm's tets, K from the co-rotational element's Hessian at rest. */
 static double energy_product(const cube_state *c, int dm, const double *d, const double *e) {
     double mu, lambda, sum = 0;
-    sw_lame(c->s.ch.youngs, c->s.ch.poisson, &mu, &lambda);
+    sw_lame(c->s.rig.ch.youngs, c->s.rig.ch.poisson, &mu, &lambda);
     int32_t base = c->vert_ptr[dm], n = c->vert_ptr[dm + 1] - base;
     for (int32_t i = c->tet_ptr[dm]; i < c->tet_ptr[dm + 1]; ++i) {
         const int32_t *tet = cube_tets + 4 * c->tets[i];

@@ -111,7 +111,7 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
                num(o, "cubature") == v->domains[d].cub_count);
         ENSURE(num(o, "energy") > 0.9 && num(o, "energy") <= 1.0);
     }
-    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == 6);
+    ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(j, "stages")) == SW_BAKE_NSTAGES);
     int32_t nbeyond;
     check_beyond(j, res, sk, &nbeyond);
     /* per frame, the joints it bends beyond training: each pose's own count, some

@@ -11,7 +11,8 @@
 #include <string.h>
 
 #include "bake_fixture.h"
-#include "bake_internal.h"
+#include "bake.h"
+#include "bake_state.h"
 #include "blob_load.h"
 #include "instance.h"
 #include "instance_internal.h"

@@ -79,6 +79,13 @@ expect bake_random_poses_range 2 "--random-poses wants an integer in 1\.\.10000,
     "$bake" "${small[@]}" --random-poses 0 --out "$tmp/a.blob"
 expect bake_seed_range 2 "--seed wants an integer in 0\.\.2147483647, got '-1'" \
     "$bake" "${small[@]}" --seed -1 --out "$tmp/a.blob"
+# a bad --out before the bake, a missing file by the system's reason
+expect bake_out_unwritable 1 "--out: write: cannot create '.*/no/such/a\.blob\.tmp': No such file or directory" \
+    "$bake" "${small[@]}" --out "$tmp/no/such/a.blob"
+expect bake_out_folder 1 "--out: write: cannot write '.*': Is a directory" \
+    "$bake" "${small[@]}" --out "$tmp"
+expect bake_missing_file 1 "missing\.glb: cannot open: No such file or directory$" \
+    "$bake" "$tmp/missing.glb" --out "$tmp/a.blob"
 expect bake_reference_spread_range 2 "--reference-spread wants an integer in 1\.\.1000000, got '0'" \
     "$bake" "${small[@]}" --reference-spread 0 --out "$tmp/a.blob"
 expect bake_solver_name 2 "--solver wants one of auto \| cholmod \| pcg, got 'lu'" \
@@ -142,9 +149,10 @@ expect bench_bake_errors_without_blob 2 "--bake-errors applies only with --blob"
 
 # one definition of the training and held-out error: the bake and the bench
 # --blob --bake-errors (the bake's poses solved anew) agree (--reference-spread measures
-# beside the errors, never changes them)
+# beside the errors, never changes them). --ship-split: the blob the figures measure (by
+# default the finger's only clip ships re-baked on all its frames, sw_bake_ships_whole_clip)
 key() { tail -n 1 "$1" | grep -oE "\"$2\":(\"[a-z_]*\"|[0-9.]+|null)" | cut -d: -f2; }
-if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference-spread 1 \
+if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference-spread 1 --ship-split \
     --json >"$tmp/bake.json" 2>"$tmp/bake.err" &&
     "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --bake-errors \
         --contract-steps 10 --json >"$tmp/bench.json" 2>"$tmp/bench.err"; then
@@ -173,6 +181,17 @@ if "$bake" --scene finger --tets 2000 --frames 6 --out "$tmp/f.blob" --reference
 else
     echo "FAIL same_errors: the bake or the bench failed" >&2
     tail -n 3 "$tmp/bake.err" "$tmp/bench.err" >&2
+    fails=$((fails + 1))
+fi
+
+# a character's only clip: measured on the split, shipped trained on the whole clip
+if "$bake" --scene finger --tets 1000 --frames 6 --out "$tmp/w.blob" --json >"$tmp/w.json" \
+    2>"$tmp/w.err" && [ "$(key "$tmp/w.json" shipped)" = '"whole_clip"' ] &&
+    grep -q "the blob ships baked on all 6 frames of the clip" "$tmp/w.err" &&
+    [ "$(key "$tmp/bake.json" shipped)" = '"as_measured"' ]; then
+    echo "ok   bake_ships_whole_clip"
+else
+    echo "FAIL bake_ships_whole_clip: $(key "$tmp/w.json" shipped)" >&2
     fails=$((fails + 1))
 fi
 

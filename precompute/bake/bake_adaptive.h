@@ -1,4 +1,4 @@
-/* The adaptive training loop (issue 16, item 1): a bake, then rounds that add the poses
+/* The adaptive training loop: a bake, then rounds that add the poses
  * the current subspace represents worst, until a held-out target or a pose budget.
  *
  * A round: `candidates` random combined poses (sw_bake_random_poses over the joints'

@@ -1,3 +1,5 @@
+/* Stage "basis" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->poses; writes s->basis, the
+ * result's *_proj_error and basis_energy. */
 /* Skinning-correction basis (thesis §4.4.1, eq. 4.13): each full-space solution x is
  * pulled back through the skinning transform, d_v = R_v^T (x_v - t_v) - rest_v, and
  * each domain gets the uncentred PCA of its vertices' d over the training poses:
@@ -8,7 +10,7 @@
  * projected in the energy norm (the Galerkin projection, bake_galerkin.c), so that span
  * is chosen for what this projection keeps of the training snapshots. Measured, it keeps
  * more modes at the same energy share, and its held-out gains come from those: at the
- * plain PCA's ranks it is no better (docs/generalisation.md), so it is off by default. Rows of
+ * plain PCA's ranks it is no better (docs/notes/generalisation.md), so it is off by default. Rows of
  * bone-driven vertices are zero, so in the subspace those vertices follow their bone exactly, as in
  * the reference. A bake for dynamics appends inertia modes (add_inertia_modes). */
 #include <cblas.h>
@@ -17,24 +19,12 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "fem_corot.h"
 #include "fullsim.h"
 #include "penalty.h"
 #include "selfcontact.h"
 #include "vec3.h"
-
-void sw_bake_unskin(const sw_bake_state *s, const double *T, const double *x, double *R, double *t,
-                    double *d) {
-    sw_bake_skin_transforms(s, T, R, t);
-    for (int32_t v = 0; v < s->nv; ++v) {
-        const double *Rv = R + 9 * v, *xv = x + 3 * v, *tv = t + 3 * v, *X = s->ch.mesh.X + 3 * v;
-        double w[3] = {xv[0] - tv[0], xv[1] - tv[1], xv[2] - tv[2]};
-        for (int i = 0; i < 3; ++i)
-            d[3 * v + i] = Rv[i] * w[0] + Rv[3 + i] * w[1] + Rv[6 + i] * w[2] - X[i];
-        if (s->ch.bone_of_vertex[v] >= 0) d[3 * v] = d[3 * v + 1] = d[3 * v + 2] = 0;
-    }
-}
 
 /* Removes from the column c (m entries, stride cs) its components along the columns
  * lo..hi-1 of the orthonormal B (m rows, stride bs), twice (twice is enough, Kahan);
@@ -78,89 +68,6 @@ static void plain_gram(const double *D, int32_t T, int64_t m, double *G) {
                 g += D[(size_t)a * m + i] * D[(size_t)b * m + i];
             G[(size_t)a * T + b] = G[(size_t)b * T + a] = g;
         }
-}
-
-/* Tets a pass of strain_gram takes: each adds 7 columns to the T-row strain matrix. */
-#define STRAIN_CHUNK 128
-#define SQRT1_2 0.70710678118654752440
-
-/* The 7 strain numbers of tet c (corners loc, shape gradients Dg) for each of the n rows
- * of D (m entries each) into S (row a at S + a * cols + 7 c): the strain e = sym(grad d)
- * gives 2 Psi = 2 mu dev(e):dev(e) + (2 mu / 3 + lambda) tr(e)^2, and the numbers'
- * squares sum to vol 2 Psi (dev = sqrt(2 mu vol), bulk = sqrt((2 mu / 3 + lambda) vol)). */
-static void strain_numbers(const double *D, int32_t n, int64_t m, const int32_t loc[4],
-                           const double Dg[12], double dev, double bulk, double *S, int64_t cols,
-                           int32_t c) {
-    for (int32_t a = 0; a < n; ++a) {
-        double g[9] = {0}; /* grad d = sum over corners d_k Dg_k^T */
-        for (int k = 0; k < 4; ++k) {
-            const double *dk = D + (size_t)a * m + 3 * loc[k];
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    g[3 * i + j] += dk[i] * Dg[3 * k + j];
-        }
-        double tr = g[0] + g[4] + g[8], *e = S + (size_t)a * cols + 7 * c;
-        e[0] = dev * (g[0] - tr / 3);
-        e[1] = dev * (g[4] - tr / 3);
-        e[2] = dev * (g[8] - tr / 3);
-        e[3] = dev * SQRT1_2 * (g[1] + g[3]); /* 2 e01^2 = ((g01 + g10) / sqrt 2)^2 */
-        e[4] = dev * SQRT1_2 * (g[2] + g[6]);
-        e[5] = dev * SQRT1_2 * (g[5] + g[7]);
-        e[6] = bulk * tr;
-    }
-}
-
-/* The products accumulate chunk by chunk of tets, in order (the bake is the same on any
- * thread count). */
-int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A, int32_t na,
-                            const double *B, int32_t nb, double *G) {
-    int64_t m = 3 * (int64_t)(s->dom_vert_ptr[dm + 1] - s->dom_vert_ptr[dm]);
-    int sym = B == NULL;
-    if (sym) nb = na;
-    double mu, lambda;
-    sw_lame(s->ch.youngs, s->ch.poisson, &mu, &lambda);
-    int32_t ntd = s->dom_tet_ptr[dm + 1] - s->dom_tet_ptr[dm];
-    const int64_t cols = 7 * STRAIN_CHUNK;
-    int32_t *local_of = malloc((size_t)s->nv * sizeof(int32_t)),
-            *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t) + 1);
-    double *dminv = malloc((size_t)ntd * 9 * sizeof(double) + 1),
-           *vol = malloc((size_t)ntd * sizeof(double) + 1),
-           *SA = malloc((size_t)na * cols * sizeof(double) + 1),
-           *SB = sym ? SA : malloc((size_t)nb * cols * sizeof(double) + 1);
-    int ok = local_of && tet_local && dminv && vol && SA && SB;
-    openblas_set_num_threads(1);
-    if (ok) {
-        sw_bake_domain_tets(s, dm, local_of, tet_local, dminv, vol);
-        memset(G, 0, (size_t)na * nb * sizeof(double));
-    }
-    for (int32_t c0 = 0; ok && c0 < ntd; c0 += STRAIN_CHUNK) {
-        int32_t nc = ntd - c0 < STRAIN_CHUNK ? ntd - c0 : STRAIN_CHUNK;
-        for (int32_t c = 0; c < nc; ++c) {
-            double Dg[12];
-            sw_tet_shape_gradients(dminv + 9 * (c0 + c), Dg);
-            double dev = sqrt(2 * mu * vol[c0 + c]),
-                   bulk = sqrt(fmax(2 * mu / 3 + lambda, 0) * vol[c0 + c]);
-            strain_numbers(A, na, m, tet_local + 4 * (c0 + c), Dg, dev, bulk, SA, cols, c);
-            if (!sym)
-                strain_numbers(B, nb, m, tet_local + 4 * (c0 + c), Dg, dev, bulk, SB, cols, c);
-        }
-        if (sym)
-            cblas_dsyrk(CblasRowMajor, CblasUpper, CblasNoTrans, na, 7 * nc, 1.0, SA, (int)cols,
-                        1.0, G, na);
-        else
-            cblas_dgemm(CblasRowMajor, CblasNoTrans, CblasTrans, na, nb, 7 * nc, 1.0, SA, (int)cols,
-                        SB, (int)cols, 1.0, G, nb);
-    }
-    for (int32_t a = 0; ok && sym && a < na; ++a)
-        for (int32_t b = a + 1; b < na; ++b)
-            G[(size_t)b * na + a] = G[(size_t)a * na + b];
-    free(local_of);
-    free(tet_local);
-    free(dminv);
-    free(vol);
-    if (!sym) free(SB);
-    free(SA);
-    return ok;
 }
 
 /* The Gram matrix G (T x T) domain dm's PCA takes (sw_bake_params.pca_strain = w): the
@@ -238,22 +145,24 @@ done:
 
 /* q_d = U_d^T d restricted to domain dm's copies (q: rank[dm] doubles). */
 static void project(const sw_bake_state *s, int32_t dm, const double *d, double *q) {
-    int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base, r = s->rank[dm];
-    const double *U = s->basis[dm];
+    int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base,
+            r = s->basis.rank[dm];
+    const double *U = s->basis.U[dm];
     for (int32_t k = 0; k < r; ++k) {
         double acc = 0;
         for (int32_t j = 0; j < n; ++j)
             for (int i = 0; i < 3; ++i)
-                acc += U[(size_t)(3 * j + i) * r + k] * d[3 * s->dom_verts[base + j] + i];
+                acc += U[(size_t)(3 * j + i) * r + k] * d[3 * s->domains.dom_verts[base + j] + i];
         q[k] = acc;
     }
 }
 
 /* Relative projection error accumulators for the snapshots d (3 nv) of one pose. */
 static void projection_error(const sw_bake_state *s, const double *d, double *num, double *den) {
-    for (int32_t dm = 0; dm < s->nd; ++dm) {
-        int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base, r = s->rank[dm];
-        const double *U = s->basis[dm];
+    for (int32_t dm = 0; dm < s->domains.nd; ++dm) {
+        int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base,
+                r = s->basis.rank[dm];
+        const double *U = s->basis.U[dm];
         double q[1024];
         project(s, dm, d, q);
         for (int32_t j = 0; j < n; ++j)
@@ -261,7 +170,7 @@ static void projection_error(const sw_bake_state *s, const double *d, double *nu
                 double p = 0;
                 for (int32_t k = 0; k < r; ++k)
                     p += U[(size_t)(3 * j + i) * r + k] * q[k];
-                double dv = d[3 * s->dom_verts[base + j] + i];
+                double dv = d[3 * s->domains.dom_verts[base + j] + i];
                 *num += (dv - p) * (dv - p);
                 *den += dv * dv;
             }
@@ -335,7 +244,7 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * of the response's whole norm, largest first, at most max_rank of them a domain. */
 static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F, double tol,
                                   sw_error *err) {
-    int64_t n3 = 3 * (int64_t)s->nv;
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.self_contact = 0;
     fp.pcg_rtol = 1e-8;
@@ -345,7 +254,7 @@ static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F,
     double *Uf = malloc((size_t)nl * n3 * sizeof(double)), *C = NULL, *gnorm = NULL;
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
     if (!Uf) goto done;
-    if ((r = sw_fullsim_create(&s->ch, &fp, &sim, err)) != SINEW_OK ||
+    if ((r = sw_fullsim_create(&s->rig.ch, &fp, &sim, err)) != SINEW_OK ||
         (r = sw_fullsim_rest_response(sim, nl, F, Uf, err)) != SINEW_OK)
         goto done;
     r = SINEW_ERROR_OUT_OF_MEMORY;
@@ -356,19 +265,21 @@ static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F,
             g += Uf[(size_t)j * n3 + i] * Uf[(size_t)j * n3 + i];
         gnorm[j] = sqrt(g);
     }
-    for (int32_t d = 0; d < s->nd; ++d) {
-        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base;
+    for (int32_t d = 0; d < s->domains.nd; ++d) {
+        int32_t base = s->domains.dom_vert_ptr[d], n = s->domains.dom_vert_ptr[d + 1] - base;
         int64_t m = 3 * (int64_t)n;
         free(C);
         if (!(C = malloc((size_t)nl * m * sizeof(double)))) goto done;
         for (int32_t j = 0; j < nl; ++j)
             for (int32_t k = 0; k < n; ++k)
-                memcpy(C + (size_t)j * m + 3 * k, Uf + (size_t)j * n3 + 3 * s->dom_verts[base + k],
+                memcpy(C + (size_t)j * m + 3 * k,
+                       Uf + (size_t)j * n3 + 3 * s->domains.dom_verts[base + k],
                        3 * sizeof(double));
-        double *W = append_columns(s->basis[d], m, &s->rank[d], C, nl, gnorm, tol, s->p->max_rank);
+        double *W =
+            append_columns(s->basis.U[d], m, &s->basis.rank[d], C, nl, gnorm, tol, s->p->max_rank);
         if (!W) goto done;
-        free(s->basis[d]);
-        s->basis[d] = W;
+        free(s->basis.U[d]);
+        s->basis.U[d] = W;
     }
     r = SINEW_OK;
 done:
@@ -381,25 +292,25 @@ done:
 }
 
 static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
-    int32_t nd = s->nd, nl = 6 * nd;
-    int64_t n3 = 3 * (int64_t)s->nv;
+    int32_t nd = s->domains.nd, nl = 6 * nd;
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
     double *F = calloc((size_t)nl * n3, sizeof(double));
     if (!F) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for inertia modes");
     for (int32_t d = 0; d < nd; ++d) {
-        int32_t b = s->dom_vert_ptr[d], e = s->dom_vert_ptr[d + 1];
+        int32_t b = s->domains.dom_vert_ptr[d], e = s->domains.dom_vert_ptr[d + 1];
         double c[3] = {0, 0, 0}, mt = 0;
         for (int32_t k = b; k < e; ++k)
             for (int i = 0; i < 3; ++i) {
-                c[i] += s->copy_mass[k] * s->ch.mesh.X[3 * s->dom_verts[k] + i];
-                mt += i == 0 ? s->copy_mass[k] : 0;
+                c[i] += s->domains.copy_mass[k] * s->rig.ch.mesh.X[3 * s->domains.dom_verts[k] + i];
+                mt += i == 0 ? s->domains.copy_mass[k] : 0;
             }
         for (int i = 0; i < 3; ++i)
             c[i] = mt > 0 ? c[i] / mt : 0;
         for (int32_t k = b; k < e; ++k) {
-            int32_t v = s->dom_verts[k];
-            double m = s->copy_mass[k], x[3];
+            int32_t v = s->domains.dom_verts[k];
+            double m = s->domains.copy_mass[k], x[3];
             for (int i = 0; i < 3; ++i)
-                x[i] = s->ch.mesh.X[3 * v + i] - c[i];
+                x[i] = s->rig.ch.mesh.X[3 * v + i] - c[i];
             for (int a = 0; a < 3; ++a) {
                 double *ft = F + (size_t)(6 * d + a) * n3 + 3 * v,
                        *fr = F + (size_t)(6 * d + 3 + a) * n3 + 3 * v;
@@ -429,20 +340,20 @@ static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
 #define SW_CONTACT_LOADS 12
 #define SW_CONTACT_MODE_TOL 0.05
 static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
-    int64_t n3 = 3 * (int64_t)s->nv;
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
     int32_t T = 0, nl = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        for (int32_t j = 0; j < s->train[i].npose; ++j)
-            T += s->train[i].contact_ptr[j + 1] > s->train[i].contact_ptr[j];
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->poses.train[i].npose; ++j)
+            T += s->poses.train[i].contact_ptr[j + 1] > s->poses.train[i].contact_ptr[j];
     if (T == 0) return SINEW_OK; /* no training pose touches itself */
     double *L = calloc((size_t)T * n3, sizeof(double)), *f = malloc((size_t)n3 * sizeof(double));
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
-           *t = malloc((size_t)s->nv * 3 * sizeof(double)), *P = NULL, *F = NULL, kept;
+    double *R = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->rig.nv * 3 * sizeof(double)), *P = NULL, *F = NULL, kept;
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
     if (!L || !f || !R || !t) goto done;
     int32_t k = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i) {
-        const sw_pose_seq *q = &s->train[i];
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i) {
+        const sw_pose_seq *q = &s->poses.train[i];
         for (int32_t j = 0; j < q->npose; ++j) {
             if (q->contact_ptr[j + 1] == q->contact_ptr[j]) continue;
             const double *x = q->x + (size_t)j * n3;
@@ -450,10 +361,10 @@ static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
             sw_contact_add_forces(q->contacts + q->contact_ptr[j],
                                   q->contact_ptr[j + 1] - q->contact_ptr[j], x, 1.0,
                                   SW_CONTACT_ALPHA, f);
-            sw_bake_skin_transforms(s, q->T + (size_t)j * 12 * s->nb, R, t);
+            sw_bake_skin_transforms(s, q->T + (size_t)j * 12 * s->rig.nb, R, t);
             double *g = L + (size_t)k++ * n3;
-            for (int32_t v = 0; v < s->nv; ++v) {
-                if (s->ch.bone_of_vertex[v] >= 0) continue; /* held by its bone */
+            for (int32_t v = 0; v < s->rig.nv; ++v) {
+                if (s->rig.ch.bone_of_vertex[v] >= 0) continue; /* held by its bone */
                 const double *Rv = R + 9 * v, *fv = f + 3 * v;
                 for (int a = 0; a < 3; ++a)
                     g[3 * v + a] = Rv[a] * fv[0] + Rv[3 + a] * fv[1] + Rv[6 + a] * fv[2];
@@ -486,63 +397,65 @@ done:
 sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sinew_result r = SINEW_OK;
     int32_t T = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        T += s->train[i].npose;
-    int64_t n3 = 3 * (int64_t)s->nv;
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        T += s->poses.train[i].npose;
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
     double *dall = malloc((size_t)T * n3 * sizeof(double));
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
-           *t = malloc((size_t)s->nv * 3 * sizeof(double));
+    double *R = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->rig.nv * 3 * sizeof(double));
     double *dtmp = malloc((size_t)n3 * sizeof(double));
-    s->rank = calloc((size_t)s->nd, sizeof(int32_t));
-    s->basis = calloc((size_t)s->nd, sizeof(double *));
-    out->basis_energy = calloc((size_t)s->nd + 1, sizeof(double));
-    if (!dall || !R || !t || !dtmp || !s->rank || !s->basis || !out->basis_energy) goto oom;
+    s->basis.rank = calloc((size_t)s->domains.nd, sizeof(int32_t));
+    s->basis.U = calloc((size_t)s->domains.nd, sizeof(double *));
+    out->basis_energy = calloc((size_t)s->domains.nd + 1, sizeof(double));
+    if (!dall || !R || !t || !dtmp || !s->basis.rank || !s->basis.U || !out->basis_energy) goto oom;
     int32_t k = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        for (int32_t j = 0; j < s->train[i].npose; ++j, ++k)
-            sw_bake_unskin(s, s->train[i].T + (size_t)j * 12 * s->nb,
-                           s->train[i].x + (size_t)j * n3, R, t, dall + (size_t)k * n3);
-    s->rank_total = 0;
-    for (int32_t dm = 0; dm < s->nd; ++dm) {
-        int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base;
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k)
+            sw_bake_unskin(s, s->poses.train[i].T + (size_t)j * 12 * s->rig.nb,
+                           s->poses.train[i].x + (size_t)j * n3, R, t, dall + (size_t)k * n3);
+    s->basis.rank_total = 0;
+    for (int32_t dm = 0; dm < s->domains.nd; ++dm) {
+        int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base;
         double *D = malloc((size_t)T * 3 * n * sizeof(double));
         if (!D) goto oom;
         for (int32_t a = 0; a < T; ++a)
             for (int32_t j = 0; j < n; ++j)
                 memcpy(D + (size_t)a * 3 * n + 3 * j,
-                       dall + (size_t)a * n3 + 3 * s->dom_verts[base + j], 3 * sizeof(double));
+                       dall + (size_t)a * n3 + 3 * s->domains.dom_verts[base + j],
+                       3 * sizeof(double));
         int32_t free0 = 0; /* the domain's first free vertex (0 when it has none) */
-        while (free0 < n && s->ch.bone_of_vertex[s->dom_verts[base + free0]] >= 0)
+        while (free0 < n && s->rig.ch.bone_of_vertex[s->domains.dom_verts[base + free0]] >= 0)
             free0++;
         double *G = malloc((size_t)T * T * sizeof(double));
         if (G && snapshot_gram(s, dm, D, T, 3 * (int64_t)n, G))
-            s->basis[dm] = domain_pca(D, T, 3 * (int64_t)n, G, s->p->max_rank, s->p->pca_energy,
-                                      free0 < n ? 3 * (int64_t)free0 : 0, &s->rank[dm],
-                                      &out->basis_energy[dm]);
+            s->basis.U[dm] = domain_pca(D, T, 3 * (int64_t)n, G, s->p->max_rank, s->p->pca_energy,
+                                        free0 < n ? 3 * (int64_t)free0 : 0, &s->basis.rank[dm],
+                                        &out->basis_energy[dm]);
         free(G);
         free(D);
-        if (!s->basis[dm]) goto oom;
+        if (!s->basis.U[dm]) goto oom;
     }
     r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
     if (r == SINEW_OK && s->p->inertia_modes) r = add_inertia_modes(s, err);
     if (r != SINEW_OK) goto done;
-    for (int32_t dm = 0; dm < s->nd; ++dm)
-        s->rank_total += s->rank[dm];
+    for (int32_t dm = 0; dm < s->domains.nd; ++dm)
+        s->basis.rank_total += s->basis.rank[dm];
     /* the pose-space warm start: every training pose's feature and projected solution */
-    s->ntrain = T;
-    s->train_q = malloc((size_t)T * s->rank_total * sizeof(double));
-    s->train_pose = malloc((size_t)T * 4 * s->nb * sizeof(double));
-    if (!s->train_q || !s->train_pose) goto oom;
+    s->basis.ntrain = T;
+    s->basis.train_q = malloc((size_t)T * s->basis.rank_total * sizeof(double));
+    s->basis.train_pose = malloc((size_t)T * 4 * s->rig.nb * sizeof(double));
+    if (!s->basis.train_q || !s->basis.train_pose) goto oom;
     k = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        for (int32_t j = 0; j < s->train[i].npose; ++j, ++k)
-            sw_pose_feature(s->train[i].T + (size_t)j * 12 * s->nb, s->ch.skel.parent, s->nb,
-                            s->train_pose + (size_t)k * 4 * s->nb);
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k)
+            sw_pose_feature(s->poses.train[i].T + (size_t)j * 12 * s->rig.nb, s->rig.ch.skel.parent,
+                            s->rig.nb, s->basis.train_pose + (size_t)k * 4 * s->rig.nb);
     for (int32_t a = 0; a < T; ++a) {
         int32_t off = 0;
-        for (int32_t dm = 0; dm < s->nd; ++dm) {
-            project(s, dm, dall + (size_t)a * n3, s->train_q + (size_t)a * s->rank_total + off);
-            off += s->rank[dm];
+        for (int32_t dm = 0; dm < s->domains.nd; ++dm) {
+            project(s, dm, dall + (size_t)a * n3,
+                    s->basis.train_q + (size_t)a * s->basis.rank_total + off);
+            off += s->basis.rank[dm];
         }
     }
     double num = 0, den = 0;
@@ -550,9 +463,9 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         projection_error(s, dall + (size_t)a * n3, &num, &den);
     out->train_proj_error = den > 0 ? sqrt(num / den) : 0;
     num = den = 0;
-    for (int32_t j = 0; j < s->heldout.npose; ++j) {
-        sw_bake_unskin(s, s->heldout.T + (size_t)j * 12 * s->nb, s->heldout.x + (size_t)j * n3, R,
-                       t, dtmp);
+    for (int32_t j = 0; j < s->poses.heldout.npose; ++j) {
+        sw_bake_unskin(s, s->poses.heldout.T + (size_t)j * 12 * s->rig.nb,
+                       s->poses.heldout.x + (size_t)j * n3, R, t, dtmp);
         projection_error(s, dtmp, &num, &den);
     }
     out->heldout_proj_error = den > 0 ? sqrt(num / den) : 0;

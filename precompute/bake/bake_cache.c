@@ -1,3 +1,5 @@
+/* A helper of the simulate stage (bake_simulate.c), below it: the chains of poses it
+ * would solve, read from and stored to the cache folder. */
 /* The simulate stage through its cache (sim_cache.h, sw_bake_params.cache_dir): the key
  * hashes every input of the full-space solves, so a file found under it holds exactly
  * the solutions this bake would compute (the reference's results do not depend on its
@@ -8,7 +10,7 @@
 #include <string.h>
 #include <sys/stat.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "blob_write.h"
 #include "sim_cache.h"
 
@@ -38,18 +40,19 @@ static uint64_t character_key(sw_bake_state *s) {
     uint64_t h = SW_FNV_START;
     const char tag[] = "sinew simulate cache";
     h = sw_fnv1a(h, tag, sizeof tag);
-    int32_t version = SW_SIM_CACHE_VERSION, nv = s->nv, nt = s->ch.mesh.ntets, nb = s->nb;
+    int32_t version = SW_SIM_CACHE_VERSION, nv = s->rig.nv, nt = s->rig.ch.mesh.ntets,
+            nb = s->rig.nb;
     MIX(h, version);
     MIX(h, nv);
     MIX(h, nt);
     MIX(h, nb);
-    h = sw_fnv1a(h, s->ch.mesh.X, (size_t)nv * 3 * sizeof(double));
-    h = sw_fnv1a(h, s->ch.mesh.tets, (size_t)nt * 4 * sizeof(int32_t));
-    h = sw_fnv1a(h, s->ch.bone_of_vertex, (size_t)nv * sizeof(int32_t));
-    h = sw_fnv1a(h, s->ch.weights.w, (size_t)nv * nb * sizeof(double));
-    MIX(h, s->ch.youngs);
-    MIX(h, s->ch.poisson);
-    MIX(h, s->ch.density);
+    h = sw_fnv1a(h, s->rig.ch.mesh.X, (size_t)nv * 3 * sizeof(double));
+    h = sw_fnv1a(h, s->rig.ch.mesh.tets, (size_t)nt * 4 * sizeof(int32_t));
+    h = sw_fnv1a(h, s->rig.ch.bone_of_vertex, (size_t)nv * sizeof(int32_t));
+    h = sw_fnv1a(h, s->rig.ch.weights.w, (size_t)nv * nb * sizeof(double));
+    MIX(h, s->rig.ch.youngs);
+    MIX(h, s->rig.ch.poisson);
+    MIX(h, s->rig.ch.density);
     sw_fullsim_params fp = sw_bake_sim_params(s->p); /* field by field: no padding bytes */
     int32_t ints[] = {(int32_t)fp.integrator, fp.self_contact,    fp.ground,
                       (int32_t)fp.hessian,    (int32_t)fp.solver, fp.contact_rounds,
@@ -72,7 +75,7 @@ static uint64_t chain_key(const sw_bake_state *s, uint64_t character, const chai
         const sw_pose_seq *q = c->seq[i];
         int32_t links[3] = {q->npose, q->then[0] != NULL, q->then[1] != NULL};
         h = sw_fnv1a(h, links, sizeof links);
-        h = sw_fnv1a(h, q->T, (size_t)q->npose * 12 * s->nb * sizeof(double));
+        h = sw_fnv1a(h, q->T, (size_t)q->npose * 12 * s->rig.nb * sizeof(double));
     }
     return h;
 }
@@ -98,7 +101,7 @@ static sinew_result adopt(sw_bake_state *s, const chain *ch, sw_sim_cache *c, sw
     for (int32_t i = 0; i < c->nseq; ++i) {
         sw_pose_seq *q = ch->seq[i];
         sw_sim_cache_seq *e = &c->seq[i];
-        memcpy(q->x, e->x, (size_t)q->npose * 3 * s->nv * sizeof(double));
+        memcpy(q->x, e->x, (size_t)q->npose * 3 * s->rig.nv * sizeof(double));
         memcpy(q->contact_ptr, e->contact_ptr, (size_t)(q->npose + 1) * sizeof(int32_t));
         free(q->contacts);
         q->contacts = e->contacts;
@@ -118,7 +121,7 @@ static sinew_result adopt(sw_bake_state *s, const chain *ch, sw_sim_cache *c, sw
  * has what it needs). */
 static void store(sw_bake_state *s, const chain *ch, uint64_t key, const char *path) {
     sw_sim_cache_seq seq[3];
-    sw_sim_cache c = {key, s->nv, ch->n, seq};
+    sw_sim_cache c = {key, s->rig.nv, ch->n, seq};
     sw_error e;
     uint8_t *b = NULL;
     size_t n = 0;
@@ -145,7 +148,7 @@ static int lookup(sw_bake_state *s, const chain *ch, uint64_t key, const char *p
         npose[i] = ch->seq[i]->npose;
     sw_sim_cache c;
     sw_error e;
-    sinew_result pr = sw_sim_cache_parse(b, n, path, key, s->nv, ch->n, npose, &c, &e);
+    sinew_result pr = sw_sim_cache_parse(b, n, path, key, s->rig.nv, ch->n, npose, &c, &e);
     free(b);
     if (pr != SINEW_OK) {
         if (s->p->progress) fprintf(stderr, "sinew-bake: simulate cache unused: %s\n", e.msg);
@@ -160,7 +163,7 @@ static int lookup(sw_bake_state *s, const chain *ch, uint64_t key, const char *p
  * chain, its key and its file under dir (0: it continues another, or is empty). */
 static int chain_file(sw_bake_state *s, int32_t i, uint64_t character, const char *dir, chain *ch,
                       uint64_t *key, char *path, size_t size) {
-    sw_pose_seq *q = i < s->ntrain_seq ? &s->train[i] : &s->heldout;
+    sw_pose_seq *q = i < s->poses.ntrain_seq ? &s->poses.train[i] : &s->poses.heldout;
     if (q->continues || q->npose == 0) return 0;
     *ch = chain_of(q);
     *key = chain_key(s, character, ch);
@@ -168,10 +171,10 @@ static int chain_file(sw_bake_state *s, int32_t i, uint64_t character, const cha
     return 1;
 }
 
-sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err) {
-    *cached = 0;
+sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err) {
+    *all = 0;
     const char *dir = s->p->cache_dir;
-    if (!dir || !dir[0]) return sw_bake_simulate(s, err);
+    if (!dir || !dir[0]) return SINEW_OK;
     struct stat st;
     if (mkdir(dir, 0755) != 0 && errno != EEXIST)
         return sw_error_set(err, SINEW_ERROR_IO, "cache folder '%s': cannot create it: %s", dir,
@@ -183,17 +186,23 @@ sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *er
     sinew_result r = SINEW_OK;
     char path[4200];
     chain ch;
-    for (int32_t i = 0; i <= s->ntrain_seq && r == SINEW_OK; ++i)
+    for (int32_t i = 0; i <= s->poses.ntrain_seq && r == SINEW_OK; ++i)
         if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path)) {
             nroot++;
             hits += lookup(s, &ch, key, path, &r, err);
         }
-    if (r != SINEW_OK) return r;
-    if ((r = sw_bake_simulate(s, err)) != SINEW_OK) return r; /* the chains not found */
-    for (int32_t i = 0; i <= s->ntrain_seq; ++i)
+    *all = r == SINEW_OK && hits == nroot;
+    return r;
+}
+
+void sw_bake_cache_store(sw_bake_state *s) {
+    const char *dir = s->p->cache_dir;
+    if (!dir || !dir[0]) return;
+    uint64_t character = character_key(s), key;
+    char path[4200];
+    chain ch;
+    for (int32_t i = 0; i <= s->poses.ntrain_seq; ++i)
         if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path) &&
             !ch.seq[0]->from_cache)
             store(s, &ch, key, path);
-    *cached = hits == nroot;
-    return SINEW_OK;
 }

@@ -1,3 +1,5 @@
+/* Stage "cubature" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->poses, s->basis; writes
+ * s->cubature, the result's cubature_error_max and selector_*. */
 /* Material cubature per domain (thesis eqs. 2.11-2.14). Training samples are the
  * reduced coordinates of the training snapshots, q = U^T d, and as many perturbed
  * copies (q + 0.5 * rms(q) * gaussian): at the snapshots themselves the reduced force
@@ -10,7 +12,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "fem_corot.h"
 
 typedef struct {
@@ -29,16 +31,16 @@ typedef struct {
 /* Reduced elastic force of domain tet i for sample s into a (r), unscaled. */
 static void tet_reduced_force(const cub_ctx *c, int64_t i, int32_t smp, double *a) {
     const sw_bake_state *s = c->s;
-    int32_t r = c->r, base = s->dom_vert_ptr[c->dom];
+    int32_t r = c->r, base = s->domains.dom_vert_ptr[c->dom];
     double xe[12], R[4][9], f[12];
     for (int k = 0; k < 4; ++k) {
-        int32_t loc = c->tet_local[4 * i + k], v = s->dom_verts[base + loc];
+        int32_t loc = c->tet_local[4 * i + k], v = s->domains.dom_verts[base + loc];
         double t[3], y[3];
-        sw_dqs_blend(c->dq + (size_t)smp * s->nb, s->skin_bone + 4 * v, s->skin_weight + 4 * v, 4,
-                     R[k], t);
+        sw_dqs_blend(c->dq + (size_t)smp * s->rig.nb, s->rig.skin_bone + 4 * v,
+                     s->rig.skin_weight + 4 * v, 4, R[k], t);
         const double *Uv = c->U + (size_t)3 * loc * r, *q = c->q + (size_t)smp * r;
         for (int d = 0; d < 3; ++d) {
-            double acc = s->ch.mesh.X[3 * v + d];
+            double acc = s->rig.ch.mesh.X[3 * v + d];
             for (int32_t j = 0; j < r; ++j)
                 acc += Uv[d * r + j] * q[j];
             y[d] = acc;
@@ -71,14 +73,16 @@ static void tet_reduced_force(const cub_ctx *c, int64_t i, int32_t smp, double *
  * every mode (soft inertia modes otherwise get a share of the error they cannot bear). */
 static void mode_weights(const cub_ctx *c, int32_t ntd, double *w) {
     const sw_bake_state *s = c->s;
-    int32_t r = c->r, base = s->dom_vert_ptr[c->dom];
+    int32_t r = c->r, base = s->domains.dom_vert_ptr[c->dom];
     for (int32_t j = 0; j < r; ++j)
         w[j] = 0;
     for (int32_t i = 0; i < ntd; ++i) {
         double xe[12], K[144], f[12];
         for (int k = 0; k < 4; ++k)
             memcpy(xe + 3 * k,
-                   s->ch.mesh.X + 3 * (int64_t)s->dom_verts[base + c->tet_local[4 * i + k]], 24);
+                   s->rig.ch.mesh.X +
+                       3 * (int64_t)s->domains.dom_verts[base + c->tet_local[4 * i + k]],
+                   24);
         sw_corot_eval(xe, c->dminv + 9 * i, c->vol[i], c->mu, c->lambda, f, K, 0);
         for (int32_t j = 0; j < r; ++j) {
             double u[12], ku = 0;
@@ -146,21 +150,22 @@ static double gauss(uint64_t *state) {
     return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
 }
 
-/* Trains domain dom's cubature; fills s->cub_n/local/w[dom]. */
+/* Trains domain dom's cubature; fills s->cubature.n/local/w[dom]. */
 static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *dsnap, int32_t T,
                                  const sw_dualquat *pose_dq, sw_bake_result *out, sw_error *err) {
-    int32_t r = s->rank[dom], base = s->dom_vert_ptr[dom], nvd = s->dom_vert_ptr[dom + 1] - base;
-    int32_t t0 = s->dom_tet_ptr[dom], ntd = s->dom_tet_ptr[dom + 1] - t0,
+    int32_t r = s->basis.rank[dom], base = s->domains.dom_vert_ptr[dom],
+            nvd = s->domains.dom_vert_ptr[dom + 1] - base;
+    int32_t t0 = s->domains.dom_tet_ptr[dom], ntd = s->domains.dom_tet_ptr[dom + 1] - t0,
             sets = s->p->inertia_modes ? 3 : 2, ns = sets * T;
-    const double *U = s->basis[dom];
+    const double *U = s->basis.U[dom];
     sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
-    int32_t *local_of = malloc((size_t)s->nv * sizeof(int32_t));
+    int32_t *local_of = malloc((size_t)s->rig.nv * sizeof(int32_t));
     int32_t *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t));
     double *dminv = malloc((size_t)ntd * 9 * sizeof(double)),
            *vol = malloc((size_t)ntd * sizeof(double));
     double *q = calloc((size_t)ns * r, sizeof(double)),
            *inv_norm = malloc((size_t)ns * sizeof(double));
-    sw_dualquat *dq = malloc((size_t)ns * s->nb * sizeof(sw_dualquat));
+    sw_dualquat *dq = malloc((size_t)ns * s->rig.nb * sizeof(sw_dualquat));
     double *b = NULL, *partial = NULL, *mode_w = NULL;
     sw_cubature_result cr;
     memset(&cr, 0, sizeof cr);
@@ -174,16 +179,17 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
             double acc = 0;
             for (int32_t k = 0; k < nvd; ++k)
                 for (int d = 0; d < 3; ++d)
-                    acc += U[(size_t)(3 * k + d) * r + j] *
-                           dsnap[(size_t)a * 3 * s->nv + 3 * s->dom_verts[base + k] + d];
+                    acc +=
+                        U[(size_t)(3 * k + d) * r + j] *
+                        dsnap[(size_t)a * 3 * s->rig.nv + 3 * s->domains.dom_verts[base + k] + d];
             q[(size_t)a * r + j] = acc;
             rms[j] += acc * acc / T;
         }
-        memcpy(dq + (size_t)a * s->nb, pose_dq + (size_t)a * s->nb,
-               (size_t)s->nb * sizeof(sw_dualquat));
+        memcpy(dq + (size_t)a * s->rig.nb, pose_dq + (size_t)a * s->rig.nb,
+               (size_t)s->rig.nb * sizeof(sw_dualquat));
         for (int k = 1; k < sets; ++k)
-            memcpy(dq + (size_t)(k * T + a) * s->nb, pose_dq + (size_t)a * s->nb,
-                   (size_t)s->nb * sizeof(sw_dualquat));
+            memcpy(dq + (size_t)(k * T + a) * s->rig.nb, pose_dq + (size_t)a * s->rig.nb,
+                   (size_t)s->rig.nb * sizeof(sw_dualquat));
     }
     uint64_t seed = s->p->seed ^ (0x9e37ULL * (uint64_t)(dom + 1));
     for (int32_t a = 0; a < T; ++a)
@@ -192,8 +198,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     if (sets == 3) {
         /* inertia modes (bake_basis.c) are barely in the snapshots, so the perturbations
            above hardly move them, and a fit blind to their force leaves them wrongly stiff
-           or soft (finger 3K: training error 0.028 -> 0.21-0.30 with them): a third set
-           perturbs every mode at the largest mode's amplitude (training error 0.062) */
+           or soft: a third set perturbs every mode at the largest mode's amplitude */
         double rmax = 0;
         for (int32_t j = 0; j < r; ++j)
             rmax = fmax(rmax, sqrt(rms[j]));
@@ -205,9 +210,8 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     for (int32_t smp = 0; smp < ns; ++smp)
         inv_norm[smp] = 1.0;
     cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, NULL, 0, 0};
-    sw_lame(s->ch.youngs, s->ch.poisson, &c.mu, &c.lambda);
-    if (s->p->inertia_modes) { /* measured with them only (finger 20K: training error
-                                   0.24 without the weights, 0.059 with) */
+    sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &c.mu, &c.lambda);
+    if (s->p->inertia_modes) { /* the inertia modes' force weighted (mode_weights) */
         if (!(mode_w = malloc((size_t)r * sizeof(double)))) goto done;
         mode_weights(&c, ntd, mode_w);
         c.mode_w = mode_w;
@@ -262,27 +266,27 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
            its flesh all driven or moving rigidly with it): its snapshots carry no force to
            fit. One tet standing for all of them keeps its unit mode's stiffness in the
            reduced system instead of leaving the domain without cubature. */
-        s->cub_n[dom] = 1;
-        s->cub_local[dom] = malloc(sizeof(int32_t));
-        s->cub_w[dom] = malloc(sizeof(double));
-        if (!s->cub_local[dom] || !s->cub_w[dom]) {
+        s->cubature.n[dom] = 1;
+        s->cubature.local[dom] = malloc(sizeof(int32_t));
+        s->cubature.w[dom] = malloc(sizeof(double));
+        if (!s->cubature.local[dom] || !s->cubature.w[dom]) {
             res = SINEW_ERROR_OUT_OF_MEMORY;
             goto done;
         }
-        s->cub_local[dom][0] = 0;
-        s->cub_w[dom][0] = (double)ntd;
+        s->cubature.local[dom][0] = 0;
+        s->cubature.w[dom][0] = (double)ntd;
         goto done;
     }
-    s->cub_n[dom] = cr.n;
-    s->cub_local[dom] = malloc((size_t)cr.n * sizeof(int32_t));
-    s->cub_w[dom] = malloc((size_t)cr.n * sizeof(double));
-    if (!s->cub_local[dom] || !s->cub_w[dom]) {
+    s->cubature.n[dom] = cr.n;
+    s->cubature.local[dom] = malloc((size_t)cr.n * sizeof(int32_t));
+    s->cubature.w[dom] = malloc((size_t)cr.n * sizeof(double));
+    if (!s->cubature.local[dom] || !s->cubature.w[dom]) {
         res = SINEW_ERROR_OUT_OF_MEMORY;
         goto done;
     }
     for (int32_t i = 0; i < cr.n; ++i) {
-        s->cub_local[dom][i] = (int32_t)cr.ids[i];
-        s->cub_w[dom][i] = cr.weights[i];
+        s->cubature.local[dom][i] = (int32_t)cr.ids[i];
+        s->cubature.w[dom][i] = cr.weights[i];
     }
     out->cubature_error_max = fmax(out->cubature_error_max, cr.rel_error);
 done:
@@ -304,44 +308,50 @@ done:
 
 sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     int32_t T = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        T += s->train[i].npose;
-    int64_t n3 = 3 * (int64_t)s->nv;
-    s->cub_n = calloc((size_t)s->nd, sizeof(int32_t));
-    s->cub_local = calloc((size_t)s->nd, sizeof(int32_t *));
-    s->cub_w = calloc((size_t)s->nd, sizeof(double *));
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        T += s->poses.train[i].npose;
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
+    s->cubature.n = calloc((size_t)s->domains.nd, sizeof(int32_t));
+    s->cubature.local = calloc((size_t)s->domains.nd, sizeof(int32_t *));
+    s->cubature.w = calloc((size_t)s->domains.nd, sizeof(double *));
     double *dsnap = malloc((size_t)T * n3 * sizeof(double));
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
-           *t = malloc((size_t)s->nv * 3 * sizeof(double));
-    sw_dualquat *pose_dq = malloc((size_t)T * s->nb * sizeof(sw_dualquat));
+    double *R = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->rig.nv * 3 * sizeof(double));
+    sw_dualquat *pose_dq = malloc((size_t)T * s->rig.nb * sizeof(sw_dualquat));
     sinew_result res = SINEW_OK;
-    if (!s->cub_n || !s->cub_local || !s->cub_w || !dsnap || !R || !t || !pose_dq) {
+    if (!s->cubature.n || !s->cubature.local || !s->cubature.w || !dsnap || !R || !t || !pose_dq) {
         res = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for cubature");
         goto done;
     }
     /* the un-skinned snapshots again (cheap next to the simulations) */
     int32_t k = 0;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        for (int32_t j = 0; j < s->train[i].npose; ++j, ++k) {
-            const double *T12 = s->train[i].T + (size_t)j * 12 * s->nb,
-                         *x = s->train[i].x + (size_t)j * n3;
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k) {
+            const double *T12 = s->poses.train[i].T + (size_t)j * 12 * s->rig.nb,
+                         *x = s->poses.train[i].x + (size_t)j * n3;
             double *d = dsnap + (size_t)k * n3;
             sw_bake_skin_transforms(s, T12, R, t);
-            for (int32_t v = 0; v < s->nv; ++v) {
-                const double *Rv = R + 9 * v, *tv = t + 3 * v, *X = s->ch.mesh.X + 3 * v;
+            for (int32_t v = 0; v < s->rig.nv; ++v) {
+                const double *Rv = R + 9 * v, *tv = t + 3 * v, *X = s->rig.ch.mesh.X + 3 * v;
                 double w[3] = {x[3 * v] - tv[0], x[3 * v + 1] - tv[1], x[3 * v + 2] - tv[2]};
                 for (int a = 0; a < 3; ++a)
                     d[3 * v + a] = Rv[a] * w[0] + Rv[3 + a] * w[1] + Rv[6 + a] * w[2] - X[a];
             }
-            for (int32_t b = 0; b < s->nb; ++b)
-                sw_dq_from_transform(T12 + 12 * b, &pose_dq[(size_t)k * s->nb + b]);
+            for (int32_t b = 0; b < s->rig.nb; ++b)
+                sw_dq_from_transform(T12 + 12 * b, &pose_dq[(size_t)k * s->rig.nb + b]);
         }
     out->cubature_error_max = 0;
-    sw_bake_progress_begin(s, "cubature", s->nd);
-    for (int32_t d = 0; d < s->nd && res == SINEW_OK; ++d) {
+    sw_bake_progress_begin(s, "cubature", s->domains.nd);
+    for (int32_t d = 0; d < s->domains.nd && res == SINEW_OK; ++d) {
         res = train_domain(s, d, dsnap, T, pose_dq, out, err);
         sw_bake_progress(s, 1);
     }
+    for (int32_t d = 0; d < s->domains.nd && res == SINEW_OK; ++d)
+        if (s->cubature.n[d] < 1) /* a blob needs one at least: say why here, not at the write */
+            res = sw_error_set(err, SINEW_ERROR_DEGENERATE,
+                               "domain %d: no cubature tets (rank %d): the training poses do not "
+                               "deform it; give a clip that bends its joint",
+                               d, s->basis.rank[d]);
 done:
     free(dsnap);
     free(R);

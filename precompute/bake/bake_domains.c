@@ -1,3 +1,4 @@
+/* Stage "domains" (bake.c, sw_bake_stages): reads s->rig; writes s->domains. */
 /* Skeletal domains (thesis §2.3, §4.4.1; DESIGN.md §8): a tet goes to the strongest
  * bone of the majority of its vertices; a bone whose tets hold less than fold_share of
  * the mesh's volume passes them to its parent (fold_bones); bones that own no tet get no
@@ -7,13 +8,13 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "fem_corot.h"
 
 static int32_t strongest_bone(const sw_bake_state *s, int32_t v) {
-    const double *w = s->weights + (size_t)v * s->nb;
+    const double *w = s->rig.weights + (size_t)v * s->rig.nb;
     int32_t best = 0;
-    for (int32_t b = 1; b < s->nb; ++b)
+    for (int32_t b = 1; b < s->rig.nb; ++b)
         if (w[b] > w[best]) best = b;
     return best;
 }
@@ -36,8 +37,8 @@ static int32_t tet_bone(const sw_bake_state *s, const int32_t *tet) {
         }
         double wk = 0, wb = 0;
         for (int j = 0; j < 4; ++j) {
-            wk += s->weights[(size_t)tet[j] * s->nb + bones[k]];
-            wb += s->weights[(size_t)tet[j] * s->nb + bones[best]];
+            wk += s->rig.weights[(size_t)tet[j] * s->rig.nb + bones[k]];
+            wb += s->rig.weights[(size_t)tet[j] * s->rig.nb + bones[best]];
         }
         if (wk > wb || (wk == wb && bones[k] < bones[best])) best = k;
     }
@@ -49,16 +50,12 @@ static int32_t tet_bone(const sw_bake_state *s, const int32_t *tet) {
  * with enough of its own and theirs: bone_of_tet maps bones to bones in place. A domain
  * costs a block of the reduced Hessian, its springs to its neighbours and a cubature of
  * its own however little it holds, and its rank is bounded by its shapes, not its size.
- * Measured on the elephant (24 bones, 1,502 tets): at 3% of the volume 24 -> 11 domains,
- * rank 483 -> 296, instance 5.9 -> 2.4 MB, cost_vs_dqs 234 -> 195, bake errors train /
- * held-out 0.0196 / 0.0886 -> 0.0196 / 0.0900 (by tet count instead of volume: 5% gave 8
- * domains and 0.102, 8% gave 5 and 0.110); the hand 20 -> 10 domains, rank 229 -> 155,
- * 0.0193 / 0.0448 -> 0.0182 / 0.0451, its cost unchanged (at 1.5%: 15 domains, 0.0450; at
- * 2%: 11, 0.0455). Off by default: it never lowered a held-out error, and with few training
- * poses it costs accuracy (test_reduced_heldout.c). Returns 0 when out of memory. */
+ * Folding by volume, not by tet count, keeps the errors (docs/notes). Off by default: it never
+ * lowered a held-out error, and with few training poses it costs accuracy (test_reduced_heldout.c).
+ * Returns 0 when out of memory. */
 static int fold_bones(const sw_bake_state *s, int32_t *bone_of_tet) {
-    const sw_skeleton *sk = &s->ch.skel;
-    int32_t nb = s->nb, maxdepth = 0;
+    const sw_skeleton *sk = &s->rig.ch.skel;
+    int32_t nb = s->rig.nb, maxdepth = 0;
     double *vol = calloc((size_t)nb, sizeof(double)), total = 0;
     int32_t *depth = malloc((size_t)nb * sizeof(int32_t)),
             *to = malloc((size_t)nb * sizeof(int32_t));
@@ -66,10 +63,10 @@ static int fold_bones(const sw_bake_state *s, int32_t *bone_of_tet) {
         free(vol), free(depth), free(to);
         return 0;
     }
-    for (int32_t t = 0; t < s->nt; ++t) {
+    for (int32_t t = 0; t < s->rig.nt; ++t) {
         double Xe[12], Dm[9], v = 0;
         for (int k = 0; k < 4; ++k)
-            memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)s->ch.mesh.tets[4 * t + k], 24);
+            memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)s->rig.ch.mesh.tets[4 * t + k], 24);
         if (!sw_tet_rest(Xe, Dm, &v)) v = 0; /* a flat tet holds no flesh */
         vol[bone_of_tet[t]] += v;
         total += v;
@@ -88,77 +85,78 @@ static int fold_bones(const sw_bake_state *s, int32_t *bone_of_tet) {
             for (int32_t c = 0; c < nb; ++c) /* b and what folded into it before */
                 if (to[c] == b) to[c] = p;
         }
-    for (int32_t t = 0; t < s->nt; ++t)
+    for (int32_t t = 0; t < s->rig.nt; ++t)
         bone_of_tet[t] = to[bone_of_tet[t]];
     free(vol), free(depth), free(to);
     return 1;
 }
 
-sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
-    const int32_t *tets = s->ch.mesh.tets;
-    int32_t *domain_of_bone = malloc((size_t)s->nb * sizeof(int32_t));
-    int32_t *mark = malloc((size_t)s->nv * sizeof(int32_t));
-    s->tet_domain = malloc((size_t)s->nt * sizeof(int32_t));
-    s->domain_bone = malloc((size_t)s->nb * sizeof(int32_t));
-    s->dom_tet_ptr = calloc((size_t)s->nb + 1, sizeof(int32_t));
-    s->dom_tets = malloc((size_t)s->nt * sizeof(int32_t));
-    s->dom_vert_ptr = calloc((size_t)s->nb + 1, sizeof(int32_t));
-    if (!domain_of_bone || !mark || !s->tet_domain || !s->domain_bone || !s->dom_tet_ptr ||
-        !s->dom_tets || !s->dom_vert_ptr) {
+sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    (void)out;
+    const int32_t *tets = s->rig.ch.mesh.tets;
+    int32_t *domain_of_bone = malloc((size_t)s->rig.nb * sizeof(int32_t));
+    int32_t *mark = malloc((size_t)s->rig.nv * sizeof(int32_t));
+    s->domains.tet_domain = malloc((size_t)s->rig.nt * sizeof(int32_t));
+    s->domains.domain_bone = malloc((size_t)s->rig.nb * sizeof(int32_t));
+    s->domains.dom_tet_ptr = calloc((size_t)s->rig.nb + 1, sizeof(int32_t));
+    s->domains.dom_tets = malloc((size_t)s->rig.nt * sizeof(int32_t));
+    s->domains.dom_vert_ptr = calloc((size_t)s->rig.nb + 1, sizeof(int32_t));
+    if (!domain_of_bone || !mark || !s->domains.tet_domain || !s->domains.domain_bone ||
+        !s->domains.dom_tet_ptr || !s->domains.dom_tets || !s->domains.dom_vert_ptr) {
         free(domain_of_bone);
         free(mark);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
     }
-    for (int32_t b = 0; b < s->nb; ++b)
+    for (int32_t b = 0; b < s->rig.nb; ++b)
         domain_of_bone[b] = -1;
-    for (int32_t t = 0; t < s->nt; ++t)
-        s->tet_domain[t] = tet_bone(s, tets + 4 * t);
-    if (s->p->fold_share > 0 && !fold_bones(s, s->tet_domain)) {
+    for (int32_t t = 0; t < s->rig.nt; ++t)
+        s->domains.tet_domain[t] = tet_bone(s, tets + 4 * t);
+    if (s->p->fold_share > 0 && !fold_bones(s, s->domains.tet_domain)) {
         free(domain_of_bone);
         free(mark);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
     }
     /* domains in bone order, only for bones that own tets */
-    for (int32_t t = 0; t < s->nt; ++t)
-        domain_of_bone[s->tet_domain[t]] = 1;
-    s->nd = 0;
-    for (int32_t b = 0; b < s->nb; ++b)
+    for (int32_t t = 0; t < s->rig.nt; ++t)
+        domain_of_bone[s->domains.tet_domain[t]] = 1;
+    s->domains.nd = 0;
+    for (int32_t b = 0; b < s->rig.nb; ++b)
         if (domain_of_bone[b] > 0) {
-            s->domain_bone[s->nd] = b;
-            domain_of_bone[b] = s->nd++;
+            s->domains.domain_bone[s->domains.nd] = b;
+            domain_of_bone[b] = s->domains.nd++;
         }
-    for (int32_t t = 0; t < s->nt; ++t) {
-        s->tet_domain[t] = domain_of_bone[s->tet_domain[t]];
-        s->dom_tet_ptr[s->tet_domain[t] + 1]++;
+    for (int32_t t = 0; t < s->rig.nt; ++t) {
+        s->domains.tet_domain[t] = domain_of_bone[s->domains.tet_domain[t]];
+        s->domains.dom_tet_ptr[s->domains.tet_domain[t] + 1]++;
     }
-    for (int32_t d = 0; d < s->nd; ++d)
-        s->dom_tet_ptr[d + 1] += s->dom_tet_ptr[d];
+    for (int32_t d = 0; d < s->domains.nd; ++d)
+        s->domains.dom_tet_ptr[d + 1] += s->domains.dom_tet_ptr[d];
     {
-        int32_t *fill = malloc((size_t)s->nd * sizeof(int32_t));
+        int32_t *fill = malloc((size_t)s->domains.nd * sizeof(int32_t));
         if (!fill) {
             free(domain_of_bone);
             free(mark);
             return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
         }
-        memcpy(fill, s->dom_tet_ptr, (size_t)s->nd * sizeof(int32_t));
-        for (int32_t t = 0; t < s->nt; ++t)
-            s->dom_tets[fill[s->tet_domain[t]]++] = t;
+        memcpy(fill, s->domains.dom_tet_ptr, (size_t)s->domains.nd * sizeof(int32_t));
+        for (int32_t t = 0; t < s->rig.nt; ++t)
+            s->domains.dom_tets[fill[s->domains.tet_domain[t]]++] = t;
         free(fill);
     }
     /* vertex copies: two passes (count, fill), vertices ascending per domain */
     int64_t ncopies = 0;
     for (int pass = 0; pass < 2; ++pass) {
         ncopies = 0;
-        for (int32_t d = 0; d < s->nd; ++d) {
-            for (int32_t v = 0; v < s->nv; ++v)
+        for (int32_t d = 0; d < s->domains.nd; ++d) {
+            for (int32_t v = 0; v < s->rig.nv; ++v)
                 mark[v] = 0;
-            for (int32_t i = s->dom_tet_ptr[d]; i < s->dom_tet_ptr[d + 1]; ++i)
+            for (int32_t i = s->domains.dom_tet_ptr[d]; i < s->domains.dom_tet_ptr[d + 1]; ++i)
                 for (int k = 0; k < 4; ++k)
-                    mark[tets[4 * s->dom_tets[i] + k]] = 1;
-            if (pass == 1) s->dom_vert_ptr[d] = (int32_t)ncopies;
-            for (int32_t v = 0; v < s->nv; ++v)
+                    mark[tets[4 * s->domains.dom_tets[i] + k]] = 1;
+            if (pass == 1) s->domains.dom_vert_ptr[d] = (int32_t)ncopies;
+            for (int32_t v = 0; v < s->rig.nv; ++v)
                 if (mark[v]) {
-                    if (pass == 1) s->dom_verts[ncopies] = v;
+                    if (pass == 1) s->domains.dom_verts[ncopies] = v;
                     ncopies++;
                 }
         }
@@ -168,51 +166,32 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err) {
                 free(mark);
                 return sw_error_set(err, SINEW_ERROR_UNSUPPORTED, "too many vertex copies");
             }
-            s->dom_verts = malloc((size_t)ncopies * sizeof(int32_t));
-            s->copy_mass = calloc((size_t)ncopies, sizeof(double));
-            if (!s->dom_verts || !s->copy_mass) {
+            s->domains.dom_verts = malloc((size_t)ncopies * sizeof(int32_t));
+            s->domains.copy_mass = calloc((size_t)ncopies, sizeof(double));
+            if (!s->domains.dom_verts || !s->domains.copy_mass) {
                 free(domain_of_bone);
                 free(mark);
                 return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for copies");
             }
         }
     }
-    s->dom_vert_ptr[s->nd] = (int32_t)ncopies;
+    s->domains.dom_vert_ptr[s->domains.nd] = (int32_t)ncopies;
     /* copy masses: lumped mass of each copy from its own domain's tets */
-    for (int32_t d = 0; d < s->nd; ++d) {
-        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base;
+    for (int32_t d = 0; d < s->domains.nd; ++d) {
+        int32_t base = s->domains.dom_vert_ptr[d], n = s->domains.dom_vert_ptr[d + 1] - base;
         for (int32_t k = 0; k < n; ++k)
-            mark[s->dom_verts[base + k]] = base + k;
-        for (int32_t i = s->dom_tet_ptr[d]; i < s->dom_tet_ptr[d + 1]; ++i) {
-            const int32_t *q = tets + 4 * s->dom_tets[i];
+            mark[s->domains.dom_verts[base + k]] = base + k;
+        for (int32_t i = s->domains.dom_tet_ptr[d]; i < s->domains.dom_tet_ptr[d + 1]; ++i) {
+            const int32_t *q = tets + 4 * s->domains.dom_tets[i];
             double Xe[12], Dm[9], vol;
             for (int k = 0; k < 4; ++k)
-                memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)q[k], 24);
+                memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)q[k], 24);
             sw_tet_rest(Xe, Dm, &vol);
             for (int k = 0; k < 4; ++k)
-                s->copy_mass[mark[q[k]]] += s->ch.density * vol / 4.0;
+                s->domains.copy_mass[mark[q[k]]] += s->rig.ch.density * vol / 4.0;
         }
     }
     free(domain_of_bone);
     free(mark);
     return SINEW_OK;
-}
-
-void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
-                         double *dminv, double *vol) {
-    int32_t base = s->dom_vert_ptr[dm], t0 = s->dom_tet_ptr[dm], ntd = s->dom_tet_ptr[dm + 1] - t0;
-    for (int32_t k = base; k < s->dom_vert_ptr[dm + 1]; ++k)
-        local_of[s->dom_verts[k]] = k - base;
-    for (int32_t i = 0; i < ntd; ++i) {
-        const int32_t *tet = s->ch.mesh.tets + 4 * (int64_t)s->dom_tets[t0 + i];
-        double Xe[12];
-        for (int k = 0; k < 4; ++k) {
-            tet_local[4 * i + k] = local_of[tet[k]];
-            memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)tet[k], 24);
-        }
-        if (!sw_tet_rest(Xe, dminv + 9 * i, vol + i)) { /* a degenerate tet weighs nothing */
-            memset(dminv + 9 * i, 0, 9 * sizeof(double));
-            vol[i] = 0;
-        }
-    }
 }

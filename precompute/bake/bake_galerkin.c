@@ -1,5 +1,6 @@
-/* The Galerkin errors (issue 16, item 4: why the runtime misses more than the basis's
- * projection). The step finds the reduced energy's minimum; for the linearised model,
+/* The galerkin stage: reads rig, domains, poses, basis and the view with its springs;
+ * writes the result's *_galerkin_error. Why the runtime misses more than the basis's
+ * projection: The step finds the reduced energy's minimum; for the linearised model,
  * rest stiffness K in the skinned frames and the interface springs S at the blob's
  * stiffness k, that minimum for a reference displacement d is
  *   (blockdiag(U_d^T K_d U_d) + k S) q = (U_d^T K_d d_d)_d,
@@ -8,22 +9,23 @@
  * projection error is (each domain's copies against the snapshot, relative), shows how
  * much of the runtime's error the span and the springs already decide, before the
  * cubature, the contact and the nonlinearity: the Fox's Run 0.266 against a projection of
- * 0.185 and a runtime error of 0.283 (docs/generalisation.md, The Galerkin projection). */
+ * 0.185 and a runtime error of 0.283 (docs/notes/generalisation.md, The Galerkin projection). */
 #include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 
 /* The un-skinned snapshots of n poses (T: 12 nb each, x: 3 nv each) into D (n x 3 nv). */
 static int unskin_all(const sw_bake_state *s, const double *T, const double *x, int32_t n,
                       double *D) {
-    int64_t n3 = 3 * (int64_t)s->nv;
-    double *R = malloc((size_t)s->nv * 9 * sizeof(double)),
-           *t = malloc((size_t)s->nv * 3 * sizeof(double));
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
+    double *R = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->rig.nv * 3 * sizeof(double));
     for (int32_t j = 0; R && t && j < n; ++j)
-        sw_bake_unskin(s, T + (size_t)j * 12 * s->nb, x + (size_t)j * n3, R, t, D + (size_t)j * n3);
+        sw_bake_unskin(s, T + (size_t)j * 12 * s->rig.nb, x + (size_t)j * n3, R, t,
+                       D + (size_t)j * n3);
     int ok = R && t;
     free(R);
     free(t);
@@ -31,25 +33,28 @@ static int unskin_all(const sw_bake_state *s, const double *T, const double *x, 
 }
 
 sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    int32_t Rt = s->rank_total, nt = 0, P;
-    for (int32_t i = 0; i < s->ntrain_seq; ++i)
-        nt += s->train[i].npose;
-    P = nt + s->heldout.npose;
-    int64_t n3 = 3 * (int64_t)s->nv;
+    int32_t Rt = s->basis.rank_total, nt = 0, P;
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        nt += s->poses.train[i].npose;
+    P = nt + s->poses.heldout.npose;
+    int64_t n3 = 3 * (int64_t)s->rig.nv;
     double *D = malloc((size_t)P * n3 * sizeof(double) + 1),
            *H = malloc((size_t)Rt * Rt * sizeof(double)),
            *Bq = calloc((size_t)Rt * P + 1, sizeof(double));
     double *Dd = NULL, *Ut = NULL, *G = NULL;
     double num[2] = {0, 0}, den[2] = {0, 0};
     int ok = D && H && Bq;
-    for (int32_t i = 0, at = 0; ok && i < s->ntrain_seq; at += s->train[i].npose, ++i)
-        ok = unskin_all(s, s->train[i].T, s->train[i].x, s->train[i].npose, D + (size_t)at * n3);
-    ok = ok && unskin_all(s, s->heldout.T, s->heldout.x, s->heldout.npose, D + (size_t)nt * n3);
+    for (int32_t i = 0, at = 0; ok && i < s->poses.ntrain_seq; at += s->poses.train[i].npose, ++i)
+        ok = unskin_all(s, s->poses.train[i].T, s->poses.train[i].x, s->poses.train[i].npose,
+                        D + (size_t)at * n3);
+    ok = ok && unskin_all(s, s->poses.heldout.T, s->poses.heldout.x, s->poses.heldout.npose,
+                          D + (size_t)nt * n3);
     for (int64_t i = 0; ok && i < (int64_t)Rt * Rt; ++i)
-        H[i] = out->spring_k * s->spring_unit[i];
+        H[i] = out->spring_k * s->reduce.spring_unit[i];
     /* per domain: U^T K U into H's diagonal block, U^T K d of every pose into Bq */
-    for (int32_t dm = 0, off = 0; ok && dm < s->nd; off += s->rank[dm], ++dm) {
-        int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base, r = s->rank[dm];
+    for (int32_t dm = 0, off = 0; ok && dm < s->domains.nd; off += s->basis.rank[dm], ++dm) {
+        int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base,
+                r = s->basis.rank[dm];
         int64_t m = 3 * (int64_t)n;
         free(Dd);
         free(Ut);
@@ -60,11 +65,11 @@ sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *e
         if (!(ok = Dd && Ut && G)) break;
         for (int32_t a = 0; a < P; ++a)
             for (int32_t j = 0; j < n; ++j)
-                memcpy(Dd + (size_t)a * m + 3 * j, D + (size_t)a * n3 + 3 * s->dom_verts[base + j],
-                       3 * sizeof(double));
+                memcpy(Dd + (size_t)a * m + 3 * j,
+                       D + (size_t)a * n3 + 3 * s->domains.dom_verts[base + j], 3 * sizeof(double));
         for (int32_t c = 0; c < r; ++c)
             for (int64_t i = 0; i < m; ++i)
-                Ut[(size_t)c * m + i] = s->basis[dm][i * r + c];
+                Ut[(size_t)c * m + i] = s->basis.U[dm][i * r + c];
         if (!(ok = sw_bake_strain_products(s, dm, Ut, r, NULL, 0, G))) break;
         double tr = 0;
         for (int32_t a = 0; a < r; ++a)
@@ -83,13 +88,14 @@ sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *e
         goto done;
     }
     /* the errors, as the projection's: each domain's copies against the snapshot */
-    for (int32_t dm = 0, off = 0; ok && dm < s->nd; off += s->rank[dm], ++dm) {
-        int32_t base = s->dom_vert_ptr[dm], n = s->dom_vert_ptr[dm + 1] - base, r = s->rank[dm];
-        const double *U = s->basis[dm];
+    for (int32_t dm = 0, off = 0; ok && dm < s->domains.nd; off += s->basis.rank[dm], ++dm) {
+        int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base,
+                r = s->basis.rank[dm];
+        const double *U = s->basis.U[dm];
         for (int32_t a = 0; a < P; ++a)
             for (int32_t j = 0; j < n; ++j)
                 for (int i = 0; i < 3; ++i) {
-                    double p = 0, dv = D[(size_t)a * n3 + 3 * s->dom_verts[base + j] + i];
+                    double p = 0, dv = D[(size_t)a * n3 + 3 * s->domains.dom_verts[base + j] + i];
                     for (int32_t c = 0; c < r; ++c)
                         p += U[(size_t)(3 * j + i) * r + c] * Bq[(size_t)(off + c) * P + a];
                     num[a >= nt] += (dv - p) * (dv - p);

@@ -1,3 +1,5 @@
+/* Stage "pairs" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->basis, s->poses, the view;
+ * writes the view's per-pair contact sections. */
 /* Pose-space self-contact per pair of domains (thesis §3.2.3, DESIGN.md §4.4 and §8): the
  * training poses' contacts grouped by the ordered pair of domains (a, b) holding the
  * contact's vertex and its triangle, a pose feature per group, and a cubature of each
@@ -25,7 +27,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "cubature_train.h"
 #include "penalty.h"
 
@@ -37,17 +39,17 @@ static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
 /* Training pose k (in stored order): its sequence, and k's index in it. */
 static const sw_pose_seq *train_seq(const sw_bake_state *s, int32_t k, int32_t *j) {
     int32_t i = 0;
-    while (k >= s->train[i].npose)
-        k -= s->train[i++].npose;
+    while (k >= s->poses.train[i].npose)
+        k -= s->poses.train[i++].npose;
     *j = k;
-    return &s->train[i];
+    return &s->poses.train[i];
 }
 
 /* The bone transforms of training pose k. */
 static const double *train_T(const sw_bake_state *s, int32_t k) {
     int32_t j;
     const sw_pose_seq *q = train_seq(s, k, &j);
-    return q->T + (size_t)j * 12 * s->nb;
+    return q->T + (size_t)j * 12 * s->rig.nb;
 }
 
 /* u = G^1/2 z: a relative transform in the coordinates where the surface's mean squared
@@ -110,9 +112,9 @@ static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map
     double G[144] = {0}, S[144] = {0}, ev[12], H[144], Gh[144];
     memset(map, 0, 72 * sizeof(double));
     if (a == b) return 1;
-    const int32_t n = s->dom_vert_ptr[b + 1] - s->dom_vert_ptr[b];
-    for (int32_t k = s->dom_vert_ptr[b]; k < s->dom_vert_ptr[b + 1]; ++k) {
-        const double *X = s->ch.mesh.X + 3 * (size_t)s->dom_verts[k];
+    const int32_t n = s->domains.dom_vert_ptr[b + 1] - s->domains.dom_vert_ptr[b];
+    for (int32_t k = s->domains.dom_vert_ptr[b]; k < s->domains.dom_vert_ptr[b + 1]; ++k) {
+        const double *X = s->rig.ch.mesh.X + 3 * (size_t)s->domains.dom_verts[k];
         for (int r = 0; r < 3; ++r) /* y_r = sum_c R_rc X_c + t_r, per coordinate r */
             for (int c = 0; c < 3; ++c) {
                 for (int e = 0; e < 3; ++e)
@@ -134,9 +136,9 @@ static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map
                 acc += H[i * 12 + k] * sqrt(fmax(ev[k], 0)) * H[j * 12 + k];
             Gh[i * 12 + j] = acc;
         }
-    for (int32_t t = 0; t < s->ntrain; ++t) { /* S = G^1/2 (sum z z^T) G^1/2 */
+    for (int32_t t = 0; t < s->basis.ntrain; ++t) { /* S = G^1/2 (sum z z^T) G^1/2 */
         double z[12], u[12];
-        relative_z(train_T(s, t), s->domain_bone[a], s->domain_bone[b], z);
+        relative_z(train_T(s, t), s->domains.domain_bone[a], s->domains.domain_bone[b], z);
         whiten(Gh, z, u);
         for (int i = 0; i < 12; ++i)
             for (int j = 0; j < 12; ++j)
@@ -170,21 +172,22 @@ static int pair_force(const sw_bake_state *s, const sw_blob_view *v, int32_t c, 
     int32_t gv[4];
     double d[3] = {0, 0, 0}, n[3], Nd[3];
     for (int m = 0; m < 4; ++m) {
-        gv[m] = s->dom_verts[s->dom_vert_ptr[cv[2 * m]] + cv[2 * m + 1]];
+        gv[m] = s->domains.dom_verts[s->domains.dom_vert_ptr[cv[2 * m]] + cv[2 * m + 1]];
         for (int i = 0; i < 3; ++i)
             d[i] += coef[m] * x[3 * (size_t)gv[m] + i];
     }
     const double *Rp = R + 9 * (size_t)gv[0];
     for (int i = 0; i < 3; ++i)
         n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
-    memset(f, 0, (size_t)s->rank_total * sizeof(double));
+    memset(f, 0, (size_t)s->basis.rank_total * sizeof(double));
     if (!(sw_penalty_gap(n, d) > 0)) return 0;
     sw_penalty_apply_N(n, SW_CONTACT_ALPHA, d, Nd);
     for (int i = 0; i < 3; ++i)
         Nd[i] *= cd[6];
     for (int m = 0; m < 4; ++m) { /* f += coef_m (R_m U_m)^T (ka N d) */
-        const int32_t dm = cv[2 * m], r = s->rank[dm];
-        const double *Rm = R + 9 * (size_t)gv[m], *U = s->basis[dm] + 3 * (size_t)cv[2 * m + 1] * r;
+        const int32_t dm = cv[2 * m], r = s->basis.rank[dm];
+        const double *Rm = R + 9 * (size_t)gv[m],
+                     *U = s->basis.U[dm] + 3 * (size_t)cv[2 * m + 1] * r;
         double w[3]; /* R_m^T ka N d */
         for (int i = 0; i < 3; ++i)
             w[i] = coef[m] * (Rm[i] * Nd[0] + Rm[3 + i] * Nd[1] + Rm[6 + i] * Nd[2]);
@@ -261,7 +264,8 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t));
     int32_t *cv2 = malloc((size_t)v->ncontacts * 8 * sizeof(int32_t));
     double *cd2 = malloc((size_t)v->ncontacts * 7 * sizeof(double)), *A = NULL;
-    double *Rv = malloc((size_t)s->nv * 9 * sizeof(double)), *tv = malloc((size_t)s->nv * 24);
+    double *Rv = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *tv = malloc((size_t)s->rig.nv * 24);
     double *map, *feat, *wt;
     int32_t *ptr, *pd;
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
@@ -283,8 +287,8 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         }
         for (int32_t t = 0; t < T; ++t) {
             double z[12];
-            relative_z(train_T(s, t), s->domain_bone[dom[2 * g]], s->domain_bone[dom[2 * g + 1]],
-                       z);
+            relative_z(train_T(s, t), s->domains.domain_bone[dom[2 * g]],
+                       s->domains.domain_bone[dom[2 * g + 1]], z);
             for (int k = 0; k < 6; ++k)
                 feat[6 * ((size_t)g * T + t) + k] = sw_dot(map + 72 * (size_t)g + 12 * k, z, 12);
         }
@@ -317,7 +321,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     for (int32_t t = 0; t < T; ++t) {
         if (v->contact_ptr[t + 1] == v->contact_ptr[t]) continue;
         int32_t j;
-        const double *x = train_seq(s, t, &j)->x + (size_t)j * 3 * s->nv; /* the reference's */
+        const double *x = train_seq(s, t, &j)->x + (size_t)j * 3 * s->rig.nv; /* the reference's */
         sw_bake_skin_transforms(s, train_T(s, t), Rv, tv);
         for (int32_t g = 0; g < G; ++g) {
             int32_t c0 = ptr[(size_t)t * G + g], n = ptr[(size_t)t * G + g + 1] - c0;

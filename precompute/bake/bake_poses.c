@@ -1,4 +1,6 @@
-/* Training and held-out poses, and their full-space solutions (DESIGN.md §5).
+/* Stage "poses" (bake.c, sw_bake_stages): reads s->rig, s->domains and the clips; writes s->poses
+ * (the pose sequences the simulate stage solves, bake_simulate.c). */
+/* Training and held-out poses (DESIGN.md §5).
  * Training: the first (1 - heldout) frames of the clip (evenly subsampled), or with
  * training clips of their own (sw_bake_params.train_clips: a glTF file's clips) each of
  * them as its own path from rest, with
@@ -12,15 +14,12 @@
  * Held-out: the clip's remaining frames, or the held-out clips one after the other on
  * one path from rest, never used to build the basis or cubature; without a clip, random combined
  * poses with a fixed seed, each reached from the one before in heldout_steps poses. Each sequence
- * is solved in order (every solve warm-starts the next); sequences run in parallel, one thread
- * each. */
+ * is solved in order, every solve warm-starting the next (bake_simulate.c). */
 #include <math.h>
-#include <stdatomic.h>
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
-#include "fullsim.h"
+#include "bake_state.h"
 #include "mat3.h"
 #include "pose_space.h"
 #include "vec3.h"
@@ -113,7 +112,7 @@ static void fill_from_range(sw_pose_seq *q, int32_t at, const clip_range *r, int
 static int32_t clip_ranges(const sw_bake_state *s, clip_range *train, clip_range *held,
                            int32_t *nheld) {
     const sw_bake_params *p = s->p;
-    int32_t nb = s->nb, ntr = 0;
+    int32_t nb = s->rig.nb, ntr = 0;
     *nheld = 0;
     if (p->ntrain_clips > 0) {
         for (int32_t i = 0; i < p->ntrain_clips; ++i)
@@ -125,7 +124,7 @@ static int32_t clip_ranges(const sw_bake_state *s, clip_range *train, clip_range
                     (clip_range){&p->heldout_clips[i], 0, p->heldout_clips[i].nframes, i};
         return ntr;
     }
-    const sw_clip *clip = &s->ch.clip;
+    const sw_clip *clip = &s->rig.ch.clip;
     int32_t nf = clip->T && clip->nbones == nb ? clip->nframes : 0;
     int32_t ntf = nf >= 2 ? (int32_t)floor(nf * (1.0 - p->heldout_fraction)) : 0;
     if (nf >= 2 && ntf < 1) ntf = 1;
@@ -190,18 +189,19 @@ int32_t sw_bake_pose_beyond(const sw_skeleton *sk, const double *T, const double
  * degrees about an axis across the bone. A bare skeleton says nothing of its joints'
  * limits: the 90 degrees bend a hand's metacarpals into the palm independently, which
  * no hand does, and 70% of the bare hand's held-out error was there; the hand's own
- * pose as its range took it from 0.369 to 0.100 (docs/generalisation.md, "Joint
+ * pose as its range took it from 0.369 to 0.100 (docs/notes/generalisation.md, "Joint
  * ranges"). */
 static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32_t ntr,
                           double *sweep_axis, double *sweep_angle) {
-    const sw_skeleton *sk = &s->ch.skel;
-    int32_t nb = s->nb;
+    const sw_skeleton *sk = &s->rig.ch.skel;
+    int32_t nb = s->rig.nb;
     for (int32_t r = 0; r < ntr; ++r)
         sw_bake_joint_reach(sk, train[r].clip->T + (size_t)train[r].first * 12 * nb, train[r].count,
                             sweep_angle, sweep_axis);
     if (ntr > 0) return;
-    if (s->ch.range.nframes > 0) {
-        sw_bake_joint_reach(sk, s->ch.range.T, s->ch.range.nframes, sweep_angle, sweep_axis);
+    if (s->rig.ch.range.nframes > 0) {
+        sw_bake_joint_reach(sk, s->rig.ch.range.T, s->rig.ch.range.nframes, sweep_angle,
+                            sweep_axis);
         return;
     }
     for (int32_t b = 0; b < nb; ++b) {
@@ -225,23 +225,23 @@ static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32
  * combined poses with a fixed seed. Returns 0 when out of memory. */
 static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld,
                          const double *sweep_axis, const double *sweep_angle, double *local) {
-    int32_t nb = s->nb, cap = s->p->max_train_frames, n = 0;
+    int32_t nb = s->rig.nb, cap = s->p->max_train_frames, n = 0;
     for (int32_t r = 0; r < nheld; ++r)
         n += held[r].count < cap ? held[r].count : cap;
     if (n > 0) {
-        if (!seq_alloc(&s->heldout, n, nb, s->nv)) return 0;
+        if (!seq_alloc(&s->poses.heldout, n, nb, s->rig.nv)) return 0;
         for (int32_t r = 0, at = 0; r < nheld; ++r) {
             int32_t k = held[r].count < cap ? held[r].count : cap;
-            fill_from_range(&s->heldout, at, &held[r], k, nb);
+            fill_from_range(&s->poses.heldout, at, &held[r], k, nb);
             at += k;
         }
         /* the reference is path dependent (contact states, buckled folds): the held-out
            part of the character's clip is solved along the clip's path, after its
            training frames, as a host playing the clip sees it; held-out clips of their
            own start from rest */
-        if (s->p->ntrain_clips == 0 && s->ntrain_seq > 0 && s->train[0].clip[0] == 0) {
-            s->train[0].then[0] = &s->heldout;
-            s->heldout.continues = 1;
+        if (s->p->ntrain_clips == 0 && s->poses.ntrain_seq > 0 && s->poses.train[0].clip[0] == 0) {
+            s->poses.train[0].then[0] = &s->poses.heldout;
+            s->poses.heldout.continues = 1;
         }
         return 1;
     }
@@ -250,9 +250,9 @@ static int heldout_poses(sw_bake_state *s, const clip_range *held, int32_t nheld
        jump of up to 90 degrees a joint left the reference's contact on another branch
        (0.24 of the bare hand's correction from the same pose reached gradually) */
     n = s->p->random_poses * s->p->heldout_steps;
-    if (!seq_alloc(&s->heldout, n, nb, s->nv)) return 0;
-    sw_bake_random_poses(&s->ch.skel, sweep_axis, sweep_angle, s->p->seed, s->p->random_poses,
-                         s->p->heldout_steps, local, s->heldout.T);
+    if (!seq_alloc(&s->poses.heldout, n, nb, s->rig.nv)) return 0;
+    sw_bake_random_poses(&s->rig.ch.skel, sweep_axis, sweep_angle, s->p->seed, s->p->random_poses,
+                         s->p->heldout_steps, local, s->poses.heldout.T);
     return 1;
 }
 
@@ -291,7 +291,7 @@ void sw_bake_random_poses(const sw_skeleton *sk, const double *sweep_axis,
 static void sweep_pose(const sw_bake_state *s, const int32_t *bones, int nsw, int32_t i, int32_t n,
                        const double *sweep_axis, const double *sweep_angle, double *local,
                        double *T) {
-    for (int32_t k = 0; k < s->nb; ++k) {
+    for (int32_t k = 0; k < s->rig.nb; ++k) {
         double *L = local + 9 * k;
         memset(L, 0, 9 * sizeof(double));
         L[0] = L[4] = L[8] = 1;
@@ -299,11 +299,11 @@ static void sweep_pose(const sw_bake_state *s, const int32_t *bones, int nsw, in
     for (int j = 0; j < nsw; ++j)
         sw_m3_axis_angle(sweep_axis + 3 * bones[j], sweep_angle[bones[j]] * i / n,
                          local + 9 * bones[j]);
-    sw_forward_kinematics(&s->ch.skel, local, NULL, T);
+    sw_forward_kinematics(&s->rig.ch.skel, local, NULL, T);
 }
 
 /* Whether the sweeps bend bone b's joint (b >= 0). A pair sweep turns a joint and its
- * parent's together when both are (issue 16: the flesh between two domain boundaries
+ * parent's together when both are (the flesh between two domain boundaries
  * depends on both joints, and the single sweeps never show them combined). */
 static int swept(const double *sweep_angle, int32_t b) {
     return b >= 0 && sweep_angle[b] > 1e-3;
@@ -354,9 +354,9 @@ static int wants_return_path(const sw_bake_params *p, int32_t nheld) {
 /* The domain that holds bone b's flesh: b's own, or (a bone folded into its parent's
  * domain, or one that owns no tet) its nearest ancestor's; -1 if none has one. */
 static int32_t bone_domain(const sw_bake_state *s, int32_t b) {
-    for (; b >= 0; b = s->ch.skel.parent[b])
-        for (int32_t d = 0; d < s->nd; ++d)
-            if (s->domain_bone[d] == b) return d;
+    for (; b >= 0; b = s->rig.ch.skel.parent[b])
+        for (int32_t d = 0; d < s->domains.nd; ++d)
+            if (s->domains.domain_bone[d] == b) return d;
     return -1;
 }
 
@@ -366,9 +366,9 @@ static int flesh_meets(const sw_bake_state *s, int32_t a, int32_t b) {
     int32_t da = bone_domain(s, a), db = bone_domain(s, b);
     if (da < 0 || db < 0) return 0;
     if (da == db) return 1;
-    int32_t i = s->dom_vert_ptr[da], j = s->dom_vert_ptr[db];
-    while (i < s->dom_vert_ptr[da + 1] && j < s->dom_vert_ptr[db + 1]) {
-        int32_t u = s->dom_verts[i], w = s->dom_verts[j];
+    int32_t i = s->domains.dom_vert_ptr[da], j = s->domains.dom_vert_ptr[db];
+    while (i < s->domains.dom_vert_ptr[da + 1] && j < s->domains.dom_vert_ptr[db + 1]) {
+        int32_t u = s->domains.dom_verts[i], w = s->domains.dom_verts[j];
         if (u == w) return 1;
         i += u < w;
         j += w < u;
@@ -379,11 +379,11 @@ static int flesh_meets(const sw_bake_state *s, int32_t a, int32_t b) {
 /* Whether every joint is also swept with its parent joint (sw_bake_params.pair_sweeps):
  * by default where the character's joint range bounds the sweeps. Within the rig's range
  * the combinations are what the single sweeps miss (the bare hand's default bake 0.100 ->
- * 0.045, docs/generalisation.md Joint ranges); at the 90-degree default they bend two
+ * 0.045, docs/notes/generalisation.md Joint ranges); at the 90-degree default they bend two
  * joints into flesh no rig reaches and made it worse (at --max-rank 60 0.421 against
- * 0.379, docs/accuracy.md). */
+ * 0.379, docs/notes/accuracy.md). */
 static int wants_pair_sweeps(const sw_bake_state *s) {
-    return s->p->pair_sweeps > 0 || (s->p->pair_sweeps < 0 && s->ch.range.nframes > 0);
+    return s->p->pair_sweeps > 0 || (s->p->pair_sweeps < 0 && s->rig.ch.range.nframes > 0);
 }
 
 /* The joints swept in pairs (pairs[2 k], pairs[2 k + 1]; NULL: only counted), returns
@@ -393,18 +393,18 @@ static int wants_pair_sweeps(const sw_bake_state *s) {
  * them, the last). */
 static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, int32_t *pairs,
                            int32_t *nparent) {
-    const sw_skeleton *sk = &s->ch.skel;
+    const sw_skeleton *sk = &s->rig.ch.skel;
     const int parent_pairs = wants_pair_sweeps(s);
     int32_t n = 0;
-    for (int32_t a = 0; s->p->sibling_sweeps && a < s->nb; ++a)
-        for (int32_t b = a + 1; b < s->nb; ++b)
+    for (int32_t a = 0; s->p->sibling_sweeps && a < s->rig.nb; ++a)
+        for (int32_t b = a + 1; b < s->rig.nb; ++b)
             if (sk->parent[a] == sk->parent[b] && sk->parent[a] >= 0 && swept(sweep_angle, a) &&
                 swept(sweep_angle, b) && flesh_meets(s, a, b)) {
                 if (pairs) pairs[2 * n] = a, pairs[2 * n + 1] = b;
                 n++;
             }
     *nparent = 0;
-    for (int32_t b = 0; parent_pairs && b < s->nb; ++b)
+    for (int32_t b = 0; parent_pairs && b < s->rig.nb; ++b)
         if (swept(sweep_angle, b) && swept(sweep_angle, sk->parent[b])) {
             if (pairs) pairs[2 * n] = b, pairs[2 * n + 1] = sk->parent[b];
             n++;
@@ -418,11 +418,11 @@ static int32_t sweep_pairs(const sw_bake_state *s, const double *sweep_angle, in
 static int add_sweep(sw_bake_state *s, const int32_t *bones, int nsw, const double *sweep_axis,
                      const double *sweep_angle, double *local, int32_t *qi) {
     int32_t n = s->p->sweep_samples;
-    sw_pose_seq *q = &s->train[*qi];
-    if (!seq_alloc(q, n, s->nb, s->nv)) return 0;
+    sw_pose_seq *q = &s->poses.train[*qi];
+    if (!seq_alloc(q, n, s->rig.nb, s->rig.nv)) return 0;
     for (int32_t i = 0; i < n; ++i)
         sweep_pose(s, bones, nsw, i + 1, n, sweep_axis, sweep_angle, local,
-                   q->T + (size_t)i * 12 * s->nb);
+                   q->T + (size_t)i * 12 * s->rig.nb);
     ++*qi;
     return 1;
 }
@@ -430,43 +430,43 @@ static int add_sweep(sw_bake_state *s, const int32_t *bones, int nsw, const doub
 static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr, int32_t nheld,
                           int32_t njoint, const double *sweep_axis, const double *sweep_angle,
                           double *local) {
-    const sw_skeleton *sk = &s->ch.skel;
-    int32_t nb = s->nb, cap = s->p->max_train_frames;
+    const sw_skeleton *sk = &s->rig.ch.skel;
+    int32_t nb = s->rig.nb, cap = s->p->max_train_frames;
     int32_t n0 = ntr > 0 ? (train[0].count < cap ? train[0].count : cap) : 0;
     int32_t nreturn = wants_return_path(s->p, nheld) && n0 >= 2 ? n0 - 1 : 0;
     int32_t nparent;
     int32_t npair = sweep_pairs(s, sweep_angle, NULL, &nparent);
-    s->pair_sweep_poses = nparent * s->p->sweep_samples;
+    s->poses.pair_sweep_poses = nparent * s->p->sweep_samples;
     int32_t chain = s->p->extra_chain > 0 ? s->p->extra_chain : s->p->nextra_poses;
     int32_t nextra = s->p->nextra_poses > 0 ? (s->p->nextra_poses + chain - 1) / chain : 0;
-    s->ntrain_seq = ntr + (nreturn > 0) + njoint + npair + nextra;
-    s->train = calloc((size_t)s->ntrain_seq + 1, sizeof(sw_pose_seq));
-    if (!s->train) return 0;
+    s->poses.ntrain_seq = ntr + (nreturn > 0) + njoint + npair + nextra;
+    s->poses.train = calloc((size_t)s->poses.ntrain_seq + 1, sizeof(sw_pose_seq));
+    if (!s->poses.train) return 0;
     int32_t qi = 0;
     for (int32_t r = 0; r < ntr; ++r, ++qi) {
         int32_t n = train[r].count < cap ? train[r].count : cap;
-        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
-        fill_from_range(&s->train[qi], 0, &train[r], n, nb);
+        if (!seq_alloc(&s->poses.train[qi], n, nb, s->rig.nv)) return 0;
+        fill_from_range(&s->poses.train[qi], 0, &train[r], n, nb);
     }
     if (nreturn > 0) { /* train[0]'s frames on the way home, continuing from its last solution */
         int32_t *idx = malloc((size_t)nreturn * sizeof(int32_t));
         if (!idx) return 0;
-        nreturn = return_frames(sk, &s->train[0], n0, nb, idx);
-        if (nreturn > 0 && !seq_alloc(&s->train[qi], nreturn, nb, s->nv)) {
+        nreturn = return_frames(sk, &s->poses.train[0], n0, nb, idx);
+        if (nreturn > 0 && !seq_alloc(&s->poses.train[qi], nreturn, nb, s->rig.nv)) {
             free(idx);
             return 0;
         }
         for (int32_t i = 0; i < nreturn; ++i)
-            memcpy(s->train[qi].T + (size_t)i * 12 * nb, s->train[0].T + (size_t)idx[i] * 12 * nb,
-                   12 * nb * sizeof(double));
+            memcpy(s->poses.train[qi].T + (size_t)i * 12 * nb,
+                   s->poses.train[0].T + (size_t)idx[i] * 12 * nb, 12 * nb * sizeof(double));
         free(idx);
-        s->return_poses = nreturn;
+        s->poses.return_poses = nreturn;
         if (nreturn > 0) {
-            s->train[0].then[1] = &s->train[qi];
-            s->train[qi].continues = 1;
+            s->poses.train[0].then[1] = &s->poses.train[qi];
+            s->poses.train[qi].continues = 1;
             qi++;
         } else { /* the clip ended at rest: nothing to go home through */
-            s->ntrain_seq--;
+            s->poses.ntrain_seq--;
         }
     }
     /* a sweep per joint, then the pairs' sweeps, both joints of a pair turned together */
@@ -482,15 +482,16 @@ static int training_poses(sw_bake_state *s, const clip_range *train, int32_t ntr
     /* the caller's poses (the adaptive loop's), `chain` at a time on a path from rest */
     for (int32_t at = 0; at < s->p->nextra_poses; at += chain, ++qi) {
         int32_t n = s->p->nextra_poses - at < chain ? s->p->nextra_poses - at : chain;
-        if (!seq_alloc(&s->train[qi], n, nb, s->nv)) return 0;
-        memcpy(s->train[qi].T, s->p->extra_poses + (size_t)at * 12 * nb,
+        if (!seq_alloc(&s->poses.train[qi], n, nb, s->rig.nv)) return 0;
+        memcpy(s->poses.train[qi].T, s->p->extra_poses + (size_t)at * 12 * nb,
                (size_t)n * 12 * nb * sizeof(double));
     }
     return 1;
 }
 
-sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
-    int32_t nb = s->nb, nheld = 0;
+sinew_result sw_bake_poses(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    (void)out;
+    int32_t nb = s->rig.nb, nheld = 0;
     int32_t nr = s->p->ntrain_clips + s->p->nheldout_clips + 1;
     clip_range *train = calloc((size_t)nr, sizeof *train), *held = calloc((size_t)nr, sizeof *held);
     double *sweep_axis = calloc((size_t)nb * 3, sizeof(double));
@@ -504,7 +505,7 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
     for (int32_t b = 0; b < nb; ++b)
         njoint += sweep_angle[b] > 1e-3;
     if (njoint == 0) { /* nothing to learn: every training snapshot is the rest shape */
-        const sw_clip *clip = &s->ch.clip;
+        const sw_clip *clip = &s->rig.ch.clip;
         int32_t nf = clip->T && clip->nbones == nb ? clip->nframes : 0;
         if (s->p->ntrain_clips > 0)
             rc = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
@@ -512,11 +513,11 @@ sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err) {
                               "the basis and the cubature are learnt from the training poses' "
                               "deformation",
                               s->p->ntrain_clips);
-        else if (ntr == 0 && s->ch.range.nframes > 0)
+        else if (ntr == 0 && s->rig.ch.range.nframes > 0)
             rc = sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                               "no training poses: the joint range turns no joint (every bone "
                               "at rest in its %d frames), so nothing is swept",
-                              s->ch.range.nframes);
+                              s->rig.ch.range.nframes);
         else
             rc = sw_error_set(
                 err, SINEW_ERROR_INVALID_ARGUMENT,
@@ -539,140 +540,8 @@ oom:
 done:
     free(train);
     free(held);
-    s->sweep_axis = sweep_axis; /* the adaptive loop's candidates (sw_bake_result) */
-    s->sweep_angle = sweep_angle;
+    s->poses.sweep_axis = sweep_axis; /* the adaptive loop's candidates (sw_bake_result) */
+    s->poses.sweep_angle = sweep_angle;
     free(local);
     return rc;
-}
-
-/* Appends the simulator's contact set as pose k's (the pose-space self-contact data,
- * bake_contacts.c). Returns 0 when out of memory. */
-static int keep_contacts(sw_pose_seq *q, int32_t k, const sw_fullsim *sim) {
-    int32_t n;
-    const sw_contact *c = sw_fullsim_contacts(sim, &n);
-    if (q->ncontacts + n > q->contact_cap) {
-        int32_t cap = 2 * (q->ncontacts + n) + 64;
-        sw_contact *m = realloc(q->contacts, (size_t)cap * sizeof *m);
-        if (!m) return 0;
-        q->contacts = m;
-        q->contact_cap = cap;
-    }
-    if (n > 0) memcpy(q->contacts + q->ncontacts, c, (size_t)n * sizeof *c);
-    q->ncontacts += n;
-    q->contact_ptr[k + 1] = q->ncontacts;
-    return 1;
-}
-
-/* Solves q's poses in order, from the simulator's current state. */
-static void simulate_seq(sw_bake_state *s, sw_fullsim *sim, sw_pose_seq *q) {
-    for (int32_t k = 0; k < q->npose; ++k) {
-        sw_fullsim_stats st;
-        sinew_result r = sw_fullsim_step(sim, q->T + (size_t)k * 12 * s->nb, &st);
-        if (r == SINEW_ERROR_NOT_FINITE) q->failed++;
-        q->unsettled += st.contacts_unsettled;
-        memcpy(q->x + (size_t)k * 3 * s->nv, sw_fullsim_positions(sim),
-               (size_t)s->nv * 3 * sizeof(double));
-        if (!keep_contacts(q, k, sim)) q->oom = 1;
-        sw_bake_progress(s, 1);
-    }
-}
-
-sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p) {
-    sw_fullsim_params fp = sw_fullsim_params_default();
-    if (p->reference) sw_fullsim_params_take_solver(&fp, p->reference);
-    fp.self_contact = p->self_contact;
-    return fp;
-}
-
-typedef struct {
-    sw_bake_state *s;
-    sw_pose_seq **seqs;
-    int32_t nseq;
-    atomic_int next;
-    atomic_int failed; /* sequences whose simulator could not be created */
-} sim_ctx;
-
-static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) {
-    (void)begin;
-    (void)end;
-    (void)worker;
-    sim_ctx *ctx = vctx;
-    sw_bake_state *s = ctx->s;
-    for (;;) { /* dynamic scheduling: sequences differ a lot in cost */
-        int i = atomic_fetch_add(&ctx->next, 1);
-        if (i >= ctx->nseq) break;
-        sw_pose_seq *q = ctx->seqs[i];
-        sw_fullsim_params fp = sw_bake_sim_params(s->p);
-        /* a chained path (the clip's training then held-out frames) is the longest serial
-           run: it gets every core (the simulator's results do not depend on its thread
-           count), the others one each */
-        fp.threads = q->then[0] || q->then[1] ? sw_pool_size(s->pool) : 1;
-        sw_fullsim *sim;
-        sw_error e;
-        if (sw_fullsim_create(&s->ch, &fp, &sim, &e) != SINEW_OK) {
-            atomic_fetch_add(&ctx->failed, 1);
-            continue;
-        }
-        simulate_seq(s, sim, q);
-        for (int c = 0; c < 2; ++c)
-            if (q->then[c] && q->npose > 0) {
-                sw_fullsim_set_state(sim, q->T + (size_t)(q->npose - 1) * 12 * s->nb,
-                                     q->x + (size_t)(q->npose - 1) * 3 * s->nv, NULL);
-                simulate_seq(s, sim, q->then[c]);
-            }
-        sw_fullsim_destroy(sim);
-    }
-}
-
-/* Poses solved one after the other from q on: q's and its continuations'. */
-static int64_t path_poses(const sw_pose_seq *q) {
-    return q->npose + (q->then[0] ? q->then[0]->npose : 0) + (q->then[1] ? q->then[1]->npose : 0);
-}
-
-sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err) {
-    sw_pose_seq *seqs[4096];
-    int32_t n = 0;
-    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
-        if (!s->train[i].continues && !s->train[i].from_cache) seqs[n++] = &s->train[i];
-    if (s->heldout.npose > 0 && !s->heldout.continues && !s->heldout.from_cache)
-        seqs[n++] = &s->heldout;
-    /* longest path first (stable): a long clip taken last by one worker would leave the
-       others idle at the end (each path's results do not depend on the order) */
-    for (int32_t i = 1; i < n; ++i)
-        for (int32_t j = i; j > 0 && path_poses(seqs[j]) > path_poses(seqs[j - 1]); --j) {
-            sw_pose_seq *t = seqs[j];
-            seqs[j] = seqs[j - 1];
-            seqs[j - 1] = t;
-        }
-    sim_ctx ctx;
-    ctx.s = s;
-    ctx.seqs = seqs;
-    ctx.nseq = n;
-    atomic_init(&ctx.next, 0);
-    atomic_init(&ctx.failed, 0);
-    int64_t poses = 0; /* the chains to solve (the others came from the cache) */
-    for (int32_t i = 0; i < n; ++i)
-        poses += path_poses(seqs[i]);
-    s->solved_poses = poses;
-    sw_bake_progress_begin(s, "simulate", poses);
-    /* one task per worker; each worker pulls sequences until none is left. The direct
-       solver's factorisations (--solver cholmod) run on OpenBLAS: with its own threads
-       beside the workers, the Fox's simulate stage spun for 524 s, with 1 it took 124 s */
-    openblas_set_num_threads(1);
-    sw_pool_parallel_for(s->pool, sw_pool_size(s->pool), simulate_worker, &ctx);
-    if (atomic_load(&ctx.failed) > 0)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "the full-space simulator rejected the character");
-    n = 0; /* the checks below: every sequence, continuations too */
-    for (int32_t i = 0; i < s->ntrain_seq && n < 4095; ++i)
-        seqs[n++] = &s->train[i];
-    if (s->heldout.npose > 0) seqs[n++] = &s->heldout;
-    for (int32_t i = 0; i < n; ++i)
-        if (seqs[i]->oom)
-            return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for contact sets");
-    for (int32_t i = 0; i < n; ++i)
-        if (seqs[i]->failed)
-            return sw_error_set(err, SINEW_ERROR_NOT_FINITE,
-                                "%d training poses of sequence %d diverged", seqs[i]->failed, i);
-    return SINEW_OK;
 }

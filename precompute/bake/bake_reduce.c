@@ -1,3 +1,5 @@
+/* Stage "reduce" (bake.c, sw_bake_stages): reads s->rig, s->domains, s->basis, s->cubature,
+ * s->contacts; writes s->reduce and the view's reduced sections. */
 /* The constant reduced matrices and the blob view (bake.h "reduce").
  *   springs (eqs. 4.17-4.20): a vertex in domains i and j has copies that skinning
  *     moves with the same (R_v, t_v), so its spring energy k/2 |U_i q_i - U_j q_j|^2
@@ -9,7 +11,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "fem_corot.h"
 #include "mesh_io.h"
 #include "vec3.h"
@@ -35,19 +37,16 @@ static double mean_edge(const sw_tetmesh *m) {
  * skeleton's root (the lower domain on a tie), by k/2 |U_i q_i - U_j q_j|^2. Every pair
  * of copies tied instead (k(k-1)/2 springs, not k - 1) coupled sibling domains that
  * meet only at their parent's vertices, and the reduced Hessian's block graph then
- * follows the mesh's corners, not the skeleton. Measured on the elephant (24 domains):
- * lower blocks of the factor in use 89 -> 68 of 276, 4.5 -> 2.9 million multiply-adds a
- * factorisation, cost_vs_dqs 295-305 -> 245-252; bake errors train / held-out elephant
- * 0.0196 / 0.0888 -> 0.0196 / 0.0886, hand 0.0200 / 0.0448 -> 0.0193 / 0.0448, finger
- * 20K and 50K unchanged (no vertex of theirs has three copies). */
+ * follows the mesh's corners, not the skeleton: the hub ties keep the factor's blocks to
+ * the skeleton's graph, at the same errors (docs/notes). */
 static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *doms,
                                   const int32_t *copy_ptr_v, const int32_t *copy_list,
                                   double *spring) {
-    int32_t R = s->rank_total;
-    for (int32_t gv = 0; gv < s->nv; ++gv) {
+    int32_t R = s->basis.rank_total;
+    for (int32_t gv = 0; gv < s->rig.nv; ++gv) {
         int32_t hub = copy_ptr_v[gv], hub_depth = INT32_MAX;
         for (int32_t a = copy_ptr_v[gv]; a < copy_ptr_v[gv + 1]; ++a) {
-            int32_t d = sw_bone_depth(&s->ch.skel, s->domain_bone[copy_list[2 * a]]);
+            int32_t d = sw_bone_depth(&s->rig.ch.skel, s->domains.domain_bone[copy_list[2 * a]]);
             if (d < hub_depth) hub_depth = d, hub = a; /* copies are in domain order */
         }
         for (int32_t b = copy_ptr_v[gv]; b < copy_ptr_v[gv + 1]; ++b) {
@@ -55,9 +54,9 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
             int32_t a = hub;
             int32_t di = copy_list[2 * a], li = copy_list[2 * a + 1];
             int32_t dj = copy_list[2 * b], lj = copy_list[2 * b + 1];
-            int32_t ri = s->rank[di], rj = s->rank[dj];
-            const double *Ui = s->basis[di] + (size_t)3 * li * ri,
-                         *Uj = s->basis[dj] + (size_t)3 * lj * rj;
+            int32_t ri = s->basis.rank[di], rj = s->basis.rank[dj];
+            const double *Ui = s->basis.U[di] + (size_t)3 * li * ri,
+                         *Uj = s->basis.U[dj] + (size_t)3 * lj * rj;
             int32_t oi = doms[di].q_offset, oj = doms[dj].q_offset;
             for (int c = 0; c < 3; ++c) {
                 for (int32_t x = 0; x < ri; ++x) {
@@ -81,105 +80,47 @@ static void add_interface_springs(const sw_bake_state *s, const sw_blob_domain *
     }
 }
 
-sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    sw_blob_view *v = &out->view;
-    int32_t R = s->rank_total, nd = s->nd, ncopies = s->dom_vert_ptr[nd];
-    /* the interface springs at unit stiffness per copy pair, and the stiffness of one
-       vertex of the mesh, E h (a fixed k would lock the interface of a fine mesh, whose
-       domains' bases cannot match there exactly): sw_bake_springs scales them (bake_springs.c) */
-    s->spring_eh = s->ch.youngs * mean_edge(&s->ch.mesh);
-    sw_surface surf;
-    memset(&surf, 0, sizeof surf);
-    sinew_result r = sw_tetmesh_surface(&s->ch.mesh, &surf, err);
-    if (r != SINEW_OK) return r;
-
-    int32_t ncub = 0;
-    int64_t nbasis = 0, ninertia = 0;
-    for (int32_t d = 0; d < nd; ++d) {
-        ncub += s->cub_n[d];
-        nbasis += (int64_t)(s->dom_vert_ptr[d + 1] - s->dom_vert_ptr[d]) * 3 * s->rank[d];
-        ninertia += 9 * (int64_t)s->rank[d] * s->rank[d];
-    }
-    double *rest, *skin_weight, *joints, *basis, *cub_weight, *cub_dminv, *cub_vol, *spring, *mass;
-    double *ins, *inx, *inu;
-    int32_t *skin_bone, *parent, *dverts, *cub_tets, *surf_tris, *copy_ptr, *copies;
-    sw_blob_domain *doms;
-    OWN(rest, 3 * s->nv, double);
-    OWN(skin_bone, 4 * s->nv, int32_t);
-    OWN(skin_weight, 4 * s->nv, double);
-    OWN(parent, s->nb, int32_t);
-    OWN(joints, 6 * s->nb, double);
-    OWN(doms, nd, sw_blob_domain);
-    OWN(dverts, ncopies, int32_t);
-    OWN(basis, nbasis, double);
-    OWN(cub_tets, 4 * ncub, int32_t);
-    OWN(cub_weight, ncub, double);
-    OWN(cub_dminv, 9 * ncub, double);
-    OWN(cub_vol, ncub, double);
-    OWN(spring, (int64_t)R * R, double);
-    OWN(mass, (int64_t)R * R, double);
-    OWN(ins, 3 * R, double);
-    OWN(inx, 9 * R, double);
-    OWN(inu, ninertia, double);
-    OWN(surf_tris, 3 * surf.ntris, int32_t);
-    OWN(copy_ptr, surf.nverts + 1, int32_t);
-    int32_t *copy_ptr_v = calloc((size_t)s->nv + 1, sizeof(int32_t)); /* copies per vertex */
-    int32_t *copy_list = malloc((size_t)ncopies * 2 * sizeof(int32_t));
-    int32_t *surf_index = malloc((size_t)s->nv * sizeof(int32_t));
-    if (!rest || !skin_bone || !skin_weight || !parent || !joints || !doms || !dverts || !basis ||
-        !cub_tets || !cub_weight || !cub_dminv || !cub_vol || !spring || !mass || !ins || !inx ||
-        !inu || !surf_tris || !copy_ptr || !copy_ptr_v || !copy_list || !surf_index ||
-        out->nstorage >= (int)(sizeof out->storage / sizeof out->storage[0])) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-        goto done;
-    }
-    memcpy(rest, s->ch.mesh.X, (size_t)s->nv * 3 * sizeof(double));
-    memcpy(skin_bone, s->skin_bone, (size_t)s->nv * 4 * sizeof(int32_t));
-    memcpy(skin_weight, s->skin_weight, (size_t)s->nv * 4 * sizeof(double));
-    for (int32_t b = 0; b < s->nb; ++b) {
-        parent[b] = s->ch.skel.parent[b];
-        memcpy(joints + 6 * b, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b], 3 * sizeof(double));
-        memcpy(joints + 6 * b + 3, s->ch.skel.joints + 3 * s->ch.skel.bones[2 * b + 1],
-               3 * sizeof(double));
-    }
-    memcpy(dverts, s->dom_verts, (size_t)ncopies * sizeof(int32_t));
-
-    /* domains, basis, cubature, mass and inertia per domain */
+/* The view's domains, basis, cubature tets, reduced mass and inertial projections, per
+ * domain (blob_view.h); local_of: nverts ints of scratch. */
+static void fill_domains(const sw_bake_state *s, sw_blob_domain *doms, double *basis,
+                         int32_t *cub_tets, double *cub_weight, double *cub_dminv, double *cub_vol,
+                         double *mass, double *ins, double *inx, double *inu, int32_t *local_of) {
+    const int32_t R = s->basis.rank_total, nd = s->domains.nd;
     int32_t qoff = 0, cub = 0;
     int64_t boff = 0, ioff = 0;
     for (int32_t d = 0; d < nd; ++d) {
-        int32_t base = s->dom_vert_ptr[d], n = s->dom_vert_ptr[d + 1] - base, r_d = s->rank[d];
+        int32_t base = s->domains.dom_vert_ptr[d], n = s->domains.dom_vert_ptr[d + 1] - base,
+                r_d = s->basis.rank[d];
         sw_blob_domain *D = &doms[d];
         memset(D, 0, sizeof *D);
-        D->bone = s->domain_bone[d];
+        D->bone = s->domains.domain_bone[d];
         D->vert_begin = base;
         D->vert_count = n;
         D->rank = r_d;
         D->q_offset = qoff;
         D->cub_begin = cub;
-        D->cub_count = s->cub_n[d];
+        D->cub_count = s->cubature.n[d];
         D->basis_offset = boff;
         D->inertia_offset = ioff;
-        const double *U = s->basis[d];
+        const double *U = s->basis.U[d];
         memcpy(basis + boff, U, (size_t)n * 3 * r_d * sizeof(double));
-        int32_t *local_of = surf_index; /* scratch: global -> local for this domain */
         for (int32_t k = 0; k < n; ++k)
-            local_of[s->dom_verts[base + k]] = k;
-        for (int32_t i = 0; i < s->cub_n[d]; ++i, ++cub) {
-            int32_t tet = s->dom_tets[s->dom_tet_ptr[d] + s->cub_local[d][i]];
+            local_of[s->domains.dom_verts[base + k]] = k;
+        for (int32_t i = 0; i < s->cubature.n[d]; ++i, ++cub) {
+            int32_t tet = s->domains.dom_tets[s->domains.dom_tet_ptr[d] + s->cubature.local[d][i]];
             double Xe[12];
             for (int k = 0; k < 4; ++k) {
-                int32_t gv = s->ch.mesh.tets[4 * (int64_t)tet + k];
+                int32_t gv = s->rig.ch.mesh.tets[4 * (int64_t)tet + k];
                 cub_tets[4 * cub + k] = local_of[gv];
-                memcpy(Xe + 3 * k, s->ch.mesh.X + 3 * (int64_t)gv, 24);
+                memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)gv, 24);
             }
             sw_tet_rest(Xe, cub_dminv + 9 * cub, cub_vol + cub);
-            cub_weight[cub] = s->cub_w[d][i];
+            cub_weight[cub] = s->cubature.w[d][i];
         }
         for (int32_t k = 0; k < n; ++k) {
-            double m = s->copy_mass[base + k];
+            double m = s->domains.copy_mass[base + k];
             const double *Uk = U + (size_t)3 * k * r_d,
-                         *X = s->ch.mesh.X + 3 * (int64_t)s->dom_verts[base + k];
+                         *X = s->rig.ch.mesh.X + 3 * (int64_t)s->domains.dom_verts[base + k];
             for (int32_t i = 0; i < r_d; ++i) {
                 for (int a = 0; a < 3; ++a) {
                     double u = m * Uk[a * r_d + i];
@@ -200,29 +141,131 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
         boff += (int64_t)n * 3 * r_d;
         ioff += 9 * (int64_t)r_d * r_d;
     }
+}
+
+/* The pose-space sections of the view: the training poses' projections and pose
+ * features (the pose-space interpolation's samples) and their self-contact pairs. */
+static sinew_result pose_sections(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    const int32_t R = s->basis.rank_total;
+    double *tq, *tp;
+    OWN(tq, (int64_t)s->basis.ntrain * R, double);
+    OWN(tp, (int64_t)s->basis.ntrain * 4 * s->rig.nb, double);
+    if (!tq || !tp) {
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    }
+    memcpy(tq, s->basis.train_q, (size_t)s->basis.ntrain * R * sizeof(double));
+    memcpy(tp, s->basis.train_pose, (size_t)s->basis.ntrain * 4 * s->rig.nb * sizeof(double));
+    v->ntrain = s->basis.ntrain;
+    v->train_q = tq;
+    v->train_pose = tp;
+    int32_t *cp, *cv;
+    double *cd;
+    OWN(cp, s->basis.ntrain + 1, int32_t);
+    OWN(cv, 8 * (int64_t)s->contacts.ncontacts, int32_t);
+    OWN(cd, 7 * (int64_t)s->contacts.ncontacts, double);
+    if (!cp || !cv || !cd) {
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    }
+    memcpy(cp, s->contacts.contact_ptr, (size_t)(s->basis.ntrain + 1) * sizeof(int32_t));
+    memcpy(cv, s->contacts.contact_verts, (size_t)s->contacts.ncontacts * 8 * sizeof(int32_t));
+    memcpy(cd, s->contacts.contact_data, (size_t)s->contacts.ncontacts * 7 * sizeof(double));
+    v->ncontacts = s->contacts.ncontacts;
+    v->contact_ptr = cp;
+    v->contact_verts = cv;
+    v->contact_data = cd;
+    return SINEW_OK;
+}
+
+sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    int32_t R = s->basis.rank_total, nd = s->domains.nd, ncopies = s->domains.dom_vert_ptr[nd];
+    /* the interface springs at unit stiffness per copy pair, and the stiffness of one
+       vertex of the mesh, E h (a fixed k would lock the interface of a fine mesh, whose
+       domains' bases cannot match there exactly): sw_bake_springs scales them (bake_springs.c) */
+    s->reduce.spring_eh = s->rig.ch.youngs * mean_edge(&s->rig.ch.mesh);
+    sw_surface surf;
+    memset(&surf, 0, sizeof surf);
+    sinew_result r = sw_tetmesh_surface(&s->rig.ch.mesh, &surf, err);
+    if (r != SINEW_OK) return r;
+
+    int32_t ncub = 0;
+    int64_t nbasis = 0, ninertia = 0;
+    for (int32_t d = 0; d < nd; ++d) {
+        ncub += s->cubature.n[d];
+        nbasis += (int64_t)(s->domains.dom_vert_ptr[d + 1] - s->domains.dom_vert_ptr[d]) * 3 *
+                  s->basis.rank[d];
+        ninertia += 9 * (int64_t)s->basis.rank[d] * s->basis.rank[d];
+    }
+    double *rest, *skin_weight, *joints, *basis, *cub_weight, *cub_dminv, *cub_vol, *spring, *mass;
+    double *ins, *inx, *inu;
+    int32_t *skin_bone, *parent, *dverts, *cub_tets, *surf_tris, *copy_ptr, *copies;
+    sw_blob_domain *doms;
+    OWN(rest, 3 * s->rig.nv, double);
+    OWN(skin_bone, 4 * s->rig.nv, int32_t);
+    OWN(skin_weight, 4 * s->rig.nv, double);
+    OWN(parent, s->rig.nb, int32_t);
+    OWN(joints, 6 * s->rig.nb, double);
+    OWN(doms, nd, sw_blob_domain);
+    OWN(dverts, ncopies, int32_t);
+    OWN(basis, nbasis, double);
+    OWN(cub_tets, 4 * ncub, int32_t);
+    OWN(cub_weight, ncub, double);
+    OWN(cub_dminv, 9 * ncub, double);
+    OWN(cub_vol, ncub, double);
+    OWN(spring, (int64_t)R * R, double);
+    OWN(mass, (int64_t)R * R, double);
+    OWN(ins, 3 * R, double);
+    OWN(inx, 9 * R, double);
+    OWN(inu, ninertia, double);
+    OWN(surf_tris, 3 * surf.ntris, int32_t);
+    OWN(copy_ptr, surf.nverts + 1, int32_t);
+    int32_t *copy_ptr_v = calloc((size_t)s->rig.nv + 1, sizeof(int32_t)); /* copies per vertex */
+    int32_t *copy_list = malloc((size_t)ncopies * 2 * sizeof(int32_t));
+    int32_t *surf_index = malloc((size_t)s->rig.nv * sizeof(int32_t));
+    if (!rest || !skin_bone || !skin_weight || !parent || !joints || !doms || !dverts || !basis ||
+        !cub_tets || !cub_weight || !cub_dminv || !cub_vol || !spring || !mass || !ins || !inx ||
+        !inu || !surf_tris || !copy_ptr || !copy_ptr_v || !copy_list || !surf_index) {
+        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+        goto done;
+    }
+    memcpy(rest, s->rig.ch.mesh.X, (size_t)s->rig.nv * 3 * sizeof(double));
+    memcpy(skin_bone, s->rig.skin_bone, (size_t)s->rig.nv * 4 * sizeof(int32_t));
+    memcpy(skin_weight, s->rig.skin_weight, (size_t)s->rig.nv * 4 * sizeof(double));
+    for (int32_t b = 0; b < s->rig.nb; ++b) {
+        parent[b] = s->rig.ch.skel.parent[b];
+        memcpy(joints + 6 * b, s->rig.ch.skel.joints + 3 * s->rig.ch.skel.bones[2 * b],
+               3 * sizeof(double));
+        memcpy(joints + 6 * b + 3, s->rig.ch.skel.joints + 3 * s->rig.ch.skel.bones[2 * b + 1],
+               3 * sizeof(double));
+    }
+    memcpy(dverts, s->domains.dom_verts, (size_t)ncopies * sizeof(int32_t));
+
+    fill_domains(s, doms, basis, cub_tets, cub_weight, cub_dminv, cub_vol, mass, ins, inx, inu,
+                 surf_index);
     /* copies of each vertex: (domain, local) */
     for (int32_t d = 0; d < nd; ++d)
-        for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k)
-            copy_ptr_v[s->dom_verts[k] + 1]++;
-    for (int32_t i = 0; i < s->nv; ++i)
+        for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k)
+            copy_ptr_v[s->domains.dom_verts[k] + 1]++;
+    for (int32_t i = 0; i < s->rig.nv; ++i)
         copy_ptr_v[i + 1] += copy_ptr_v[i];
     {
         int32_t *fill = surf_index;
-        memcpy(fill, copy_ptr_v, (size_t)s->nv * sizeof(int32_t));
+        memcpy(fill, copy_ptr_v, (size_t)s->rig.nv * sizeof(int32_t));
         for (int32_t d = 0; d < nd; ++d)
-            for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k) {
-                int32_t gv = s->dom_verts[k], at = fill[gv]++;
+            for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k) {
+                int32_t gv = s->domains.dom_verts[k], at = fill[gv]++;
                 copy_list[2 * at] = d;
-                copy_list[2 * at + 1] = k - s->dom_vert_ptr[d];
+                copy_list[2 * at + 1] = k - s->domains.dom_vert_ptr[d];
             }
     }
-    if (!(s->spring_unit = calloc((size_t)R * R + 1, sizeof(double)))) {
+    if (!(s->reduce.spring_unit = calloc((size_t)R * R + 1, sizeof(double)))) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the springs");
         goto done;
     }
-    add_interface_springs(s, doms, copy_ptr_v, copy_list, s->spring_unit);
+    add_interface_springs(s, doms, copy_ptr_v, copy_list, s->reduce.spring_unit);
     /* output surface: the tet mesh's boundary; each vertex the mean of its copies */
-    for (int32_t i = 0; i < s->nv; ++i)
+    for (int32_t i = 0; i < s->rig.nv; ++i)
         surf_index[i] = -1;
     for (int32_t i = 0; i < surf.nverts; ++i)
         surf_index[surf.verts[i]] = i;
@@ -246,15 +289,15 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
                (size_t)(copy_ptr_v[gv + 1] - copy_ptr_v[gv]) * 2 * sizeof(int32_t));
     }
 
-    v->nverts = s->nv;
-    v->nbones = s->nb;
+    v->nverts = s->rig.nv;
+    v->nbones = s->rig.nb;
     v->ndomains = nd;
     v->rank_total = R;
     v->ndomain_verts = ncopies;
     v->ncub = ncub;
     v->nsurf_verts = surf.nverts;
     v->nsurf_tris = surf.ntris;
-    sw_lame(s->ch.youngs, s->ch.poisson, &v->mu, &v->lambda);
+    sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &v->mu, &v->lambda);
     v->rayleigh_alpha = 0.01; /* thesis §2.1.3 */
     v->rayleigh_beta = 0.001;
     v->contact_k = 1e6; /* the training simulations' penalty (fullsim default) */
@@ -271,7 +314,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->cub_weight = cub_weight;
     v->cub_dminv = cub_dminv;
     v->cub_vol = cub_vol;
-    v->spring_hessian = spring;
+    v->spring_hessian = s->reduce.spring = spring; /* the springs stage scales it */
     v->mass = mass;
     v->inertia_s = ins;
     v->inertia_x = inx;
@@ -281,35 +324,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->surf_copy_ptr = copy_ptr;
     v->surf_copies = copies;
     v->nsurf_copies = nsc;
-    double *tq, *tp;
-    OWN(tq, (int64_t)s->ntrain * R, double);
-    OWN(tp, (int64_t)s->ntrain * 4 * s->nb, double);
-    if (!tq || !tp) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-        goto done;
-    }
-    memcpy(tq, s->train_q, (size_t)s->ntrain * R * sizeof(double));
-    memcpy(tp, s->train_pose, (size_t)s->ntrain * 4 * s->nb * sizeof(double));
-    v->ntrain = s->ntrain;
-    v->train_q = tq;
-    v->train_pose = tp;
-    int32_t *cp, *cv;
-    double *cd;
-    OWN(cp, s->ntrain + 1, int32_t);
-    OWN(cv, 8 * (int64_t)s->ncontacts, int32_t);
-    OWN(cd, 7 * (int64_t)s->ncontacts, double);
-    if (!cp || !cv || !cd) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-        goto done;
-    }
-    memcpy(cp, s->contact_ptr, (size_t)(s->ntrain + 1) * sizeof(int32_t));
-    memcpy(cv, s->contact_verts, (size_t)s->ncontacts * 8 * sizeof(int32_t));
-    memcpy(cd, s->contact_data, (size_t)s->ncontacts * 7 * sizeof(double));
-    v->ncontacts = s->ncontacts;
-    v->contact_ptr = cp;
-    v->contact_verts = cv;
-    v->contact_data = cd;
-    r = SINEW_OK;
+    r = pose_sections(s, out, err);
 done:
     free(copy_ptr_v);
     free(copy_list);

@@ -1,3 +1,5 @@
+/* Stage "render" (bake.c, sw_bake_stages): reads s->embed, s->domains, s->basis; writes the view's
+ * render sections. */
 /* The render mesh's blob sections (bake.h "embed" and "reduce"): the embedding computed in
  * prepare (precompute/import/embed.h) turned into the runtime's terms. Only the tets that
  * hold a render vertex are stored (RENDER_TETS), over the simulation vertices at their
@@ -6,7 +8,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 
 #define OWN(ptr, n, type)                                                                          \
     ((ptr) = sw_bake_own(out, calloc((size_t)(n) > 0 ? (size_t)(n) : 1, sizeof(type))))
@@ -22,25 +24,25 @@ static void number_tets_and_nodes(const sw_bake_state *s, int32_t *tet_slot, int
         if (tet_slot[t] >= 0) continue;
         tet_slot[t] = (*nembed)++;
         for (int k = 0; k < 4; ++k) {
-            int32_t gv = s->ch.mesh.tets[4 * (int64_t)t + k];
+            int32_t gv = s->rig.ch.mesh.tets[4 * (int64_t)t + k];
             if (node_of[gv] < 0) node_of[gv] = (*nnodes)++;
         }
     }
 }
 
 sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    const sw_trimesh *rm = &s->ch.render;
+    const sw_trimesh *rm = &s->rig.ch.render;
     const sw_embedding *e = &s->embed;
     if (rm->nverts == 0) return SINEW_OK;
     sw_blob_view *v = &out->view;
-    int32_t nd = s->nd, *tet_slot = malloc((size_t)s->nt * sizeof(int32_t)),
-            *node_of = malloc((size_t)s->nv * sizeof(int32_t));
+    int32_t nd = s->domains.nd, *tet_slot = malloc((size_t)s->rig.nt * sizeof(int32_t)),
+            *node_of = malloc((size_t)s->rig.nv * sizeof(int32_t));
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
     int32_t *tris, *tet, *weld, *tets, *ptr, *copies = NULL, nembed, nnodes;
     double *bary;
     if (!tet_slot || !node_of) goto done;
-    memset(tet_slot, 0xff, (size_t)s->nt * sizeof(int32_t)); /* -1 */
-    memset(node_of, 0xff, (size_t)s->nv * sizeof(int32_t));
+    memset(tet_slot, 0xff, (size_t)s->rig.nt * sizeof(int32_t)); /* -1 */
+    memset(node_of, 0xff, (size_t)s->rig.nv * sizeof(int32_t));
     number_tets_and_nodes(s, tet_slot, node_of, &nembed, &nnodes);
     OWN(tris, 3 * (int64_t)rm->ntris, int32_t);
     OWN(tet, rm->nverts, int32_t);
@@ -54,24 +56,24 @@ sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err
     memcpy(weld, e->weld, (size_t)rm->nverts * sizeof(int32_t));
     for (int32_t i = 0; i < rm->nverts; ++i)
         tet[i] = tet_slot[e->tet[i]];
-    for (int32_t t = 0; t < s->nt; ++t)
+    for (int32_t t = 0; t < s->rig.nt; ++t)
         if (tet_slot[t] >= 0)
             for (int k = 0; k < 4; ++k)
-                tets[4 * tet_slot[t] + k] = node_of[s->ch.mesh.tets[4 * (int64_t)t + k]];
+                tets[4 * tet_slot[t] + k] = node_of[s->rig.ch.mesh.tets[4 * (int64_t)t + k]];
     /* each node's copies, domain by domain: counted, then filled */
-    for (int32_t k = 0; k < s->dom_vert_ptr[nd]; ++k)
-        if (node_of[s->dom_verts[k]] >= 0) ptr[node_of[s->dom_verts[k]] + 1]++;
+    for (int32_t k = 0; k < s->domains.dom_vert_ptr[nd]; ++k)
+        if (node_of[s->domains.dom_verts[k]] >= 0) ptr[node_of[s->domains.dom_verts[k]] + 1]++;
     for (int32_t n = 0; n < nnodes; ++n)
         ptr[n + 1] += ptr[n];
     OWN(copies, 2 * (int64_t)ptr[nnodes], int32_t);
     if (!copies) goto done;
     for (int32_t d = 0; d < nd; ++d)
-        for (int32_t k = s->dom_vert_ptr[d]; k < s->dom_vert_ptr[d + 1]; ++k) {
-            int32_t n = node_of[s->dom_verts[k]];
+        for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k) {
+            int32_t n = node_of[s->domains.dom_verts[k]];
             if (n < 0) continue;
             int32_t at = ptr[n]++;
             copies[2 * at] = d;
-            copies[2 * at + 1] = k - s->dom_vert_ptr[d];
+            copies[2 * at + 1] = k - s->domains.dom_vert_ptr[d];
         }
     for (int32_t n = nnodes; n > 0; --n) /* the fill advanced ptr[n] to ptr[n+1]: back */
         ptr[n] = ptr[n - 1];

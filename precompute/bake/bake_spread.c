@@ -16,7 +16,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 #include "blob_load.h"
 #include "instance.h"
 

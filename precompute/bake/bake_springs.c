@@ -1,3 +1,5 @@
+/* Stage "springs" (bake.c, sw_bake_stages): reads s->reduce, the view, the training poses; writes
+ * the view's spring Hessian (through s->reduce.spring) and the result's spring_*. */
 /* The interface springs' stiffness (thesis eq. 4.20): k/2 |x_c - x_hub|^2 ties every copy
  * of a vertex to its hub copy (bake_reduce.c). Too stiff, and the domains' bases, which
  * cannot match exactly at an interface, lock each other: the reduced model holds only
@@ -5,7 +7,7 @@
  * their mean, but each side of the seam follows its own domain: a crease) and the
  * domains drift apart. Where between depends on the character: the
  * training error is lowest at 10 E h on the hand, the fingers, the elephant and the
- * robot, at 2.5-5 E h on the Fox (measured 2026-12-03, docs/game-assets.md).
+ * robot, at 2.5-5 E h on the Fox (docs/notes/game-assets.md).
  *
  * So, unless the caller gives k, the bake measures the training error (the bake's own
  * figure: pose-space self-contact, sw_bake_train_error) of the blob at each of
@@ -19,7 +21,7 @@
 #include <stdlib.h>
 #include <string.h>
 
-#include "bake_internal.h"
+#include "bake_state.h"
 
 double sw_bake_spring_mult(int i) {
     static const double mult[SW_SPRING_CHOICES] = {20, 10, 5, 2.5};
@@ -39,25 +41,26 @@ double sw_bake_spring_mult(int i) {
  * (above SW_SPRING_MAX_EH E h, or springs that overflow). */
 static sinew_result set_springs(const sw_bake_state *s, sw_bake_result *out, double k,
                                 sw_error *err) {
-    double *spring = (double *)out->view.spring_hessian; /* owned by out (bake_reduce.c) */
+    double *spring = s->reduce.spring; /* the view's, owned by out (bake_reduce.c) */
     int finite = 1;
-    for (int64_t i = 0; i < (int64_t)s->rank_total * s->rank_total; ++i) {
-        spring[i] = k * s->spring_unit[i];
+    for (int64_t i = 0; i < (int64_t)s->basis.rank_total * s->basis.rank_total; ++i) {
+        spring[i] = k * s->reduce.spring_unit[i];
         finite &= isfinite(spring[i]) != 0;
     }
     out->spring_k = k;
-    if (finite && !(k > SW_SPRING_MAX_EH * s->spring_eh)) return SINEW_OK;
+    if (finite && !(k > SW_SPRING_MAX_EH * s->reduce.spring_eh)) return SINEW_OK;
     return sw_error_set(
         err, SINEW_ERROR_INVALID_ARGUMENT,
         "interface springs: stiffness %g is %g E h (E h = %g for this mesh), above the %g E h "
         "where they swamp the flesh (or overflow); without --spring-k the bake chooses among "
         "2.5-20 E h",
-        k, s->spring_eh > 0 ? k / s->spring_eh : 0, s->spring_eh, SW_SPRING_MAX_EH);
+        k, s->reduce.spring_eh > 0 ? k / s->reduce.spring_eh : 0, s->reduce.spring_eh,
+        SW_SPRING_MAX_EH);
 }
 
 sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     out->nspring_tried = 0;
-    out->spring_eh = s->spring_eh;
+    out->spring_eh = s->reduce.spring_eh;
     if (s->p->spring_k > 0) return set_springs(s, out, s->p->spring_k, err);
     int best = -1;
     for (int c = 0; c < SW_SPRING_CHOICES; ++c) {
@@ -65,7 +68,7 @@ sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *er
         void *mem = NULL;
         sinew_blob *blob = NULL;
         sw_eval_result e;
-        sinew_result r = set_springs(s, out, mult * s->spring_eh, err);
+        sinew_result r = set_springs(s, out, mult * s->reduce.spring_eh, err);
         if (r == SINEW_OK) r = sw_bake_result_blob(out, &mem, &blob, err);
         if (r == SINEW_OK)
             r = sw_bake_train_error(blob, out, SINEW_SELF_CONTACT_POSE_SPACE, &e, NULL, err);
@@ -82,5 +85,5 @@ sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *er
         else if (out->spring_tried_err[c] >= eb)
             break; /* past the lowest */
     }
-    return set_springs(s, out, sw_bake_spring_mult(best) * s->spring_eh, err);
+    return set_springs(s, out, sw_bake_spring_mult(best) * s->reduce.spring_eh, err);
 }

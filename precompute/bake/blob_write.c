@@ -8,6 +8,7 @@
 
 #include <errno.h>
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
@@ -237,5 +238,27 @@ sinew_result sw_blob_write(const char *path, const sw_blob_view *view, sw_error 
     if (r != SINEW_OK) return r;
     r = sw_write_file_atomic(path, data, size, err);
     free(data);
+    return r;
+}
+
+sinew_result sw_write_file_check(const char *path, sw_error *err) {
+    struct stat st;
+    if (!path || !path[0]) return io_error(err, "write", "", ENOENT);
+    if (stat(path, &st) == 0 && S_ISDIR(st.st_mode)) return io_error(err, "write", path, EISDIR);
+    size_t len = strlen(path);
+    char *tmp = malloc(len + 5);
+    if (!tmp) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "write: out of memory");
+    memcpy(tmp, path, len);
+    memcpy(tmp + len, ".tmp", 5);
+    const int existed = access(tmp, F_OK) == 0;
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_CLOEXEC, 0644);
+    sinew_result r = SINEW_OK;
+    if (fd < 0)
+        r = io_error(err, "create", tmp, errno);
+    else {
+        close(fd);
+        if (!existed) unlink(tmp);
+    }
+    free(tmp);
     return r;
 }

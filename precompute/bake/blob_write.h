@@ -25,6 +25,12 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
  * the system's reason; other codes as sw_blob_write_memory. */
 sinew_result sw_blob_write(const char *path, const sw_blob_view *view, sw_error *err);
 
+/* Whether `path` can be written as sw_blob_write writes it, before the work that makes
+ * it: not a folder, and its path.tmp can be created in its folder (created and removed
+ * again; a path.tmp already there is opened, not removed). SINEW_ERROR_IO names the file
+ * and the system's reason. */
+sinew_result sw_write_file_check(const char *path, sw_error *err);
+
 /* Writes size bytes to `path` atomically, as sw_blob_write does (path.tmp, fsync,
  * rename, the folder fsynced). */
 sinew_result sw_write_file_atomic(const char *path, const uint8_t *data, size_t size,

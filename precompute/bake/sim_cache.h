@@ -1,4 +1,4 @@
-/* The simulate stage's cache file (issue 14: a re-bake redoes only what changed). The
+/* The simulate stage's cache file (a re-bake redoes only what changed). The
  * full-space solutions of every pose sequence and their contact sets, under a key that
  * hashes everything they depend on (bake_cache.c), so that a bake that changes only the
  * cubature tolerance, the rank or the report reads them back instead of solving again.

@@ -14,6 +14,7 @@
 #include <math.h>
 #include <stdio.h>
 #include <stdlib.h>
+#include <errno.h>
 #include <string.h>
 
 #include "gltf_precheck.h"
@@ -688,7 +689,9 @@ sinew_result sw_scene_import(const char *path, const sw_import_options *o,
     sinew_result rc = check_options(o, name, &use, err);
     if (rc) return rc;
     FILE *f = path ? fopen(path, "rb") : NULL;
-    if (!f) return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot open", name);
+    if (!f) /* the system's reason (a missing file: "No such file or directory") */
+        return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot open: %s", name,
+                            strerror(path ? errno : EINVAL));
     const char *dot = strrchr(path, '.');
     int gltf = is_gltf_ext(dot ? dot + 1 : NULL);
     rc = gltf ? precheck_file(f, is_glb(dot + 1), name, err) : SINEW_OK;

@@ -5,33 +5,25 @@
 #include <stdio.h>
 #include <string.h>
 
+#include "blob_write.h"
+
 static const char *const tool = "sinew-bake";
+
+enum { BAKE_NFLAGS = 16, RESEARCH_NFLAGS = 40 }; /* room in the groups' arrays */
 
 #define TEXT_(x) #x
 #define TEXT(x) TEXT_(x)
 
 static const char *const SYNOPSIS =
-    "sinew-bake (FILE [--tets N] [--train-clips A,B] [--heldout-clips C]\n"
-    "                   [--fps F] [--height H] |\n"
-    "                   --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
-    "                   --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
-    "                   [--clip FILE [--frames F] | --joint-range FILE])\n"
-    "                  --out FILE.blob [--report DIR]\n"
-    "                  [--selector greedy|importance|nnhtp] [--tol T]\n"
-    "                  [--max-rank R] [--fold-share S] [--spring-k K]\n"
-    "                  [--compare-cubature] [--no-self-contact]\n"
-    "                  [--return-path|--no-return-path]\n"
-    "                  [--pair-sweeps | --no-pair-sweeps] [--no-sibling-sweeps]\n"
-    "                  [--adaptive R [--adaptive-add K]\n"
-    "                  [--adaptive-candidates C] [--adaptive-budget B]\n"
-    "                  [--adaptive-target E]] [--heldout-steps S]\n"
-    "                  [--random-poses N] [--seed S]\n"
-    "                  [--inertia-modes] [--contact-modes] [--contact-tol T]\n"
-    "                  [--no-pose-force]\n"
-    "                  [--eval-self-contact pose-space|pose-pairs]\n"
-    "                  [--reference-spread K] [reference options]\n"
-    "                  [--cache DIR] [--threads T] [--force]\n"
-    "                  [--json]\n";
+    "sinew-bake FILE --out FILE.blob [--report DIR] [--tets N]\n"
+    "                  [--train-clips A,B] [--heldout-clips C]\n"
+    "       sinew-bake (FILE | --scene NAME | --mesh FILE --skeleton FILE.tgf)\n"
+    "                  --out FILE.blob [bake options] [character options]\n"
+    "                  [research options] [reference options]\n"
+    "An artist's bake needs the rigged glTF 2.0 / FBX FILE, --out, and often --report,\n"
+    "--tets and the clips (--train-clips, --heldout-clips); the rest has defaults that\n"
+    "suit a character. A character's only clip is split: the figures are measured on its\n"
+    "last 40%, then the blob ships trained on all of it (--ship-split: the split's).\n";
 
 /* --selector greedy | importance | nnhtp */
 static int take_selector(const char *tool, const char *flag, const char *v, void *target) {
@@ -58,11 +50,10 @@ static int take_fold_share(const char *tool, const char *flag, const char *v, vo
     return ok;
 }
 
-/* The bake's own flags, bound to o, into f; returns their count. */
+/* The bake's own flags (what every bake may want), bound to o, into f; returns their
+ * count. */
 static size_t bake_flags(bake_options *o, sw_flag *f) {
-    static const char *const eval_modes[] = {"pose-space", "pose-pairs", NULL};
     sw_bake_params *p = &o->p;
-    sw_adaptive_params *ad = &o->ad;
     const sw_flag flags[] = {
         {SW_STR("--out", &o->out_path, "FILE",
                 "the blob to write (atomically: FILE.tmp, then renamed)")},
@@ -70,6 +61,34 @@ static size_t bake_flags(bake_options *o, sw_flag *f) {
                 "write the bake report: DIR/report.html (plots of every clip\n"
                 "frame's error, ranks, cubature, stage times, a contact sheet of\n"
                 "held-out frames) and DIR/report.json (the same figures)")},
+        {SW_STR("--cache", &p->cache_dir, "DIR",
+                "keep the full-space solutions in DIR and reuse them when a\n"
+                "later bake solves the same poses of the same character (a\n"
+                "re-bake that changes the cubature, rank or report only)")},
+        {SW_SET("--ship-split", &p->ship_split, 1,
+                "ship the blob trained on the split of a character's only\n"
+                "clip, the one the held-out figures measure (default: baked\n"
+                "again on the whole clip once measured)")},
+        {SW_INT("--threads", &p->threads, 0, 256, "T", "0..256 (default 0: all cores)")},
+        {SW_SET("--force", &o->force, 1,
+                "write the blob even when its training error is " TEXT(
+                    SW_BAKE_MAX_TRAIN_ERROR) " or more\n"
+                                             "(the share of the physics correction it misses "
+                                             "on its own\n"
+                                             "training poses; without --force that is an error)")},
+        {SW_SET("--json", &o->json, 1, "one JSON object with the figures as the last stdout line")},
+    };
+    _Static_assert(SW_FLAGS_N(flags) <= BAKE_NFLAGS, "room for the flags");
+    memcpy(f, flags, sizeof flags);
+    return SW_FLAGS_N(flags);
+}
+
+/* The model's knobs, for studying the method, bound to o, into f; returns their count. */
+static size_t research_flags(bake_options *o, sw_flag *f) {
+    static const char *const eval_modes[] = {"pose-space", "pose-pairs", NULL};
+    sw_bake_params *p = &o->p;
+    sw_adaptive_params *ad = &o->ad;
+    const sw_flag flags[] = {
         {SW_CALL("--selector", take_selector, &p->selector, "S",
                  "cubature selector: greedy | importance | nnhtp (default)")},
         {SW_REAL("--tol", &p->cubature_tol, 0, 1, "in the open range 0..1", "T",
@@ -157,19 +176,8 @@ static size_t bake_flags(bake_options *o, sw_flag *f) {
                 "for the dynamic step: basis modes for the inertia of the\n"
                 "bones' accelerations (static responses to them), so that the\n"
                 "flesh lags and overshoots as the reference does; a higher rank")},
-        {SW_STR("--cache", &p->cache_dir, "DIR",
-                "keep the full-space solutions in DIR and reuse them when a\n"
-                "later bake solves the same poses of the same character (a\n"
-                "re-bake that changes the cubature, rank or report only)")},
-        {SW_INT("--threads", &p->threads, 0, 256, "T", "0..256 (default 0: all cores)")},
-        {SW_SET("--force", &o->force, 1,
-                "write the blob even when its training error is " TEXT(
-                    SW_BAKE_MAX_TRAIN_ERROR) " or more\n"
-                                             "(the share of the physics correction it misses "
-                                             "on its own\n"
-                                             "training poses; without --force that is an error)")},
-        {SW_SET("--json", &o->json, 1, "one JSON object with the figures as the last stdout line")},
     };
+    _Static_assert(SW_FLAGS_N(flags) <= RESEARCH_NFLAGS, "room for the flags");
     memcpy(f, flags, sizeof flags);
     return SW_FLAGS_N(flags);
 }
@@ -183,10 +191,13 @@ int bake_parse_args(int argc, char **argv, bake_options *o) {
     o->ad = sw_adaptive_params_default();
     o->ad.rounds = 0;
     o->p.progress = 1;
-    sw_flag character[SW_CHARACTER_NFLAGS], bake[48], reference[SW_REFERENCE_NFLAGS];
+    sw_flag character[SW_CHARACTER_NFLAGS], bake[BAKE_NFLAGS], research[RESEARCH_NFLAGS],
+        reference[SW_REFERENCE_NFLAGS];
     const sw_flag_group groups[] = {
-        {"character:\n" SW_CHARACTER_FILE_USAGE, character, sw_character_flags(&o->ca, character)},
         {"bake:", bake, bake_flags(o, bake)},
+        {"character:\n" SW_CHARACTER_FILE_USAGE, character, sw_character_flags(&o->ca, character)},
+        {"research (the model's knobs, for studying the method):", research,
+         research_flags(o, research)},
         {"reference options (every full-space solve of the bake; a change of them\n"
          "solves the poses again instead of reading the cache):",
          reference, sw_reference_flags(&o->reference, reference)}};
@@ -214,5 +225,9 @@ int bake_parse_args(int argc, char **argv, bake_options *o) {
                     dirs[k][0], dirs[k][1], strerror(errno ? errno : EACCES));
             return 1;
         }
+    /* the blob's path too: a folder that is missing, or a path that is a folder */
+    sw_error err;
+    sinew_result r = sw_write_file_check(o->out_path, &err);
+    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: --out: ", tool);
     return 0;
 }

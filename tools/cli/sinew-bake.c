@@ -75,6 +75,8 @@ typedef struct {
     int32_t kept; /* the pose-space pairs the per-pair cubature keeps */
     sw_joint_reach beyond[BAKE_BEYOND];
     int32_t nbeyond_all, nbeyond;
+    int ship_whole;       /* the blob shipped is baked again on the whole clip */
+    sw_bake_result whole; /* that bake */
 } bake;
 
 /* The character from the command line, its summary on stderr. */
@@ -186,6 +188,7 @@ static int write_outputs(const bake *b) {
     const int force = b->o.force;
     const int spread_every = b->o.spread_every;
     const int absurd = b->absurd;
+    const sw_bake_result *shipped = b->ship_whole ? &b->whole : &b->res;
     sw_error err;
     sinew_result r;
     if (absurd && !force && et.failed > 0) {
@@ -206,7 +209,7 @@ static int write_outputs(const bake *b) {
                 tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
         return 1;
     }
-    if ((r = sw_blob_write(out_path, &res.view, &err)) != SINEW_OK) {
+    if ((r = sw_blob_write(out_path, &shipped->view, &err)) != SINEW_OK) {
         sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
         return 1;
     }
@@ -272,11 +275,10 @@ static void print_summary(const bake *b) {
     char num[32];
     const sw_blob_view *v = &res.view;
     fprintf(stderr, "%s: wrote %s\n", tool, out_path);
-    fprintf(stderr,
-            "  stages (s): prepare %.2f, domains %.2f, simulate %.2f, basis %.2f, cubature %.2f, "
-            "reduce %.2f; total %.2f\n",
-            res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2], res.stage_seconds[3],
-            res.stage_seconds[4], res.stage_seconds[5], bake_seconds);
+    fprintf(stderr, "  stages (s):");
+    for (int k = 0; k < SW_BAKE_NSTAGES; ++k) /* the bake's table (bake.h) */
+        fprintf(stderr, "%s %s %.2f", k ? "," : "", sw_bake_stages[k].name, res.stage_seconds[k]);
+    fprintf(stderr, "; total %.2f\n", bake_seconds);
     fprintf(stderr, "  domains %d, total rank %d (", v->ndomains, v->rank_total);
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].rank);
@@ -423,14 +425,17 @@ static void print_json(const bake *b) {
                "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
                "heldout\":%.5f,"
                "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
-               "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f,\"stage_seconds\":[%.2f,%.2f,%.2f,%.2f,"
-               "%.2f,%.2f]",
+               "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f",
                out_path, ch.mesh.ntets, ch.mesh.nverts, ch.skel.nbones, v->ndomains, v->rank_total,
                v->ncub, res.cubature_error_max, res.ntrain, res.return_poses, res.pair_sweep_poses,
                res.nheldout, res.train_proj_error, res.heldout_proj_error, et.correction_error,
                eh.correction_error, res.train_unsettled, res.heldout_unsettled, bake_seconds,
-               eval_seconds, res.stage_seconds[0], res.stage_seconds[1], res.stage_seconds[2],
-               res.stage_seconds[3], res.stage_seconds[4], res.stage_seconds[5]);
+               eval_seconds);
+        printf(",\"stages\":["); /* the bake's table (bake.h), as the report's JSON */
+        for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
+            printf("%s{\"name\":\"%s\",\"seconds\":%.2f}", k ? "," : "", sw_bake_stages[k].name,
+                   res.stage_seconds[k]);
+        printf("]");
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
                "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
                res.force_poses, model_err, sw_linear_solver_name(reference.solver),
@@ -513,13 +518,32 @@ static void print_json(const bake *b) {
             printf(",%.2f,%.2f]", beyond[k].heldout_deg, beyond[k].train_deg);
         }
         printf("]");
-        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s}\n",
+        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s,"
+               "\"shipped\":\"%s\"}\n",
                res.simulate_cached ? "true" : "false", res.simulate_solved,
-               absurd ? "true" : "false");
+               absurd ? "true" : "false", b->ship_whole ? "whole_clip" : "as_measured");
     }
 }
 
+/* The figures are the split's; a character's only clip then ships trained on the whole
+ * clip (sw_bake_ships_whole_clip) unless --ship-split or adaptive rounds. Not when the
+ * blob is not going to be written (absurd without --force). */
+static int ship_whole_clip(bake *b, sw_error *err) {
+    const bake_options *o = &b->o;
+    if (o->ad.rounds > 0 || !sw_bake_ships_whole_clip(&b->ch, &o->p)) return 0;
+    if (b->absurd && !o->force) return 0;
+    fprintf(stderr,
+            "%s: the figures are of the split (held-out: the clip's last %.0f%%); the blob "
+            "ships baked on all %d frames of the clip (--ship-split: the split's)\n",
+            tool, 100 * o->p.heldout_fraction, b->ch.clip.nframes);
+    sinew_result r = sw_bake_whole_clip(&b->ch, &o->p, &b->whole, err);
+    if (r != SINEW_OK) return sw_tool_failed(r, err, "%s: the whole clip's bake: ", tool);
+    b->ship_whole = 1;
+    return 0;
+}
+
 static void bake_free(bake *b) {
+    sw_bake_result_free(&b->whole);
     sw_bake_spread_free(&b->spread);
     sinew_blob_destroy(b->blob);
     free(b->mem);
@@ -539,7 +563,8 @@ int main(int argc, char **argv) {
         sw_clip_split_free(&b.clips);
         return status;
     }
-    if (!(status = measure(&b, &err)) && !(status = write_outputs(&b))) {
+    if (!(status = measure(&b, &err)) && !(status = ship_whole_clip(&b, &err)) &&
+        !(status = write_outputs(&b))) {
         print_summary(&b);
         print_json(&b);
     }

@@ -32,7 +32,10 @@ int sw_tool_failed(sinew_result r, const sw_error *err, const char *prefix, ...)
     va_start(ap, prefix);
     vfprintf(stderr, prefix, ap);
     va_end(ap);
-    fprintf(stderr, "%s (%s)\n", err->msg, sinew_result_string(r));
+    if (r == SINEW_ERROR_IO) /* its message names the system's reason: "No such file..." */
+        fprintf(stderr, "%s\n", err->msg);
+    else
+        fprintf(stderr, "%s (%s)\n", err->msg, sinew_result_string(r));
     return 1;
 }
 

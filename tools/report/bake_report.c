@@ -21,6 +21,8 @@
  *   seams {train, heldout, max_train, max_heldout}: the domains' copies of a vertex apart
  *              (sw_eval_result's seam, seam_max), or null
  *   bake_seconds, eval_seconds, stages [{name, seconds}]
+ *   render {verts, outside, max_outside}: the render mesh's vertices, those embedded
+ *              outside the tets (they follow the nearest tet, extrapolated), or null
  *   clips [{name, split "train" | "heldout", frames [clip frame], error [per frame]}]
  *   sweeps {poses, mean_error}: the training poses of no clip (joint sweeps, return path)
  *   domains [{bone, rank, energy, cubature}]
@@ -57,17 +59,15 @@
 #include "pose_space.h"
 #include "tool_common.h"
 
-/* The one place the report reads the bake's stage list: the names of the first
- * SW_BAKE_REPORT_STAGES slots of sw_bake_result.stage_seconds. */
+/* The one place the report reads the bake's stage list: the bake's own table
+ * (sw_bake_stages, bake.h) and the seconds sw_bake_result.stage_seconds keeps for each. */
 int32_t report_stage_times(const sw_bake_result *res, const char **names, double *seconds) {
-    _Static_assert(SW_BAKE_REPORT_STAGES <= REPORT_MAX_STAGES, "room for the stages");
-    static const char *const stage_names[SW_BAKE_REPORT_STAGES] = {
-        "prepare", "domains", "simulate", "basis", "cubature", "reduce"};
-    for (int32_t k = 0; k < SW_BAKE_REPORT_STAGES; ++k) {
-        names[k] = stage_names[k];
+    _Static_assert(SW_BAKE_NSTAGES <= REPORT_MAX_STAGES, "room for the stages");
+    for (int32_t k = 0; k < SW_BAKE_NSTAGES; ++k) {
+        names[k] = sw_bake_stages[k].name;
         seconds[k] = res->stage_seconds[k];
     }
-    return SW_BAKE_REPORT_STAGES;
+    return SW_BAKE_NSTAGES;
 }
 
 void report_bone_name(const sw_character *ch, int32_t bone, char *buf, size_t n) {
@@ -392,6 +392,13 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
         cJSON_AddNumberToObject(o, "seconds", seconds[k]);
         cJSON_AddItemToArray(st, o);
     }
+    if (in->ch->render.nverts > 0) { /* the bake's log warns of vertices outside */
+        cJSON *rd = cJSON_AddObjectToObject(j, "render");
+        cJSON_AddNumberToObject(rd, "verts", in->ch->render.nverts);
+        cJSON_AddNumberToObject(rd, "outside", res->render_outside);
+        cJSON_AddNumberToObject(rd, "max_outside", res->render_max_outside);
+    } else
+        cJSON_AddNullToObject(j, "render");
     cJSON_AddItemToObject(j, "clips", json_clips(r));
     cJSON *sw = cJSON_AddObjectToObject(j, "sweeps");
     cJSON_AddNumberToObject(sw, "poses", r->sweep_poses);

@@ -23,7 +23,6 @@
 #include "sw_mesh.h"
 
 #define SW_BAKE_REPORT_VERSION 1
-#define SW_BAKE_REPORT_STAGES 6
 
 /* The held-out error the verdict measures against when none is given: sinew's acceptance
  * limit for a character's held-out clip (the runtime misses at most a fifth of the

@@ -1,10 +1,12 @@
-/* State shared by the bake's stages (bake.c orchestrates; one file per stage). */
-#ifndef SW_BAKE_INTERNAL_H
-#define SW_BAKE_INTERNAL_H
+/* The bake's state and the helpers its stages share (bake_state.c), below the stages:
+ * every stage file includes this, none the orchestrator's bake.h. */
+#ifndef SW_BAKE_STATE_H
+#define SW_BAKE_STATE_H
 
 #include <pthread.h>
 
-#include "bake.h"
+#include "bake_eval.h"
+#include "bake_params.h"
 #include "dqs.h"
 #include "embed.h"
 #include "fullsim.h"
@@ -39,16 +41,19 @@ typedef struct sw_pose_seq {
     int from_cache; /* its solutions were read from the simulate cache: not solved again */
 } sw_pose_seq;
 
-typedef struct sw_bake_state {
-    const sw_bake_params *p;
-    sw_character ch; /* the character with the bake's weights (mesh/skeleton borrowed) */
-    double *weights; /* owned nverts * nbones */
+/* The state, grouped by the stage that writes it (bake.c, sw_bake_stages): a stage
+ * reads the groups of the stages before it and writes its own. */
+typedef struct sw_rig_state { /* prepare */
+    sw_character ch;          /* the character with the bake's weights (mesh/skeleton borrowed) */
+    double *weights;          /* owned nverts * nbones */
     int32_t nv, nt, nb;
     /* top-4 skin influences (runtime's DQS) */
     int32_t *skin_bone;  /* 4 nv */
     double *skin_weight; /* 4 nv */
     double *mass;        /* nv lumped masses (all tets) */
-    /* domains */
+} sw_rig_state;
+
+typedef struct sw_domains_state { /* domains */
     int32_t nd;
     int32_t *tet_domain;   /* nt */
     int32_t *domain_bone;  /* nd */
@@ -57,42 +62,73 @@ typedef struct sw_bake_state {
     int32_t *dom_tet_ptr;  /* nd + 1 into dom_tets */
     int32_t *dom_tets;     /* tets of each domain, ascending */
     double *copy_mass;     /* per copy: mass from the domain's own tets */
-    /* poses */
+} sw_domains_state;
+
+typedef struct sw_poses_state { /* poses; simulate fills the sequences' solutions */
     sw_pose_seq *train;
     int32_t ntrain_seq;
     double *sweep_axis, *sweep_angle; /* per bone: each joint's sweep (bake_poses.c) */
-    int64_t solved_poses;     /* poses the simulate stage solved (not read from the cache) */
-    int32_t return_poses;     /* poses on the way home (bake_poses.c, return_frames) */
+    int32_t return_poses;             /* poses on the way home (bake_poses.c, return_frames) */
     int32_t pair_sweep_poses; /* poses of the joints swept with their parents (sweep_pairs) */
     sw_pose_seq heldout;
-    /* basis: per domain 3 n_d x r_d, row-major */
+    int64_t solved_poses; /* poses the simulate stage solved (not read from the cache) */
+} sw_poses_state;
+
+typedef struct sw_basis_state { /* basis: per domain 3 n_d x r_d, row-major */
     int32_t *rank;
-    double **basis;
+    double **U;
     int32_t rank_total;
     double *train_q;    /* ntrain x rank_total: projected training solutions */
     double *train_pose; /* ntrain x 4 nbones: pose features */
     int32_t ntrain;
-    /* pose-space self-contact pairs of the training solutions (bake_contacts.c) */
+} sw_basis_state;
+
+typedef struct sw_cubature_state { /* cubature: per domain local tet index into dom_tets and weights
+                                    */
+    int32_t *n;
+    int32_t **local; /* index into the domain's dom_tets range */
+    double **w;
+} sw_cubature_state;
+
+typedef struct sw_contacts_state { /* contacts: pose-space self-contact pairs of the training
+                                     solutions (bake_contacts.c) */
     int32_t ncontacts;
     int32_t *contact_ptr;   /* ntrain + 1 */
     int32_t *contact_verts; /* 8 per contact */
     double *contact_data;   /* 7 per contact */
-    /* cubature: per domain local tet index into dom_tets and weights */
-    int32_t *cub_n;
-    int32_t **cub_local; /* index into the domain's dom_tets range */
-    double **cub_w;
+} sw_contacts_state;
+
+typedef struct sw_reduce_state { /* reduce */
     /* interface springs (bake_reduce.c): their Hessian at unit stiffness (rank_total^2)
        and the stiffness of one vertex of the mesh, E h, the unit of the choice */
     double *spring_unit;
     double spring_eh;
+    double *spring; /* the view's spring Hessian (owned by the result): springs scales it */
+} sw_reduce_state;
+
+typedef struct sw_bake_state {
+    /* inputs */
+    const sw_bake_params *p;
+    const sw_character *c;
     sw_pool *pool;
-    sw_embedding embed; /* the render mesh in the tets (none: nverts 0) */
+    /* the stages' results */
+    sw_rig_state rig;
+    sw_embedding embed; /* embed: the render mesh in the tets (none: nverts 0) */
+    sw_domains_state domains;
+    sw_poses_state poses;
+    sw_basis_state basis;
+    sw_cubature_state cubature;
+    sw_contacts_state contacts;
+    sw_reduce_state reduce;
     /* progress of the running stage (sw_bake_progress) */
     pthread_mutex_t progress_lock;
     int64_t progress_done, progress_total;
     double progress_t0;
     const char *progress_stage;
 } sw_bake_state;
+
+/* The state's memory (every group; what a failed stage leaves too) and the pool. */
+void sw_bake_state_free(sw_bake_state *s);
 
 /* Starts stage progress over `total` units; then sw_bake_progress(s, 1) from any thread
  * as units finish: params->on_progress sees them one call at a time. */
@@ -103,65 +139,54 @@ void sw_bake_progress(sw_bake_state *s, int64_t units);
 void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R /* 9 nv */,
                              double *t /* 3 nv */);
 
-sinew_result sw_bake_domains(sw_bake_state *s, sw_error *err);
+/* Helpers of the stages after domains and basis (bake_shapes.c). */
 /* Rest data of domain dm's tets in dom_tets order: each corner's copy in the domain
  * (tet_local, 4 a tet), Dm^-1 (9 a tet; zero for a degenerate tet) and rest volume (0 for
  * a degenerate tet). local_of: nverts ints of scratch. */
 void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
                          double *dminv, double *vol);
-sinew_result sw_bake_poses(sw_bake_state *s, sw_error *err);
-sinew_result sw_bake_simulate(sw_bake_state *s, sw_error *err);
 /* The reference simulator's parameters of the simulate stage (threads aside). */
 sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p);
-/* The simulate stage through the cache of sw_bake_params.cache_dir (bake_cache.c): the
- * solutions read back when the cache holds this bake's, else solved and stored. Sets
- * *cached when they were read back. */
-sinew_result sw_bake_simulate_cached(sw_bake_state *s, int *cached, sw_error *err);
-/* The un-skinned displacements of one pose (bake_basis.c, thesis eq. 4.13): d (3 nv) from
+/* The simulate stage's cache (bake_cache.c; sw_bake_params.cache_dir, nothing without
+ * one): read marks the pose chains the cache holds as solved (sw_pose_seq.from_cache),
+ * *all when it holds every one; store writes the chains that were solved. */
+sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err);
+void sw_bake_cache_store(sw_bake_state *s);
+/* The un-skinned displacements of one pose (thesis eq. 4.13): d (3 nv) from
  * positions x and bone transforms T, d_v = R_v^T (x_v - t_v) - rest_v (0 at bone-driven
  * vertices); R (9 nv) and t (3 nv) are scratch for the skinning transforms. */
 void sw_bake_unskin(const sw_bake_state *s, const double *T, const double *x, double *R, double *t,
                     double *d);
-sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-/* The Galerkin errors (bake_galerkin.c), once the springs are chosen: the training and
- * held-out snapshots projected in the reduced model's linearised energy (sw_bake_result
- * train_galerkin_error, heldout_galerkin_error). */
-sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* G (na x nb) = A K B^T: the products of the rows of A and B (na and nb rows of domain dm's
  * 3 n copies' displacements) in the rest linear-elastic energy of the domain's tets, K
- * the stiffness of the co-rotational energy (eq. 2.3) at rest (bake_basis.c). B NULL: the
+ * the stiffness of the co-rotational energy (eq. 2.3) at rest. B NULL: the
  * Gram matrix of A (na x na). 0 when out of memory. The PCA's strain share
  * (sw_bake_params.pca_strain) and the Galerkin errors (bake_galerkin.c) take them. */
 int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A, int32_t na,
                             const double *B, int32_t nb, double *G);
-sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-sinew_result sw_bake_contacts(sw_bake_state *s, sw_error *err);
-sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-/* The interface springs' stiffness (bake_springs.c), once the view is whole: the given
- * sw_bake_params.spring_k, or the one of the sw_bake_spring_mult multiples of E h the training
- * poses prefer. */
-sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-/* The pose-space equilibrium force of every training pose (bake_equilibrium.c), once the
- * view is whole and its springs chosen (sw_bake_params.pose_force; 0: none). */
-sinew_result sw_bake_equilibrium(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-/* The render mesh's sections of the view from s->embed (nothing without a render mesh);
- * after sw_bake_reduce (bake_render.c). */
-sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-/* The condensation tet mesh's sections of the view (the whole tet mesh, its incidences and
- * lumped masses, the cubature tets' ids); after sw_bake_reduce (bake_cond.c). */
-sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err);
-
-/* The per-pair self-contact sections of the view (groups of domains, pose features, each
- * pose's pairs sorted by group with their cubature weights); after sw_bake_cond
- * (bake_pairs.c). */
-sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* The pairs stage's cubature of one (pose, group): weights w (n) >= 0 for the columns of A
  * (m x n, column-major: each pair's reduced contact force) with |A w - A 1| <= tol |A 1|,
  * by the cubature trainer's greedy selector (cubature_train.h); a zero column keeps
  * weight 0. */
 sinew_result sw_bake_pair_cubature(const double *A, int64_t m, int32_t n, double tol, double *w,
                                    sw_error *err);
-/* Records an owned allocation in the result (freed with it); returns p. */
-void *sw_bake_own(sw_bake_result *out, void *p);
+
+/* The stages, in the order sw_bake runs them (bake.c, sw_bake_stages, says what each reads
+ * and writes; so does each stage file's opening comment). */
+sinew_result sw_bake_prepare(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_embed(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_poses(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_simulate(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_contacts(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+sinew_result sw_bake_equilibrium(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 
 #endif
