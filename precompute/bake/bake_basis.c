@@ -10,9 +10,9 @@
  * projected in the energy norm (the Galerkin projection, bake_galerkin.c), so that span
  * is chosen for what this projection keeps of the training snapshots. Measured, it keeps
  * more modes at the same energy share, and its held-out gains come from those: at the
- * plain PCA's ranks it is no better (docs/notes/generalisation.md), so it is off by default. Rows of
- * bone-driven vertices are zero, so in the subspace those vertices follow their bone exactly, as in
- * the reference. A bake for dynamics appends inertia modes (add_inertia_modes). */
+ * plain PCA's ranks it is no better (docs/notes/generalisation.md), so it is off by default. Rows
+ * of bone-driven vertices are zero, so in the subspace those vertices follow their bone exactly, as
+ * in the reference. A bake for dynamics appends inertia modes (add_inertia_modes). */
 #include <cblas.h>
 #include <lapacke.h>
 #include <math.h>

@@ -224,8 +224,9 @@ typedef struct sw_joint_reach {
  * step's rule, sw_joint_beyond_training), the
  * largest multiple of the trained bend first, at most max of them into out; returns how many there
  * are (-1 out of memory). There the basis extrapolates: a held-out clip that turns a joint two or
- * three times as far as the training clips is beyond what the bake learnt (docs/notes/generalisation.md
- * "The Fox's Run is beyond its training"). Random held-out poses stay within the sweeps. */
+ * three times as far as the training clips is beyond what the bake learnt
+ * (docs/notes/generalisation.md "The Fox's Run is beyond its training"). Random held-out poses stay
+ * within the sweeps. */
 int32_t sw_bake_beyond_training(const sw_bake_result *r, const sw_skeleton *sk, sw_joint_reach *out,
                                 int32_t max);
 

@@ -12,8 +12,8 @@
  *
  * The lattice mesher (tet_lattice.h) stays the default: it takes any surface (holes,
  * several intersecting primitives, open sheets), its count follows the request, and its
- * angles are 45-90 degrees by construction. docs/notes/game-assets.md, "The lattice or TetGen", compares
- * the two on the shared characters. */
+ * angles are 45-90 degrees by construction. docs/notes/game-assets.md, "The lattice or TetGen",
+ * compares the two on the shared characters. */
 #ifndef SW_TETGEN_RUN_H
 #define SW_TETGEN_RUN_H
 

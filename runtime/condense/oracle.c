@@ -264,12 +264,12 @@ static void full_tets(sw_cond *c, const sw_reduced *red) {
 /* Eq. 4.12 where the patch covers most of a domain: the domain's cubature was fitted to
  * the whole domain, and scaled to the little volume left outside it stands for that rest
  * badly (the 100K capsule at rho 0.236 missed 0.124 of the correction against 0.093 at
- * rho 0.151, the difference outside the patch; docs/notes/world.md). Past SW_COND_EXACT_SHARE of its
- * volume in the patch, the domain's other tets become elements whose four corners are all
- * ring copies, evaluated exactly at q (its cubature's weights go to 0 with its volume
- * outside): no more tets than the patch holds of that domain, so no O(N) work. A domain
- * the budget's arrays cannot hold keeps its scaled cubature. Leaves each domain's volume
- * in the patch in dom_fv (all of it for these), the scale sw_cond_weights_apply reads. */
+ * rho 0.151, the difference outside the patch; docs/notes/world.md). Past SW_COND_EXACT_SHARE of
+ * its volume in the patch, the domain's other tets become elements whose four corners are all ring
+ * copies, evaluated exactly at q (its cubature's weights go to 0 with its volume outside): no more
+ * tets than the patch holds of that domain, so no O(N) work. A domain the budget's arrays cannot
+ * hold keeps its scaled cubature. Leaves each domain's volume in the patch in dom_fv (all of it for
+ * these), the scale sw_cond_weights_apply reads. */
 static void exact_domains(sw_cond *c, const sw_reduced *red) {
     const sw_blob_view *v = c->v;
     c->nring_patch = c->nring;
