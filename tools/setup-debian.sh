@@ -19,6 +19,12 @@ packages=(
     abigail-tools    # abidw/abidiff: the ABI baseline test (tests/abi/abi_check.sh)
     clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
     python3          # docs/status.md from the benchmarks' JSON (tools/scripts/status_table.py)
+    libglfw3-dev     # sinew-view's window and GL context
+    libgl-dev        # sinew-view: OpenGL 3.3 core (Mesa)
+    libgl1-mesa-dri  # Mesa's llvmpipe: sinew-view without a GPU
+    xvfb             # sinew-view's tests and offscreen runs (xvfb-run)
+    xauth            # xvfb-run needs it
+    ffmpeg           # sinew-view --record
 )
 
 installed() {

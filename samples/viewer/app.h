@@ -1,0 +1,64 @@
+/* The viewer's state between its main loop (main.c) and the rest: options, the blob,
+ * the imported character, the instances, the view and the timings. */
+#ifndef SW_VIEWER_APP_H
+#define SW_VIEWER_APP_H
+
+#include <stdint.h>
+#include <stdio.h>
+
+#include "gl.h"
+#include "sim.h"
+
+enum { VW_VIEW_SINEW = 1, VW_VIEW_SKIN = 2, VW_VIEW_BOTH = 3 };
+
+typedef struct vw_options {
+    const char *blob, *asset, *scene, *clip, *world, *screenshot, *record, *script;
+    int instances, threads, frames, width, height, json, view, dqs, dynamic, colour;
+    double step_hz, render_hz, colour_scale;
+} vw_options;
+
+typedef struct vw_event {
+    double t;
+    char key;
+} vw_event;
+
+typedef struct vw_app {
+    vw_options opt;
+    sinew_blob *blob;
+    vw_asset asset;
+    vw_sim sim;
+    void *window;
+    vw_glmesh *mesh_sinew, *mesh_skin; /* per instance */
+    float *col_sinew, *col_skin;       /* scratch colours */
+    uint32_t *tris;
+    int32_t ntris;
+    float size; /* the rest surface's bounding-box diagonal */
+    float rest_lo[3], rest_hi[3];
+    int clip;
+    /* controls */
+    int paused, single, slow, reinit, view, teleport_pending;
+    double step_dt, acc, sim_t;
+    vw_event *events;
+    int nevents, next_event;
+    /* figures */
+    int steps_this_frame;
+    int64_t steps, frames, step_frames;
+    double step_ms_sum, render_ms_sum, last_render_ms, wall_s;
+    uint8_t *hud, *pixels;
+    int hud_w, hud_h;
+    FILE *ffmpeg;
+} vw_app;
+
+/* -1: go on; otherwise the exit code (help printed, or bad arguments). */
+int vw_app_parse(vw_app *app, int argc, char **argv);
+int vw_app_load(vw_app *app, char *err, size_t errlen);
+int vw_app_gl_setup(vw_app *app, char *err, size_t errlen);
+int vw_app_reinit(vw_app *app);
+void vw_app_key(vw_app *app, char key);
+void vw_app_script(vw_app *app, double clock);
+void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms);
+int vw_app_capture(vw_app *app, int w, int h, int last_frame);
+void vw_app_print_json(const vw_app *app);
+void vw_app_free(vw_app *app);
+
+#endif

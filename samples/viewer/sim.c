@@ -1,0 +1,126 @@
+/* Stepping N instances on T threads. The instances are independent (sinew.h): a worker
+ * owns instances k, k + T, ...; workers are started for each batch of steps, which costs
+ * tens of microseconds a frame and keeps the viewer free of a job system. */
+#include "sim.h"
+
+#include <pthread.h>
+#include <stdlib.h>
+#include <string.h>
+
+static void log_stderr(sinew_log_level level, uint32_t id, const char *msg, void *user) {
+    (void)user;
+    fprintf(stderr, "sinew-view: sinew %s %u: %s\n", level == SINEW_LOG_ERROR ? "error" : "warning",
+            id, msg);
+}
+
+static int create_instances(vw_sim *s, char *err, size_t errlen) {
+    sinew_instance_def d = sinew_instance_def_default();
+    d.mode = s->dynamic ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+    d.logger.log = log_stderr;
+    for (int32_t i = 0; i < s->n; ++i) {
+        sinew_result r = sinew_instance_create(s->blob, &d, &s->ch[i].inst);
+        if (r != SINEW_OK) {
+            snprintf(err, errlen, "cannot create instance %d: %s", i, sinew_result_string(r));
+            return 0;
+        }
+    }
+    return 1;
+}
+
+int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip, int32_t n,
+                  int threads, int dynamic, char *err, size_t errlen) {
+    memset(s, 0, sizeof *s);
+    s->blob = blob, s->asset = a, s->clip = clip, s->n = n, s->dynamic = dynamic;
+    s->threads = threads < 1 ? 1 : (threads > n ? n : threads);
+    s->ch = calloc((size_t)n, sizeof *s->ch);
+    if (!s->ch) return snprintf(err, errlen, "out of memory"), 0;
+    size_t nv = 3 * (size_t)a->nverts;
+    for (int32_t i = 0; i < n; ++i) {
+        vw_char *c = &s->ch[i];
+        c->pose = malloc(sizeof(float) * 12 * (size_t)a->nbones);
+        c->pos = calloc(nv, sizeof(float)), c->nrm = calloc(nv, sizeof(float));
+        c->skin_pos = calloc(nv, sizeof(float)), c->skin_nrm = calloc(nv, sizeof(float));
+        if (!c->pose || !c->pos || !c->nrm || !c->skin_pos || !c->skin_nrm)
+            return snprintf(err, errlen, "out of memory"), 0;
+        /* different phases, so a crowd does not move in lockstep */
+        c->phase = a->clip_duration[clip] > 0 ? 0.37 * i : 0;
+        c->stats.struct_size = sizeof c->stats;
+    }
+    return create_instances(s, err, errlen);
+}
+
+int vw_sim_set_mode(vw_sim *s, int dynamic, char *err, size_t errlen) {
+    for (int32_t i = 0; i < s->n; ++i)
+        sinew_instance_destroy(s->ch[i].inst), s->ch[i].inst = NULL;
+    s->dynamic = dynamic;
+    return create_instances(s, err, errlen);
+}
+
+typedef struct batch {
+    vw_sim *s;
+    int worker;
+    double t;
+    float dt;
+} batch;
+
+static void step_one(vw_sim *s, vw_char *c, double t, float dt) {
+    const vw_asset *a = s->asset;
+    if (!a->pose(a, s->clip, t + c->phase, c->pose)) return;
+    c->last = sinew_instance_set_pose(c->inst, c->pose, (uint32_t)a->nbones);
+    if (c->last == SINEW_OK) c->last = sinew_instance_step(c->inst, dt);
+    sinew_instance_get_stats(c->inst, &c->stats);
+    sinew_instance_read_surface(c->inst, c->pos, c->nrm, (uint32_t)a->nverts);
+}
+
+static void *worker(void *arg) {
+    batch *b = arg;
+    for (int32_t i = b->worker; i < b->s->n; i += b->s->threads)
+        step_one(b->s, &b->s->ch[i], b->t, b->dt);
+    return NULL;
+}
+
+void vw_sim_step(vw_sim *s, double t, float dt) {
+    s->t = t;
+    if (s->threads <= 1) {
+        for (int32_t i = 0; i < s->n; ++i)
+            step_one(s, &s->ch[i], t, dt);
+        return;
+    }
+    pthread_t tid[64];
+    batch b[64];
+    int nt = s->threads > 64 ? 64 : s->threads, started = 0;
+    for (int k = 0; k < nt; ++k)
+        b[k] = (batch){s, k, t, dt};
+    for (int k = 1; k < nt; ++k) {
+        if (pthread_create(&tid[k], NULL, worker, &b[k]) != 0) break;
+        started = k;
+    }
+    worker(&b[0]);
+    for (int k = 1; k <= started; ++k)
+        pthread_join(tid[k], NULL);
+    for (int k = started + 1; k < nt; ++k) /* (a worker that did not start: its share here) */
+        worker(&b[k]);
+}
+
+void vw_sim_teleport(vw_sim *s) {
+    for (int32_t i = 0; i < s->n; ++i)
+        sinew_instance_mark_teleport(s->ch[i].inst);
+}
+
+void vw_sim_skin(vw_sim *s, int dqs) {
+    for (int32_t i = 0; i < s->n; ++i) {
+        vw_char *c = &s->ch[i];
+        if (s->asset->pose(s->asset, s->clip, s->t + c->phase, c->pose))
+            vw_skin(s->asset, c->pose, dqs, c->skin_pos, c->skin_nrm);
+    }
+}
+
+void vw_sim_destroy(vw_sim *s) {
+    for (int32_t i = 0; s->ch && i < s->n; ++i) {
+        vw_char *c = &s->ch[i];
+        sinew_instance_destroy(c->inst);
+        free(c->pose), free(c->pos), free(c->nrm), free(c->skin_pos), free(c->skin_nrm);
+    }
+    free(s->ch);
+    memset(s, 0, sizeof *s);
+}

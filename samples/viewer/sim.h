@@ -1,0 +1,40 @@
+/* The viewer's characters: N sinew instances of one blob, each playing the clip at its own
+ * phase, stepped on T threads. */
+#ifndef SW_VIEWER_SIM_H
+#define SW_VIEWER_SIM_H
+
+#include <sinew/sinew.h>
+
+#include "viewer.h"
+
+typedef struct vw_char {
+    sinew_instance *inst;
+    float *pose;      /* 12 nbones */
+    float *pos, *nrm; /* sinew's surface */
+    float *skin_pos, *skin_nrm;
+    sinew_step_stats stats;
+    sinew_result last;
+    double phase; /* seconds added to the clip time */
+} vw_char;
+
+typedef struct vw_sim {
+    const sinew_blob *blob;
+    const vw_asset *asset;
+    int clip, threads, dynamic;
+    int32_t n;
+    vw_char *ch;
+    double t; /* clip time of the last step */
+} vw_sim;
+
+int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip, int32_t n,
+                  int threads, int dynamic, char *err, size_t errlen);
+/* Recreates the instances in the other step mode (instances are created in one mode). */
+int vw_sim_set_mode(vw_sim *s, int dynamic, char *err, size_t errlen);
+/* Advances every character to clip time t by dt seconds. */
+void vw_sim_step(vw_sim *s, double t, float dt);
+void vw_sim_teleport(vw_sim *s);
+/* Fills every character's skinned surface at its last pose. */
+void vw_sim_skin(vw_sim *s, int dqs);
+void vw_sim_destroy(vw_sim *s);
+
+#endif
