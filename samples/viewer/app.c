@@ -208,6 +208,36 @@ static int pick_clip(vw_app *app, char *err, size_t errlen) {
     return 0;
 }
 
+/* The blob's rest surface against the asset's: equal counts are not the same character. */
+static int check_rest(vw_app *app, uint32_t nv, char *err, size_t errlen) {
+    float *rest = malloc(sizeof(float) * 3 * (size_t)nv), lo = INFINITY, hi = -INFINITY;
+    if (!rest || !blob_rest_surface(app->blob, rest, nv)) {
+        free(rest);
+        return snprintf(err, errlen, "%s: cannot step it in the rest pose", app->opt.blob), 0;
+    }
+    double worst = 0;
+    uint32_t at = 0;
+    for (uint32_t v = 0; v < nv; ++v) {
+        double d2 = 0;
+        for (int c = 0; c < 3; ++c) {
+            double d = rest[3 * v + c] - app->asset.rest[3 * v + c];
+            d2 += d * d;
+            lo = fminf(lo, app->asset.rest[3 * v + c]), hi = fmaxf(hi, app->asset.rest[3 * v + c]);
+        }
+        if (d2 > worst) worst = d2, at = v;
+    }
+    free(rest);
+    double size = hi > lo ? hi - lo : 1;
+    /* (the bake may move a vertex outside the tets a little: a tolerance, not equality) */
+    if (sqrt(worst) > 1e-3 * size)
+        return snprintf(err, errlen,
+                        "%s: render vertex %u rests %g from the blob's (the character is %g "
+                        "across): not the file it was baked from",
+                        app->opt.asset, at, sqrt(worst), size),
+               0;
+    return 1;
+}
+
 int vw_app_load(vw_app *app, char *err, size_t errlen) {
     const vw_options *o = &app->opt;
     sinew_blob_def bd = sinew_blob_def_default();
@@ -248,6 +278,7 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
                             o->asset, app->asset.nverts, nv),
                    0;
         if (!pick_clip(app, err, errlen)) return 0;
+        if (!check_rest(app, nv, err, errlen)) return 0;
     }
     if (o->script && !load_script(app, err, errlen)) return 0;
     const vw_asset *a = &app->asset;

@@ -530,7 +530,7 @@ int vw_asset_import(const char *path, vw_asset *a, char *err, size_t errlen) {
     if (!ok) snprintf(err, errlen, "%s: out of memory, or a node tree deeper than 4096", path);
     ok = ok && build_skeleton(s, W, &a->nbones, err, errlen);
     ok = ok && build_render(s, W, a, err, errlen);
-    if (ok && !build_clips(s, a)) ok = FAIL("out of memory");
+    if (ok && (!build_clips(s, a) || !vw_asset_weld(a))) ok = FAIL("out of memory");
     free(W);
     if (!ok) vw_asset_free(a);
     return ok;
@@ -538,6 +538,6 @@ int vw_asset_import(const char *path, vw_asset *a, char *err, size_t errlen) {
 
 void vw_asset_free(vw_asset *a) {
     if (a->release) a->release(a);
-    free(a->rest), free(a->tris), free(a->wbone), free(a->wgt);
+    free(a->rest), free(a->tris), free(a->wbone), free(a->wgt), free(a->weld);
     memset(a, 0, sizeof *a);
 }

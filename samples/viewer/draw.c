@@ -87,15 +87,23 @@ static void view_projection(const float eye[3], const float at[3], float fovy, f
         }
 }
 
-/* Where character i (and its skinned copy) stands: a grid of cells in x and z. */
+/* Where character i (and its skinned copy) stands: a grid whose rows run across the
+ * screen. The camera looks at the character's side (across its longer horizontal
+ * extent), so a fox is seen walking and a finger bending. */
+static int side_on(const vw_app *app) {
+    return app->rest_hi[2] - app->rest_lo[2] > app->rest_hi[0] - app->rest_lo[0];
+}
+
 static void layout(const vw_app *app, int32_t i, int skin, float *off) {
-    float ex = app->rest_hi[0] - app->rest_lo[0], ez = app->rest_hi[2] - app->rest_lo[2];
-    float cell = fmaxf(ex, 0.5f * app->size) * 1.25f;
+    int side = side_on(app), across = side ? 2 : 0, along = side ? 0 : 2;
+    float e_across = app->rest_hi[across] - app->rest_lo[across];
+    float e_along = app->rest_hi[along] - app->rest_lo[along];
+    float cell = fmaxf(e_across, 0.3f * app->size) * 1.15f;
     int both = app->view == VW_VIEW_BOTH, cols = (int)ceil(sqrt((double)app->sim.n));
-    float cw = both ? 2 * cell : cell;
-    off[0] = (float)(i % cols) * cw + (both ? (skin ? -0.5f : 0.5f) * cell : 0);
-    off[1] = 0;
-    off[2] = -(float)(i / cols) * fmaxf(ez, 0.5f * app->size) * 1.4f;
+    float cw = both ? 2 * cell : cell, sign = side ? -1.0f : 1.0f; /* screen right */
+    off[0] = off[1] = off[2] = 0;
+    off[across] = sign * ((float)(i % cols) * cw + (both ? (skin ? -0.5f : 0.5f) * cell : 0));
+    off[along] = -(float)(i / cols) * fmaxf(e_along, 0.3f * app->size) * 1.3f;
 }
 
 static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
@@ -113,11 +121,12 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
                     hi[k] = fmaxf(hi[k], p[3 * v + k] + off[k]);
         }
     float at[3], r = 0, dir[3] = {0.2f, 0.3f, 1.0f}, dl = sqrtf(0.04f + 0.09f + 1);
+    if (side_on(app)) dir[0] = 1.0f, dir[2] = 0.2f;
     for (int k = 0; k < 3; ++k)
         at[k] = 0.5f * (lo[k] + hi[k]), r += 0.25f * (hi[k] - lo[k]) * (hi[k] - lo[k]);
     r = sqrtf(r);
     if (!(r > 0)) r = app->size;
-    float fovy = 0.7f, aspect = (float)fb_w / (float)(fb_h ? fb_h : 1);
+    float fovy = 0.5f, aspect = (float)fb_w / (float)(fb_h ? fb_h : 1);
     float dist = r / sinf(0.5f * fovy * fminf(1.0f, aspect)) * 0.95f, eye[3];
     for (int k = 0; k < 3; ++k)
         eye[k] = at[k] + dir[k] / dl * dist;

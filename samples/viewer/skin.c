@@ -1,6 +1,7 @@
 /* Plain skinning on the CPU, as the engine draws a character without sinew: linear blend
  * or dual quaternions of the bones' transforms, from the asset's own weights. */
 #include <math.h>
+#include <stdlib.h>
 #include <string.h>
 
 #include "viewer.h"
@@ -101,10 +102,37 @@ void vw_skin(const vw_asset *a, const float *T, int dqs, float *pos, float *nrm)
             memcpy(pos + 3 * v, o, sizeof o);
         }
     }
-    if (nrm) vw_normals(pos, a->nverts, a->tris, a->ntris, nrm);
+    if (nrm) vw_normals(pos, a->nverts, a->tris, a->ntris, a->weld, nrm);
 }
 
-void vw_normals(const float *pos, int32_t nverts, const uint32_t *tris, int32_t ntris, float *nrm) {
+static const float *weld_pos;
+
+static int by_position(const void *pa, const void *pb) {
+    const float *a = weld_pos + 3 * *(const int32_t *)pa, *b = weld_pos + 3 * *(const int32_t *)pb;
+    for (int k = 0; k < 3; ++k)
+        if (a[k] != b[k]) return a[k] < b[k] ? -1 : 1;
+    return *(const int32_t *)pa - *(const int32_t *)pb;
+}
+
+int vw_asset_weld(vw_asset *a) {
+    int32_t *order = malloc(sizeof(int32_t) * (size_t)a->nverts);
+    a->weld = malloc(sizeof(int32_t) * (size_t)a->nverts);
+    if (!order || !a->weld) return free(order), 0;
+    for (int32_t v = 0; v < a->nverts; ++v)
+        order[v] = v;
+    weld_pos = a->rest; /* (load time, one thread) */
+    qsort(order, (size_t)a->nverts, sizeof *order, by_position);
+    for (int32_t k = 0, first = 0; k < a->nverts; ++k) {
+        if (k && memcmp(a->rest + 3 * order[k], a->rest + 3 * order[k - 1], 3 * sizeof(float)))
+            first = k;
+        a->weld[order[k]] = order[first];
+    }
+    free(order);
+    return 1;
+}
+
+void vw_normals(const float *pos, int32_t nverts, const uint32_t *tris, int32_t ntris,
+                const int32_t *weld, float *nrm) {
     memset(nrm, 0, sizeof(float) * 3 * (size_t)nverts);
     for (int32_t t = 0; t < ntris; ++t) {
         const float *p0 = pos + 3 * tris[3 * t], *p1 = pos + 3 * tris[3 * t + 1],
@@ -115,8 +143,10 @@ void vw_normals(const float *pos, int32_t nverts, const uint32_t *tris, int32_t 
                       e1[0] * e2[1] - e1[1] * e2[0]};
         for (int c = 0; c < 3; ++c)
             for (int k = 0; k < 3; ++k)
-                nrm[3 * tris[3 * t + c] + k] += n[k];
+                nrm[3 * (weld ? weld[tris[3 * t + c]] : (int32_t)tris[3 * t + c]) + k] += n[k];
     }
+    for (int32_t v = 0; weld && v < nverts; ++v)
+        if (weld[v] != v) memcpy(nrm + 3 * v, nrm + 3 * weld[v], 3 * sizeof(float));
     for (int32_t v = 0; v < nverts; ++v) {
         float *n = nrm + 3 * v, l = sqrtf(n[0] * n[0] + n[1] * n[1] + n[2] * n[2]);
         if (l > 0) n[0] /= l, n[1] /= l, n[2] /= l;

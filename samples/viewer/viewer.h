@@ -20,6 +20,7 @@ typedef struct vw_asset {
     uint32_t *tris; /* 3 ntris */
     int32_t *wbone; /* 4 nverts */
     float *wgt;     /* 4 nverts, summing to 1 */
+    int32_t *weld;  /* nverts: the first vertex at the same rest position (a seam's) */
     int32_t nclips;
     char clip_names[VW_MAX_CLIPS][64];
     double clip_duration[VW_MAX_CLIPS]; /* seconds */
@@ -43,8 +44,12 @@ void vw_asset_free(vw_asset *a);
 /* Plain skinning on the CPU: linear blend (dqs 0) or dual quaternions (dqs 1). */
 void vw_skin(const vw_asset *a, const float *T, int dqs, float *pos, float *nrm);
 
-/* Area-weighted vertex normals of a triangle mesh. */
-void vw_normals(const float *pos, int32_t nverts, const uint32_t *tris, int32_t ntris, float *nrm);
+/* Fills a->weld: a UV seam's copies of a vertex share one normal, as the blob's do. */
+int vw_asset_weld(vw_asset *a);
+
+/* Area-weighted vertex normals of a triangle mesh, shared across weld (NULL: none). */
+void vw_normals(const float *pos, int32_t nverts, const uint32_t *tris, int32_t ntris,
+                const int32_t *weld, float *nrm);
 
 /* 8-bit RGB PNG (zlib-compressed), rows top first. 0 on success. */
 int vw_write_png(const char *path, int w, int h, const uint8_t *rgb);
