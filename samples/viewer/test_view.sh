@@ -60,4 +60,10 @@ for v in skin sinew; do
 done
 python3 "$here/check_shot.py" differ "$tmp/skin.png" "$tmp/sinew.png" $min_diff
 grep -q "\"frames\": $frames," "$tmp/sinew.json" || { echo "FAIL: frames"; exit 1; }
+if command -v ffmpeg >/dev/null 2>&1; then
+    "${run[@]}" "$view" "${args[@]}" --frames 10 --record "$tmp/v.mp4" >/dev/null
+    [ -s "$tmp/v.mp4" ] || { echo "FAIL: --record wrote nothing"; exit 1; }
+else
+    echo "(no ffmpeg: --record not tried)"
+fi
 echo "sinew-view $what: ok"
