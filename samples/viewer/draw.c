@@ -127,7 +127,7 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
     r = sqrtf(r);
     if (!(r > 0)) r = app->size;
     float fovy = 0.5f, aspect = (float)fb_w / (float)(fb_h ? fb_h : 1);
-    float dist = r / sinf(0.5f * fovy * fminf(1.0f, aspect)) * 0.95f, eye[3];
+    float dist = r / sinf(0.5f * fovy * fminf(1.0f, aspect)) * 0.8f, eye[3];
     for (int k = 0; k < 3; ++k)
         eye[k] = at[k] + dir[k] / dl * dist;
     view_projection(eye, at, fovy, aspect, 0.01f * dist, 4 * dist, vp);
