@@ -3,7 +3,8 @@
 # assets are there (the Fox of ../shared/data/gltf-fox, training on its Survey and Walk
 # clips, Run held out) or else a generated sample character (the folding finger), write
 # the bake report, run the blob headless against the full-space reference and plain
-# skinning, print frame times and the benchmark summary, and write pictures.
+# skinning, print frame times and the benchmark summary, write pictures, and record the
+# character played by sinew-view beside its plain skinning (an MP4, under Xvfb).
 #   bash tools/run-main.sh [TETS] [FRAMES]
 #     TETS    simulation tets, 1000..2000000 (default: 8000 for the Fox, 20000 for the
 #             finger)
@@ -67,6 +68,15 @@ if [ "$name" = finger ]; then
         --json | tail -n 1 | tee "$out/fullsim.json"
     build/tools/sinew-render --frames "$out/full" --grid 3 --out "$out/full.png" --quiet
     echo "wrote $out/full.png (full-space reference): a contact sheet of the clip"
+fi
+echo "== video: sinew-view under Xvfb, plain skinning beside sinew coloured by the correction"
+if [ -x build/tools/sinew-view ] && command -v xvfb-run >/dev/null && command -v ffmpeg >/dev/null; then
+    if [ "$name" = fox ]; then view=(--asset "$fox" --clip Walk); else view=(--scene finger); fi
+    xvfb-run -a -s "-screen 0 1280x720x24" build/tools/sinew-view --blob "$out/$name.blob" \
+        "${view[@]}" --frames 240 --record "$out/$name.mp4" --json | tee "$out/view.json"
+    echo "wrote $out/$name.mp4: 4 s of the clip, plain skinning left, sinew right"
+else
+    echo "(no video: sinew-view, xvfb-run or ffmpeg is missing)"
 fi
 echo "wrote $out/subspace.png (runtime): a contact sheet of the clip"
 echo "wrote $out/report/report.html: the bake report (open it in a browser), $out/report/report.json"
