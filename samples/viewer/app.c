@@ -13,6 +13,7 @@ static const char *usage =
     "  --scene NAME        a procedural sample it was baked from (finger, cylinder, capsule)\n"
     "  --clip NAME         the clip to play (default: the file's first)\n"
     "  --instances N       characters (default 1), --threads T: stepped on T threads\n"
+    "  --world FILE        a world file (samples/worlds/): its colliders, moving on their keys\n"
     "  --view V            sinew, skin or both (default both)\n"
     "  --dqs               dual-quaternion plain skinning (default linear blend)\n"
     "  --dynamic           dynamic steps (default quasistatic)\n"
@@ -126,7 +127,6 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
                       : !o->asset == !o->scene      ? "give one of --asset FILE and --scene NAME"
                       : o->screenshot && !o->frames ? "--screenshot needs --frames N"
                       : o->record && !o->frames     ? "--record needs --frames N"
-                      : o->world                    ? "--world is not supported by this viewer yet"
                                                     : NULL;
     if (bad) {
         fprintf(stderr, "sinew-view: %s\n", bad);
@@ -292,9 +292,11 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
     for (int c = 0; c < 3; ++c)
         d2 += (app->rest_hi[c] - app->rest_lo[c]) * (app->rest_hi[c] - app->rest_lo[c]);
     app->size = sqrtf(d2) > 0 ? sqrtf(d2) : 1;
+    if (o->world && !vw_world_load(o->world, &app->world, err, errlen)) return 0;
     if (!vw_sim_create(&app->sim, app->blob, a, app->clip, o->instances, o->threads, o->dynamic,
-                       err, errlen))
+                       app->world.world, app->world.rest_pose, err, errlen))
         return 0;
+    if (app->world.world) vw_world_move(&app->world, 0);
     vw_sim_step(&app->sim, 0, (float)app->step_dt); /* a surface to draw before the first step */
     return 1;
 }
@@ -371,7 +373,11 @@ void vw_app_free(vw_app *app) {
     for (int32_t i = 0; app->mesh_sinew && i < app->sim.n; ++i)
         vw_glmesh_destroy(&app->mesh_sinew[i]), vw_glmesh_destroy(&app->mesh_skin[i]);
     free(app->mesh_sinew), free(app->mesh_skin), free(app->col_sinew), free(app->col_skin);
+    for (int i = 0; i < app->world.ncol; ++i)
+        vw_glmesh_destroy(&app->mesh_col[i]);
+    free(app->col_collider);
     vw_sim_destroy(&app->sim);
+    vw_world_free(&app->world);
     vw_asset_free(&app->asset);
     sinew_blob_destroy(app->blob);
     free(app->tris), free(app->events), free(app->hud), free(app->pixels);

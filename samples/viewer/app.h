@@ -8,6 +8,7 @@
 
 #include "gl.h"
 #include "sim.h"
+#include "world.h"
 
 enum { VW_VIEW_SINEW = 1, VW_VIEW_SKIN = 2, VW_VIEW_BOTH = 3 };
 
@@ -29,7 +30,10 @@ typedef struct vw_app {
     vw_sim sim;
     void *window;
     vw_glmesh *mesh_sinew, *mesh_skin; /* per instance */
-    float *col_sinew, *col_skin;       /* scratch colours */
+    vw_world world;                    /* --world: its colliders */
+    vw_glmesh mesh_col[VW_WORLD_MAX_COLLIDERS];
+    float *col_collider;
+    float *col_sinew, *col_skin; /* scratch colours */
     uint32_t *tris;
     int32_t ntris;
     float size; /* the rest surface's bounding-box diagonal */

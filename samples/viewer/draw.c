@@ -23,6 +23,18 @@ int vw_app_gl_setup(vw_app *app, char *err, size_t errlen) {
         if (!vw_glmesh_create(&app->mesh_sinew[i], nv, app->tris, app->ntris) ||
             !vw_glmesh_create(&app->mesh_skin[i], nv, app->tris, app->ntris))
             return snprintf(err, errlen, "cannot create the GL buffers"), 0;
+    int32_t most = 1;
+    for (int i = 0; i < app->world.ncol; ++i) {
+        vw_collider *c = &app->world.col[i];
+        most = c->nverts > most ? c->nverts : most;
+        if (!vw_glmesh_create(&app->mesh_col[i], c->nverts, c->tris, c->ntris))
+            return snprintf(err, errlen, "cannot create the GL buffers"), 0;
+    }
+    app->col_collider = malloc(sizeof(float) * 3 * (size_t)most);
+    if (!app->col_collider) return snprintf(err, errlen, "out of memory"), 0;
+    for (int32_t v = 0; v < most; ++v)
+        app->col_collider[3 * v] = 0.45f, app->col_collider[3 * v + 1] = 0.6f,
+                              app->col_collider[3 * v + 2] = 0.45f;
     for (int32_t v = 0; v < nv; ++v) {
         float *c = app->col_skin + 3 * v;
         c[0] = 0.55f, c[1] = 0.65f, c[2] = 0.8f;
@@ -95,15 +107,15 @@ static int side_on(const vw_app *app) {
 }
 
 static void layout(const vw_app *app, int32_t i, int skin, float *off) {
-    int side = side_on(app), across = side ? 2 : 0, along = side ? 0 : 2;
+    int side = side_on(app), across = side ? 2 : 0;
     float e_across = app->rest_hi[across] - app->rest_lo[across];
-    float e_along = app->rest_hi[along] - app->rest_lo[along];
     float cell = fmaxf(e_across, 0.3f * app->size) * 1.15f;
     int both = app->view == VW_VIEW_BOTH, cols = (int)ceil(sqrt((double)app->sim.n));
     float cw = both ? 2 * cell : cell, sign = side ? -1.0f : 1.0f; /* screen right */
     off[0] = off[1] = off[2] = 0;
     off[across] = sign * ((float)(i % cols) * cw + (both ? (skin ? -0.5f : 0.5f) * cell : 0));
-    off[along] = -(float)(i / cols) * fmaxf(e_along, 0.3f * app->size) * 1.3f;
+    /* rows stack upwards: behind one another they would hide each other */
+    off[1] = (float)(i / cols) * (app->rest_hi[1] - app->rest_lo[1]) * 1.25f;
 }
 
 static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
@@ -143,9 +155,10 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
              step_ms, app->steps_this_frame, app->last_render_ms, app->sim.n,
              app->asset.clip_names[app->clip]);
     snprintf(lines[1], 160,
-             "SKIN %.2f CONTACT %.2f DYN %.2f SOLVE %.2f OUTPUT %.2f WORLD %.2f MS  NEWTON %u",
+             "SKIN %.2f CONTACT %.2f DYN %.2f SOLVE %.2f OUTPUT %.2f WORLD %.2f MS  NEWTON %u  "
+             "WORLD CONTACTS %u PATCH %u",
              s->ms_skin, s->ms_contact, s->ms_dynamics, s->ms_solve, s->ms_output, s->ms_world,
-             s->newton_iterations);
+             s->newton_iterations, s->world_contacts, s->patch_vertices);
     int n = snprintf(lines[2], 160, "%s%s%s%s", (s->status & SINEW_STEP_BUDGET) ? "BUDGET " : "",
                      (s->status & SINEW_STEP_TELEPORT) ? "TELEPORT " : "",
                      (s->status & SINEW_STEP_LIMITED) ? "LIMITED " : "",
@@ -198,6 +211,16 @@ void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_m
             vw_glmesh_update(&app->mesh_skin[i], c->skin_pos, c->skin_nrm, app->col_skin);
             layout(app, i, 1, off);
             vw_gl_draw(&app->mesh_skin[i], vp, off);
+        }
+    }
+    for (int k = 0; k < app->world.ncol && app->view != VW_VIEW_SKIN; ++k) {
+        vw_collider *col = &app->world.col[k];
+        vw_normals(col->pos, col->nverts, col->tris, col->ntris, NULL, col->nrm);
+        vw_glmesh_update(&app->mesh_col[k], col->pos, col->nrm, app->col_collider);
+        for (int32_t i = 0; i < app->sim.n; ++i) { /* every character has the world's copy */
+            float off[3];
+            layout(app, i, 0, off);
+            vw_gl_draw(&app->mesh_col[k], vp, off);
         }
     }
     draw_hud(app, fb_w, fb_h, frame_ms, step_ms);

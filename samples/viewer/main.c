@@ -40,12 +40,14 @@ static double advance(vw_app *app, double frame_dt) {
     int n = 0;
     while (app->acc >= app->step_dt - 1e-9 && n < 4) {
         app->sim_t += app->step_dt;
+        if (app->world.world) vw_world_move(&app->world, app->sim_t);
         vw_sim_step(&app->sim, app->sim_t, (float)app->step_dt);
         app->acc -= app->step_dt, n++, app->steps++;
     }
     if (n == 4) app->acc = 0;
     if (app->single) {
         app->sim_t += app->step_dt;
+        if (app->world.world) vw_world_move(&app->world, app->sim_t);
         vw_sim_step(&app->sim, app->sim_t, (float)app->step_dt);
         app->single = 0, n++, app->steps++;
     }

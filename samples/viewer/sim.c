@@ -17,8 +17,18 @@ static int create_instances(vw_sim *s, char *err, size_t errlen) {
     sinew_instance_def d = sinew_instance_def_default();
     d.mode = s->dynamic ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
     d.logger.log = log_stderr;
+    /* Against a world, flesh pressed on a collider is solved in full space where it
+     * touches; a blob without the tet mesh cannot, and steps without it. */
+    sinew_instance *probe = NULL;
+    d.max_patch_vertices = s->world ? 2000 : 0;
+    d.logger.log = NULL; /* (the probe's refusal is expected: silent) */
+    if (d.max_patch_vertices && sinew_instance_create(s->blob, &d, &probe) != SINEW_OK)
+        d.max_patch_vertices = 0;
+    sinew_instance_destroy(probe);
+    d.logger.log = log_stderr;
     for (int32_t i = 0; i < s->n; ++i) {
         sinew_result r = sinew_instance_create(s->blob, &d, &s->ch[i].inst);
+        if (r == SINEW_OK && s->world) r = sinew_instance_set_world(s->ch[i].inst, s->world);
         if (r != SINEW_OK) {
             snprintf(err, errlen, "cannot create instance %d: %s", i, sinew_result_string(r));
             return 0;
@@ -28,8 +38,10 @@ static int create_instances(vw_sim *s, char *err, size_t errlen) {
 }
 
 int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip, int32_t n,
-                  int threads, int dynamic, char *err, size_t errlen) {
+                  int threads, int dynamic, const sinew_world *world, int rest_pose, char *err,
+                  size_t errlen) {
     memset(s, 0, sizeof *s);
+    s->world = world, s->rest_pose = rest_pose;
     s->blob = blob, s->asset = a, s->clip = clip, s->n = n, s->dynamic = dynamic;
     s->threads = threads < 1 ? 1 : (threads > n ? n : threads);
     s->ch = calloc((size_t)n, sizeof *s->ch);
@@ -63,9 +75,18 @@ typedef struct batch {
     float dt;
 } batch;
 
+/* The pose of character c at clip time t: the clip's, or the rest pose. */
+static int pose_at(const vw_sim *s, vw_char *c, double t) {
+    if (!s->rest_pose) return s->asset->pose(s->asset, s->clip, t + c->phase, c->pose);
+    memset(c->pose, 0, sizeof(float) * 12 * (size_t)s->asset->nbones);
+    for (int32_t b = 0; b < s->asset->nbones; ++b)
+        c->pose[12 * b] = c->pose[12 * b + 4] = c->pose[12 * b + 8] = 1;
+    return 1;
+}
+
 static void step_one(vw_sim *s, vw_char *c, double t, float dt) {
     const vw_asset *a = s->asset;
-    if (!a->pose(a, s->clip, t + c->phase, c->pose)) return;
+    if (!pose_at(s, c, t)) return;
     c->last = sinew_instance_set_pose(c->inst, c->pose, (uint32_t)a->nbones);
     if (c->last == SINEW_OK) c->last = sinew_instance_step(c->inst, dt);
     sinew_instance_get_stats(c->inst, &c->stats);
@@ -110,8 +131,7 @@ void vw_sim_teleport(vw_sim *s) {
 void vw_sim_skin(vw_sim *s, int dqs) {
     for (int32_t i = 0; i < s->n; ++i) {
         vw_char *c = &s->ch[i];
-        if (s->asset->pose(s->asset, s->clip, s->t + c->phase, c->pose))
-            vw_skin(s->asset, c->pose, dqs, c->skin_pos, c->skin_nrm);
+        if (pose_at(s, c, s->t)) vw_skin(s->asset, c->pose, dqs, c->skin_pos, c->skin_nrm);
     }
 }
 

@@ -4,6 +4,7 @@
 #define SW_VIEWER_SIM_H
 
 #include <sinew/sinew.h>
+#include <sinew/sinew_world.h>
 
 #include "viewer.h"
 
@@ -21,13 +22,16 @@ typedef struct vw_sim {
     const sinew_blob *blob;
     const vw_asset *asset;
     int clip, threads, dynamic;
+    const sinew_world *world; /* or NULL; set before vw_sim_create's instances */
+    int rest_pose;            /* hold the rest pose (a world file's "pose": "rest") */
     int32_t n;
     vw_char *ch;
     double t; /* clip time of the last step */
 } vw_sim;
 
 int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip, int32_t n,
-                  int threads, int dynamic, char *err, size_t errlen);
+                  int threads, int dynamic, const sinew_world *world, int rest_pose, char *err,
+                  size_t errlen);
 /* Recreates the instances in the other step mode (instances are created in one mode). */
 int vw_sim_set_mode(vw_sim *s, int dynamic, char *err, size_t errlen);
 /* Advances every character to clip time t by dt seconds. */
