@@ -20,11 +20,20 @@ else
     exit 77
 fi
 
+# refused RC PATTERN WHAT: the run exited 1 with a message matching PATTERN
+refused() {
+    if [ "$1" != 1 ] || ! grep -q "$2" "$tmp/err"; then
+        cat "$tmp/err"
+        echo "FAIL: $3 (exit $1)"
+        exit 1
+    fi
+}
+
 # Bad input is a clear error, never a crash.
 set +e
 "$view" --blob "$tmp/none.blob" --scene finger --frames 1 2>"$tmp/err"; rc=$?
 set -e
-[ "$rc" = 1 ] && grep -q "cannot load the blob" "$tmp/err" || { cat "$tmp/err"; echo "FAIL: missing blob"; exit 1; }
+refused "$rc" "cannot load the blob" "a missing blob"
 
 if [ "$what" = finger ]; then
     "$bake" --scene finger --tets 2000 --frames 12 --out "$tmp/c.blob" >/dev/null
@@ -48,7 +57,7 @@ else
     set +e
     "${run[@]}" "$view" --blob "$tmp/f.blob" --asset "$fox" --frames 1 2>"$tmp/err"; rc=$?
     set -e
-    [ "$rc" = 1 ] && grep -q "bones, the blob" "$tmp/err" || { cat "$tmp/err"; echo "FAIL: mismatch"; exit 1; }
+    refused "$rc" "bones, the blob" "an asset that is not the blob's"
 fi
 
 printf '0.5 s\n0.6 s\n' >"$tmp/script" # slow motion on and off again: the script is read
@@ -68,7 +77,7 @@ if [ "$what" = finger ]; then # a world file: the table rises into the finger
     "${run[@]}" "$view" "${args[@]}" --world "$here/../worlds/finger_props.json" --frames 1 2>"$tmp/err"
     rc=$?
     set -e
-    [ "$rc" = 1 ] && grep -q "shape 'mesh'" "$tmp/err" || { cat "$tmp/err"; echo "FAIL: mesh collider"; exit 1; }
+    refused "$rc" "shape 'mesh'" "a mesh collider"
 fi
 if command -v ffmpeg >/dev/null 2>&1; then
     "${run[@]}" "$view" "${args[@]}" --frames 10 --record "$tmp/v.mp4" >/dev/null
