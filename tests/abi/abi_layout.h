@@ -50,7 +50,10 @@
     X(offsetof(sinew_step_stats, active_vertices))                                                 \
     X(offsetof(sinew_step_stats, budget_exceeded))                                                 \
     X(offsetof(sinew_step_stats, ms_self_contact))                                                 \
-    X(offsetof(sinew_step_stats, beyond_training_deg))
+    X(offsetof(sinew_step_stats, beyond_training_deg))                                             \
+    X(sizeof(sinew_blob_provenance))                                                               \
+    X(offsetof(sinew_blob_provenance, source_hash))                                                \
+    X(offsetof(sinew_blob_provenance, options_hash))
 
 #ifdef __cplusplus
 extern "C" {

@@ -263,6 +263,18 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
 #define SINEW_BUDGET_WORLD_CONTACTS 2u /**< sinew_instance_def.max_world_contacts */
 #define SINEW_BUDGET_PATCH 4u          /**< sinew_instance_def.max_patch_vertices */
 
+/** What a blob was baked from (sinew_blob_get_provenance): compare with the asset and the
+ * library an engine ships, and bake again when either changed. Hashes are FNV-1a 64
+ * (sinew_hash_bytes), 0 when not known. */
+typedef struct sinew_blob_provenance {
+    uint32_t struct_size;    /**< set by the caller to sizeof(sinew_blob_provenance) */
+    uint32_t sinew_version;  /**< SINEW_VERSION of the bake that wrote the blob */
+    uint64_t source_hash;    /**< of the source asset file's bytes (0: no file) */
+    uint64_t options_hash;   /**< of the bake options that shape the blob */
+    uint32_t format_version; /**< the blob's format version (SINEW_BLOB_VERSION) */
+    uint32_t reserved;       /**< zero */
+} sinew_blob_provenance;
+
 /** Figures of an instance's last step. */
 typedef struct sinew_step_stats {
     uint32_t struct_size;       /**< set by the caller to sizeof(sinew_step_stats) */
