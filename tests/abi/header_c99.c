@@ -47,6 +47,7 @@ SW_ABI_ASSERT(SINEW_ERROR_CAPACITY == 9, capacity);
 SW_ABI_ASSERT(SINEW_ERROR_NOT_CONVERGED == 10, not_converged);
 SW_ABI_ASSERT(SINEW_ERROR_UNSUPPORTED == 11, unsupported);
 SW_ABI_ASSERT(SINEW_RESULT_COUNT_ >= 12, result_count);
+SW_ABI_ASSERT(SINEW_LOG_NONE == -1, log_none);
 SW_ABI_ASSERT(SINEW_LOG_ERROR == 0 && SINEW_LOG_WARNING == 1, log_levels_low);
 SW_ABI_ASSERT(SINEW_LOG_INFO == 2 && SINEW_LOG_DEBUG == 3, log_levels_high);
 SW_ABI_ASSERT(SINEW_STEP_QUASISTATIC == 0 && SINEW_STEP_DYNAMIC == 1, step_modes);
@@ -198,6 +199,7 @@ TEST(inline_defaults_fill_every_field) {
     ENSURE(d.allocator.alloc == NULL && d.allocator.free == NULL && d.allocator.user == NULL);
     ENSURE(d.logger.log == NULL && d.logger.user == NULL);
     ENSURE(d.logger.max_level == SINEW_LOG_WARNING);
+    ENSURE(sinew_logger_silent().log == NULL && sinew_logger_silent().max_level == SINEW_LOG_NONE);
 }
 
 TEST(host_hooks_and_handles_fit_the_types) {
