@@ -11,7 +11,10 @@
 
 #define MIX(h, x) ((h) = sw_fnv1a((h), &(x), sizeof(x)))
 
-/* The options that shape the blob, field by field (the struct has pointers and padding). */
+/* The options that shape the blob, field by field (the struct has pointers and padding).
+ * Not the springs' stiffness: 0 asks the bake to choose one, and the blob baked with the
+ * chosen one given is the same blob (its SPRING_HESSIAN holds it). Not the thread count:
+ * the blob is the same for any. */
 static uint64_t options_hash(const sw_bake_params *p) {
     uint64_t h = SW_FNV_START;
     MIX(h, p->max_rank), MIX(h, p->fold_share), MIX(h, p->pca_energy), MIX(h, p->pca_strain);
@@ -20,7 +23,7 @@ static uint64_t options_hash(const sw_bake_params *p) {
     MIX(h, p->max_train_frames), MIX(h, p->return_path), MIX(h, p->pose_force);
     MIX(h, p->contact_modes), MIX(h, p->contact_cubature_tol), MIX(h, p->inertia_modes);
     MIX(h, p->heldout_fraction), MIX(h, p->ship_split), MIX(h, p->random_poses);
-    MIX(h, p->heldout_steps), MIX(h, p->self_contact), MIX(h, p->spring_k), MIX(h, p->seed);
+    MIX(h, p->heldout_steps), MIX(h, p->self_contact), MIX(h, p->seed);
     MIX(h, p->ntrain_clips), MIX(h, p->nheldout_clips), MIX(h, p->nextra_poses);
     MIX(h, p->extra_chain);
     return h;

@@ -36,6 +36,8 @@
     X(offsetof(sinew_instance_def, max_contact_pairs))                                             \
     X(offsetof(sinew_instance_def, tasks))                                                         \
     X(offsetof(sinew_instance_def, self_contact))                                                  \
+    X(offsetof(sinew_instance_def, profiler))                                                      \
+    X(sizeof(sinew_profiler))                                                                      \
     X(sizeof(sinew_self_contact))                                                                  \
     X(sizeof(sinew_task_callbacks))                                                                \
     X(offsetof(sinew_task_callbacks, enqueue))                                                     \
