@@ -318,6 +318,43 @@ static inline void fixture_add_pairs(fixture *f, pair_fixture *p) {
 #undef POINT
 }
 
+/* The asset description: names (one of the file's, "bone N" for the rest), bind poses,
+ * two source meshes of 3 and 4 vertices and each output vertex's source (the first
+ * output vertex has none). Added after the render mesh when there is one: the output
+ * surface's size is read from the view. */
+enum { NSRC = 2, NOUT_MAX = 16 };
+typedef struct asset_fixture {
+    char bone_names[NB * 16];
+    double bone_bind[12 * NB];
+    int32_t source_mesh_verts[NSRC];
+    int32_t output_source[2 * NOUT_MAX];
+} asset_fixture;
+
+static inline void fixture_add_asset(fixture *f, asset_fixture *a) {
+    sw_blob_view *v = &f->v;
+    memset(a, 0, sizeof *a);
+    int32_t at = 0;
+    for (int32_t b = 0; b < NB; ++b)
+        at += 1 + snprintf(a->bone_names + at, 16, b == 0 ? "Hips" : "bone %d", (int)b);
+    for (int32_t b = 0; b < NB; ++b) {
+        double *m = a->bone_bind + 12 * b;
+        m[0] = m[4] = m[8] = 1;
+        m[9] = 0.5 * b, m[10] = 1.0 + b, m[11] = -0.25 * b;
+    }
+    a->source_mesh_verts[0] = 3, a->source_mesh_verts[1] = 4;
+    const int32_t nout = sw_blob_output_verts(v);
+    for (int32_t i = 0; i < nout && i < NOUT_MAX; ++i) {
+        a->output_source[2 * i] = i == 0 ? -1 : i % NSRC;
+        a->output_source[2 * i + 1] = i == 0 ? -1 : i % a->source_mesh_verts[i % NSRC];
+    }
+    v->nname_bytes = at, v->nsource_meshes = NSRC, v->noutput_verts = nout;
+    v->sinew_version = SINEW_VERSION, v->source_hash = 0x0123456789abcdefull;
+    v->options_hash = 0xfedcba9876543210ull;
+#define POINT(id, NAME, elem_size, type, field, ...) v->field = a->field;
+    SINEW_BLOB_ASSET_ARRAY_SECTIONS(POINT)
+#undef POINT
+}
+
 /* ---- helpers --------------------------------------------------------------------- */
 
 /* First field in which two views differ (counts, scalars bitwise, arrays bitwise, the
@@ -332,6 +369,10 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     SINEW_BLOB_RENDER_COUNTS(SAME_BITS)
     SINEW_BLOB_COND_COUNTS(SAME_BITS)
     SINEW_BLOB_PAIR_COUNTS(SAME_BITS)
+    SINEW_BLOB_ASSET_COUNTS(SAME_BITS)
+    SAME_BITS(sinew_version)
+    SAME_BITS(source_hash)
+    SAME_BITS(options_hash)
 #undef SAME_BITS
     SW_BLOB_COUNT_LOCALS(a);
 #define SAME_ARRAY(id, NAME, elem_size, type, field, by_meta, count, formula)                      \
@@ -348,6 +389,10 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     if (a->npair_groups > 0) {
         SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_PAIR_COUNTS);
         SINEW_BLOB_PAIR_ARRAY_SECTIONS(SAME_ARRAY)
+    }
+    if (a->bone_names) {
+        SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_ASSET_COUNTS);
+        SINEW_BLOB_ASSET_ARRAY_SECTIONS(SAME_ARRAY)
     }
 #undef SAME_ARRAY
     return NULL;

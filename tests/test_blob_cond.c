@@ -37,9 +37,9 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     ENSURE(capsule_fixture());
     const sw_blob_view *v = sw_blob_get_view(fx.blob);
     const sw_tetmesh *m = &fx.ch.mesh;
-    ENSURE(hdr(fx.data)->section_count == SINEW_SECTION_COUNT_V1 + NCOND +
-                                              (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
-                                              (v->train_force ? 1u : 0u));
+    ENSURE(hdr(fx.data)->section_count ==
+           SINEW_SECTION_COUNT_V1 + NCOND + (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
+               (v->train_force ? 1u : 0u) + (v->bone_names ? 5u : 0u));
     ENSURE(v->ntets == m->ntets && v->nvert_tets == 4 * m->ntets && v->nverts == m->nverts);
     ENSURE(v->ndomains >= 2); /* tets in more than one domain, vertices with several copies */
     ENSURE(memcmp(v->tets, m->tets, 4 * sizeof(int32_t) * (size_t)m->ntets) == 0);
@@ -137,6 +137,7 @@ TEST(a_view_without_the_tet_mesh_writes_the_blob_of_before) {
     SINEW_BLOB_COND_ARRAY_SECTIONS(CLEAR)
     SINEW_BLOB_PAIR_ARRAY_SECTIONS(CLEAR)
     SINEW_BLOB_FORCE_SECTIONS(CLEAR)
+    SINEW_BLOB_ASSET_ARRAY_SECTIONS(CLEAR)
 #undef CLEAR
     size_t size = 0;
     void *data = NULL;
@@ -323,7 +324,8 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     free(b);
 }
 
-/* The same character with per-pair sections and equilibrium forces as well (all 51):
+/* The same character with per-pair sections, equilibrium forces and the asset description
+ * as well (all 56):
  * written, parsed back the same, and the fuzz seed
  * tests/fuzz/corpus/blob_fixed/synth_pairs.blob is these bytes (SINEW_WRITE_SEEDS=1
  * rewrites it), so the blob fuzzers start from every optional section. */
@@ -332,10 +334,12 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     static render_fixture r;
     static cond_fixture c;
     static pair_fixture p;
+    static asset_fixture a;
     fixture_init(&f, 3);
     fixture_add_render(&f, &r);
     fixture_add_cond(&f, &c);
     fixture_add_pairs(&f, &p);
+    fixture_add_asset(&f, &a);
     static double force[4096];
     const int64_t nforce = (int64_t)f.v.ntrain * f.v.rank_total;
     ENSURE(nforce <= 4096);

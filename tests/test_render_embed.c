@@ -329,8 +329,11 @@ TEST(the_loader_rejects_a_damaged_render_mesh) {
     FRESH(); /* one of the eight turned into an unknown id: the rest is incomplete */
     entry(b, SINEW_SECTION_RENDER_WELD)->id = 200;
     ENSURE(rejects(b, SINEW_ERROR_CORRUPT, "RENDER_WELD", "all or none"));
-    FRESH(); /* all eight unknown: a blob of the tet boundary, as an older writer's */
+    FRESH(); /* all eight unknown: a blob of the tet boundary, as an older writer's (whose
+                blobs had no asset description either: its output map is the render mesh's) */
     for (uint32_t id = SINEW_SECTION_RENDER_FIRST; id <= SINEW_SECTION_RENDER_LAST; ++id)
+        entry(b, id)->id = 100 + id;
+    for (uint32_t id = SINEW_SECTION_ASSET_FIRST; id <= SINEW_SECTION_ASSET_LAST; ++id)
         entry(b, id)->id = 100 + id;
     fix_checksum(b, fx.size);
     sw_blob_view plain;

@@ -249,7 +249,7 @@ const sw_bake_stage sw_bake_stages[SW_BAKE_NSTAGES] = {
        inertial projections, the view's reduced sections */
     {"reduce", sw_bake_reduce, sum_reduce, 0, "rig, domains, basis, cubature, contacts",
      "reduce, view"},
-    {"render", sw_bake_render, sum_render, 0, "embed, domains, basis", "view (render)"},
+    {"render", sw_bake_render, sum_render, 0, "embed, domains, basis, rig", "view (render, asset)"},
     {"cond", sw_bake_cond, sum_cond, 0, "rig, domains, cubature", "view (tet mesh)"},
     {"pairs", sw_bake_pairs, sum_pairs, 0, "rig, domains, basis, poses, view",
      "view (per-pair contact)"},

@@ -1,5 +1,5 @@
-/* Stage "render" (bake.c, sw_bake_stages): reads s->embed, s->domains, s->basis; writes the view's
- * render sections. */
+/* Stage "render" (bake.c, sw_bake_stages): reads s->embed, s->domains, s->basis, the rig's
+ * character; writes the view's render sections and its asset description (bake_asset.c). */
 /* The render mesh's blob sections (bake.h "embed" and "reduce"): the embedding computed in
  * prepare (precompute/import/embed.h) turned into the runtime's terms. Only the tets that
  * hold a render vertex are stored (RENDER_TETS), over the simulation vertices at their
@@ -30,7 +30,7 @@ static void number_tets_and_nodes(const sw_bake_state *s, int32_t *tet_slot, int
     }
 }
 
-sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+static sinew_result render_sections(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     const sw_trimesh *rm = &s->rig.ch.render;
     const sw_embedding *e = &s->embed;
     if (rm->nverts == 0) return SINEW_OK;
@@ -96,4 +96,11 @@ done:
     free(tet_slot);
     free(node_of);
     return r;
+}
+
+/* The render mesh's sections, then the asset description, which maps the output vertices
+ * (the render mesh's when there is one). */
+sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sinew_result r = render_sections(s, out, err);
+    return r != SINEW_OK ? r : sw_bake_asset(s, out, err);
 }

@@ -183,6 +183,8 @@ sinew_result sw_bake_cubature(sw_bake_state *s, sw_bake_result *out, sw_error *e
 sinew_result sw_bake_contacts(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_render(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* The asset description's sections (bake_asset.c), after the render mesh's. */
+sinew_result sw_bake_asset(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err);

@@ -1,6 +1,6 @@
 /* Blob layout: header (64 bytes), section table (26 entries, 8 more with a render mesh, 10
  * more with the condensation tet mesh, 6 more with per-pair self-contact, 1 more with the
- * pose-space equilibrium force), then the sections in id
+ * pose-space equilibrium force, 5 more with the asset description), then the sections in id
  * order, each starting at a multiple of SINEW_BLOB_ALIGN; the checksum (FNV-1a 64) covers
  * everything after the header. A view without the optional groups writes exactly the 26 sections it
  * always did, byte for byte. */
@@ -35,12 +35,13 @@ typedef struct group_metas {
     sinew_blob_render_meta render;
     sinew_blob_cond_meta cond;
     sinew_blob_pair_meta pair;
+    sinew_blob_asset_meta asset;
 } group_metas;
 
 /* The sections of a validated view, in id order, into s; returns their number (26, plus 8
  * with a render mesh, plus 10 with the condensation tet mesh, plus 6 with per-pair
- * self-contact, plus 1 with the equilibrium force). `meta` and `g` must outlive
- * the result. */
+ * self-contact, plus 1 with the equilibrium force, plus 5 with the asset description). `meta` and
+ * `g` must outlive the result. */
 static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
                          section_src s[SINEW_SECTION_ID_MAX]) {
     SW_BLOB_COUNT_LOCALS(v);
@@ -74,6 +75,13 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
         memcpy(s + n, force, sizeof force);
         n += (int)(sizeof force / sizeof force[0]);
     }
+    if (v->bone_names) {
+        SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_ASSET_COUNTS);
+        const section_src asset[] = {{SINEW_SECTION_ASSET_META, sizeof g->asset, &g->asset, 1},
+                                     SINEW_BLOB_ASSET_ARRAY_SECTIONS(SOURCE)};
+        memcpy(s + n, asset, sizeof asset);
+        n += (int)(sizeof asset / sizeof asset[0]);
+    }
     return n;
 }
 #undef SOURCE
@@ -106,6 +114,12 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
 #define TO_PAIR_META(field) g.pair.field = view->field;
     SINEW_BLOB_PAIR_COUNTS(TO_PAIR_META)
 #undef TO_PAIR_META
+#define TO_ASSET_META(field) g.asset.field = view->field;
+    SINEW_BLOB_ASSET_COUNTS(TO_ASSET_META)
+#undef TO_ASSET_META
+    g.asset.sinew_version = view->sinew_version;
+    g.asset.source_hash = view->source_hash;
+    g.asset.options_hash = view->options_hash;
 
     section_src src[SINEW_SECTION_ID_MAX];
     sinew_blob_section table[SINEW_SECTION_ID_MAX];

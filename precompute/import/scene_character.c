@@ -1,6 +1,8 @@
 /* A simulation character from a glTF/FBX file (scene_character.h). */
 #include "scene_character.h"
 
+#include "hash.h"
+
 #include "character_io.h"
 #include "rig.h"
 
@@ -262,6 +264,11 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
     memset(&ic->skel, 0, sizeof ic->skel);
     out->bone_names = ic->bone_names;
     ic->bone_names = NULL;
+    out->bone_bind = ic->bone_bind;
+    ic->bone_bind = NULL;
+    out->nsource_meshes = ic->nsource_meshes;
+    out->source_mesh_verts = ic->source_mesh_verts;
+    ic->source_mesh_verts = NULL;
     if ((rc = sw_weights_from_surface(&out->mesh, &ic->render, &ic->weights, &out->weights, err)) ||
         (rc = drive_vertices(out, info, err)))
         return rc;
@@ -274,11 +281,34 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
     info->nclips = ic->nclips;
     info->unit_scale = ic->unit_scale;
     info->weight_dropped_max = ic->weight_dropped_max;
+    out->render_source = malloc(2 * sizeof(int32_t) * (size_t)(ic->render.nverts + 1));
+    if (!out->render_source)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the vertex sources");
+    for (int32_t i = 0; i < ic->render.nverts; ++i) {
+        out->render_source[2 * i] = ic->render_source[i];
+        out->render_source[2 * i + 1] = ic->render_source_vertex[i];
+    }
     out->render = ic->render; /* moved: the bake embeds it (sw_character.render) */
     memset(&ic->render, 0, sizeof ic->render);
     info->size = cbrt(sw_tetmesh_volume(&out->mesh));
     sw_scene_material(info->size, &out->youngs, &out->poisson, &out->density);
     sw_file_stem(path, out->name, sizeof out->name);
+    return SINEW_OK;
+}
+
+/* FNV-1a 64 of the file's bytes: what the blob says it was baked from. */
+static sinew_result hash_file(const char *path, uint64_t *hash, sw_error *err) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot read it again to hash it", path);
+    unsigned char buf[65536];
+    uint64_t h = SW_FNV_START;
+    size_t n;
+    while ((n = fread(buf, 1, sizeof buf, f)) > 0)
+        h = sw_fnv1a(h, buf, n);
+    const int bad = ferror(f);
+    fclose(f);
+    if (bad) return sw_error_set(err, SINEW_ERROR_IO, "%s: read error while hashing it", path);
+    *hash = h;
     return SINEW_OK;
 }
 
@@ -305,6 +335,7 @@ sinew_result sw_character_from_scene(const char *path, const sw_scene_character_
     sinew_result rc = sw_scene_import(path, &io, &ic, err);
     if (rc) return rc; /* the importer names the file */
     rc = named(build_character(path, &ic, &opt, out, split, info, err), path, err);
+    if (!rc) rc = hash_file(path, &out->source_hash, err);
     sw_imported_character_free(&ic);
     if (rc) {
         sw_character_free(out);

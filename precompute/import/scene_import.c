@@ -300,8 +300,9 @@ static sinew_result build_skeleton(scene_state *s, sw_imported_character *out, s
     k->bones = malloc(sizeof(int32_t) * 2 * (size_t)nb);
     k->parent = malloc(sizeof(int32_t) * (size_t)nb);
     out->bone_names = calloc((size_t)nb, sizeof *out->bone_names);
+    out->bone_bind = malloc(12 * sizeof(double) * (size_t)nb);
     int32_t *nchild = calloc((size_t)nb, sizeof(int32_t));
-    if (!k->joints || !k->bones || !k->parent || !out->bone_names || !nchild) {
+    if (!k->joints || !k->bones || !k->parent || !out->bone_names || !out->bone_bind || !nchild) {
         free(nchild);
         return oom(s, err);
     }
@@ -313,6 +314,9 @@ static sinew_result build_skeleton(scene_state *s, sw_imported_character *out, s
         copy_name(out->bone_names[b], nd->mName.data);
         for (int c = 0; c < 3; ++c) {
             k->joints[3 * b + c] = s->B[16 * b + 4 * c + 3];
+            for (int j = 0; j < 3; ++j)
+                out->bone_bind[12 * b + 3 * c + j] = s->B[16 * b + 4 * c + j];
+            out->bone_bind[12 * b + 9 + c] = s->B[16 * b + 4 * c + 3];
         }
         k->bones[2 * b] = b;
         k->bones[2 * b + 1] = nb + b;
@@ -378,6 +382,7 @@ static sinew_result add_mesh(scene_state *s, unsigned m, const double *M, int32_
                                     "%s: mesh %u, vertex %u is not finite", s->name, m, v);
         }
         out->render_source[base + v] = (int32_t)m;
+        out->render_source_vertex[base + v] = (int32_t)v;
     }
     int32_t t = tbase;
     for (unsigned f = 0; f < me->mNumFaces; ++f) {
@@ -511,14 +516,20 @@ static sinew_result build_render(scene_state *s, sw_imported_character *out, sw_
     out->render.X = malloc(sizeof(double) * 3 * (size_t)nv);
     out->render.tris = malloc(sizeof(int32_t) * 3 * (size_t)(nt ? nt : 1));
     out->render_source = malloc(sizeof(int32_t) * (size_t)nv);
+    out->render_source_vertex = malloc(sizeof(int32_t) * (size_t)nv);
+    out->nsource_meshes = (int32_t)sc->mNumMeshes;
+    out->source_mesh_verts = malloc(sizeof(int32_t) * (sc->mNumMeshes ? sc->mNumMeshes : 1));
     out->weights.w = calloc((size_t)nv * (size_t)s->nbones, sizeof(double));
     unsigned char *skinned = calloc((size_t)nv, 1);
-    if (!out->render.X || !out->render.tris || !out->render_source || !out->weights.w || !skinned) {
+    if (!out->render.X || !out->render.tris || !out->render_source || !out->weights.w || !skinned ||
+        !out->render_source_vertex || !out->source_mesh_verts) {
         free(skinned);
         return oom(s, err);
     }
     out->weights.nverts = (int32_t)nv;
     out->weights.nbones = s->nbones;
+    for (unsigned m = 0; m < sc->mNumMeshes; ++m)
+        out->source_mesh_verts[m] = (int32_t)sc->mMeshes[m]->mNumVertices;
     int32_t base = 0, tbase = 0;
     sinew_result rc = SINEW_OK;
     for (unsigned m = 0; m < sc->mNumMeshes && !rc; ++m) {
@@ -585,6 +596,10 @@ static sinew_result apply_scale(scene_state *s, const sw_import_options *o,
         out->render.X[i] *= k;
     for (size_t i = 0; i < 3 * (size_t)out->skel.njoints; ++i)
         out->skel.joints[i] *= k;
+    /* the bind frames keep their orientation; their origins move with the scale */
+    for (int32_t b = 0; b < out->skel.nbones; ++b)
+        for (int c = 9; c < 12; ++c)
+            out->bone_bind[12 * b + c] *= k;
     return SINEW_OK;
 }
 
@@ -728,6 +743,9 @@ void sw_imported_character_free(sw_imported_character *c) {
     if (!c) return;
     sw_trimesh_free(&c->render);
     free(c->render_source);
+    free(c->render_source_vertex);
+    free(c->source_mesh_verts);
+    free(c->bone_bind);
     sw_skeleton_free(&c->skel);
     free(c->bone_names);
     sw_weights_free(&c->weights);

@@ -69,6 +69,9 @@ void sw_character_free(sw_character *c) {
     sw_trimesh_free(&c->render);
     free(c->bone_of_vertex);
     free(c->bone_names);
+    free(c->bone_bind);
+    free(c->render_source);
+    free(c->source_mesh_verts);
     memset(c, 0, sizeof *c);
 }
 

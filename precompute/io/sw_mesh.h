@@ -83,6 +83,12 @@ typedef struct sw_character {
      * otherwise the output surface is the tet mesh's boundary. */
     sw_trimesh render;
     char (*bone_names)[64]; /* skel.nbones names from the file (glTF/FBX nodes), or NULL */
+    /* What the file was, for the blob's asset description (NULL / 0: not from a file): */
+    double *bone_bind;          /* 12 skel.nbones: bind global transforms, or NULL (identity) */
+    int32_t *render_source;     /* 2 render.nverts: (file mesh, vertex in it), or NULL */
+    int32_t nsource_meshes;     /* the file's meshes as imported */
+    int32_t *source_mesh_verts; /* nsource_meshes vertex counts */
+    uint64_t source_hash;       /* FNV-1a 64 of the file's bytes (0: none) */
 } sw_character;
 
 void sw_tetmesh_free(sw_tetmesh *m);

@@ -159,3 +159,73 @@ SINEW_API sinew_result sinew_blob_surface_triangles(const sinew_blob *blob, uint
         indices[i] = (uint32_t)tris[i];
     return SINEW_OK;
 }
+
+/* The asset description's names are back to back, each ended by a zero (validated). */
+SINEW_API const char *sinew_blob_bone_name(const sinew_blob *blob, uint32_t bone) {
+    if (!blob || !blob->view.bone_names || bone >= (uint32_t)blob->view.nbones) return NULL;
+    const char *p = blob->view.bone_names;
+    for (uint32_t b = 0; b < bone; ++b)
+        p += strlen(p) + 1;
+    return p;
+}
+
+SINEW_API int32_t sinew_blob_find_bone(const sinew_blob *blob, const char *name) {
+    if (!blob || !name || !blob->view.bone_names) return -1;
+    const char *p = blob->view.bone_names;
+    for (int32_t b = 0; b < blob->view.nbones; ++b) {
+        if (strcmp(p, name) == 0) return b;
+        p += strlen(p) + 1;
+    }
+    return -1;
+}
+
+SINEW_API sinew_result sinew_blob_bone_parent(const sinew_blob *blob, uint32_t bone,
+                                              int32_t *parent) {
+    if (!blob || !parent || bone >= (uint32_t)blob->view.nbones)
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    *parent = blob->view.bone_parent[bone];
+    return SINEW_OK;
+}
+
+SINEW_API sinew_result sinew_blob_bone_bind(const sinew_blob *blob, uint32_t bone,
+                                            double bind[12]) {
+    if (!blob || !bind || bone >= (uint32_t)blob->view.nbones) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (!blob->view.bone_bind) return SINEW_ERROR_UNSUPPORTED;
+    memcpy(bind, blob->view.bone_bind + 12 * (size_t)bone, 12 * sizeof(double));
+    return SINEW_OK;
+}
+
+SINEW_API uint32_t sinew_blob_source_mesh_count(const sinew_blob *blob) {
+    return blob ? (uint32_t)blob->view.nsource_meshes : 0u;
+}
+
+SINEW_API sinew_result sinew_blob_output_sources(const sinew_blob *blob, int32_t *pairs,
+                                                 uint32_t capacity) {
+    if (!blob || !pairs) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (!blob->view.output_source) return SINEW_ERROR_UNSUPPORTED;
+    const uint64_t n = 2 * (uint64_t)blob->view.noutput_verts;
+    if (capacity < n) return SINEW_ERROR_CAPACITY;
+    memcpy(pairs, blob->view.output_source, (size_t)n * sizeof(int32_t));
+    return SINEW_OK;
+}
+
+SINEW_API sinew_result sinew_blob_get_provenance(const sinew_blob *blob,
+                                                 sinew_blob_provenance *out) {
+    if (!blob || !out || out->struct_size < 8) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (!blob->view.bone_names) return SINEW_ERROR_UNSUPPORTED;
+    const sw_blob_view *v = &blob->view;
+    sinew_blob_provenance p;
+    memset(&p, 0, sizeof p);
+    p.struct_size = out->struct_size < sizeof p ? out->struct_size : (uint32_t)sizeof p;
+    p.sinew_version = v->sinew_version;
+    p.source_hash = v->source_hash;
+    p.options_hash = v->options_hash;
+    p.format_version = SINEW_BLOB_VERSION;
+    memcpy(out, &p, p.struct_size);
+    return SINEW_OK;
+}
+
+SINEW_API uint64_t sinew_hash_bytes(const void *data, size_t size) {
+    if (!data && size) return 0;
+    return sw_blob_checksum(data ? data : "", size);
+}

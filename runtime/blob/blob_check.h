@@ -131,4 +131,15 @@ sinew_result sw_blob_force_fill(const uint8_t *bytes, const sinew_blob_section *
 /* Layer 2: every force finite (nothing when train_force is NULL). */
 sinew_result sw_blob_force_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
+/* Layer 1 of the asset description (blob_asset.c): the five optional sections all present or
+ * all absent, ASSET_META's counts and reserved words, every section's count against them and
+ * META's; points the view's fields at them (left 0 / NULL when absent). After META. */
+sinew_result sw_blob_asset_fill(const uint8_t *bytes, const sinew_blob_section *s,
+                                const int found[], sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 2: nbones names of 1..255 bytes filling BONE_NAMES exactly, finite bind transforms,
+ * mesh vertex counts >= 0, noutput_verts the output surface's and every source pair in range
+ * (nothing when bone_names is NULL); after the render mesh has been checked. */
+sinew_result sw_blob_asset_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
 #endif

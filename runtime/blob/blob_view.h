@@ -179,6 +179,18 @@ typedef struct sw_blob_view {
      * reduced force train_force[R t ..] that makes train_q[R t ..] the quasistatic step's
      * equilibrium at pose t (pose_space.h, sw_pose_space_force) */
     const double *train_force;
+
+    /* the optional asset description (bone_names NULL: none, every field below 0 / NULL):
+     * nbones zero-terminated names back to back (nname_bytes in all), each bone's bind-pose
+     * global transform (12 doubles), the source file's meshes' vertex counts and each output
+     * vertex's (source mesh, vertex in it) or (-1, -1); what the blob was baked from */
+    int32_t nname_bytes, nsource_meshes, noutput_verts;
+    uint32_t sinew_version;
+    uint64_t source_hash, options_hash;
+    const char *bone_names;
+    const double *bone_bind;
+    const int32_t *source_mesh_verts;
+    const int32_t *output_source;
 } sw_blob_view;
 
 /* The output surface a host reads (sinew_instance_read_surface): the render mesh when the

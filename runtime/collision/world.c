@@ -29,7 +29,7 @@ static uint32_t message_id(sinew_result code) {
 }
 
 static sinew_result vfail(const sinew_logger *lg, sinew_result code, const char *fmt, va_list ap) {
-    if (!lg || !lg->log || lg->max_level < SINEW_LOG_ERROR) return code;
+    if (!lg || lg->max_level < SINEW_LOG_ERROR) return code;
     char text[640];
     vsnprintf(text, sizeof text, fmt, ap);
     sw_log(lg, SINEW_LOG_ERROR, message_id(code), "%s", text);

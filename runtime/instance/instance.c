@@ -317,6 +317,8 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
         : d->max_newton_iters > 100 ? "max_newton_iters is above 100"
         : sw_allocator_check(&d->allocator) != SINEW_OK
             ? "allocator.alloc and allocator.free must both be set or both be NULL"
+        : !d->profiler.zone_begin != !d->profiler.zone_end
+            ? "profiler.zone_begin and profiler.zone_end must both be set or both be NULL"
         : tasks && (!d->tasks.enqueue || !d->tasks.finish)
             ? "tasks.enqueue and tasks.finish must both be set or both be NULL"
         : tasks && (d->tasks.worker_count < 1 || d->tasks.worker_count > SW_MAX_TASK_WORKERS)
@@ -497,6 +499,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.nworkers = z.nworkers;
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
+    in->profiler = d.profiler;
     in->red.nact_step = z.nact_step;
     (void)active_vertices(v, in->red.act_vert, &in->red.nact_step);
     visit_active(v, &in->red, ACT_STEP | ACT_SURFACE, assign_active, &in->red);

@@ -45,6 +45,7 @@ struct sinew_instance {
     double *h_ref; /* Newton's reference Hessian's domain blocks (red.h_ref when in use) */
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
+    sinew_profiler profiler;    /* the def's zones (zone_begin NULL: none) */
 };
 
 /* The most task workers an instance reserves scratch for (sinew_task_callbacks). */

@@ -420,15 +420,25 @@ static sinew_result check_output(sw_step_ctx *c) {
     return SINEW_OK;
 }
 
+/* A phase inside the host's profiler zone `name` (a static string); without a profiler,
+ * one test. */
+#define ZONE(in, name, call)                                                                       \
+    do {                                                                                           \
+        const sinew_profiler *zp_ = &(in)->profiler;                                               \
+        if (zp_->zone_begin) zp_->zone_begin(name, zp_->user);                                     \
+        call;                                                                                      \
+        if (zp_->zone_begin) zp_->zone_end(name, zp_->user);                                       \
+    } while (0)
+
 /* The phases before the solve: what the step's potential needs. */
 static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
     step_begin(c, inst, dt);
-    phase_skin(c);
-    phase_contact(c);
-    phase_dynamics(c);
-    phase_self(c);
-    phase_world(c);
-    phase_oracle(c);
+    ZONE(inst, "skin", phase_skin(c));
+    ZONE(inst, "contact", phase_contact(c));
+    ZONE(inst, "dynamics", phase_dynamics(c));
+    ZONE(inst, "self_contact", phase_self(c));
+    ZONE(inst, "world", phase_world(c));
+    ZONE(inst, "oracle", phase_oracle(c));
 }
 
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
@@ -440,11 +450,11 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
     }
     sw_step_ctx c;
     phases_to_solve(&c, inst, dt);
-    sinew_result r = phase_solve(&c); /* a non-finite state is undone: nothing advances */
+    sinew_result r;
+    ZONE(inst, "solve", r = phase_solve(&c)); /* a non-finite state is undone: nothing advances */
     if (r == SINEW_OK) {
-        phase_advance(&c);
-        phase_output(&c);
-        r = check_output(&c);
+        ZONE(inst, "advance", phase_advance(&c));
+        ZONE(inst, "output", phase_output(&c); r = check_output(&c));
     }
     /* a failed step's state, or the iterate the energy guard kept, is not its prediction's
        solution: the next step starts from its own prediction alone */

@@ -36,6 +36,8 @@
     X(offsetof(sinew_instance_def, max_contact_pairs))                                             \
     X(offsetof(sinew_instance_def, tasks))                                                         \
     X(offsetof(sinew_instance_def, self_contact))                                                  \
+    X(offsetof(sinew_instance_def, profiler))                                                      \
+    X(sizeof(sinew_profiler))                                                                      \
     X(sizeof(sinew_self_contact))                                                                  \
     X(sizeof(sinew_task_callbacks))                                                                \
     X(offsetof(sinew_task_callbacks, enqueue))                                                     \
@@ -50,7 +52,10 @@
     X(offsetof(sinew_step_stats, active_vertices))                                                 \
     X(offsetof(sinew_step_stats, budget_exceeded))                                                 \
     X(offsetof(sinew_step_stats, ms_self_contact))                                                 \
-    X(offsetof(sinew_step_stats, beyond_training_deg))
+    X(offsetof(sinew_step_stats, beyond_training_deg))                                             \
+    X(sizeof(sinew_blob_provenance))                                                               \
+    X(offsetof(sinew_blob_provenance, source_hash))                                                \
+    X(offsetof(sinew_blob_provenance, options_hash))
 
 #ifdef __cplusplus
 extern "C" {

@@ -47,6 +47,7 @@ SW_ABI_ASSERT(SINEW_ERROR_CAPACITY == 9, capacity);
 SW_ABI_ASSERT(SINEW_ERROR_NOT_CONVERGED == 10, not_converged);
 SW_ABI_ASSERT(SINEW_ERROR_UNSUPPORTED == 11, unsupported);
 SW_ABI_ASSERT(SINEW_RESULT_COUNT_ >= 12, result_count);
+SW_ABI_ASSERT(SINEW_LOG_NONE == -1, log_none);
 SW_ABI_ASSERT(SINEW_LOG_ERROR == 0 && SINEW_LOG_WARNING == 1, log_levels_low);
 SW_ABI_ASSERT(SINEW_LOG_INFO == 2 && SINEW_LOG_DEBUG == 3, log_levels_high);
 SW_ABI_ASSERT(SINEW_STEP_QUASISTATIC == 0 && SINEW_STEP_DYNAMIC == 1, step_modes);
@@ -73,11 +74,15 @@ SINEW_BLOB_SECTIONS(SW_ABI_ELEM_SIZE)
 SW_ABI_ASSERT(SINEW_SECTION_RENDER_FIRST == 27 && SINEW_SECTION_RENDER_LAST == 34, render_ids);
 SW_ABI_ASSERT(SINEW_SECTION_COND_FIRST == 35 && SINEW_SECTION_COND_LAST == 44, cond_ids);
 SW_ABI_ASSERT(SINEW_SECTION_PAIR_FIRST == 45 && SINEW_SECTION_PAIR_LAST == 50, pair_ids);
-SW_ABI_ASSERT(SINEW_SECTION_TRAIN_FORCE == 51 && SINEW_SECTION_ID_MAX == SINEW_SECTION_TRAIN_FORCE,
-              force_id);
+SW_ABI_ASSERT(SINEW_SECTION_TRAIN_FORCE == 51, force_id);
+SW_ABI_ASSERT(SINEW_SECTION_ASSET_FIRST == 52 && SINEW_SECTION_ASSET_LAST == 56 &&
+                  SINEW_SECTION_ID_MAX == SINEW_SECTION_ASSET_LAST,
+              asset_ids);
 SINEW_BLOB_RENDER_SECTIONS(SW_ABI_ELEM_SIZE)
 SINEW_BLOB_COND_SECTIONS(SW_ABI_ELEM_SIZE)
 SINEW_BLOB_FORCE_SECTIONS(SW_ABI_ELEM_SIZE)
+SINEW_BLOB_ASSET_SECTIONS(SW_ABI_ELEM_SIZE)
+SW_ABI_ASSERT(offsetof(sinew_blob_provenance, struct_size) == 0, provenance_size_first);
 
 /* Every public function, with the exact signature a host binary was built against. */
 typedef uint32_t (*sw_abi_version_fn)(void);
@@ -86,6 +91,14 @@ typedef int (*sw_abi_version_compatible_fn)(uint32_t);
 typedef const char *(*sw_abi_result_string_fn)(sinew_result);
 typedef sinew_blob_def (*sw_abi_blob_def_default_fn)(void);
 typedef sinew_instance_def (*sw_abi_instance_def_default_fn)(void);
+typedef const char *(*sw_abi_bone_name_fn)(const sinew_blob *, uint32_t);
+typedef int32_t (*sw_abi_find_bone_fn)(const sinew_blob *, const char *);
+typedef sinew_result (*sw_abi_bone_parent_fn)(const sinew_blob *, uint32_t, int32_t *);
+typedef sinew_result (*sw_abi_bone_bind_fn)(const sinew_blob *, uint32_t, double *);
+typedef uint32_t (*sw_abi_source_mesh_count_fn)(const sinew_blob *);
+typedef sinew_result (*sw_abi_output_sources_fn)(const sinew_blob *, int32_t *, uint32_t);
+typedef sinew_result (*sw_abi_get_provenance_fn)(const sinew_blob *, sinew_blob_provenance *);
+typedef uint64_t (*sw_abi_hash_bytes_fn)(const void *, size_t);
 
 static int sw_abi_log_calls;
 
@@ -119,6 +132,26 @@ TEST(functions_have_the_pinned_signatures) {
     sw_abi_instance_def_default_fn instance_default = &sinew_instance_def_default;
     ENSURE(version && version_string && compatible && result_string);
     ENSURE(blob_default && instance_default);
+    {
+        sw_abi_bone_name_fn bone_name = &sinew_blob_bone_name;
+        sw_abi_find_bone_fn find_bone = &sinew_blob_find_bone;
+        sw_abi_bone_parent_fn bone_parent = &sinew_blob_bone_parent;
+        sw_abi_bone_bind_fn bone_bind = &sinew_blob_bone_bind;
+        sw_abi_source_mesh_count_fn mesh_count = &sinew_blob_source_mesh_count;
+        sw_abi_output_sources_fn sources = &sinew_blob_output_sources;
+        sw_abi_get_provenance_fn provenance = &sinew_blob_get_provenance;
+        sw_abi_hash_bytes_fn hash = &sinew_hash_bytes;
+        sinew_blob_provenance p;
+        int32_t parent = 7;
+        p.struct_size = (uint32_t)sizeof p;
+        /* NULL blobs are refused, never dereferenced */
+        ENSURE(bone_name(NULL, 0) == NULL && find_bone(NULL, "x") == -1);
+        ENSURE(bone_parent(NULL, 0, &parent) == SINEW_ERROR_INVALID_ARGUMENT && parent == 7);
+        ENSURE(bone_bind(NULL, 0, NULL) == SINEW_ERROR_INVALID_ARGUMENT);
+        ENSURE(mesh_count(NULL) == 0 && sources(NULL, NULL, 0) == SINEW_ERROR_INVALID_ARGUMENT);
+        ENSURE(provenance(NULL, &p) == SINEW_ERROR_INVALID_ARGUMENT);
+        ENSURE(hash("", 0) == 0xcbf29ce484222325ull); /* FNV-1a 64's offset basis */
+    }
     /* Calls through the pointers reach the same code as direct calls. */
     ENSURE(version() == sinew_version());
     ENSURE(version_string() == sinew_version_string());
@@ -166,6 +199,7 @@ TEST(inline_defaults_fill_every_field) {
     ENSURE(d.allocator.alloc == NULL && d.allocator.free == NULL && d.allocator.user == NULL);
     ENSURE(d.logger.log == NULL && d.logger.user == NULL);
     ENSURE(d.logger.max_level == SINEW_LOG_WARNING);
+    ENSURE(sinew_logger_silent().log == NULL && sinew_logger_silent().max_level == SINEW_LOG_NONE);
 }
 
 TEST(host_hooks_and_handles_fit_the_types) {

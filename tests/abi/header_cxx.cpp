@@ -34,8 +34,10 @@ SINEW_BLOB_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 SINEW_BLOB_RENDER_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 SINEW_BLOB_COND_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 SINEW_BLOB_FORCE_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
+SINEW_BLOB_ASSET_SECTIONS(SW_ABI_CXX_ELEM_SIZE)
 static_assert(SINEW_SECTION_COND_FIRST == 35 && SINEW_SECTION_PAIR_FIRST == 45 &&
-                  SINEW_SECTION_TRAIN_FORCE == 51 && SINEW_SECTION_ID_MAX == 51,
+                  SINEW_SECTION_TRAIN_FORCE == 51 && SINEW_SECTION_ASSET_FIRST == 52 &&
+                  SINEW_SECTION_ID_MAX == 56,
               "optional section ids");
 static_assert(std::is_same<decltype(SINEW_VERSION), uint32_t>::value, "version is u32");
 
@@ -47,6 +49,18 @@ static_assert(std::is_same<decltype(&sinew_result_string), const char *(*)(sinew
               "sig");
 static_assert(std::is_same<decltype(&sinew_blob_def_default), sinew_blob_def (*)()>::value, "sig");
 static_assert(std::is_same<decltype(&sinew_instance_def_default), sinew_instance_def (*)()>::value,
+              "sig");
+static_assert(std::is_same<decltype(&sinew_blob_bone_name),
+                           const char *(*)(const sinew_blob *, uint32_t)>::value,
+              "sig");
+static_assert(std::is_same<decltype(&sinew_blob_find_bone),
+                           int32_t (*)(const sinew_blob *, const char *)>::value,
+              "sig");
+static_assert(std::is_same<decltype(&sinew_blob_output_sources),
+                           sinew_result (*)(const sinew_blob *, int32_t *, uint32_t)>::value,
+              "sig");
+static_assert(std::is_same<decltype(&sinew_blob_get_provenance),
+                           sinew_result (*)(const sinew_blob *, sinew_blob_provenance *)>::value,
               "sig");
 
 namespace {

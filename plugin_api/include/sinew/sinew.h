@@ -37,6 +37,56 @@ SINEW_API uint32_t sinew_blob_surface_triangle_count(const sinew_blob *blob);
 SINEW_API sinew_result sinew_blob_surface_triangles(const sinew_blob *blob, uint32_t *indices,
                                                     uint32_t capacity);
 
+/** Name of bone `bone` (< sinew_blob_bone_count) as the bake imported it (a glTF joint's
+ * node name; "bone N" when the source had none): zero-terminated, owned by the blob and
+ * valid while it lives. NULL for a NULL blob, an out-of-range bone, or a blob baked without
+ * the asset description (bake it again). Thread-safe. */
+SINEW_API const char *sinew_blob_bone_name(const sinew_blob *blob, uint32_t bone);
+
+/** The index of the first bone named exactly `name` (case-sensitive), or -1 when there is
+ * none, the blob has no names, or an argument is NULL. Linear in the names' bytes; map a
+ * skeleton once, at load. Thread-safe. */
+SINEW_API int32_t sinew_blob_find_bone(const sinew_blob *blob, const char *name);
+
+/** Writes bone `bone`'s parent bone into *parent (-1 for a root). Every blob has it.
+ * INVALID_ARGUMENT for NULL or an out-of-range bone. Thread-safe. */
+SINEW_API sinew_result sinew_blob_bone_parent(const sinew_blob *blob, uint32_t bone,
+                                              int32_t *parent);
+
+/** Writes bone `bone`'s bind-pose global transform into `bind` (12 doubles: 3x3 row-major,
+ * then the translation; the asset's units after the bake's import, the frame the pose's
+ * transforms map from). The pose transform of a bone at its bind pose is the identity; a
+ * host's skinning matrix is its bone's global transform times the inverse of this.
+ * INVALID_ARGUMENT for NULL or an out-of-range bone; UNSUPPORTED for a blob without the
+ * asset description. Thread-safe. */
+SINEW_API sinew_result sinew_blob_bone_bind(const sinew_blob *blob, uint32_t bone,
+                                            double bind[12]);
+
+/** Number of meshes of the source file as the bake imported it (assimp's aiScene mMeshes;
+ * glTF: one a primitive), 0 for NULL or a blob without the asset description. Thread-safe. */
+SINEW_API uint32_t sinew_blob_source_mesh_count(const sinew_blob *blob);
+
+/** The output map: for each output vertex (sinew_blob_surface_vertex_count of them), the
+ * source mesh and the vertex within it, into `pairs` (2 int32_t a vertex: mesh, vertex;
+ * -1, -1 for a vertex with no source, such as the tet boundary's) which holds `capacity`
+ * int32_t (at least 2 * the vertex count, else CAPACITY and nothing written). A host that
+ * imports the asset itself copies output vertex i to its mesh's vertex. INVALID_ARGUMENT for
+ * NULL; UNSUPPORTED for a blob without the asset description. Thread-safe. */
+SINEW_API sinew_result sinew_blob_output_sources(const sinew_blob *blob, int32_t *pairs,
+                                                 uint32_t capacity);
+
+/** Fills *out (set out->struct_size first; fields it does not cover are not written) with
+ * what the blob was baked from. UNSUPPORTED for a blob without the asset description (then
+ * nothing is known: bake it again); INVALID_ARGUMENT for NULL or a struct_size below 8.
+ * Thread-safe. */
+SINEW_API sinew_result sinew_blob_get_provenance(const sinew_blob *blob,
+                                                 sinew_blob_provenance *out);
+
+/** FNV-1a 64 of `size` bytes: what sinew_blob_provenance.source_hash holds for the source
+ * asset's file. Hash the file as shipped and compare to force a re-bake when it changed.
+ * 0 for NULL data with a nonzero size. Thread-safe. */
+SINEW_API uint64_t sinew_hash_bytes(const void *data, size_t size);
+
 /** Creates an instance of `blob` (which must outlive it), reserving all the memory it
  * will ever use in one block through the def's allocator (or the blob's): see
  * sinew_instance_memory_size. The instance starts at rest in the rest pose. A bad def

@@ -75,8 +75,9 @@ typedef struct sinew_allocator {
     void *user;
 } sinew_allocator;
 
-/** Severity of a log message. */
+/** Severity of a log message; SINEW_LOG_NONE as a logger's max_level passes none. */
 typedef enum sinew_log_level {
+    SINEW_LOG_NONE = -1,
     SINEW_LOG_ERROR = 0,
     SINEW_LOG_WARNING = 1,
     SINEW_LOG_INFO = 2,
@@ -84,7 +85,9 @@ typedef enum sinew_log_level {
 } sinew_log_level;
 
 /** Host log hook. `message_id` is stable across versions (see SINEW_MSG_*); `message`
- * is valid only during the call. May be called from any thread that calls into sinew. */
+ * is valid only during the call. May be called from any thread that calls into sinew.
+ * Without a hook (log NULL) errors and warnings within max_level are printed to stderr,
+ * one line each ("sinew: error: ..."), by one write(2): no allocation, no lock. */
 typedef struct sinew_logger {
     void (*log)(sinew_log_level level, uint32_t message_id, const char *message, void *user);
     void *user;
@@ -100,12 +103,19 @@ static inline sinew_allocator sinew_allocator_default(void) {
     return a;
 }
 
-/** A silent logger (no hook) that would pass errors and warnings. */
+/** The default logger: no hook, so errors and warnings are printed to stderr. */
 static inline sinew_logger sinew_logger_default(void) {
     sinew_logger l;
     l.log = NULL;
     l.user = NULL;
     l.max_level = SINEW_LOG_WARNING;
+    return l;
+}
+
+/** A logger that passes nothing (max_level SINEW_LOG_NONE): the silence of before. */
+static inline sinew_logger sinew_logger_silent(void) {
+    sinew_logger l = sinew_logger_default();
+    l.max_level = SINEW_LOG_NONE;
     return l;
 }
 

@@ -86,6 +86,21 @@
  *                 that makes TRAIN_Q's solution of t the quasistatic step's equilibrium at
  *                 pose t: minus the gradient of the step's potential there, with t's
  *                 pose-space self-contact ([t][rank_total])
+ *
+ * Optional sections (SINEW_BLOB_ASSET_SECTIONS, ids 52..56): what a host that imports the
+ * source asset itself needs to drive the blob, all five present or none. A blob without
+ * them is byte for byte what it was before they existed; a runtime that predates them skips
+ * them (they change nothing in a step). Counts in ASSET_META (sinew_blob_asset_meta) and
+ * META (nbones), rows:
+ *   BONE_NAMES     nbones names, each 1..255 bytes and its terminating zero, in bone order
+ *                  (the file's node names: glTF joint names; "bone N" when the source had
+ *                  none)
+ *   BONE_BIND      per bone, its bind-pose global transform in the bake's rest space: 3x3
+ *                  row-major, then the translation (12 doubles, finite)
+ *   SOURCE_MESH_VERTS per mesh of the source file (as imported), its vertex count (>= 0)
+ *   OUTPUT_SOURCE  per output vertex (the render mesh's when embedded, else the tet
+ *                  boundary's), the source mesh and the vertex within it, or (-1, -1) for
+ *                  a vertex that has none (a tet boundary's)
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -224,6 +239,18 @@ typedef struct sinew_blob_section {
 #define SINEW_BLOB_FORCE_SECTIONS(X)                                                               \
     X(51, TRAIN_FORCE,   8, double,  train_force,  1, ntrain * rank_total, "ntrain rank_total")
 
+/* The optional asset description (id 52..56): counts named by SINEW_BLOB_ASSET_COUNTS from
+ * ASSET_META, with META's nbones; rows as in SINEW_BLOB_SECTIONS. */
+#define SINEW_BLOB_ASSET_COUNTS(X) X(nname_bytes) X(nsource_meshes) X(noutput_verts)
+#define SINEW_BLOB_ASSET_SECTIONS(X)                                                               \
+    X(52, ASSET_META,        64, sinew_blob_asset_meta, asset_meta, 1, 1, "1")                     \
+    SINEW_BLOB_ASSET_ARRAY_SECTIONS(X)
+#define SINEW_BLOB_ASSET_ARRAY_SECTIONS(X)                                                         \
+    X(53, BONE_NAMES,         1, char,    bone_names,   1, nname_bytes,      "nname_bytes")        \
+    X(54, BONE_BIND,          8, double,  bone_bind,    1, 12 * nbones,      "12 nbones")          \
+    X(55, SOURCE_MESH_VERTS,  4, int32_t, source_mesh_verts, 1, nsource_meshes, "nsource_meshes") \
+    X(56, OUTPUT_SOURCE,      4, int32_t, output_source, 1, 2 * noutput_verts, "2 noutput_verts")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
@@ -232,7 +259,8 @@ typedef struct sinew_blob_section {
  * has; SINEW_SECTION_RENDER_FIRST .. _RENDER_LAST are the optional render mesh's,
  * SINEW_SECTION_COND_FIRST .. _COND_LAST the optional condensation tet mesh's,
  * SINEW_SECTION_PAIR_FIRST .. _PAIR_LAST the optional per-pair self-contact's,
- * SINEW_SECTION_TRAIN_FORCE the optional pose-space equilibrium force;
+ * SINEW_SECTION_TRAIN_FORCE the optional pose-space equilibrium force,
+ * SINEW_SECTION_ASSET_FIRST .. _ASSET_LAST the optional asset description;
  * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
@@ -250,7 +278,10 @@ enum sinew_blob_section_id {
     SINEW_SECTION_PAIR_LAST =
         SINEW_SECTION_COND_LAST SINEW_BLOB_PAIR_SECTIONS(SINEW_BLOB_PLUS_ONE_),
     SINEW_BLOB_FORCE_SECTIONS(SINEW_BLOB_ENUM_ROW_)
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_TRAIN_FORCE
+    SINEW_BLOB_ASSET_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_ASSET_FIRST = SINEW_SECTION_ASSET_META,
+    SINEW_SECTION_ASSET_LAST = SINEW_SECTION_OUTPUT_SOURCE,
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_ASSET_LAST
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
@@ -287,6 +318,18 @@ typedef struct sinew_blob_pair_meta {
     int32_t npair_groups; /**< domain pairs with contacts (1 .. ndomains^2) */
     int32_t reserved[7];  /**< zero */
 } sinew_blob_pair_meta;
+
+/** Section ASSET_META: what the blob was baked from and the asset sections' counts (64
+ * bytes). A hash is FNV-1a 64 (0: not known). */
+typedef struct sinew_blob_asset_meta {
+    int32_t nname_bytes;     /**< bytes of BONE_NAMES, every name's zero included */
+    int32_t nsource_meshes;  /**< meshes of the source file (0: no file, or none kept) */
+    int32_t noutput_verts;   /**< output surface vertices (OUTPUT_SOURCE holds 2 each) */
+    uint32_t sinew_version;  /**< SINEW_VERSION of the bake that wrote the blob */
+    uint64_t source_hash;    /**< of the source asset file's bytes */
+    uint64_t options_hash;   /**< of the bake's options that shape the blob */
+    int32_t reserved[8];     /**< zero */
+} sinew_blob_asset_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
 typedef struct sinew_blob_domain_record {

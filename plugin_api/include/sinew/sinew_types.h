@@ -143,6 +143,18 @@ typedef enum sinew_newton_hessian {
     SINEW_NEWTON_HESSIAN_REST_FIRST = 2
 } sinew_newton_hessian;
 
+/** Profiler zones around each phase of a step (in the manner of Jolt's external profile
+ * and PhysX's PxProfilerCallback): zone_begin(name) before a phase, zone_end(name) after
+ * it, on the stepping thread, nested in none and balanced; `name` is a static string
+ * ("skin", "contact", "dynamics", "self_contact", "world", "oracle", "solve", "advance",
+ * "output"), the same pointer every step. Both set or both NULL; unset, a step pays one
+ * test a phase. The callbacks must not call into the instance. */
+typedef struct sinew_profiler {
+    void (*zone_begin)(const char *name, void *user);
+    void (*zone_end)(const char *name, void *user);
+    void *user;
+} sinew_profiler;
+
 /** How to create an instance of a blob. All memory is reserved at creation. */
 typedef struct sinew_instance_def {
     uint32_t struct_size;      /**< sizeof(sinew_instance_def), set by the default */
@@ -185,6 +197,8 @@ typedef struct sinew_instance_def {
     /** The Hessian quasistatic Newton updates start on: SINEW_NEWTON_HESSIAN_AUTO (the
      * default), _CURRENT or _REST_FIRST (see there). */
     sinew_newton_hessian newton_hessian;
+    /** Profiler zones around the step's phases (see sinew_profiler); zero: none. */
+    sinew_profiler profiler;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -205,6 +219,9 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.patch_radius = 0.0f;
     d.self_contact = SINEW_SELF_CONTACT_POSE_SPACE;
     d.newton_hessian = SINEW_NEWTON_HESSIAN_AUTO;
+    d.profiler.zone_begin = NULL;
+    d.profiler.zone_end = NULL;
+    d.profiler.user = NULL;
     return d;
 }
 
@@ -262,6 +279,18 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
 #define SINEW_BUDGET_CONTACT_PAIRS 1u  /**< sinew_instance_def.max_contact_pairs */
 #define SINEW_BUDGET_WORLD_CONTACTS 2u /**< sinew_instance_def.max_world_contacts */
 #define SINEW_BUDGET_PATCH 4u          /**< sinew_instance_def.max_patch_vertices */
+
+/** What a blob was baked from (sinew_blob_get_provenance): compare with the asset and the
+ * library an engine ships, and bake again when either changed. Hashes are FNV-1a 64
+ * (sinew_hash_bytes), 0 when not known. */
+typedef struct sinew_blob_provenance {
+    uint32_t struct_size;    /**< set by the caller to sizeof(sinew_blob_provenance) */
+    uint32_t sinew_version;  /**< SINEW_VERSION of the bake that wrote the blob */
+    uint64_t source_hash;    /**< of the source asset file's bytes (0: no file) */
+    uint64_t options_hash;   /**< of the bake options that shape the blob */
+    uint32_t format_version; /**< the blob's format version (SINEW_BLOB_VERSION) */
+    uint32_t reserved;       /**< zero */
+} sinew_blob_provenance;
 
 /** Figures of an instance's last step. */
 typedef struct sinew_step_stats {
