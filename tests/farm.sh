@@ -72,7 +72,8 @@ touch "$tmp/afile"
 entries() { ls "$1"/simulate-*.bin; }
 cp -r "$tmp/c2" "$tmp/bad"
 e=($(entries "$tmp/bad"))
-printf '\x55' | dd of="${e[0]}" bs=1 seek=100 conv=notrunc status=none # corrupted
+half=$(($(stat -c %s "${e[0]}") / 2))
+printf '\x55' | dd of="${e[0]}" bs=1 seek="$half" conv=notrunc status=none # corrupted
 head -c 1000 "${e[1]}" >"$tmp/cut" && mv "$tmp/cut" "${e[1]}"         # truncated
 cp "${e[2]}" "${e[3]}"                                                  # foreign
 reduce "$tmp/bad" "$tmp/bad.blob"

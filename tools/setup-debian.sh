@@ -19,6 +19,8 @@ packages=(
     abigail-tools    # abidw/abidiff: the ABI baseline test (tests/abi/abi_check.sh)
     clang-format     # the format stage of tools/run-tests.sh (Debian 12: clang-format 14)
     python3          # docs/status.md from the benchmarks' JSON (tools/scripts/status_table.py)
+    slurm-wlm        # the farm test: a single-node Slurm cluster (tests/slurm.sh, tools/slurm/)
+    munge            # Slurm's authentication daemon
 )
 
 installed() {

@@ -20,6 +20,12 @@ static cJSON *items_json(cJSON *bakes, const char *name, const sw_bake_result *r
         !cJSON_AddItemToObject(b, "items", items))
         return NULL;
     cJSON_AddStringToObject(b, "bake", name);
+    for (int k = 0; k < SW_BAKE_NSTAGES; ++k) /* the stages' wall times, by the table */
+        if (sw_bake_stages[k].solutions && res->stage_seconds[k] > 0) {
+            char key[48];
+            snprintf(key, sizeof key, "%s_seconds", sw_bake_stages[k].name);
+            cJSON_AddNumberToObject(b, key, res->stage_seconds[k]);
+        }
     for (int32_t i = 0; i < res->nitems; ++i) {
         const sw_bake_item *it = &res->items[i];
         char key[24];
