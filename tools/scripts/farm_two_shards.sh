@@ -5,8 +5,8 @@
 #   bash tools/scripts/farm_two_shards.sh BUILD_DIR [OUT_DIR]
 set -u
 B=$(cd "${1:?usage: farm_two_shards.sh BUILD_DIR [OUT_DIR]}" && pwd)/tools/sinew-bake
-out=${2:-$(mktemp -d)}; mkdir -p "$out"; cd "$out" || exit 1
 data=${SINEW_DATA:-$(cd "$(dirname "$0")/../../.." && pwd)/shared/data}
+out=${2:-$(mktemp -d)}; mkdir -p "$out"; cd "$out" || exit 1
 F=("$data/gltf-fox/Fox.glb" --tets 20000 --train-clips Survey,Walk --heldout-clips Run)
 rm -rf one one1 two
 t0=$(date +%s.%N)
