@@ -3,7 +3,9 @@
 /* The simulate stage through its cache (sim_cache.h, sw_bake_params.cache_dir): the key
  * hashes every input of the full-space solves, so a file found under it holds exactly
  * the solutions this bake would compute (the reference's results do not depend on its
- * thread count). A file that cannot be used is reported and solved around. */
+ * thread count). A file that cannot be used is reported and solved around. Each file is
+ * one work item of a farm (sw_bake_params.shard_count): shards on many machines fill one
+ * shared folder, and a bake that finds every item there only reduces. */
 #include <errno.h>
 #include <fcntl.h>
 #include <stdatomic.h>

@@ -157,8 +157,9 @@ sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err);
 int32_t sw_bake_cache_store(sw_bake_state *s);
 /* The simulate stage's work items (sw_bake_item), one per chain the cache keeps, into
  * out->items in the stage's order, each with its shard (the longest first to the shard
- * with the fewest poses so far: a deterministic balance of the poses); with shard_count
- * > 0 the chains of the other shards are marked skip. Called after sw_bake_cache_read. */
+ * with the fewest poses so far: a deterministic balance of the poses); the chains not to
+ * solve here are marked skip: all of them for a plan, the other shards' for a shard.
+ * Called after sw_bake_cache_read. */
 sinew_result sw_bake_cache_items(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 /* Each item's solve time from its chain (after the solves). */
 void sw_bake_cache_item_times(const sw_bake_state *s, sw_bake_result *out);
