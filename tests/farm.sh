@@ -19,10 +19,10 @@ fail() {
 }
 finger=(--scene finger --tets 2000 --threads 2)
 
-# shards I (in the order given) of N into cache $1, then the reduce into $2.blob
+# shards I (in the order given) of N into cache $1
 run_shards() {
-    local cache=$1 out=$2 n=$3
-    shift 3
+    local cache=$1 n=$2
+    shift 2
     for i in "$@"; do
         "$bake" "${finger[@]}" "${extra[@]}" --shard "$i/$n" --cache "$cache" \
             2>>"$tmp/shards.log" || fail "shard $i/$n exited $?"
@@ -43,10 +43,10 @@ grep -q '"sinew_plan":1' "$tmp/plan.json" && grep -q '"key":"[0-9a-f]\{16\}"' "$
     fail "plan: no items in $(head -c 200 "$tmp/plan.json")"
 
 # N = 1, 2, 3, 7 in shuffled orders
-run_shards "$tmp/c1" "$tmp/n1" 1 0
-run_shards "$tmp/c2" "$tmp/n2" 2 1 0
-run_shards "$tmp/c3" "$tmp/n3" 3 2 0 1
-run_shards "$tmp/c7" "$tmp/n7" 7 6 3 0 5 2 4 1
+run_shards "$tmp/c1" 1 0
+run_shards "$tmp/c2" 2 1 0
+run_shards "$tmp/c3" 3 2 0 1
+run_shards "$tmp/c7" 7 6 3 0 5 2 4 1
 for n in 1 2 3 7; do
     reduce "$tmp/c$n" "$tmp/n$n.blob"
     same "$tmp/n$n.blob" "$tmp/local.blob" "N=$n"
@@ -71,7 +71,7 @@ touch "$tmp/afile"
 # faults on copies of the full cache c2
 entries() { ls "$1"/simulate-*.bin; }
 cp -r "$tmp/c2" "$tmp/bad"
-e=($(entries "$tmp/bad"))
+mapfile -t e < <(entries "$tmp/bad")
 half=$(($(stat -c %s "${e[0]}") / 2))
 printf '\x55' | dd of="${e[0]}" bs=1 seek="$half" conv=notrunc status=none # corrupted
 head -c 1000 "${e[1]}" >"$tmp/cut" && mv "$tmp/cut" "${e[1]}"         # truncated
@@ -92,7 +92,7 @@ kill -KILL "$pid"
 wait "$pid" 2>/dev/null
 [ -n "$(ls "$tmp/kill" 2>/dev/null | grep -v '^simulate-[0-9a-f]*\.bin$\|\.tmp-')" ] &&
     fail "killed shard left $(ls "$tmp/kill")"
-run_shards "$tmp/kill" "" 1 0
+run_shards "$tmp/kill" 1 0
 reduce "$tmp/kill" "$tmp/kill.blob"
 same "$tmp/kill.blob" "$tmp/local.blob" "killed shard rerun"
 
@@ -109,7 +109,7 @@ grep -q "0 of them solved" "$tmp/twice.blob.log" || fail "two shards: entries un
 
 # a shard that never ran: the reduce solves its items and names them
 mkdir -p "$tmp/half"
-run_shards "$tmp/half" "" 2 0
+run_shards "$tmp/half" 2 0
 reduce "$tmp/half" "$tmp/half.blob"
 same "$tmp/half.blob" "$tmp/local.blob" "missing shard"
 grep -q "work items not in the cache, solving them" "$tmp/half.blob.log" ||
@@ -118,8 +118,8 @@ grep -q "work items not in the cache, solving them" "$tmp/half.blob.log" ||
 # the adaptive loop as rounds of items: each round's shards, then the reduce
 extra=(--adaptive 2)
 "$bake" "${finger[@]}" "${extra[@]}" --out "$tmp/ad.blob" >/dev/null 2>&1 || fail "local adaptive"
-for round in 0 1 2 3; do # one round more than the loop has: its shards find nothing to do
-    run_shards "$tmp/cad" "" 3 2 0 1
+for _ in 0 1 2 3; do # one round more than the loop has: its shards find nothing to do
+    run_shards "$tmp/cad" 3 2 0 1
 done
 grep -q "every round in the cache" "$tmp/shards.log" || fail "adaptive: the rounds never ended"
 reduce "$tmp/cad" "$tmp/ad3.blob"

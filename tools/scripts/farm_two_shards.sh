@@ -24,4 +24,4 @@ t3=$(date +%s.%N)
 /usr/bin/time -f "%e s reduce" $B "${F[@]}" --cache two --out fox20k.blob > reduce.log 2>&1
 t4=$(date +%s.%N)
 echo "reduce: $(echo "$t4 - $t3" | bc) s wall"
-echo done
+echo "finished"
