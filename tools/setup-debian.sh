@@ -25,6 +25,8 @@ packages=(
     xvfb             # sinew-view's tests and offscreen runs (xvfb-run)
     xauth            # xvfb-run needs it
     ffmpeg           # sinew-view --record
+    slurm-wlm        # the farm test: a single-node Slurm cluster (tests/slurm.sh, tools/slurm/)
+    munge            # Slurm's authentication daemon
 )
 
 installed() {

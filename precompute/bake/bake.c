@@ -300,7 +300,9 @@ sinew_result sw_bake(const sw_character *c, const sw_bake_params *params, sw_bak
     sw_bake_params p = params ? *params : sw_bake_params_default();
     sw_bake_state s;
     sinew_result r = bake_begin(&s, &p, c, err);
-    if (r == SINEW_OK) r = run_stages(&s, out, 0, err);
+    /* a plan or a shard: the stages that make the solutions, the simulate stage only
+       listing its items or solving a shard's of them */
+    if (r == SINEW_OK) r = run_stages(&s, out, p.plan_only || p.shard_count > 0, err);
     sw_bake_state_free(&s);
     if (r != SINEW_OK) sw_bake_result_free(out);
     return r;

@@ -226,11 +226,40 @@ static sinew_result verify(const sinew_blob *prev, const sw_bake_result *res, in
     return r;
 }
 
+/* A round's bake. For a plan or a shard, its items first: when the cache held them all
+ * the round is baked whole from it (the next round needs its blob), otherwise the
+ * items are listed or the shard's solved, and *done says the loop stops here. */
+static sinew_result farm_round(const sw_character *c, const sw_bake_params *p, sw_bake_result *res,
+                               int *done, sw_error *err) {
+    *done = 0;
+    if (!p->plan_only && p->shard_count == 0) return sw_bake(c, p, res, err);
+    sw_bake_params whole = *p;
+    whole.plan_only = 1;
+    whole.shard_count = 0;
+    sinew_result r = sw_bake(c, &whole, res, err);
+    if (r != SINEW_OK) return r;
+    int32_t missing = 0;
+    for (int32_t i = 0; i < res->nitems; ++i)
+        missing += !res->items[i].cached;
+    if (missing > 0 && p->plan_only) {
+        *done = 1;
+        return SINEW_OK;
+    }
+    sw_bake_result_free(res);
+    if (missing > 0) {
+        *done = 1;
+        return sw_bake(c, p, res, err);
+    }
+    whole.plan_only = 0;
+    return sw_bake(c, &whole, res, err);
+}
+
 sinew_result sw_bake_adaptive(const sw_character *c, const sw_bake_params *params,
                               const sw_adaptive_params *ap, sw_bake_result *out,
                               sw_adaptive_report *rep, sw_error *err) {
     memset(out, 0, sizeof *out);
     memset(rep, 0, sizeof *rep);
+    rep->farm_round = -1;
     sw_adaptive_params a = ap ? *ap : sw_adaptive_params_default();
     sw_bake_params p = params ? *params : sw_bake_params_default();
     sinew_result r = check(&a, err);
@@ -256,7 +285,13 @@ sinew_result sw_bake_adaptive(const sw_character *c, const sw_bake_params *param
         void *mem = NULL;
         p.extra_poses = extra;
         p.nextra_poses = nextra;
-        if ((r = sw_bake(c, &p, &res, err)) != SINEW_OK) break;
+        int done = 0; /* a farm's shard: this round's items still missing, its work done */
+        if ((r = farm_round(c, &p, &res, &done, err)) != SINEW_OK) break;
+        if (done) {
+            rep->farm_round = round;
+            *out = res;
+            break;
+        }
         rep->nrounds = round + 1;
         if ((r = sw_bake_result_blob(&res, &mem, &blob, err)) == SINEW_OK &&
             (r = measure(blob, &res, nextra, rd, err)) == SINEW_OK && prev && picked > 0)

@@ -50,10 +50,19 @@ typedef struct sw_adaptive_round {
 typedef struct sw_adaptive_report {
     int32_t nrounds; /* bakes made: the first is the plain bake */
     sw_adaptive_round round[SW_ADAPTIVE_MAX_ROUNDS + 1];
+    /* with p->plan_only or p->shard_count > 0: the round whose items `out` lists (the
+       first whose items the cache did not all hold), or -1 when the cache held every
+       round's (`out` then the last round's whole bake) */
+    int32_t farm_round;
 } sw_adaptive_report;
 
 /* sw_bake with the loop above: `out` is the last round's bake (its training poses
- * include the loop's), `rep` every round's figures. p->progress prints a line a round. */
+ * include the loop's), `rep` every round's figures. p->progress prints a line a round.
+ * A farm runs the rounds as rounds of work items (sw_bake_params.shard_count): a round's
+ * items depend on the blob of the round before, so a shard reduces the rounds whose
+ * items the cache holds (their bakes read every solution from it) and then plans or
+ * solves its items of the first round it lacks, and stops there; the next round's
+ * shards run after every shard of this one. */
 sinew_result sw_bake_adaptive(const sw_character *c, const sw_bake_params *p,
                               const sw_adaptive_params *a, sw_bake_result *out,
                               sw_adaptive_report *rep, sw_error *err);

@@ -3,12 +3,17 @@
 /* The simulate stage through its cache (sim_cache.h, sw_bake_params.cache_dir): the key
  * hashes every input of the full-space solves, so a file found under it holds exactly
  * the solutions this bake would compute (the reference's results do not depend on its
- * thread count). A file that cannot be used is reported and solved around. */
+ * thread count). A file that cannot be used is reported and solved around. Each file is
+ * one work item of a farm (sw_bake_params.shard_count): shards on many machines fill one
+ * shared folder, and a bake that finds every item there only reduces. */
 #include <errno.h>
+#include <fcntl.h>
+#include <stdatomic.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include "bake_state.h"
 #include "blob_write.h"
@@ -117,9 +122,42 @@ static sinew_result adopt(sw_bake_state *s, const chain *ch, sw_sim_cache *c, sw
     return SINEW_OK;
 }
 
-/* Stores the chain's solutions under key (a failure is only reported: the bake itself
- * has what it needs). */
-static void store(sw_bake_state *s, const chain *ch, uint64_t key, const char *path) {
+/* Writes the entry as a farm's shared cache needs it: to a temporary name no other
+ * writer uses (host, process, call), then renamed over `path`. rename is atomic on a
+ * POSIX file system and on NFS, so a reader sees the whole entry or none, two shards
+ * that solve the same item at once each rename identical bytes, and a writer killed
+ * mid-write leaves only its temporary file, which no reader opens. No lock: NFS does
+ * not honour every kind. */
+static sinew_result write_entry(const char *path, const uint8_t *b, size_t n, sw_error *err) {
+    static atomic_int calls;
+    char host[64] = "host", tmp[4300];
+    gethostname(host, sizeof host - 1);
+    host[sizeof host - 1] = 0;
+    snprintf(tmp, sizeof tmp, "%s.tmp-%s-%ld-%d", path, host, (long)getpid(),
+             atomic_fetch_add(&calls, 1));
+    int fd = open(tmp, O_WRONLY | O_CREAT | O_EXCL | O_CLOEXEC, 0644);
+    if (fd < 0)
+        return sw_error_set(err, SINEW_ERROR_IO, "cannot create '%s': %s", tmp, strerror(errno));
+    size_t at = 0;
+    int e = 0;
+    while (at < n && !e) {
+        ssize_t w = write(fd, b + at, n - at);
+        if (w < 0 && errno != EINTR) e = errno;
+        if (w > 0) at += (size_t)w;
+    }
+    if (!e && fsync(fd) != 0) e = errno;
+    if (close(fd) != 0 && !e) e = errno;
+    if (!e && rename(tmp, path) != 0) e = errno;
+    if (e) {
+        unlink(tmp);
+        return sw_error_set(err, SINEW_ERROR_IO, "cannot write '%s': %s", path, strerror(e));
+    }
+    return SINEW_OK;
+}
+
+/* Stores the chain's solutions under key (0 when it could not: reported, and only a
+ * shard, whose work is the entry, fails for it). */
+static int store(sw_bake_state *s, const chain *ch, uint64_t key, const char *path) {
     sw_sim_cache_seq seq[3];
     sw_sim_cache c = {key, s->rig.nv, ch->n, seq};
     sw_error e;
@@ -131,10 +169,11 @@ static void store(sw_bake_state *s, const chain *ch, uint64_t key, const char *p
                                     q->x,     q->contact_ptr, q->contacts};
     }
     sinew_result r = sw_sim_cache_encode(&c, &b, &n, &e);
-    if (r == SINEW_OK) r = sw_write_file_atomic(path, b, n, &e);
+    if (r == SINEW_OK) r = write_entry(path, b, n, &e);
     if (r != SINEW_OK && s->p->progress)
         fprintf(stderr, "sinew-bake: simulate cache not stored: %s\n", e.msg);
     free(b); /* the arrays are the sequences' */
+    return r == SINEW_OK;
 }
 
 /* Reads the chain's file when there is a usable one (1), reporting one that is not. */
@@ -195,14 +234,78 @@ sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err) {
     return r;
 }
 
-void sw_bake_cache_store(sw_bake_state *s) {
+int32_t sw_bake_cache_store(sw_bake_state *s) {
     const char *dir = s->p->cache_dir;
-    if (!dir || !dir[0]) return;
+    if (!dir || !dir[0]) return 0;
     uint64_t character = character_key(s), key;
     char path[4200];
     chain ch;
+    int32_t failed = 0;
     for (int32_t i = 0; i <= s->poses.ntrain_seq; ++i)
         if (chain_file(s, i, character, dir, &ch, &key, path, sizeof path) &&
-            !ch.seq[0]->from_cache)
-            store(s, &ch, key, path);
+            !ch.seq[0]->from_cache && !ch.seq[0]->skip)
+            failed += !store(s, &ch, key, path);
+    return failed;
+}
+
+sinew_result sw_bake_cache_items(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    const sw_bake_params *p = s->p;
+    const int32_t nshard = p->shard_count > 0 ? p->shard_count : 1;
+    uint64_t character = character_key(s), key;
+    char path[4200];
+    chain ch;
+    int32_t n = 0;
+    sw_bake_item *it = sw_bake_own(out, malloc(((size_t)s->poses.ntrain_seq + 1) * sizeof *it));
+    int64_t *load = calloc((size_t)nshard, sizeof *load);
+    int32_t *order = malloc(((size_t)s->poses.ntrain_seq + 1) * sizeof *order);
+    if (!it || !load || !order) {
+        free(load);
+        free(order);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for work items");
+    }
+    for (int32_t i = 0; i <= s->poses.ntrain_seq; ++i)
+        if (chain_file(s, i, character, "", &ch, &key, path, sizeof path)) {
+            int32_t poses = 0;
+            for (int32_t k = 0; k < ch.n; ++k)
+                poses += ch.seq[k]->npose;
+            it[n] = (sw_bake_item){key, ch.n, poses, 0, ch.seq[0]->from_cache, 0};
+            order[n] = n;
+            n++;
+        }
+    /* the most poses first (ties in the stage's order), each to the shard with the fewest
+       poses so far (the lowest index of a tie): the same plan on every machine */
+    for (int32_t i = 1; i < n; ++i)
+        for (int32_t j = i; j > 0 && it[order[j]].poses > it[order[j - 1]].poses; --j) {
+            int32_t t = order[j];
+            order[j] = order[j - 1];
+            order[j - 1] = t;
+        }
+    for (int32_t i = 0; i < n; ++i) {
+        int32_t best = 0;
+        for (int32_t k = 1; k < nshard; ++k)
+            if (load[k] < load[best]) best = k;
+        it[order[i]].shard = best;
+        load[best] += it[order[i]].poses;
+    }
+    free(load);
+    free(order);
+    out->items = it;
+    out->nitems = n;
+    out->items_character = character;
+    n = 0;
+    for (int32_t i = 0; i <= s->poses.ntrain_seq; ++i)
+        if (chain_file(s, i, character, "", &ch, &key, path, sizeof path)) {
+            ch.seq[0]->skip = p->plan_only || (p->shard_count > 0 && it[n].shard != p->shard_index);
+            n++;
+        }
+    return SINEW_OK;
+}
+
+void sw_bake_cache_item_times(const sw_bake_state *s, sw_bake_result *out) {
+    int32_t n = 0;
+    for (int32_t i = 0; i <= s->poses.ntrain_seq && n < out->nitems; ++i) {
+        const sw_pose_seq *q = i < s->poses.ntrain_seq ? &s->poses.train[i] : &s->poses.heldout;
+        if (q->continues || q->npose == 0) continue;
+        out->items[n++].seconds = q->from_cache || q->skip ? 0 : q->seconds;
+    }
 }

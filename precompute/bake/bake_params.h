@@ -121,7 +121,27 @@ typedef struct sw_bake_params {
     int32_t nextra_poses, extra_chain;
     int compare_selectors; /* also train the other two selectors on the same data and
                               report their sizes and times (the blob keeps `selector`) */
+    /* The bake in work items for a farm (docs/baking.md, "Baking on a farm"): an item is
+       one cache entry of the simulate stage, a chain of full-space solves from rest
+       (bake_cache.c). With plan_only or shard_count > 0 sw_bake runs only the stages
+       flagged `solutions` (bake.c) and stops after simulate, which lists its items in
+       sw_bake_result.items: plan_only solves none; shard_count > 0 solves only the items
+       of shard shard_index (0..shard_count-1) that cache_dir lacks and stores them there.
+       A later sw_bake with the same cache_dir then reads them all and only reduces.
+       Default 0: the whole bake. */
+    int plan_only;
+    int32_t shard_index, shard_count;
 } sw_bake_params;
+
+/* One work item of the simulate stage (sw_bake_params.plan_only, shard_count). */
+typedef struct sw_bake_item {
+    uint64_t key;   /* the hash of every input of its solves: its cache entry's name */
+    int32_t nseq;   /* sequences in the chain (a path and the paths that continue it) */
+    int32_t poses;  /* full-space solves in it */
+    int32_t shard;  /* the shard that solves it (of shard_count; 0 without shards) */
+    int cached;     /* found in the cache before this run solved anything */
+    double seconds; /* wall time of its solves in this run (0: not solved here) */
+} sw_bake_item;
 
 sw_bake_params sw_bake_params_default(void);
 
@@ -193,6 +213,12 @@ typedef struct sw_bake_result {
     /* every joint's sweep: its axis (3 per bone) and largest angle (per bone; 0 for a
        joint the training poses do not bend), the range random combined poses span */
     double *sweep_axis, *sweep_angle;
+    /* the simulate stage's work items in its order (owned; filled when cache_dir is set
+       or with plan_only / shard_count > 0), and the hash of what every item shares (the
+       mesh, weights, material and simulator: two plans of one character agree on it) */
+    sw_bake_item *items;
+    int32_t nitems;
+    uint64_t items_character;
 } sw_bake_result;
 
 /* n random combined poses, each reached in `steps` poses (n * steps poses of 12 nbones

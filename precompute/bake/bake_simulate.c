@@ -4,10 +4,12 @@
  * chain of poses on its own core, each pose warm-started from the one before; the chains
  * the cache holds are read from it instead (bake_cache.c). */
 #include <stdatomic.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "bake_state.h"
+#include "clock.h"
 #include "fullsim.h"
 
 /* Appends the simulator's contact set as pose k's (the pose-space self-contact data,
@@ -60,6 +62,7 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
         int i = atomic_fetch_add(&ctx->next, 1);
         if (i >= ctx->nseq) break;
         sw_pose_seq *q = ctx->seqs[i];
+        const double t0 = sw_now_seconds();
         sw_fullsim_params fp = sw_bake_sim_params(s->p);
         /* a chained path (the clip's training then held-out frames) is the longest serial
            run: it gets every core (the simulator's results do not depend on its thread
@@ -79,6 +82,7 @@ static void simulate_worker(void *vctx, int64_t begin, int64_t end, int worker) 
                 simulate_seq(s, sim, q->then[c]);
             }
         sw_fullsim_destroy(sim);
+        q->seconds = sw_now_seconds() - t0;
     }
 }
 
@@ -91,9 +95,11 @@ static sinew_result simulate_solve(sw_bake_state *s, sw_error *err) {
     sw_pose_seq *seqs[4096];
     int32_t n = 0;
     for (int32_t i = 0; i < s->poses.ntrain_seq && n < 4095; ++i)
-        if (!s->poses.train[i].continues && !s->poses.train[i].from_cache)
+        if (!s->poses.train[i].continues && !s->poses.train[i].from_cache &&
+            !s->poses.train[i].skip)
             seqs[n++] = &s->poses.train[i];
-    if (s->poses.heldout.npose > 0 && !s->poses.heldout.continues && !s->poses.heldout.from_cache)
+    if (s->poses.heldout.npose > 0 && !s->poses.heldout.continues && !s->poses.heldout.from_cache &&
+        !s->poses.heldout.skip)
         seqs[n++] = &s->poses.heldout;
     /* longest path first (stable): a long clip taken last by one worker would leave the
        others idle at the end (each path's results do not depend on the order) */
@@ -171,14 +177,47 @@ static sinew_result keep_solutions(const sw_bake_state *s, sw_bake_result *out, 
 
 /* simulate: the poses' full-space solutions (through the cache), and what the result keeps
  * of them for evaluation (sinew-bench, the report). */
+/* Says which items a bake that shares a cache with a farm solves itself: those no shard
+ * stored (a shard that never ran, or a corrupt entry), so that the bake completes. */
+static void say_missing(const sw_bake_state *s, const sw_bake_result *out) {
+    int32_t hit = 0, miss = 0;
+    for (int32_t i = 0; i < out->nitems; ++i)
+        out->items[i].cached ? ++hit : ++miss;
+    if (!s->p->progress || hit == 0 || miss == 0) return;
+    fprintf(stderr,
+            "sinew-bake: simulate: %d of %d work items not in the cache, solving them:", miss,
+            out->nitems);
+    for (int32_t i = 0; i < out->nitems; ++i)
+        if (!out->items[i].cached)
+            fprintf(stderr, " %d (%016llx)", i, (unsigned long long)out->items[i].key);
+    fprintf(stderr, "\n");
+}
+
 sinew_result sw_bake_simulate(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    const sw_bake_params *p = s->p;
+    const int farm = p->plan_only || p->shard_count > 0;
+    if (p->shard_count > 0 && (!p->cache_dir || !p->cache_dir[0]))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "a shard's work goes to the cache: give a cache folder");
+    if (p->shard_count > 0 && (p->shard_index < 0 || p->shard_index >= p->shard_count))
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "shard %d of %d: want 0..%d",
+                            p->shard_index, p->shard_count, p->shard_count - 1);
     int all = 0; /* the chains the cache holds are marked read, the rest solved */
     sinew_result r = sw_bake_cache_read(s, &all, err);
-    if (r == SINEW_OK) r = simulate_solve(s, err);
+    if (r == SINEW_OK && (farm || (p->cache_dir && p->cache_dir[0])))
+        r = sw_bake_cache_items(s, out, err);
+    if (r == SINEW_OK && !farm) say_missing(s, out);
+    if (r == SINEW_OK && !p->plan_only) r = simulate_solve(s, err);
     if (r != SINEW_OK) return r;
-    sw_bake_cache_store(s);
-    out->simulate_cached = s->p->cache_dir && s->p->cache_dir[0] && all;
+    const int32_t unstored = sw_bake_cache_store(s);
+    if (unstored > 0 && p->shard_count > 0)
+        return sw_error_set(err, SINEW_ERROR_IO,
+                            "shard %d of %d: %d work items solved but not stored in '%s'",
+                            p->shard_index, p->shard_count, unstored, p->cache_dir);
+    if (out->nitems) sw_bake_cache_item_times(s, out);
     out->simulate_solved = (int32_t)s->poses.solved_poses;
+    if (farm) return SINEW_OK; /* the items are in the cache: the reduce is another run's */
+    out->simulate_cached = p->cache_dir && p->cache_dir[0] && all;
     out->return_poses = s->poses.return_poses;
     out->pair_sweep_poses = s->poses.pair_sweep_poses;
     size_t na = (size_t)s->rig.nb * 3 * sizeof(double);

@@ -39,6 +39,8 @@ typedef struct sw_pose_seq {
     struct sw_pose_seq *then[2];
     int continues;  /* this sequence is another's `then`: not scheduled on its own */
     int from_cache; /* its solutions were read from the simulate cache: not solved again */
+    int skip;       /* another shard's item (sw_bake_params.shard_count): not solved here */
+    double seconds; /* wall time of its chain's solves (simulate, on the chain's first) */
 } sw_pose_seq;
 
 /* The state, grouped by the stage that writes it (bake.c, sw_bake_stages): a stage
@@ -149,9 +151,18 @@ void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, 
 sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p);
 /* The simulate stage's cache (bake_cache.c; sw_bake_params.cache_dir, nothing without
  * one): read marks the pose chains the cache holds as solved (sw_pose_seq.from_cache),
- * *all when it holds every one; store writes the chains that were solved. */
+ * *all when it holds every one; store writes the chains that were solved and returns
+ * how many it could not. */
 sinew_result sw_bake_cache_read(sw_bake_state *s, int *all, sw_error *err);
-void sw_bake_cache_store(sw_bake_state *s);
+int32_t sw_bake_cache_store(sw_bake_state *s);
+/* The simulate stage's work items (sw_bake_item), one per chain the cache keeps, into
+ * out->items in the stage's order, each with its shard (the longest first to the shard
+ * with the fewest poses so far: a deterministic balance of the poses); the chains not to
+ * solve here are marked skip: all of them for a plan, the other shards' for a shard.
+ * Called after sw_bake_cache_read. */
+sinew_result sw_bake_cache_items(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* Each item's solve time from its chain (after the solves). */
+void sw_bake_cache_item_times(const sw_bake_state *s, sw_bake_result *out);
 /* The un-skinned displacements of one pose (thesis eq. 4.13): d (3 nv) from
  * positions x and bone transforms T, d_v = R_v^T (x_v - t_v) - rest_v (0 at bone-driven
  * vertices); R (9 nv) and t (3 nv) are scratch for the skinning transforms. */

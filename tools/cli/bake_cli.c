@@ -50,6 +50,21 @@ static int take_fold_share(const char *tool, const char *flag, const char *v, vo
     return ok;
 }
 
+/* --shard I/N, 0 <= I < N <= 100000 */
+static int take_shard(const char *tool, const char *flag, const char *v, void *target) {
+    sw_bake_params *p = target;
+    int i = -1, n = 0, used = 0;
+    if (sscanf(v, "%d/%d%n", &i, &n, &used) != 2 || v[used] != 0 || n < 1 || n > 100000 || i < 0 ||
+        i >= n) {
+        fprintf(stderr, "%s: %s wants I/N with 0 <= I < N <= 100000 (shard I of N), got '%s'\n",
+                tool, flag, v);
+        return 0;
+    }
+    p->shard_index = i;
+    p->shard_count = n;
+    return 1;
+}
+
 /* The bake's own flags (what every bake may want), bound to o, into f; returns their
  * count. */
 static size_t bake_flags(bake_options *o, sw_flag *f) {
@@ -65,6 +80,14 @@ static size_t bake_flags(bake_options *o, sw_flag *f) {
                 "keep the full-space solutions in DIR and reuse them when a\n"
                 "later bake solves the same poses of the same character (a\n"
                 "re-bake that changes the cubature, rank or report only)")},
+        {SW_STR("--plan", &o->plan_path, "FILE",
+                "write the bake's work items (each chain of full-space solves,\n"
+                "named by the hash of its inputs) as a JSON manifest and exit;\n"
+                "with --shard, check that FILE is this character's")},
+        {SW_CALL("--shard", take_shard, p, "I/N",
+                 "solve only shard I's work items (of N, 0 <= I < N) into the\n"
+                 "--cache folder and exit; the plain bake with the same --cache\n"
+                 "then only reduces (docs/baking.md, Baking on a farm)")},
         {SW_SET("--ship-split", &p->ship_split, 1,
                 "ship the blob trained on the split of a character's only\n"
                 "clip, the one the held-out figures measure (default: baked\n"
@@ -211,7 +234,18 @@ int bake_parse_args(int argc, char **argv, bake_options *o) {
     int status = sw_flags_parse(&cli, argc, argv);
     if (status) return status;
     if (o->seed_given) o->p.seed = (uint64_t)o->seed;
-    if (!o->out_path) {
+    if (o->p.shard_count > 0 && !o->p.cache_dir) {
+        fprintf(stderr, "%s: --shard puts its work in the shared cache: give --cache DIR\n", tool);
+        return 2;
+    }
+    const int farm = o->plan_path || o->p.shard_count > 0;
+    o->p.plan_only = o->plan_path && o->p.shard_count == 0;
+    if (farm && (o->out_path || o->report_dir)) {
+        fprintf(stderr, "%s: --plan and --shard write no blob or report: drop --out, --report\n",
+                tool);
+        return 2;
+    }
+    if (!o->out_path && !farm) {
         fprintf(stderr, "%s: give --out FILE.blob\n", tool);
         sw_flags_usage(&cli, stderr);
         return 2;
@@ -227,7 +261,12 @@ int bake_parse_args(int argc, char **argv, bake_options *o) {
         }
     /* the blob's path too: a folder that is missing, or a path that is a folder */
     sw_error err;
-    sinew_result r = sw_write_file_check(o->out_path, &err);
-    if (r != SINEW_OK) return sw_tool_failed(r, &err, "%s: --out: ", tool);
+    const int plan_out = o->plan_path && o->p.shard_count == 0;
+    sinew_result r = sw_write_file_check(plan_out      ? o->plan_path
+                                         : o->out_path ? o->out_path
+                                                       : "",
+                                         &err);
+    if (r != SINEW_OK && (plan_out || o->out_path))
+        return sw_tool_failed(r, &err, "%s: %s: ", tool, plan_out ? "--plan" : "--out");
     return 0;
 }

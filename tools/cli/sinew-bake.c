@@ -558,6 +558,13 @@ int main(int argc, char **argv) {
     sw_error err;
     int status = bake_parse_args(argc, argv, &b.o);
     if (status || (status = load_character(&b, &err))) return status;
+    if (b.o.plan_path || b.o.p.shard_count > 0) { /* a farm's plan or shard: no blob */
+        sw_tool_bake_clips(&b.o.ca, &b.clips, &b.o.p);
+        status = bake_farm(&b.o, &b.ch);
+        sw_character_free(&b.ch);
+        sw_clip_split_free(&b.clips);
+        return status;
+    }
     if ((status = run_bake(&b, &err))) {
         sw_character_free(&b.ch);
         sw_clip_split_free(&b.clips);
