@@ -33,15 +33,15 @@ typedef struct sw_imported_clip {
 } sw_imported_clip;
 
 typedef struct sw_imported_character {
-    sw_trimesh render;         /* every skinned mesh and rigid prop merged, bind pose, metres */
-    int32_t *render_source;    /* render.nverts: index of the aiMesh the vertex came from */
+    sw_trimesh render;             /* every skinned mesh and rigid prop merged, bind pose, metres */
+    int32_t *render_source;        /* render.nverts: index of the aiMesh the vertex came from */
     int32_t *render_source_vertex; /* render.nverts: its index within that aiMesh */
     int32_t nsource_meshes;        /* the aiScene's meshes */
     int32_t *source_mesh_verts;    /* nsource_meshes: each one's vertex count */
-    double *bone_bind; /* 12 skel.nbones: bind global transforms (3x3 row-major, t), scaled */
-    sw_skeleton skel;          /* joints 0..nb-1 are bone heads, nb..2nb-1 their tails */
-    char (*bone_names)[64];    /* skel.nbones node names, cut to 63 bytes */
-    sw_weights weights;        /* render.nverts x skel.nbones, <= 4 non-zero per row, rows sum 1 */
+    double *bone_bind;      /* 12 skel.nbones: bind global transforms (3x3 row-major, t), scaled */
+    sw_skeleton skel;       /* joints 0..nb-1 are bone heads, nb..2nb-1 their tails */
+    char (*bone_names)[64]; /* skel.nbones node names, cut to 63 bytes */
+    sw_weights weights;     /* render.nverts x skel.nbones, <= 4 non-zero per row, rows sum 1 */
     double weight_dropped_max; /* largest share of a vertex's weight cut by the 4-influence limit */
     double weight_dropped_mean; /* mean of that share over the skinned vertices */
     int32_t nskinned;           /* meshes with bones merged */

@@ -59,8 +59,7 @@ SINEW_API sinew_result sinew_blob_bone_parent(const sinew_blob *blob, uint32_t b
  * host's skinning matrix is its bone's global transform times the inverse of this.
  * INVALID_ARGUMENT for NULL or an out-of-range bone; UNSUPPORTED for a blob without the
  * asset description. Thread-safe. */
-SINEW_API sinew_result sinew_blob_bone_bind(const sinew_blob *blob, uint32_t bone,
-                                            double bind[12]);
+SINEW_API sinew_result sinew_blob_bone_bind(const sinew_blob *blob, uint32_t bone, double bind[12]);
 
 /** Number of meshes of the source file as the bake imported it (assimp's aiScene mMeshes;
  * glTF: one a primitive), 0 for NULL or a blob without the asset description. Thread-safe. */

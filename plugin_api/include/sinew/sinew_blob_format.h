@@ -322,13 +322,13 @@ typedef struct sinew_blob_pair_meta {
 /** Section ASSET_META: what the blob was baked from and the asset sections' counts (64
  * bytes). A hash is FNV-1a 64 (0: not known). */
 typedef struct sinew_blob_asset_meta {
-    int32_t nname_bytes;     /**< bytes of BONE_NAMES, every name's zero included */
-    int32_t nsource_meshes;  /**< meshes of the source file (0: no file, or none kept) */
-    int32_t noutput_verts;   /**< output surface vertices (OUTPUT_SOURCE holds 2 each) */
-    uint32_t sinew_version;  /**< SINEW_VERSION of the bake that wrote the blob */
-    uint64_t source_hash;    /**< of the source asset file's bytes */
-    uint64_t options_hash;   /**< of the bake's options that shape the blob */
-    int32_t reserved[8];     /**< zero */
+    int32_t nname_bytes;    /**< bytes of BONE_NAMES, every name's zero included */
+    int32_t nsource_meshes; /**< meshes of the source file (0: no file, or none kept) */
+    int32_t noutput_verts;  /**< output surface vertices (OUTPUT_SOURCE holds 2 each) */
+    uint32_t sinew_version; /**< SINEW_VERSION of the bake that wrote the blob */
+    uint64_t source_hash;   /**< of the source asset file's bytes */
+    uint64_t options_hash;  /**< of the bake's options that shape the blob */
+    int32_t reserved[8];    /**< zero */
 } sinew_blob_asset_meta;
 
 /** Section DOMAINS: one record per domain (48 bytes). */
