@@ -173,7 +173,8 @@ TEST(two_identical_samples_blended_are_one) {
         for (int32_t i = 0; i < R; ++i)
             q[i] = in->solver.q[i] * (k < 4 ? 1 + 0.5 * k : -0.5 * (k - 3));
         memset(in->red.g, 0, sizeof(double) * (size_t)R);
-        e1 = sw_contact_pairs_eval(&in->red, &set, ps->pairs, n, ps->pair_w, ps->pair_tan, q, 1, 0);
+        e1 = sw_contact_pairs_eval(&in->red, &set, ps->pairs, NULL, n, ps->pair_w, ps->pair_tan, q,
+                                   1, 0);
     }
     memcpy(g1, in->red.g, sizeof(double) * (size_t)R);
     ps->blend = 0.3; /* into arrays that hold both (the budget holds the two fullest) */
@@ -186,7 +187,7 @@ TEST(two_identical_samples_blended_are_one) {
     ENSUREF(ps->npairs == 2 * n && ps->dropped == 0, "blended: %d pairs of %d, %d dropped",
             ps->npairs, 2 * n, ps->dropped);
     memset(in->red.g, 0, sizeof(double) * (size_t)R);
-    double e2 = sw_contact_pairs_eval(&in->red, &set, ps->pairs, ps->npairs, ps->pair_w,
+    double e2 = sw_contact_pairs_eval(&in->red, &set, ps->pairs, NULL, ps->npairs, ps->pair_w,
                                       ps->pair_tan, q, 1, 0);
     ENSUREF(e1 > 0, "the pairs never press: energy %g", e1);
     ENSUREF(fabs(e1 - e2) <= 1e-12 * e1, "one sample %.17g, blended with itself %.17g", e1, e2);

@@ -103,7 +103,7 @@ TEST(the_potential_with_detected_pairs_matches_finite_differences) {
     /* the pairs' energy at the solution: some pair still presses (penalty contact) */
     sw_pair_set set = sw_self_contacts_pairs(&in->sc);
     double e_pairs =
-        sw_contact_pairs_eval(&in->red, &set, NULL, in->sc.npairs, NULL, NULL, q, 0, 0);
+        sw_contact_pairs_eval(&in->red, &set, NULL, NULL, in->sc.npairs, NULL, NULL, q, 0, 0);
     ENSUREF(e_pairs > 0, "frame %d: %d pairs, none pressing", best, in->sc.npairs);
     double e = sw_instance_step_potential(in, 1.0f / 30, q, g, NULL, 0), gmax = 0;
     ENSURE(isfinite(e));

@@ -190,12 +190,15 @@ enum {
     P_MESH_HULL,    /* quasistatic and dynamic, 10^4 steps against a triangle mesh (Embree)
                        and a convex hull (libccd) that move every step */
     P_PATCH,        /* the same world, quasistatic with condensation patches */
+    P_NOVEL,        /* quasistatic, the fold taken past its training: novel self-contact
+                       seeding patches without a world */
     P_COUNT
 };
 static const char *const path_names[P_COUNT] = {
-    "quasistatic",  "dynamic",    "translate jump", "rotation snap", "dt spikes",     "cut",
-    "limited",      "guard",      "failed",         "reset",         "pair budget",   "world",
-    "world budget", "exhaustive", "pose pairs",     "rest first",    "mesh and hull", "patch"};
+    "quasistatic", "dynamic",       "translate jump", "rotation snap", "dt spikes",
+    "cut",         "limited",       "guard",          "failed",        "reset",
+    "pair budget", "world",         "world budget",   "exhaustive",    "pose pairs",
+    "rest first",  "mesh and hull", "patch",          "novel"};
 
 typedef struct {
     int steps, failed;         /* steps made; of them, returning an error */
@@ -206,6 +209,7 @@ typedef struct {
     uint32_t self_contacts; /* self-contact pairs in the solves, summed */
     uint32_t rest_updates;  /* Newton updates on the rest Hessian, summed */
     uint32_t patch_max;     /* the largest condensation patch */
+    uint32_t novel;         /* novel self-contacts, summed */
 } path_record;
 
 typedef struct {
@@ -251,7 +255,70 @@ static sinew_result step_path(contract_run *cr, int p, sinew_instance *inst, con
     r->self_contacts += st.self_contacts;
     r->rest_updates += st.rest_updates;
     if (st.patch_vertices > r->patch_max) r->patch_max = st.patch_vertices;
+    r->novel += st.novel_contacts;
     return res;
+}
+
+/* The clip's most folded pose with every joint's bend (the bone's rotation in its parent's
+ * frame; the finger's bones are a chain, bone b's parent b - 1) raised to the power m:
+ * the fold taken m times as far as the clip takes it, past the bake's training. */
+static double bend(const float *P, const float *B) { /* the angle of R_p^T R_b */
+    double tr = 0;
+    for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < 3; ++k)
+            tr += (double)P[3 * k + i] * B[3 * k + i];
+    return acos(fmax(-1.0, fmin(1.0, 0.5 * (tr - 1))));
+}
+
+static void folded_pose(const contract_fixture *f, double m, float *out) {
+    int deepest = 0; /* the clip's frame folded furthest */
+    double most = -1;
+    for (int k = 0; k < f->frames; ++k) {
+        const float *T = clip_pose(f, k);
+        double sum = 0;
+        for (uint32_t b = 1; b < f->nb; ++b)
+            sum += bend(T + 12 * (b - 1), T + 12 * b);
+        if (sum > most) most = sum, deepest = k;
+    }
+    const float *T = clip_pose(f, deepest);
+    memcpy(out, T, 12 * sizeof(float)); /* the root as the clip has it */
+    for (uint32_t b = 1; b < f->nb; ++b) {
+        const float *P = T + 12 * (b - 1), *B = T + 12 * b;
+        double L[9], t[3], c, ang, ax[3];
+        for (int i = 0; i < 3; ++i) /* L = R_p^T R_b, t = R_p^T (t_b - t_p) */
+            for (int j = 0; j < 3; ++j) {
+                L[3 * i + j] = 0;
+                for (int k = 0; k < 3; ++k)
+                    L[3 * i + j] += (double)P[3 * k + i] * B[3 * k + j];
+            }
+        for (int i = 0; i < 3; ++i) {
+            t[i] = 0;
+            for (int k = 0; k < 3; ++k)
+                t[i] += (double)P[3 * k + i] * (B[9 + k] - P[9 + k]);
+        }
+        c = fmax(-1.0, fmin(1.0, 0.5 * (L[0] + L[4] + L[8] - 1)));
+        ang = acos(c);
+        ax[0] = L[7] - L[5], ax[1] = L[2] - L[6], ax[2] = L[3] - L[1];
+        double n = sqrt(ax[0] * ax[0] + ax[1] * ax[1] + ax[2] * ax[2]);
+        double a = fmin(m * ang, 3.0), sa = sin(a), ca = cos(a), R[9];
+        for (int i = 0; i < 3; ++i)
+            ax[i] = n > 0 ? ax[i] / n : (i == 2);
+        for (int i = 0; i < 3; ++i) /* Rodrigues */
+            for (int j = 0; j < 3; ++j) {
+                static const int e[3][3] = {{0, -3, 2}, {3, 0, -1}, {-2, 1, 0}};
+                int k = e[i][j] > 0 ? e[i][j] - 1 : -e[i][j] - 1;
+                double K = e[i][j] == 0 ? 0 : (e[i][j] > 0 ? ax[k] : -ax[k]);
+                R[3 * i + j] = (i == j ? ca : 0) + (1 - ca) * ax[i] * ax[j] + sa * K;
+            }
+        float *Pn = out + 12 * (b - 1), *Bn = out + 12 * b;
+        for (int i = 0; i < 3; ++i) { /* the child: parent's new frame times (R, t) */
+            for (int j = 0; j < 3; ++j)
+                Bn[3 * i + j] =
+                    (float)(Pn[3 * i] * R[j] + Pn[3 * i + 1] * R[3 + j] + Pn[3 * i + 2] * R[6 + j]);
+            Bn[9 + i] =
+                (float)(Pn[3 * i] * t[0] + Pn[3 * i + 1] * t[1] + Pn[3 * i + 2] * t[2] + Pn[9 + i]);
+        }
+    }
 }
 
 /* The pose k of the clip with every bone carried by x -> R x + t. */
@@ -348,6 +415,7 @@ enum {
     I_MHQ,
     I_MHD,
     I_MHP,
+    I_NOVEL,
     I_COUNT
 };
 
@@ -376,7 +444,8 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         if (i == I_Q || i == I_FRESH) d.newton_hessian = SINEW_NEWTON_HESSIAN_CURRENT;
         if (i == I_REST) d.newton_hessian = SINEW_NEWTON_HESSIAN_REST_FIRST;
         if (i == I_WBUDGET) d.max_world_contacts = 1;
-        if (i == I_MHP) d.max_patch_vertices = 300;
+        if (i == I_MHP || i == I_NOVEL) d.max_patch_vertices = 300;
+        if (i == I_NOVEL) d.novel_contact = 1;
         size_t bytes = 0;
         int before = heap.allocs;
         ENSURE(sinew_instance_memory_size(f->blob, &d, &bytes) == SINEW_OK);
@@ -508,6 +577,14 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
         hull_push += fabsf(F[0]) + fabsf(F[1]) + fabsf(F[2]);
         if (s < 4 * frames) step_path(&cr, P_PATCH, in[I_MHP], clip_pose(f, s), 1.0f / 30);
     }
+    /* the clip, then its fold taken on to 2.6 times as far, there and back, twice */
+    for (int s = 0; s < frames; ++s)
+        step_path(&cr, P_NOVEL, in[I_NOVEL], clip_pose(f, s), 1.0f / 30);
+    for (int s = 0; s < 64; ++s) {
+        int k = s % 32 < 16 ? s % 32 : 31 - s % 32;
+        folded_pose(f, 1.0 + 1.6 * k / 15.0, pose);
+        step_path(&cr, P_NOVEL, in[I_NOVEL], pose, 1.0f / 30);
+    }
     sw_rt_counts c = sw_rt_count_end(); /* ================= to here ================= */
 
     fprintf(stderr, "    %s, %d steps: %s; host allocator %d allocs %d frees\n", VARIANT, cr.steps,
@@ -560,7 +637,7 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
             ENSUREF(r->min_iters >= 1, "path %s: a step with no Newton iteration", path_names[p]);
         /* a quasistatic step starts from the pose space, a dynamic one never */
         int quasi = p == P_QUASISTATIC || p == P_GUARD || p == P_PAIR_BUDGET || p == P_POSE_PAIRS ||
-                    p == P_REST_FIRST;
+                    p == P_REST_FIRST || p == P_NOVEL;
         if (quasi) ENSUREF(r->all & SINEW_STEP_POSE_SPACE, "path %s", path_names[p]);
         if (!quasi && p != P_RESET && p != P_WORLD && p != P_EXHAUSTIVE && p != P_MESH_HULL &&
             p != P_PATCH)
@@ -574,6 +651,8 @@ TEST(every_path_of_the_step_allocates_and_locks_nothing) {
     ENSUREF(rec[P_PATCH].world_contacts > 0 && rec[P_PATCH].patch_max > 0,
             "patch: %u contacts, largest patch %u", rec[P_PATCH].world_contacts,
             rec[P_PATCH].patch_max);
+    ENSUREF(rec[P_NOVEL].novel > 0 && rec[P_NOVEL].patch_max > 0,
+            "novel: %u contacts, largest patch %u", rec[P_NOVEL].novel, rec[P_NOVEL].patch_max);
     ENSURE(rec[P_QUASISTATIC].any & SINEW_STEP_CONVERGED &&
            rec[P_DYNAMIC].any & SINEW_STEP_CONVERGED);
     ENSURE(!(rec[P_QUASISTATIC].any & ~(SINEW_STEP_CONVERGED | SINEW_STEP_POSE_SPACE)));

@@ -134,6 +134,8 @@ sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mas
     def.mode = o->mode;
     def.max_newton_iters = o->max_newton;
     def.self_contact = o->self_contact;
+    def.novel_contact = o->novel_contact;
+    def.max_patch_vertices = o->patch_vertices;
     sinew_instance *inst;
     sinew_result r = sinew_instance_create(blob, &def, &inst);
     if (r != SINEW_OK)

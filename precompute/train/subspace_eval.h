@@ -78,7 +78,8 @@ typedef void (*sw_eval_frame_fn)(void *ctx, int32_t pose, const sinew_instance *
 /* How sw_eval_correction_opts steps: the instance's mode, the step's dt, Newton's
  * iterations a step, `skip` leading poses stepped but not compared (a dynamic path's
  * lead-in: its held-out frames depend on the frames before them), the instance's
- * self-contact mode (0: pose-space, the default), and an optional per-pose callback
+ * self-contact mode (0: pose-space, the default), novel contact and patch budget (0: the
+ * defaults), and an optional per-pose callback
  * (NULL: none). */
 typedef struct sw_eval_options {
     sinew_step_mode mode;
@@ -86,6 +87,8 @@ typedef struct sw_eval_options {
     uint32_t max_newton;
     int32_t skip;
     sinew_self_contact self_contact;
+    uint32_t novel_contact;  /* sinew_instance_def.novel_contact (0: off) */
+    uint32_t patch_vertices; /* sinew_instance_def.max_patch_vertices (0: no patches) */
     sw_eval_frame_fn on_frame;
     void *frame_ctx;
 } sw_eval_options;

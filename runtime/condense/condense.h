@@ -32,6 +32,7 @@
 
 #include <stdint.h>
 
+#include "self_contact.h"
 #include "solver.h"
 
 /* The patch radius when the def leaves it 0, in units of the rest diagonal. */
@@ -42,13 +43,15 @@
 
 /* Sizes an instance reserves for a patch budget (all 0 when condensation is off). */
 typedef struct sw_cond_sizes {
-    int32_t max_verts; /* patch vertices */
-    int32_t max_tets;  /* full tets */
-    int32_t max_pairs; /* pose-space contact pairs a step may use */
-    int32_t max_ring;  /* ring copies */
-    int32_t max_cand;  /* vertices the growth may accept before the budget's cut */
-    int32_t max_seeds; /* seeds of one step */
-    int32_t rmax;      /* the largest domain rank */
+    int32_t max_verts;    /* patch vertices */
+    int32_t max_tets;     /* full tets */
+    int32_t max_pairs;    /* contact pair elements: pose-space pairs a step may use, then
+                             detected pairs (self_contact.h) a patch may take over */
+    int32_t max_detected; /* detected pairs a step may hold (sc's skip flags) */
+    int32_t max_ring;     /* ring copies */
+    int32_t max_cand;     /* vertices the growth may accept before the budget's cut */
+    int32_t max_seeds;    /* seeds of one step */
+    int32_t rmax;         /* the largest domain rank */
 } sw_cond_sizes;
 
 typedef struct sw_cond {
@@ -91,6 +94,10 @@ typedef struct sw_cond {
     double *pp_w;           /* max_pairs: their pose-space blend weights */
     double *pp_alpha;       /* max_pairs: their law's anisotropy (pose_contact.c) */
     unsigned char *pp_skip; /* max_pairs: per ps->pairs entry, the patch evaluates it */
+    unsigned char *pp_src;  /* max_pairs: the element's pair list, SW_COND_TRAINED or
+                               SW_COND_DETECTED */
+    unsigned char *sc_skip; /* max_detected: per detected pair in use, the patch evaluates it */
+    sw_pair_set pp_sets[2]; /* the two lists, as the oracle found them this step */
     signed char *pp_active; /* max_pairs: in contact for this solve (-1: not decided yet) */
     int32_t *fv;            /* nf: patch vertices (global ids) */
     int32_t *ft;            /* nt full tets, then (from nt + np) the rest's nrest tets */
@@ -128,9 +135,13 @@ typedef struct sw_cond {
     int32_t nkeep, keep;
 } sw_cond;
 
-/* The sizes for a budget of max_verts patch vertices (0: off). */
+/* The lists a patch's pair elements come from. */
+enum { SW_COND_TRAINED = 0, SW_COND_DETECTED = 1 };
+
+/* The sizes for a budget of max_verts patch vertices (0: off), max_pairs pose-space pairs
+ * and max_detected detected pairs (self_contact.h), of which max_self_seeds may seed. */
 sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world,
-                           int32_t max_pairs);
+                           int32_t max_pairs, int32_t max_detected, int32_t max_self_seeds);
 
 /* Creation (no allocation: the arrays are laid out by the instance): per-domain volumes,
  * the tet -> cubature map, cleared stamps. rho in world units. */
@@ -140,13 +151,15 @@ void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho);
 void sw_cond_forget(sw_cond *c);
 
 /* The partition oracle at the state q: seeds from the world's candidates penetrating at
- * q (and those of the two steps before, and in a dynamic step the last patch while it
- * has not settled), the growth, the full tets and ring copies (their skinning and
- * Jacobians), the pose-space pairs the patch touches, and the patch's start positions
- * (the subspace position plus the deviation the vertex had when it was last in a patch).
- * Returns the patch's vertex count; then sw_cond_detect and sw_cond_tag_candidates. */
+ * q (wc NULL: no world) and, with seed_self, the vertices of the detected self-contact
+ * pairs in use (sc; novel_contact.h), with those of the two steps before, and in a dynamic
+ * step the last patch while it has not settled; the growth, the full tets and ring copies
+ * (their skinning and Jacobians), the pose-space and detected pairs the patch touches, and
+ * the patch's start positions (the subspace position plus the deviation the vertex had
+ * when it was last in a patch). Returns the patch's vertex count; then sw_cond_detect and
+ * sw_cond_tag_candidates. */
 int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, sw_pose_space *ps,
-                       const double *q);
+                       sw_self_contacts *sc, int seed_self, const double *q);
 
 /* The world's candidates of the patch's surface vertices at their patch positions, as
  * sw_world_contacts_at's mode says (world_contact.h). Returns how many were added; tag

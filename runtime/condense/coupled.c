@@ -107,7 +107,7 @@ static void ring_blocks_flush(sw_cond *c, sw_reduced *red, int32_t k0, int32_t k
     }
 }
 
-/* Pose-space contact pair j of the patch (a trained pair with a corner in the patch, the
+/* Contact pair j of the patch (a trained or detected pair with a corner in the patch, the
  * law of pose_contact.c at the corners' patch or subspace positions x12: p, t0, t1, t2):
  * E = 1/2 kk d^T N d, d = sum b_m x_tm - x_p, for a pair that collides at the solve's
  * start, or at one of the solve's law refreshes (sw_cond_solve). Between those the set is
@@ -117,13 +117,13 @@ static void ring_blocks_flush(sw_cond *c, sw_reduced *red, int32_t k0, int32_t k
  * decrease (capsule 20K, rho 0.45: 5 of 5 contact frames stopped at 4-6% of the first
  * gradient, 0.50 of the correction missed). Its forces into f, its Hessian
  * kk (c c^T kron N) into K (12 x 12) when not NULL. */
-static double patch_pair(sw_cond *c, const sw_reduced *red, int32_t j, const double x12[12],
-                         double f[12], double *K) {
+static double patch_pair(sw_cond *c, int32_t j, const double x12[12], double f[12], double *K) {
     const sw_blob_view *v = c->v;
+    const sw_pair_set *set = &c->pp_sets[c->pp_src[j]];
     int32_t id = c->pp_id[j];
-    const double *cd = v->contact_data + 7 * (int64_t)id;
+    const double *cd = set->data + 7 * (int64_t)id;
     const double coef[4] = {-1.0, cd[0], cd[1], cd[2]};
-    const double *Rp = red->act_R + 9 * red->contact_act[4 * id];
+    const double *Rp = set->act_R + 9 * set->act[4 * id];
     double d[3] = {0, 0, 0}, n[3], Nd[3], N[9];
     for (int m = 0; m < 4; ++m)
         for (int i = 0; i < 3; ++i)
@@ -187,7 +187,7 @@ static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t 
         phi = sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, f,
                             want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
     } else {
-        phi = patch_pair(c, red, e - c->nt, x12, f, want_hess ? K : NULL);
+        phi = patch_pair(c, e - c->nt, x12, f, want_hess ? K : NULL);
     }
     for (int k = 0; k < 4; ++k) {
         if (slot[k] >= 0) {

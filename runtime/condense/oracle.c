@@ -29,16 +29,17 @@ static int32_t min32(int64_t a, int64_t b) {
 }
 
 sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t max_world,
-                           int32_t max_pairs) {
+                           int32_t max_pairs, int32_t max_detected, int32_t max_self_seeds) {
     sw_cond_sizes z;
     memset(&z, 0, sizeof z);
     if (max_verts == 0 || v->ntets == 0) return z;
     z.max_verts = min32(max_verts, v->nverts);
     z.max_tets = min32((int64_t)z.max_verts * max_valence(v), v->ntets);
-    z.max_pairs = max_pairs;
-    z.max_ring = min32(4 * ((int64_t)z.max_tets + max_pairs), v->ndomain_verts);
+    z.max_pairs = max_pairs + max_detected;
+    z.max_detected = max_detected;
+    z.max_ring = min32(4 * ((int64_t)z.max_tets + z.max_pairs), v->ndomain_verts);
     z.max_cand = min32(4 * (int64_t)z.max_verts + 64, v->nverts);
-    z.max_seeds = max_world > 0 ? max_world : 1;
+    z.max_seeds = (max_world > 0 ? max_world : 1) + max_self_seeds;
     for (int32_t k = 0; k < v->ndomains; ++k)
         if (v->domains[k].rank > z.rmax) z.rmax = v->domains[k].rank;
     return z;
@@ -205,12 +206,14 @@ static void keep_nearest(sw_cond *c, int32_t k) {
 }
 
 /* This step's seeds: the vertices of the candidates penetrating at q (their copies'
- * positions at q). */
+ * positions at q), then those of the detected self-contact pairs. */
 static void find_seeds(sw_cond *c, const sw_reduced *red, const sw_world_contacts *wc,
-                       const double *q) {
+                       const sw_self_contacts *sc, const double *q) {
     const sw_blob_view *v = c->v;
     int32_t *seeds = c->seeds + (int64_t)c->slot * c->z.max_seeds, n = 0;
-    for (int32_t j = 0; j < wc->ncand && n < c->z.max_seeds; ++j) {
+    for (int32_t j = 0; sc && j < sc->npairs && n < c->z.max_seeds; ++j)
+        seeds[n++] = sc->act[4 * (int64_t)j];
+    for (int32_t j = 0; wc && j < wc->ncand && n < c->z.max_seeds; ++j) {
         const sw_world_cand *cd = &wc->cand[j];
         int32_t d = v->surf_copies[2 * cd->copy], lv = v->surf_copies[2 * cd->copy + 1];
         int32_t gv = v->domain_verts[v->domains[d].vert_begin + lv];
@@ -345,43 +348,73 @@ void sw_cond_tag_candidates(const sw_cond *c, sw_world_contacts *wc) {
     wc->patch_x = c->nf > 0 ? c->x : NULL;
 }
 
-/* The pose-space contact pairs in use with a corner in the patch: elements after the full
- * tets, evaluated at the patch's positions (the rest stay reduced; ps->in_patch says
- * which). */
-static void patch_pairs(sw_cond *c, const sw_reduced *red, sw_pose_space *ps) {
+/* The pairs of one list (ids NULL: 0..n-1) with a corner in the patch become elements
+ * after the full tets, evaluated at the patch's positions; skip[i] says which. Those past
+ * the elements' budget stay reduced. */
+static int add_pairs(sw_cond *c, const sw_reduced *red, const sw_pair_set *set, const int32_t *ids,
+                     int32_t n, const double *w, const double *tan, unsigned char src,
+                     unsigned char *skip) {
     const sw_blob_view *v = c->v;
-    c->np = 0;
-    ps->in_patch = NULL;
-    for (int32_t p = 0; p < ps->npairs; ++p) {
-        const int32_t *cv = v->contact_verts + 8 * (int64_t)ps->pairs[p];
+    int any_in = 0;
+    for (int32_t p = 0; p < n; ++p) {
+        int32_t id = ids ? ids[p] : p;
+        const int32_t *cv = set->verts + 8 * (int64_t)id;
         int32_t gv[4], any = 0;
         for (int m = 0; m < 4; ++m) {
             gv[m] = v->domain_verts[v->domains[cv[2 * m]].vert_begin + cv[2 * m + 1]];
             any |= c->in_patch[gv[m]] == c->stamp;
         }
-        c->pp_skip[p] = (unsigned char)any;
+        if (any && c->np == c->z.max_pairs) any = 0; /* no room: the subspace keeps it */
+        skip[p] = (unsigned char)any;
         if (!any) continue;
+        any_in = 1;
         int32_t *slot = c->ft_slot + 4 * ((int64_t)c->nt + c->np);
         for (int m = 0; m < 4; ++m)
             slot[m] = c->in_patch[gv[m]] == c->stamp
                           ? c->vloc[gv[m]]
                           : -1 - ring_copy(c, red, gv[m], cv[2 * m], cv[2 * m + 1]);
         c->pp_active[c->np] = -1;
-        c->pp_id[c->np] = ps->pairs[p];
-        c->pp_alpha[c->np] = SW_CONTACT_ALPHA * ps->pair_tan[p];
-        c->pp_w[c->np++] = ps->pair_w[p];
+        c->pp_id[c->np] = id;
+        c->pp_src[c->np] = src;
+        c->pp_alpha[c->np] = SW_CONTACT_ALPHA * (tan ? tan[p] : 1);
+        c->pp_w[c->np++] = w ? w[p] : 1;
     }
-    if (c->np > 0) ps->in_patch = c->pp_skip;
+    return any_in;
+}
+
+/* The pose-space pairs in use, then the detected pairs (sc, NULL: none), with a corner in
+ * the patch: elements evaluated at the patch's positions (the rest stay reduced;
+ * ps->in_patch and sc->in_patch say which). */
+static void patch_pairs(sw_cond *c, const sw_reduced *red, sw_pose_space *ps,
+                        sw_self_contacts *sc) {
+    c->np = 0;
+    ps->in_patch = NULL;
+    sw_pair_set trained = sw_pose_pair_set(red);
+    c->pp_sets[SW_COND_TRAINED] = trained;
+    if (add_pairs(c, red, &trained, ps->pairs, ps->npairs, ps->pair_w, ps->pair_tan,
+                  SW_COND_TRAINED, c->pp_skip))
+        ps->in_patch = c->pp_skip;
+    if (!sc) return;
+    sc->in_patch = NULL;
+    sw_pair_set found = sw_self_contacts_pairs(sc);
+    c->pp_sets[SW_COND_DETECTED] = found;
+    int32_t n = sc->npairs < c->z.max_detected ? sc->npairs : c->z.max_detected;
+    if (add_pairs(c, red, &found, NULL, n, sc->w, sc->tan, SW_COND_DETECTED, c->sc_skip)) {
+        for (int32_t p = n; p < sc->npairs; ++p) /* beyond the flags: reduced */
+            c->sc_skip[p] = 0;
+        sc->in_patch = c->sc_skip;
+    }
 }
 
 int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc, sw_pose_space *ps,
-                       const double *q) {
+                       sw_self_contacts *sc, int seed_self, const double *q) {
     c->stamp++;
     c->slot = (c->slot + 1) % SEED_STEPS;
     c->ncand = c->dropped = 0;
     c->nf = c->nt = c->nring = c->np = c->nrest = c->nring_patch = 0;
     ps->in_patch = NULL;
-    find_seeds(c, red, wc, q);
+    if (sc) sc->in_patch = NULL;
+    find_seeds(c, red, wc, seed_self ? sc : NULL, q);
     /* the oldest seeds first, this step's last; a vertex seeded twice grows once */
     for (int32_t k = 0; k < SEED_STEPS; ++k)
         for (int32_t i = 0, sl = (c->slot + 1 + k) % SEED_STEPS; i < c->nseeds[sl]; ++i) {
@@ -402,7 +435,7 @@ int32_t sw_cond_oracle(sw_cond *c, const sw_reduced *red, sw_world_contacts *wc,
         c->vloc[c->cand[i]] = i;
     }
     full_tets(c, red);
-    patch_pairs(c, red, ps);
+    patch_pairs(c, red, ps, sc);
     exact_domains(c, red);
     start_positions(c, red, q);
     return c->nf;

@@ -116,10 +116,10 @@ sw_pair_set sw_pose_pair_set(const sw_reduced *red) {
     return set;
 }
 
-double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids, int32_t n,
-                             const double *weight, const double *tangent, const double *q,
-                             int want_grad, int want_hess) {
-    return contact_pairs(red, set, ids, NULL, n, weight, tangent, q, want_grad, want_hess);
+double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids,
+                             const unsigned char *skip, int32_t n, const double *weight,
+                             const double *tangent, const double *q, int want_grad, int want_hess) {
+    return contact_pairs(red, set, ids, skip, n, weight, tangent, q, want_grad, want_hess);
 }
 
 /* The pairs the pose space gathered, each at its weight: the pose-space blend (DESIGN.md

@@ -24,15 +24,16 @@ typedef struct sw_pair_set {
 /* The blob's training-pose pairs, with the active vertices' transforms of red. */
 sw_pair_set sw_pose_pair_set(const sw_reduced *red);
 
-/* Contact energy at q of the pairs ids[0..n) of set (ids NULL: pairs 0..n-1), pair i
+/* Contact energy at q of the pairs ids[0..n) of set (ids NULL: pairs 0..n-1) but those
+ * whose skip[i] is set (skip NULL: none; a condensation patch evaluates them), pair i
  * scaled by weight[i], its tangential term at share tangent[i] of SW_CONTACT_ALPHA (either
  * NULL: 1 for every pair); with
  * want_grad it adds the gradient to red->g, with want_hess the Hessian blocks (which may
  * couple two domains) to red->H. Call after the cubature, so the blocks land on the full
  * (mirrored) matrix. */
-double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids, int32_t n,
-                             const double *weight, const double *tangent, const double *q,
-                             int want_grad, int want_hess);
+double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int32_t *ids,
+                             const unsigned char *skip, int32_t n, const double *weight,
+                             const double *tangent, const double *q, int want_grad, int want_hess);
 
 /* Contact energy at q of the pairs ps gathered (sw_contact_pairs_eval of the blob's
  * pairs at ps->pair_w and ps->pair_tan). */

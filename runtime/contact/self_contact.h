@@ -38,7 +38,10 @@ typedef struct sw_self_contacts {
     int32_t *act;    /* 4 nsurf */
     double *w, *tan; /* nsurf: each pair's weight and tangential share (1 when detected) */
     int32_t npairs;  /* pairs in use (at most nsurf) */
-    int64_t tests;   /* candidate tets the last detection tested */
+    /* per pair in use: 1 when a condensation patch evaluates it at the patch's positions
+       instead (condense.h); NULL: none does */
+    const unsigned char *in_patch;
+    int64_t tests; /* candidate tets the last detection tested */
     /* the pose-pairs re-test's (sw_self_contacts_retest): the detection each vertex and
        tet was last mapped or listed in (stamp), and the candidate tets of one pair */
     int32_t *vstamp; /* nverts */
@@ -82,6 +85,15 @@ int32_t sw_self_contacts_detect_pairs(sw_self_contacts *sc, const sw_reduced *re
  * Returns how many pairs moved. */
 int32_t sw_self_contacts_retest(sw_self_contacts *sc, const sw_reduced *red, const double *q,
                                 sw_pose_space *ps);
+
+/* The pieces of a detection that maps only what it reads (the re-test's, novel_contact.h):
+ * a fresh stamp; vertex gv at the state q, mapped once a stamp (its position, its
+ * skinning transform in vR, vt); a contact appended to the pairs in use at weight w and
+ * tangential share tan (0 when the list is full). */
+void sw_self_contacts_begin(sw_self_contacts *sc, const sw_blob_view *v);
+const double *sw_self_contacts_map(sw_self_contacts *sc, const sw_reduced *red, const double *q,
+                                   int32_t gv);
+int32_t sw_self_contacts_add(sw_self_contacts *sc, const sw_contact *c, double w, double tan);
 
 /* Forgets the pairs in use. */
 void sw_self_contacts_clear(sw_self_contacts *sc);

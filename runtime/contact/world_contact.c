@@ -171,7 +171,8 @@ void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
 /* Each bone's rigid motion since the last output, D = T1 T0^-1 (12 doubles: R row-major,
  * t) and ||dR - I||_2 = sqrt(3 - tr dR), once per detection into wc->bone_motion (13 per
  * bone). */
-static void bone_motions(sw_world_contacts *wc, int32_t nbones, const double *T, const double *T0) {
+void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const double *T,
+                              const double *T0) {
     for (int32_t b = 0; b < nbones; ++b) {
         const double *A = T0 + 12 * b, *B = T + 12 * b;
         double *D = wc->bone_motion + 13 * b;
@@ -272,8 +273,8 @@ static int collider_box(const sw_world_contacts *wc, uint32_t s, double box[6]) 
 
 /* The broad-phase box of cluster c: its box at the last output grown by the motion of
  * the bones that skin it since (T_last -> T) and the detection radius. */
-static void cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
-                        double box[6]) {
+void sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                          double box[6]) {
     const double *b = wc->cl_box + 6 * c;
     double ctr[3], rho = 0, grow = 0;
     for (int k = 0; k < 3; ++k) {
@@ -325,10 +326,10 @@ int32_t sw_world_contacts_detect(sw_world_contacts *wc, const sw_reduced *red, c
     if (!wc->world) return 0;
     memcpy(wc->q_detect, q, (size_t)red->R * sizeof(double));
     int use_boxes = wc->boxes_valid && T_last;
-    if (use_boxes) bone_motions(wc, red->v->nbones, T, T_last);
+    if (use_boxes) sw_world_clusters_motion(wc, red->v->nbones, T, T_last);
     for (int32_t c = 0; c < wc->ncl; ++c) {
         double box[6];
-        if (use_boxes) cluster_box(wc, red->v, c, box);
+        if (use_boxes) sw_world_cluster_box(wc, red->v, c, box);
         narrow_cluster(wc, red, q, c, use_boxes ? box : NULL, NULL, 0);
     }
     return wc->ncand;

@@ -112,6 +112,15 @@ double sw_world_contact_eval(sw_reduced *red, const sw_world_contacts *wc, const
  * candidate's at its patch position. */
 void sw_world_contacts_finish(sw_world_contacts *wc, sw_reduced *red, const double *q);
 
+/* The broad phase's pieces, shared with the novel self-contact's (novel_contact.h): each
+ * bone's rigid motion from the pose T0 (the last output's) to T, into wc->bone_motion;
+ * cluster c's box at the last output grown by the motion of the bones that skin it and
+ * by the detection radius. */
+void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const double *T,
+                              const double *T0);
+void sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                          double box[6]);
+
 /* Takes the cluster boxes from the copies' output positions wc->copy_x. */
 void sw_world_contacts_update_boxes(sw_world_contacts *wc);
 

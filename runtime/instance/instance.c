@@ -29,7 +29,8 @@ typedef struct {
     /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
        mode's fallback on novel contact when the blob has the tet mesh */
     int detect;
-    int rest; /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
+    int novel; /* the def's novel_contact */
+    int rest;  /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -83,6 +84,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     ps->novel_mask = NULL;
     if (z->per_pair && z->detect) TAKE(ps->novel_mask, nd * nd);
     if (z->detect) sw_self_contacts_take(p, v, &in->sc);
+    if (z->novel) sw_novel_take(p, v, sw_world_cluster_bound(v), &in->novel);
     /* the solver */
     sw_solver *s = &in->solver;
     TAKE(s->q, R);
@@ -150,6 +152,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->pp_w, np);
         TAKE(c->pp_alpha, np);
         TAKE(c->pp_skip, np);
+        TAKE(c->pp_src, np);
+        TAKE(c->sc_skip, (uint64_t)cz->max_detected);
         TAKE(c->pp_active, np);
         TAKE(c->ft, ntf);
         TAKE(c->ft_slot, 4 * ntf);
@@ -335,11 +339,12 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
             ? "exhaustive self-contact needs a blob with the tet mesh (bake it again)"
         : d->self_contact == SINEW_SELF_CONTACT_POSE_PAIRS && v->npair_groups == 0
             ? "pose-pairs self-contact needs a blob with per-pair sections (bake it again)"
-        /* detected pairs are evaluated at subspace positions, a patch's vertices at
-           patch positions: the two would disagree where detected contact meets a patch */
-        : d->max_patch_vertices > 0 && d->self_contact != SINEW_SELF_CONTACT_POSE_SPACE
-            ? "condensation patches (max_patch_vertices) with detected self-contact "
-              "(exhaustive or pose-pairs) are not simulated yet: use pose-space self-contact"
+        : d->novel_contact > 1 ? "novel_contact is neither 0 nor 1"
+        : d->novel_contact && v->ntets == 0
+            ? "novel_contact needs a blob with the tet mesh (bake it again)"
+        : d->novel_contact && d->self_contact != SINEW_SELF_CONTACT_POSE_SPACE
+            ? "novel_contact adds to pose-space self-contact; the exhaustive and pose-pairs "
+              "modes detect contact themselves"
         : d->newton_hessian != SINEW_NEWTON_HESSIAN_AUTO &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_REST_FIRST
@@ -370,9 +375,17 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->max_world = d->max_world_contacts == 0          ? (int32_t)wneed
                    : d->max_world_contacts > 4 * wneed ? (int32_t)(4 * wneed)
                                                        : (int32_t)d->max_world_contacts;
-    z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs);
     z->rho = d->patch_radius > 0 ? d->patch_radius : SW_COND_DEFAULT_RADIUS;
-    z->detect = d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE || (z->per_pair && v->ntets > 0);
+    z->novel = d->novel_contact == 1;
+    z->detect = d->self_contact == SINEW_SELF_CONTACT_EXHAUSTIVE || (z->per_pair && v->ntets > 0) ||
+                z->novel;
+    /* the detected pairs a patch may take over: as many as the novel detection keeps, or
+       (exhaustive, pose-pairs) one per boundary vertex up to that many */
+    int32_t detected = !z->detect                               ? 0
+                       : v->nsurf_verts < SW_NOVEL_MAX_CONTACTS ? v->nsurf_verts
+                                                                : SW_NOVEL_MAX_CONTACTS;
+    z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs, detected,
+                           z->novel ? SW_NOVEL_MAX_CONTACTS : 0);
     z->rest = d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT;
     return SINEW_OK;
 }
@@ -532,6 +545,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
             return SINEW_ERROR_INVALID_ARGUMENT;
         }
     }
+    in->novel_on = z.novel;
+    if (z.novel) sw_novel_build(&in->novel, v, &in->wc, &in->sc);
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
     sw_solver_order_blocks(&in->solver, v);
@@ -573,8 +588,9 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);
     if (inst->cond.z.max_verts > 0) sw_cond_forget(&inst->cond);
-    if (inst->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE || inst->ps.novel_mask)
+    if (inst->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE || inst->ps.novel_mask || inst->novel_on)
         sw_self_contacts_clear(&inst->sc);
+    inst->sc.in_patch = NULL;
     inst->ps.in_patch = NULL;
     for (int32_t c = 0; c < inst->v->ncub; ++c) { /* identity: a cold start */
         double *V = inst->red.svd_V + 9 * (int64_t)c;

@@ -6,6 +6,7 @@
 #include "blob_load.h"
 #include "condense.h"
 #include "inertia.h"
+#include "novel_contact.h"
 #include "pose_space.h"
 #include "reduced_map.h"
 #include "solver.h"
@@ -38,10 +39,12 @@ struct sinew_instance {
     sw_world_contacts wc;         /* the collision world's candidates of the step */
     sw_cond cond;                 /* subspace condensation (cond.z.max_verts 0: off) */
     sinew_self_contact self_mode; /* the def's self_contact */
-    sw_self_contacts sc;          /* the exhaustive mode's detection (unused arrays otherwise) */
-    double *surf_x, *surf_n;      /* 3 per output surface vertex each (sw_blob_output_verts) */
-    double *node_x;               /* 3 per render node: the mean of its copies (render mesh only) */
-    int32_t *weld_tris;           /* 3 per render triangle: its corners' weld representatives */
+    sw_novel novel;               /* self-contact nobody trained (novel_on: the def's) */
+    int novel_on;
+    sw_self_contacts sc;     /* the exhaustive mode's detection (unused arrays otherwise) */
+    double *surf_x, *surf_n; /* 3 per output surface vertex each (sw_blob_output_verts) */
+    double *node_x;          /* 3 per render node: the mean of its copies (render mesh only) */
+    int32_t *weld_tris;      /* 3 per render triangle: its corners' weld representatives */
     double *h_ref; /* Newton's reference Hessian's domain blocks (red.h_ref when in use) */
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */

@@ -41,9 +41,10 @@ static void copies_mean(const sinew_instance *in, const int32_t *copies, const i
 void sw_instance_write_surface(sinew_instance *in) {
     const sw_blob_view *v = in->v;
     /* the boundary is the output, or (under a render mesh) only what carries the world's
-     * broad phase next step: without a world it is skipped (attaching one invalidates
-     * the boxes, instance_world.c) */
-    for (int32_t s = 0; s < (v->nrender_verts == 0 || in->wc.world ? v->nsurf_verts : 0); ++s) {
+     * and the novel self-contact's broad phase next step: without either it is skipped
+     * (attaching a world invalidates the boxes, instance_world.c) */
+    int boxes = in->wc.world || in->novel_on; /* a broad phase reads them next step */
+    for (int32_t s = 0; s < (v->nrender_verts == 0 || boxes ? v->nsurf_verts : 0); ++s) {
         double x[3];
         copies_mean(in, v->surf_copies, in->red.copy_act, v->surf_copy_ptr[s],
                     v->surf_copy_ptr[s + 1], in->wc.copy_x,
@@ -58,7 +59,7 @@ void sw_instance_write_surface(sinew_instance *in) {
     } else {
         sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
     }
-    if (in->wc.world) sw_world_contacts_update_boxes(&in->wc);
+    if (boxes) sw_world_contacts_update_boxes(&in->wc);
 }
 
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,

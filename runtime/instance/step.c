@@ -74,10 +74,10 @@ static int exhaustive(const sinew_instance *in) {
     return in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE;
 }
 
-/* The exhaustive detection's pairs are in use: its mode, or the pose-pairs mode's fallback
- * on novel contact. */
+/* The detection's pairs are in use: the exhaustive mode, the pose-pairs mode's fallback
+ * on novel contact, or the novel self-contact beside the pose-space pairs. */
 static int detected(const sinew_instance *in) {
-    return exhaustive(in) || (in->ps.novel_mask && in->sc.npairs > 0);
+    return exhaustive(in) || ((in->ps.novel_mask || in->novel_on) && in->sc.npairs > 0);
 }
 
 sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) {
@@ -114,6 +114,23 @@ static void phase_contact(sw_step_ctx *c) {
     c->st.ms_self_contact = c->st.ms_contact;
 }
 
+/* Novel self-contact (novel_contact.h) at the start state, beside the pose-space pairs
+ * still in use; the broad phase reads the last output's boxes when the last step's pose
+ * is the one before this. */
+static void novel_self(sw_step_ctx *c) {
+    sinew_instance *in = c->in;
+    double t = sw_now_seconds();
+    const double *T_last = in->pose.history >= 1 ? in->pose.T_prev : NULL;
+    sw_novel_detect(&in->novel, &in->sc, &in->wc, &in->red, in->solver.q, &in->ps, in->pose.T_cur,
+                    T_last);
+    if (in->sc.npairs > 0) in->solver.mat_at_qn = 0; /* a dynamic step's part at q_n lacks them */
+    c->st.novel_contacts = (uint32_t)in->sc.npairs;
+    c->st.novel_cluster_pairs = (uint32_t)in->novel.cluster_pairs;
+    c->st.self_contact_tests += (uint32_t)in->novel.tests;
+    c->st.self_contacts += (uint32_t)in->sc.npairs;
+    c->st.ms_novel = 1e3 * (sw_now_seconds() - t);
+}
+
 /* Exhaustive mode: the pairs touching at the start state. Pose-space modes: the pairs
  * that have come apart there dropped (pose_contact.h). Either mode: the pairs in use
  * fix the Hessian's block pattern for the step (the factorisations add their fill). */
@@ -143,6 +160,7 @@ static void phase_self(sw_step_ctx *c) {
             in->solver.mat_at_qn = 0;
         c->st.self_contact_tests += (uint32_t)(in->sc.tests - tests);
     }
+    if (in->novel_on) novel_self(c);
     sw_step_contacts ct = sw_instance_contacts(in, NULL);
     sw_solver_block_pattern(&in->solver, in->v, &ct);
     double ms = lap(c);
@@ -241,14 +259,17 @@ static void phase_oracle(sw_step_ctx *c) {
     sw_cond *cd = &in->cond;
     if (cd->z.max_verts == 0) return;
     if (c->st.status & SINEW_STEP_TELEPORT) sw_cond_forget(cd);
-    if (!in->wc.world) {
+    sw_world_contacts *wc = in->wc.world ? &in->wc : NULL;
+    sw_self_contacts *sc = detected(in) ? &in->sc : NULL;
+    if (!wc && !in->novel_on) { /* nothing seeds a patch */
         cd->nf = cd->np = 0;
         in->ps.in_patch = NULL;
+        if (sc) sc->in_patch = NULL;
         return;
     }
     cd->pcg_iters = 0;
     cd->g0_step = 0;
-    if (sw_cond_oracle(cd, &in->red, &in->wc, &in->ps, in->solver.q) > 0) {
+    if (sw_cond_oracle(cd, &in->red, wc, &in->ps, sc, in->novel_on, in->solver.q) > 0) {
         if (c->dc.dynamic) {
             const sw_pose_history *ph = &in->pose;
             for (int32_t b = 0; b < in->v->nbones; ++b) {
@@ -259,9 +280,9 @@ static void phase_oracle(sw_step_ctx *c) {
                                    ph->history >= 1 ? cd->dq_prev : NULL,
                                    ph->history >= 2 ? cd->dq_prev2 : NULL);
         }
-        sw_cond_detect(cd, &in->wc, SW_WC_AT_DETECT);
+        if (wc) sw_cond_detect(cd, wc, SW_WC_AT_DETECT);
     }
-    sw_cond_tag_candidates(cd, &in->wc);
+    if (wc) sw_cond_tag_candidates(cd, wc);
     c->st.patch_vertices = (uint32_t)cd->nf;
     c->st.patch_tets = (uint32_t)cd->nt;
     if (cd->dropped > 0) {
@@ -299,7 +320,9 @@ static sinew_result phase_solve(sw_step_ctx *c) {
     double self_s = 0; /* the self-contact terms' share of the evaluations */
     sw_step_contacts ct = sw_instance_contacts(in, &self_s);
     sinew_result r = solve(c, &ct);
-    if (r == SINEW_OK && exhaustive(in)) { /* the solution pressed into flesh it did not touch */
+    /* the solution pressed into flesh it did not touch (not under a patch, whose pair
+       elements are the detection's pairs of the start state) */
+    if (r == SINEW_OK && exhaustive(in) && in->cond.nf == 0) {
         double t = sw_now_seconds();
         int32_t fresh = sw_self_contacts_detect(&in->sc, &in->red, in->solver.q);
         c->st.self_contact_tests += (uint32_t)in->sc.tests;
@@ -389,6 +412,14 @@ static void phase_advance(sw_step_ctx *c) {
     if (limited) {
         c->st.status |= SINEW_STEP_LIMITED;
         c->written = 0;
+        /* a patch solved against a state that ran to its bound is no solution: its
+           vertices go back to their subspace positions (the output's), and no later patch
+           starts from where they were */
+        if (in->cond.nf > 0) {
+            sw_cond_forget(&in->cond);
+            in->ps.in_patch = NULL;
+            in->sc.in_patch = NULL;
+        }
     }
     sw_pose_history_advance(&in->pose, v->nbones, c->dc.h);
     c->st.ms_dynamics += lap(c);
@@ -413,6 +444,7 @@ static sinew_result check_output(sw_step_ctx *c) {
             memset(in->solver.qdot, 0, (size_t)in->red.R * sizeof(double));
             in->cond.nf = in->cond.np = 0; /* no patch: the subspace state alone */
             in->ps.in_patch = NULL;
+            in->sc.in_patch = NULL;
             sw_instance_write_surface(in);
             c->st.status |= SINEW_STEP_FAILED;
             return SINEW_ERROR_NOT_FINITE;

@@ -10,6 +10,7 @@
 #include "clock.h"
 #include "pose_contact.h"
 #include "solver.h"
+#include <stdlib.h>
 
 /* The block pairs (a, b) of domains where a matrix of the step may be nonzero. */
 enum block_set {
@@ -102,8 +103,8 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
     if (ct->sc) {
         double t0 = ct->self_seconds ? sw_now_seconds() : 0;
         sw_pair_set set = sw_self_contacts_pairs(ct->sc);
-        phi += sw_contact_pairs_eval(red, &set, NULL, ct->sc->npairs, ct->sc->w, ct->sc->tan, q,
-                                     want_grad, want_hess);
+        phi += sw_contact_pairs_eval(red, &set, NULL, ct->sc->in_patch, ct->sc->npairs, ct->sc->w,
+                                     ct->sc->tan, q, want_grad, want_hess);
         if (ct->self_seconds) *ct->self_seconds += sw_now_seconds() - t0;
     }
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);

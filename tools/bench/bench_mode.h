@@ -10,6 +10,7 @@
 #include "dyn_bench.h"
 #include "gap_bench.h"
 #include "newton_bench.h"
+#include "novel_bench.h"
 #include "sc_bench.h"
 #include "world_bench.h"
 
@@ -27,7 +28,7 @@ typedef struct sw_bench_ctx {
     /* the modes' flags */
     const char *world_path;
     const sw_cond_bench_params *cond;
-    int dynamic, hold_frames, instances, sc_compare, newton_compare, error_gap;
+    int dynamic, hold_frames, instances, sc_compare, newton_compare, error_gap, novel;
     /* found */
     long failed; /* the modes' failed steps */
     sw_world_bench wb;
@@ -36,6 +37,7 @@ typedef struct sw_bench_ctx {
     sw_sc_bench scb;
     sw_newton_bench nwb;
     sw_gap_bench gap;
+    sw_novel_bench nvb;
 } sw_bench_ctx;
 
 typedef struct sw_bench_mode {

@@ -56,6 +56,25 @@ static void sc_json(const sw_bench_ctx *c) {
     sw_sc_bench_print(&c->scb, stdout, 1);
 }
 
+/* ---- --novel: self-contact nobody trained, with and without patches ---- */
+
+static int novel_wanted(const sw_bench_ctx *c) {
+    return c->novel;
+}
+
+static sinew_result novel_run(sw_bench_ctx *c, sw_error *err) {
+    sinew_result r =
+        sw_novel_bench_run(c->blob, c->ch, c->ch->clip.T, c->full_x, c->kf, &c->nvb, err);
+    if (r != SINEW_OK) return r;
+    c->failed += c->nvb.failed;
+    sw_novel_bench_print(&c->nvb, stderr, 0);
+    return SINEW_OK;
+}
+
+static void novel_json(const sw_bench_ctx *c) {
+    sw_novel_bench_print(&c->nvb, stdout, 1);
+}
+
 /* ---- --newton-compare: Newton on the current and on the rest Hessian ---- */
 
 static int newton_wanted(const sw_bench_ctx *c) {
@@ -226,5 +245,6 @@ const sw_bench_mode sw_bench_modes[] = {
     {"--error-gap", gap_wanted, gap_run, gap_json, ""},
     {"--world", world_wanted, world_run, world_json, "world run failed: "},
     {"--dynamic", dyn_wanted, dyn_run, dyn_json, "dynamic run failed: "},
+    {"--novel", novel_wanted, novel_run, novel_json, "novel-contact run failed: "},
 };
 const int sw_bench_nmodes = (int)(sizeof sw_bench_modes / sizeof sw_bench_modes[0]);

@@ -29,7 +29,8 @@ static void terms(sinew_instance *in, const double *q, double o[4]) {
     o[2] = sw_pose_contact_eval(&in->red, &in->ps, q, 0, 0);
     if (in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE) {
         sw_pair_set set = sw_self_contacts_pairs(&in->sc);
-        o[2] += sw_contact_pairs_eval(&in->red, &set, NULL, in->sc.npairs, NULL, NULL, q, 0, 0);
+        o[2] +=
+            sw_contact_pairs_eval(&in->red, &set, NULL, NULL, in->sc.npairs, NULL, NULL, q, 0, 0);
     }
     int32_t R = v->rank_total;
     o[3] = 0;

@@ -215,7 +215,7 @@ typedef struct {
     int json, full_frames, contract_steps, threads, bake_errors, timing_passes;
     int dynamic, hold_frames, instances, patch_budget;
     int self_mode; /* sinew_self_contact */
-    int sc_compare, error_gap, newton_compare;
+    int sc_compare, error_gap, newton_compare, novel;
     sw_cond_bench_params cond;
 } options;
 
@@ -231,7 +231,7 @@ static const char *const SYNOPSIS =
     "                   [--world FILE.json [--rho R] [--patch-budget N]]\n"
     "                   [--dynamic [--hold-frames H]] [--instances N]\n"
     "                   [--self-contact pose-space|exhaustive] [--sc-compare]\n"
-    "                   [--newton-compare]\n"
+    "                   [--newton-compare] [--novel]\n"
     "                   [--error-gap] [--json]\n";
 
 /* The bench's own flags, bound to o, into f; returns their count. */
@@ -283,6 +283,9 @@ static size_t bench_flags(options *o, sw_flag *f) {
          .range = "pose-space, exhaustive or pose-pairs"},
         {SW_SET("--sc-compare", &o->sc_compare, 1,
                 "also time self-contact in both modes over the clip: sc_*")},
+        {SW_SET("--novel", &o->novel, 1,
+                "also the clip with novel self-contact (through the\n"
+                "subspace, and seeding patches): pen_self_*, err_clip_*")},
         {SW_SET("--newton-compare", &o->newton_compare, 1,
                 "also time the quasistatic step with Newton on the current\n"
                 "and starting on the rest Hessian over the clip: newton_*")},
@@ -653,6 +656,7 @@ static int run_modes(bench *b, sw_error *err) {
                         .hold_frames = o->hold_frames,
                         .instances = o->instances,
                         .sc_compare = o->sc_compare,
+                        .novel = o->novel,
                         .newton_compare = o->newton_compare,
                         .error_gap = o->error_gap};
     for (int k = 0; k < sw_bench_nmodes; ++k) {

@@ -199,6 +199,15 @@ typedef struct sinew_instance_def {
     sinew_newton_hessian newton_hessian;
     /** Profiler zones around the step's phases (see sinew_profiler); zero: none. */
     sinew_profiler profiler;
+    /** Self-contact nobody trained: 1 detects, at each step's start, where two parts of
+     * the body that no training pose pressed together meet (a fist past the bake's
+     * sweeps, a limb against the chest), with the full-space reference's own rule, at a
+     * cost that follows what is near each other; the pose-space pairs keep what the bake
+     * trained. With a patch budget (max_patch_vertices) the contact seeds a condensation
+     * patch, where it is solved in full space; without one it is applied through the
+     * subspace. 0 (the default): off. Needs a blob with the tet mesh and pose-space
+     * self-contact; INVALID_ARGUMENT otherwise. */
+    uint32_t novel_contact;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -222,6 +231,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.profiler.zone_begin = NULL;
     d.profiler.zone_end = NULL;
     d.profiler.user = NULL;
+    d.novel_contact = 0;
     return d;
 }
 
@@ -361,6 +371,12 @@ typedef struct sinew_step_stats {
     uint32_t reserved2; /**< zero */
     /** how far (degrees) that joint's bend exceeds the largest of the training poses */
     double beyond_training_deg;
+    /** sinew_instance_def.novel_contact: the contacts found this step that no pose-space
+     * pair in use held, and the pairs of surface clusters whose boxes met */
+    uint32_t novel_contacts;
+    uint32_t novel_cluster_pairs;
+    /** wall-clock milliseconds of that detection (inside ms_self_contact) */
+    double ms_novel;
 } sinew_step_stats;
 
 #ifdef __cplusplus

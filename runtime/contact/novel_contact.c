@@ -1,0 +1,236 @@
+/* Novel self-contact (novel_contact.h): the clusters' broad phase, the layers' narrow
+ * phase with the reference's rule, the deepest contact of each vertex. */
+#include "novel_contact.h"
+
+#include <math.h>
+#include <string.h>
+
+#include "sorted.h"
+
+static int32_t max_valence(const sw_blob_view *v) {
+    int32_t m = 0;
+    for (int32_t gv = 0; gv < v->nverts; ++gv)
+        m = v->vert_tet_ptr[gv + 1] - v->vert_tet_ptr[gv] > m
+                ? v->vert_tet_ptr[gv + 1] - v->vert_tet_ptr[gv]
+                : m;
+    return m;
+}
+
+/* The global vertex of surface copy i. */
+static int32_t copy_vertex(const sw_blob_view *v, int32_t i) {
+    const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+    return v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
+}
+
+void sw_novel_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, sw_novel *nv) {
+    memset(nv, 0, sizeof *nv);
+    uint64_t layers = 0, nv3 = (uint64_t)v->nverts;
+    for (int32_t i = 0; i < v->nsurf_copies; ++i) {
+        int32_t gv = copy_vertex(v, i);
+        layers += (uint64_t)(v->vert_tet_ptr[gv + 1] - v->vert_tet_ptr[gv]);
+    }
+    nv->max_layer = SW_WORLD_CLUSTER * max_valence(v);
+#define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
+    TAKE(nv->cl_dom, (uint64_t)ncl);
+    TAKE(nv->cl_now, 6 * (uint64_t)ncl);
+    TAKE(nv->order, (uint64_t)ncl);
+    TAKE(nv->layer_ptr, (uint64_t)ncl + 1);
+    TAKE(nv->layer_tets, layers);
+    TAKE(nv->layer_box, 6 * layers);
+    TAKE(nv->cl_boxed, (uint64_t)ncl);
+    TAKE(nv->cand, (uint64_t)nv->max_layer);
+    TAKE(nv->held, nv3);
+    TAKE(nv->best, nv3);
+    TAKE(nv->best_i, nv3);
+    TAKE(nv->hits, (uint64_t)SW_NOVEL_MAX_CONTACTS);
+#undef TAKE
+}
+
+static void box_empty(double b[6]) {
+    for (int k = 0; k < 3; ++k) {
+        b[k] = INFINITY;
+        b[3 + k] = -INFINITY;
+    }
+}
+
+static void box_add(double b[6], const double x[3]) {
+    for (int k = 0; k < 3; ++k) {
+        b[k] = fmin(b[k], x[k]);
+        b[3 + k] = fmax(b[3 + k], x[k]);
+    }
+}
+
+static void box_grow(double b[6], double r) {
+    for (int k = 0; k < 3; ++k) {
+        b[k] -= r;
+        b[3 + k] += r;
+    }
+}
+
+static int box_meets(const double a[6], const double b[6]) {
+    for (int k = 0; k < 3; ++k)
+        if (a[k] > b[3 + k] || b[k] > a[3 + k]) return 0;
+    return 1;
+}
+
+static int box_holds(const double b[6], const double x[3]) {
+    return x[0] >= b[0] && x[1] >= b[1] && x[2] >= b[2] && x[0] <= b[3] && x[1] <= b[4] &&
+           x[2] <= b[5];
+}
+
+void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts *wc,
+                    sw_self_contacts *sc) {
+    nv->ncl = wc->ncl;
+    int32_t n = 0, mark = 0;
+    for (int32_t c = 0; c < wc->ncl; ++c) {
+        nv->order[c] = c;
+        nv->cl_dom[c] = v->surf_copies[2 * wc->cl_copy[wc->cl_begin[c]]];
+        nv->layer_ptr[c] = n;
+        ++mark; /* each tet listed once a layer (the re-test's tet stamps, free here) */
+        for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i) {
+            int32_t gv = copy_vertex(v, wc->cl_copy[i]);
+            for (int32_t e = v->vert_tet_ptr[gv]; e < v->vert_tet_ptr[gv + 1]; ++e) {
+                int32_t t = v->vert_tets[e];
+                if (sc->tstamp[t] == mark) continue;
+                sc->tstamp[t] = mark;
+                nv->layer_tets[n++] = t;
+            }
+        }
+    }
+    memset(sc->tstamp, 0, (size_t)v->ntets * sizeof *sc->tstamp);
+    nv->layer_ptr[wc->ncl] = n;
+    memset(nv->best, 0, (size_t)v->nverts * sizeof *nv->best);
+    memset(nv->held, 0, (size_t)v->nverts * sizeof *nv->held);
+    memset(nv->cl_boxed, 0, (size_t)wc->ncl * sizeof *nv->cl_boxed);
+    nv->stamp = 0;
+}
+
+/* A fresh stamp for held[] and best[] (both cleared on wrap-around). */
+static void next_stamp(sw_novel *nv, int32_t nverts) {
+    if (nv->stamp == INT32_MAX) {
+        memset(nv->best, 0, (size_t)nverts * sizeof *nv->best);
+        memset(nv->held, 0, (size_t)nverts * sizeof *nv->held);
+        memset(nv->cl_boxed, 0, (size_t)nv->ncl * sizeof *nv->cl_boxed);
+        nv->stamp = 0;
+    }
+    nv->stamp++;
+}
+
+/* This step's box of every cluster: the last output's grown by the bones' motion, or,
+ * without one, the copies at q. */
+static void cluster_boxes(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *wc,
+                          const sw_reduced *red, const double *q, const double *T,
+                          const double *T_last) {
+    const sw_blob_view *v = red->v;
+    int use_boxes = wc->boxes_valid && T_last;
+    if (use_boxes) sw_world_clusters_motion(wc, v->nbones, T, T_last);
+    for (int32_t c = 0; c < nv->ncl; ++c) {
+        double *b = nv->cl_now + 6 * c;
+        if (use_boxes) {
+            sw_world_cluster_box(wc, v, c, b);
+            continue;
+        }
+        box_empty(b);
+        for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
+            box_add(b, sw_self_contacts_map(sc, red, q, copy_vertex(v, wc->cl_copy[i])));
+        box_grow(b, wc->radius);
+    }
+    /* insertion sort by the low x: the order of the last step is almost this one's */
+    for (int32_t a = 1; a < nv->ncl; ++a)
+        for (int32_t j = a;
+             j > 0 && nv->cl_now[6 * nv->order[j - 1]] > nv->cl_now[6 * nv->order[j]]; --j) {
+            int32_t t = nv->order[j];
+            nv->order[j] = nv->order[j - 1];
+            nv->order[j - 1] = t;
+        }
+}
+
+/* The hit of vertex gv: kept when it is the vertex's first or deeper than its last. */
+static void keep_hit(sw_novel *nv, int32_t gv, const sw_self_hit *hit) {
+    if (nv->best[gv] == nv->stamp) {
+        sw_self_hit *h = &nv->hits[nv->best_i[gv]];
+        if (hit->rest_depth > h->rest_depth ||
+            (hit->rest_depth == h->rest_depth && hit->tet < h->tet))
+            *h = *hit;
+        return;
+    }
+    if (nv->nhits == SW_NOVEL_MAX_CONTACTS) {
+        nv->dropped++;
+        return;
+    }
+    nv->best[gv] = nv->stamp;
+    nv->best_i[gv] = nv->nhits;
+    nv->hits[nv->nhits++] = *hit;
+}
+
+/* The copies of cluster a inside cluster b's box against b's layer. */
+static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *wc,
+                   const sw_reduced *red, const double *q, int32_t a, int32_t b) {
+    const sw_blob_view *v = red->v;
+    const sw_self_mesh *m = &sc->m;
+    const double *bb = nv->cl_now + 6 * b;
+    int32_t lb = nv->layer_ptr[b], ln = nv->layer_ptr[b + 1] - lb;
+    const double *boxes = nv->layer_box + 6 * (int64_t)lb;
+    for (int32_t i = wc->cl_begin[a]; i < wc->cl_begin[a + 1]; ++i) {
+        int32_t gv = copy_vertex(v, wc->cl_copy[i]);
+        if (nv->held[gv] == nv->stamp) continue;
+        const double *x = sw_self_contacts_map(sc, red, q, gv);
+        if (!box_holds(bb, x)) continue;
+        if (nv->cl_boxed[b] != nv->stamp) { /* the layer's tet boxes, once a step */
+            for (int32_t k = 0; k < ln; ++k) {
+                double *tb = nv->layer_box + 6 * (int64_t)(lb + k);
+                box_empty(tb);
+                for (int c = 0; c < 4; ++c)
+                    box_add(tb, sw_self_contacts_map(
+                                    sc, red, q, v->tets[4 * (int64_t)nv->layer_tets[lb + k] + c]));
+            }
+            nv->cl_boxed[b] = nv->stamp;
+        }
+        int32_t n = 0;
+        for (int32_t k = 0; k < ln; ++k)
+            if (box_holds(boxes + 6 * k, x)) nv->cand[n++] = nv->layer_tets[lb + k];
+        if (n == 0) continue;
+        nv->tests += n;
+        int32_t si = sw_sorted_index(m->surf, m->nsurf, gv);
+        sw_self_hit hit;
+        if (si >= 0 && sw_self_detect_among(m, sc->x, si, nv->cand, n, &hit))
+            keep_hit(nv, gv, &hit);
+    }
+}
+
+int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *wc,
+                        const sw_reduced *red, const double *q, const sw_pose_space *ps,
+                        const double *T, const double *T_last) {
+    const sw_blob_view *v = red->v;
+    sw_self_contacts_clear(sc);
+    sw_self_contacts_begin(sc, v);
+    next_stamp(nv, v->nverts);
+    nv->nhits = nv->dropped = nv->cluster_pairs = 0;
+    nv->tests = 0;
+    for (int32_t i = 0; i < ps->npairs; ++i) /* the vertices the trained pairs hold */
+        nv->held[red->act_vert[red->contact_act[4 * (int64_t)ps->pairs[i]]]] = nv->stamp;
+    cluster_boxes(nv, sc, wc, red, q, T, T_last);
+    for (int32_t a = 0; a < nv->ncl; ++a) {
+        int32_t i = nv->order[a];
+        const double *bi = nv->cl_now + 6 * i;
+        for (int32_t k = a + 1; k < nv->ncl; ++k) {
+            int32_t j = nv->order[k];
+            const double *bj = nv->cl_now + 6 * j;
+            if (bj[0] > bi[3]) break; /* sorted by the low x: none after meets i */
+            if (nv->cl_dom[i] == nv->cl_dom[j] || !box_meets(bi, bj)) continue;
+            nv->cluster_pairs++;
+            narrow(nv, sc, wc, red, q, i, j);
+            narrow(nv, sc, wc, red, q, j, i);
+        }
+    }
+    for (int32_t h = 0; h < nv->nhits; ++h) {
+        const int32_t *tv = sw_self_hit_triangle(&sc->m, &nv->hits[h]);
+        for (int k = 0; k < 3; ++k)
+            sw_self_contacts_map(sc, red, q, tv[k]);
+        sw_contact c;
+        sw_self_detect_finish(&sc->m, sc->x, &nv->hits[h], &c);
+        sw_self_contacts_add(sc, &c, 1, 1);
+    }
+    sc->tests = nv->tests;
+    return sc->npairs;
+}
