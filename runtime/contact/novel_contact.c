@@ -43,6 +43,14 @@ void sw_novel_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, sw_novel 
     TAKE(nv->best, nv3);
     TAKE(nv->best_i, nv3);
     TAKE(nv->hits, (uint64_t)SW_NOVEL_MAX_CONTACTS);
+    uint64_t seams = 0; /* pairs of copies of one boundary vertex */
+    for (int32_t sv = 0; sv < v->nsurf_verts; ++sv) {
+        uint64_t k = (uint64_t)(v->surf_copy_ptr[sv + 1] - v->surf_copy_ptr[sv]);
+        seams += k * (k - 1);
+    }
+    TAKE(nv->seam_ptr, (uint64_t)ncl + 1);
+    TAKE(nv->seam, seams);
+    TAKE(nv->copy_cl, (uint64_t)v->nsurf_copies);
 #undef TAKE
 }
 
@@ -78,6 +86,41 @@ static int box_holds(const double b[6], const double x[3]) {
            x[2] <= b[5];
 }
 
+/* Whether cluster b is listed among a's seam neighbours. */
+static int on_seam(const sw_novel *nv, int32_t a, int32_t b) {
+    for (int32_t k = nv->seam_ptr[a]; k < nv->seam_ptr[a + 1]; ++k)
+        if (nv->seam[k] == b) return 1;
+    return 0;
+}
+
+/* Each cluster's seam neighbours: the clusters holding another copy of one of its
+ * boundary vertices (the interface between two domains, where a joint bends). */
+static void seam_neighbours(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts *wc) {
+    for (int32_t c = 0; c < wc->ncl; ++c)
+        for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
+            nv->copy_cl[wc->cl_copy[i]] = c;
+    int32_t n = 0;
+    for (int32_t a = 0; a < wc->ncl; ++a) {
+        nv->seam_ptr[a] = nv->seam_ptr[a + 1] = n; /* on_seam reads the list so far */
+        for (int32_t i = wc->cl_begin[a]; i < wc->cl_begin[a + 1]; ++i) {
+            int32_t ci = wc->cl_copy[i], lo = 0, hi = v->nsurf_verts - 1;
+            while (lo < hi) { /* its boundary vertex: the last sv with ptr[sv] <= ci */
+                int32_t mid = lo + (hi - lo + 1) / 2;
+                if (v->surf_copy_ptr[mid] <= ci)
+                    lo = mid;
+                else
+                    hi = mid - 1;
+            }
+            for (int32_t j = v->surf_copy_ptr[lo]; j < v->surf_copy_ptr[lo + 1]; ++j) {
+                int32_t b = nv->copy_cl[j];
+                if (b == a || on_seam(nv, a, b)) continue;
+                nv->seam[n++] = b;
+                nv->seam_ptr[a + 1] = n;
+            }
+        }
+    }
+}
+
 void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts *wc,
                     sw_self_contacts *sc) {
     nv->ncl = wc->ncl;
@@ -98,6 +141,7 @@ void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts
         }
     }
     memset(sc->tstamp, 0, (size_t)v->ntets * sizeof *sc->tstamp);
+    seam_neighbours(nv, v, wc);
     nv->layer_ptr[wc->ncl] = n;
     memset(nv->best, 0, (size_t)v->nverts * sizeof *nv->best);
     memset(nv->held, 0, (size_t)v->nverts * sizeof *nv->held);
@@ -132,7 +176,7 @@ static void cluster_boxes(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts 
         }
         box_empty(b);
         for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
-            box_add(b, sw_self_contacts_map(sc, red, q, copy_vertex(v, wc->cl_copy[i])));
+            box_add(b, sw_self_contacts_map(sc, q, copy_vertex(v, wc->cl_copy[i])));
         box_grow(b, wc->radius);
     }
     /* insertion sort by the low x: the order of the last step is almost this one's */
@@ -174,7 +218,7 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
     for (int32_t i = wc->cl_begin[a]; i < wc->cl_begin[a + 1]; ++i) {
         int32_t gv = copy_vertex(v, wc->cl_copy[i]);
         if (nv->held[gv] == nv->stamp) continue;
-        const double *x = sw_self_contacts_map(sc, red, q, gv);
+        const double *x = sw_self_contacts_map(sc, q, gv);
         if (!box_holds(bb, x)) continue;
         if (nv->cl_boxed[b] != nv->stamp) { /* the layer's tet boxes, once a step */
             for (int32_t k = 0; k < ln; ++k) {
@@ -182,7 +226,7 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
                 box_empty(tb);
                 for (int c = 0; c < 4; ++c)
                     box_add(tb, sw_self_contacts_map(
-                                    sc, red, q, v->tets[4 * (int64_t)nv->layer_tets[lb + k] + c]));
+                                    sc, q, v->tets[4 * (int64_t)nv->layer_tets[lb + k] + c]));
             }
             nv->cl_boxed[b] = nv->stamp;
         }
@@ -200,10 +244,10 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
 
 int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *wc,
                         const sw_reduced *red, const double *q, const sw_pose_space *ps,
-                        const double *T, const double *T_last) {
+                        const double *T, const double *T_last, int seams) {
     const sw_blob_view *v = red->v;
     sw_self_contacts_clear(sc);
-    sw_self_contacts_begin(sc, v);
+    sw_self_contacts_begin(sc, red);
     next_stamp(nv, v->nverts);
     nv->nhits = nv->dropped = nv->cluster_pairs = 0;
     nv->tests = 0;
@@ -217,7 +261,9 @@ int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *w
             int32_t j = nv->order[k];
             const double *bj = nv->cl_now + 6 * j;
             if (bj[0] > bi[3]) break; /* sorted by the low x: none after meets i */
-            if (nv->cl_dom[i] == nv->cl_dom[j] || !box_meets(bi, bj)) continue;
+            if (nv->cl_dom[i] == nv->cl_dom[j] || !box_meets(bi, bj) ||
+                (!seams && on_seam(nv, i, j)))
+                continue;
             nv->cluster_pairs++;
             narrow(nv, sc, wc, red, q, i, j);
             narrow(nv, sc, wc, red, q, j, i);
@@ -226,7 +272,7 @@ int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *w
     for (int32_t h = 0; h < nv->nhits; ++h) {
         const int32_t *tv = sw_self_hit_triangle(&sc->m, &nv->hits[h]);
         for (int k = 0; k < 3; ++k)
-            sw_self_contacts_map(sc, red, q, tv[k]);
+            sw_self_contacts_map(sc, q, tv[k]);
         sw_contact c;
         sw_self_detect_finish(&sc->m, sc->x, &nv->hits[h], &c);
         sw_self_contacts_add(sc, &c, 1, 1);

@@ -106,7 +106,7 @@ void sw_self_contacts_clear(sw_self_contacts *sc) {
 }
 
 /* A fresh stamp for the vertices and tets of a detection (all cleared on wrap-around). */
-void sw_self_contacts_begin(sw_self_contacts *sc, const sw_blob_view *v) {
+static void next_stamp(sw_self_contacts *sc, const sw_blob_view *v) {
     if (sc->stamp == INT32_MAX || sc->stamp <= 0) {
         memset(sc->vstamp, 0, (size_t)v->nverts * sizeof(int32_t));
         memset(sc->tstamp, 0, (size_t)v->ntets * sizeof(int32_t));
@@ -255,7 +255,7 @@ int32_t sw_self_contacts_retest(sw_self_contacts *sc, const sw_reduced *red, con
     sw_self_mesh *m = &sc->m;
     sw_reduced map = vertex_map(sc, red);
     int32_t kept = 0, moved = 0;
-    sw_self_contacts_begin(sc, v);
+    next_stamp(sc, v);
     for (int32_t i = 0; i < ps->npairs; ++i) {
         const int32_t c = ps->pairs[i], *ca = red->contact_act + 4 * (int64_t)c;
         int32_t p = red->act_vert[ca[0]], si = sw_sorted_index(m->surf, m->nsurf, p);
@@ -288,12 +288,13 @@ int32_t sw_self_contacts_retest(sw_self_contacts *sc, const sw_reduced *red, con
     return moved;
 }
 
-const double *sw_self_contacts_map(sw_self_contacts *sc, const sw_reduced *red, const double *q,
-                                   int32_t gv) {
-    if (sc->vstamp[gv] != sc->stamp) {
-        sw_reduced map = vertex_map(sc, red);
-        map_once(sc, &map, q, gv);
-    }
+void sw_self_contacts_begin(sw_self_contacts *sc, const sw_reduced *red) {
+    next_stamp(sc, red->v);
+    sc->map = vertex_map(sc, red);
+}
+
+const double *sw_self_contacts_map(sw_self_contacts *sc, const double *q, int32_t gv) {
+    map_once(sc, &sc->map, q, gv);
     return sc->x + 3 * (int64_t)gv;
 }
 

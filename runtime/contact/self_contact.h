@@ -48,6 +48,7 @@ typedef struct sw_self_contacts {
     int32_t *tstamp; /* ntets */
     int32_t *cand;   /* SW_RETEST_CANDIDATES: one pair's candidate tets */
     int32_t stamp;
+    sw_reduced map; /* the detection's map: red with the transforms indexed by vertex */
 } sw_self_contacts;
 
 /* The most tets a cubature vertex is tested against: those incident to its trained
@@ -87,12 +88,11 @@ int32_t sw_self_contacts_retest(sw_self_contacts *sc, const sw_reduced *red, con
                                 sw_pose_space *ps);
 
 /* The pieces of a detection that maps only what it reads (the re-test's, novel_contact.h):
- * a fresh stamp; vertex gv at the state q, mapped once a stamp (its position, its
- * skinning transform in vR, vt); a contact appended to the pairs in use at weight w and
- * tangential share tan (0 when the list is full). */
-void sw_self_contacts_begin(sw_self_contacts *sc, const sw_blob_view *v);
-const double *sw_self_contacts_map(sw_self_contacts *sc, const sw_reduced *red, const double *q,
-                                   int32_t gv);
+ * a fresh stamp and the map of red's pose; vertex gv at the state q, mapped once a stamp
+ * (its position, its skinning transform in vR, vt); a contact appended to the pairs in use
+ * at weight w and tangential share tan (0 when the list is full). */
+void sw_self_contacts_begin(sw_self_contacts *sc, const sw_reduced *red);
+const double *sw_self_contacts_map(sw_self_contacts *sc, const double *q, int32_t gv);
 int32_t sw_self_contacts_add(sw_self_contacts *sc, const sw_contact *c, double w, double tan);
 
 /* Forgets the pairs in use. */

@@ -122,7 +122,7 @@ static void novel_self(sw_step_ctx *c) {
     double t = sw_now_seconds();
     const double *T_last = in->pose.history >= 1 ? in->pose.T_prev : NULL;
     sw_novel_detect(&in->novel, &in->sc, &in->wc, &in->red, in->solver.q, &in->ps, in->pose.T_cur,
-                    T_last);
+                    T_last, c->st.joints_beyond_training > 0);
     if (in->sc.npairs > 0) in->solver.mat_at_qn = 0; /* a dynamic step's part at q_n lacks them */
     c->st.novel_contacts = (uint32_t)in->sc.npairs;
     c->st.novel_cluster_pairs = (uint32_t)in->novel.cluster_pairs;

@@ -18,7 +18,7 @@ static const char *const config_key[SW_NOVEL_CONFIGS] = {"pose_space", "novel", 
 typedef struct {
     sw_selfcontact *sc;
     double *x, *count;
-    double pen, step_ms, novel_ms, contacts, patch_max;
+    double pen, step_ms, novel_ms, contacts, patch_max, cluster_pairs, tests;
     int frames;
 } frame_sums;
 
@@ -33,6 +33,8 @@ static void on_frame(void *ctx, int32_t pose, const sinew_instance *inst, const 
     s->step_ms += sw_step_ms(&st);
     s->novel_ms += st.ms_novel;
     s->contacts += st.novel_contacts;
+    s->cluster_pairs += st.novel_cluster_pairs;
+    s->tests += st.self_contact_tests;
     s->patch_max = fmax(s->patch_max, st.patch_vertices);
     s->frames++;
 }
@@ -82,7 +84,7 @@ sinew_result sw_novel_bench_run(const sinew_blob *blob, const sw_character *ch, 
                              .patch_vertices = k == 2 ? (uint32_t)(v->nverts / 10 + 1) : 0,
                              .on_frame = on_frame,
                              .frame_ctx = &s};
-        s.pen = s.step_ms = s.novel_ms = s.contacts = s.patch_max = 0;
+        s.pen = s.step_ms = s.novel_ms = s.contacts = s.patch_max = s.cluster_pairs = s.tests = 0;
         s.frames = 0;
         sw_eval_result e;
         r = sw_eval_correction_frames(blob, mass, T, full_x, kf, &o, NULL, &e, err);
@@ -94,6 +96,8 @@ sinew_result sw_novel_bench_run(const sinew_blob *blob, const sw_character *ch, 
         out->novel_ms[k] = s.novel_ms / nf;
         out->novel_contacts[k] = s.contacts / nf;
         out->patch_max[k] = s.patch_max;
+        out->cluster_pairs[k] = s.cluster_pairs / nf;
+        out->tests[k] = s.tests / nf;
         out->failed += e.failed;
     }
     out->frames = kf;
@@ -114,9 +118,10 @@ void sw_novel_bench_print(const sw_novel_bench *b, FILE *f, int json) {
         for (int k = 0; k < SW_NOVEL_CONFIGS; ++k)
             fprintf(f,
                     "             %-10s error %.4f, self-penetration %.4g, step %.3f ms, "
-                    "detection %.4f ms, %.1f novel contacts, patch up to %.0f vertices\n",
+                    "detection %.4f ms (%.1f cluster pairs, %.0f tets tested), %.2f novel "
+                    "contacts, patch up to %.0f vertices\n",
                     config_key[k], b->err[k], b->pen_self[k], b->step_ms[k], b->novel_ms[k],
-                    b->novel_contacts[k], b->patch_max[k]);
+                    b->cluster_pairs[k], b->tests[k], b->novel_contacts[k], b->patch_max[k]);
         return;
     }
     fprintf(f, ",\"novel_frames\":%d,\"pen_self_full\":%.6g,\"size\":%.6g", b->frames,
@@ -124,8 +129,9 @@ void sw_novel_bench_print(const sw_novel_bench *b, FILE *f, int json) {
     for (int k = 0; k < SW_NOVEL_CONFIGS; ++k)
         fprintf(f,
                 ",\"pen_self_%s\":%.6g,\"err_clip_%s\":%.5f,\"step_ms_%s\":%.4f,"
-                "\"novel_detect_ms_%s\":%.5f,\"novel_contacts_%s\":%.2f,\"patch_max_%s\":%.0f",
+                "\"novel_detect_ms_%s\":%.5f,\"novel_contacts_%s\":%.2f,\"patch_max_%s\":%.0f,"
+                "\"novel_cluster_pairs_%s\":%.2f",
                 config_key[k], b->pen_self[k], config_key[k], b->err[k], config_key[k],
                 b->step_ms[k], config_key[k], b->novel_ms[k], config_key[k], b->novel_contacts[k],
-                config_key[k], b->patch_max[k]);
+                config_key[k], b->patch_max[k], config_key[k], b->cluster_pairs[k]);
 }

@@ -24,6 +24,8 @@ typedef struct sw_novel_bench {
     double novel_ms[SW_NOVEL_CONFIGS];       /* mean novel detection */
     double novel_contacts[SW_NOVEL_CONFIGS]; /* mean a step */
     double patch_max[SW_NOVEL_CONFIGS];      /* most patch vertices in a step */
+    double cluster_pairs[SW_NOVEL_CONFIGS];  /* mean cluster pairs the broad phase passed */
+    double tests[SW_NOVEL_CONFIGS];          /* mean self-contact tests a step */
     double size;                             /* rest diagonal */
     long failed;
 } sw_novel_bench;
