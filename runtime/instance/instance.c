@@ -500,6 +500,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
     in->profiler = d.profiler;
+    in->blob = blob;
     in->red.nact_step = z.nact_step;
     (void)active_vertices(v, in->red.act_vert, &in->red.nact_step);
     visit_active(v, &in->red, ACT_STEP | ACT_SURFACE, assign_active, &in->red);

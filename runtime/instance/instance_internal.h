@@ -46,6 +46,7 @@ struct sinew_instance {
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
     sinew_profiler profiler;    /* the def's zones (zone_begin NULL: none) */
+    const sinew_blob *blob;     /* the blob the view is of (bone binds, a recording) */
 };
 
 /* The most task workers an instance reserves scratch for (sinew_task_callbacks). */

@@ -160,6 +160,20 @@ SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, f
  * not written). */
 SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sinew_step_stats *out);
 
+/** Draws the last step's state through `draw`'s callbacks (sinew_debug_draw): with
+ * SINEW_DEBUG_DRAW_CONTACTS each world contact in force (its point on the collider, a
+ * point and a segment along its outward normal, SINEW_DEBUG_COLOR_WORLD_CONTACT: as many
+ * as sinew_step_stats.world_contacts) and each self-contact pair in use (the vertex and
+ * the triangle's normal there, SINEW_DEBUG_COLOR_SELF_CONTACT); _PATCH the condensation
+ * patch's vertices (points) and its tets' faces (triangles); _COLLIDERS each collider of
+ * the attached world as its oriented box (12 lines; a plane as a square around the actor);
+ * _BONES each bone as a line from its parent's joint to its own (a blob without the asset
+ * description: a point per bone). Call it after a step and before the next set_pose or
+ * set_actor, on the instance's owner thread, outside the step. Allocates nothing and takes
+ * no lock; an instance never drawn pays nothing. INVALID_ARGUMENT for NULL. */
+SINEW_API sinew_result sinew_instance_debug_draw(const sinew_instance *inst,
+                                                 const sinew_debug_draw *draw);
+
 #ifdef __cplusplus
 }
 #endif

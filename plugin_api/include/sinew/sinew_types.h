@@ -363,6 +363,40 @@ typedef struct sinew_step_stats {
     double beyond_training_deg;
 } sinew_step_stats;
 
+/** What sinew_instance_debug_draw draws (sinew_debug_draw.flags). */
+#define SINEW_DEBUG_DRAW_CONTACTS 1u  /**< world contacts and self-contact pairs */
+#define SINEW_DEBUG_DRAW_PATCH 2u     /**< the condensation patch's vertices and tets */
+#define SINEW_DEBUG_DRAW_COLLIDERS 4u /**< the attached world's colliders (oriented boxes) */
+#define SINEW_DEBUG_DRAW_BONES 8u     /**< the pose's bones (parent joint to joint) */
+
+/** The colours sinew_instance_debug_draw uses, packed 0xRRGGBBAA, one per kind of item
+ * (a host may tell the kinds apart by them). */
+#define SINEW_DEBUG_COLOR_WORLD_CONTACT 0xff4020ffu /**< a world contact and its normal */
+#define SINEW_DEBUG_COLOR_SELF_CONTACT 0x20c0ffffu  /**< a self-contact pair and its normal */
+#define SINEW_DEBUG_COLOR_PATCH 0xffd000ffu         /**< a patch vertex, a patch tet's face */
+#define SINEW_DEBUG_COLOR_COLLIDER 0x80ff80ffu      /**< a collider's box */
+#define SINEW_DEBUG_COLOR_BONE 0xffffffffu          /**< a bone */
+
+/** Debug-draw callbacks in the manner of Box2D's b2DebugDraw: a zero-initialised struct
+ * of function pointers with a context pointer, and flags saying what to draw. Positions
+ * are floats in the actor's frame, as sinew_instance_read_surface gives the surface (draw
+ * them with the actor's matrix); colours are packed 0xRRGGBBAA (SINEW_DEBUG_COLOR_*). A
+ * NULL callback skips its items. The callbacks must not call into the instance. */
+typedef struct sinew_debug_draw {
+    /** a segment from p0 to p1 (a contact's normal, a box edge, a bone) */
+    void (*draw_line)(const float p0[3], const float p1[3], uint32_t rgba, void *context);
+    /** a point of `size` in the surface's units (a contact point, a patch vertex) */
+    void (*draw_point)(const float p[3], float size, uint32_t rgba, void *context);
+    /** a triangle (a patch tet's face) */
+    void (*draw_triangle)(const float p0[3], const float p1[3], const float p2[3], uint32_t rgba,
+                          void *context);
+    uint32_t flags; /**< SINEW_DEBUG_DRAW_* bits; 0 draws nothing */
+    /** length of a contact's normal segment, in the surface's units; 0 means 2% of the
+     * character's rest bounding-box diagonal */
+    float normal_length;
+    void *context; /**< handed to every callback */
+} sinew_debug_draw;
+
 #ifdef __cplusplus
 }
 #endif
