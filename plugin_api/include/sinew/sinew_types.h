@@ -397,6 +397,34 @@ typedef struct sinew_debug_draw {
     void *context; /**< handed to every callback */
 } sinew_debug_draw;
 
+/** A recorder: writes every call an instance receives to a file a host can send with a
+ * bug report, for sinew-replay to play back bitwise (opaque; sinew_recorder_open). */
+typedef struct sinew_recorder sinew_recorder;
+
+/** How to open a recorder. */
+typedef struct sinew_recorder_def {
+    uint32_t struct_size;      /**< sizeof(sinew_recorder_def), set by the default */
+    uint32_t buffer_bytes;     /**< the in-memory buffer; 0 means 1 MiB, at least 64 KiB */
+    const char *path;          /**< the file to create (truncated when it exists) */
+    sinew_allocator allocator; /**< memory hooks; zero means the C library */
+    sinew_logger logger;       /**< log hook; zero means the default (stderr) */
+} sinew_recorder_def;
+
+/** A sinew_recorder_def with every field at its default. */
+static inline sinew_recorder_def sinew_recorder_def_default(void) {
+    sinew_recorder_def d;
+    d.struct_size = (uint32_t)sizeof(sinew_recorder_def);
+    d.buffer_bytes = 0;
+    d.path = NULL;
+    d.allocator = sinew_allocator_default();
+    d.logger = sinew_logger_default();
+    return d;
+}
+
+/** Stable log message ids of the recorder (sinew_logger). */
+#define SINEW_MSG_RECORDER_IO 0x0500u      /**< error: the file could not be written */
+#define SINEW_MSG_RECORDER_REFUSED 0x0501u /**< error: attached too late, or twice */
+
 #ifdef __cplusplus
 }
 #endif
