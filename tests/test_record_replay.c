@@ -116,8 +116,8 @@ TEST(a_session_with_pokes_and_a_teleport_replays_bitwise) {
     unsigned char *data = read_all(&n);
     ENSURE(data);
     sw_recording rec;
-    char err[256];
-    ENSUREF(sw_recording_parse(data, n, &rec, err, sizeof err) == SINEW_OK, "%s", err);
+    sw_error err;
+    ENSUREF(sw_recording_parse(data, n, &rec, &err) == SINEW_OK, "%s", err.msg);
     ENSURE(rec.steps == FRAMES);
     sw_replay_report rep;
     t0 = sw_now_seconds();
@@ -158,8 +158,8 @@ TEST(a_recording_without_one_pose_differs_from_there) {
     unsigned char *data = read_all(&n);
     ENSURE(data);
     sw_recording rec;
-    char err[256];
-    ENSURE(sw_recording_parse(data, n, &rec, err, sizeof err) == SINEW_OK);
+    sw_error err;
+    ENSURE(sw_recording_parse(data, n, &rec, &err) == SINEW_OK);
     unsigned char *cut = malloc(rec.size);
     size_t pos = 0, at = 0, m = 0;
     sw_rec_record r;
@@ -177,7 +177,7 @@ TEST(a_recording_without_one_pose_differs_from_there) {
     size_t n2;
     unsigned char *d2 = rechunk(cut, m, &n2);
     sw_recording rec2;
-    ENSUREF(sw_recording_parse(d2, n2, &rec2, err, sizeof err) == SINEW_OK, "%s", err);
+    ENSUREF(sw_recording_parse(d2, n2, &rec2, &err) == SINEW_OK, "%s", err.msg);
     sw_replay_report rep;
     ENSURE(sw_recording_replay(fixture()->blob, &rec2, NULL, NULL, &rep) == SINEW_OK);
     fprintf(stderr, "    without the pose of step %d: %u steps differ, the first %lld\n", DROP_AT,
@@ -192,10 +192,10 @@ TEST(a_recording_without_one_pose_differs_from_there) {
 
 static int parse_says(const unsigned char *d, size_t n, const char *what) {
     sw_recording rec;
-    char err[256];
-    sinew_result r = sw_recording_parse(d, n, &rec, err, sizeof err);
-    fprintf(stderr, "    %s\n", err);
-    return r != SINEW_OK && strstr(err, what) != NULL;
+    sw_error err;
+    sinew_result r = sw_recording_parse(d, n, &rec, &err);
+    fprintf(stderr, "    %s\n", err.msg);
+    return r != SINEW_OK && err.code == r && strstr(err.msg, what) != NULL;
 }
 
 TEST(damaged_recordings_are_refused_clearly) {
@@ -216,8 +216,8 @@ TEST(damaged_recordings_are_refused_clearly) {
     ENSURE(parse_says(data, first, "no END record"));
     /* against another blob */
     sw_recording rec;
-    char err[256];
-    ENSURE(sw_recording_parse(data, n, &rec, err, sizeof err) == SINEW_OK);
+    sw_error err;
+    ENSURE(sw_recording_parse(data, n, &rec, &err) == SINEW_OK);
     bake_fixture other;
     ENSURE(bake_fixture_make(&other, "finger", 1500, 12, 0));
     sw_replay_report rep;
@@ -282,8 +282,8 @@ TEST(a_short_recording_is_the_fuzzers_seed) {
     unsigned char *d = (unsigned char *)sw_test_read_file(path, &n);
     ENSURE(d && n < 4096);
     sw_recording r;
-    char err[256];
-    ENSUREF(sw_recording_parse(d, n, &r, err, sizeof err) == SINEW_OK, "%s", err);
+    sw_error err;
+    ENSUREF(sw_recording_parse(d, n, &r, &err) == SINEW_OK, "%s", err.msg);
     ENSURE(r.steps == 3);
     sw_replay_report rep;
     ENSURE(sw_recording_replay(f->blob, &r, NULL, NULL, &rep) == SINEW_OK && rep.differing == 0);

@@ -31,6 +31,7 @@
 #include <stdint.h>
 
 #include "sinew/sinew.h"
+#include "sw_error.h"
 
 #define SW_REC_VERSION 1u
 #define SW_REC_PREAMBLE_BYTES 16u
@@ -82,10 +83,9 @@ typedef struct sw_rec_record {
 
 /* Parses and validates n bytes of a recording into *out: the preamble, every chunk's
  * size and checksum, every record's type and size against its contents, BEGIN first and
- * END last. Anything else is SINEW_ERROR_CORRUPT (or _VERSION) with a message in err
- * naming the byte and what is wrong, never a crash. Allocates the stream (malloc). */
-sinew_result sw_recording_parse(const void *data, size_t n, sw_recording *out, char *err,
-                                size_t errlen);
+ * END last. Anything else is SINEW_ERROR_CORRUPT (or _VERSION) with err's message naming
+ * the byte and what is wrong, never a crash. Allocates the stream (malloc). */
+sinew_result sw_recording_parse(const void *data, size_t n, sw_recording *out, sw_error *err);
 void sw_recording_free(sw_recording *r);
 
 /* The record at *pos of a parsed recording, advancing *pos; 0 at the end. */

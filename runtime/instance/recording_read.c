@@ -1,81 +1,59 @@
 /* Reading a recording (recording.h): every byte checked before a record is handed out,
  * since a recording comes with a bug report from outside. A damaged, cut or forged file
  * is SINEW_ERROR_CORRUPT with the byte and the reason, never a read out of bounds. */
-#include <stdarg.h>
-#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
 #include "hash.h"
 #include "recording.h"
 #include "sinew/sinew_world.h"
+#include "sw_error.h"
 
-uint32_t sw_rec_u32(const unsigned char *p) {
-    uint32_t x;
-    memcpy(&x, p, sizeof x);
-    return x;
-}
-
-uint64_t sw_rec_u64(const unsigned char *p) {
-    uint64_t x;
-    memcpy(&x, p, sizeof x);
-    return x;
-}
-
-float sw_rec_f32(const unsigned char *p) {
-    float x;
-    memcpy(&x, p, sizeof x);
-    return x;
-}
-
-double sw_rec_f64(const unsigned char *p) {
-    double x;
-    memcpy(&x, p, sizeof x);
-    return x;
-}
-
-static sinew_result fail(char *err, size_t errlen, sinew_result r, const char *fmt, ...) {
-    if (err && errlen) {
-        va_list ap;
-        va_start(ap, fmt);
-        vsnprintf(err, errlen, fmt, ap);
-        va_end(ap);
+/* The readers of recording.h: memcpy, so any byte offset will do. */
+#define SW_REC_READER(name, type)                                                                  \
+    type name(const unsigned char *p) {                                                            \
+        type x;                                                                                    \
+        memcpy(&x, p, sizeof x);                                                                   \
+        return x;                                                                                  \
     }
-    return r;
-}
+SW_REC_READER(sw_rec_u32, uint32_t)
+SW_REC_READER(sw_rec_u64, uint64_t)
+SW_REC_READER(sw_rec_f32, float)
+SW_REC_READER(sw_rec_f64, double)
 
 /* Checks the preamble and every chunk, and concatenates the payloads into out->stream. */
-static sinew_result read_chunks(const unsigned char *d, size_t n, sw_recording *out, char *err,
-                                size_t errlen) {
+static sinew_result read_chunks(const unsigned char *d, size_t n, sw_recording *out,
+                                sw_error *err) {
     static const unsigned char magic[8] = {'S', 'I', 'N', 'E', 'W', 'R', 'E', 'C'};
     if (n < SW_REC_PREAMBLE_BYTES || memcmp(d, magic, sizeof magic) != 0)
-        return fail(err, errlen, SINEW_ERROR_CORRUPT,
-                    "not a sinew recording (no SINEWREC preamble)");
+        return sw_error_set(err, SINEW_ERROR_CORRUPT,
+                            "not a sinew recording (no SINEWREC preamble)");
     out->version = sw_rec_u32(d + 8);
     if (sw_rec_u32(d + 12) != 0x01020304u)
-        return fail(err, errlen, SINEW_ERROR_VERSION,
-                    "recorded on a host of the other byte order (replay it on one like it)");
+        return sw_error_set(
+            err, SINEW_ERROR_VERSION,
+            "recorded on a host of the other byte order (replay it on one like it)");
     if (out->version != SW_REC_VERSION)
-        return fail(err, errlen, SINEW_ERROR_VERSION,
-                    "recording format version %u; this library reads version %u",
-                    (unsigned)out->version, (unsigned)SW_REC_VERSION);
+        return sw_error_set(err, SINEW_ERROR_VERSION,
+                            "recording format version %u; this library reads version %u",
+                            (unsigned)out->version, (unsigned)SW_REC_VERSION);
     out->stream = malloc(n); /* the payloads are smaller than the file */
-    if (!out->stream) return fail(err, errlen, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+    if (!out->stream) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     size_t at = SW_REC_PREAMBLE_BYTES;
     for (uint32_t c = 0; at < n; ++c) {
         if (n - at < SW_REC_CHUNK_BYTES || sw_rec_u32(d + at) != SW_REC_CHUNK_TAG)
-            return fail(err, errlen, SINEW_ERROR_CORRUPT, "chunk %u at byte %zu: %s", (unsigned)c,
-                        at, n - at < SW_REC_CHUNK_BYTES ? "truncated header" : "bad tag");
+            return sw_error_set(err, SINEW_ERROR_CORRUPT, "chunk %u at byte %zu: %s", (unsigned)c,
+                                at, n - at < SW_REC_CHUNK_BYTES ? "truncated header" : "bad tag");
         size_t len = sw_rec_u32(d + at + 4);
         if (len > n - at - SW_REC_CHUNK_BYTES)
-            return fail(
-                err, errlen, SINEW_ERROR_CORRUPT,
+            return sw_error_set(
+                err, SINEW_ERROR_CORRUPT,
                 "chunk %u at byte %zu: %zu payload bytes, the file has %zu left (truncated)",
                 (unsigned)c, at, len, n - at - SW_REC_CHUNK_BYTES);
         const unsigned char *p = d + at + SW_REC_CHUNK_BYTES;
         if (sw_fnv1a(SW_FNV_START, p, len) != sw_rec_u64(d + at + 8))
-            return fail(err, errlen, SINEW_ERROR_CORRUPT, "chunk %u at byte %zu: checksum mismatch",
-                        (unsigned)c, at);
+            return sw_error_set(err, SINEW_ERROR_CORRUPT, "chunk %u at byte %zu: checksum mismatch",
+                                (unsigned)c, at);
         memcpy(out->stream + out->size, p, len);
         out->size += len;
         at += SW_REC_CHUNK_BYTES + len;
@@ -139,18 +117,19 @@ int sw_recording_next(const sw_recording *r, size_t *pos, sw_rec_record *rec) {
 }
 
 /* Walks the records: each whole and of its type's size, BEGIN first and once, END last. */
-static sinew_result check_records(sw_recording *r, char *err, size_t errlen) {
+static sinew_result check_records(sw_recording *r, sw_error *err) {
     size_t pos = 0, at = 0;
     sw_rec_record rec;
     uint32_t steps = 0, count = 0, ended = 0;
     while (at = pos, sw_recording_next(r, &pos, &rec)) {
         if (ended)
-            return fail(err, errlen, SINEW_ERROR_CORRUPT, "record %u (stream byte %zu) after END",
-                        (unsigned)count, at);
+            return sw_error_set(err, SINEW_ERROR_CORRUPT, "record %u (stream byte %zu) after END",
+                                (unsigned)count, at);
         if ((count == 0) != (rec.type == SW_REC_BEGIN))
-            return fail(err, errlen, SINEW_ERROR_CORRUPT,
-                        "record %u (stream byte %zu): type %u where %s", (unsigned)count, at,
-                        (unsigned)rec.type, count == 0 ? "BEGIN must come first" : "BEGIN again");
+            return sw_error_set(err, SINEW_ERROR_CORRUPT,
+                                "record %u (stream byte %zu): type %u where %s", (unsigned)count,
+                                at, (unsigned)rec.type,
+                                count == 0 ? "BEGIN must come first" : "BEGIN again");
         if (rec.type == SW_REC_BEGIN) {
             r->blob_hash = sw_rec_u64(rec.p);
             r->blob_bytes = sw_rec_u64(rec.p + 8);
@@ -158,40 +137,41 @@ static sinew_result check_records(sw_recording *r, char *err, size_t errlen) {
             r->surface = sw_rec_u32(rec.p + 20);
         }
         if (!record_fits(r, &rec))
-            return fail(err, errlen, SINEW_ERROR_CORRUPT,
-                        "record %u (stream byte %zu): type %u with %u bytes does not add up",
-                        (unsigned)count, at, (unsigned)rec.type, (unsigned)rec.bytes);
+            return sw_error_set(
+                err, SINEW_ERROR_CORRUPT,
+                "record %u (stream byte %zu): type %u with %u bytes does not add up",
+                (unsigned)count, at, (unsigned)rec.type, (unsigned)rec.bytes);
         if (rec.type == SW_REC_STEP) steps++;
         if (rec.type == SW_REC_END) {
             ended = 1;
             if (sw_rec_u32(rec.p) != steps)
-                return fail(err, errlen, SINEW_ERROR_CORRUPT,
-                            "END says %u steps, the recording holds %u (records lost)",
-                            (unsigned)sw_rec_u32(rec.p), (unsigned)steps);
+                return sw_error_set(err, SINEW_ERROR_CORRUPT,
+                                    "END says %u steps, the recording holds %u (records lost)",
+                                    (unsigned)sw_rec_u32(rec.p), (unsigned)steps);
         }
         count++;
     }
     if (at != r->size)
-        return fail(err, errlen, SINEW_ERROR_CORRUPT,
-                    "record %u (stream byte %zu): cut short (the file was truncated)",
-                    (unsigned)count, at);
+        return sw_error_set(err, SINEW_ERROR_CORRUPT,
+                            "record %u (stream byte %zu): cut short (the file was truncated)",
+                            (unsigned)count, at);
     if (!ended)
-        return fail(err, errlen, SINEW_ERROR_CORRUPT,
-                    "no END record after %u steps: the recorder was not closed, or the file "
-                    "was cut",
-                    (unsigned)steps);
+        return sw_error_set(
+            err, SINEW_ERROR_CORRUPT,
+            "no END record after %u steps: the recorder was not closed, or the file "
+            "was cut",
+            (unsigned)steps);
     r->steps = steps;
     return SINEW_OK;
 }
 
-sinew_result sw_recording_parse(const void *data, size_t n, sw_recording *out, char *err,
-                                size_t errlen) {
-    if (err && errlen) err[0] = 0;
+sinew_result sw_recording_parse(const void *data, size_t n, sw_recording *out, sw_error *err) {
+    sw_error_clear(err);
     if (!out) return SINEW_ERROR_INVALID_ARGUMENT;
     memset(out, 0, sizeof *out);
-    if (!data && n) return fail(err, errlen, SINEW_ERROR_INVALID_ARGUMENT, "no data");
-    sinew_result r = read_chunks(data, n, out, err, errlen);
-    if (r == SINEW_OK) r = check_records(out, err, errlen);
+    if (!data && n) return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "no data");
+    sinew_result r = read_chunks(data, n, out, err);
+    if (r == SINEW_OK) r = check_records(out, err);
     if (r != SINEW_OK) sw_recording_free(out);
     return r;
 }

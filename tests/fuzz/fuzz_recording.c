@@ -17,10 +17,10 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 
 static void read_once(const uint8_t *b, size_t n) {
     sw_recording r;
-    char err[256];
-    sinew_result rc = sw_recording_parse(b, n, &r, err, sizeof err);
+    sw_error err;
+    sinew_result rc = sw_recording_parse(b, n, &r, &err);
     if (rc != SINEW_OK) {
-        if (err[0] == 0 || !sw_fuzz_zeroed(&r, sizeof r)) abort();
+        if (err.code != rc || err.msg[0] == 0 || !sw_fuzz_zeroed(&r, sizeof r)) abort();
         return;
     }
     size_t pos = 0;

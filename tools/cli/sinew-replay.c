@@ -35,11 +35,11 @@ static int load_recording(const char *path, sw_recording *rec) {
         fprintf(stderr, "%s: out of memory reading %s\n", tool, path);
         return 0;
     }
-    char err[256];
-    sinew_result r = sw_recording_parse(d, n, rec, err, sizeof err);
+    sw_error err;
+    sinew_result r = sw_recording_parse(d, n, rec, &err);
     free(d);
     if (r != SINEW_OK)
-        fprintf(stderr, "%s: %s: %s (%s)\n", tool, path, err, sinew_result_string(r));
+        fprintf(stderr, "%s: %s: %s (%s)\n", tool, path, err.msg, sinew_result_string(r));
     return r == SINEW_OK;
 }
 
