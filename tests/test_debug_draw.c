@@ -93,13 +93,17 @@ static sinew_instance *pressed(const sinew_instance_def *def, sinew_world *w, in
     return inst;
 }
 
-TEST(contact_lines_are_the_steps_contacts) {
+/* Over the clip, in self-contact mode `self` (the pairs in use come from the pose space,
+ * or from the exhaustive detection). */
+static void contact_lines_in_mode(sinew_self_contact self) {
     const bake_fixture *f = fixture();
     ENSURE(f);
     sinew_collider_id id;
     sinew_world *w = table_world(0.08, 0.3f, &id);
     ENSURE(w);
-    sinew_instance *inst = pressed(NULL, w, 3);
+    sinew_instance_def def = sinew_instance_def_default();
+    def.self_contact = self;
+    sinew_instance *inst = pressed(&def, w, 3);
     ENSURE(inst);
     uint32_t nb = (uint32_t)f->ch.skel.nbones, world_seen = 0, self_seen = 0;
     float *pose = malloc(sizeof(float) * 12 * nb);
@@ -132,9 +136,10 @@ TEST(contact_lines_are_the_steps_contacts) {
         self_seen += st.self_contacts;
     }
     fprintf(stderr,
-            "    over the clip: %u world contact and %u self-contact lines, as counted; "
+            "    %s, over the clip: %u world contact and %u self-contact lines, as counted; "
             "the draws: %llu allocations, %llu locks\n",
-            world_seen, self_seen, (unsigned long long)c.allocs, (unsigned long long)c.locks);
+            self == SINEW_SELF_CONTACT_EXHAUSTIVE ? "exhaustive" : "pose space", world_seen,
+            self_seen, (unsigned long long)c.allocs, (unsigned long long)c.locks);
     ENSURE(world_seen > 0 && self_seen > 0);
     if (active & SW_RT_CAT_ALLOCS) ENSURE(c.allocs == 0);
     if (active & SW_RT_CAT_LOCKS) ENSURE(c.locks == 0);
@@ -151,6 +156,14 @@ TEST(contact_lines_are_the_steps_contacts) {
     free(pose);
     sinew_instance_destroy(inst);
     sinew_world_destroy(w);
+}
+
+TEST(contact_lines_are_the_steps_contacts) {
+    contact_lines_in_mode(SINEW_SELF_CONTACT_POSE_SPACE);
+}
+
+TEST(contact_lines_are_the_detected_contacts) {
+    contact_lines_in_mode(SINEW_SELF_CONTACT_EXHAUSTIVE);
 }
 
 TEST(colliders_and_bones_are_drawn) {
@@ -205,5 +218,6 @@ TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
 }
 
-SW_TEST_MAIN(CASE(contact_lines_are_the_steps_contacts), CASE(colliders_and_bones_are_drawn),
+SW_TEST_MAIN(CASE(contact_lines_are_the_steps_contacts),
+             CASE(contact_lines_are_the_detected_contacts), CASE(colliders_and_bones_are_drawn),
              CASE(the_patch_is_drawn_as_the_stats_count_it), CASE(release_fixture))

@@ -1,6 +1,7 @@
 /* sinew — the types of the public ABI: opaque handles, the def structs with their
- * defaults, the task callbacks, the step's status flags and statistics. The functions
- * are in sinew.h, the collision world's in sinew_world.h.
+ * defaults, the task callbacks, the step's status flags and statistics, the debug-draw
+ * callbacks and the recorder's def. The functions are in sinew.h, the collision world's in
+ * sinew_world.h.
  *
  * Conventions (STYLE.md §1-§5):
  *  - Functions are sinew_<object>_<verb>; types are sinew_<snake_name>; macros SINEW_*.
