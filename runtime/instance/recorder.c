@@ -111,10 +111,17 @@ SINEW_API sinew_result sinew_recorder_open(const sinew_recorder_def *def, sinew_
         sw_free(&d.allocator, rec);
         return SINEW_ERROR_IO;
     }
-    const uint32_t pre[4] = {0x454e4953u, 0x43455257u, SW_REC_VERSION, 0x01020304u}; /* SINEWREC */
-    write_all(rec, (const unsigned char *)pre, sizeof pre);
+    unsigned char pre[SW_REC_PREAMBLE_BYTES] = {'S', 'I', 'N', 'E', 'W', 'R', 'E', 'C'};
+    const uint32_t tail[2] = {SW_REC_VERSION, 0x01020304u}; /* the host's byte order */
+    memcpy(pre + 8, tail, sizeof tail);
+    if (write_all(rec, pre, sizeof pre) != SINEW_OK) {
+        close(rec->fd);
+        sw_free(&d.allocator, buf);
+        sw_free(&d.allocator, rec);
+        return SINEW_ERROR_IO;
+    }
     *out = rec;
-    return rec->err;
+    return SINEW_OK;
 }
 
 SINEW_API sinew_result sinew_recorder_flush(sinew_recorder *rec) {
