@@ -287,6 +287,12 @@ expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: not a glTF binary" "$inspe
 printf 'not a 3D file\n' >"$tmp/text.fbx"
 expect inspect_text_fbx 1 "sinew-inspect: $tmp/text\.fbx: assimp could not read it" \
     "$inspect" "$tmp/text.fbx"
+# sinew-replay: exit 2 on bad arguments, 1 (message naming the file) when the blob or the
+# recording cannot be read; its bitwise replay is the CTest sinew_replay_session
+replay=$build/tools/sinew-replay
+expect replay_no_args 2 "usage: sinew-replay --blob B --recording R" "$replay"
+expect replay_no_blob 1 "sinew-replay: cannot load $tmp/none\.blob" \
+    "$replay" --blob "$tmp/none.blob" --recording "$tmp/none.rec"
 # expect_stdout NAME CMD...: passes when CMD exits 0 and every extended regex in the
 # array `want` matches a line of its stdout.
 expect_stdout() {

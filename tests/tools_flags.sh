@@ -11,7 +11,7 @@ build=$1
 src=$2
 write=${3:-}
 doc=$src/docs/tools.md
-tools="sinew-bake sinew-bench sinew-fullsim sinew-render sinew-invariance sinew-inspect sinew-soak"
+tools="sinew-bake sinew-bench sinew-fullsim sinew-render sinew-invariance sinew-inspect sinew-soak sinew-replay"
 fails=0
 fail() {
     echo "FAIL $*" >&2

@@ -21,6 +21,65 @@ void sw_collider_transform(const sw_collider *c, double R[9], double t[3]) {
         t[i] = c->t[i];
 }
 
+void sw_collider_source(const sw_collider *c, sinew_collider_def *d) {
+    *d = c->src;
+}
+
+const double *sw_collider_points(const sw_collider *c, uint32_t *count) {
+    *count = c->shape == SINEW_SHAPE_HULL   ? c->hull.count
+             : c->shape == SINEW_SHAPE_MESH ? c->mesh.nverts
+                                            : 0;
+    return c->shape == SINEW_SHAPE_HULL   ? c->hull.points
+           : c->shape == SINEW_SHAPE_MESH ? c->mesh.X
+                                          : NULL;
+}
+
+const uint32_t *sw_collider_triangles(const sw_collider *c, uint32_t *count) {
+    *count = c->shape == SINEW_SHAPE_MESH ? c->mesh.ntris : 0;
+    return c->shape == SINEW_SHAPE_MESH ? c->mesh.tris : NULL;
+}
+
+/* The plane's square around `around`: its closest point there, two unit axes across. */
+static void plane_square(const sw_collider *c, const double around[3], double extent,
+                         double corners[8][3]) {
+    double n[3], p0[3], u[3], v[3], d = 0;
+    for (int i = 0; i < 3; ++i) {
+        n[i] = c->R[3 * i] * c->u.plane.n[0] + c->R[3 * i + 1] * c->u.plane.n[1] +
+               c->R[3 * i + 2] * c->u.plane.n[2];
+        p0[i] = n[i] * c->u.plane.offset + c->t[i]; /* R (n offset) + t */
+    }
+    for (int i = 0; i < 3; ++i)
+        d += n[i] * (around[i] - p0[i]);
+    int k = fabs(n[0]) < 0.6 ? 0 : 1; /* an axis not along n */
+    double a[3] = {k == 0, k == 1, 0};
+    sw_v3_cross(n, a, u);
+    double un = sw_v3_norm(u);
+    for (int i = 0; i < 3; ++i)
+        u[i] /= un;
+    sw_v3_cross(n, u, v);
+    for (int j = 0; j < 4; ++j) {
+        double su = (j == 0 || j == 3) ? -extent : extent, sv = j < 2 ? -extent : extent;
+        for (int i = 0; i < 3; ++i)
+            corners[j][i] = around[i] - d * n[i] + su * u[i] + sv * v[i];
+    }
+}
+
+int sw_collider_outline(const sw_collider *c, const double around[3], double extent,
+                        double corners[8][3]) {
+    if (c->shape == SINEW_SHAPE_PLANE) {
+        plane_square(c, around, extent, corners);
+        return 4;
+    }
+    for (int j = 0; j < 8; ++j) {
+        double y[3] = {(j & 1) ? c->hi[0] : c->lo[0], (j & 2) ? c->hi[1] : c->lo[1],
+                       (j & 4) ? c->hi[2] : c->lo[2]};
+        for (int i = 0; i < 3; ++i)
+            corners[j][i] =
+                c->R[3 * i] * y[0] + c->R[3 * i + 1] * y[1] + c->R[3 * i + 2] * y[2] + c->t[i];
+    }
+    return 8;
+}
+
 /* The plane's world box: unbounded, except on the axis its world normal lies along
  * (within 1e-12 in each other component), where the solid ends at the plane. */
 static void plane_box(const sw_collider *c, double lo[3], double hi[3]) {

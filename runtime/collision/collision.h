@@ -50,6 +50,24 @@ void sw_collider_transform(const sw_collider *c, double R[9], double t[3]);
  * (for a plane, the half-space's box: infinite along the plane, +-HUGE_VAL). */
 void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], double hi[3]);
 
+/* The def it was added with, at the host's last transform (sinew_transform as given), its
+ * arrays NULL: the hull's points or the mesh's vertices are sw_collider_points (3 each,
+ * doubles holding the def's floats exactly), the mesh's triangles sw_collider_triangles
+ * (3 each); NULL and 0 for the other shapes. */
+void sw_collider_source(const sw_collider *c, sinew_collider_def *d);
+const double *sw_collider_points(const sw_collider *c, uint32_t *count);
+const uint32_t *sw_collider_triangles(const sw_collider *c, uint32_t *count);
+
+/* Its outline in the world for a debug draw: the 8 corners of its local box placed by its
+ * transform (corner j takes hi on axis k when bit k of j is set), returning 8; or for a
+ * plane the 4 corners, in order round, of a square of half-side `extent` centred where
+ * the plane is closest to `around`, returning 4. */
+int sw_collider_outline(const sw_collider *c, const double around[3], double extent,
+                        double corners[8][3]);
+
+/* The world's capacity (sinew_world_def.max_colliders as resolved). */
+uint32_t sw_world_capacity(const sinew_world *w);
+
 /* The query: returns 1 and fills `hit` when x is inside the collider or within
  * `radius` (> 0, finite) of its surface, else 0 (hit untouched). */
 int sw_collider_query(const sw_collider *c, const double x[3], double radius, sw_collider_hit *hit);

@@ -47,6 +47,9 @@ struct sw_collider {
     double lo[3], hi[3]; /* local box of the solid (plane: +-HUGE_VAL where unbounded) */
     double box[6];       /* world box of the solid (lo, hi) at R, t: sw_collider_place */
     double stiffness, friction;
+    /* the def it was added with (arrays NULL) and the host's last transform, as given:
+       what a recording (sinew_recorder) writes so a replay builds the same collider */
+    sinew_collider_def src;
     union {
         struct {
             double n[3], offset;

@@ -207,6 +207,9 @@ sinew_result sinew_world_add_collider(sinew_world *world, const sinew_collider_d
     memcpy(c->t, t, sizeof t);
     c->stiffness = d.stiffness;
     c->friction = d.friction;
+    c->src = d;
+    c->src.points = c->src.vertices = NULL;
+    c->src.indices = NULL;
     if ((r = build_shape(world, &d, c)) != SINEW_OK) {
         sw_free(&world->allocator, c);
         return r;
@@ -246,11 +249,16 @@ sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collid
     sinew_result r = read_transform(world, transform, fn, R, t);
     if (r != SINEW_OK) return r; /* the old transform stays */
     sw_collider_place(world->slots[s], R, t);
+    world->slots[s]->src.transform = *transform;
     return SINEW_OK;
 }
 
 uint32_t sinew_world_collider_count(const sinew_world *world) {
     return world ? world->live : 0;
+}
+
+uint32_t sw_world_capacity(const sinew_world *w) {
+    return w ? w->capacity : 0;
 }
 
 uint32_t sw_world_slot_count(const sinew_world *w) {

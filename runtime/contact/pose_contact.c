@@ -110,6 +110,22 @@ static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32
     return E;
 }
 
+void sw_contact_pair_point(const sw_reduced *red, const sw_pair_set *set, int32_t c,
+                           const double *q, double x[3], double n[3]) {
+    sw_reduced map = *red; /* the same map with the set's skinning transforms */
+    map.act_R = (double *)set->act_R;
+    map.act_t = (double *)set->act_t;
+    const sw_blob_domain *D[4];
+    double xs[4][3], d[3];
+    pair_gap(&map, set, c, q, D, xs, d);
+    const double *cd = set->data + 7 * (int64_t)c;
+    const double *Rp = set->act_R + 9 * (int64_t)set->act[4 * (int64_t)c];
+    for (int i = 0; i < 3; ++i) {
+        x[i] = xs[0][i];
+        n[i] = Rp[3 * i] * cd[3] + Rp[3 * i + 1] * cd[4] + Rp[3 * i + 2] * cd[5];
+    }
+}
+
 sw_pair_set sw_pose_pair_set(const sw_reduced *red) {
     const sw_blob_view *v = red->v;
     sw_pair_set set = {v->contact_verts, v->contact_data, red->contact_act, red->act_R, red->act_t};

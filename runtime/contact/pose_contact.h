@@ -35,6 +35,11 @@ double sw_contact_pairs_eval(sw_reduced *red, const sw_pair_set *set, const int3
                              const unsigned char *skip, int32_t n, const double *weight,
                              const double *tangent, const double *q, int want_grad, int want_hess);
 
+/* Pair c of set at q (red's skinning): the vertex's position x and the triangle's
+ * normal n there, in the simulation frame (the debug draw's). */
+void sw_contact_pair_point(const sw_reduced *red, const sw_pair_set *set, int32_t c,
+                           const double *q, double x[3], double n[3]);
+
 /* Contact energy at q of the pairs ps gathered (sw_contact_pairs_eval of the blob's
  * pairs at ps->pair_w and ps->pair_tan). */
 double sw_pose_contact_eval(sw_reduced *red, const sw_pose_space *ps, const double *q,

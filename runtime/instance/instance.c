@@ -10,6 +10,7 @@
 #include "def_read.h"
 #include "instance.h"
 #include "instance_internal.h"
+#include "recording.h"
 #include "log.h"
 #include "mem_plan.h"
 #include "sorted.h"
@@ -513,6 +514,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
     in->profiler = d.profiler;
+    in->def = d;
+    in->blob = blob;
     in->red.nact_step = z.nact_step;
     (void)active_vertices(v, in->red.act_vert, &in->red.nact_step);
     visit_active(v, &in->red, ACT_STEP | ACT_SURFACE, assign_active, &in->red);
@@ -554,7 +557,9 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     choose_newton_hessian(in, d.newton_hessian, &share);
     in->logger = d.logger;
     sw_instance_actor_identity(in);
+    in->rec = NULL;
     sinew_instance_reset(in);
+    in->touched = 0;
     sw_log(&d.logger, SINEW_LOG_INFO, SINEW_MSG_INSTANCE_CREATED,
            "sinew_instance_create: %zu bytes in one block; %d active vertices, rank %d, %d "
            "contact pairs a step at most; quasistatic Newton starts on the %s Hessian (a "
@@ -567,6 +572,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
 
 SINEW_API void sinew_instance_destroy(sinew_instance *inst) {
     if (!inst) return;
+    if (inst->rec) sinew_instance_set_recorder(inst, NULL);
     sinew_allocator a = inst->allocator;
     sw_free(&a, inst);
 }
@@ -601,5 +607,6 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     if (inst->red.h_ref) sw_cubature_rest_hessian(&inst->red, inst->red.h_ref);
     memset(&inst->stats, 0, sizeof inst->stats);
     inst->stats.struct_size = sizeof inst->stats;
+    sw_rec_mark(inst, SW_REC_RESET);
     return SINEW_OK;
 }

@@ -49,6 +49,10 @@ struct sinew_instance {
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
     sinew_profiler profiler;    /* the def's zones (zone_begin NULL: none) */
+    const sinew_blob *blob;     /* the blob the view is of (bone binds, a recording) */
+    sinew_instance_def def;     /* as resolved at creation (a recording's BEGIN) */
+    sinew_recorder *rec;        /* the attached recorder, or NULL (recorder.c) */
+    int touched;                /* posed, placed or stepped since creation */
 };
 
 /* The most task workers an instance reserves scratch for (sinew_task_callbacks). */

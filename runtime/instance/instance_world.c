@@ -4,6 +4,7 @@
 
 #include "collision.h"
 #include "instance_internal.h"
+#include "recording.h"
 #include "log.h"
 
 SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sinew_world *world) {
@@ -20,6 +21,7 @@ SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sine
     inst->red.skin_surface = world != NULL || inst->v->nrender_verts == 0;
     sw_world_contacts_clear(&inst->wc);
     inst->wc.boxes_valid = 0; /* the next step's broad phase starts from every cluster */
+    sw_rec_world(inst);
     return SINEW_OK;
 }
 

@@ -6,7 +6,9 @@
 #include <string.h>
 
 #include "instance.h"
+#include "hash.h"
 #include "instance_internal.h"
+#include "recording.h"
 #include "surface_normals.h"
 
 /* The mean x of copies [b, e) (domain, local vertex pairs, their active indices act) at
@@ -95,6 +97,11 @@ SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sine
     memcpy(out, &inst->stats, n);
     out->struct_size = n;
     return SINEW_OK;
+}
+
+uint64_t sw_instance_surface_hash(const sinew_instance *in) {
+    size_t n = 3 * (size_t)sw_blob_output_verts(in->v) * sizeof(double);
+    return sw_fnv1a(sw_fnv1a(SW_FNV_START, in->surf_x, n), in->surf_n, n);
 }
 
 const double *sw_instance_surface(const sinew_instance *inst) {

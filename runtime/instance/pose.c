@@ -12,6 +12,7 @@
 
 #include "instance.h"
 #include "instance_internal.h"
+#include "recording.h"
 #include "log.h"
 
 /* A scale outside this range is refused: the flesh of a character 10^-6 or 10^6 times
@@ -146,7 +147,12 @@ SINEW_API sinew_result sinew_instance_set_pose(sinew_instance *inst, const float
                                                uint32_t bone_count) {
     if (!inst || !transforms || bone_count != (uint32_t)inst->v->nbones)
         return SINEW_ERROR_INVALID_ARGUMENT;
-    return set_pose(inst, NULL, transforms);
+    sinew_result r = set_pose(inst, NULL, transforms);
+    if (r == SINEW_OK) {
+        inst->touched = 1;
+        sw_rec_pose(inst, transforms);
+    }
+    return r;
 }
 
 SINEW_API sinew_result sinew_instance_set_actor(sinew_instance *inst, const double transform[12]) {
@@ -170,11 +176,15 @@ SINEW_API sinew_result sinew_instance_set_actor(sinew_instance *inst, const doub
         inst->actor[i] = transform[i];
     inst->actor_scale = s;
     compose(inst);
+    inst->touched = 1;
+    sw_rec_actor(inst, transform);
     return SINEW_OK;
 }
 
 SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst) {
     if (!inst) return SINEW_ERROR_INVALID_ARGUMENT;
     inst->pose.declared_jump = 1;
+    inst->touched = 1;
+    sw_rec_mark(inst, SW_REC_TELEPORT);
     return SINEW_OK;
 }

@@ -26,6 +26,7 @@
 #include "cubature.h"
 #include "instance.h"
 #include "instance_internal.h"
+#include "recording.h"
 
 typedef struct sw_step_ctx {
     sinew_instance *in;
@@ -473,8 +474,8 @@ static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
     ZONE(inst, "oracle", phase_oracle(c));
 }
 
-SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
-    if (!inst || !(dt >= 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
+/* The step proper (sinew_instance_step records it when a recorder is attached). */
+static sinew_result step(sinew_instance *inst, float dt) {
     if (dt == 0) { /* a paused frame (an engine's pause passes dt = 0): nothing moves */
         memset(&inst->stats, 0, sizeof inst->stats);
         inst->stats.struct_size = sizeof inst->stats;
@@ -492,6 +493,14 @@ SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
        solution: the next step starts from its own prediction alone */
     if (r != SINEW_OK || (c.st.status & SINEW_STEP_GUARD)) inst->solver.pred_valid = 0;
     inst->stats = c.st;
+    return r;
+}
+
+SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
+    if (!inst || !(dt >= 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
+    sinew_result r = step(inst, dt);
+    inst->touched = 1;
+    sw_rec_step(inst, dt, r);
     return r;
 }
 

@@ -99,6 +99,10 @@ typedef uint32_t (*sw_abi_source_mesh_count_fn)(const sinew_blob *);
 typedef sinew_result (*sw_abi_output_sources_fn)(const sinew_blob *, int32_t *, uint32_t);
 typedef sinew_result (*sw_abi_get_provenance_fn)(const sinew_blob *, sinew_blob_provenance *);
 typedef uint64_t (*sw_abi_hash_bytes_fn)(const void *, size_t);
+typedef sinew_result (*sw_abi_debug_draw_fn)(const sinew_instance *, const sinew_debug_draw *);
+typedef sinew_result (*sw_abi_recorder_open_fn)(const sinew_recorder_def *, sinew_recorder **);
+typedef sinew_result (*sw_abi_recorder_fn)(sinew_recorder *);
+typedef sinew_result (*sw_abi_set_recorder_fn)(sinew_instance *, sinew_recorder *);
 
 static int sw_abi_log_calls;
 
@@ -151,6 +155,19 @@ TEST(functions_have_the_pinned_signatures) {
         ENSURE(mesh_count(NULL) == 0 && sources(NULL, NULL, 0) == SINEW_ERROR_INVALID_ARGUMENT);
         ENSURE(provenance(NULL, &p) == SINEW_ERROR_INVALID_ARGUMENT);
         ENSURE(hash("", 0) == 0xcbf29ce484222325ull); /* FNV-1a 64's offset basis */
+    }
+    {
+        sw_abi_debug_draw_fn draw = &sinew_instance_debug_draw;
+        sw_abi_recorder_open_fn open_rec = &sinew_recorder_open;
+        sw_abi_recorder_fn flush = &sinew_recorder_flush, close_rec = &sinew_recorder_close;
+        sw_abi_set_recorder_fn set_rec = &sinew_instance_set_recorder;
+        sinew_recorder_def rd = sinew_recorder_def_default();
+        sinew_recorder *rec = NULL;
+        ENSURE(draw(NULL, NULL) == SINEW_ERROR_INVALID_ARGUMENT);
+        ENSURE(open_rec(&rd, &rec) == SINEW_ERROR_INVALID_ARGUMENT && rec == NULL); /* no path */
+        ENSURE(flush(NULL) == SINEW_ERROR_INVALID_ARGUMENT && close_rec(NULL) == SINEW_OK);
+        ENSURE(set_rec(NULL, NULL) == SINEW_ERROR_INVALID_ARGUMENT);
+        ENSURE(rd.struct_size == sizeof(sinew_recorder_def));
     }
     /* Calls through the pointers reach the same code as direct calls. */
     ENSURE(version() == sinew_version());

@@ -160,6 +160,49 @@ SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, f
  * not written). */
 SINEW_API sinew_result sinew_instance_get_stats(const sinew_instance *inst, sinew_step_stats *out);
 
+/** Draws the last step's state through `draw`'s callbacks (sinew_debug_draw): with
+ * SINEW_DEBUG_DRAW_CONTACTS each world contact in force (its point on the collider, a
+ * point and a segment along its outward normal, SINEW_DEBUG_COLOR_WORLD_CONTACT: as many
+ * as sinew_step_stats.world_contacts) and each self-contact pair in use (the vertex and
+ * the triangle's normal there, SINEW_DEBUG_COLOR_SELF_CONTACT); _PATCH the condensation
+ * patch's vertices (points) and its tets' faces (triangles); _COLLIDERS each collider of
+ * the attached world as its oriented box (12 lines; a plane as a square around the actor);
+ * _BONES each bone as a line from its parent's joint to its own (a blob without the asset
+ * description: a point per bone). Call it after a step and before the next set_pose or
+ * set_actor, on the instance's owner thread, outside the step. Allocates nothing and takes
+ * no lock; an instance never drawn pays nothing. INVALID_ARGUMENT for NULL. */
+SINEW_API sinew_result sinew_instance_debug_draw(const sinew_instance *inst,
+                                                 const sinew_debug_draw *draw);
+
+/** Opens a recorder on def->path (created or truncated), allocating its buffer through
+ * def->allocator. I/O happens here (the file's preamble), in sinew_recorder_flush and
+ * sinew_recorder_close, in sinew_instance_set_recorder and sinew_instance_set_world (the
+ * instance's configuration, the world's colliders), and in a recorded call whose record no
+ * longer fits the buffer (one write(2) of the buffer: keep it out of the step by flushing
+ * between frames). IO when the file cannot be created. Any thread. */
+SINEW_API sinew_result sinew_recorder_open(const sinew_recorder_def *def, sinew_recorder **out);
+
+/** Writes the buffered records to the file (one checksummed chunk). IO when a write failed
+ * (then or earlier: the first failure is kept and every later call returns it). The owner
+ * thread of the instance it records. */
+SINEW_API sinew_result sinew_recorder_flush(sinew_recorder *rec);
+
+/** Ends the recording (an end record, a flush), closes the file and frees the recorder;
+ * detach it from its instance first (sinew_instance_set_recorder(inst, NULL)) or destroy the
+ * instance. Returns the first I/O error of the recording, if any (NULL: OK). */
+SINEW_API sinew_result sinew_recorder_close(sinew_recorder *rec);
+
+/** Attaches a recorder to an instance (NULL detaches): from now on every call the instance
+ * receives (set_actor, set_pose, mark_teleport, reset, set_world with its colliders, step
+ * with dt, the world's collider transforms at the step and a hash of the output surface
+ * after it) is appended to the recording, with the blob's FNV-1a 64 hash and the instance's
+ * def at its start. Attach right after sinew_instance_create (a world may be attached
+ * before): an instance that has been posed, placed or stepped is refused with
+ * INVALID_ARGUMENT (SINEW_MSG_RECORDER_REFUSED), as is a recorder already attached to
+ * another. A recorded step allocates nothing and takes no lock; it hashes the surface
+ * (O(surface)). Owner thread of the instance; never while it steps. */
+SINEW_API sinew_result sinew_instance_set_recorder(sinew_instance *inst, sinew_recorder *rec);
+
 #ifdef __cplusplus
 }
 #endif

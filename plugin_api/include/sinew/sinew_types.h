@@ -1,6 +1,7 @@
 /* sinew — the types of the public ABI: opaque handles, the def structs with their
- * defaults, the task callbacks, the step's status flags and statistics. The functions
- * are in sinew.h, the collision world's in sinew_world.h.
+ * defaults, the task callbacks, the step's status flags and statistics, the debug-draw
+ * callbacks and the recorder's def. The functions are in sinew.h, the collision world's in
+ * sinew_world.h.
  *
  * Conventions (STYLE.md §1-§5):
  *  - Functions are sinew_<object>_<verb>; types are sinew_<snake_name>; macros SINEW_*.
@@ -378,6 +379,68 @@ typedef struct sinew_step_stats {
     /** wall-clock milliseconds of that detection (inside ms_self_contact) */
     double ms_novel;
 } sinew_step_stats;
+
+/** What sinew_instance_debug_draw draws (sinew_debug_draw.flags). */
+#define SINEW_DEBUG_DRAW_CONTACTS 1u  /**< world contacts and self-contact pairs */
+#define SINEW_DEBUG_DRAW_PATCH 2u     /**< the condensation patch's vertices and tets */
+#define SINEW_DEBUG_DRAW_COLLIDERS 4u /**< the attached world's colliders (oriented boxes) */
+#define SINEW_DEBUG_DRAW_BONES 8u     /**< the pose's bones (parent joint to joint) */
+
+/** The colours sinew_instance_debug_draw uses, packed 0xRRGGBBAA, one per kind of item
+ * (a host may tell the kinds apart by them). */
+#define SINEW_DEBUG_COLOR_WORLD_CONTACT 0xff4020ffu /**< a world contact and its normal */
+#define SINEW_DEBUG_COLOR_SELF_CONTACT 0x20c0ffffu  /**< a self-contact pair and its normal */
+#define SINEW_DEBUG_COLOR_PATCH 0xffd000ffu         /**< a patch vertex, a patch tet's face */
+#define SINEW_DEBUG_COLOR_COLLIDER 0x80ff80ffu      /**< a collider's box */
+#define SINEW_DEBUG_COLOR_BONE 0xffffffffu          /**< a bone */
+
+/** Debug-draw callbacks in the manner of Box2D's b2DebugDraw: a zero-initialised struct
+ * of function pointers with a context pointer, and flags saying what to draw. Positions
+ * are floats in the actor's frame, as sinew_instance_read_surface gives the surface (draw
+ * them with the actor's matrix); colours are packed 0xRRGGBBAA (SINEW_DEBUG_COLOR_*). A
+ * NULL callback skips its items. The callbacks must not call into the instance. */
+typedef struct sinew_debug_draw {
+    /** a segment from p0 to p1 (a contact's normal, a box edge, a bone) */
+    void (*draw_line)(const float p0[3], const float p1[3], uint32_t rgba, void *context);
+    /** a point of `size` in the surface's units (a contact point, a patch vertex) */
+    void (*draw_point)(const float p[3], float size, uint32_t rgba, void *context);
+    /** a triangle (a patch tet's face) */
+    void (*draw_triangle)(const float p0[3], const float p1[3], const float p2[3], uint32_t rgba,
+                          void *context);
+    uint32_t flags; /**< SINEW_DEBUG_DRAW_* bits; 0 draws nothing */
+    /** length of a contact's normal segment, in the surface's units; 0 means 2% of the
+     * character's rest bounding-box diagonal */
+    float normal_length;
+    void *context; /**< handed to every callback */
+} sinew_debug_draw;
+
+/** A recorder: writes every call an instance receives to a file a host can send with a
+ * bug report, for sinew-replay to play back bitwise (opaque; sinew_recorder_open). */
+typedef struct sinew_recorder sinew_recorder;
+
+/** How to open a recorder. */
+typedef struct sinew_recorder_def {
+    uint32_t struct_size;      /**< sizeof(sinew_recorder_def), set by the default */
+    uint32_t buffer_bytes;     /**< the in-memory buffer; 0 means 1 MiB, at least 64 KiB */
+    const char *path;          /**< the file to create (truncated when it exists) */
+    sinew_allocator allocator; /**< memory hooks; zero means the C library */
+    sinew_logger logger;       /**< log hook; zero means the default (stderr) */
+} sinew_recorder_def;
+
+/** A sinew_recorder_def with every field at its default. */
+static inline sinew_recorder_def sinew_recorder_def_default(void) {
+    sinew_recorder_def d;
+    d.struct_size = (uint32_t)sizeof(sinew_recorder_def);
+    d.buffer_bytes = 0;
+    d.path = NULL;
+    d.allocator = sinew_allocator_default();
+    d.logger = sinew_logger_default();
+    return d;
+}
+
+/** Stable log message ids of the recorder (sinew_logger). */
+#define SINEW_MSG_RECORDER_IO 0x0500u      /**< error: the file could not be written */
+#define SINEW_MSG_RECORDER_REFUSED 0x0501u /**< error: attached too late, or twice */
 
 #ifdef __cplusplus
 }

@@ -1,0 +1,324 @@
+/* The recorder and its replay (sinew_recorder, sinew-replay): a 1,000-frame dynamic
+ * session of the finger on a table with a ball poking along it, a reset of the actor's
+ * place, a declared teleport and a paused frame replays bitwise, step by step; recorded
+ * steps allocate and lock nothing; a recording with one record left out replays but
+ * differs from that step on; a damaged, cut or foreign recording is refused with a
+ * message saying what is wrong. */
+#include <stdio.h>
+#include <stdlib.h>
+#include <string.h>
+
+#include "clock.h"
+#include "hash.h"
+#include "recording.h"
+#include "rt_interpose.h"
+#include "sw_test.h"
+#include "world_fixture.h"
+
+#define FRAMES 1000
+#define TELEPORT_AT 600
+
+static char g_path[512];
+static uint64_t g_hash[FRAMES]; /* the surface hash the session saw after each step */
+
+static void session_pose(const bake_fixture *f, int s, float *pose) {
+    /* a jump of the clip at the teleport: frames from the other end */
+    bake_fixture_pose(f, s < TELEPORT_AT ? s : s + f->ch.clip.nframes / 2, pose);
+}
+
+/* What a run of the session saw. */
+typedef struct session {
+    uint64_t hash[FRAMES]; /* the surface hash after each step */
+    sw_rt_counts counts;   /* allocations and locks inside the steps */
+    uint64_t contacts;     /* world contacts, summed over the steps */
+    uint32_t teleports;    /* steps flagged SINEW_STEP_TELEPORT */
+    double step_seconds;   /* wall clock inside sinew_instance_step */
+} session;
+
+/* Runs the session, recorded into g_path when `record` is set; 1 on success. */
+static int run_session(moving_scene *m, int record, session *out) {
+    const bake_fixture *f = m->f;
+    uint32_t nb = (uint32_t)f->ch.skel.nbones;
+    sinew_instance_def d = sinew_instance_def_default();
+    d.mode = SINEW_STEP_DYNAMIC;
+    sinew_instance *inst;
+    if (sinew_instance_create(f->blob, &d, &inst) != SINEW_OK) return 0;
+    if (sinew_instance_set_world(inst, m->w) != SINEW_OK) return 0;
+    sinew_recorder_def rd = sinew_recorder_def_default();
+    rd.path = g_path;
+    rd.buffer_bytes = 1u << 16; /* small: the session fills it many times */
+    sinew_recorder *rec = NULL;
+    if (record && sinew_recorder_open(&rd, &rec) != SINEW_OK) return 0;
+    if (record && sinew_instance_set_recorder(inst, rec) != SINEW_OK) return 0;
+    float *pose = malloc(sizeof(float) * 12 * nb);
+    double actor[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    memset(out, 0, sizeof *out);
+    int ok = 1;
+    for (int s = 0; s < FRAMES && ok; ++s) {
+        sinew_transform t;
+        ball_at(s, &t);
+        sinew_world_set_collider_transform(m->w, m->ball, &t);
+        actor[10] = s < 300 ? 0.0 : 0.01; /* the actor lifts a little at frame 300 */
+        if (s == 0 || s == 300) ok &= sinew_instance_set_actor(inst, actor) == SINEW_OK;
+        if (s == TELEPORT_AT) ok &= sinew_instance_mark_teleport(inst) == SINEW_OK;
+        session_pose(f, s, pose);
+        ok &= sinew_instance_set_pose(inst, pose, nb) == SINEW_OK;
+        float dt = s == 700 ? 0.0f : (s % 3 ? 1.0f / 60 : 1.0f / 50); /* a pause, uneven dt */
+        double t0 = sw_now_seconds();
+        sw_rt_count_begin();
+        sinew_instance_step(inst, dt);
+        sw_rt_counts c = sw_rt_count_end();
+        out->step_seconds += sw_now_seconds() - t0;
+        out->counts.allocs += c.allocs;
+        out->counts.frees += c.frees;
+        out->counts.locks += c.locks;
+        out->hash[s] = sw_instance_surface_hash(inst);
+        sinew_step_stats st;
+        st.struct_size = sizeof st;
+        sinew_instance_get_stats(inst, &st);
+        out->contacts += st.world_contacts;
+        out->teleports += (st.status & SINEW_STEP_TELEPORT) != 0;
+        if (rec && s % 100 == 99) ok &= sinew_recorder_flush(rec) == SINEW_OK;
+    }
+    ok &= sinew_instance_set_recorder(inst, NULL) == SINEW_OK;
+    if (rec) ok &= sinew_recorder_close(rec) == SINEW_OK;
+    free(pose);
+    sinew_instance_destroy(inst);
+    return ok;
+}
+
+static unsigned char *read_all(size_t *n) {
+    return (unsigned char *)sw_test_read_file(g_path, n);
+}
+
+/* A recording of the records `stream` (size n) in one chunk, as the recorder writes them. */
+static unsigned char *rechunk(const unsigned char *stream, size_t n, size_t *out_n) {
+    unsigned char *d = malloc(SW_REC_PREAMBLE_BYTES + SW_REC_CHUNK_BYTES + n);
+    static const unsigned char pre[8] = {'S', 'I', 'N', 'E', 'W', 'R', 'E', 'C'};
+    uint32_t u[4] = {SW_REC_VERSION, 0x01020304u, SW_REC_CHUNK_TAG, (uint32_t)n};
+    uint64_t h = sw_fnv1a(SW_FNV_START, stream, n);
+    memcpy(d, pre, 8);
+    memcpy(d + 8, u, 16);
+    memcpy(d + 24, &h, 8);
+    memcpy(d + 32, stream, n);
+    *out_n = 32 + n;
+    return d;
+}
+
+TEST(a_session_with_pokes_and_a_teleport_replays_bitwise) {
+    moving_scene m;
+    ENSURE(moving_scene_make(&m));
+    snprintf(g_path, sizeof g_path, "%s/tests/test_record_replay.rec", SINEW_BINARY_DIR);
+    static session plain, recorded; /* (big: off the stack) */
+    ENSURE(run_session(&m, 0, &plain));
+    double t0 = sw_now_seconds();
+    ENSURE(run_session(&m, 1, &recorded));
+    double t_rec = sw_now_seconds() - t0;
+    fprintf(stderr,
+            "    the session: %.1f world contacts a step, %u teleports flagged; steps %.3f s "
+            "unrecorded, %.3f s recorded\n",
+            recorded.contacts / (double)FRAMES, recorded.teleports, plain.step_seconds,
+            recorded.step_seconds);
+    ENSURE(recorded.contacts > FRAMES && recorded.teleports >= 1); /* it poked, and jumped */
+    /* recording changes nothing the host sees */
+    ENSURE(memcmp(plain.hash, recorded.hash, sizeof plain.hash) == 0);
+    memcpy(g_hash, recorded.hash, sizeof g_hash);
+    unsigned active = sw_rt_interpose_active();
+    const sw_rt_counts *c = &recorded.counts;
+    if (active & SW_RT_CAT_ALLOCS)
+        ENSUREF(c->allocs == 0 && c->frees == 0, "allocs %llu", (unsigned long long)c->allocs);
+    if (active & SW_RT_CAT_LOCKS) ENSURE(c->locks == 0);
+    size_t n;
+    unsigned char *data = read_all(&n);
+    ENSURE(data);
+    sw_recording rec;
+    sw_error err;
+    ENSUREF(sw_recording_parse(data, n, &rec, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(rec.steps == FRAMES);
+    sw_replay_report rep;
+    t0 = sw_now_seconds();
+    ENSUREF(sw_recording_replay(m.f->blob, &rec, NULL, NULL, &rep) == SINEW_OK, "%s", rep.msg);
+    double t_rep = sw_now_seconds() - t0;
+    fprintf(stderr,
+            "    %u steps recorded in %.2f s (%zu bytes), replayed in %.2f s: %u differ "
+            "(first %lld)\n",
+            rec.steps, t_rec, n, t_rep, rep.differing, (long long)rep.first_diff);
+    ENSURE(rep.steps == FRAMES && rep.differing == 0 && rep.first_diff == -1);
+    /* the recorded hashes are the session's own */
+    size_t pos = 0;
+    sw_rec_record r;
+    int s = 0, same = 1;
+    while (sw_recording_next(&rec, &pos, &r))
+        if (r.type == SW_REC_STEP) same &= sw_rec_u64(r.p + 16) == g_hash[s++];
+    ENSURE(same && s == FRAMES);
+    /* for sinew-replay's tests (tests/CMakeLists.txt): the blob beside the recording, and a
+       copy of the recording with one bit flipped */
+    char path[600];
+    snprintf(path, sizeof path, "%s/tests/test_record_replay.blob", SINEW_BINARY_DIR);
+    FILE *fp = fopen(path, "wb");
+    ENSURE(fp && fwrite(m.f->data, 1, m.f->size, fp) == m.f->size && fclose(fp) == 0);
+    snprintf(path, sizeof path, "%s/tests/test_record_replay.tampered.rec", SINEW_BINARY_DIR);
+    data[n / 2] ^= 0x10;
+    fp = fopen(path, "wb");
+    ENSURE(fp && fwrite(data, 1, n, fp) == n && fclose(fp) == 0);
+    sw_recording_free(&rec);
+    free(data);
+    sinew_world_destroy(m.w);
+}
+
+/* The replay must notice a record that went missing: without the pose set before step
+ * DROP_AT, that step and the ones after it differ. */
+#define DROP_AT 400
+TEST(a_recording_without_one_pose_differs_from_there) {
+    size_t n;
+    unsigned char *data = read_all(&n);
+    ENSURE(data);
+    sw_recording rec;
+    sw_error err;
+    ENSURE(sw_recording_parse(data, n, &rec, &err) == SINEW_OK);
+    unsigned char *cut = malloc(rec.size);
+    size_t pos = 0, at = 0, m = 0;
+    sw_rec_record r;
+    int steps = 0, dropped = 0;
+    while (at = pos, sw_recording_next(&rec, &pos, &r)) {
+        if (r.type == SW_REC_POSE && steps == DROP_AT && !dropped) {
+            dropped = 1;
+            continue;
+        }
+        steps += r.type == SW_REC_STEP;
+        memcpy(cut + m, rec.stream + at, pos - at);
+        m += pos - at;
+    }
+    ENSURE(dropped);
+    size_t n2;
+    unsigned char *d2 = rechunk(cut, m, &n2);
+    sw_recording rec2;
+    ENSUREF(sw_recording_parse(d2, n2, &rec2, &err) == SINEW_OK, "%s", err.msg);
+    sw_replay_report rep;
+    ENSURE(sw_recording_replay(fixture()->blob, &rec2, NULL, NULL, &rep) == SINEW_OK);
+    fprintf(stderr, "    without the pose of step %d: %u steps differ, the first %lld\n", DROP_AT,
+            rep.differing, (long long)rep.first_diff);
+    ENSURE(rep.differing > 0 && rep.first_diff == DROP_AT);
+    sw_recording_free(&rec2);
+    sw_recording_free(&rec);
+    free(d2);
+    free(cut);
+    free(data);
+}
+
+static int parse_says(const unsigned char *d, size_t n, const char *what) {
+    sw_recording rec;
+    sw_error err;
+    sinew_result r = sw_recording_parse(d, n, &rec, &err);
+    fprintf(stderr, "    %s\n", err.msg);
+    return r != SINEW_OK && err.code == r && strstr(err.msg, what) != NULL;
+}
+
+TEST(damaged_recordings_are_refused_clearly) {
+    size_t n;
+    unsigned char *data = read_all(&n);
+    ENSURE(data);
+    unsigned char *d = malloc(n);
+    memcpy(d, data, n);
+    d[n / 2] ^= 0x10; /* one bit in some chunk */
+    ENSURE(parse_says(d, n, "checksum mismatch"));
+    ENSURE(parse_says(data, n - 5, "truncated"));
+    ENSURE(parse_says(data, 7, "not a sinew recording"));
+    memcpy(d, data, n);
+    d[8] = 99; /* the format version */
+    ENSURE(parse_says(d, n, "format version 99"));
+    /* a recording cut at a chunk boundary has no END */
+    size_t first = SW_REC_PREAMBLE_BYTES + SW_REC_CHUNK_BYTES + sw_rec_u32(data + 20);
+    ENSURE(parse_says(data, first, "no END record"));
+    /* against another blob */
+    sw_recording rec;
+    sw_error err;
+    ENSURE(sw_recording_parse(data, n, &rec, &err) == SINEW_OK);
+    bake_fixture other;
+    ENSURE(bake_fixture_make(&other, "finger", 1500, 12, 0));
+    sw_replay_report rep;
+    ENSURE(sw_recording_replay(other.blob, &rec, NULL, NULL, &rep) != SINEW_OK);
+    fprintf(stderr, "    %s\n", rep.msg);
+    ENSURE(strstr(rep.msg, "another blob") != NULL);
+    bake_fixture_free(&other);
+    sw_recording_free(&rec);
+    free(d);
+    free(data);
+}
+
+TEST(a_recorder_attaches_only_to_a_fresh_instance) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    ENSURE(sinew_instance_step(inst, 1.0f / 60) == SINEW_OK);
+    char path[600];
+    snprintf(path, sizeof path, "%s.late", g_path);
+    sinew_recorder_def rd = sinew_recorder_def_default();
+    rd.path = path;
+    rd.logger = sinew_logger_silent();
+    sinew_recorder *rec;
+    ENSURE(sinew_recorder_open(&rd, &rec) == SINEW_OK);
+    ENSURE(sinew_instance_set_recorder(inst, rec) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sinew_recorder_close(rec) == SINEW_OK);
+    rd.path = "/nonexistent-dir/x.rec";
+    ENSURE(sinew_recorder_open(&rd, &rec) == SINEW_ERROR_IO);
+    sinew_instance_destroy(inst);
+    remove(path);
+}
+
+/* The fuzzer's seed (SINEW_WRITE_SEEDS=1 rewrites it): three steps of the finger against
+ * the table and the ball, a pose and a teleport. */
+TEST(a_short_recording_is_the_fuzzers_seed) {
+    moving_scene m;
+    ENSURE(moving_scene_make(&m));
+    const bake_fixture *f = m.f;
+    uint32_t nb = (uint32_t)f->ch.skel.nbones;
+    char path[600];
+    snprintf(path, sizeof path, "%s.short", g_path);
+    sinew_instance *inst;
+    ENSURE(sinew_instance_create(f->blob, NULL, &inst) == SINEW_OK);
+    ENSURE(sinew_instance_set_world(inst, m.w) == SINEW_OK);
+    sinew_recorder_def rd = sinew_recorder_def_default();
+    rd.path = path;
+    sinew_recorder *rec;
+    ENSURE(sinew_recorder_open(&rd, &rec) == SINEW_OK);
+    ENSURE(sinew_instance_set_recorder(inst, rec) == SINEW_OK);
+    float pose[12 * 8];
+    ENSURE(nb <= 8);
+    for (int s = 0; s < 3; ++s) {
+        bake_fixture_pose(f, 4 * s, pose);
+        ENSURE(sinew_instance_set_pose(inst, pose, nb) == SINEW_OK);
+        if (s == 2) ENSURE(sinew_instance_mark_teleport(inst) == SINEW_OK);
+        ENSURE(sinew_instance_step(inst, 1.0f / 60) == SINEW_OK);
+    }
+    sinew_instance_destroy(inst); /* (detaches the recorder) */
+    ENSURE(sinew_recorder_close(rec) == SINEW_OK);
+    size_t n;
+    unsigned char *d = (unsigned char *)sw_test_read_file(path, &n);
+    ENSURE(d && n < 4096);
+    sw_recording r;
+    sw_error err;
+    ENSUREF(sw_recording_parse(d, n, &r, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(r.steps == 3);
+    sw_replay_report rep;
+    ENSURE(sw_recording_replay(f->blob, &r, NULL, NULL, &rep) == SINEW_OK && rep.differing == 0);
+    sw_recording_free(&r);
+    if (getenv("SINEW_WRITE_SEEDS")) {
+        FILE *fp = fopen(SINEW_SOURCE_DIR "/tests/fuzz/corpus/recording/short.rec", "wb");
+        ENSURE(fp && fwrite(d, 1, n, fp) == n && fclose(fp) == 0);
+    }
+    free(d);
+    remove(path);
+    sinew_world_destroy(m.w);
+}
+
+TEST(release_fixture) {
+    if (fx_ok > 0) bake_fixture_free(&fx);
+}
+
+SW_TEST_MAIN(CASE(a_session_with_pokes_and_a_teleport_replays_bitwise),
+             CASE(a_recording_without_one_pose_differs_from_there),
+             CASE(damaged_recordings_are_refused_clearly),
+             CASE(a_recorder_attaches_only_to_a_fresh_instance),
+             CASE(a_short_recording_is_the_fuzzers_seed), CASE(release_fixture))
