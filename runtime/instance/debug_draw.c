@@ -58,9 +58,7 @@ static void draw_contacts(const dd_ctx *c) {
             contact(c, x, n, SINEW_DEBUG_COLOR_SELF_CONTACT);
         }
     }
-    int detected =
-        in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE || (in->ps.novel_mask && in->sc.npairs > 0);
-    if (detected) {
+    if (sw_instance_detects(in)) {
         sw_pair_set set = sw_self_contacts_pairs(&in->sc);
         for (int32_t p = 0; p < in->sc.npairs; ++p) {
             sw_contact_pair_point(&in->red, &set, p, in->solver.q, x, n);

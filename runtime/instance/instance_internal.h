@@ -92,4 +92,11 @@ void sw_render_positions(const sw_blob_view *v, const double *node_x, double *x)
 void sw_render_normals(const sw_blob_view *v, const int32_t *weld_tris, const double *x, double *n);
 void sw_render_weld_tris(const sw_blob_view *v, int32_t *weld_tris);
 
+/* The detection's pairs (in->sc) are in use: the exhaustive mode, the pose-pairs mode's
+ * fallback on novel contact, or the novel self-contact beside the pose-space pairs. */
+static inline int sw_instance_detects(const sinew_instance *in) {
+    return in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE ||
+           ((in->ps.novel_mask || in->novel_on) && in->sc.npairs > 0);
+}
+
 #endif

@@ -75,15 +75,9 @@ static int exhaustive(const sinew_instance *in) {
     return in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE;
 }
 
-/* The detection's pairs are in use: the exhaustive mode, the pose-pairs mode's fallback
- * on novel contact, or the novel self-contact beside the pose-space pairs. */
-static int detected(const sinew_instance *in) {
-    return exhaustive(in) || ((in->ps.novel_mask || in->novel_on) && in->sc.npairs > 0);
-}
-
 sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) {
-    sw_step_contacts ct = {&in->ps, in->wc.world ? &in->wc : NULL, detected(in) ? &in->sc : NULL,
-                           self_seconds};
+    sw_step_contacts ct = {&in->ps, in->wc.world ? &in->wc : NULL,
+                           sw_instance_detects(in) ? &in->sc : NULL, self_seconds};
     return ct;
 }
 
@@ -261,7 +255,7 @@ static void phase_oracle(sw_step_ctx *c) {
     if (cd->z.max_verts == 0) return;
     if (c->st.status & SINEW_STEP_TELEPORT) sw_cond_forget(cd);
     sw_world_contacts *wc = in->wc.world ? &in->wc : NULL;
-    sw_self_contacts *sc = detected(in) ? &in->sc : NULL;
+    sw_self_contacts *sc = sw_instance_detects(in) ? &in->sc : NULL;
     if (!wc && !in->novel_on) { /* nothing seeds a patch */
         cd->nf = cd->np = 0;
         in->ps.in_patch = NULL;
