@@ -193,8 +193,15 @@ typedef struct sw_blob_view {
     const int32_t *output_source;
 } sw_blob_view;
 
+/* The simulation vertex of surface copy i (a (domain, local vertex) pair). */
+static inline int32_t sw_blob_surf_copy_vertex(const sw_blob_view *v, int32_t i) {
+    const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
+    return v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
+}
+
 /* The output surface a host reads (sinew_instance_read_surface): the render mesh when the
  * blob has one, else the tet mesh's boundary. */
+
 static inline int32_t sw_blob_output_verts(const sw_blob_view *v) {
     return v->nrender_verts > 0 ? v->nrender_verts : v->nsurf_verts;
 }

@@ -16,17 +16,11 @@ static int32_t max_valence(const sw_blob_view *v) {
     return m;
 }
 
-/* The global vertex of surface copy i. */
-static int32_t copy_vertex(const sw_blob_view *v, int32_t i) {
-    const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
-    return v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
-}
-
 void sw_novel_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, sw_novel *nv) {
     memset(nv, 0, sizeof *nv);
     uint64_t layers = 0, nv3 = (uint64_t)v->nverts;
     for (int32_t i = 0; i < v->nsurf_copies; ++i) {
-        int32_t gv = copy_vertex(v, i);
+        int32_t gv = sw_blob_surf_copy_vertex(v, i);
         layers += (uint64_t)(v->vert_tet_ptr[gv + 1] - v->vert_tet_ptr[gv]);
     }
     nv->max_layer = SW_WORLD_CLUSTER * max_valence(v);
@@ -43,14 +37,8 @@ void sw_novel_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, sw_novel 
     TAKE(nv->best, nv3);
     TAKE(nv->best_i, nv3);
     TAKE(nv->hits, (uint64_t)SW_NOVEL_MAX_CONTACTS);
-    uint64_t seams = 0; /* pairs of copies of one boundary vertex */
-    for (int32_t sv = 0; sv < v->nsurf_verts; ++sv) {
-        uint64_t k = (uint64_t)(v->surf_copy_ptr[sv + 1] - v->surf_copy_ptr[sv]);
-        seams += k * (k - 1);
-    }
-    TAKE(nv->seam_ptr, (uint64_t)ncl + 1);
-    TAKE(nv->seam, seams);
-    TAKE(nv->copy_cl, (uint64_t)v->nsurf_copies);
+    TAKE(nv->cl_rest, 6 * (uint64_t)ncl);
+    TAKE(nv->cl_grow, (uint64_t)ncl);
 #undef TAKE
 }
 
@@ -86,38 +74,20 @@ static int box_holds(const double b[6], const double x[3]) {
            x[2] <= b[5];
 }
 
-/* Whether cluster b is listed among a's seam neighbours. */
-static int on_seam(const sw_novel *nv, int32_t a, int32_t b) {
-    for (int32_t k = nv->seam_ptr[a]; k < nv->seam_ptr[a + 1]; ++k)
-        if (nv->seam[k] == b) return 1;
-    return 0;
-}
-
-/* Each cluster's seam neighbours: the clusters holding another copy of one of its
- * boundary vertices (the interface between two domains, where a joint bends). */
-static void seam_neighbours(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts *wc) {
-    for (int32_t c = 0; c < wc->ncl; ++c)
+/* Each cluster's rest box grown by the reach of the reference's neighbour rule (the
+ * longest rest edge of the boundary times its factor): two clusters whose grown boxes
+ * meet are one stretch of skin across a joint. */
+static void rest_boxes(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts *wc,
+                       const sw_self_contacts *sc) {
+    double edge = 0;
+    for (int32_t t = 0; t < sc->m.ntris; ++t)
+        edge = fmax(edge, sc->m.tri_edge[t]);
+    for (int32_t c = 0; c < wc->ncl; ++c) {
+        double *b = nv->cl_rest + 6 * c;
+        box_empty(b);
         for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
-            nv->copy_cl[wc->cl_copy[i]] = c;
-    int32_t n = 0;
-    for (int32_t a = 0; a < wc->ncl; ++a) {
-        nv->seam_ptr[a] = nv->seam_ptr[a + 1] = n; /* on_seam reads the list so far */
-        for (int32_t i = wc->cl_begin[a]; i < wc->cl_begin[a + 1]; ++i) {
-            int32_t ci = wc->cl_copy[i], lo = 0, hi = v->nsurf_verts - 1;
-            while (lo < hi) { /* its boundary vertex: the last sv with ptr[sv] <= ci */
-                int32_t mid = lo + (hi - lo + 1) / 2;
-                if (v->surf_copy_ptr[mid] <= ci)
-                    lo = mid;
-                else
-                    hi = mid - 1;
-            }
-            for (int32_t j = v->surf_copy_ptr[lo]; j < v->surf_copy_ptr[lo + 1]; ++j) {
-                int32_t b = nv->copy_cl[j];
-                if (b == a || on_seam(nv, a, b)) continue;
-                nv->seam[n++] = b;
-                nv->seam_ptr[a + 1] = n;
-            }
-        }
+            box_add(b, v->rest + 3 * (int64_t)sw_blob_surf_copy_vertex(v, wc->cl_copy[i]));
+        box_grow(b, 0.5 * SW_SELF_NEIGHBOUR_FACTOR * edge);
     }
 }
 
@@ -131,7 +101,7 @@ void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts
         nv->layer_ptr[c] = n;
         ++mark; /* each tet listed once a layer (the re-test's tet stamps, free here) */
         for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i) {
-            int32_t gv = copy_vertex(v, wc->cl_copy[i]);
+            int32_t gv = sw_blob_surf_copy_vertex(v, wc->cl_copy[i]);
             for (int32_t e = v->vert_tet_ptr[gv]; e < v->vert_tet_ptr[gv + 1]; ++e) {
                 int32_t t = v->vert_tets[e];
                 if (sc->tstamp[t] == mark) continue;
@@ -141,7 +111,7 @@ void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts
         }
     }
     memset(sc->tstamp, 0, (size_t)v->ntets * sizeof *sc->tstamp);
-    seam_neighbours(nv, v, wc);
+    rest_boxes(nv, v, wc, sc);
     nv->layer_ptr[wc->ncl] = n;
     memset(nv->best, 0, (size_t)v->nverts * sizeof *nv->best);
     memset(nv->held, 0, (size_t)v->nverts * sizeof *nv->held);
@@ -171,12 +141,13 @@ static void cluster_boxes(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts 
     for (int32_t c = 0; c < nv->ncl; ++c) {
         double *b = nv->cl_now + 6 * c;
         if (use_boxes) {
-            sw_world_cluster_box(wc, v, c, b);
+            nv->cl_grow[c] = sw_world_cluster_box(wc, v, c, b);
             continue;
         }
+        nv->cl_grow[c] = -1; /* no last output: the copies are mapped */
         box_empty(b);
         for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
-            box_add(b, sw_self_contacts_map(sc, q, copy_vertex(v, wc->cl_copy[i])));
+            box_add(b, sw_self_contacts_map(sc, q, sw_blob_surf_copy_vertex(v, wc->cl_copy[i])));
         box_grow(b, wc->radius);
     }
     /* insertion sort by the low x: the order of the last step is almost this one's */
@@ -215,9 +186,20 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
     const double *bb = nv->cl_now + 6 * b;
     int32_t lb = nv->layer_ptr[b], ln = nv->layer_ptr[b + 1] - lb;
     const double *boxes = nv->layer_box + 6 * (int64_t)lb;
+    const double g = nv->cl_grow[a], *D0 = wc->bone_motion + 13 * wc->cl_bone0[a];
     for (int32_t i = wc->cl_begin[a]; i < wc->cl_begin[a + 1]; ++i) {
-        int32_t gv = copy_vertex(v, wc->cl_copy[i]);
+        int32_t gv = sw_blob_surf_copy_vertex(v, wc->cl_copy[i]);
         if (nv->held[gv] == nv->stamp) continue;
+        if (g >= 0) { /* where its last output and the bones' motion put it, before mapping */
+            const double *xl = wc->copy_x + 3 * (int64_t)wc->cl_copy[i];
+            int out = 0;
+            for (int r = 0; r < 3 && !out; ++r) {
+                double y =
+                    D0[9 + r] + D0[3 * r] * xl[0] + D0[3 * r + 1] * xl[1] + D0[3 * r + 2] * xl[2];
+                out = y < bb[r] - g || y > bb[3 + r] + g;
+            }
+            if (out) continue;
+        }
         const double *x = sw_self_contacts_map(sc, q, gv);
         if (!box_holds(bb, x)) continue;
         if (nv->cl_boxed[b] != nv->stamp) { /* the layer's tet boxes, once a step */
@@ -244,7 +226,7 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
 
 int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *wc,
                         const sw_reduced *red, const double *q, const sw_pose_space *ps,
-                        const double *T, const double *T_last, int seams) {
+                        const double *T, const double *T_last, int near) {
     const sw_blob_view *v = red->v;
     sw_self_contacts_clear(sc);
     sw_self_contacts_begin(sc, red);
@@ -262,7 +244,7 @@ int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *w
             const double *bj = nv->cl_now + 6 * j;
             if (bj[0] > bi[3]) break; /* sorted by the low x: none after meets i */
             if (nv->cl_dom[i] == nv->cl_dom[j] || !box_meets(bi, bj) ||
-                (!seams && on_seam(nv, i, j)))
+                (!near && box_meets(nv->cl_rest + 6 * i, nv->cl_rest + 6 * j)))
                 continue;
             nv->cluster_pairs++;
             narrow(nv, sc, wc, red, q, i, j);

@@ -6,10 +6,11 @@
  *  - broad: the output surface's clusters (world_contact.h, median splits of each
  *    domain's surface copies) with their boxes from the last step's output grown by the
  *    bones' motion since; a sweep along x over those boxes gives the pairs of clusters of
- *    different domains that overlap. Clusters on the two sides of a domain interface
- *    (holding copies of one vertex) always do; the skin folding there is the joint's own,
- *    which the training held as far as it bent the joint, so such pairs are tested only
- *    while a joint bends beyond the training (where the reference's neighbour rule, per
+ *    different domains that overlap. Clusters that are neighbours in the rest pose (their
+ *    rest boxes within the reach of the reference's neighbour rule: one stretch of skin
+ *    across a joint) overlap whenever the joint bends; the skin folding there is the
+ *    joint's own, which the training held as far as it bent the joint, so such pairs are
+ *    tested only while a joint bends beyond the training (where the neighbour rule, per
  *    vertex, tells the skin folding from a contact).
  *  - narrow: each copy of one cluster inside the other's box, at the step's start state,
  *    is tested with the reference's rule (self_detect.h) against the tets of the other
@@ -35,6 +36,7 @@ typedef struct sw_novel {
     int32_t ncl;         /* the surface clusters (those of wc) */
     int32_t *cl_dom;     /* ncl: each cluster's domain */
     double *cl_now;      /* 6 ncl: this step's broad-phase boxes */
+    double *cl_grow;     /* ncl: their growth past the carried last output (-1: mapped) */
     int32_t *order;      /* ncl: the clusters sorted by their box's low x (kept between
                             steps, so the insertion sort sees an order almost sorted) */
     int32_t *layer_ptr;  /* ncl + 1 */
@@ -42,9 +44,7 @@ typedef struct sw_novel {
     int32_t max_layer;   /* the largest layer */
     double *layer_box;   /* 6 per layer tet: its box this step (when cl_boxed says so) */
     int32_t *cl_boxed;   /* ncl: the stamp of the step its layer's boxes were taken */
-    int32_t *seam_ptr;   /* ncl + 1 */
-    int32_t *seam;       /* each cluster's seam neighbours (another copy of a vertex) */
-    int32_t *copy_cl;    /* nsurf_copies: each surface copy's cluster */
+    double *cl_rest;     /* 6 ncl: its rest box grown by half the neighbour rule's reach */
     int32_t *cand;       /* max_layer: one vertex's candidate tets (scratch) */
     int32_t *held;       /* nverts: stamp of the vertices a pose-space pair in use holds */
     int32_t *best;       /* nverts: stamp of the vertex's contact in hits */
@@ -60,7 +60,7 @@ typedef struct sw_novel {
 /* Lays out the arrays for blob v (its tet mesh) in p; ncl the clusters' bound. */
 void sw_novel_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, sw_novel *nv);
 
-/* Creation: the clusters' domains, layers and seam neighbours (wc built, sc built; sc's tet
+/* Creation: the clusters' domains, layers and rest boxes (wc built, sc built; sc's tet
  * stamps are borrowed and left cleared). */
 void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts *wc,
                     sw_self_contacts *sc);
@@ -69,10 +69,10 @@ void sw_novel_build(sw_novel *nv, const sw_blob_view *v, const sw_world_contacts
  * boxes of the last output (wc->cl_box) grown by the bones' motion since (T_last: the
  * last output's pose, NULL when there is none: every box is taken at q), and makes them
  * sc's pairs in use (weight and tangential share 1). ps: the pose-space pairs in use;
- * seams: test the seam neighbours too (a joint bends beyond the training). Returns how
+ * near: test the rest neighbours too (a joint bends beyond the training). Returns how
  * many. */
 int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *wc,
                         const sw_reduced *red, const double *q, const sw_pose_space *ps,
-                        const double *T, const double *T_last, int seams);
+                        const double *T, const double *T_last, int near);
 
 #endif

@@ -15,8 +15,7 @@ int32_t sw_world_cluster_bound(const sw_blob_view *v) {
 
 /* The rest position of surface copy i. */
 static const double *copy_rest(const sw_blob_view *v, int32_t i) {
-    const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
-    return v->rest + 3 * (int64_t)v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]];
+    return v->rest + 3 * (int64_t)sw_blob_surf_copy_vertex(v, i);
 }
 
 /* Orders idx[0, n) so that idx[k] is the k-th by (coordinate ax of its rest position,
@@ -105,6 +104,24 @@ static void copy_areas(sw_world_contacts *wc, const sw_blob_view *v) {
     }
 }
 
+/* The bone with the most skinning weight over cluster c's copies (its first, on a tie). */
+static int32_t dominant_bone(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c) {
+    int32_t best = 0;
+    double most = -1;
+    for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
+        for (int k = 0; k < SW_BLOB_INFLUENCES; ++k) {
+            int32_t bone = v->skin_bone[4 * sw_blob_surf_copy_vertex(v, wc->cl_copy[i]) + k];
+            double sum = 0;
+            for (int32_t j = wc->cl_begin[c]; j < wc->cl_begin[c + 1]; ++j)
+                for (int m = 0; m < SW_BLOB_INFLUENCES; ++m) {
+                    int32_t gv = sw_blob_surf_copy_vertex(v, wc->cl_copy[j]);
+                    if (v->skin_bone[4 * gv + m] == bone) sum += v->skin_weight[4 * gv + m];
+                }
+            if (sum > most) most = sum, best = bone;
+        }
+    return best;
+}
+
 void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
     int32_t n = 0;
     wc->ncl = 0;
@@ -144,6 +161,7 @@ void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
                 }
         }
         wc->cl_bones[c] = v->nbones > 64 ? ~0ull : mask;
+        wc->cl_bone0[c] = dominant_bone(wc, v, c);
     }
     copy_areas(wc, v);
     for (int32_t i = 0; i < v->nsurf_copies; ++i)
@@ -191,17 +209,6 @@ void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const doubl
         }
         D[12] = sqrt(fmax(0.0, 3 - (D[0] + D[4] + D[8])));
     }
-}
-
-/* How far a point of the box (centre c, half-diagonal rho) moves under bone motion D:
- * |D(c) - c| + ||dR - I|| rho. */
-static double box_motion(const double *D, const double c[3], double rho) {
-    double m2 = 0;
-    for (int r = 0; r < 3; ++r) {
-        double y = D[9 + r] + D[3 * r] * c[0] + D[3 * r + 1] * c[1] + D[3 * r + 2] * c[2] - c[r];
-        m2 += y * y;
-    }
-    return sqrt(m2) + D[12] * rho;
 }
 
 static int boxes_overlap(const double a[6], const double b[6]) {
@@ -271,27 +278,54 @@ static int collider_box(const sw_world_contacts *wc, uint32_t s, double box[6]) 
     return 1;
 }
 
-/* The broad-phase box of cluster c: its box at the last output grown by the motion of
- * the bones that skin it since (T_last -> T) and the detection radius. */
-void sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
-                          double box[6]) {
-    const double *b = wc->cl_box + 6 * c;
-    double ctr[3], rho = 0, grow = 0;
+/* How far a point of the box (centre c, half-diagonal rho) moved by bone motion B lands
+ * from where motion A takes it: |B(c) - A(c)| + ||R_B - R_A||_2 rho, the norm
+ * sqrt(3 - tr(R_B R_A^T)) (2 sin of half the angle between them). */
+static double motion_apart(const double *A, const double *B, const double c[3], double rho) {
+    double d2 = 0, tr = 0;
+    for (int r = 0; r < 3; ++r) {
+        double y = B[9 + r] - A[9 + r];
+        for (int k = 0; k < 3; ++k) {
+            y += (B[3 * r + k] - A[3 * r + k]) * c[k];
+            tr += B[3 * r + k] * A[3 * r + k];
+        }
+        d2 += y * y;
+    }
+    return sqrt(d2) + sqrt(fmax(0.0, 3 - tr)) * rho;
+}
+
+/* The broad-phase box of cluster c: its box at the last output carried by the motion of
+ * its dominant bone since (T_last -> T), grown by how far the other bones that skin it
+ * move its points apart from that, and by the detection radius. Carried, not grown by
+ * the whole motion: a character running or turning moves every box far in a step, while
+ * its bones move little relative to each other. */
+double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                            double box[6]) {
+    const double *b = wc->cl_box + 6 * c, *D0 = wc->bone_motion + 13 * wc->cl_bone0[c];
+    double ctr[3], half[3], rho = 0, grow = 0;
     for (int k = 0; k < 3; ++k) {
         ctr[k] = 0.5 * (b[k] + b[3 + k]);
-        rho += 0.25 * (b[3 + k] - b[k]) * (b[3 + k] - b[k]);
+        half[k] = 0.5 * (b[3 + k] - b[k]);
+        rho += half[k] * half[k];
     }
     rho = sqrt(rho);
     for (int32_t bone = 0; bone < v->nbones; ++bone)
         if (wc->cl_bones[c] >> (bone < 64 ? bone : 63) & 1)
-            grow = sw_max(grow, box_motion(wc->bone_motion + 13 * bone, ctr, rho));
-    /* a dual-quaternion blend of bone motions moves a point no further than about the
-     * largest of them; 1.25 x leaves room for the blend and the correction's change */
+            grow = sw_max(grow, motion_apart(D0, wc->bone_motion + 13 * bone, ctr, rho));
+    /* a dual-quaternion blend of bone motions lands a point about no further from the
+     * dominant bone's than the furthest of them; 1.25 x leaves room for the blend and the
+     * correction's change */
     grow = 1.25 * grow + wc->radius;
-    for (int k = 0; k < 3; ++k) {
-        box[k] = b[k] - grow;
-        box[3 + k] = b[3 + k] + grow;
+    for (int r = 0; r < 3; ++r) { /* the box of the carried box */
+        double cr = D0[9 + r], hr = 0;
+        for (int k = 0; k < 3; ++k) {
+            cr += D0[3 * r + k] * ctr[k];
+            hr += fabs(D0[3 * r + k]) * half[k];
+        }
+        box[r] = cr - hr - grow;
+        box[3 + r] = cr + hr + grow;
     }
+    return grow;
 }
 
 /* Narrow phase of cluster c at q against every collider whose box meets `box` (NULL:

@@ -6,9 +6,9 @@
  * Detection is two-phase and its cost follows the copies near colliders, not the mesh:
  *  - broad: the surface copies are grouped at creation into clusters of at most
  *    SW_WORLD_CLUSTER copies (median splits of each domain's copies in rest space). Each
- *    cluster's box is taken from the last step's output and grown by how far the bones
- *    that skin it moved since (their rigid motion applied to the box), plus the
- *    detection radius; only clusters whose grown box meets a collider's box go on.
+ *    cluster's box is taken from the last step's output, carried by its dominant bone's
+ *    motion since and grown by how far the other bones that skin it move apart from it,
+ *    plus the detection radius; only clusters whose grown box meets a collider's box go on.
  *  - narrow: each copy of those clusters, at the step's start state, is queried against
  *    each collider whose box holds it (collision.h); a copy within the detection radius
  *    becomes a candidate with its frozen law (world_penalty.h).
@@ -46,6 +46,7 @@ typedef struct sw_world_contacts {
     int32_t *cl_begin;        /* ncl + 1: cluster c holds cl_copy[cl_begin[c] .. cl_begin[c+1]) */
     int32_t *cl_copy;         /* nsurf_copies, in cluster order */
     uint64_t *cl_bones;       /* ncl: bits of the bones skinning the cluster (all when > 64) */
+    int32_t *cl_bone0;        /* ncl: the bone with the most of the cluster's skinning weight */
     double *cl_box;           /* 6 per cluster: its copies' box at the last output */
     double *copy_area;        /* nsurf_copies: rest area per copy */
     int32_t *copy_first;      /* nsurf_copies: the copy's first candidate, or -1 */
@@ -114,12 +115,13 @@ void sw_world_contacts_finish(sw_world_contacts *wc, sw_reduced *red, const doub
 
 /* The broad phase's pieces, shared with the novel self-contact's (novel_contact.h): each
  * bone's rigid motion from the pose T0 (the last output's) to T, into wc->bone_motion;
- * cluster c's box at the last output grown by the motion of the bones that skin it and
- * by the detection radius. */
+ * cluster c's box at the last output carried by its dominant bone's motion and grown by
+ * the other bones' and the detection radius; returns that growth (a copy of c lies
+ * within it of where the dominant bone's motion carries its last output position). */
 void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const double *T,
                               const double *T0);
-void sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
-                          double box[6]);
+double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                            double box[6]);
 
 /* Takes the cluster boxes from the copies' output positions wc->copy_x. */
 void sw_world_contacts_update_boxes(sw_world_contacts *wc);

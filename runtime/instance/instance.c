@@ -113,6 +113,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(wc->cl_begin, ncl + 1);
     TAKE(wc->cl_copy, nc);
     TAKE(wc->cl_bones, ncl);
+    TAKE(wc->cl_bone0, ncl);
     TAKE(wc->cl_box, 6 * ncl);
     TAKE(wc->cl_pass, ncl);
     TAKE(wc->copy_area, nc);
@@ -549,6 +550,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
         }
     }
     in->novel_on = z.novel;
+    /* the novel detection's broad phase reads the boundary's boxes of the last output */
+    if (z.novel) in->red.skin_surface = 1;
     if (z.novel) sw_novel_build(&in->novel, v, &in->wc, &in->sc);
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
