@@ -12,6 +12,12 @@ static const char *usage =
     "  --asset FILE        the glTF/FBX file it was baked from (assimp imports it)\n"
     "  --scene NAME        a procedural sample it was baked from (finger, cylinder, capsule)\n"
     "  --clip NAME         the clip to play (default: the file's first)\n"
+    "  --fade-to NAME      cross-fade into this clip (local transforms blended, slerp)\n"
+    "  --fade-at S         when the fade starts, seconds (default 1); --fade-time S: its length "
+    "(0.5)\n"
+    "  --root-motion BONE  take BONE's ground motion and heading out of the clip into the actor\n"
+    "  --walk U            the actor walks U asset units a second along its +z (0)\n"
+    "  --turn DEG          and turns DEG degrees a second (0); the camera follows\n"
     "  --instances N       characters (default 1), --threads T: stepped on T threads\n"
     "  --world FILE        a world file (samples/worlds/): its colliders, moving on their keys\n"
     "  --view V            sinew, skin or both (default both)\n"
@@ -56,6 +62,7 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
     vw_options *o = &app->opt;
     o->instances = o->threads = 1, o->width = 960, o->height = 540, o->view = VW_VIEW_BOTH;
     o->step_hz = o->render_hz = 60, o->colour = 1, o->colour_scale = 0.03;
+    o->fade_at = 1, o->fade_time = 0.5;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1, used = 1;
@@ -70,6 +77,18 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
             o->scene = v;
         else if (!strcmp(a, "--clip"))
             o->clip = v;
+        else if (!strcmp(a, "--fade-to"))
+            o->fade_to = v;
+        else if (!strcmp(a, "--root-motion"))
+            o->root_bone = v;
+        else if (!strcmp(a, "--fade-at"))
+            ok = arg_double(a, v, 0, 1e6, &o->fade_at);
+        else if (!strcmp(a, "--fade-time"))
+            ok = arg_double(a, v, 0, 1e6, &o->fade_time);
+        else if (!strcmp(a, "--walk"))
+            ok = arg_double(a, v, -1e6, 1e6, &o->walk);
+        else if (!strcmp(a, "--turn"))
+            ok = arg_double(a, v, -3600, 3600, &o->turn_deg);
         else if (!strcmp(a, "--world"))
             o->world = v;
         else if (!strcmp(a, "--screenshot"))
@@ -196,16 +215,43 @@ static int load_script(vw_app *app, char *err, size_t errlen) {
     return ok;
 }
 
-static int pick_clip(vw_app *app, char *err, size_t errlen) {
-    const vw_asset *a = &app->asset;
-    if (a->nclips == 0) return snprintf(err, errlen, "%s has no clip to play", app->opt.asset), 0;
-    if (!app->opt.clip) return 1;
+static int find_clip(const vw_asset *a, const char *name, int *clip, char *err, size_t errlen) {
     for (int k = 0; k < a->nclips; ++k)
-        if (!strcmp(a->clip_names[k], app->opt.clip)) return app->clip = k, 1;
-    int n = snprintf(err, errlen, "no clip '%s'; the file has:", app->opt.clip);
+        if (!strcmp(a->clip_names[k], name)) return *clip = k, 1;
+    int n = snprintf(err, errlen, "no clip '%s'; the file has:", name);
     for (int k = 0; k < a->nclips && n > 0 && (size_t)n < errlen; ++k)
         n += snprintf(err + n, errlen - (size_t)n, " %s", a->clip_names[k]);
     return 0;
+}
+
+/* What the characters play: the clip, the fade, root motion and the actor's walk. */
+static int pick_motion(vw_app *app, char *err, size_t errlen) {
+    const vw_asset *a = &app->asset;
+    const vw_options *o = &app->opt;
+    vw_motion *m = &app->motion;
+    *m = (vw_motion){.fade_clip = -1,
+                     .root_bone = -1,
+                     .fade_at = o->fade_at,
+                     .fade_time = o->fade_time,
+                     .walk = o->walk,
+                     .turn = o->turn_deg * 3.14159265358979323846 / 180};
+    if (a->nclips == 0) return snprintf(err, errlen, "%s has no clip to play", o->asset), 0;
+    if (o->clip && !find_clip(a, o->clip, &m->clip, err, errlen)) return 0;
+    if (o->fade_to && !a->sample)
+        return snprintf(err, errlen, "--fade-to: a procedural scene has one clip"), 0;
+    if (o->fade_to && !find_clip(a, o->fade_to, &m->fade_clip, err, errlen)) return 0;
+    if (o->root_bone) {
+        double bind[12];
+        m->root_bone = sinew_blob_find_bone(app->blob, o->root_bone);
+        if (m->root_bone < 0)
+            return snprintf(err, errlen, "--root-motion: the blob has no bone '%s'", o->root_bone),
+                   0;
+        if (sinew_blob_bone_bind(app->blob, (uint32_t)m->root_bone, bind) != SINEW_OK)
+            return snprintf(err, errlen, "--root-motion: the blob has no bind pose"), 0;
+        for (int k = 0; k < 3; ++k)
+            m->root_bind[k] = bind[9 + k];
+    }
+    return 1;
 }
 
 /* The blob's rest surface against the asset's: equal counts are not the same character. */
@@ -263,23 +309,12 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
         free(rest);
         if (!ok) return 0;
     } else {
-        if (!vw_asset_import(o->asset, &app->asset, err, errlen)) return 0;
-        /* Without bone names in the blob, counts are all a host can check: equal counts
-         * with a different skeleton would play, wrongly. */
-        if ((uint32_t)app->asset.nbones != nb)
-            return snprintf(err, errlen,
-                            "%s has %d bones, the blob %u: not the file it was baked from",
-                            o->asset, app->asset.nbones, nb),
-                   0;
-        if ((uint32_t)app->asset.nverts != nv)
-            return snprintf(err, errlen,
-                            "%s has %d render vertices, the blob's surface %u: not the file it was "
-                            "baked from (or the blob has no embedded render mesh)",
-                            o->asset, app->asset.nverts, nv),
-                   0;
-        if (!pick_clip(app, err, errlen)) return 0;
+        /* bones by name and vertices by the output map (asset.c): a file that is not
+         * the blob's is refused naming what it lacks */
+        if (!vw_asset_import(o->asset, app->blob, &app->asset, err, errlen)) return 0;
         if (!check_rest(app, nv, err, errlen)) return 0;
     }
+    if (!pick_motion(app, err, errlen)) return 0;
     if (o->script && !load_script(app, err, errlen)) return 0;
     const vw_asset *a = &app->asset;
     for (int c = 0; c < 3; ++c)
@@ -293,7 +328,7 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
         d2 += (app->rest_hi[c] - app->rest_lo[c]) * (app->rest_hi[c] - app->rest_lo[c]);
     app->size = sqrtf(d2) > 0 ? sqrtf(d2) : 1;
     if (o->world && !vw_world_load(o->world, &app->world, err, errlen)) return 0;
-    if (!vw_sim_create(&app->sim, app->blob, a, app->clip, o->instances, o->threads, o->dynamic,
+    if (!vw_sim_create(&app->sim, app->blob, a, &app->motion, o->instances, o->threads, o->dynamic,
                        app->world.world, app->world.rest_pose, err, errlen))
         return 0;
     if (app->world.world) vw_world_move(&app->world, 0);
@@ -327,7 +362,7 @@ void vw_app_key(vw_app *app, char key) {
         app->reinit = 1;
         break;
     case 't': /* a cut: half the clip ahead, declared so no inertia is taken from the jump */
-        app->sim_t += 0.5 * app->asset.clip_duration[app->clip];
+        app->sim_t += 0.5 * app->asset.clip_duration[app->motion.clip];
         vw_sim_teleport(&app->sim);
         break;
     case '1':

@@ -14,8 +14,9 @@ enum { VW_VIEW_SINEW = 1, VW_VIEW_SKIN = 2, VW_VIEW_BOTH = 3 };
 
 typedef struct vw_options {
     const char *blob, *asset, *scene, *clip, *world, *screenshot, *record, *script;
+    const char *fade_to, *root_bone;
     int instances, threads, frames, width, height, json, view, dqs, dynamic, colour;
-    double step_hz, render_hz, colour_scale;
+    double step_hz, render_hz, colour_scale, fade_at, fade_time, walk, turn_deg;
 } vw_options;
 
 typedef struct vw_event {
@@ -38,7 +39,7 @@ typedef struct vw_app {
     int32_t ntris;
     float size; /* the rest surface's bounding-box diagonal */
     float rest_lo[3], rest_hi[3];
-    int clip;
+    vw_motion motion;
     /* controls */
     int paused, single, slow, reinit, view, teleport_pending;
     double step_dt, acc, sim_t;

@@ -151,9 +151,16 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
     const char *view = app->view == VW_VIEW_SINEW  ? "SINEW"
                        : app->view == VW_VIEW_SKIN ? "SKIN"
                                                    : "SKIN | SINEW";
-    snprintf(lines[0], 160, "FRAME %.1f MS  STEP %.2f MS (%d)  RENDER %.1f MS  %d X %s", frame_ms,
-             step_ms, app->steps_this_frame, app->last_render_ms, app->sim.n,
-             app->asset.clip_names[app->clip]);
+    const vw_motion *m = &app->sim.motion;
+    char clip[64];
+    if (m->fade_clip >= 0 && app->sim_t >= m->fade_at)
+        snprintf(clip, sizeof clip, "%.24s > %.24s %.0f%%", app->asset.clip_names[m->clip],
+                 app->asset.clip_names[m->fade_clip],
+                 100 * (m->fade_time > 0 ? fmin(1, (app->sim_t - m->fade_at) / m->fade_time) : 1));
+    else
+        snprintf(clip, sizeof clip, "%.60s", app->asset.clip_names[m->clip]);
+    snprintf(lines[0], 160, "FRAME %.1f MS  STEP %.2f MS (%d)  RENDER %.1f MS  %d X %.60s",
+             frame_ms, step_ms, app->steps_this_frame, app->last_render_ms, app->sim.n, clip);
     snprintf(lines[1], 160,
              "SKIN %.2f CONTACT %.2f DYN %.2f SOLVE %.2f OUTPUT %.2f WORLD %.2f MS  NEWTON %u  "
              "WORLD CONTACTS %u PATCH %u",

@@ -62,7 +62,7 @@ else
     set +e
     "${run[@]}" "$view" --blob "$tmp/f.blob" --asset "$fox" --frames 1 2>"$tmp/err"; rc=$?
     set -e
-    refused "$rc" "bones, the blob" "an asset that is not the blob's"
+    refused "$rc" "is no node of the file" "an asset that is not the blob's (its bones by name)"
 fi
 
 printf '0.5 s\n0.6 s\n' >"$tmp/script" # slow motion on and off again: the script is read
