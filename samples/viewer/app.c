@@ -13,27 +13,34 @@ static const char *usage =
     "  --scene NAME        a procedural sample it was baked from (finger, cylinder, capsule)\n"
     "  --clip NAME         the clip to play (default: the file's first)\n"
     "  --fade-to NAME      cross-fade into this clip (local transforms blended, slerp)\n"
-    "  --fade-at S         when the fade starts, seconds (default 1); --fade-time S: its length "
-    "(0.5)\n"
+    "  --fade-at S         when the fade starts, seconds of the clock (default 1)\n"
+    "  --fade-time S       how long it takes (0.5)\n"
     "  --root-motion BONE  take BONE's ground motion and heading out of the clip into the actor\n"
     "  --walk U            the actor walks U asset units a second along its +z (0)\n"
     "  --turn DEG          and turns DEG degrees a second (0); the camera follows\n"
-    "  --instances N       characters (default 1), --threads T: stepped on T threads\n"
+    "  --instances N       characters (default 1)\n"
+    "  --threads T         stepped on T threads (default 1)\n"
     "  --world FILE        a world file (samples/worlds/): its colliders, moving on their keys\n"
     "  --view V            sinew, skin or both (default both)\n"
     "  --dqs               dual-quaternion plain skinning (default linear blend)\n"
     "  --dynamic           dynamic steps (default quasistatic)\n"
     "  --no-colour         no colouring by correction magnitude\n"
     "  --colour-scale F    correction drawn full red, as a fraction of the size (0.03)\n"
-    "  --step-hz H         simulation steps a second (60); --render-hz H: --frames clock (60)\n"
-    "  --width W --height H  window size (960 x 540)\n"
+    "  --step-hz H         simulation steps a second (60)\n"
+    "  --render-hz H       frames a second of the --frames clock (60)\n"
+    "  --width W           window width (960)\n"
+    "  --height H          window height (540)\n"
     "  --frames N          render N frames, then exit (the clock advances 1/render-hz a frame)\n"
     "  --screenshot OUT    write the last frame to OUT.png (with --frames)\n"
     "  --record OUT        pipe every frame to ffmpeg, writing OUT (.mp4)\n"
-    "  --script FILE       timed keys, one a line: SECONDS KEY (space, period or a key's letter)\n"
-    "  --json              print frames, steps, mean step and render ms and fps at exit\n"
+    "  --script FILE       timed events, one a line: SECONDS KEY (space, period or a key's\n"
+    "                      letter), SECONDS press|move X Y (X, Y fractions of the window: a\n"
+    "                      press picks a world collider, a move drags it), SECONDS release\n"
+    "  --json              print frames, steps, mean step and render ms, fps and the first\n"
+    "                      character's world contacts (most in a step, first time) at exit\n"
     "keys: space pause, . single step, s slow motion, d dynamic/quasistatic, t teleport,\n"
-    "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion, q quit\n";
+    "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion, q quit;\n"
+    "      left drag: a world collider\n";
 
 static int arg_int(const char *flag, const char *v, int lo, int hi, int *out) {
     char *end;
@@ -63,6 +70,7 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
     o->instances = o->threads = 1, o->width = 960, o->height = 540, o->view = VW_VIEW_BOTH;
     o->step_hz = o->render_hz = 60, o->colour = 1, o->colour_scale = 0.03;
     o->fade_at = 1, o->fade_time = 0.5;
+    app->poke.col = -1, app->poke.first_press_s = app->first_contact_s = -1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1, used = 1;
@@ -131,7 +139,7 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
             else if (!strcmp(a, "--no-colour"))
                 o->colour = 0;
             else {
-                fprintf(stderr, "sinew-view: unknown argument '%s'\n%s", a, usage);
+                fprintf(stderr, "sinew-view: unknown or incomplete argument '%s'\n%s", a, usage);
                 return 2;
             }
         }
@@ -180,6 +188,21 @@ static int blob_rest_surface(const sinew_blob *blob, float *pos, uint32_t nv) {
     return ok;
 }
 
+/* A script line after its time: a key's name, or a mouse event. */
+static int parse_event(const char *line, const char *word, vw_event *ev) {
+    float x, y;
+    if (!strcmp(word, "press") || !strcmp(word, "move")) {
+        if (sscanf(line, "%*f %*s %f %f", &x, &y) != 2 || !(x >= 0 && x <= 1 && y >= 0 && y <= 1))
+            return 0;
+        ev->kind = word[0] == 'p' ? VW_EV_PRESS : VW_EV_MOVE, ev->x = x, ev->y = y;
+        return 1;
+    }
+    if (!strcmp(word, "release")) return ev->kind = VW_EV_RELEASE, 1;
+    ev->key = !strcmp(word, "space") ? ' ' : !strcmp(word, "period") ? '.' : 0;
+    if (!ev->key && strlen(word) == 1 && strchr(" .sdt123clq", word[0])) ev->key = word[0];
+    return ev->key != 0;
+}
+
 static int load_script(vw_app *app, char *err, size_t errlen) {
     FILE *f = fopen(app->opt.script, "r");
     if (!f) return snprintf(err, errlen, "%s: cannot open", app->opt.script), 0;
@@ -194,10 +217,12 @@ static int load_script(vw_app *app, char *err, size_t errlen) {
             ok = 0, snprintf(err, errlen, "%s:%d: expected SECONDS KEY", app->opt.script, n);
             break;
         }
-        char k = !strcmp(key, "space") ? ' ' : !strcmp(key, "period") ? '.' : 0;
-        if (!k && strlen(key) == 1 && strchr(" .sdt123clq", key[0])) k = key[0];
-        if (!k) {
-            ok = 0, snprintf(err, errlen, "%s:%d: unknown key '%s'", app->opt.script, n, key);
+        vw_event ev = {t, VW_EV_KEY, 0, 0, 0};
+        if (!parse_event(s, key, &ev)) {
+            ok = 0, snprintf(err, errlen,
+                             "%s:%d: expected SECONDS KEY, SECONDS press|move X Y (fractions of "
+                             "the window) or SECONDS release; got '%s'",
+                             app->opt.script, n, key);
             break;
         }
         if (app->nevents == cap) {
@@ -209,7 +234,7 @@ static int load_script(vw_app *app, char *err, size_t errlen) {
             }
             app->events = e;
         }
-        app->events[app->nevents++] = (vw_event){t, k};
+        app->events[app->nevents++] = ev;
     }
     fclose(f);
     return ok;
@@ -389,19 +414,26 @@ void vw_app_key(vw_app *app, char key) {
 }
 
 void vw_app_script(vw_app *app, double clock) {
-    while (app->next_event < app->nevents && app->events[app->next_event].t <= clock + 1e-9)
-        vw_app_key(app, app->events[app->next_event++].key);
+    while (app->next_event < app->nevents && app->events[app->next_event].t <= clock + 1e-9) {
+        const vw_event *e = &app->events[app->next_event++];
+        if (e->kind == VW_EV_KEY) vw_app_key(app, e->key);
+        if (e->kind == VW_EV_PRESS) vw_poke_press(app, e->x, e->y);
+        if (e->kind == VW_EV_MOVE) vw_poke_move(app, e->x, e->y);
+        if (e->kind == VW_EV_RELEASE) vw_poke_release(app);
+    }
 }
 
 void vw_app_print_json(const vw_app *app) {
     double fps = app->wall_s > 0 ? (double)app->frames / app->wall_s : 0;
     printf("{\"frames\": %lld, \"steps\": %lld, \"instances\": %d, \"threads\": %d, "
            "\"mean_step_ms\": %.3f, \"mean_render_ms\": %.3f, \"mean_frame_ms\": %.3f, "
-           "\"fps\": %.1f}\n",
+           "\"fps\": %.1f, \"world_contacts_max\": %u, \"first_contact_s\": %.3f, "
+           "\"first_press_s\": %.3f}\n",
            (long long)app->frames, (long long)app->steps, app->sim.n, app->sim.threads,
            app->step_frames ? app->step_ms_sum / (double)app->step_frames : 0,
            app->frames ? app->render_ms_sum / (double)app->frames : 0,
-           app->frames ? 1000 * app->wall_s / (double)app->frames : 0, fps);
+           app->frames ? 1000 * app->wall_s / (double)app->frames : 0, fps, app->contacts_max,
+           app->first_contact_s, app->poke.first_press_s);
 }
 
 void vw_app_free(vw_app *app) {

@@ -19,10 +19,24 @@ typedef struct vw_options {
     double step_hz, render_hz, colour_scale, fade_at, fade_time, walk, turn_deg;
 } vw_options;
 
+/* A scripted event: a key, or the mouse (x, y: fractions of the window, top left 0). */
+enum { VW_EV_KEY, VW_EV_PRESS, VW_EV_MOVE, VW_EV_RELEASE };
 typedef struct vw_event {
     double t;
+    int kind;
     char key;
+    float x, y;
 } vw_event;
+
+/* The camera as last drawn, and the collider being dragged. */
+typedef struct vw_poke {
+    int valid; /* a frame was drawn: the camera is known */
+    float eye[3], at[3], fovy, aspect;
+    float off[3];            /* the first character's (and its world's) drawn offset */
+    int col;                 /* the dragged collider, or -1 */
+    float plane[3], grab[3]; /* the drag plane's point (facing the camera); grab offset */
+    double first_press_s;    /* simulation time of the first press, or -1 */
+} vw_poke;
 
 typedef struct vw_app {
     vw_options opt;
@@ -45,6 +59,9 @@ typedef struct vw_app {
     double step_dt, acc, sim_t;
     vw_event *events;
     int nevents, next_event;
+    vw_poke poke;
+    uint32_t contacts_max;  /* the first character's world contacts: the most in a step */
+    double first_contact_s; /* and the simulation time of the first, or -1 */
     /* figures */
     int steps_this_frame;
     int64_t steps, frames, step_frames;
@@ -61,6 +78,11 @@ int vw_app_gl_setup(vw_app *app, char *err, size_t errlen);
 int vw_app_reinit(vw_app *app);
 void vw_app_key(vw_app *app, char key);
 void vw_app_script(vw_app *app, double clock);
+/* Mouse: a press picks the collider nearest the ray under (x, y) (fractions of the
+ * window), a move drags it in the plane through it facing the camera (poke.c). */
+void vw_poke_press(vw_app *app, float x, float y);
+void vw_poke_move(vw_app *app, float x, float y);
+void vw_poke_release(vw_app *app);
 void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms);
 int vw_app_capture(vw_app *app, int w, int h, int last_frame);
 void vw_app_print_json(const vw_app *app);

@@ -143,6 +143,10 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
     for (int k = 0; k < 3; ++k)
         eye[k] = at[k] + dir[k] / dl * dist;
     view_projection(eye, at, fovy, aspect, 0.01f * dist, 4 * dist, vp);
+    vw_poke *p = &app->poke; /* what a mouse press is cast from */
+    memcpy(p->eye, eye, sizeof eye), memcpy(p->at, at, sizeof at);
+    p->fovy = fovy, p->aspect = aspect, p->valid = 1;
+    layout(app, 0, app->view == VW_VIEW_SKIN, p->off);
 }
 
 /* The HUD's lines: frame and step times, the first character's phases and flags. */
