@@ -448,6 +448,7 @@ void vw_app_free(vw_app *app) {
     vw_asset_free(&app->asset);
     sinew_blob_destroy(app->blob);
     free(app->tris), free(app->events), free(app->hud), free(app->pixels);
+    free(app->lines.pos), free(app->lines.col);
     if (app->ffmpeg && pclose(app->ffmpeg) != 0)
         fprintf(stderr, "sinew-view: ffmpeg failed writing %s\n", app->opt.record);
     memset(app, 0, sizeof *app);

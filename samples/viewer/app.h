@@ -28,6 +28,14 @@ typedef struct vw_event {
     float x, y;
 } vw_event;
 
+/* Lines to draw this frame, in world space (the first character's frame), colours packed
+ * 0xRRGGBB as debug-draw callbacks hand them over: a debug-draw hook's lines and points
+ * go here. */
+typedef struct vw_lines {
+    float *pos, *col; /* 3 a vertex, 2 vertices a segment */
+    int32_t n, cap;
+} vw_lines;
+
 /* The camera as last drawn, and the collider being dragged. */
 typedef struct vw_poke {
     int valid; /* a frame was drawn: the camera is known */
@@ -60,6 +68,7 @@ typedef struct vw_app {
     vw_event *events;
     int nevents, next_event;
     vw_poke poke;
+    vw_lines lines;
     uint32_t contacts_max;  /* the first character's world contacts: the most in a step */
     double first_contact_s; /* and the simulation time of the first, or -1 */
     /* figures */
@@ -84,6 +93,9 @@ void vw_poke_press(vw_app *app, float x, float y);
 void vw_poke_move(vw_app *app, float x, float y);
 void vw_poke_release(vw_app *app);
 void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms);
+/* A segment or a point (a cross of three segments `size` across) drawn with this frame. */
+void vw_draw_line(vw_app *app, const float a[3], const float b[3], uint32_t rgb);
+void vw_draw_point(vw_app *app, const float p[3], float size, uint32_t rgb);
 int vw_app_capture(vw_app *app, int w, int h, int last_frame);
 void vw_app_print_json(const vw_app *app);
 void vw_app_free(vw_app *app);

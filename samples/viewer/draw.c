@@ -203,6 +203,42 @@ static void draw_hud(vw_app *app, int fb_w, int fb_h, double frame_ms, double st
     glfwSetWindowTitle(app->window, title);
 }
 
+void vw_draw_line(vw_app *app, const float a[3], const float b[3], uint32_t rgb) {
+    vw_lines *l = &app->lines;
+    if (l->n + 2 > l->cap) {
+        int32_t cap = l->cap ? 2 * l->cap : 256;
+        float *p = realloc(l->pos, sizeof(float) * 3 * (size_t)cap);
+        if (p) l->pos = p;
+        float *c = p ? realloc(l->col, sizeof(float) * 3 * (size_t)cap) : NULL;
+        if (!c) return; /* (a frame without its lines, not a failure) */
+        l->col = c, l->cap = cap;
+    }
+    const float c[3] = {(float)((rgb >> 16) & 255) / 255, (float)((rgb >> 8) & 255) / 255,
+                        (float)(rgb & 255) / 255};
+    memcpy(l->pos + 3 * l->n, a, 3 * sizeof(float)), memcpy(l->col + 3 * l->n, c, sizeof c);
+    memcpy(l->pos + 3 * l->n + 3, b, 3 * sizeof(float)), memcpy(l->col + 3 * l->n + 3, c, sizeof c);
+    l->n += 2;
+}
+
+void vw_draw_point(vw_app *app, const float p[3], float size, uint32_t rgb) {
+    for (int k = 0; k < 3; ++k) {
+        float a[3] = {p[0], p[1], p[2]}, b[3] = {p[0], p[1], p[2]};
+        a[k] -= 0.5f * size, b[k] += 0.5f * size;
+        vw_draw_line(app, a, b, rgb);
+    }
+}
+
+/* A held collider: where its keys would have it, and a line to where it is held. */
+static void held_colliders(vw_app *app) {
+    for (int k = 0; k < app->world.ncol; ++k) {
+        const vw_collider *c = &app->world.col[k];
+        if (!c->held) continue;
+        const float *from = c->nkeys ? c->keys[0].position : c->def.transform.position;
+        vw_draw_point(app, from, 0.05f * app->size, 0xffc040);
+        vw_draw_line(app, from, c->now.position, 0xffc040);
+    }
+}
+
 void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms) {
     int need_skin = app->view != VW_VIEW_SINEW || app->opt.colour;
     if (need_skin) vw_sim_skin(&app->sim, app->opt.dqs);
@@ -224,15 +260,27 @@ void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_m
             vw_gl_draw(&app->mesh_skin[i], vp, off);
         }
     }
-    for (int k = 0; k < app->world.ncol && app->view != VW_VIEW_SKIN; ++k) {
+    for (int k = 0; k < app->world.ncol; ++k) {
         vw_collider *col = &app->world.col[k];
         vw_normals(col->pos, col->nverts, col->tris, col->ntris, NULL, col->nrm);
         vw_glmesh_update(&app->mesh_col[k], col->pos, col->nrm, app->col_collider);
-        for (int32_t i = 0; i < app->sim.n; ++i) { /* every character has the world's copy */
-            float off[3];
-            layout(app, i, 0, off);
-            vw_gl_draw(&app->mesh_col[k], vp, off);
-        }
+        /* every character has the world's copy; the plain skinning's too, which it passes
+         * through */
+        for (int32_t i = 0; i < app->sim.n; ++i)
+            for (int skin = 0; skin < 2; ++skin) {
+                if ((skin && app->view == VW_VIEW_SINEW) || (!skin && app->view == VW_VIEW_SKIN))
+                    continue;
+                float off[3];
+                layout(app, i, skin, off);
+                vw_gl_draw(&app->mesh_col[k], vp, off);
+            }
+    }
+    held_colliders(app);
+    if (app->lines.n) {
+        float off[3];
+        layout(app, 0, app->view == VW_VIEW_SKIN, off);
+        vw_gl_lines(app->lines.pos, app->lines.col, app->lines.n, vp, off);
+        app->lines.n = 0;
     }
     draw_hud(app, fb_w, fb_h, frame_ms, step_ms);
 }
