@@ -36,8 +36,9 @@ static const char *usage =
     "  --script FILE       timed events, one a line: SECONDS KEY (space, period or a key's\n"
     "                      letter), SECONDS press|move X Y (X, Y fractions of the window: a\n"
     "                      press picks a world collider, a move drags it), SECONDS release\n"
-    "  --json              print frames, steps, mean step and render ms, fps and the first\n"
-    "                      character's world contacts (most in a step, first time) at exit\n"
+    "  --json              print frames, steps, mean step and render ms, fps, the first\n"
+    "                      character's world contacts (most in a step, first time) and where\n"
+    "                      its actor stands (x, z, heading in degrees) at exit\n"
     "keys: space pause, . single step, s slow motion, d dynamic/quasistatic, t teleport,\n"
     "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion, q quit;\n"
     "      left drag: a world collider\n";
@@ -424,16 +425,18 @@ void vw_app_script(vw_app *app, double clock) {
 }
 
 void vw_app_print_json(const vw_app *app) {
+    const vw_planar *a = &app->sim.ch[0].actor; /* the first actor: x, z, heading in degrees */
     double fps = app->wall_s > 0 ? (double)app->frames / app->wall_s : 0;
     printf("{\"frames\": %lld, \"steps\": %lld, \"instances\": %d, \"threads\": %d, "
            "\"mean_step_ms\": %.3f, \"mean_render_ms\": %.3f, \"mean_frame_ms\": %.3f, "
            "\"fps\": %.1f, \"world_contacts_max\": %u, \"first_contact_s\": %.3f, "
-           "\"first_press_s\": %.3f}\n",
+           "\"first_press_s\": %.3f, \"actor\": [%.4g, %.4g, %.4g]}\n",
            (long long)app->frames, (long long)app->steps, app->sim.n, app->sim.threads,
            app->step_frames ? app->step_ms_sum / (double)app->step_frames : 0,
            app->frames ? app->render_ms_sum / (double)app->frames : 0,
            app->frames ? 1000 * app->wall_s / (double)app->frames : 0, fps, app->contacts_max,
-           app->first_contact_s, app->poke.first_press_s);
+           app->first_contact_s, app->poke.first_press_s, a->x, a->z,
+           a->yaw * 180 / 3.14159265358979323846);
 }
 
 void vw_app_free(vw_app *app) {

@@ -89,7 +89,30 @@ if [ "$what" = finger ]; then # a world file: the table rises into the finger
     rc=$?
     set -e
     refused "$rc" "shape 'cone'" "an unknown collider shape"
-else # the poke: a scripted drag pushes a sphere into the Fox's face
+else
+    # a cross-fade into the held-out Run while the actor walks a quarter circle (50 units a
+    # second turning 90 degrees a second: radius 31.8, so 45 from the start after 1 s)
+    walked() { # FRAMES EXPECTED_DISTANCE EXPECTED_HEADING TOLERANCE ARGS...
+        local frames=$1 dist=$2 yaw=$3 tol=$4
+        shift 4
+        "${run[@]}" "$view" "${args[@]}" --view sinew --frames "$frames" "$@" \
+            --screenshot "$tmp/walk.png" --json >"$tmp/walk.json"
+        cat "$tmp/walk.json"
+        python3 "$here/check_shot.py" present "$tmp/walk.png"
+        python3 - "$tmp/walk.json" "$dist" "$yaw" "$tol" <<'EOS'
+import json, math, sys
+x, z, yaw = json.load(open(sys.argv[1]))["actor"]
+dist, want, tol = (float(a) for a in sys.argv[2:])
+if not (abs(yaw - want) < tol and abs(math.hypot(x, z) - dist) < tol):
+    sys.exit("FAIL: the actor should be %g from the start heading %g: at (%g, %g) heading %g"
+             % (dist, want, x, z, yaw))
+EOS
+    }
+    walked 60 45 90 0.5 --fade-to Run --fade-at 0.2 --fade-time 0.3 --walk 50 --turn 90
+    # root motion of a clip animated in place: the hip's sway moves the actor within a
+    # cycle and back, across the loop's end (2 loops of the 0.708 s Walk: 85 steps)
+    walked 85 0 0 0.1 --root-motion b_Hip_01
+    # the poke: a scripted drag pushes a sphere into the Fox's face
     cat >"$tmp/poke" <<'EOS'
 1.0 press 0.30 0.45
 1.1 move 0.33 0.45
