@@ -67,14 +67,15 @@ static vw_planar inverse(vw_planar a) {
  * bind heading. */
 static void remove_root(const vw_planar *f, float *pose, int32_t nbones) {
     const vw_planar g = inverse(*f);
-    for (int32_t b = 0; b < nbones; ++b)
-        for (int c = 0; c < 4; ++c) {
-            float v[3] = {pose[12 * b + (c < 3 ? c : 9)], pose[12 * b + (c < 3 ? 3 + c : 10)],
-                          pose[12 * b + (c < 3 ? 6 + c : 11)]};
-            vw_planar_apply(&g, v, c == 3);
-            pose[12 * b + (c < 3 ? c : 9)] = v[0], pose[12 * b + (c < 3 ? 3 + c : 10)] = v[1],
-                                       pose[12 * b + (c < 3 ? 6 + c : 11)] = v[2];
+    for (int32_t b = 0; b < nbones; ++b) {
+        float *T = pose + 12 * b;
+        for (int c = 0; c < 3; ++c) { /* the rotation's columns turn, the translation moves */
+            float v[3] = {T[c], T[3 + c], T[6 + c]};
+            vw_planar_apply(&g, v, 0);
+            T[c] = v[0], T[3 + c] = v[1], T[6 + c] = v[2];
         }
+        vw_planar_apply(&g, T + 9, 1);
+    }
 }
 
 int vw_motion_pose(const vw_asset *a, const vw_motion *m, double t, double clock, float *out) {
