@@ -177,9 +177,13 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
     if (s->status & SINEW_STEP_BEYOND_TRAINING)
         snprintf(lines[2] + n, 160 - (size_t)n, "BEYOND TRAINING: %u JOINTS, BONE %d +%.0f DEG",
                  s->joints_beyond_training, s->beyond_training_bone, s->beyond_training_deg);
-    snprintf(lines[3], 160, "%s  %s  %s%s%s  1 SINEW 2 SKIN 3 BOTH", view,
-             app->sim.dynamic ? "DYNAMIC" : "QUASISTATIC", app->opt.dqs ? "DQS " : "LBS ",
-             app->paused ? "PAUSED " : "", app->slow ? "SLOW " : "");
+    n = snprintf(lines[3], 160, "%s  %s  %s%s%s  1 SINEW 2 SKIN 3 BOTH", view,
+                 app->sim.dynamic ? "DYNAMIC" : "QUASISTATIC", app->opt.dqs ? "DQS " : "LBS ",
+                 app->paused ? "PAUSED " : "", app->slow ? "SLOW " : "");
+    const vw_planar *a = &app->sim.ch[0].actor;
+    if (m->root_bone >= 0 || m->walk != 0 || m->turn != 0)
+        snprintf(lines[3] + n, 160 - (size_t)n, "  ACTOR %.1f %.1f %.0f DEG", a->x, a->z,
+                 a->yaw * 180 / 3.14159265358979323846);
 }
 
 static void draw_hud(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms) {
