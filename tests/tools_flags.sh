@@ -12,6 +12,8 @@ src=$2
 write=${3:-}
 doc=$src/docs/tools.md
 tools="sinew-bake sinew-bench sinew-fullsim sinew-render sinew-invariance sinew-inspect sinew-soak sinew-replay"
+# sinew-view is built only where GLFW, OpenGL and assimp are (samples/viewer/CMakeLists.txt)
+[ -x "$build/tools/sinew-view" ] && tools="$tools sinew-view"
 fails=0
 fail() {
     echo "FAIL $*" >&2

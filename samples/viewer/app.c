@@ -12,22 +12,36 @@ static const char *usage =
     "  --asset FILE        the glTF/FBX file it was baked from (assimp imports it)\n"
     "  --scene NAME        a procedural sample it was baked from (finger, cylinder, capsule)\n"
     "  --clip NAME         the clip to play (default: the file's first)\n"
-    "  --instances N       characters (default 1), --threads T: stepped on T threads\n"
+    "  --fade-to NAME      cross-fade into this clip (local transforms blended, slerp)\n"
+    "  --fade-at S         when the fade starts, seconds of the clock (default 1)\n"
+    "  --fade-time S       how long it takes (0.5)\n"
+    "  --root-motion BONE  take BONE's ground motion and heading out of the clip into the actor\n"
+    "  --walk U            the actor walks U asset units a second along its +z (0)\n"
+    "  --turn DEG          and turns DEG degrees a second (0); the camera follows\n"
+    "  --instances N       characters (default 1)\n"
+    "  --threads T         stepped on T threads (default 1)\n"
     "  --world FILE        a world file (samples/worlds/): its colliders, moving on their keys\n"
     "  --view V            sinew, skin or both (default both)\n"
     "  --dqs               dual-quaternion plain skinning (default linear blend)\n"
     "  --dynamic           dynamic steps (default quasistatic)\n"
     "  --no-colour         no colouring by correction magnitude\n"
     "  --colour-scale F    correction drawn full red, as a fraction of the size (0.03)\n"
-    "  --step-hz H         simulation steps a second (60); --render-hz H: --frames clock (60)\n"
-    "  --width W --height H  window size (960 x 540)\n"
+    "  --step-hz H         simulation steps a second (60)\n"
+    "  --render-hz H       frames a second of the --frames clock (60)\n"
+    "  --width W           window width (960)\n"
+    "  --height H          window height (540)\n"
     "  --frames N          render N frames, then exit (the clock advances 1/render-hz a frame)\n"
     "  --screenshot OUT    write the last frame to OUT.png (with --frames)\n"
     "  --record OUT        pipe every frame to ffmpeg, writing OUT (.mp4)\n"
-    "  --script FILE       timed keys, one a line: SECONDS KEY (space, period or a key's letter)\n"
-    "  --json              print frames, steps, mean step and render ms and fps at exit\n"
+    "  --script FILE       timed events, one a line: SECONDS KEY (space, period or a key's\n"
+    "                      letter), SECONDS press|move X Y (X, Y fractions of the window: a\n"
+    "                      press picks a world collider, a move drags it), SECONDS release\n"
+    "  --json              print frames, steps, mean step and render ms, fps, the first\n"
+    "                      character's world contacts (most in a step, first time) and where\n"
+    "                      its actor stands (x, z, heading in degrees) at exit\n"
     "keys: space pause, . single step, s slow motion, d dynamic/quasistatic, t teleport,\n"
-    "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion, q quit\n";
+    "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion, q quit;\n"
+    "      left drag: a world collider\n";
 
 static int arg_int(const char *flag, const char *v, int lo, int hi, int *out) {
     char *end;
@@ -56,6 +70,8 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
     vw_options *o = &app->opt;
     o->instances = o->threads = 1, o->width = 960, o->height = 540, o->view = VW_VIEW_BOTH;
     o->step_hz = o->render_hz = 60, o->colour = 1, o->colour_scale = 0.03;
+    o->fade_at = 1, o->fade_time = 0.5;
+    app->poke.col = -1, app->poke.first_press_s = app->first_contact_s = -1;
     for (int i = 1; i < argc; ++i) {
         const char *a = argv[i], *v = i + 1 < argc ? argv[i + 1] : NULL;
         int ok = 1, used = 1;
@@ -70,6 +86,18 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
             o->scene = v;
         else if (!strcmp(a, "--clip"))
             o->clip = v;
+        else if (!strcmp(a, "--fade-to"))
+            o->fade_to = v;
+        else if (!strcmp(a, "--root-motion"))
+            o->root_bone = v;
+        else if (!strcmp(a, "--fade-at"))
+            ok = arg_double(a, v, 0, 1e6, &o->fade_at);
+        else if (!strcmp(a, "--fade-time"))
+            ok = arg_double(a, v, 0, 1e6, &o->fade_time);
+        else if (!strcmp(a, "--walk"))
+            ok = arg_double(a, v, -1e6, 1e6, &o->walk);
+        else if (!strcmp(a, "--turn"))
+            ok = arg_double(a, v, -3600, 3600, &o->turn_deg);
         else if (!strcmp(a, "--world"))
             o->world = v;
         else if (!strcmp(a, "--screenshot"))
@@ -112,7 +140,7 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
             else if (!strcmp(a, "--no-colour"))
                 o->colour = 0;
             else {
-                fprintf(stderr, "sinew-view: unknown argument '%s'\n%s", a, usage);
+                fprintf(stderr, "sinew-view: unknown or incomplete argument '%s'\n%s", a, usage);
                 return 2;
             }
         }
@@ -161,6 +189,21 @@ static int blob_rest_surface(const sinew_blob *blob, float *pos, uint32_t nv) {
     return ok;
 }
 
+/* A script line after its time: a key's name, or a mouse event. */
+static int parse_event(const char *line, const char *word, vw_event *ev) {
+    float x, y;
+    if (!strcmp(word, "press") || !strcmp(word, "move")) {
+        if (sscanf(line, "%*f %*s %f %f", &x, &y) != 2 || !(x >= 0 && x <= 1 && y >= 0 && y <= 1))
+            return 0;
+        ev->kind = word[0] == 'p' ? VW_EV_PRESS : VW_EV_MOVE, ev->x = x, ev->y = y;
+        return 1;
+    }
+    if (!strcmp(word, "release")) return ev->kind = VW_EV_RELEASE, 1;
+    ev->key = !strcmp(word, "space") ? ' ' : !strcmp(word, "period") ? '.' : 0;
+    if (!ev->key && strlen(word) == 1 && strchr(" .sdt123clq", word[0])) ev->key = word[0];
+    return ev->key != 0;
+}
+
 static int load_script(vw_app *app, char *err, size_t errlen) {
     FILE *f = fopen(app->opt.script, "r");
     if (!f) return snprintf(err, errlen, "%s: cannot open", app->opt.script), 0;
@@ -175,10 +218,12 @@ static int load_script(vw_app *app, char *err, size_t errlen) {
             ok = 0, snprintf(err, errlen, "%s:%d: expected SECONDS KEY", app->opt.script, n);
             break;
         }
-        char k = !strcmp(key, "space") ? ' ' : !strcmp(key, "period") ? '.' : 0;
-        if (!k && strlen(key) == 1 && strchr(" .sdt123clq", key[0])) k = key[0];
-        if (!k) {
-            ok = 0, snprintf(err, errlen, "%s:%d: unknown key '%s'", app->opt.script, n, key);
+        vw_event ev = {t, VW_EV_KEY, 0, 0, 0};
+        if (!parse_event(s, key, &ev)) {
+            ok = 0, snprintf(err, errlen,
+                             "%s:%d: expected SECONDS KEY, SECONDS press|move X Y (fractions of "
+                             "the window) or SECONDS release; got '%s'",
+                             app->opt.script, n, key);
             break;
         }
         if (app->nevents == cap) {
@@ -190,22 +235,49 @@ static int load_script(vw_app *app, char *err, size_t errlen) {
             }
             app->events = e;
         }
-        app->events[app->nevents++] = (vw_event){t, k};
+        app->events[app->nevents++] = ev;
     }
     fclose(f);
     return ok;
 }
 
-static int pick_clip(vw_app *app, char *err, size_t errlen) {
-    const vw_asset *a = &app->asset;
-    if (a->nclips == 0) return snprintf(err, errlen, "%s has no clip to play", app->opt.asset), 0;
-    if (!app->opt.clip) return 1;
+static int find_clip(const vw_asset *a, const char *name, int *clip, char *err, size_t errlen) {
     for (int k = 0; k < a->nclips; ++k)
-        if (!strcmp(a->clip_names[k], app->opt.clip)) return app->clip = k, 1;
-    int n = snprintf(err, errlen, "no clip '%s'; the file has:", app->opt.clip);
+        if (!strcmp(a->clip_names[k], name)) return *clip = k, 1;
+    int n = snprintf(err, errlen, "no clip '%s'; the file has:", name);
     for (int k = 0; k < a->nclips && n > 0 && (size_t)n < errlen; ++k)
         n += snprintf(err + n, errlen - (size_t)n, " %s", a->clip_names[k]);
     return 0;
+}
+
+/* What the characters play: the clip, the fade, root motion and the actor's walk. */
+static int pick_motion(vw_app *app, char *err, size_t errlen) {
+    const vw_asset *a = &app->asset;
+    const vw_options *o = &app->opt;
+    vw_motion *m = &app->motion;
+    *m = (vw_motion){.fade_clip = -1,
+                     .root_bone = -1,
+                     .fade_at = o->fade_at,
+                     .fade_time = o->fade_time,
+                     .walk = o->walk,
+                     .turn = o->turn_deg * 3.14159265358979323846 / 180};
+    if (a->nclips == 0) return snprintf(err, errlen, "%s has no clip to play", o->asset), 0;
+    if (o->clip && !find_clip(a, o->clip, &m->clip, err, errlen)) return 0;
+    if (o->fade_to && !a->sample)
+        return snprintf(err, errlen, "--fade-to: a procedural scene has one clip"), 0;
+    if (o->fade_to && !find_clip(a, o->fade_to, &m->fade_clip, err, errlen)) return 0;
+    if (o->root_bone) {
+        double bind[12];
+        m->root_bone = sinew_blob_find_bone(app->blob, o->root_bone);
+        if (m->root_bone < 0)
+            return snprintf(err, errlen, "--root-motion: the blob has no bone '%s'", o->root_bone),
+                   0;
+        if (sinew_blob_bone_bind(app->blob, (uint32_t)m->root_bone, bind) != SINEW_OK)
+            return snprintf(err, errlen, "--root-motion: the blob has no bind pose"), 0;
+        for (int k = 0; k < 3; ++k)
+            m->root_bind[k] = bind[9 + k];
+    }
+    return 1;
 }
 
 /* The blob's rest surface against the asset's: equal counts are not the same character. */
@@ -263,23 +335,12 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
         free(rest);
         if (!ok) return 0;
     } else {
-        if (!vw_asset_import(o->asset, &app->asset, err, errlen)) return 0;
-        /* Without bone names in the blob, counts are all a host can check: equal counts
-         * with a different skeleton would play, wrongly. */
-        if ((uint32_t)app->asset.nbones != nb)
-            return snprintf(err, errlen,
-                            "%s has %d bones, the blob %u: not the file it was baked from",
-                            o->asset, app->asset.nbones, nb),
-                   0;
-        if ((uint32_t)app->asset.nverts != nv)
-            return snprintf(err, errlen,
-                            "%s has %d render vertices, the blob's surface %u: not the file it was "
-                            "baked from (or the blob has no embedded render mesh)",
-                            o->asset, app->asset.nverts, nv),
-                   0;
-        if (!pick_clip(app, err, errlen)) return 0;
+        /* bones by name and vertices by the output map (asset.c): a file that is not
+         * the blob's is refused naming what it lacks */
+        if (!vw_asset_import(o->asset, app->blob, &app->asset, err, errlen)) return 0;
         if (!check_rest(app, nv, err, errlen)) return 0;
     }
+    if (!pick_motion(app, err, errlen)) return 0;
     if (o->script && !load_script(app, err, errlen)) return 0;
     const vw_asset *a = &app->asset;
     for (int c = 0; c < 3; ++c)
@@ -293,7 +354,7 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
         d2 += (app->rest_hi[c] - app->rest_lo[c]) * (app->rest_hi[c] - app->rest_lo[c]);
     app->size = sqrtf(d2) > 0 ? sqrtf(d2) : 1;
     if (o->world && !vw_world_load(o->world, &app->world, err, errlen)) return 0;
-    if (!vw_sim_create(&app->sim, app->blob, a, app->clip, o->instances, o->threads, o->dynamic,
+    if (!vw_sim_create(&app->sim, app->blob, a, &app->motion, o->instances, o->threads, o->dynamic,
                        app->world.world, app->world.rest_pose, err, errlen))
         return 0;
     if (app->world.world) vw_world_move(&app->world, 0);
@@ -327,7 +388,7 @@ void vw_app_key(vw_app *app, char key) {
         app->reinit = 1;
         break;
     case 't': /* a cut: half the clip ahead, declared so no inertia is taken from the jump */
-        app->sim_t += 0.5 * app->asset.clip_duration[app->clip];
+        app->sim_t += 0.5 * app->asset.clip_duration[app->motion.clip];
         vw_sim_teleport(&app->sim);
         break;
     case '1':
@@ -354,19 +415,28 @@ void vw_app_key(vw_app *app, char key) {
 }
 
 void vw_app_script(vw_app *app, double clock) {
-    while (app->next_event < app->nevents && app->events[app->next_event].t <= clock + 1e-9)
-        vw_app_key(app, app->events[app->next_event++].key);
+    while (app->next_event < app->nevents && app->events[app->next_event].t <= clock + 1e-9) {
+        const vw_event *e = &app->events[app->next_event++];
+        if (e->kind == VW_EV_KEY) vw_app_key(app, e->key);
+        if (e->kind == VW_EV_PRESS) vw_poke_press(app, e->x, e->y);
+        if (e->kind == VW_EV_MOVE) vw_poke_move(app, e->x, e->y);
+        if (e->kind == VW_EV_RELEASE) vw_poke_release(app);
+    }
 }
 
 void vw_app_print_json(const vw_app *app) {
+    const vw_planar *a = &app->sim.ch[0].actor; /* the first actor: x, z, heading in degrees */
     double fps = app->wall_s > 0 ? (double)app->frames / app->wall_s : 0;
     printf("{\"frames\": %lld, \"steps\": %lld, \"instances\": %d, \"threads\": %d, "
            "\"mean_step_ms\": %.3f, \"mean_render_ms\": %.3f, \"mean_frame_ms\": %.3f, "
-           "\"fps\": %.1f}\n",
+           "\"fps\": %.1f, \"world_contacts_max\": %u, \"first_contact_s\": %.3f, "
+           "\"first_press_s\": %.3f, \"actor\": [%.4g, %.4g, %.4g]}\n",
            (long long)app->frames, (long long)app->steps, app->sim.n, app->sim.threads,
            app->step_frames ? app->step_ms_sum / (double)app->step_frames : 0,
            app->frames ? app->render_ms_sum / (double)app->frames : 0,
-           app->frames ? 1000 * app->wall_s / (double)app->frames : 0, fps);
+           app->frames ? 1000 * app->wall_s / (double)app->frames : 0, fps, app->contacts_max,
+           app->first_contact_s, app->poke.first_press_s, a->x, a->z,
+           a->yaw * 180 / 3.14159265358979323846);
 }
 
 void vw_app_free(vw_app *app) {
@@ -381,6 +451,7 @@ void vw_app_free(vw_app *app) {
     vw_asset_free(&app->asset);
     sinew_blob_destroy(app->blob);
     free(app->tris), free(app->events), free(app->hud), free(app->pixels);
+    free(app->lines.pos), free(app->lines.col);
     if (app->ffmpeg && pclose(app->ffmpeg) != 0)
         fprintf(stderr, "sinew-view: ffmpeg failed writing %s\n", app->opt.record);
     memset(app, 0, sizeof *app);

@@ -1,22 +1,15 @@
-/* The character as an engine imports it: assimp reads the file, and the viewer builds its
- * skeleton, render mesh, weights and clips the way the bake's import did (the bake is
- * precompute/import/scene_import.c; the viewer links only the runtime, so it repeats the
- * rules here).
+/* The character as an engine imports it: assimp reads the file, and the viewer maps it
+ * onto the blob through what the blob says, not through the bake's import rules.
  *
- * Bone order. The blob carries no bone names yet, so a host cannot map its skeleton by
- * name: it must reproduce the bake's order. That order is the skin joints' nodes in
- * depth-first node order (first child first). When the blob gains bone names the mapping
- * below becomes a lookup by name and this file stops depending on the bake's rules.
+ * Bones by name: blob bone b is the file's node named sinew_blob_bone_name(b) (among
+ * nodes of one name, the one nearest the blob's bind pose). Its transform at time t is
+ * G(t) B^-1, G the node's global in the clip and B the blob's bind pose of the bone.
  *
- * Vertex order. The output surface is the render mesh in the import's order: each
- * skinned aiMesh in mesh order, then each boneless mesh shown below a joint (a rigid
- * prop), in node order. A UV seam's duplicate vertices stay separate (the blob welds
- * them to one position and normal, which the host does not need to know).
- *
- * Bind space (glTF 2.0 3.7.3.3): a glTF skin ignores the mesh node's transform, so a
- * mesh's bind space is placed at W = G_r IBM_r of its first joint r; other formats place
- * it by the mesh node. A bone's bind global is B = W offset^-1 and its transform at time
- * t is G(t) B^-1. */
+ * Vertices by the output map: output vertex i is vertex v of source mesh m
+ * (sinew_blob_output_sources). A skinned mesh is placed in bind space by W = B offset of
+ * any of its bones (glTF 2.0 3.7.3.3: a skin ignores the mesh node's transform; W is the
+ * same for every bone of the mesh), a boneless prop by its node and rides the bone at or
+ * above it. The triangles are the blob's, over the output vertices. */
 #include <assimp/cimport.h>
 #include <assimp/postprocess.h>
 #include <assimp/scene.h>
@@ -29,14 +22,14 @@
 
 typedef struct imp {
     const struct aiScene *sc;
-    int32_t nn;                 /* nodes, depth-first */
-    const struct aiNode **node; /* nn */
-    int32_t *parent;            /* nn */
-    double *G;                  /* 16 nn: node-pose globals */
-    int32_t *node_bone;         /* nn: bone or -1 */
-    int32_t *bone_node;         /* nbones */
-    double *Binv;               /* 16 nbones */
-    int gltf;
+    int32_t nn;                     /* nodes, depth-first */
+    const struct aiNode **node;     /* nn */
+    int32_t *parent;                /* nn */
+    double *G;                      /* 16 nn: node-pose globals */
+    int32_t *node_bone;             /* nn: bone or -1 */
+    int32_t *bone_node;             /* nbones */
+    double *Binv;                   /* 16 nbones: the blob's bind poses inverted */
+    vw_trs *rest_trs;               /* nn: each node's node-pose local */
     double unit;                    /* file unit in metres (positions scale) */
     const struct aiNodeAnim **chan; /* nclips x nn */
     double tps[VW_MAX_CLIPS];
@@ -81,166 +74,68 @@ static void m4_ai(const struct aiMatrix4x4 *m, double *o) {
         o[k] = (double)v[k];
 }
 
-static int build_nodes(imp *s) {
-    int32_t cap = 64, top = 0;
-    const struct aiNode **stack = malloc(sizeof *stack * 4096);
-    int32_t *spar = malloc(sizeof *spar * 4096);
-    s->node = malloc(sizeof *s->node * (size_t)cap);
-    s->parent = malloc(sizeof *s->parent * (size_t)cap);
-    if (!stack || !spar || !s->node || !s->parent) goto fail;
-    stack[top] = s->sc->mRootNode, spar[top++] = -1;
-    while (top) {
-        const struct aiNode *nd = stack[--top];
-        int32_t par = spar[top];
-        if (s->nn == cap) {
-            cap *= 2;
-            const struct aiNode **a = realloc(s->node, sizeof *a * (size_t)cap);
-            int32_t *b = a ? realloc(s->parent, sizeof *b * (size_t)cap) : NULL;
-            if (a) s->node = a;
-            if (!a || !b) goto fail;
-            s->parent = b;
-        }
-        s->node[s->nn] = nd, s->parent[s->nn] = par;
-        int32_t self = s->nn++;
-        if (top + (int32_t)nd->mNumChildren > 4096) goto fail;
-        for (unsigned c = nd->mNumChildren; c-- > 0;) /* first child popped first */
-            stack[top] = nd->mChildren[c], spar[top++] = self;
-    }
-    free(stack), free(spar);
-    s->G = malloc(sizeof(double) * 16 * (size_t)s->nn);
-    if (!s->G) return 0;
+/* The blob's bone b as a node: the file's node of the bone's name; names repeat (a mesh
+ * node named after the joint that carries it), so among equal names the node whose node
+ * pose lies nearest the blob's bind pose. */
+static int32_t node_of_bone(const imp *s, const char *name, const double *B) {
+    int32_t best = -1;
+    double dbest = INFINITY;
     for (int32_t i = 0; i < s->nn; ++i) {
-        double L[16];
-        m4_ai(&s->node[i]->mTransformation, L);
-        if (s->parent[i] < 0)
-            memcpy(s->G + 16 * i, L, sizeof L);
-        else
-            m4_mul(s->G + 16 * s->parent[i], L, s->G + 16 * i);
-    }
-    return 1;
-fail:
-    free(stack), free(spar);
-    return 0;
-}
-
-/* The node of an aiBone: names tie them, and names repeat (a mesh node named after the
- * joint that carries it), so among equal names take the node whose global is nearest the
- * bone's bind transform W0 offset^-1 (as the bake does). */
-static int32_t bone_node_of(const imp *s, const double *W0, const struct aiBone *bone) {
-    int32_t best = -1, count = 0;
-    for (int32_t i = 0; i < s->nn; ++i)
-        if (!strcmp(s->node[i]->mName.data, bone->mName.data)) {
-            if (best < 0) best = i;
-            count++;
-        }
-    if (count < 2) return best;
-    double O[16], Oi[16], B[16], dbest = INFINITY;
-    m4_ai(&bone->mOffsetMatrix, O);
-    if (!m4_inv(O, Oi)) return best;
-    m4_mul(W0, Oi, B);
-    for (int32_t i = 0; i < s->nn; ++i) {
-        if (strcmp(s->node[i]->mName.data, bone->mName.data)) continue;
+        if (strcmp(s->node[i]->mName.data, name)) continue;
         double d = 0;
-        for (int k = 0; k < 16; ++k)
+        for (int k = 0; k < 12; ++k)
             d += (s->G[16 * i + k] - B[k]) * (s->G[16 * i + k] - B[k]);
         if (d < dbest) dbest = d, best = i;
     }
     return best;
 }
 
+#define FAIL(...) (snprintf(err, errlen, __VA_ARGS__), 0)
+
+/* The blob's bind pose of bone b as a 4x4 in the file's units. */
+static int blob_bind(const imp *s, const sinew_blob *blob, uint32_t b, double *B) {
+    double bind[12];
+    if (sinew_blob_bone_bind(blob, b, bind) != SINEW_OK) return 0;
+    for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c)
+            B[4 * r + c] = bind[3 * r + c];
+        B[4 * r + 3] = bind[9 + r] / s->unit;
+    }
+    B[12] = B[13] = B[14] = 0, B[15] = 1;
+    return 1;
+}
+
+/* Skeleton by name: each blob bone's node and the inverse of its bind pose. */
+static int map_skeleton(imp *s, const sinew_blob *blob, int32_t *nbones, char *err, size_t errlen) {
+    const uint32_t nb = sinew_blob_bone_count(blob);
+    if (nb == 0 || nb > VW_MAX_BONES)
+        return FAIL("the blob has %u bones (1 to %d)", nb, VW_MAX_BONES);
+    if (!sinew_blob_bone_name(blob, 0))
+        return FAIL("the blob has no bone names (baked before they were recorded: bake it again)");
+    s->node_bone = malloc(sizeof(int32_t) * (size_t)s->nn);
+    s->bone_node = malloc(sizeof(int32_t) * nb);
+    s->Binv = malloc(sizeof(double) * 16 * nb);
+    if (!s->node_bone || !s->bone_node || !s->Binv) return FAIL("out of memory");
+    for (int32_t i = 0; i < s->nn; ++i)
+        s->node_bone[i] = -1;
+    for (uint32_t b = 0; b < nb; ++b) {
+        const char *name = sinew_blob_bone_name(blob, b);
+        double B[16];
+        if (!blob_bind(s, blob, b, B))
+            return FAIL("bone %u ('%s'): the blob has no bind pose", b, name);
+        const int32_t i = node_of_bone(s, name, B);
+        if (i < 0) return FAIL("the blob's bone %u, '%s', is no node of the file", b, name);
+        if (!m4_inv(B, s->Binv + 16 * b)) return FAIL("bone '%s' has a singular bind pose", name);
+        s->bone_node[b] = i, s->node_bone[i] = (int32_t)b;
+    }
+    *nbones = (int32_t)nb;
+    return 1;
+}
+
 static int32_t joint_at_or_above(const imp *s, int32_t i) {
     for (; i >= 0; i = s->parent[i])
         if (s->node_bone[i] >= 0) return s->node_bone[i];
     return -1;
-}
-
-#define FAIL(...) (snprintf(err, errlen, __VA_ARGS__), 0)
-
-/* Skeleton: W per mesh, each bone's node, bones in node order, B^-1. */
-static int build_skeleton(imp *s, double *W, int32_t *nbones, char *err, size_t errlen) {
-    const struct aiScene *sc = s->sc;
-    static const double I[16] = {1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1};
-    int gltf = s->gltf;
-    int32_t *offset_mesh = malloc(sizeof(int32_t) * (size_t)s->nn);
-    double *offset = malloc(sizeof(double) * 16 * (size_t)s->nn);
-    s->node_bone = malloc(sizeof(int32_t) * (size_t)s->nn);
-    if (!offset_mesh || !offset || !s->node_bone) {
-        free(offset_mesh), free(offset);
-        return FAIL("out of memory");
-    }
-    for (int32_t i = 0; i < s->nn; ++i)
-        offset_mesh[i] = -1, s->node_bone[i] = -1;
-    int ok = 1;
-    for (unsigned m = 0; m < sc->mNumMeshes && ok; ++m) {
-        const struct aiMesh *me = sc->mMeshes[m];
-        int32_t mesh_node = -1;
-        for (int32_t i = 0; i < s->nn && mesh_node < 0; ++i)
-            for (unsigned k = 0; k < s->node[i]->mNumMeshes; ++k)
-                if (s->node[i]->mMeshes[k] == m) mesh_node = i;
-        memcpy(W + 16 * m, gltf || mesh_node < 0 ? I : s->G + 16 * mesh_node, sizeof I);
-        int32_t first = -1;
-        unsigned first_bone = 0;
-        for (unsigned b = 0; b < me->mNumBones && ok; ++b) {
-            int32_t i = bone_node_of(s, W + 16 * m, me->mBones[b]);
-            if (i < 0)
-                ok = FAIL("bone '%s' of mesh %u has no node", me->mBones[b]->mName.data, m);
-            else if (first < 0 || i < first)
-                first = i, first_bone = b;
-            if (i >= 0 && offset_mesh[i] < 0) {
-                m4_ai(&me->mBones[b]->mOffsetMatrix, offset + 16 * i);
-                offset_mesh[i] = (int32_t)m;
-            }
-        }
-        if (ok && gltf && first >= 0) {
-            double O[16];
-            m4_ai(&me->mBones[first_bone]->mOffsetMatrix, O);
-            m4_mul(s->G + 16 * first, O, W + 16 * m);
-        }
-    }
-    int32_t nb = 0;
-    for (int32_t i = 0; i < s->nn; ++i)
-        if (offset_mesh[i] >= 0) s->node_bone[i] = nb++;
-    if (ok && nb == 0) ok = FAIL("no skinned mesh (no mesh has bones): not a rigged character");
-    if (ok && nb > VW_MAX_BONES) ok = FAIL("%d joints, at most %d", nb, VW_MAX_BONES);
-    s->bone_node = ok ? malloc(sizeof(int32_t) * (size_t)nb) : NULL;
-    s->Binv = ok ? malloc(sizeof(double) * 16 * (size_t)nb) : NULL;
-    if (ok && (!s->bone_node || !s->Binv)) ok = FAIL("out of memory");
-    for (int32_t i = 0; i < s->nn && ok; ++i) {
-        int32_t b = s->node_bone[i];
-        if (b < 0) continue;
-        s->bone_node[b] = i;
-        double oinv[16], B[16];
-        if (!m4_inv(offset + 16 * i, oinv)) {
-            ok = FAIL("joint '%s' has a singular inverse bind matrix", s->node[i]->mName.data);
-            break;
-        }
-        m4_mul(W + 16 * offset_mesh[i], oinv, B);
-        if (!m4_inv(B, s->Binv + 16 * b))
-            ok = FAIL("joint '%s' has a singular bind transform", s->node[i]->mName.data);
-    }
-    free(offset_mesh), free(offset);
-    *nbones = nb;
-    return ok;
-}
-
-static void add_vertices(const struct aiMesh *me, const double *M, double k, float *x) {
-    for (unsigned v = 0; v < me->mNumVertices; ++v) {
-        const double p[3] = {me->mVertices[v].x, me->mVertices[v].y, me->mVertices[v].z};
-        for (int r = 0; r < 3; ++r)
-            x[3 * v + r] = (float)(k * (M[4 * r] * p[0] + M[4 * r + 1] * p[1] +
-                                        M[4 * r + 2] * p[2] + M[4 * r + 3]));
-    }
-}
-
-static int32_t add_tris(const struct aiMesh *me, uint32_t base, uint32_t *t) {
-    int32_t n = 0;
-    for (unsigned f = 0; f < me->mNumFaces; ++f) {
-        if (me->mFaces[f].mNumIndices != 3) continue; /* points and lines */
-        for (int c = 0; c < 3; ++c)
-            if (t) t[3 * n + c] = base + me->mFaces[f].mIndices[c];
-        n++;
-    }
-    return n;
 }
 
 /* Keeps a dense row's 4 largest weights (ties: the lower bone), renormalised. */
@@ -265,69 +160,133 @@ static int top4(const double *row, int32_t nb, int32_t *bone, float *w) {
     return 1;
 }
 
-/* Render mesh and weights: skinned meshes in mesh order, then rigid props in node order. */
-static int build_render(imp *s, const double *W, vw_asset *a, char *err, size_t errlen) {
-    const struct aiScene *sc = s->sc;
-    int64_t nv = 0, nt = 0;
-    for (int pass = 0; pass < 2; ++pass) {
-        int32_t base = 0, tbase = 0;
-        double *dense = NULL;
-        for (unsigned m = 0; m < sc->mNumMeshes; ++m) {
-            const struct aiMesh *me = sc->mMeshes[m];
-            if (!me->mNumBones) continue;
-            if (pass) {
-                add_vertices(me, W + 16 * m, s->unit, a->rest + 3 * (size_t)base);
-                add_tris(me, (uint32_t)base, a->tris + 3 * (size_t)tbase);
-                dense = calloc((size_t)me->mNumVertices * (size_t)a->nbones, sizeof(double));
-                if (!dense) return FAIL("out of memory");
-                for (unsigned k = 0; k < me->mNumBones; ++k) {
-                    const struct aiBone *bone = me->mBones[k];
-                    int32_t b = s->node_bone[bone_node_of(s, W + 16 * m, bone)];
-                    for (unsigned j = 0; j < bone->mNumWeights; ++j)
-                        if (bone->mWeights[j].mVertexId < me->mNumVertices && b >= 0)
-                            dense[(size_t)bone->mWeights[j].mVertexId * a->nbones + b] +=
-                                bone->mWeights[j].mWeight;
-                }
-                for (unsigned v = 0; v < me->mNumVertices; ++v)
-                    if (!top4(dense + (size_t)v * a->nbones, a->nbones, a->wbone + 4 * (base + v),
-                              a->wgt + 4 * (base + v))) {
-                        free(dense);
-                        return FAIL("mesh %u, vertex %u has no skin weight", m, v);
-                    }
-                free(dense);
-            }
-            base += (int32_t)me->mNumVertices, tbase += add_tris(me, 0, NULL);
+/* How a source mesh reaches the output: its vertices placed by W (the bind space of a
+ * skinned mesh, W = B offset of a bone, any bone giving the same; a rigid prop's node),
+ * and per vertex 4 bones and weights. */
+typedef struct mesh_map {
+    double W[16];
+    int32_t *wbone; /* 4 nverts */
+    float *wgt;
+} mesh_map;
+
+static int map_skinned(const imp *s, const sinew_blob *blob, unsigned m, mesh_map *mm, int32_t nb,
+                       char *err, size_t errlen) {
+    const struct aiMesh *me = s->sc->mMeshes[m];
+    double *dense = calloc((size_t)me->mNumVertices * (size_t)nb, sizeof(double));
+    if (!dense) return FAIL("out of memory");
+    int ok = 1;
+    for (unsigned k = 0; k < me->mNumBones && ok; ++k) {
+        const struct aiBone *bone = me->mBones[k];
+        const int32_t b = sinew_blob_find_bone(blob, bone->mName.data);
+        if (b < 0) {
+            ok = FAIL("mesh %u's bone '%.200s' is not in the blob", m, bone->mName.data);
+            break;
         }
-        for (int32_t i = 0; i < s->nn; ++i) {
-            int32_t b = joint_at_or_above(s, i);
-            for (unsigned k = 0; k < s->node[i]->mNumMeshes && b >= 0; ++k) {
-                const struct aiMesh *me = sc->mMeshes[s->node[i]->mMeshes[k]];
-                if (me->mNumBones) continue;
-                if (pass) {
-                    add_vertices(me, s->G + 16 * i, s->unit, a->rest + 3 * (size_t)base);
-                    add_tris(me, (uint32_t)base, a->tris + 3 * (size_t)tbase);
-                    for (unsigned v = 0; v < me->mNumVertices; ++v) {
-                        int32_t *wb = a->wbone + 4 * (base + v);
-                        float *ww = a->wgt + 4 * (base + v);
-                        wb[0] = b, wb[1] = wb[2] = wb[3] = 0;
-                        ww[0] = 1, ww[1] = ww[2] = ww[3] = 0;
-                    }
-                }
-                base += (int32_t)me->mNumVertices, tbase += add_tris(me, 0, NULL);
-            }
+        if (k == 0) { /* W = B offset */
+            double O[16], B[16];
+            m4_ai(&bone->mOffsetMatrix, O);
+            ok = blob_bind(s, blob, (uint32_t)b, B);
+            m4_mul(B, O, mm->W);
         }
-        nv = base, nt = tbase;
-        if (pass) break;
-        if (nv == 0 || nv > (1 << 26) || nt > (1 << 26))
-            return FAIL("%lld render vertices (none, or too many)", (long long)nv);
-        a->nverts = (int32_t)nv, a->ntris = (int32_t)nt;
-        a->rest = malloc(sizeof(float) * 3 * (size_t)nv);
-        a->tris = malloc(sizeof(uint32_t) * 3 * (size_t)(nt ? nt : 1));
-        a->wbone = malloc(sizeof(int32_t) * 4 * (size_t)nv);
-        a->wgt = malloc(sizeof(float) * 4 * (size_t)nv);
-        if (!a->rest || !a->tris || !a->wbone || !a->wgt) return FAIL("out of memory");
+        for (unsigned j = 0; j < bone->mNumWeights; ++j)
+            if (bone->mWeights[j].mVertexId < me->mNumVertices)
+                dense[(size_t)bone->mWeights[j].mVertexId * nb + b] += bone->mWeights[j].mWeight;
+    }
+    for (unsigned v = 0; v < me->mNumVertices && ok; ++v)
+        if (!top4(dense + (size_t)v * nb, nb, mm->wbone + 4 * v, mm->wgt + 4 * v))
+            mm->wbone[4 * v] = -1; /* (an error only if the output uses it) */
+    free(dense);
+    return ok;
+}
+
+static int map_rigid(const imp *s, unsigned m, mesh_map *mm, char *err, size_t errlen) {
+    const struct aiMesh *me = s->sc->mMeshes[m];
+    int32_t b = -1;
+    for (int32_t i = 0; i < s->nn && b < 0; ++i)
+        for (unsigned k = 0; k < s->node[i]->mNumMeshes && b < 0; ++k)
+            if (s->node[i]->mMeshes[k] == m) {
+                b = joint_at_or_above(s, i);
+                memcpy(mm->W, s->G + 16 * i, sizeof mm->W);
+            }
+    if (b < 0) return FAIL("mesh %u has no bones and hangs below no bone", m);
+    for (unsigned v = 0; v < me->mNumVertices; ++v) {
+        int32_t *wb = mm->wbone + 4 * v;
+        float *ww = mm->wgt + 4 * v;
+        wb[0] = b, wb[1] = wb[2] = wb[3] = 0;
+        ww[0] = 1, ww[1] = ww[2] = ww[3] = 0;
     }
     return 1;
+}
+
+/* Output vertex i of the blob is vertex pairs[2i + 1] of mesh pairs[2i]: the host's own
+ * vertex, placed and weighted as its mesh says. */
+static int place_outputs(const imp *s, const int32_t *pairs, mesh_map *mm, vw_asset *a, char *err,
+                         size_t errlen) {
+    for (int32_t i = 0; i < a->nverts; ++i) {
+        const int32_t m = pairs[2 * i], v = pairs[2 * i + 1];
+        if (m < 0 || (unsigned)m >= s->sc->mNumMeshes || v < 0 ||
+            (unsigned)v >= s->sc->mMeshes[m]->mNumVertices)
+            return FAIL("output vertex %d comes from mesh %d, vertex %d: not in the file", i, m, v);
+        if (!mm[m].wbone) return FAIL("out of memory");
+        if (mm[m].wbone[4 * v] < 0) return FAIL("mesh %d, vertex %d has no skin weight", m, v);
+        const struct aiVector3D *x = &s->sc->mMeshes[m]->mVertices[v];
+        const double *W = mm[m].W, p[3] = {x->x, x->y, x->z};
+        for (int r = 0; r < 3; ++r)
+            a->rest[3 * i + r] = (float)(s->unit * (W[4 * r] * p[0] + W[4 * r + 1] * p[1] +
+                                                    W[4 * r + 2] * p[2] + W[4 * r + 3]));
+        memcpy(a->wbone + 4 * i, mm[m].wbone + 4 * v, 4 * sizeof(int32_t));
+        memcpy(a->wgt + 4 * i, mm[m].wgt + 4 * v, 4 * sizeof(float));
+    }
+    return 1;
+}
+
+/* Render mesh: the blob's output vertices by the output map, its triangles as the blob's. */
+static int map_render(imp *s, const sinew_blob *blob, vw_asset *a, char *err, size_t errlen) {
+    const uint32_t nv = sinew_blob_surface_vertex_count(blob);
+    const uint32_t nt = sinew_blob_surface_triangle_count(blob);
+    const unsigned nm = s->sc->mNumMeshes;
+    if (sinew_blob_source_mesh_count(blob) != nm)
+        return FAIL("the blob was baked from %u meshes, the file has %u: not the file it was "
+                    "baked from",
+                    sinew_blob_source_mesh_count(blob), nm);
+    if (nv == 0 || nv > (1u << 26) || nt > (1u << 26))
+        return FAIL("the blob's surface has %u vertices (none, or too many)", nv);
+    a->nverts = (int32_t)nv, a->ntris = (int32_t)nt;
+    a->rest = malloc(sizeof(float) * 3 * nv);
+    a->tris = malloc(sizeof(uint32_t) * 3 * (nt ? nt : 1));
+    a->wbone = malloc(sizeof(int32_t) * 4 * nv);
+    a->wgt = malloc(sizeof(float) * 4 * nv);
+    int32_t *pairs = malloc(sizeof(int32_t) * 2 * nv);
+    mesh_map *mm = calloc(nm ? nm : 1, sizeof *mm);
+    int ok = a->rest && a->tris && a->wbone && a->wgt && pairs && mm;
+    if (!ok) ok = FAIL("out of memory");
+    if (ok && sinew_blob_surface_triangles(blob, a->tris, 3 * nt) != SINEW_OK)
+        ok = FAIL("cannot read the blob's triangles");
+    sinew_result r = ok ? sinew_blob_output_sources(blob, pairs, 2 * nv) : SINEW_OK;
+    if (ok && r != SINEW_OK)
+        ok = FAIL("the blob has no output map (%s): bake it again", sinew_result_string(r));
+    for (unsigned m = 0; m < nm && ok; ++m) {
+        const struct aiMesh *me = s->sc->mMeshes[m];
+        mm[m].wbone = malloc(sizeof(int32_t) * 4 * (me->mNumVertices + 1));
+        mm[m].wgt = malloc(sizeof(float) * 4 * (me->mNumVertices + 1));
+        if (!mm[m].wbone || !mm[m].wgt)
+            ok = FAIL("out of memory");
+        else if (me->mNumBones)
+            ok = map_skinned(s, blob, m, &mm[m], a->nbones, err, errlen);
+        else {
+            for (unsigned v = 0; v < me->mNumVertices; ++v)
+                mm[m].wbone[4 * v] = -1; /* a mesh no output vertex needs may hang anywhere */
+            int used = 0;
+            for (uint32_t i = 0; i < nv && !used; ++i)
+                used = pairs[2 * i] == (int32_t)m;
+            if (used) ok = map_rigid(s, m, &mm[m], err, errlen);
+        }
+    }
+    if (ok) ok = place_outputs(s, pairs, mm, a, err, errlen);
+    for (unsigned m = 0; mm && m < nm; ++m)
+        free(mm[m].wbone), free(mm[m].wgt);
+    free(mm), free(pairs);
+    return ok;
 }
 
 /* Keys: positions and scales linear, rotations by shortest-path slerp; before the first
@@ -358,85 +317,117 @@ static void sample_vec(const struct aiVectorKey *k, unsigned n, double t, double
 
 static void sample_quat(const struct aiQuatKey *k, unsigned n, double t, double *o) {
     unsigned i = key_before(k, sizeof *k, n, t), j = i + 1 < n ? i + 1 : i;
-    double u = frac(k[i].mTime, k[j].mTime, t);
     const struct aiQuaternion *qa = &k[i].mValue, *qb = &k[j].mValue;
-    double a[4] = {qa->w, qa->x, qa->y, qa->z}, b[4] = {qb->w, qb->x, qb->y, qb->z};
-    double d = a[0] * b[0] + a[1] * b[1] + a[2] * b[2] + a[3] * b[3], wa = 1 - u, wb = u, nrm = 0;
-    if (d < 0)
-        for (int c = 0; c < 4; ++c)
-            b[c] = -b[c];
-    d = fabs(d);
-    if (d < 0.9995) {
-        double th = acos(fmin(1.0, d)), s = sin(th);
-        wa = sin((1 - u) * th) / s, wb = sin(u * th) / s;
-    }
-    for (int c = 0; c < 4; ++c)
-        o[c] = wa * a[c] + wb * b[c], nrm += o[c] * o[c];
-    nrm = sqrt(nrm);
-    for (int c = 0; c < 4; ++c)
-        o[c] = nrm > 1e-12 ? o[c] / nrm : (c == 0);
+    const double a[4] = {qa->w, qa->x, qa->y, qa->z}, b[4] = {qb->w, qb->x, qb->y, qb->z};
+    vw_quat_slerp(a, b, frac(k[i].mTime, k[j].mTime, t), o);
 }
 
-/* A node's local transform: its channel's keys over its bind TRS. */
-static void node_local(const imp *s, int32_t i, const struct aiNodeAnim *c, double t, double *m) {
-    m4_ai(&s->node[i]->mTransformation, m);
-    if (!c) return;
-    double tr[3], q[4] = {1, 0, 0, 0}, sc[3], R[9];
+/* A node's local transform as translation, rotation and scale (its node pose's). */
+static void trs_of(const double *m, vw_trs *o) {
+    double R[9];
     for (int k = 0; k < 3; ++k) {
-        sc[k] = sqrt(m[k] * m[k] + m[4 + k] * m[4 + k] + m[8 + k] * m[8 + k]);
+        o->s[k] = sqrt(m[k] * m[k] + m[4 + k] * m[4 + k] + m[8 + k] * m[8 + k]);
         for (int r = 0; r < 3; ++r)
-            R[3 * r + k] = sc[k] > 1e-300 ? m[4 * r + k] / sc[k] : (r == k);
-        tr[k] = m[4 * k + 3];
+            R[3 * r + k] = o->s[k] > 1e-300 ? m[4 * r + k] / o->s[k] : (r == k);
+        o->t[k] = m[4 * k + 3];
     }
-    double tq = R[0] + R[4] + R[8], k4;
-    if (tq > 0) {
-        k4 = 2 * sqrt(tq + 1);
-        q[0] = 0.25 * k4, q[1] = (R[7] - R[5]) / k4, q[2] = (R[2] - R[6]) / k4,
-        q[3] = (R[3] - R[1]) / k4;
-    } else if (R[0] > R[4] && R[0] > R[8]) {
-        k4 = 2 * sqrt(fmax(0.0, 1 + R[0] - R[4] - R[8]));
-        q[0] = (R[7] - R[5]) / k4, q[1] = 0.25 * k4, q[2] = (R[1] + R[3]) / k4,
-        q[3] = (R[2] + R[6]) / k4;
-    } else if (R[4] > R[8]) {
-        k4 = 2 * sqrt(fmax(0.0, 1 + R[4] - R[0] - R[8]));
-        q[0] = (R[2] - R[6]) / k4, q[1] = (R[1] + R[3]) / k4, q[2] = 0.25 * k4,
-        q[3] = (R[5] + R[7]) / k4;
-    } else {
-        k4 = 2 * sqrt(fmax(0.0, 1 + R[8] - R[0] - R[4]));
-        q[0] = (R[3] - R[1]) / k4, q[1] = (R[2] + R[6]) / k4, q[2] = (R[5] + R[7]) / k4,
-        q[3] = 0.25 * k4;
-    }
-    if (c->mNumPositionKeys) sample_vec(c->mPositionKeys, c->mNumPositionKeys, t, tr);
-    if (c->mNumScalingKeys) sample_vec(c->mScalingKeys, c->mNumScalingKeys, t, sc);
-    if (c->mNumRotationKeys) sample_quat(c->mRotationKeys, c->mNumRotationKeys, t, q);
-    const double w = q[0], x = q[1], y = q[2], z = q[3];
-    const double Q[9] = {1 - 2 * (y * y + z * z), 2 * (x * y - w * z),     2 * (x * z + w * y),
-                         2 * (x * y + w * z),     1 - 2 * (x * x + z * z), 2 * (y * z - w * x),
-                         2 * (x * z - w * y),     2 * (y * z + w * x),     1 - 2 * (x * x + y * y)};
+    vw_quat_from_matrix(R, o->q);
+}
+
+static void trs_matrix(const vw_trs *l, double *m) {
+    double Q[9];
+    vw_quat_matrix(l->q, Q);
     for (int r = 0; r < 3; ++r) {
         for (int k = 0; k < 3; ++k)
-            m[4 * r + k] = Q[3 * r + k] * sc[k];
-        m[4 * r + 3] = tr[r];
+            m[4 * r + k] = Q[3 * r + k] * l->s[k];
+        m[4 * r + 3] = l->t[r];
     }
+    m[12] = m[13] = m[14] = 0, m[15] = 1;
 }
 
-static int asset_pose(const vw_asset *a, int clip, double t, float *out) {
+/* Globals from locals (4x4 each), parents first (the nodes are in depth-first order). */
+static void globals(const imp *s, const double *L, double *G) {
+    for (int32_t i = 0; i < s->nn; ++i)
+        if (s->parent[i] < 0)
+            memcpy(G + 16 * i, L + 16 * i, 16 * sizeof(double));
+        else
+            m4_mul(G + 16 * s->parent[i], L + 16 * i, G + 16 * i);
+}
+
+static int build_nodes(imp *s) {
+    int32_t cap = 64, top = 0;
+    const struct aiNode **stack = malloc(sizeof *stack * 4096);
+    int32_t *spar = malloc(sizeof *spar * 4096);
+    s->node = malloc(sizeof *s->node * (size_t)cap);
+    s->parent = malloc(sizeof *s->parent * (size_t)cap);
+    if (!stack || !spar || !s->node || !s->parent) goto fail;
+    stack[top] = s->sc->mRootNode, spar[top++] = -1;
+    while (top) {
+        const struct aiNode *nd = stack[--top];
+        int32_t par = spar[top];
+        if (s->nn == cap) {
+            cap *= 2;
+            const struct aiNode **a = realloc(s->node, sizeof *a * (size_t)cap);
+            int32_t *b = a ? realloc(s->parent, sizeof *b * (size_t)cap) : NULL;
+            if (a) s->node = a;
+            if (!a || !b) goto fail;
+            s->parent = b;
+        }
+        s->node[s->nn] = nd, s->parent[s->nn] = par;
+        int32_t self = s->nn++;
+        if (top + (int32_t)nd->mNumChildren > 4096) goto fail;
+        for (unsigned c = nd->mNumChildren; c-- > 0;) /* first child popped first */
+            stack[top] = nd->mChildren[c], spar[top++] = self;
+    }
+    free(stack), free(spar);
+    double *L = malloc(sizeof(double) * 16 * (size_t)s->nn);
+    s->G = malloc(sizeof(double) * 16 * (size_t)s->nn);
+    s->rest_trs = malloc(sizeof *s->rest_trs * (size_t)s->nn);
+    int ok = L && s->G && s->rest_trs;
+    for (int32_t i = 0; ok && i < s->nn; ++i) {
+        m4_ai(&s->node[i]->mTransformation, L + 16 * i);
+        trs_of(L + 16 * i, &s->rest_trs[i]);
+    }
+    if (ok) globals(s, L, s->G);
+    free(L);
+    return ok;
+fail:
+    free(stack), free(spar);
+    return 0;
+}
+
+/* Every node's local transform in `clip` at t seconds (looped): its channel's keys over
+ * its node pose. */
+static int asset_sample(const vw_asset *a, int clip, double t, vw_trs *local) {
     const imp *s = a->impl;
     if (clip < 0 || clip >= a->nclips) return 0;
-    double dur = a->clip_duration[clip];
+    const double dur = a->clip_duration[clip];
     t = dur > 0 ? fmod(t, dur) : 0;
     if (t < 0) t += dur;
-    double *G = malloc(sizeof(double) * 16 * (size_t)s->nn);
-    if (!G) return 0;
+    const double tick = t * s->tps[clip];
     const struct aiNodeAnim *const *ch = s->chan + (size_t)clip * s->nn;
     for (int32_t i = 0; i < s->nn; ++i) {
-        double L[16];
-        node_local(s, i, ch[i], t * s->tps[clip], L);
-        if (s->parent[i] < 0)
-            memcpy(G + 16 * i, L, sizeof L);
-        else
-            m4_mul(G + 16 * s->parent[i], L, G + 16 * i);
+        const struct aiNodeAnim *c = ch[i];
+        local[i] = s->rest_trs[i];
+        if (!c) continue;
+        if (c->mNumPositionKeys)
+            sample_vec(c->mPositionKeys, c->mNumPositionKeys, tick, local[i].t);
+        if (c->mNumScalingKeys) sample_vec(c->mScalingKeys, c->mNumScalingKeys, tick, local[i].s);
+        if (c->mNumRotationKeys)
+            sample_quat(c->mRotationKeys, c->mNumRotationKeys, tick, local[i].q);
     }
+    return 1;
+}
+
+/* Bone b's transform: its node's global times the inverse of the blob's bind pose, in
+ * the blob's units. */
+static int asset_compose(const vw_asset *a, const vw_trs *local, float *out) {
+    const imp *s = a->impl;
+    double *L = malloc(sizeof(double) * 32 * (size_t)s->nn), *G = L + 16 * (size_t)s->nn;
+    if (!L) return 0;
+    for (int32_t i = 0; i < s->nn; ++i)
+        trs_matrix(&local[i], L + 16 * i);
+    globals(s, L, G);
     for (int32_t b = 0; b < a->nbones; ++b) {
         double M[16];
         m4_mul(G + 16 * s->bone_node[b], s->Binv + 16 * b, M);
@@ -446,15 +437,22 @@ static int asset_pose(const vw_asset *a, int clip, double t, float *out) {
             out[12 * b + 9 + r] = (float)(M[4 * r + 3] * s->unit);
         }
     }
-    free(G);
+    free(L);
     return 1;
+}
+
+static int asset_pose(const vw_asset *a, int clip, double t, float *out) {
+    vw_trs *local = malloc(sizeof *local * (size_t)a->nnodes);
+    int ok = local && asset_sample(a, clip, t, local) && asset_compose(a, local, out);
+    free(local);
+    return ok;
 }
 
 static void asset_release(vw_asset *a) {
     imp *s = a->impl;
     if (!s) return;
     free(s->node), free(s->parent), free(s->G), free(s->node_bone), free(s->bone_node);
-    free(s->Binv), free(s->chan);
+    free(s->Binv), free(s->chan), free(s->rest_trs);
     if (s->sc) aiReleaseImport(s->sc);
     free(s);
 }
@@ -501,7 +499,28 @@ static double file_unit(const struct aiScene *sc, int gltf) {
     return 1;
 }
 
-int vw_asset_import(const char *path, vw_asset *a, char *err, size_t errlen) {
+/* The file as shipped against the one the blob was baked from: a changed file plays, but
+ * an engine would bake it again. */
+static void check_provenance(const char *path, const sinew_blob *blob) {
+    sinew_blob_provenance p;
+    p.struct_size = sizeof p;
+    if (sinew_blob_get_provenance(blob, &p) != SINEW_OK) return;
+    FILE *f = fopen(path, "rb");
+    char *data = NULL;
+    long n = f && !fseek(f, 0, SEEK_END) ? ftell(f) : -1;
+    if (n > 0 && !fseek(f, 0, SEEK_SET) && (data = malloc((size_t)n)) &&
+        fread(data, 1, (size_t)n, f) == (size_t)n &&
+        sinew_hash_bytes(data, (size_t)n) != p.source_hash)
+        fprintf(stderr,
+                "sinew-view: warning: %s differs from the file the blob was baked from "
+                "(bake it again)\n",
+                path);
+    free(data);
+    if (f) fclose(f);
+}
+
+int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *a, char *err,
+                    size_t errlen) {
     memset(a, 0, sizeof *a);
     FILE *f = fopen(path, "rb");
     if (!f) return FAIL("%s: cannot open", path);
@@ -512,12 +531,13 @@ int vw_asset_import(const char *path, vw_asset *a, char *err, size_t errlen) {
         ext[i] = (char)tolower((unsigned char)dot[i + 1]);
     int gltf = !strcmp(ext, "gltf") || !strcmp(ext, "glb");
     unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
-    /* FBX is unrolled one vertex per face corner; the bake welds it back, and so must we */
+    /* FBX is unrolled one vertex per face corner; the bake welds it back, and so must we
+     * (the output map's vertex indices are the welded mesh's) */
     if (!gltf) flags |= aiProcess_JoinIdenticalVertices;
     imp *s = calloc(1, sizeof *s);
     if (!s) return FAIL("out of memory");
     a->impl = s, a->release = asset_release, a->pose = asset_pose;
-    s->gltf = gltf;
+    a->sample = asset_sample, a->compose = asset_compose;
     s->sc = aiImportFile(path, flags);
     if (!s->sc || !s->sc->mRootNode || (s->sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         snprintf(err, errlen, "%s: assimp could not read it: %s", path, aiGetErrorString());
@@ -525,13 +545,15 @@ int vw_asset_import(const char *path, vw_asset *a, char *err, size_t errlen) {
         return 0;
     }
     s->unit = file_unit(s->sc, gltf);
-    double *W = malloc(sizeof(double) * 16 * (s->sc->mNumMeshes + 1));
-    int ok = W && build_nodes(s);
+    int ok = build_nodes(s);
     if (!ok) snprintf(err, errlen, "%s: out of memory, or a node tree deeper than 4096", path);
-    ok = ok && build_skeleton(s, W, &a->nbones, err, errlen);
-    ok = ok && build_render(s, W, a, err, errlen);
+    a->nnodes = s->nn;
+    char why[400] = "";
+    ok = ok && map_skeleton(s, blob, &a->nbones, why, sizeof why) &&
+         map_render(s, blob, a, why, sizeof why);
+    if (why[0]) snprintf(err, errlen, "%s: %s", path, why);
     if (ok && (!build_clips(s, a) || !vw_asset_weld(a))) ok = FAIL("out of memory");
-    free(W);
+    if (ok) check_provenance(path, blob);
     if (!ok) vw_asset_free(a);
     return ok;
 }

@@ -143,6 +143,10 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
     for (int k = 0; k < 3; ++k)
         eye[k] = at[k] + dir[k] / dl * dist;
     view_projection(eye, at, fovy, aspect, 0.01f * dist, 4 * dist, vp);
+    vw_poke *p = &app->poke; /* what a mouse press is cast from */
+    memcpy(p->eye, eye, sizeof eye), memcpy(p->at, at, sizeof at);
+    p->fovy = fovy, p->aspect = aspect, p->valid = 1;
+    layout(app, 0, app->view == VW_VIEW_SKIN, p->off);
 }
 
 /* The HUD's lines: frame and step times, the first character's phases and flags. */
@@ -151,9 +155,16 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
     const char *view = app->view == VW_VIEW_SINEW  ? "SINEW"
                        : app->view == VW_VIEW_SKIN ? "SKIN"
                                                    : "SKIN | SINEW";
-    snprintf(lines[0], 160, "FRAME %.1f MS  STEP %.2f MS (%d)  RENDER %.1f MS  %d X %s", frame_ms,
-             step_ms, app->steps_this_frame, app->last_render_ms, app->sim.n,
-             app->asset.clip_names[app->clip]);
+    const vw_motion *m = &app->sim.motion;
+    char clip[64];
+    if (m->fade_clip >= 0 && app->sim_t >= m->fade_at)
+        snprintf(clip, sizeof clip, "%.24s > %.24s %.0f%%", app->asset.clip_names[m->clip],
+                 app->asset.clip_names[m->fade_clip],
+                 100 * (m->fade_time > 0 ? fmin(1, (app->sim_t - m->fade_at) / m->fade_time) : 1));
+    else
+        snprintf(clip, sizeof clip, "%.60s", app->asset.clip_names[m->clip]);
+    snprintf(lines[0], 160, "FRAME %.1f MS  STEP %.2f MS (%d)  RENDER %.1f MS  %d X %.60s",
+             frame_ms, step_ms, app->steps_this_frame, app->last_render_ms, app->sim.n, clip);
     snprintf(lines[1], 160,
              "SKIN %.2f CONTACT %.2f DYN %.2f SOLVE %.2f OUTPUT %.2f WORLD %.2f MS  NEWTON %u  "
              "WORLD CONTACTS %u PATCH %u",
@@ -166,9 +177,13 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
     if (s->status & SINEW_STEP_BEYOND_TRAINING)
         snprintf(lines[2] + n, 160 - (size_t)n, "BEYOND TRAINING: %u JOINTS, BONE %d +%.0f DEG",
                  s->joints_beyond_training, s->beyond_training_bone, s->beyond_training_deg);
-    snprintf(lines[3], 160, "%s  %s  %s%s%s  1 SINEW 2 SKIN 3 BOTH", view,
-             app->sim.dynamic ? "DYNAMIC" : "QUASISTATIC", app->opt.dqs ? "DQS " : "LBS ",
-             app->paused ? "PAUSED " : "", app->slow ? "SLOW " : "");
+    n = snprintf(lines[3], 160, "%s  %s  %s%s%s  1 SINEW 2 SKIN 3 BOTH", view,
+                 app->sim.dynamic ? "DYNAMIC" : "QUASISTATIC", app->opt.dqs ? "DQS " : "LBS ",
+                 app->paused ? "PAUSED " : "", app->slow ? "SLOW " : "");
+    const vw_planar *a = &app->sim.ch[0].actor;
+    if (m->root_bone >= 0 || m->walk != 0 || m->turn != 0)
+        snprintf(lines[3] + n, 160 - (size_t)n, "  ACTOR %.1f %.1f %.0f DEG", a->x, a->z,
+                 a->yaw * 180 / 3.14159265358979323846);
 }
 
 static void draw_hud(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms) {
@@ -192,6 +207,42 @@ static void draw_hud(vw_app *app, int fb_w, int fb_h, double frame_ms, double st
     glfwSetWindowTitle(app->window, title);
 }
 
+void vw_draw_line(vw_app *app, const float a[3], const float b[3], uint32_t rgb) {
+    vw_lines *l = &app->lines;
+    if (l->n + 2 > l->cap) {
+        int32_t cap = l->cap ? 2 * l->cap : 256;
+        float *p = realloc(l->pos, sizeof(float) * 3 * (size_t)cap);
+        if (p) l->pos = p;
+        float *c = p ? realloc(l->col, sizeof(float) * 3 * (size_t)cap) : NULL;
+        if (!c) return; /* (a frame without its lines, not a failure) */
+        l->col = c, l->cap = cap;
+    }
+    const float c[3] = {(float)((rgb >> 16) & 255) / 255, (float)((rgb >> 8) & 255) / 255,
+                        (float)(rgb & 255) / 255};
+    memcpy(l->pos + 3 * l->n, a, 3 * sizeof(float)), memcpy(l->col + 3 * l->n, c, sizeof c);
+    memcpy(l->pos + 3 * l->n + 3, b, 3 * sizeof(float)), memcpy(l->col + 3 * l->n + 3, c, sizeof c);
+    l->n += 2;
+}
+
+void vw_draw_point(vw_app *app, const float p[3], float size, uint32_t rgb) {
+    for (int k = 0; k < 3; ++k) {
+        float a[3] = {p[0], p[1], p[2]}, b[3] = {p[0], p[1], p[2]};
+        a[k] -= 0.5f * size, b[k] += 0.5f * size;
+        vw_draw_line(app, a, b, rgb);
+    }
+}
+
+/* A held collider: where its keys would have it, and a line to where it is held. */
+static void held_colliders(vw_app *app) {
+    for (int k = 0; k < app->world.ncol; ++k) {
+        const vw_collider *c = &app->world.col[k];
+        if (!c->held) continue;
+        const float *from = c->nkeys ? c->keys[0].position : c->def.transform.position;
+        vw_draw_point(app, from, 0.05f * app->size, 0xffc040);
+        vw_draw_line(app, from, c->now.position, 0xffc040);
+    }
+}
+
 void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms) {
     int need_skin = app->view != VW_VIEW_SINEW || app->opt.colour;
     if (need_skin) vw_sim_skin(&app->sim, app->opt.dqs);
@@ -213,15 +264,27 @@ void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_m
             vw_gl_draw(&app->mesh_skin[i], vp, off);
         }
     }
-    for (int k = 0; k < app->world.ncol && app->view != VW_VIEW_SKIN; ++k) {
+    for (int k = 0; k < app->world.ncol; ++k) {
         vw_collider *col = &app->world.col[k];
         vw_normals(col->pos, col->nverts, col->tris, col->ntris, NULL, col->nrm);
         vw_glmesh_update(&app->mesh_col[k], col->pos, col->nrm, app->col_collider);
-        for (int32_t i = 0; i < app->sim.n; ++i) { /* every character has the world's copy */
-            float off[3];
-            layout(app, i, 0, off);
-            vw_gl_draw(&app->mesh_col[k], vp, off);
-        }
+        /* every character has the world's copy; the plain skinning's too, which it passes
+         * through */
+        for (int32_t i = 0; i < app->sim.n; ++i)
+            for (int skin = 0; skin < 2; ++skin) {
+                if ((skin && app->view == VW_VIEW_SINEW) || (!skin && app->view == VW_VIEW_SKIN))
+                    continue;
+                float off[3];
+                layout(app, i, skin, off);
+                vw_gl_draw(&app->mesh_col[k], vp, off);
+            }
+    }
+    held_colliders(app);
+    if (app->lines.n) {
+        float off[3];
+        layout(app, 0, app->view == VW_VIEW_SKIN, off);
+        vw_gl_lines(app->lines.pos, app->lines.col, app->lines.n, vp, off);
+        app->lines.n = 0;
     }
     draw_hud(app, fb_w, fb_h, frame_ms, step_ms);
 }

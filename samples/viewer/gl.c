@@ -90,7 +90,8 @@ static const char *hud_fs =
     "void main() { vec3 c = texture(tex, uv).rgb; if (c.r + c.g + c.b == 0.0) discard;\n"
     "  o = vec4(c, 1.0); }\n";
 
-static unsigned mesh_prog, hud_prog, hud_tex, hud_vao;
+static unsigned mesh_prog, hud_prog, hud_tex, hud_vao, line_vao, line_vbo[3];
+static size_t line_cap; /* vertices line_vbo holds */
 static int loc_vp, loc_off, loc_rect, loc_tex;
 
 static unsigned compile(unsigned type, const char *src, char *err, size_t errlen) {
@@ -152,6 +153,15 @@ int vw_gl_init(char *err, size_t errlen) {
     p_glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
     p_glTexParameteri(GL_TEXTURE_2D, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
     p_glGenVertexArrays(1, &hud_vao); /* core profile: a draw needs a bound VAO */
+    p_glGenVertexArrays(1, &line_vao);
+    p_glBindVertexArray(line_vao);
+    p_glGenBuffers(3, line_vbo);
+    for (unsigned k = 0; k < 3; ++k) {
+        p_glBindBuffer(GL_ARRAY_BUFFER, line_vbo[k]);
+        p_glEnableVertexAttribArray(k);
+        p_glVertexAttribPointer(k, 3, GL_FLOAT, GL_FALSE, 0, NULL);
+    }
+    p_glBindVertexArray(0);
     return 1;
 }
 
@@ -161,6 +171,9 @@ void vw_gl_shutdown(void) {
     p_glDeleteProgram(hud_prog);
     p_glDeleteTextures(1, &hud_tex);
     p_glDeleteVertexArrays(1, &hud_vao);
+    p_glDeleteBuffers(3, line_vbo);
+    p_glDeleteVertexArrays(1, &line_vao);
+    line_cap = 0;
 }
 
 int vw_glmesh_create(vw_glmesh *m, int32_t nverts, const uint32_t *tris, int32_t ntris) {
@@ -214,6 +227,33 @@ void vw_gl_draw(const vw_glmesh *m, const float vp[16], const float off[3]) {
     p_glUniform3fv(loc_off, 1, off);
     p_glBindVertexArray(m->vao);
     p_glDrawElements(GL_TRIANGLES, 3 * m->ntris, GL_UNSIGNED_INT, NULL);
+    p_glBindVertexArray(0);
+}
+
+void vw_gl_lines(const float *pos, const float *col, int32_t nverts, const float vp[16],
+                 const float off[3]) {
+    if (nverts < 2) return;
+    /* the mesh shader, with every normal towards its light: the colours come out unshaded */
+    float *nrm = malloc(sizeof(float) * 3 * (size_t)nverts);
+    if (!nrm) return;
+    for (int32_t v = 0; v < nverts; ++v)
+        nrm[3 * v] = 0.3f, nrm[3 * v + 1] = 0.8f, nrm[3 * v + 2] = 0.6f;
+    const float *src[3] = {pos, nrm, col};
+    const GLsizeiptr bytes = (GLsizeiptr)(sizeof(float) * 3 * (size_t)nverts);
+    p_glBindVertexArray(line_vao);
+    for (int k = 0; k < 3; ++k) {
+        p_glBindBuffer(GL_ARRAY_BUFFER, line_vbo[k]);
+        if ((size_t)nverts > line_cap)
+            p_glBufferData(GL_ARRAY_BUFFER, bytes, src[k], GL_STREAM_DRAW);
+        else
+            p_glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, src[k]);
+    }
+    if ((size_t)nverts > line_cap) line_cap = (size_t)nverts;
+    free(nrm);
+    p_glUseProgram(mesh_prog);
+    p_glUniformMatrix4fv(loc_vp, 1, GL_FALSE, vp);
+    p_glUniform3fv(loc_off, 1, off);
+    p_glDrawArrays(GL_LINES, 0, nverts & ~1);
     p_glBindVertexArray(0);
 }
 

@@ -23,6 +23,10 @@ void vw_glmesh_destroy(vw_glmesh *m);
 void vw_gl_begin(int w, int h);
 /* Draws m with the column-major view-projection vp, shifted by off. */
 void vw_gl_draw(const vw_glmesh *m, const float vp[16], const float off[3]);
+/* Draws line segments (vertices 2k, 2k + 1; per-vertex colours, unlit) with vp, shifted by
+ * off. */
+void vw_gl_lines(const float *pos, const float *col, int32_t nverts, const float vp[16],
+                 const float off[3]);
 /* Draws an RGB image (top row first) at the top-left of the frame; black is transparent. */
 void vw_gl_hud(const uint8_t *rgb, int w, int h, int fb_w, int fb_h);
 /* Reads the frame into rgb (top row first). */

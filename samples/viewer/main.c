@@ -32,6 +32,31 @@ static void on_key(GLFWwindow *w, int key, int scancode, int action, int mods) {
     if (c) vw_app_key(app, c);
 }
 
+static void mouse_at(GLFWwindow *w, double *x, double *y) {
+    int ww, wh;
+    glfwGetCursorPos(w, x, y);
+    glfwGetWindowSize(w, &ww, &wh);
+    *x = ww > 0 ? fmin(1, fmax(0, *x / ww)) : 0, *y = wh > 0 ? fmin(1, fmax(0, *y / wh)) : 0;
+}
+
+static void on_button(GLFWwindow *w, int button, int action, int mods) {
+    (void)mods;
+    if (button != GLFW_MOUSE_BUTTON_LEFT) return;
+    vw_app *app = glfwGetWindowUserPointer(w);
+    double x, y;
+    mouse_at(w, &x, &y);
+    if (action == GLFW_PRESS) vw_poke_press(app, (float)x, (float)y);
+    if (action == GLFW_RELEASE) vw_poke_release(app);
+}
+
+static void on_cursor(GLFWwindow *w, double cx, double cy) {
+    (void)cx, (void)cy;
+    vw_app *app = glfwGetWindowUserPointer(w);
+    double x, y;
+    mouse_at(w, &x, &y);
+    vw_poke_move(app, (float)x, (float)y);
+}
+
 /* Steps due this frame: the accumulator holds simulated time not yet stepped; a frame
  * that falls far behind drops time rather than spiral (at most 4 steps a frame). */
 static double advance(vw_app *app, double frame_dt) {
@@ -52,6 +77,9 @@ static double advance(vw_app *app, double frame_dt) {
         app->single = 0, n++, app->steps++;
     }
     app->steps_this_frame = n;
+    const uint32_t wc = app->sim.ch[0].stats.world_contacts;
+    if (wc > app->contacts_max) app->contacts_max = wc;
+    if (wc && app->first_contact_s < 0) app->first_contact_s = app->sim_t;
     return n ? 1000 * (now_s() - t0) : 0;
 }
 
@@ -122,6 +150,8 @@ int main(int argc, char **argv) {
     glfwSwapInterval(app.opt.frames ? 0 : 1);
     glfwSetWindowUserPointer(win, &app);
     glfwSetKeyCallback(win, on_key);
+    glfwSetMouseButtonCallback(win, on_button);
+    glfwSetCursorPosCallback(win, on_cursor);
     app.window = win;
     int ok = vw_gl_init(err, sizeof err) && vw_app_gl_setup(&app, err, sizeof err);
     if (!ok) fprintf(stderr, "sinew-view: %s\n", err);

@@ -37,12 +37,12 @@ static int create_instances(vw_sim *s, char *err, size_t errlen) {
     return 1;
 }
 
-int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip, int32_t n,
-                  int threads, int dynamic, const sinew_world *world, int rest_pose, char *err,
-                  size_t errlen) {
+int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, const vw_motion *m,
+                  int32_t n, int threads, int dynamic, const sinew_world *world, int rest_pose,
+                  char *err, size_t errlen) {
     memset(s, 0, sizeof *s);
     s->world = world, s->rest_pose = rest_pose;
-    s->blob = blob, s->asset = a, s->clip = clip, s->n = n, s->dynamic = dynamic;
+    s->blob = blob, s->asset = a, s->motion = *m, s->n = n, s->dynamic = dynamic;
     s->threads = threads < 1 ? 1 : (threads > n ? n : threads);
     s->ch = calloc((size_t)n, sizeof *s->ch);
     if (!s->ch) return snprintf(err, errlen, "out of memory"), 0;
@@ -55,7 +55,8 @@ int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip
         if (!c->pose || !c->pos || !c->nrm || !c->skin_pos || !c->skin_nrm)
             return snprintf(err, errlen, "out of memory"), 0;
         /* different phases, so a crowd does not move in lockstep */
-        c->phase = a->clip_duration[clip] > 0 ? 0.37 * i : 0;
+        c->phase = a->clip_duration[m->clip] > 0 ? 0.37 * i : 0;
+        c->last_t = -1;
         c->stats.struct_size = sizeof c->stats;
     }
     return create_instances(s, err, errlen);
@@ -75,22 +76,42 @@ typedef struct batch {
     float dt;
 } batch;
 
-/* The pose of character c at clip time t: the clip's, or the rest pose. */
+/* The pose of character c at simulation time t: the clip's (or the fade's), or the rest
+ * pose. */
 static int pose_at(const vw_sim *s, vw_char *c, double t) {
-    if (!s->rest_pose) return s->asset->pose(s->asset, s->clip, t + c->phase, c->pose);
+    if (!s->rest_pose) return vw_motion_pose(s->asset, &s->motion, t + c->phase, t, c->pose);
     memset(c->pose, 0, sizeof(float) * 12 * (size_t)s->asset->nbones);
     for (int32_t b = 0; b < s->asset->nbones; ++b)
         c->pose[12 * b] = c->pose[12 * b + 4] = c->pose[12 * b + 8] = 1;
     return 1;
 }
 
+static int moves(const vw_sim *s) {
+    return s->motion.root_bone >= 0 || s->motion.walk != 0 || s->motion.turn != 0;
+}
+
+/* The actor's frame to the world's, for drawing. */
+static void to_world(const vw_sim *s, const vw_char *c, float *pos, float *nrm) {
+    for (int32_t v = 0; moves(s) && v < s->asset->nverts; ++v)
+        vw_planar_apply(&c->actor, pos + 3 * v, 1), vw_planar_apply(&c->actor, nrm + 3 * v, 0);
+}
+
 static void step_one(vw_sim *s, vw_char *c, double t, float dt) {
     const vw_asset *a = s->asset;
     if (!pose_at(s, c, t)) return;
+    if (moves(s) && !s->rest_pose) {
+        if (c->last_t >= 0 && t > c->last_t && t - c->last_t <= 0.25)
+            vw_motion_advance(a, &s->motion, c->last_t + c->phase, t + c->phase, t, &c->actor);
+        double A[12];
+        vw_planar_matrix(&c->actor, A);
+        sinew_instance_set_actor(c->inst, A);
+    }
+    c->last_t = t;
     c->last = sinew_instance_set_pose(c->inst, c->pose, (uint32_t)a->nbones);
     if (c->last == SINEW_OK) c->last = sinew_instance_step(c->inst, dt);
     sinew_instance_get_stats(c->inst, &c->stats);
     sinew_instance_read_surface(c->inst, c->pos, c->nrm, (uint32_t)a->nverts);
+    to_world(s, c, c->pos, c->nrm);
 }
 
 static void *worker(void *arg) {
@@ -125,13 +146,15 @@ void vw_sim_step(vw_sim *s, double t, float dt) {
 
 void vw_sim_teleport(vw_sim *s) {
     for (int32_t i = 0; i < s->n; ++i)
-        sinew_instance_mark_teleport(s->ch[i].inst);
+        sinew_instance_mark_teleport(s->ch[i].inst), s->ch[i].last_t = -1;
 }
 
 void vw_sim_skin(vw_sim *s, int dqs) {
     for (int32_t i = 0; i < s->n; ++i) {
         vw_char *c = &s->ch[i];
-        if (pose_at(s, c, s->t)) vw_skin(s->asset, c->pose, dqs, c->skin_pos, c->skin_nrm);
+        if (!pose_at(s, c, s->t)) continue;
+        vw_skin(s->asset, c->pose, dqs, c->skin_pos, c->skin_nrm);
+        to_world(s, c, c->skin_pos, c->skin_nrm);
     }
 }
 

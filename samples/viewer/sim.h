@@ -6,6 +6,7 @@
 #include <sinew/sinew.h>
 #include <sinew/sinew_world.h>
 
+#include "motion.h"
 #include "viewer.h"
 
 typedef struct vw_char {
@@ -15,13 +16,16 @@ typedef struct vw_char {
     float *skin_pos, *skin_nrm;
     sinew_step_stats stats;
     sinew_result last;
-    double phase; /* seconds added to the clip time */
+    double phase;    /* seconds added to the clip time */
+    vw_planar actor; /* where the actor stands (root motion, walking) */
+    double last_t;   /* simulation time of the last step, or -1 */
 } vw_char;
 
 typedef struct vw_sim {
     const sinew_blob *blob;
     const vw_asset *asset;
-    int clip, threads, dynamic;
+    vw_motion motion;
+    int threads, dynamic;
     const sinew_world *world; /* or NULL; set before vw_sim_create's instances */
     int rest_pose;            /* hold the rest pose (a world file's "pose": "rest") */
     int32_t n;
@@ -29,12 +33,13 @@ typedef struct vw_sim {
     double t; /* clip time of the last step */
 } vw_sim;
 
-int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, int clip, int32_t n,
-                  int threads, int dynamic, const sinew_world *world, int rest_pose, char *err,
-                  size_t errlen);
+int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, const vw_motion *m,
+                  int32_t n, int threads, int dynamic, const sinew_world *world, int rest_pose,
+                  char *err, size_t errlen);
 /* Recreates the instances in the other step mode (instances are created in one mode). */
 int vw_sim_set_mode(vw_sim *s, int dynamic, char *err, size_t errlen);
-/* Advances every character to clip time t by dt seconds. */
+/* Advances every character to simulation time t by dt seconds (a jump back, or of more
+ * than a quarter second, is a cut: the actor does not move across it). */
 void vw_sim_step(vw_sim *s, double t, float dt);
 void vw_sim_teleport(vw_sim *s);
 /* Fills every character's skinned surface at its last pose. */

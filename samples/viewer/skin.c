@@ -6,29 +6,17 @@
 
 #include "viewer.h"
 
-/* Unit quaternion (w, x, y, z) of a rotation matrix (row-major 3x3, scale removed). */
+/* Unit quaternion (w, x, y, z) of a bone transform's rotation (its uniform scale removed). */
 static void mat_quat(const float *T, float *q) {
     double s = cbrt(fabs((double)T[0] * (T[4] * T[8] - T[5] * T[7]) -
                          (double)T[1] * (T[3] * T[8] - T[5] * T[6]) +
                          (double)T[2] * (T[3] * T[7] - T[4] * T[6])));
-    double R[9];
+    double R[9], qd[4];
     for (int k = 0; k < 9; ++k)
         R[k] = s > 0 ? T[k] / s : (k % 4 == 0);
-    double tr = R[0] + R[4] + R[8], w, x, y, z, k4;
-    if (tr > 0) {
-        k4 = 2 * sqrt(tr + 1), w = 0.25 * k4, x = (R[7] - R[5]) / k4, y = (R[2] - R[6]) / k4,
-        z = (R[3] - R[1]) / k4;
-    } else if (R[0] > R[4] && R[0] > R[8]) {
-        k4 = 2 * sqrt(fmax(0.0, 1 + R[0] - R[4] - R[8]));
-        w = (R[7] - R[5]) / k4, x = 0.25 * k4, y = (R[1] + R[3]) / k4, z = (R[2] + R[6]) / k4;
-    } else if (R[4] > R[8]) {
-        k4 = 2 * sqrt(fmax(0.0, 1 + R[4] - R[0] - R[8]));
-        w = (R[2] - R[6]) / k4, x = (R[1] + R[3]) / k4, y = 0.25 * k4, z = (R[5] + R[7]) / k4;
-    } else {
-        k4 = 2 * sqrt(fmax(0.0, 1 + R[8] - R[0] - R[4]));
-        w = (R[3] - R[1]) / k4, x = (R[2] + R[6]) / k4, y = (R[5] + R[7]) / k4, z = 0.25 * k4;
-    }
-    q[0] = (float)w, q[1] = (float)x, q[2] = (float)y, q[3] = (float)z;
+    vw_quat_from_matrix(R, qd);
+    for (int k = 0; k < 4; ++k)
+        q[k] = (float)qd[k];
 }
 
 static void qrot(const float *q, const float *v, float *o) {

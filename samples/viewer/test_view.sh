@@ -62,7 +62,7 @@ else
     set +e
     "${run[@]}" "$view" --blob "$tmp/f.blob" --asset "$fox" --frames 1 2>"$tmp/err"; rc=$?
     set -e
-    refused "$rc" "bones, the blob" "an asset that is not the blob's"
+    refused "$rc" "is no node of the file" "an asset that is not the blob's (its bones by name)"
 fi
 
 printf '0.5 s\n0.6 s\n' >"$tmp/script" # slow motion on and off again: the script is read
@@ -78,11 +78,62 @@ if [ "$what" = finger ]; then # a world file: the table rises into the finger
     "${run[@]}" "$view" "${args[@]}" --world "$here/../worlds/finger_table.json" --frames 33 \
         --screenshot "$tmp/world.png" >/dev/null
     python3 "$here/check_shot.py" present "$tmp/world.png"
+    # a mesh (OBJ) and a hull collider load, are drawn and touch the finger
+    "${run[@]}" "$view" "${args[@]}" --world "$here/../worlds/finger_props.json" --frames 20 \
+        --json >"$tmp/props.json"
+    grep -q '"world_contacts_max": [1-9]' "$tmp/props.json" || {
+        cat "$tmp/props.json"; echo "FAIL: the mesh and hull colliders make no contact"; exit 1; }
+    sed 's/"sphere"/"cone"/' "$here/../worlds/fox_poke.json" >"$tmp/cone.json"
     set +e
-    "${run[@]}" "$view" "${args[@]}" --world "$here/../worlds/finger_props.json" --frames 1 2>"$tmp/err"
+    "${run[@]}" "$view" "${args[@]}" --world "$tmp/cone.json" --frames 1 2>"$tmp/err"
     rc=$?
     set -e
-    refused "$rc" "shape 'mesh'" "a mesh collider"
+    refused "$rc" "shape 'cone'" "an unknown collider shape"
+else
+    # a cross-fade into the held-out Run while the actor walks a quarter circle (50 units a
+    # second turning 90 degrees a second: radius 31.8, so 45 from the start after 1 s)
+    walked() { # FRAMES EXPECTED_DISTANCE EXPECTED_HEADING TOLERANCE ARGS...
+        local frames=$1 dist=$2 yaw=$3 tol=$4
+        shift 4
+        "${run[@]}" "$view" "${args[@]}" --view sinew --frames "$frames" "$@" \
+            --screenshot "$tmp/walk.png" --json >"$tmp/walk.json"
+        cat "$tmp/walk.json"
+        python3 "$here/check_shot.py" present "$tmp/walk.png"
+        python3 - "$tmp/walk.json" "$dist" "$yaw" "$tol" <<'EOS'
+import json, math, sys
+x, z, yaw = json.load(open(sys.argv[1]))["actor"]
+dist, want, tol = (float(a) for a in sys.argv[2:])
+if not (abs(yaw - want) < tol and abs(math.hypot(x, z) - dist) < tol):
+    sys.exit("FAIL: the actor should be %g from the start heading %g: at (%g, %g) heading %g"
+             % (dist, want, x, z, yaw))
+EOS
+    }
+    walked 60 45 90 0.5 --fade-to Run --fade-at 0.2 --fade-time 0.3 --walk 50 --turn 90
+    # root motion of a clip animated in place: the hip's sway moves the actor within a
+    # cycle and back, across the loop's end (2 loops of the 0.708 s Walk: 85 steps)
+    walked 85 0 0 0.1 --root-motion b_Hip_01
+    # the poke: a scripted drag pushes a sphere into the Fox's face
+    cat >"$tmp/poke" <<'EOS'
+1.0 press 0.30 0.45
+1.1 move 0.33 0.45
+1.2 move 0.36 0.45
+1.3 move 0.39 0.45
+1.4 move 0.42 0.45
+1.5 move 0.45 0.45
+2.5 release
+EOS
+    "${run[@]}" "$view" "${args[@]}" --view sinew --world "$here/../worlds/fox_poke.json" \
+        --script "$tmp/poke" --frames 100 --screenshot "$tmp/poke.png" --json >"$tmp/poke.json"
+    cat "$tmp/poke.json"
+    python3 "$here/check_shot.py" present "$tmp/poke.png"
+    python3 - "$tmp/poke.json" <<'EOS'
+import json, sys
+j = json.load(open(sys.argv[1]))
+press, first, most = j["first_press_s"], j["first_contact_s"], j["world_contacts_max"]
+if not (press >= 0 and most > 0 and first >= press):
+    sys.exit("FAIL: the poke (pressed at %g s) should make the first world contact (%g s; "
+             "most %d in a step)" % (press, first, most))
+EOS
 fi
 if command -v ffmpeg >/dev/null 2>&1; then
     "${run[@]}" "$view" "${args[@]}" --frames 10 --record "$tmp/v.mp4" >/dev/null

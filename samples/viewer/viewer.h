@@ -5,15 +5,22 @@
 #ifndef SW_VIEWER_H
 #define SW_VIEWER_H
 
+#include <sinew/sinew.h>
 #include <stdint.h>
 #include <stdio.h>
 
 #define VW_MAX_BONES 256
 #define VW_MAX_CLIPS 64
 
+/* One node's local transform: translation, rotation (w, x, y, z), scale. */
+typedef struct vw_trs {
+    double t[3], q[4], s[3];
+} vw_trs;
+
 /* What the host imported: the render mesh with its skin weights (4 per vertex), the
  * skeleton's bind transforms and the clips, as an engine's asset pipeline would hold
- * them. Bone b and vertex v are in the order the bake imported them (see asset.c). */
+ * them. Bone b is the blob's bone of the same name, vertex v the blob's output vertex v
+ * (found through the blob's output map: see asset.c). */
 typedef struct vw_asset {
     int32_t nbones, nverts, ntris;
     float *rest;    /* 3 nverts, bind pose */
@@ -28,11 +35,19 @@ typedef struct vw_asset {
     /* Bone transforms (12 floats each: 3x3 row-major, then the translation) mapping the
      * bind pose to the pose of `clip` at `t` seconds (looped). */
     int (*pose)(const struct vw_asset *a, int clip, double t, float *out);
+    /* For blending clips (NULL for a procedural scene): the nnodes node-local transforms
+     * of `clip` at t seconds (looped), and the bone transforms (as pose's) of such locals. */
+    int32_t nnodes;
+    int (*sample)(const struct vw_asset *a, int clip, double t, vw_trs *local);
+    int (*compose)(const struct vw_asset *a, const vw_trs *local, float *out);
     void (*release)(struct vw_asset *a);
 } vw_asset;
 
-/* Imports FILE with assimp. 0 on success; otherwise writes a message into err. */
-int vw_asset_import(const char *path, vw_asset *out, char *err, size_t errlen);
+/* Imports FILE with assimp and maps it onto `blob`: each blob bone to the file's node of
+ * that name, each output vertex to its source mesh's vertex (the blob's output map). 0 on
+ * success; otherwise writes a message into err (a name or a vertex the file lacks). */
+int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *out, char *err,
+                    size_t errlen);
 
 /* A procedural sample scene ("finger", "cylinder", "capsule") described as the bake
  * generates it, skinning the blob's own rest surface (rest: 3 nverts floats, tris). */
@@ -50,6 +65,12 @@ int vw_asset_weld(vw_asset *a);
 /* Area-weighted vertex normals of a triangle mesh, shared across weld (NULL: none). */
 void vw_normals(const float *pos, int32_t nverts, const uint32_t *tris, int32_t ntris,
                 const int32_t *weld, float *nrm);
+
+/* Unit quaternions (w, x, y, z) and 3x3 row-major rotations (quat.c). */
+void vw_quat_from_matrix(const double *R, double *q);
+void vw_quat_matrix(const double *q, double *R);
+/* Slerp from a (u = 0) to b (u = 1) along the shorter arc, normalised. */
+void vw_quat_slerp(const double *a, const double *b, double u, double *o);
 
 /* 8-bit RGB PNG (zlib-compressed), rows top first. 0 on success. */
 int vw_write_png(const char *path, int w, int h, const uint8_t *rgb);

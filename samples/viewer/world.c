@@ -31,6 +31,129 @@ static int read_float(const cJSON *o, const char *name, float *out) {
     return 1;
 }
 
+/* An OBJ's vertices and faces (fanned into triangles; negative indices count back). */
+static int read_obj(const char *path, vw_collider *c, char *err, size_t errlen) {
+    FILE *f = fopen(path, "r");
+    if (!f) return FAIL("%s: cannot open", path);
+    char line[1024];
+    int nv = 0, nt = 0, cv = 0, ct = 0, ok = 1, ln = 0;
+    while (ok && fgets(line, sizeof line, f)) {
+        ln++;
+        if (line[0] == 'v' && line[1] == ' ') {
+            float p[3];
+            if (sscanf(line + 2, "%f %f %f", &p[0], &p[1], &p[2]) != 3 ||
+                !isfinite(p[0] + p[1] + p[2])) {
+                ok = FAIL("%s:%d: a vertex needs 3 numbers", path, ln);
+                break;
+            }
+            if (nv == cv) {
+                cv = cv ? 2 * cv : 64;
+                float *g = realloc(c->shape, sizeof(float) * 3 * (size_t)cv);
+                if (!g)
+                    ok = FAIL("out of memory");
+                else
+                    c->shape = g;
+            }
+            if (ok) memcpy(c->shape + 3 * nv++, p, sizeof p);
+        } else if (line[0] == 'f' && line[1] == ' ') {
+            long idx[64];
+            int n = 0;
+            for (char *t = strtok(line + 2, " \t\r\n"); t && n < 64; t = strtok(NULL, " \t\r\n")) {
+                long k = strtol(t, NULL, 10);
+                idx[n++] = k < 0 ? nv + k : k - 1;
+            }
+            for (int k = 0; k < n && ok; ++k)
+                if (idx[k] < 0 || idx[k] >= nv)
+                    ok = FAIL("%s:%d: a face names a vertex not yet given", path, ln);
+            for (int k = 2; k < n && ok; ++k) {
+                if (nt == ct) {
+                    ct = ct ? 2 * ct : 64;
+                    uint32_t *g = realloc(c->shape_tris, sizeof(uint32_t) * 3 * (size_t)ct);
+                    if (!g) {
+                        ok = FAIL("out of memory");
+                        break;
+                    }
+                    c->shape_tris = g;
+                }
+                const uint32_t tri[3] = {(uint32_t)idx[0], (uint32_t)idx[k - 1], (uint32_t)idx[k]};
+                memcpy(c->shape_tris + 3 * nt++, tri, sizeof tri);
+            }
+        }
+    }
+    fclose(f);
+    if (ok && (!nv || !nt)) ok = FAIL("%s: no triangles", path);
+    c->def.vertices = c->shape, c->def.vertex_count = (uint32_t)nv;
+    c->def.indices = c->shape_tris, c->def.triangle_count = (uint32_t)nt;
+    return ok;
+}
+
+static int read_hull(const cJSON *o, vw_collider *c, int i, char *err, size_t errlen) {
+    const cJSON *pts = cJSON_GetObjectItemCaseSensitive(o, "points"), *p;
+    const int n = cJSON_IsArray(pts) ? cJSON_GetArraySize(pts) : 0;
+    if (n < 4 || n > VW_WORLD_MAX_HULL)
+        return FAIL("collider %d (hull): 4 to %d points (the viewer draws hulls of so many)", i,
+                    VW_WORLD_MAX_HULL);
+    c->shape = malloc(sizeof(float) * 3 * (size_t)n);
+    if (!c->shape) return FAIL("out of memory");
+    int k = 0;
+    cJSON_ArrayForEach(p, pts) {
+        if (!cJSON_IsArray(p) || cJSON_GetArraySize(p) != 3)
+            return FAIL("collider %d (hull): point %d is not [x, y, z]", i, k);
+        for (int j = 0; j < 3; ++j) {
+            const cJSON *x = cJSON_GetArrayItem(p, j);
+            if (!cJSON_IsNumber(x) || !isfinite(x->valuedouble))
+                return FAIL("collider %d (hull): point %d is not [x, y, z]", i, k);
+            c->shape[3 * k + j] = (float)x->valuedouble;
+        }
+        k++;
+    }
+    c->def.points = c->shape, c->def.point_count = (uint32_t)n;
+    return 1;
+}
+
+/* A hull's faces for drawing: every triangle of points with all points behind it
+ * (O(n^4), hence the viewer's limit on hull points; coplanar points give overlapping
+ * triangles, drawn alike). */
+static int hull_mesh(vw_collider *c) {
+    const int n = (int)c->def.point_count;
+    const float *p = c->shape;
+    int cap = 64;
+    c->tris = malloc(sizeof(uint32_t) * 3 * (size_t)cap);
+    c->local = malloc(sizeof(float) * 3 * (size_t)n);
+    if (!c->tris || !c->local) return 0;
+    memcpy(c->local, p, sizeof(float) * 3 * (size_t)n);
+    c->nverts = n, c->ntris = 0;
+    for (int a = 0; a < n; ++a)
+        for (int b = a + 1; b < n; ++b)
+            for (int d = b + 1; d < n; ++d) {
+                const float *A = p + 3 * a, *B = p + 3 * b, *D = p + 3 * d;
+                float e1[3] = {B[0] - A[0], B[1] - A[1], B[2] - A[2]},
+                      e2[3] = {D[0] - A[0], D[1] - A[1], D[2] - A[2]};
+                float nn[3] = {e1[1] * e2[2] - e1[2] * e2[1], e1[2] * e2[0] - e1[0] * e2[2],
+                               e1[0] * e2[1] - e1[1] * e2[0]};
+                float l = sqrtf(nn[0] * nn[0] + nn[1] * nn[1] + nn[2] * nn[2]);
+                if (!(l > 1e-12f)) continue;
+                int above = 0, below = 0;
+                for (int q = 0; q < n; ++q) {
+                    float s = (nn[0] * (p[3 * q] - A[0]) + nn[1] * (p[3 * q + 1] - A[1]) +
+                               nn[2] * (p[3 * q + 2] - A[2])) /
+                              l;
+                    above += s > 1e-6f, below += s < -1e-6f;
+                }
+                if (above && below) continue;
+                if (c->ntris == cap) {
+                    cap *= 2;
+                    uint32_t *g = realloc(c->tris, sizeof(uint32_t) * 3 * (size_t)cap);
+                    if (!g) return 0;
+                    c->tris = g;
+                }
+                const uint32_t t[3] = {(uint32_t)a, (uint32_t)(above ? d : b),
+                                       (uint32_t)(above ? b : d)};
+                memcpy(c->tris + 3 * c->ntris++, t, sizeof t);
+            }
+    return 1;
+}
+
 /* A unit sphere's mesh (rings x segments), stretched per shape below. */
 static int sphere_mesh(vw_collider *c, int rings, int segs) {
     c->nverts = (rings + 1) * (segs + 1), c->ntris = 2 * rings * segs;
@@ -59,7 +182,16 @@ static int sphere_mesh(vw_collider *c, int rings, int segs) {
  * (hemispheres pushed apart) or a plane's square. */
 static int collider_mesh(vw_collider *c, float size) {
     const sinew_collider_def *d = &c->def;
-    if (d->shape == SINEW_SHAPE_BOX) {
+    if (d->shape == SINEW_SHAPE_HULL) {
+        if (!hull_mesh(c)) return 0;
+    } else if (d->shape == SINEW_SHAPE_MESH) {
+        c->nverts = (int32_t)d->vertex_count, c->ntris = (int32_t)d->triangle_count;
+        c->local = malloc(sizeof(float) * 3 * (size_t)c->nverts);
+        c->tris = malloc(sizeof(uint32_t) * 3 * (size_t)c->ntris);
+        if (!c->local || !c->tris) return 0;
+        memcpy(c->local, c->shape, sizeof(float) * 3 * (size_t)c->nverts);
+        memcpy(c->tris, c->shape_tris, sizeof(uint32_t) * 3 * (size_t)c->ntris);
+    } else if (d->shape == SINEW_SHAPE_BOX) {
         static const float corner[8][3] = {{-1, -1, -1}, {1, -1, -1}, {1, 1, -1}, {-1, 1, -1},
                                            {-1, -1, 1},  {1, -1, 1},  {1, 1, 1},  {-1, 1, 1}};
         static const uint32_t faces[12][3] = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7},
@@ -110,7 +242,8 @@ static int collider_mesh(vw_collider *c, float size) {
     return c->pos && c->nrm;
 }
 
-static int read_collider(const cJSON *o, vw_collider *c, int i, char *err, size_t errlen) {
+static int read_collider(const cJSON *o, const char *dir, vw_collider *c, int i, char *err,
+                         size_t errlen) {
     c->def = sinew_collider_def_default();
     sinew_collider_def *d = &c->def;
     const cJSON *sh = cJSON_GetObjectItemCaseSensitive(o, "shape");
@@ -128,9 +261,20 @@ static int read_collider(const cJSON *o, vw_collider *c, int i, char *err, size_
     } else if (!strcmp(s, "plane")) {
         d->shape = SINEW_SHAPE_PLANE;
         ok = read_floats(o, "normal", d->normal, 3, 0) && read_float(o, "offset", &d->offset);
+    } else if (!strcmp(s, "hull")) {
+        d->shape = SINEW_SHAPE_HULL;
+        if (!read_hull(o, c, i, err, errlen)) return 0;
+    } else if (!strcmp(s, "mesh")) {
+        const cJSON *obj = cJSON_GetObjectItemCaseSensitive(o, "obj");
+        char path[1024];
+        d->shape = SINEW_SHAPE_MESH;
+        if (!cJSON_IsString(obj)) return FAIL("collider %d (mesh): \"obj\" names no file", i);
+        /* (relative to the world file, as the tools read it) */
+        snprintf(path, sizeof path, "%s%.900s", obj->valuestring[0] == '/' ? "" : dir,
+                 obj->valuestring);
+        if (!read_obj(path, c, err, errlen)) return 0;
     } else {
-        return FAIL("collider %d: shape '%s' (the viewer draws sphere, capsule, box and plane)", i,
-                    s);
+        return FAIL("collider %d: shape '%s' (sphere, capsule, box, plane, hull or mesh)", i, s);
     }
     ok = ok && read_float(o, "friction", &d->friction) && read_float(o, "stiffness", &d->stiffness);
     if (!ok) return FAIL("collider %d (%s): a size is missing or not a number", i, s);
@@ -163,6 +307,9 @@ int vw_world_load(const char *path, vw_world *w, char *err, size_t errlen) {
     fclose(f);
     if (!text) return FAIL("out of memory");
     text[n] = 0;
+    char dir[1024] = "";
+    const char *slash = strrchr(path, '/');
+    if (slash && slash - path < (long)sizeof dir - 1) memcpy(dir, path, (size_t)(slash - path) + 1);
     cJSON *root = cJSON_Parse(text);
     free(text);
     if (!root) return FAIL("%s: not JSON (or larger than 1 MiB)", path);
@@ -182,7 +329,7 @@ int vw_world_load(const char *path, vw_world *w, char *err, size_t errlen) {
             break;
         }
         vw_collider *vc = &w->col[w->ncol++];
-        ok = read_collider(c, vc, w->ncol - 1, err, errlen);
+        ok = read_collider(c, dir, vc, w->ncol - 1, err, errlen);
         if (!ok) break;
         sinew_result r = sinew_world_add_collider(w->world, &vc->def, &vc->id);
         if (r != SINEW_OK)
@@ -215,7 +362,11 @@ void vw_world_move(vw_world *w, double t) {
     for (int i = 0; i < w->ncol; ++i) {
         vw_collider *c = &w->col[i];
         sinew_transform tr = c->def.transform;
-        if (c->nkeys) {
+        if (c->held) {
+            tr = c->now;
+            memcpy(tr.position, c->hold, sizeof c->hold);
+            sinew_world_set_collider_transform(w->world, c->id, &tr);
+        } else if (c->nkeys) {
             int k = 0;
             while (k + 1 < c->nkeys && c->keys[k + 1].frame <= frame)
                 ++k;
@@ -233,13 +384,28 @@ void vw_world_move(vw_world *w, double t) {
                     (float)((1 - u) * a->rotation[j] + u * (dot < 0 ? -1 : 1) * b->rotation[j]);
             sinew_world_set_collider_transform(w->world, c->id, &tr);
         }
+        c->now = tr;
         place(c, &tr);
     }
 }
 
+void vw_world_hold(vw_world *w, int i, const float p[3]) {
+    vw_collider *c = &w->col[i];
+    c->held = 1;
+    memcpy(c->hold, p, sizeof c->hold);
+    memcpy(c->now.position, p, sizeof c->hold);
+    sinew_world_set_collider_transform(w->world, c->id, &c->now);
+    place(c, &c->now);
+}
+
+void vw_world_position(const vw_world *w, int i, float p[3]) {
+    memcpy(p, w->col[i].now.position, 3 * sizeof(float));
+}
+
 void vw_world_free(vw_world *w) {
     for (int i = 0; i < w->ncol; ++i)
-        free(w->col[i].local), free(w->col[i].pos), free(w->col[i].nrm), free(w->col[i].tris);
+        free(w->col[i].local), free(w->col[i].pos), free(w->col[i].nrm), free(w->col[i].tris),
+            free(w->col[i].shape), free(w->col[i].shape_tris);
     sinew_world_destroy(w->world);
     memset(w, 0, sizeof *w);
 }
