@@ -1,0 +1,219 @@
+"""How a blob maps onto a Blender armature and mesh, and the preview that steps it.
+
+Three spaces meet here: the blob's rest space R (the baked file's, after the bake's import),
+the mesh object's local space M (where mesh.vertices live) and the armature's space. Bone
+orientations differ between Blender and the file (the glTF importer turns bones to point
+along +Y), so nothing is mapped through bone frames: a bone's sinew transform is its
+skinning matrix (posed times inverse rest, which is orientation-free) carried into R by a
+similarity A: M -> R fitted to the bone heads, which every exporter and importer keeps.
+"""
+
+import time
+
+import numpy as np
+
+from . import sinew_lib
+
+
+class BindError(RuntimeError):
+    """The blob does not fit this armature or mesh; the message says why."""
+
+
+def _similarity(src, dst):
+    """The scale * rotation + translation taking the points `src` onto `dst` in the least
+    squares sense (Umeyama 1991), as a 4x4 matrix."""
+    mu_s, mu_d = src.mean(0), dst.mean(0)
+    s0, d0 = src - mu_s, dst - mu_d
+    var = (s0**2).sum() / len(src)
+    if var <= 0:
+        raise BindError("the armature's bones all sit at one point")
+    u, sig, vt = np.linalg.svd(d0.T @ s0 / len(src))
+    d = np.ones(3)
+    if np.linalg.det(u) * np.linalg.det(vt) < 0:
+        d[2] = -1
+    rot = u @ np.diag(d) @ vt
+    scale = (sig * d).sum() / var
+    a = np.eye(4)
+    a[:3, :3] = scale * rot
+    a[:3, 3] = mu_d - scale * rot @ mu_s
+    return a
+
+
+def _matrix(m):
+    return np.array([list(row) for row in m], dtype=np.float64)
+
+
+class Binding:
+    """A blob bound to (armature, mesh): the bone order, the space map, the vertex map.
+    Raises BindError naming what does not fit."""
+
+    def __init__(self, blob, arm_obj, mesh_obj):
+        self.blob, self.arm, self.mesh = blob, arm_obj, mesh_obj
+        names = blob.bone_names()
+        pose_names = [pb.name for pb in arm_obj.pose.bones]
+        index = {n: i for i, n in enumerate(pose_names)}
+        missing = [n for n in names if n not in index]
+        if missing:
+            more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
+            raise BindError(
+                f"the blob's bones {', '.join(missing[:5])}{more} are not in the armature "
+                f"'{arm_obj.name}': the blob was baked from another character"
+            )
+        self.pose_index = np.array([index[n] for n in names])
+        self.npose = len(pose_names)
+
+        # armature space -> mesh space, fixed while previewing
+        k = _matrix(mesh_obj.matrix_world.inverted() @ arm_obj.matrix_world)
+        heads = np.array([list(arm_obj.data.bones[n].head_local) + [1.0] for n in names])
+        heads_m = (heads @ k.T)[:, :3]
+        binds = np.array([blob.bone_bind(i)[9:12] for i in range(len(names))])
+        self.A = _similarity(heads_m, binds)
+        self.A_inv = np.linalg.inv(self.A)
+        size = float(np.linalg.norm(binds.max(0) - binds.min(0)))
+        fit = np.abs((heads_m @ self.A[:3, :3].T + self.A[:3, 3]) - binds).max()
+        if fit > 1e-3 * size:
+            raise BindError(
+                f"the armature's bone heads are {fit:.3g} units from the blob's bind pose: "
+                "the armature was moved or re-rigged since the bake, or the blob is another "
+                "character's; bake again"
+            )
+        # T_b = L P_b Q_b: armature -> R on the left, inverse rest -> M on the right
+        self.L = self.A @ k
+        rest_inv = np.array([np.linalg.inv(_matrix(arm_obj.data.bones[n].matrix_local)) for n in names])
+        self.Q = rest_inv @ np.linalg.inv(self.L)
+
+        self.nv = len(mesh_obj.data.vertices)
+        self.rest_m = np.empty(3 * self.nv, dtype=np.float32)
+        mesh_obj.data.vertices.foreach_get("co", self.rest_m)
+        self.rest_m = self.rest_m.reshape(-1, 3)
+        self.vmap = self._vertex_map()
+
+    def _rest_surface(self):
+        inst = sinew_lib.Instance(self.blob)
+        try:
+            pose = np.tile(np.array([1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0], np.float32), self.blob.bone_count)
+            inst.set_pose(pose)
+            inst.step(1.0 / 24.0)
+            out = np.empty(3 * self.blob.vertex_count, np.float32)
+            inst.read_surface(out)
+        finally:
+            inst.close()
+        return out.reshape(-1, 3).astype(np.float64)
+
+    def _vertex_map(self):
+        """For each mesh vertex the output vertex that moves it: the blob's output map when
+        the baked file's vertices are this mesh's (one source mesh, same order), else the
+        nearest output vertex at rest. Either way checked at rest."""
+        rest_r = self._rest_surface()
+        mine = self.rest_m.astype(np.float64) @ self.A[:3, :3].T + self.A[:3, 3]
+        size = float(np.linalg.norm(rest_r.max(0) - rest_r.min(0)))
+        self.size = size
+        tol = 2e-3 * size  # the rest step's correction plus float rounding of the export
+        sources = self.blob.output_sources()
+        if self.blob.lib.blob_source_mesh_count(self.blob.handle) == 1 and len(sources) == self.nv:
+            direct = np.full(self.nv, -1)
+            for out, (m, v) in enumerate(sources):
+                if 0 <= v < self.nv:
+                    direct[v] = out
+            if (direct >= 0).all() and np.linalg.norm(rest_r[direct] - mine, axis=1).max() <= tol:
+                return direct
+        from mathutils.kdtree import KDTree
+
+        tree = KDTree(len(rest_r))
+        for i, p in enumerate(rest_r):
+            tree.insert(p, i)
+        tree.balance()
+        vmap = np.empty(self.nv, dtype=np.int64)
+        worst = 0.0
+        for j, p in enumerate(mine):
+            _, i, d = tree.find(p)
+            vmap[j] = i
+            worst = max(worst, d)
+        if worst > tol:
+            raise BindError(
+                f"mesh '{self.mesh.name}' is not the blob's surface (a vertex {worst:.3g} units "
+                f"from it, {worst / size:.2%} of the size): bake again, or choose the baked mesh"
+            )
+        return vmap
+
+    def pose_transforms(self, pose_bones, out):
+        """Writes the blob-order bone transforms (bone_count x 12 float32) of the posed
+        armature into `out`."""
+        flat = np.empty(16 * self.npose, dtype=np.float64)
+        pose_bones.foreach_get("matrix", flat)
+        # foreach_get gives each matrix column after column
+        p = flat.reshape(-1, 4, 4).transpose(0, 2, 1)[self.pose_index]
+        t = self.L @ p @ self.Q
+        out[:, :9] = t[:, :3, :3].reshape(-1, 9)
+        out[:, 9:] = t[:, :3, 3]
+
+    def to_mesh(self, surface):
+        """Output surface (R) -> mesh vertex positions (M), float32, mesh vertex order."""
+        s = surface.reshape(-1, 3)[self.vmap].astype(np.float64)
+        return (s @ self.A_inv[:3, :3].T + self.A_inv[:3, 3]).astype(np.float32)
+
+
+class Preview:
+    """An instance stepped from the armature's pose at every frame change, written into
+    the mesh. Quasistatic: any frame order (backwards resets first). Dynamic: forward one
+    frame at a time; a jump back resets, a jump forward is declared a teleport."""
+
+    def __init__(self, binding, dynamic, fps, record=False):
+        self.b, self.dynamic, self.dt = binding, dynamic, 1.0 / fps
+        self.inst = sinew_lib.Instance(binding.blob, dynamic)
+        nb = binding.blob.bone_count
+        self.pose = np.zeros((nb, 12), dtype=np.float32)
+        self.surface = np.zeros(3 * binding.blob.vertex_count, dtype=np.float32)
+        self.last_frame = None
+        self.record = [] if record else None
+        self.frames, self.failed = {}, 0
+        self.ms_total, self.ms_step = [], []
+        mesh = binding.mesh
+        self.modifiers = [(m.name, m.show_viewport, m.show_render) for m in mesh.modifiers if m.type == "ARMATURE"]
+        for m in mesh.modifiers:  # the flesh is the simulation's now, not the skinning's
+            if m.type == "ARMATURE":
+                m.show_viewport = m.show_render = False
+
+    def update(self, frame, pose_bones):
+        t0 = time.perf_counter()
+        reset = teleport = False
+        if self.last_frame is not None and frame == self.last_frame:
+            return
+        if self.last_frame is None or frame < self.last_frame:
+            reset = self.last_frame is not None
+        elif self.dynamic and frame != self.last_frame + 1:
+            teleport = True
+        if reset:
+            self.inst.reset()
+        if teleport:
+            self.inst.mark_teleport()
+        self.b.pose_transforms(pose_bones, self.pose)
+        self.inst.set_pose(self.pose)
+        t1 = time.perf_counter()
+        status = self.inst.step(self.dt)
+        t2 = time.perf_counter()
+        self.inst.read_surface(self.surface)
+        co = self.b.to_mesh(self.surface)
+        mesh = self.b.mesh.data
+        mesh.vertices.foreach_set("co", co.ravel())
+        mesh.update()
+        self.last_frame = frame
+        if status & sinew_lib.STEP_FAILED:
+            self.failed += 1
+        self.frames[frame] = co
+        if self.record is not None:
+            self.record.append({"frame": frame, "reset": reset, "teleport": teleport, "dt": self.dt, "pose": self.pose.ravel().tolist()})
+        t3 = time.perf_counter()
+        self.ms_total.append(1e3 * (t3 - t0))
+        self.ms_step.append(1e3 * (t2 - t1))
+
+    def stop(self):
+        """Puts the rest mesh and the armature modifiers back."""
+        mesh = self.b.mesh
+        mesh.data.vertices.foreach_set("co", self.b.rest_m.ravel())
+        mesh.data.update()
+        for name, viewport, render in self.modifiers:
+            m = mesh.modifiers.get(name)
+            if m:
+                m.show_viewport, m.show_render = viewport, render
+        self.inst.close()
