@@ -1,0 +1,270 @@
+"""Headless sinew in Blender, for pipelines and tests:
+
+    blender -b --factory-startup --python-exit-code 1 -P samples/blender/run.py -- \\
+        ASSET --tets N --out DIR [--frames F] [--train A,B] [--heldout C] [--play CLIP]
+        [--dynamic] [--lib libsinew.so] [--bake sinew-bake] [--no-gltf] [--no-render]
+
+imports ASSET (glTF or FBX, Blender's importers), bakes it through the add-on, plays F
+frames of a clip through the preview, exports them (PC2, MDD, shape keys, glTF morph
+targets), reads the caches back, renders one frame with Workbench to DIR/frame.png and
+writes DIR/run.json with the figures and DIR/preview_record.json with the poses the
+preview stepped (check_replay.py steps them again outside Blender).
+"""
+
+import argparse
+import json
+import os
+import statistics
+import sys
+import time
+
+import bpy
+import numpy as np
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+import sinew  # noqa: E402  (the add-on package beside this file)
+from sinew import bake, sinew_lib  # noqa: E402
+
+
+def parse():
+    argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
+    ap = argparse.ArgumentParser(prog="run.py", description=__doc__.split("\n\n")[0])
+    ap.add_argument("asset")
+    ap.add_argument("--tets", type=int, required=True)
+    ap.add_argument("--out", required=True)
+    ap.add_argument("--frames", type=int, default=30)
+    ap.add_argument("--train", default="", help="actions (or their glTF clip names) to train on, comma separated")
+    ap.add_argument("--heldout", default="", help="actions to hold out, comma separated")
+    ap.add_argument("--play", default="", help="the action to preview (default: the first held out)")
+    ap.add_argument("--dynamic", action="store_true")
+    ap.add_argument("--lib", default="", help="libsinew.so (default $SINEW_LIB)")
+    ap.add_argument("--bake", default="", help="sinew-bake (default $SINEW_BAKE, then PATH)")
+    ap.add_argument("--no-gltf", action="store_true")
+    ap.add_argument("--no-render", action="store_true")
+    return ap.parse_args(argv)
+
+
+def import_asset(path):
+    ext = os.path.splitext(path)[1].lower()
+    if ext in (".glb", ".gltf"):
+        bpy.ops.import_scene.gltf(filepath=path)
+    elif ext == ".fbx":
+        bpy.ops.import_scene.fbx(filepath=path)
+    else:
+        raise SystemExit(f"run.py: {path}: not a .glb, .gltf or .fbx file")
+    meshes = [o for o in bpy.data.objects if o.type == "MESH" and sinew.armature_of(o)]
+    if not meshes:
+        raise SystemExit(f"run.py: {path} has no mesh deformed by an armature")
+    return max(meshes, key=lambda o: len(o.data.vertices))
+
+
+def choose_clips(mesh_obj, train, heldout):
+    sinew.refresh_clips(mesh_obj)
+    arm = sinew.armature_of(mesh_obj)
+    wanted = {n: "TRAIN" for n in train} | {n: "HELDOUT" for n in heldout}
+    if wanted:
+        for c in mesh_obj.sinew.clips:
+            c.use = wanted.get(c.name, wanted.get(bake.clip_name(arm, c.name), "NONE"))
+
+
+def run_bake(mesh_obj, exe):
+    arm = sinew.armature_of(mesh_obj)
+    path = sinew.blob_path(mesh_obj)
+    report = os.path.splitext(path)[0] + "_report"
+    t0 = time.time()
+    proc, tmp = bake.start(mesh_obj.sinew, arm, mesh_obj, exe, path, report)
+    shown = ""
+    while proc.poll() is None:
+        time.sleep(0.5)
+        if proc.status() != shown:
+            shown = proc.status()
+            print(shown, flush=True)
+    try:
+        summary = proc.result()
+    finally:
+        bake.shutil.rmtree(tmp, ignore_errors=True)
+    return time.time() - t0, summary, report
+
+
+def play_action(scene, mesh_obj, name, nframes):
+    """Makes `name` the armature's only animation and sets the scene's range to its first
+    `nframes` frames."""
+    arm = sinew.armature_of(mesh_obj)
+    action = bpy.data.actions.get(name) or next(
+        (a for a in bpy.data.actions if bake.clip_name(arm, a.name) == name), None
+    )
+    if action is None:
+        raise SystemExit(f"run.py: no action {name}; the file has {', '.join(a.name for a in bpy.data.actions)}")
+    ad = arm.animation_data
+    for t in ad.nla_tracks:
+        t.mute = True
+    ad.action = action
+    first = int(action.frame_range[0])
+    scene.frame_start, scene.frame_end = first, first + nframes - 1
+    return action.name
+
+
+def replay_runtime(p, lib_path):
+    """The same poses stepped by a second instance straight through the C ABI; the largest
+    distance of the mesh's positions (carried back into the blob's space) from it, over
+    the character's size."""
+    b = p.b
+    blob = sinew_lib.Blob(sinew_lib.Library(lib_path), b.blob.path)
+    inst = sinew_lib.Instance(blob, p.dynamic)
+    out = np.empty(3 * blob.vertex_count, np.float32)
+    worst = 0.0
+    for rec in p.record:
+        if rec["reset"]:
+            inst.reset()
+        if rec["teleport"]:
+            inst.mark_teleport()
+        inst.set_pose(np.array(rec["pose"], np.float32))
+        inst.step(rec["dt"])
+        inst.read_surface(out)
+        mine = p.frames[rec["frame"]].astype(np.float64) @ b.A[:3, :3].T + b.A[:3, 3]
+        worst = max(worst, float(np.abs(mine - out.reshape(-1, 3)[b.vmap]).max()))
+    inst.close()
+    blob.close()
+    return worst / b.size
+
+
+def read_back(scene, mesh_obj, path, fmt, frames, cos):
+    """The largest difference between the cache read back by Blender's Mesh Cache modifier
+    and the frames written (0: exact to float)."""
+    m = mesh_obj.modifiers.new("sinew_cache", "MESH_CACHE")
+    m.cache_format, m.filepath = fmt, path
+    m.frame_start = frames[0]
+    bpy.context.view_layer.objects.active = mesh_obj
+    bpy.ops.object.modifier_move_to_index(modifier=m.name, index=0)
+    shape_mute = mesh_obj.data.shape_keys.key_blocks if mesh_obj.data.shape_keys else []
+    for kb in shape_mute:
+        kb.mute = True
+    worst = 0.0
+    buf = np.empty(3 * len(mesh_obj.data.vertices), np.float32)
+    for f, co in zip(frames, cos):
+        scene.frame_set(f)
+        ev = mesh_obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+        ev.data.vertices.foreach_get("co", buf)
+        worst = max(worst, float(np.abs(buf - co.ravel()).max()))
+    for kb in shape_mute:
+        kb.mute = False
+    mesh_obj.modifiers.remove(m)
+    return worst
+
+
+def render(scene, mesh_obj, frame, path):
+    """One Workbench frame of the mesh, seen from the side by an orthographic camera; the
+    share of the centre's pixels that are not background."""
+    scene.frame_set(frame)
+    ev = mesh_obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
+    pts = np.array([ev.matrix_world @ v.co for v in ev.data.vertices])
+    lo, hi = pts.min(0), pts.max(0)
+    centre, ext = (lo + hi) / 2, hi - lo
+    cam_data = bpy.data.cameras.new("sinew_cam")
+    cam_data.type = "ORTHO"
+    cam_data.ortho_scale = 1.2 * float(max(ext[0], ext[2], ext[1]))
+    cam = bpy.data.objects.new("sinew_cam", cam_data)
+    scene.collection.objects.link(cam)
+    d = 2.0 * float(np.linalg.norm(ext))
+    cam.location = (centre[0] + d, centre[1], centre[2])  # looking along -X at the side
+    cam.rotation_euler = (np.pi / 2, 0, np.pi / 2)
+    cam_data.clip_end = 4 * d
+    scene.camera = cam
+    scene.render.engine = "BLENDER_WORKBENCH"
+    scene.render.resolution_x, scene.render.resolution_y, scene.render.resolution_percentage = 320, 240, 100
+    scene.render.film_transparent = False
+    scene.render.image_settings.file_format = "PNG"
+    scene.render.filepath = path
+    bpy.ops.render.render(write_still=True)
+    img = bpy.data.images.load(path)
+    px = np.array(img.pixels[:]).reshape(img.size[1], img.size[0], img.channels)[:, :, :3]
+    bg = px[0, 0]
+    h, w = px.shape[:2]
+    centre_px = px[h // 3 : 2 * h // 3, w // 3 : 2 * w // 3]
+    return float((np.abs(centre_px - bg).max(axis=2) > 0.05).mean())
+
+
+def main():
+    a = parse()
+    if a.lib:
+        os.environ["SINEW_LIB"] = os.path.abspath(a.lib)
+    os.makedirs(a.out, exist_ok=True)
+    out = os.path.abspath(a.out)
+    bpy.ops.wm.read_factory_settings(use_empty=True)
+    sinew.register()
+    mesh_obj = import_asset(os.path.abspath(a.asset))
+    bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out, "scene.blend"))  # the blob goes beside it
+    s = mesh_obj.sinew
+    s.tets, s.dynamic = a.tets, a.dynamic
+    choose_clips(mesh_obj, [n for n in a.train.split(",") if n], [n for n in a.heldout.split(",") if n])
+    exe = bake.find_bake(a.bake)
+    bake_s, summary, report = run_bake(mesh_obj, exe)
+    print(f"run.py: baked in {bake_s:.1f} s: {summary.get('tets')} tets, held-out error {summary.get('err_heldout')}")
+
+    scene = bpy.context.scene
+    held = [c.name for c in s.clips if c.use == "HELDOUT"] or [c.name for c in s.clips]
+    played = play_action(scene, mesh_obj, a.play or held[0], a.frames)
+    frames = list(range(scene.frame_start, scene.frame_end + 1))
+    p = sinew.play(scene, mesh_obj, frames, record=True)
+    lib_path = sinew_lib.find_library(os.environ.get("SINEW_LIB", ""))
+    dev = replay_runtime(p, lib_path)
+    overhead = [t - s_ for t, s_ in zip(p.ms_total, p.ms_step)]
+
+    exported = sinew.export_frames(scene, mesh_obj, out, gltf=not a.no_gltf)
+    cos = [p.frames[f] for f in frames]
+    keys = mesh_obj.data.shape_keys.key_blocks
+    buf = np.empty(3 * len(mesh_obj.data.vertices), np.float32)
+    key_diff = 0.0
+    for f, co in zip(frames, cos):
+        keys[f"{sinew.export.KEY_PREFIX}{f:04d}"].data.foreach_get("co", buf)
+        key_diff = max(key_diff, float(np.abs(buf - co.ravel()).max()))
+    pc2_diff = read_back(scene, mesh_obj, exported["pc2"], "PC2", frames, cos)
+    mdd_diff = read_back(scene, mesh_obj, exported["mdd"], "MDD", frames, cos)
+    centre = None
+    if not a.no_render:
+        centre = render(scene, mesh_obj, frames[len(frames) // 2], os.path.join(out, "frame.png"))
+
+    record = {
+        "blob": p.b.blob.path,
+        "dynamic": p.dynamic,
+        "A": p.b.A.tolist(),
+        "vmap": p.b.vmap.tolist(),
+        "size": p.b.size,
+        "frames": p.record,
+        "positions": [p.frames[r["frame"]].ravel().tolist() for r in p.record],
+    }
+    with open(os.path.join(out, "preview_record.json"), "w") as f:
+        json.dump(record, f)
+    fig = {
+        "asset": os.path.abspath(a.asset),
+        "mesh": mesh_obj.name,
+        "tets": summary.get("tets"),
+        "err_heldout": summary.get("err_heldout"),
+        "bake_seconds": round(bake_s, 2),
+        "bake_tool_seconds": summary.get("bake_seconds"),
+        "report": os.path.join(report, "report.html"),
+        "played": played,
+        "frames": len(frames),
+        "failed_steps": p.failed,
+        "step_ms_median": statistics.median(p.ms_step),
+        "overhead_ms_median": statistics.median(overhead),
+        "overhead_ms_mean": statistics.mean(overhead),
+        "overhead_ms_max": max(overhead),
+        "max_dev_runtime": dev,
+        "shape_key_max_diff": key_diff,
+        "pc2_max_diff": pc2_diff,
+        "mdd_max_diff": mdd_diff,
+        "render": os.path.join(out, "frame.png") if centre is not None else None,
+        "render_centre_share": centre,
+        "exported": exported,
+    }
+    with open(os.path.join(out, "run.json"), "w") as f:
+        json.dump(fig, f, indent=1)
+    print("run.py: " + json.dumps(fig))
+
+
+try:
+    main()
+except (sinew_lib.SinewError, bake.BakeError, sinew.binding.BindError) as e:
+    print(f"run.py: {e}", file=sys.stderr)
+    sys.exit(1)
