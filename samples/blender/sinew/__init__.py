@@ -205,27 +205,48 @@ class SINEW_OT_preview(bpy.types.Operator):
 class SINEW_OT_bake(bpy.types.Operator):
     bl_idname = "sinew.bake"
     bl_label = "Bake"
-    bl_description = "Export the armature and mesh to glTF and bake them with sinew-bake"
+    bl_description = "Export the armature and mesh to glTF and bake them with sinew-bake (Esc cancels)"
 
     _timer = None
     _proc = None
 
-    def invoke(self, context, event):
+    def _prepare(self, context):
+        """What the bake needs, checked; the mesh's preview stopped (the exporter must see
+        the rest mesh)."""
+        obj, arm = _mesh_and_armature(context)
+        p = prefs()
+        exe = bake.find_bake(bpy.path.abspath(p.bake_path) if p and p.bake_path else "")
+        path = blob_path(obj)
+        if path is None:
+            raise bake.BakeError("save the .blend first: the blob is kept beside it")
+        if not obj.sinew.clips:
+            refresh_clips(obj)
+        stop_preview(obj)
+        self._obj, self._arm, self._exe, self._path = obj, arm, exe, path
+        self._report, self._t0 = os.path.splitext(path)[0] + "_report", time.time()
+
+    def _done(self, summary):
+        s = self._obj.sinew
+        s.report_path = os.path.join(self._report, "report.html")
+        s.last_bake = f"{summary.get('tets', '?')} tets, held-out error {summary.get('err_heldout', '?')}, {time.time() - self._t0:.0f} s"
+        self.report({"INFO"}, f"sinew: baked {self._path} ({s.last_bake}); report {s.report_path}")
+
+    def execute(self, context):  # scripts and background Blender: the bake blocks
         try:
-            obj, arm = _mesh_and_armature(context)
-            exe = bake.find_bake(bpy.path.abspath(prefs().bake_path) if prefs() and prefs().bake_path else "")
-            path = blob_path(obj)
-            if path is None:
-                raise bake.BakeError("save the .blend first: the blob is kept beside it")
-            if not obj.sinew.clips:
-                refresh_clips(obj)
-            stop_preview(obj)
-            report = os.path.splitext(path)[0] + "_report"
-            self._proc, self._tmp = bake.start(obj.sinew, arm, obj, exe, path, report)
+            self._prepare(context)
+            self._done(bake.run(self._obj.sinew, self._arm, self._obj, self._exe, self._path, self._report))
         except (binding.BindError, bake.BakeError) as e:
             self.report({"ERROR"}, f"sinew: {e}")
             return {"CANCELLED"}
-        self._obj, self._report, self._t0 = obj, report, time.time()
+        return {"FINISHED"}
+
+    def invoke(self, context, event):  # the UI: the bake runs while Blender stays usable
+        try:
+            self._prepare(context)
+            self._proc, self._tmp = bake.start(self._obj.sinew, self._arm, self._obj, self._exe, self._path, self._report)
+        except (binding.BindError, bake.BakeError) as e:
+            self.report({"ERROR"}, f"sinew: {e}")
+            return {"CANCELLED"}
         wm = context.window_manager
         wm.progress_begin(0, 100)
         self._timer = wm.event_timer_add(0.25, window=context.window)
@@ -245,16 +266,12 @@ class SINEW_OT_bake(bpy.types.Operator):
         context.window_manager.progress_end()
         context.workspace.status_text_set(None)
         try:
-            summary = self._proc.result()
+            self._done(self._proc.result())
         except bake.BakeError as e:
             self.report({"ERROR"}, f"sinew: {e}")
             return {"CANCELLED"}
         finally:
             bake.shutil.rmtree(self._tmp, ignore_errors=True)
-        s = self._obj.sinew
-        s.report_path = os.path.join(self._report, "report.html")
-        s.last_bake = f"{summary.get('tets', '?')} tets, held-out error {summary.get('err_heldout', '?')}, {time.time() - self._t0:.0f} s"
-        self.report({"INFO"}, f"sinew: baked ({s.last_bake}); report {s.report_path}")
         return {"FINISHED"}
 
 

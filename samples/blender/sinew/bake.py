@@ -8,6 +8,7 @@ import shutil
 import subprocess
 import tempfile
 import threading
+import time
 
 import bpy
 
@@ -27,7 +28,7 @@ def find_bake(path=""):
         if candidate:
             if not os.access(candidate, os.X_OK):
                 raise BakeError(f"sinew-bake not found at {candidate}")
-            return candidate
+            return os.path.abspath(candidate)  # the bake runs in a temporary folder
     found = shutil.which("sinew-bake")
     if not found:
         raise BakeError("sinew-bake not found: set its path in the add-on's preferences, or SINEW_BAKE")
@@ -93,7 +94,10 @@ class BakeProcess:
     def __init__(self, cmd, workdir):
         self.cmd, self.workdir = cmd, workdir
         self.stage, self.percent, self.lines = "starting", 0, []
-        self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=workdir)
+        try:
+            self.proc = subprocess.Popen(cmd, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, cwd=workdir)
+        except OSError as e:
+            raise BakeError(f"cannot run {cmd[0]}: {e}") from e
         self.stdout = []
         self._out = threading.Thread(target=lambda: self.stdout.extend(self.proc.stdout), daemon=True)
         self._err = threading.Thread(target=self._read_err, daemon=True)
@@ -132,6 +136,21 @@ class BakeProcess:
             raise BakeError(f"sinew-bake failed (exit {rc}): " + " | ".join(errors[-3:]))
         text = "".join(self.stdout).strip().splitlines()
         return json.loads(text[-1]) if text else {}
+
+
+def run(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir, on_status=print):
+    """The whole bake, blocking (scripts, background Blender): its summary JSON."""
+    proc, tmp = start(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir)
+    shown = ""
+    try:
+        while proc.poll() is None:
+            time.sleep(0.25)
+            if proc.status() != shown:
+                shown = proc.status()
+                on_status(shown)
+        return proc.result()
+    finally:
+        shutil.rmtree(tmp, ignore_errors=True)
 
 
 def start(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir):

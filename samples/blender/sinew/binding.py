@@ -57,7 +57,7 @@ class Binding:
             more = f" and {len(missing) - 5} more" if len(missing) > 5 else ""
             raise BindError(
                 f"the blob's bones {', '.join(missing[:5])}{more} are not in the armature "
-                f"'{arm_obj.name}': the blob was baked from another character"
+                f"'{arm_obj.name}': bones renamed since the bake, or a blob of another character"
             )
         self.pose_index = np.array([index[n] for n in names])
         self.npose = len(pose_names)

@@ -74,7 +74,7 @@ def find_library(path=""):
         if candidate:
             if not os.path.isfile(candidate):
                 raise SinewError(f"libsinew not found at {candidate}")
-            return candidate
+            return os.path.abspath(candidate)
     found = ctypes.util.find_library("sinew")
     if not found:
         raise SinewError(
