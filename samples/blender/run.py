@@ -68,21 +68,11 @@ def choose_clips(mesh_obj, train, heldout):
 
 
 def run_bake(mesh_obj, exe):
-    arm = sinew.armature_of(mesh_obj)
     path = sinew.blob_path(mesh_obj)
     report = os.path.splitext(path)[0] + "_report"
     t0 = time.time()
-    proc, tmp = bake.start(mesh_obj.sinew, arm, mesh_obj, exe, path, report)
-    shown = ""
-    while proc.poll() is None:
-        time.sleep(0.5)
-        if proc.status() != shown:
-            shown = proc.status()
-            print(shown, flush=True)
-    try:
-        summary = proc.result()
-    finally:
-        bake.shutil.rmtree(tmp, ignore_errors=True)
+    summary = bake.run(mesh_obj.sinew, sinew.armature_of(mesh_obj), mesh_obj, exe, path, report,
+                       lambda s: print(s, flush=True))
     return time.time() - t0, summary, report
 
 
@@ -102,6 +92,16 @@ def play_action(scene, mesh_obj, name, nframes):
     first = int(action.frame_range[0])
     scene.frame_start, scene.frame_end = first, first + nframes - 1
     return action.name
+
+
+def skinned(scene, mesh_obj, frames):
+    """The mesh as Blender's Armature modifier deforms it at each frame (mesh space)."""
+    out, buf = [], np.empty(3 * len(mesh_obj.data.vertices), np.float32)
+    for f in frames:
+        scene.frame_set(f)
+        mesh_obj.evaluated_get(bpy.context.evaluated_depsgraph_get()).data.vertices.foreach_get("co", buf)
+        out.append(buf.reshape(-1, 3).astype(np.float64))
+    return out
 
 
 def replay_runtime(p, lib_path):
@@ -205,7 +205,13 @@ def main():
     held = [c.name for c in s.clips if c.use == "HELDOUT"] or [c.name for c in s.clips]
     played = play_action(scene, mesh_obj, a.play or held[0], a.frames)
     frames = list(range(scene.frame_start, scene.frame_end + 1))
+    skin = skinned(scene, mesh_obj, frames)
     p = sinew.play(scene, mesh_obj, frames, record=True)
+    # the flesh follows the bones: how far, on average, it sits from Blender's own skinning
+    # (a bone mapped wrong puts whole limbs elsewhere)
+    scale = float(np.cbrt(np.linalg.det(p.b.A[:3, :3])))  # mesh units -> blob units
+    from_skin = max(float(np.linalg.norm(p.frames[f] - k, axis=1).mean()) for f, k in zip(frames, skin))
+    from_skin *= scale / p.b.size
     lib_path = sinew_lib.find_library(os.environ.get("SINEW_LIB", ""))
     dev = replay_runtime(p, lib_path)
     overhead = [t - s_ for t, s_ in zip(p.ms_total, p.ms_step)]
@@ -251,6 +257,7 @@ def main():
         "overhead_ms_mean": statistics.mean(overhead),
         "overhead_ms_max": max(overhead),
         "max_dev_runtime": dev,
+        "mean_dist_from_skinning": from_skin,
         "shape_key_max_diff": key_diff,
         "pc2_max_diff": pc2_diff,
         "mdd_max_diff": mdd_diff,
