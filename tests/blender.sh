@@ -5,7 +5,8 @@
 # the positions Blender showed equal the runtime's for the same poses stepped outside
 # Blender through the C ABI (check_replay.py, plain python3 and ctypes) within 1e-6 of the
 # character's size; the PC2 and MDD caches read back by Blender's Mesh Cache modifier and
-# the shape keys equal them exactly; a Workbench render shows the character; bad input
+# the shape keys equal them exactly; a sphere empty tagged as a collider pushes the flesh
+# out; a Workbench render shows the character; bad input
 # (missing library or tool, another character's blob, a truncated blob, a missing bone, an
 # edited mesh) is refused with its reason (check_errors.py). Without blender the test is
 # skipped (77), except under CI=true, where tools/setup-debian.sh has installed it.
@@ -51,6 +52,9 @@ checks = [
     ("shape keys exact", r["shape_key_max_diff"] == 0.0),
     ("PC2 read back exact", r["pc2_max_diff"] == 0.0),
     ("MDD read back exact", r["mdd_max_diff"] == 0.0),
+    ("a sphere collider touches the flesh", r["collider_contact_frames"] > 0 and r["collider_failed_steps"] == 0),
+    ("the collider pushes the flesh out (penetration under half that without it)",
+     r["collider_penetration"] < 0.5 * r["collider_penetration_free"]),
     ("the render's centre shows the character", (r["render_centre_share"] or 0) >= 0.2),
     ("the render written", os.path.getsize(r["render"]) > 1000),
     ("the report written", os.path.isfile(r["report"])),

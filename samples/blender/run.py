@@ -152,6 +152,34 @@ def read_back(scene, mesh_obj, path, fmt, frames, cos):
     return worst
 
 
+def collider_pass(scene, mesh_obj, frames, free):
+    """A sphere empty tagged as a collider, pressed into the character's back at the middle
+    frame; the frames played again with it. Returns the frames with world contact and the
+    deepest penetration into the sphere, over its radius, with and without it."""
+    mw = np.array(mesh_obj.matrix_world)
+    world = lambda co: co.astype(np.float64) @ mw[:3, :3].T + mw[:3, 3]  # noqa: E731
+    pts = world(free[frames[len(frames) // 2]])
+    lo, hi = pts.min(0), pts.max(0)
+    mid, ext = (lo + hi) / 2, hi - lo
+    near = (np.abs(pts[:, :2] - mid[:2]) <= 0.15 * ext[:2]).all(1)
+    top = pts[near][np.argmax(pts[near][:, 2])]
+    r = 0.1 * float(ext[2])
+    centre = top + np.array([0.0, 0.0, 0.6 * r])
+    empty = bpy.data.objects.new("sinew_test_sphere", None)
+    empty.empty_display_type, empty.empty_display_size = "SPHERE", r
+    empty.location = centre.tolist()
+    scene.collection.objects.link(empty)
+    empty.sinew_collider = True
+    p = sinew.play(scene, mesh_obj, frames)
+    scene.collection.objects.unlink(empty)
+
+    def depth(cos):
+        return max(float((r - np.linalg.norm(world(c) - centre, axis=1)).max()) for c in cos) / r
+
+    contact = sum(1 for n in p.world_contacts if n > 0)
+    return contact, p.failed, depth([p.frames[f] for f in frames]), depth([free[f] for f in frames])
+
+
 def render(scene, mesh_obj, frame, path):
     """One Workbench frame of the mesh, seen from the side by an orthographic camera; the
     share of the centre's pixels that are not background."""
@@ -230,6 +258,9 @@ def main():
     if not a.no_render:
         centre = render(scene, mesh_obj, frames[len(frames) // 2], os.path.join(out, "frame.png"))
 
+    free = {f: p.frames[f] for f in frames}
+    contact_frames, collider_failed, pen, pen_free = collider_pass(scene, mesh_obj, frames, free)
+
     record = {
         "blob": p.b.blob.path,
         "dynamic": p.dynamic,
@@ -261,6 +292,10 @@ def main():
         "shape_key_max_diff": key_diff,
         "pc2_max_diff": pc2_diff,
         "mdd_max_diff": mdd_diff,
+        "collider_contact_frames": contact_frames,
+        "collider_failed_steps": collider_failed,
+        "collider_penetration": pen,
+        "collider_penetration_free": pen_free,
         "render": os.path.join(out, "frame.png") if centre is not None else None,
         "render_centre_share": centre,
         "exported": exported,

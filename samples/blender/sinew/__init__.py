@@ -26,7 +26,7 @@ import numpy
 if "bool" not in vars(numpy):
     numpy.bool = numpy.bool_
 
-from . import bake, binding, export, sinew_lib  # noqa: E402
+from . import bake, binding, colliders, export, sinew_lib  # noqa: E402
 
 # one preview a mesh object, by name: what the frame handler steps
 _previews = {}
@@ -144,11 +144,16 @@ def start_preview(scene, mesh_obj, record=False):
     if not path or not os.path.isfile(path):
         raise binding.BindError(f"no blob at {path or '(save the .blend first)'}: bake first")
     blob = sinew_lib.Blob(library(), path)
+    world = None
     try:
         b = binding.Binding(blob, armature_of(mesh_obj), mesh_obj)
         fps = scene.render.fps / scene.render.fps_base
-        p = binding.Preview(b, mesh_obj.sinew.dynamic, fps, record)
+        if colliders.tagged(scene, (mesh_obj, b.arm)):
+            world = colliders.Colliders(library(), b, scene)
+        p = binding.Preview(b, mesh_obj.sinew.dynamic, fps, record, world)
     except Exception:
+        if world:
+            world.close()
         blob.close()
         raise
     _previews[mesh_obj.name] = p
@@ -329,6 +334,25 @@ def export_frames(scene, mesh_obj, folder, gltf=True):
     return out
 
 
+class SINEW_PT_collider(bpy.types.Panel):
+    bl_label = "sinew collider"
+    bl_space_type = "PROPERTIES"
+    bl_region_type = "WINDOW"
+    bl_context = "object"
+
+    @classmethod
+    def poll(cls, context):
+        o = context.object
+        return o is not None and o.type in ("MESH", "EMPTY") and not (o.type == "MESH" and armature_of(o))
+
+    def draw(self, context):
+        o = context.object
+        self.layout.prop(o, "sinew_collider")
+        if o.sinew_collider and o.type == "EMPTY":
+            kind = "a sphere" if o.empty_display_type == "SPHERE" else "a capsule along local Z"
+            self.layout.label(text=f"Collides as {kind} (display size, scale)")
+
+
 class SINEW_PT_panel(bpy.types.Panel):
     bl_label = "sinew"
     bl_space_type = "PROPERTIES"
@@ -371,6 +395,7 @@ _classes = (
     SINEW_OT_bake,
     SINEW_OT_export,
     SINEW_PT_panel,
+    SINEW_PT_collider,
 )
 
 
@@ -378,6 +403,9 @@ def register():
     for c in _classes:
         bpy.utils.register_class(c)
     bpy.types.Object.sinew = bpy.props.PointerProperty(type=SinewSettings)
+    bpy.types.Object.sinew_collider = bpy.props.BoolProperty(
+        name="sinew collider", description="The previewed flesh collides with this object (a mesh, or an empty as a sphere or capsule)"
+    )
     bpy.app.handlers.frame_change_post.append(_step_previews)
     bpy.app.handlers.save_pre.append(_stop_all)
     bpy.app.handlers.load_pre.append(_stop_all)
@@ -393,5 +421,6 @@ def unregister():
         if fn in h:
             h.remove(fn)
     del bpy.types.Object.sinew
+    del bpy.types.Object.sinew_collider
     for c in reversed(_classes):
         bpy.utils.unregister_class(c)

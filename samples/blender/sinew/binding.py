@@ -158,9 +158,16 @@ class Preview:
     the mesh. Quasistatic: any frame order (backwards resets first). Dynamic: forward one
     frame at a time; a jump back resets, a jump forward is declared a teleport."""
 
-    def __init__(self, binding, dynamic, fps, record=False):
+    def __init__(self, binding, dynamic, fps, record=False, colliders=None):
         self.b, self.dynamic, self.dt = binding, dynamic, 1.0 / fps
-        self.inst = sinew_lib.Instance(binding.blob, dynamic)
+        # with colliders, flesh pressed beyond the subspace is solved in full space on a
+        # patch (subspace condensation); a quarter of the surface bounds it
+        patch = binding.blob.vertex_count // 4 if colliders else 0
+        self.inst = sinew_lib.Instance(binding.blob, dynamic, patch)
+        self.colliders = colliders
+        if colliders:
+            self.inst.set_world(colliders.world)
+        self.world_contacts = []
         nb = binding.blob.bone_count
         self.pose = np.zeros((nb, 12), dtype=np.float32)
         self.surface = np.zeros(3 * binding.blob.vertex_count, dtype=np.float32)
@@ -189,9 +196,12 @@ class Preview:
             self.inst.mark_teleport()
         self.b.pose_transforms(pose_bones, self.pose)
         self.inst.set_pose(self.pose)
+        if self.colliders:
+            self.colliders.update()
         t1 = time.perf_counter()
         status = self.inst.step(self.dt)
         t2 = time.perf_counter()
+        self.world_contacts.append(self.inst.stats.world_contacts)
         self.inst.read_surface(self.surface)
         co = self.b.to_mesh(self.surface)
         mesh = self.b.mesh.data
@@ -217,3 +227,5 @@ class Preview:
             if m:
                 m.show_viewport, m.show_render = viewport, render
         self.inst.close()
+        if self.colliders:
+            self.colliders.close()

@@ -40,6 +40,15 @@ class _BlobDef(ctypes.Structure):
     ]
 
 
+class _Tasks(ctypes.Structure):
+    _fields_ = [
+        ("enqueue", ctypes.c_void_p),
+        ("finish", ctypes.c_void_p),
+        ("worker_count", ctypes.c_uint32),
+        ("user", ctypes.c_void_p),
+    ]
+
+
 class _InstanceDef(ctypes.Structure):
     # the leading fields of sinew_instance_def (sinew_types.h); the rest stay default
     _fields_ = [
@@ -48,6 +57,10 @@ class _InstanceDef(ctypes.Structure):
         ("max_newton_iters", ctypes.c_uint32),
         ("allocator", _Allocator),
         ("logger", _Logger),
+        ("max_contact_pairs", ctypes.c_uint32),
+        ("tasks", _Tasks),
+        ("max_world_contacts", ctypes.c_uint32),
+        ("max_patch_vertices", ctypes.c_uint32),
     ]
 
 
@@ -65,7 +78,56 @@ class _StepStats(ctypes.Structure):
         ("ms_dynamics", ctypes.c_double),
         ("ms_solve", ctypes.c_double),
         ("ms_output", ctypes.c_double),
+        ("active_vertices", ctypes.c_uint32),
+        ("cubature_tets", ctypes.c_uint32),
+        ("potential_evals", ctypes.c_uint32),
+        ("contact_pairs", ctypes.c_uint32),
+        ("contact_pairs_dropped", ctypes.c_uint32),
+        ("budget_exceeded", ctypes.c_uint32),
+        ("ms_world", ctypes.c_double),
+        ("world_queries", ctypes.c_uint32),
+        ("world_candidates", ctypes.c_uint32),
+        ("world_contacts", ctypes.c_uint32),
     ]
+
+
+class _WorldDef(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("max_colliders", ctypes.c_uint32),
+        ("allocator", _Allocator),
+        ("logger", _Logger),
+    ]
+
+
+class Transform(ctypes.Structure):
+    """sinew_transform: x = R(rotation) y + position; rotation a quaternion w, x, y, z."""
+
+    _fields_ = [("position", ctypes.c_float * 3), ("rotation", ctypes.c_float * 4)]
+
+
+class _ColliderDef(ctypes.Structure):
+    _fields_ = [
+        ("struct_size", ctypes.c_uint32),
+        ("shape", ctypes.c_int),
+        ("normal", ctypes.c_float * 3),
+        ("offset", ctypes.c_float),
+        ("radius", ctypes.c_float),
+        ("half_height", ctypes.c_float),
+        ("half_extents", ctypes.c_float * 3),
+        ("points", ctypes.POINTER(ctypes.c_float)),
+        ("point_count", ctypes.c_uint32),
+        ("vertices", ctypes.POINTER(ctypes.c_float)),
+        ("vertex_count", ctypes.c_uint32),
+        ("indices", ctypes.POINTER(ctypes.c_uint32)),
+        ("triangle_count", ctypes.c_uint32),
+        ("stiffness", ctypes.c_float),
+        ("friction", ctypes.c_float),
+        ("transform", Transform),
+    ]
+
+
+SHAPE_SPHERE, SHAPE_CAPSULE, SHAPE_MESH = 1, 2, 5
 
 
 def find_library(path=""):
@@ -121,6 +183,14 @@ class Library:
                 [vp, ctypes.POINTER(f32), ctypes.POINTER(f32), u32],
             ),
             "sinew_instance_get_stats": (ctypes.c_int, [vp, ctypes.POINTER(_StepStats)]),
+            "sinew_world_create": (ctypes.c_int, [ctypes.POINTER(_WorldDef), ctypes.POINTER(vp)]),
+            "sinew_world_destroy": (None, [vp]),
+            "sinew_world_add_collider": (
+                ctypes.c_int,
+                [vp, ctypes.POINTER(_ColliderDef), ctypes.POINTER(u32)],
+            ),
+            "sinew_world_set_collider_transform": (ctypes.c_int, [vp, u32, ctypes.POINTER(Transform)]),
+            "sinew_instance_set_world": (ctypes.c_int, [vp, vp]),
         }
         for name, (res, args) in sig.items():
             try:
@@ -201,9 +271,12 @@ class Instance:
     """One simulated character of a blob; poses and surfaces are ctypes float buffers
     (or anything exposing a writable float32 buffer of the right length)."""
 
-    def __init__(self, blob, dynamic=False):
+    def __init__(self, blob, dynamic=False, patch_vertices=0):
+        """patch_vertices: the budget of the full-space patch where the world presses the
+        flesh beyond what the subspace holds (0: none)."""
         self.blob, self.lib = blob, blob.lib
         d = _InstanceDef(ctypes.sizeof(_InstanceDef), STEP_DYNAMIC if dynamic else STEP_QUASISTATIC, 0, _Allocator(), blob.log.logger())
+        d.max_patch_vertices = patch_vertices
         h = ctypes.c_void_p()
         r = self.lib.instance_create(blob.handle, ctypes.byref(d), ctypes.byref(h))
         if r != SINEW_OK:
@@ -235,6 +308,9 @@ class Instance:
         self.lib.instance_get_stats(self.handle, ctypes.byref(self.stats))
         return self.stats.status
 
+    def set_world(self, world):
+        self._check(self.lib.instance_set_world(self.handle, world.handle if world else None), "set_world")
+
     def read_surface(self, positions):
         p = _float_ptr(positions, 3 * self.blob.vertex_count)
         self._check(self.lib.instance_read_surface(self.handle, p, None, self.blob.vertex_count), "read_surface")
@@ -242,6 +318,47 @@ class Instance:
     def _check(self, r, what):
         if r != SINEW_OK:
             raise SinewError(f"{what}: {self.blob.log.last or self.lib.result_string(r)}")
+
+
+class World:
+    """A collision world: spheres, capsules and triangle meshes the flesh collides with,
+    in the blob's space (the add-on leaves the actor at the identity)."""
+
+    def __init__(self, lib):
+        self.lib, self.log = lib, _Log()
+        d = _WorldDef(ctypes.sizeof(_WorldDef), 0, _Allocator(), self.log.logger())
+        h = ctypes.c_void_p()
+        r = lib.world_create(ctypes.byref(d), ctypes.byref(h))
+        if r != SINEW_OK:
+            raise SinewError(f"cannot create a collision world: {self.log.last or lib.result_string(r)}")
+        self.handle = h
+
+    def close(self):
+        if self.handle:
+            self.lib.world_destroy(self.handle)
+            self.handle = None
+
+    def add(self, shape, transform, radius=0.0, half_height=0.0, vertices=None, indices=None, friction=0.0):
+        """Adds a collider (SHAPE_SPHERE, _CAPSULE or _MESH: flat float xyz and uint32
+        triangle lists, copied by the library) and returns its id."""
+        d = _ColliderDef()
+        d.struct_size, d.shape = ctypes.sizeof(_ColliderDef), shape
+        d.radius, d.half_height, d.friction, d.transform = radius, half_height, friction, transform
+        if shape == SHAPE_MESH:
+            v = (ctypes.c_float * len(vertices))(*vertices)
+            t = (ctypes.c_uint32 * len(indices))(*indices)
+            d.vertices, d.vertex_count = v, len(vertices) // 3
+            d.indices, d.triangle_count = t, len(indices) // 3
+        cid = ctypes.c_uint32()
+        r = self.lib.world_add_collider(self.handle, ctypes.byref(d), ctypes.byref(cid))
+        if r != SINEW_OK:
+            raise SinewError(f"collider refused: {self.log.last or self.lib.result_string(r)}")
+        return cid.value
+
+    def move(self, cid, transform):
+        r = self.lib.world_set_collider_transform(self.handle, cid, ctypes.byref(transform))
+        if r != SINEW_OK:
+            raise SinewError(f"collider transform refused: {self.log.last or self.lib.result_string(r)}")
 
 
 def _float_ptr(buf, count):
