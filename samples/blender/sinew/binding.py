@@ -5,7 +5,8 @@ the mesh object's local space M (where mesh.vertices live) and the armature's sp
 orientations differ between Blender and the file (the glTF importer turns bones to point
 along +Y), so nothing is mapped through bone frames: a bone's sinew transform is its
 skinning matrix (posed times inverse rest, which is orientation-free) carried into R by a
-similarity A: M -> R fitted to the bone heads, which every exporter and importer keeps.
+similarity A: M -> R, the glTF exporter's axes or a fit of the bone heads (which every
+exporter and importer keeps), whichever puts the mesh's rest shape on the blob's.
 """
 
 import time
@@ -62,31 +63,48 @@ class Binding:
         self.pose_index = np.array([index[n] for n in names])
         self.npose = len(pose_names)
 
+        self.nv = len(mesh_obj.data.vertices)
+        self.rest_m = np.empty(3 * self.nv, dtype=np.float32)
+        mesh_obj.data.vertices.foreach_get("co", self.rest_m)
+        self.rest_m = self.rest_m.reshape(-1, 3)
+        rest_r = self._rest_surface()
+        self.size = float(np.linalg.norm(rest_r.max(0) - rest_r.min(0)))
+
         # armature space -> mesh space, fixed while previewing
         k = _matrix(mesh_obj.matrix_world.inverted() @ arm_obj.matrix_world)
-        heads = np.array([list(arm_obj.data.bones[n].head_local) + [1.0] for n in names])
-        heads_m = (heads @ k.T)[:, :3]
-        binds = np.array([blob.bone_bind(i)[9:12] for i in range(len(names))])
-        self.A = _similarity(heads_m, binds)
+        self.A, self.vmap = self._space_map(names, k, rest_r)
         self.A_inv = np.linalg.inv(self.A)
-        size = float(np.linalg.norm(binds.max(0) - binds.min(0)))
-        fit = np.abs((heads_m @ self.A[:3, :3].T + self.A[:3, 3]) - binds).max()
-        if fit > 1e-3 * size:
-            raise BindError(
-                f"the armature's bone heads are {fit:.3g} units from the blob's bind pose: "
-                "the armature was moved or re-rigged since the bake, or the blob is another "
-                "character's; bake again"
-            )
         # T_b = L P_b Q_b: armature -> R on the left, inverse rest -> M on the right
         self.L = self.A @ k
         rest_inv = np.array([np.linalg.inv(_matrix(arm_obj.data.bones[n].matrix_local)) for n in names])
         self.Q = rest_inv @ np.linalg.inv(self.L)
 
-        self.nv = len(mesh_obj.data.vertices)
-        self.rest_m = np.empty(3 * self.nv, dtype=np.float32)
-        mesh_obj.data.vertices.foreach_get("co", self.rest_m)
-        self.rest_m = self.rest_m.reshape(-1, 3)
-        self.vmap = self._vertex_map()
+    def _space_map(self, names, k, rest_r):
+        """The similarity A: M -> R and the vertex map under it. Two candidates, the one
+        whose rest shape lands on the blob's kept: the glTF exporter's axes (Blender's
+        world turned Y-up: exact for what the add-on bakes, and for a glTF Blender
+        imported), and the fit of the armature's bone heads onto the blob's bind poses (a
+        blob baked from another format; it leaves a free turn when the bones are in a line)."""
+        gltf = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1.0]]) @ _matrix(self.mesh.matrix_world)
+        candidates = [gltf]
+        heads = np.array([list(self.arm.data.bones[n].head_local) + [1.0] for n in names])
+        binds = np.array([self.blob.bone_bind(i)[9:12] for i in range(len(names))])
+        try:
+            candidates.append(_similarity((heads @ k.T)[:, :3], binds))
+        except BindError:
+            pass
+        best = None
+        for a in candidates:
+            vmap, worst = self._vertex_map(a, rest_r)
+            if best is None or worst < best[2]:
+                best = (a, vmap, worst)
+        a, vmap, worst = best
+        if worst > 2e-3 * self.size:  # the rest step's correction plus the export's rounding
+            raise BindError(
+                f"mesh '{self.mesh.name}' is not the blob's surface (a vertex {worst:.3g} units "
+                f"from it, {worst / self.size:.2%} of the size): bake again, or choose the baked mesh"
+            )
+        return a, vmap
 
     def _rest_surface(self):
         inst = sinew_lib.Instance(self.blob)
@@ -100,23 +118,22 @@ class Binding:
             inst.close()
         return out.reshape(-1, 3).astype(np.float64)
 
-    def _vertex_map(self):
-        """For each mesh vertex the output vertex that moves it: the blob's output map when
-        the baked file's vertices are this mesh's (one source mesh, same order), else the
-        nearest output vertex at rest. Either way checked at rest."""
-        rest_r = self._rest_surface()
-        mine = self.rest_m.astype(np.float64) @ self.A[:3, :3].T + self.A[:3, 3]
-        size = float(np.linalg.norm(rest_r.max(0) - rest_r.min(0)))
-        self.size = size
-        tol = 2e-3 * size  # the rest step's correction plus float rounding of the export
+    def _vertex_map(self, a, rest_r):
+        """For each mesh vertex the output vertex that moves it, under the space map `a`,
+        and the largest distance between the two at rest: the blob's output map when the
+        baked file's vertices are this mesh's (one source mesh, same count), else the
+        nearest output vertex."""
+        mine = self.rest_m.astype(np.float64) @ a[:3, :3].T + a[:3, 3]
         sources = self.blob.output_sources()
         if self.blob.lib.blob_source_mesh_count(self.blob.handle) == 1 and len(sources) == self.nv:
             direct = np.full(self.nv, -1)
             for out, (m, v) in enumerate(sources):
                 if 0 <= v < self.nv:
                     direct[v] = out
-            if (direct >= 0).all() and np.linalg.norm(rest_r[direct] - mine, axis=1).max() <= tol:
-                return direct
+            if (direct >= 0).all():
+                worst = float(np.linalg.norm(rest_r[direct] - mine, axis=1).max())
+                if worst <= 2e-3 * self.size:
+                    return direct, worst
         from mathutils.kdtree import KDTree
 
         tree = KDTree(len(rest_r))
@@ -129,12 +146,7 @@ class Binding:
             _, i, d = tree.find(p)
             vmap[j] = i
             worst = max(worst, d)
-        if worst > tol:
-            raise BindError(
-                f"mesh '{self.mesh.name}' is not the blob's surface (a vertex {worst:.3g} units "
-                f"from it, {worst / size:.2%} of the size): bake again, or choose the baked mesh"
-            )
-        return vmap
+        return vmap, worst
 
     def pose_transforms(self, pose_bones, out):
         """Writes the blob-order bone transforms (bone_count x 12 float32) of the posed
