@@ -71,7 +71,7 @@ def run_bake(mesh_obj, exe):
     path = sinew.blob_path(mesh_obj)
     report = os.path.splitext(path)[0] + "_report"
     t0 = time.time()
-    summary = bake.run(mesh_obj.sinew, sinew.armature_of(mesh_obj), mesh_obj, exe, path, report,
+    summary = bake.run(mesh_obj.sinew, sinew.armature_of(mesh_obj), sinew.character_meshes(mesh_obj), exe, path, report,
                        lambda s: print(s, flush=True))
     return time.time() - t0, summary, report
 
@@ -181,11 +181,12 @@ def collider_pass(scene, mesh_obj, frames, free):
 
 
 def render(scene, mesh_obj, frame, path):
-    """One Workbench frame of the mesh, seen from the side by an orthographic camera; the
+    """One Workbench frame of the character's meshes, seen from the side by an orthographic camera; the
     share of the centre's pixels that are not background."""
     scene.frame_set(frame)
-    ev = mesh_obj.evaluated_get(bpy.context.evaluated_depsgraph_get())
-    pts = np.array([ev.matrix_world @ v.co for v in ev.data.vertices])
+    dg = bpy.context.evaluated_depsgraph_get()
+    evs = [o.evaluated_get(dg) for o in sinew.character_meshes(mesh_obj)]
+    pts = np.array([ev.matrix_world @ v.co for ev in evs for v in ev.data.vertices])
     lo, hi = pts.min(0), pts.max(0)
     centre, ext = (lo + hi) / 2, hi - lo
     cam_data = bpy.data.cameras.new("sinew_cam")

@@ -56,6 +56,13 @@ def armature_of(mesh_obj):
     return None
 
 
+def character_meshes(mesh_obj):
+    """The mesh and every other mesh its armature deforms: one character, one bake."""
+    arm = armature_of(mesh_obj)
+    others = [o for o in bpy.context.scene.objects if o.type == "MESH" and o != mesh_obj and armature_of(o) == arm]
+    return [mesh_obj] + sorted(others, key=lambda o: o.name)
+
+
 def blob_path(mesh_obj):
     s = mesh_obj.sinew
     path = s.blob_path or f"//{bpy.path.clean_name(mesh_obj.name)}.blob"
@@ -146,9 +153,9 @@ def start_preview(scene, mesh_obj, record=False):
     blob = sinew_lib.Blob(library(), path)
     world = None
     try:
-        b = binding.Binding(blob, armature_of(mesh_obj), mesh_obj)
+        b = binding.Binding(blob, armature_of(mesh_obj), mesh_obj, character_meshes(mesh_obj)[1:])
         fps = scene.render.fps / scene.render.fps_base
-        if colliders.tagged(scene, (mesh_obj, b.arm)):
+        if colliders.tagged(scene, [part.obj for part in b.parts] + [b.arm]):
             world = colliders.Colliders(library(), b, scene)
         p = binding.Preview(b, mesh_obj.sinew.dynamic, fps, record, world)
     except Exception:
@@ -239,7 +246,7 @@ class SINEW_OT_bake(bpy.types.Operator):
     def execute(self, context):  # scripts and background Blender: the bake blocks
         try:
             self._prepare(context)
-            self._done(bake.run(self._obj.sinew, self._arm, self._obj, self._exe, self._path, self._report))
+            self._done(bake.run(self._obj.sinew, self._arm, character_meshes(self._obj), self._exe, self._path, self._report))
         except (binding.BindError, bake.BakeError) as e:
             self.report({"ERROR"}, f"sinew: {e}")
             return {"CANCELLED"}
@@ -248,7 +255,7 @@ class SINEW_OT_bake(bpy.types.Operator):
     def invoke(self, context, event):  # the UI: the bake runs while Blender stays usable
         try:
             self._prepare(context)
-            self._proc, self._tmp = bake.start(self._obj.sinew, self._arm, self._obj, self._exe, self._path, self._report)
+            self._proc, self._tmp = bake.start(self._obj.sinew, self._arm, character_meshes(self._obj), self._exe, self._path, self._report)
         except (binding.BindError, bake.BakeError) as e:
             self.report({"ERROR"}, f"sinew: {e}")
             return {"CANCELLED"}
@@ -294,7 +301,7 @@ class SINEW_OT_export(bpy.types.Operator):
         except (binding.BindError, sinew_lib.SinewError, OSError) as e:
             self.report({"ERROR"}, f"sinew: {e}")
             return {"CANCELLED"}
-        self.report({"INFO"}, f"sinew: exported {', '.join(out.values())}")
+        self.report({"INFO"}, f"sinew: exported {', '.join(str(v) for v in out.values())}")
         return {"FINISHED"}
 
 
@@ -311,26 +318,33 @@ def play(scene, mesh_obj, frames, record=False):
 
 
 def export_frames(scene, mesh_obj, folder, gltf=True):
-    """Plays the scene's frame range and writes shape keys, <mesh>.pc2, <mesh>.mdd and,
-    with `gltf`, <mesh>_morph.glb into `folder`. The mesh's armature modifiers are left
-    off: the keys hold the whole motion."""
+    """Plays the scene's frame range and writes, for every mesh of the character, shape
+    keys, <mesh>.pc2, <mesh>.mdd and, with `gltf`, <mesh>_morph.glb into `folder`. The
+    meshes' armature modifiers are left off: the keys hold the whole motion."""
     frames = list(range(scene.frame_start, scene.frame_end + 1))
     p = play(scene, mesh_obj, frames)
-    cos = [p.frames[f] for f in frames]
     os.makedirs(folder, exist_ok=True)
-    base = os.path.join(folder, bpy.path.clean_name(mesh_obj.name))
     fps = scene.render.fps / scene.render.fps_base
-    out = {"pc2": base + ".pc2", "mdd": base + ".mdd"}
-    export.write_pc2(out["pc2"], cos, frames[0], fps)
-    export.write_mdd(out["mdd"], cos, frames[0], fps)
-    export.shape_keys(mesh_obj, cos, frames[0])
-    out["shape_keys"] = f"{len(cos)} shape keys"
-    for m in mesh_obj.modifiers:
-        if m.type == "ARMATURE":
-            m.show_viewport = m.show_render = False
-    if gltf:
-        out["gltf"] = base + "_morph.glb"
-        export.gltf_morph(armature_of(mesh_obj), mesh_obj, out["gltf"])
+    out = {}
+    for i, part in enumerate(p.b.parts):
+        obj = part.obj
+        cos = [p.frames_all[f][i] for f in frames]
+        base = os.path.join(folder, bpy.path.clean_name(obj.name))
+        files = {"pc2": base + ".pc2", "mdd": base + ".mdd"}
+        export.write_pc2(files["pc2"], cos, frames[0], fps)
+        export.write_mdd(files["mdd"], cos, frames[0], fps)
+        export.shape_keys(obj, cos, frames[0])
+        files["shape_keys"] = f"{len(cos)} shape keys"
+        for m in obj.modifiers:
+            if m.type == "ARMATURE":
+                m.show_viewport = m.show_render = False
+        if gltf:
+            files["gltf"] = base + "_morph.glb"
+            export.gltf_morph(armature_of(obj), obj, files["gltf"])
+        if i == 0:
+            out.update(files)
+        else:
+            out[obj.name] = files
     return out
 
 

@@ -46,15 +46,16 @@ def clip_name(arm_obj, action_name):
     return action_name
 
 
-def export_gltf(arm_obj, mesh_obj, path):
-    """Writes the armature and its mesh, with every action, to `path` (.glb) through
+def export_gltf(arm_obj, meshes, path):
+    """Writes the armature and its meshes, with every action, to `path` (.glb) through
     Blender's exporter; the selection is put back afterwards."""
     selected = [o for o in bpy.context.view_layer.objects if o.select_get()]
     active = bpy.context.view_layer.objects.active
     for o in selected:
         o.select_set(False)
     arm_obj.select_set(True)
-    mesh_obj.select_set(True)
+    for m in meshes:
+        m.select_set(True)
     bpy.context.view_layer.objects.active = arm_obj
     try:
         bpy.ops.export_scene.gltf(
@@ -71,7 +72,8 @@ def export_gltf(arm_obj, mesh_obj, path):
         )
     finally:
         arm_obj.select_set(False)
-        mesh_obj.select_set(False)
+        for m in meshes:
+            m.select_set(False)
         for o in selected:
             o.select_set(True)
         bpy.context.view_layer.objects.active = active
@@ -138,9 +140,9 @@ class BakeProcess:
         return json.loads(text[-1]) if text else {}
 
 
-def run(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir, on_status=print):
+def run(settings, arm_obj, meshes, bake_exe, blob_path, report_dir, on_status=print):
     """The whole bake, blocking (scripts, background Blender): its summary JSON."""
-    proc, tmp = start(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir)
+    proc, tmp = start(settings, arm_obj, meshes, bake_exe, blob_path, report_dir)
     shown = ""
     try:
         while proc.poll() is None:
@@ -153,13 +155,13 @@ def run(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir, on_status=
         shutil.rmtree(tmp, ignore_errors=True)
 
 
-def start(settings, arm_obj, mesh_obj, bake_exe, blob_path, report_dir):
-    """Exports the scene and starts sinew-bake; returns the BakeProcess and its temporary
+def start(settings, arm_obj, meshes, bake_exe, blob_path, report_dir):
+    """Exports the armature and its meshes (the first names the files) and starts sinew-bake; returns the BakeProcess and its temporary
     folder (remove it when the bake is done)."""
     train = [clip_name(arm_obj, c.name) for c in settings.clips if c.use == "TRAIN"]
     heldout = [clip_name(arm_obj, c.name) for c in settings.clips if c.use == "HELDOUT"]
     tmp = tempfile.mkdtemp(prefix="sinew-bake-")
-    glb = os.path.join(tmp, mesh_obj.name + ".glb")
-    export_gltf(arm_obj, mesh_obj, glb)
+    glb = os.path.join(tmp, bpy.path.clean_name(meshes[0].name) + ".glb")
+    export_gltf(arm_obj, meshes, glb)
     cmd = command(bake_exe, glb, blob_path, report_dir, settings.tets, train, heldout, settings.dynamic)
     return BakeProcess(cmd, tmp), tmp

@@ -44,11 +44,30 @@ def _matrix(m):
     return np.array([list(row) for row in m], dtype=np.float64)
 
 
-class Binding:
-    """A blob bound to (armature, mesh): the bone order, the space map, the vertex map.
-    Raises BindError naming what does not fit."""
+class Part:
+    """One mesh object of the character: its rest positions (M), its space map A: M -> R
+    and, for each of its vertices, the output vertex that moves it."""
 
-    def __init__(self, blob, arm_obj, mesh_obj):
+    def __init__(self, obj):
+        self.obj = obj
+        self.nv = len(obj.data.vertices)
+        rest = np.empty(3 * self.nv, dtype=np.float32)
+        obj.data.vertices.foreach_get("co", rest)
+        self.rest_m = rest.reshape(-1, 3)
+        self.A = self.A_inv = self.vmap = None
+
+    def to_mesh(self, surface):
+        """Output surface (R) -> this mesh's vertex positions (M), float32, its order."""
+        s = surface.reshape(-1, 3)[self.vmap].astype(np.float64)
+        return (s @ self.A_inv[:3, :3].T + self.A_inv[:3, 3]).astype(np.float32)
+
+
+class Binding:
+    """A blob bound to an armature and the meshes it deforms (the first is the one the
+    settings live on): the bone order, the space map, the vertex maps. Raises BindError
+    naming what does not fit."""
+
+    def __init__(self, blob, arm_obj, mesh_obj, others=()):
         self.blob, self.arm, self.mesh = blob, arm_obj, mesh_obj
         names = blob.bone_names()
         pose_names = [pb.name for pb in arm_obj.pose.bones]
@@ -63,48 +82,60 @@ class Binding:
         self.pose_index = np.array([index[n] for n in names])
         self.npose = len(pose_names)
 
-        self.nv = len(mesh_obj.data.vertices)
-        self.rest_m = np.empty(3 * self.nv, dtype=np.float32)
-        mesh_obj.data.vertices.foreach_get("co", self.rest_m)
-        self.rest_m = self.rest_m.reshape(-1, 3)
+        self.parts = [Part(mesh_obj)] + [Part(o) for o in others if o != mesh_obj]
         rest_r = self._rest_surface()
         self.size = float(np.linalg.norm(rest_r.max(0) - rest_r.min(0)))
+        from mathutils.kdtree import KDTree
 
-        # armature space -> mesh space, fixed while previewing
-        k = _matrix(mesh_obj.matrix_world.inverted() @ arm_obj.matrix_world)
-        self.A, self.vmap = self._space_map(names, k, rest_r)
-        self.A_inv = np.linalg.inv(self.A)
-        # T_b = L P_b Q_b: armature -> R on the left, inverse rest -> M on the right
-        self.L = self.A @ k
+        self._tree = KDTree(len(rest_r))
+        for i, p in enumerate(rest_r):
+            self._tree.insert(p, i)
+        self._tree.balance()
+        arm_w = _matrix(arm_obj.matrix_world)
+        a_w = self._space_map(names, arm_w, rest_r)  # world -> R
+        for part in self.parts:
+            part.A = a_w @ _matrix(part.obj.matrix_world)
+            part.A_inv = np.linalg.inv(part.A)
+        first = self.parts[0]
+        self.A, self.A_inv, self.vmap, self.rest_m, self.nv = first.A, first.A_inv, first.vmap, first.rest_m, first.nv
+        # T_b = L P_b Q_b: armature -> R on the left, inverse rest -> R on the right
+        self.L = a_w @ arm_w
         rest_inv = np.array([np.linalg.inv(_matrix(arm_obj.data.bones[n].matrix_local)) for n in names])
         self.Q = rest_inv @ np.linalg.inv(self.L)
 
-    def _space_map(self, names, k, rest_r):
-        """The similarity A: M -> R and the vertex map under it. Two candidates, the one
-        whose rest shape lands on the blob's kept: the glTF exporter's axes (Blender's
-        world turned Y-up: exact for what the add-on bakes, and for a glTF Blender
-        imported), and the fit of the armature's bone heads onto the blob's bind poses (a
-        blob baked from another format; it leaves a free turn when the bones are in a line)."""
-        gltf = np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1.0]]) @ _matrix(self.mesh.matrix_world)
-        candidates = [gltf]
+    def _space_map(self, names, arm_w, rest_r):
+        """The similarity world -> R, with every part's vertex map under it set. Two
+        candidates, the one under which the meshes' rest shapes land on the blob's kept:
+        the glTF exporter's axes (Blender's world turned Y-up: exact for what the add-on
+        bakes, and for a glTF Blender imported), and the fit of the armature's bone heads
+        onto the blob's bind poses (a blob baked from another format; it leaves a free
+        turn when the bones are in a line)."""
+        candidates = [np.array([[1, 0, 0, 0], [0, 0, 1, 0], [0, -1, 0, 0], [0, 0, 0, 1.0]])]
         heads = np.array([list(self.arm.data.bones[n].head_local) + [1.0] for n in names])
         binds = np.array([self.blob.bone_bind(i)[9:12] for i in range(len(names))])
         try:
-            candidates.append(_similarity((heads @ k.T)[:, :3], binds))
+            candidates.append(_similarity((heads @ arm_w.T)[:, :3], binds))
         except BindError:
             pass
         best = None
-        for a in candidates:
-            vmap, worst = self._vertex_map(a, rest_r)
-            if best is None or worst < best[2]:
-                best = (a, vmap, worst)
-        a, vmap, worst = best
+        for a_w in candidates:
+            maps = [
+                self._vertex_map(part, a_w @ _matrix(part.obj.matrix_world), rest_r, len(self.parts) == 1)
+                for part in self.parts
+            ]
+            worst = max(w for _, w, _ in maps)
+            if best is None or worst < best[1]:
+                best = (a_w, worst, maps)
+        a_w, worst, maps = best
         if worst > 2e-3 * self.size:  # the rest step's correction plus the export's rounding
+            bad = max(maps, key=lambda m: m[1])[2]
             raise BindError(
-                f"mesh '{self.mesh.name}' is not the blob's surface (a vertex {worst:.3g} units "
+                f"mesh '{bad}' is not the blob's surface (a vertex {worst:.3g} units "
                 f"from it, {worst / self.size:.2%} of the size): bake again, or choose the baked mesh"
             )
-        return a, vmap
+        for part, (vmap, _, _) in zip(self.parts, maps):
+            part.vmap = vmap
+        return a_w
 
     def _rest_surface(self):
         inst = sinew_lib.Instance(self.blob)
@@ -118,35 +149,29 @@ class Binding:
             inst.close()
         return out.reshape(-1, 3).astype(np.float64)
 
-    def _vertex_map(self, a, rest_r):
-        """For each mesh vertex the output vertex that moves it, under the space map `a`,
-        and the largest distance between the two at rest: the blob's output map when the
-        baked file's vertices are this mesh's (one source mesh, same count), else the
-        nearest output vertex."""
-        mine = self.rest_m.astype(np.float64) @ a[:3, :3].T + a[:3, 3]
+    def _vertex_map(self, part, a, rest_r, single):
+        """For each vertex of `part` under the space map `a` the output vertex that moves
+        it, the largest distance between the two at rest, and the part's name: the blob's
+        output map when the baked file's vertices are this one mesh's (one source mesh,
+        same count), else the nearest output vertex."""
+        mine = part.rest_m.astype(np.float64) @ a[:3, :3].T + a[:3, 3]
         sources = self.blob.output_sources()
-        if self.blob.lib.blob_source_mesh_count(self.blob.handle) == 1 and len(sources) == self.nv:
-            direct = np.full(self.nv, -1)
+        if single and self.blob.lib.blob_source_mesh_count(self.blob.handle) == 1 and len(sources) == part.nv:
+            direct = np.full(part.nv, -1)
             for out, (m, v) in enumerate(sources):
-                if 0 <= v < self.nv:
+                if 0 <= v < part.nv:
                     direct[v] = out
             if (direct >= 0).all():
                 worst = float(np.linalg.norm(rest_r[direct] - mine, axis=1).max())
                 if worst <= 2e-3 * self.size:
-                    return direct, worst
-        from mathutils.kdtree import KDTree
-
-        tree = KDTree(len(rest_r))
-        for i, p in enumerate(rest_r):
-            tree.insert(p, i)
-        tree.balance()
-        vmap = np.empty(self.nv, dtype=np.int64)
+                    return direct, worst, part.obj.name
+        vmap = np.empty(part.nv, dtype=np.int64)
         worst = 0.0
         for j, p in enumerate(mine):
-            _, i, d = tree.find(p)
+            _, i, d = self._tree.find(p)
             vmap[j] = i
             worst = max(worst, d)
-        return vmap, worst
+        return vmap, worst, part.obj.name
 
     def pose_transforms(self, pose_bones, out):
         """Writes the blob-order bone transforms (bone_count x 12 float32) of the posed
@@ -160,9 +185,8 @@ class Binding:
         out[:, 9:] = t[:, :3, 3]
 
     def to_mesh(self, surface):
-        """Output surface (R) -> mesh vertex positions (M), float32, mesh vertex order."""
-        s = surface.reshape(-1, 3)[self.vmap].astype(np.float64)
-        return (s @ self.A_inv[:3, :3].T + self.A_inv[:3, 3]).astype(np.float32)
+        """Output surface (R) -> the first mesh's vertex positions (M)."""
+        return self.parts[0].to_mesh(surface)
 
 
 class Preview:
@@ -185,13 +209,15 @@ class Preview:
         self.surface = np.zeros(3 * binding.blob.vertex_count, dtype=np.float32)
         self.last_frame = None
         self.record = [] if record else None
-        self.frames, self.failed = {}, 0
+        # frames: the first mesh's positions a frame; frames_all: every part's
+        self.frames, self.frames_all, self.failed = {}, {}, 0
         self.ms_total, self.ms_step = [], []
-        mesh = binding.mesh
-        self.modifiers = [(m.name, m.show_viewport, m.show_render) for m in mesh.modifiers if m.type == "ARMATURE"]
-        for m in mesh.modifiers:  # the flesh is the simulation's now, not the skinning's
-            if m.type == "ARMATURE":
-                m.show_viewport = m.show_render = False
+        self.modifiers = []
+        for part in binding.parts:
+            for m in part.obj.modifiers:  # the flesh is the simulation's now, not the skinning's
+                if m.type == "ARMATURE":
+                    self.modifiers.append((part.obj, m.name, m.show_viewport, m.show_render))
+                    m.show_viewport = m.show_render = False
 
     def update(self, frame, pose_bones):
         t0 = time.perf_counter()
@@ -215,14 +241,16 @@ class Preview:
         t2 = time.perf_counter()
         self.world_contacts.append(self.inst.stats.world_contacts)
         self.inst.read_surface(self.surface)
-        co = self.b.to_mesh(self.surface)
-        mesh = self.b.mesh.data
-        mesh.vertices.foreach_set("co", co.ravel())
-        mesh.update()
+        cos = []
+        for part in self.b.parts:
+            co = part.to_mesh(self.surface)
+            part.obj.data.vertices.foreach_set("co", co.ravel())
+            part.obj.data.update()
+            cos.append(co)
         self.last_frame = frame
         if status & sinew_lib.STEP_FAILED:
             self.failed += 1
-        self.frames[frame] = co
+        self.frames[frame], self.frames_all[frame] = cos[0], cos
         if self.record is not None:
             self.record.append({"frame": frame, "reset": reset, "teleport": teleport, "dt": self.dt, "pose": self.pose.ravel().tolist()})
         t3 = time.perf_counter()
@@ -230,12 +258,12 @@ class Preview:
         self.ms_step.append(1e3 * (t2 - t1))
 
     def stop(self):
-        """Puts the rest mesh and the armature modifiers back."""
-        mesh = self.b.mesh
-        mesh.data.vertices.foreach_set("co", self.b.rest_m.ravel())
-        mesh.data.update()
-        for name, viewport, render in self.modifiers:
-            m = mesh.modifiers.get(name)
+        """Puts the rest meshes and the armature modifiers back."""
+        for part in self.b.parts:
+            part.obj.data.vertices.foreach_set("co", part.rest_m.ravel())
+            part.obj.data.update()
+        for obj, name, viewport, render in self.modifiers:
+            m = obj.modifiers.get(name)
             if m:
                 m.show_viewport, m.show_render = viewport, render
         self.inst.close()

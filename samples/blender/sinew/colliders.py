@@ -37,7 +37,7 @@ class Colliders:
         self.b, self.items = binding, []
         self.world = sinew_lib.World(lib)
         try:
-            for obj in tagged(scene, (binding.mesh, binding.arm)):
+            for obj in tagged(scene, [part.obj for part in binding.parts] + [binding.arm]):
                 self._add(obj)
         except Exception:
             self.world.close()
