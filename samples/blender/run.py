@@ -162,6 +162,8 @@ def collider_pass(scene, mesh_obj, frames, free):
     lo, hi = pts.min(0), pts.max(0)
     mid, ext = (lo + hi) / 2, hi - lo
     near = (np.abs(pts[:, :2] - mid[:2]) <= 0.15 * ext[:2]).all(1)
+    if not near.any():  # a sheet or a ring: nothing above the middle
+        near[:] = True
     top = pts[near][np.argmax(pts[near][:, 2])]
     r = 0.1 * float(ext[2])
     centre = top + np.array([0.0, 0.0, 0.6 * r])
