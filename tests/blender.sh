@@ -5,7 +5,8 @@
 # the positions Blender showed equal the runtime's for the same poses stepped outside
 # Blender through the C ABI (check_replay.py, plain python3 and ctypes) within 1e-6 of the
 # character's size; the PC2 and MDD caches read back by Blender's Mesh Cache modifier and
-# the shape keys equal them exactly; a sphere empty tagged as a collider pushes the flesh
+# the shape keys equal them exactly, the morph-target glTF read back by Blender's importer
+# within 1e-6 of the size; a sphere empty tagged as a collider pushes the flesh
 # out; a Workbench render shows the character; bad input
 # (missing library or tool, another character's blob, a truncated blob, a missing bone, an
 # edited mesh) is refused with its reason (check_errors.py). Without blender the test is
@@ -52,6 +53,8 @@ checks = [
     ("shape keys exact", r["shape_key_max_diff"] == 0.0),
     ("PC2 read back exact", r["pc2_max_diff"] == 0.0),
     ("MDD read back exact", r["mdd_max_diff"] == 0.0),
+    ("the morph-target glTF read back: 30 keys within 1e-6 of the size",
+     r["gltf_morph_keys"] == 30 and r["gltf_morph_max_dev"] <= 1e-6),
     ("a sphere collider touches the flesh", r["collider_contact_frames"] > 0 and r["collider_failed_steps"] == 0),
     ("the collider pushes the flesh out (penetration under half that without it)",
      r["collider_penetration"] < 0.5 * r["collider_penetration_free"]),

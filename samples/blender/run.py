@@ -6,9 +6,10 @@
 
 imports ASSET (glTF or FBX, Blender's importers), bakes it through the add-on, plays F
 frames of a clip through the preview, exports them (PC2, MDD, shape keys, glTF morph
-targets), reads the caches back, renders one frame with Workbench to DIR/frame.png and
-writes DIR/run.json with the figures and DIR/preview_record.json with the poses the
-preview stepped (check_replay.py steps them again outside Blender).
+targets), reads the caches and the glTF back, renders one frame with Workbench to
+DIR/frame.png, plays the frames again against a sphere collider pressed into the
+character's back, and writes DIR/run.json with the figures and DIR/preview_record.json
+with the poses the preview stepped (check_replay.py steps them again outside Blender).
 """
 
 import argparse
@@ -92,6 +93,40 @@ def play_action(scene, mesh_obj, name, nframes):
     first = int(action.frame_range[0])
     scene.frame_start, scene.frame_end = first, first + nframes - 1
     return action.name
+
+
+def gltf_back(path, rest, cos, frames, size):
+    """The morph-target glTF imported back by Blender's importer: the number of frames'
+    shape keys found and their largest distance from the frames written, over the size
+    (the file stores deltas from the rest mesh, so float rounding, not 0). The exporter
+    splits vertices along seams, so each mesh vertex is found by its rest position."""
+    from mathutils.kdtree import KDTree
+
+    before = set(bpy.data.objects)
+    bpy.ops.import_scene.gltf(filepath=path)
+    new = [o for o in bpy.data.objects if o not in before and o.type == "MESH" and o.data.shape_keys]
+    worst, found = 0.0, 0
+    if new:
+        keys = new[0].data.shape_keys.key_blocks
+        n = len(new[0].data.vertices)
+        basis = np.empty(3 * n, np.float32)
+        keys[0].data.foreach_get("co", basis)
+        tree = KDTree(n)
+        for i, q in enumerate(basis.reshape(-1, 3)):
+            tree.insert(q, i)
+        tree.balance()
+        match = np.array([tree.find(q)[1] for q in rest])
+        buf = np.empty(3 * n, np.float32)
+        for f, co in zip(frames, cos):
+            kb = keys.get(f"{sinew.export.KEY_PREFIX}{f:04d}")
+            if kb is None:
+                continue
+            kb.data.foreach_get("co", buf)
+            worst = max(worst, float(np.abs(buf.reshape(-1, 3)[match] - co).max()))
+            found += 1
+    for o in [o for o in bpy.data.objects if o not in before]:
+        bpy.data.objects.remove(o)
+    return found, worst / size
 
 
 def skinned(scene, mesh_obj, frames):
@@ -243,6 +278,7 @@ def main():
     scale = float(np.cbrt(np.linalg.det(p.b.A[:3, :3])))  # mesh units -> blob units
     from_skin = max(float(np.linalg.norm(p.frames[f] - k, axis=1).mean()) for f, k in zip(frames, skin))
     from_skin *= scale / p.b.size
+    size_m = p.b.size / scale  # the size in the mesh's units
     lib_path = sinew_lib.find_library(os.environ.get("SINEW_LIB", ""))
     dev = replay_runtime(p, lib_path)
     overhead = [t - s_ for t, s_ in zip(p.ms_total, p.ms_step)]
@@ -261,6 +297,7 @@ def main():
     if not a.no_render:
         centre = render(scene, mesh_obj, frames[len(frames) // 2], os.path.join(out, "frame.png"))
 
+    gltf_keys, gltf_dev = (0, None) if a.no_gltf else gltf_back(exported["gltf"], p.b.rest_m, cos, frames, size_m)
     free = {f: p.frames[f] for f in frames}
     contact_frames, collider_failed, pen, pen_free = collider_pass(scene, mesh_obj, frames, free)
 
@@ -295,6 +332,8 @@ def main():
         "shape_key_max_diff": key_diff,
         "pc2_max_diff": pc2_diff,
         "mdd_max_diff": mdd_diff,
+        "gltf_morph_keys": gltf_keys,
+        "gltf_morph_max_dev": gltf_dev,
         "collider_contact_frames": contact_frames,
         "collider_failed_steps": collider_failed,
         "collider_penetration": pen,
