@@ -2,7 +2,7 @@
 
     blender -b --factory-startup --python-exit-code 1 -P samples/blender/run.py -- \\
         ASSET --tets N --out DIR [--frames F] [--train A,B] [--heldout C] [--play CLIP]
-        [--dynamic] [--lib libsinew.so] [--bake sinew-bake] [--no-gltf] [--no-render]
+        [--dynamic] [--lib libsinew.so] [--bake sinew-bake] [--blob F] [--no-gltf] [--no-render]
 
 imports ASSET (glTF or FBX, Blender's importers), bakes it through the add-on, plays F
 frames of a clip through the preview, exports them (PC2, MDD, shape keys, glTF morph
@@ -31,7 +31,7 @@ def parse():
     argv = sys.argv[sys.argv.index("--") + 1 :] if "--" in sys.argv else []
     ap = argparse.ArgumentParser(prog="run.py", description=__doc__.split("\n\n")[0])
     ap.add_argument("asset")
-    ap.add_argument("--tets", type=int, required=True)
+    ap.add_argument("--tets", type=int, default=8000)
     ap.add_argument("--out", required=True)
     ap.add_argument("--frames", type=int, default=30)
     ap.add_argument("--train", default="", help="actions (or their glTF clip names) to train on, comma separated")
@@ -40,6 +40,7 @@ def parse():
     ap.add_argument("--dynamic", action="store_true")
     ap.add_argument("--lib", default="", help="libsinew.so (default $SINEW_LIB)")
     ap.add_argument("--bake", default="", help="sinew-bake (default $SINEW_BAKE, then PATH)")
+    ap.add_argument("--blob", default="", help="preview this blob instead of baking (--tets is then ignored)")
     ap.add_argument("--no-gltf", action="store_true")
     ap.add_argument("--no-render", action="store_true")
     return ap.parse_args(argv)
@@ -263,9 +264,12 @@ def main():
     s = mesh_obj.sinew
     s.tets, s.dynamic = a.tets, a.dynamic
     choose_clips(mesh_obj, [n for n in a.train.split(",") if n], [n for n in a.heldout.split(",") if n])
-    exe = bake.find_bake(a.bake)
-    bake_s, summary, report = run_bake(mesh_obj, exe)
-    print(f"run.py: baked in {bake_s:.1f} s: {summary.get('tets')} tets, held-out error {summary.get('err_heldout')}")
+    if a.blob:  # baked before (for this asset through Blender): no bake, the preview's figures
+        s.blob_path = os.path.abspath(a.blob)
+        bake_s, summary, report = None, {}, ""
+    else:
+        bake_s, summary, report = run_bake(mesh_obj, bake.find_bake(a.bake))
+        print(f"run.py: baked in {bake_s:.1f} s: {summary.get('tets')} tets, held-out error {summary.get('err_heldout')}")
 
     scene = bpy.context.scene
     held = [c.name for c in s.clips if c.use == "HELDOUT"] or [c.name for c in s.clips]
@@ -317,16 +321,18 @@ def main():
         "mesh": mesh_obj.name,
         "tets": summary.get("tets"),
         "err_heldout": summary.get("err_heldout"),
-        "bake_seconds": round(bake_s, 2),
+        "bake_seconds": round(bake_s, 2) if bake_s is not None else None,
         "bake_tool_seconds": summary.get("bake_seconds"),
-        "report": os.path.join(report, "report.html"),
+        "report": os.path.join(report, "report.html") if report else None,
         "played": played,
         "frames": len(frames),
         "failed_steps": p.failed,
         "step_ms_median": statistics.median(p.ms_step),
         "overhead_ms_median": statistics.median(overhead),
         "overhead_ms_mean": statistics.mean(overhead),
+        "overhead_ms_p90": float(np.percentile(overhead, 90)),
         "overhead_ms_max": max(overhead),
+        "overhead_ms_first": overhead[0],
         "max_dev_runtime": dev,
         "mean_dist_from_skinning": from_skin,
         "shape_key_max_diff": key_diff,
