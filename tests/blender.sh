@@ -28,6 +28,7 @@ fi
 fox=$data/gltf-fox/Fox.glb
 [ -f "$fox" ] || { echo "blender: SKIPPED: no $fox"; exit 77; }
 export SINEW_LIB=$build/runtime/libsinew.so SINEW_BAKE=$build/tools/sinew-bake
+export PYTHONDONTWRITEBYTECODE=1 # no __pycache__ in the source tree
 [ -f "$SINEW_LIB" ] || fail "no $SINEW_LIB"
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
