@@ -22,6 +22,7 @@ import time
 import bpy
 import numpy as np
 
+sys.dont_write_bytecode = True  # no __pycache__ beside the sources
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sinew  # noqa: E402  (the add-on package beside this file)
 from sinew import bake, sinew_lib  # noqa: E402
