@@ -9,8 +9,10 @@
 # within 1e-6 of the size; a sphere empty tagged as a collider pushes the flesh
 # out; a Workbench render shows the character; bad input
 # (missing library or tool, another character's blob, a truncated blob, a missing bone, an
-# edited mesh) is refused with its reason (check_errors.py). Without blender the test is
-# skipped (77), except under CI=true, where tools/setup-debian.sh has installed it.
+# edited mesh) is refused with its reason (check_errors.py); the add-on zipped, installed and
+# enabled through Blender's preferences previews a saved scene, scrubbing back from rest
+# (check_install.py). Without blender the test is skipped (77), except under CI=true,
+# where tools/setup-debian.sh has installed it.
 #   bash tests/blender.sh BUILD_DIR SOURCE_DIR DATA_DIR
 set -uo pipefail
 build=$1
@@ -74,4 +76,17 @@ python3 "$src/samples/blender/check_replay.py" "$tmp/fox/preview_record.json" --
 "$SINEW_BAKE" --scene finger --tets 1000 --out "$tmp/finger.blob" >/dev/null 2>&1 || fail "the finger's bake"
 run_blender "$tmp/errors.log" -P "$src/samples/blender/check_errors.py" -- "$tmp/fox/scene.blend" "$tmp/finger.blob"
 grep '^check_errors' "$tmp/errors.log"
+
+python3 - "$src/samples/blender" "$tmp/sinew.zip" <<'PY' || fail "zip the add-on"
+import os, sys, zipfile
+root, out = sys.argv[1], sys.argv[2]
+with zipfile.ZipFile(out, "w") as z:
+    for name in sorted(os.listdir(os.path.join(root, "sinew"))):
+        if name.endswith(".py"):
+            z.write(os.path.join(root, "sinew", name), "sinew/" + name)
+PY
+mkdir -p "$tmp/home"
+HOME=$tmp/home SINEW_LIB= run_blender "$tmp/install.log" -P "$src/samples/blender/check_install.py" -- \
+    "$tmp/sinew.zip" "$build/runtime/libsinew.so" "$tmp/fox/scene.blend"
+grep '^check_install' "$tmp/install.log"
 echo "blender: passed"
