@@ -104,8 +104,9 @@ class SinewSettings(bpy.types.PropertyGroup):
 
 
 def refresh_clips(mesh_obj):
-    """The armature's actions as clips, keeping the choices already made; with none made,
-    the two longest train and the next is held out (sinew-bake's own default)."""
+    """The armature's actions as clips, longest first, keeping the choices already made;
+    with none made, the two longest train and the next is held out (sinew-bake's own
+    default)."""
     arm = armature_of(mesh_obj)
     s = mesh_obj.sinew
     old = {c.name: c.use for c in s.clips}
@@ -116,12 +117,18 @@ def refresh_clips(mesh_obj):
             names += [st.action.name for st in t.strips if st.action]
         if ad.action:
             names.append(ad.action.name)
-    names = sorted(set(names), key=lambda n: -bpy.data.actions[n].frame_range[1] + bpy.data.actions[n].frame_range[0])
+    def length(name):
+        first, last = bpy.data.actions[name].frame_range
+        return last - first
+
     s.clips.clear()
-    for i, n in enumerate(names):
+    for i, n in enumerate(sorted(set(names), key=length, reverse=True)):
         c = s.clips.add()
         c.name = n
-        c.use = old.get(n, "TRAIN" if i < 2 else "HELDOUT" if i == 2 else "NONE") if old else ("TRAIN" if i < 2 else "HELDOUT" if i == 2 else "NONE")
+        if old:  # an action new since the last choice is left out until chosen
+            c.use = old.get(n, "NONE")
+        else:
+            c.use = "TRAIN" if i < 2 else "HELDOUT" if i == 2 else "NONE"
 
 
 def _mesh_and_armature(context):

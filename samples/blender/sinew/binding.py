@@ -98,7 +98,8 @@ class Binding:
             part.A_inv = np.linalg.inv(part.A)
         first = self.parts[0]
         self.A, self.A_inv, self.vmap, self.rest_m, self.nv = first.A, first.A_inv, first.vmap, first.rest_m, first.nv
-        # T_b = L P_b Q_b: armature -> R on the left, inverse rest -> R on the right
+        # T_b = L P_b Q_b: R -> the bone's rest frame on the right (Q), its posed frame -> R
+        # on the left (L); P_b is the pose bone's armature-space matrix
         self.L = a_w @ arm_w
         rest_inv = np.array([np.linalg.inv(_matrix(arm_obj.data.bones[n].matrix_local)) for n in names])
         self.Q = rest_inv @ np.linalg.inv(self.L)
