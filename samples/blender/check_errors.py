@@ -11,18 +11,20 @@ character's. Exits 1 when a case is not refused with its message.
 import os
 import shutil
 import sys
+import time
 
 import bpy
 
 sys.dont_write_bytecode = True  # no __pycache__ beside the sources
 sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
 import sinew  # noqa: E402
+from sinew import bake  # noqa: E402
 
 
 def expect_error(what, words, op):
     try:
         r = op()
-    except RuntimeError as e:  # Blender raises an operator's ERROR report
+    except (RuntimeError, bake.BakeError) as e:  # Blender raises an operator's ERROR report
         msg = str(e)
         missing = [w for w in words if w not in msg]
         if missing:
@@ -73,11 +75,33 @@ def main():
     expect_error("a mesh edited since the bake", ["is not the blob's surface"], preview)
     mesh.data.vertices[0].co.x = x
 
+    check_progress(os.path.dirname(scene_blend))
+
     if preview() != {"FINISHED"} or mesh.name not in sinew._previews:
         raise SystemExit("check_errors: the good blob does not preview")
     preview()  # stops it
     shutil.os.remove(broken)
     print("check_errors: every case refused with its reason")
+
+
+def check_progress(workdir):
+    """What the status bar shows comes from sinew-bake's progress lines (a stand-in process
+    prints them here); a failed bake's error line reaches the report."""
+    lines = [
+        "sinew-bake: simulate   40% (99/246), 7 s, about 10 s left",
+        "sinew-bake: basis          0.40 s  total rank 288",
+    ]
+    script = "; ".join(f"echo '{ln}' >&2; sleep 0.3" for ln in lines) + "; echo '{\"tets\": 7}'"
+    proc = bake.BakeProcess(["sh", "-c", script], workdir)
+    shown = set()
+    while proc.poll() is None:
+        shown.add(proc.status())
+        time.sleep(0.05)
+    if proc.result() != {"tets": 7} or not {"sinew bake: simulate 40%", "sinew bake: basis 100%"} <= shown:
+        raise SystemExit(f"check_errors: the bake's progress read as {sorted(shown)}")
+    proc = bake.BakeProcess(["sh", "-c", "echo 'sinew-bake: error: no clip named Jump' >&2; exit 1"], workdir)
+    expect_error("a failed bake", ["exit 1", "no clip named Jump"], proc.result)
+    print("check_errors: the bake's progress and failure read")
 
 
 def _default(mesh):
