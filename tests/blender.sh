@@ -9,7 +9,8 @@
 # within 1e-6 of the size; a sphere empty tagged as a collider pushes the flesh
 # out; a Workbench render shows the character; bad input
 # (missing library or tool, another character's blob, a truncated blob, a missing bone, an
-# edited mesh) is refused with its reason (check_errors.py); the add-on zipped, installed and
+# edited mesh, a failed bake) is refused with its reason and the bake's progress lines are
+# read as the status bar shows them (check_errors.py); the add-on zipped, installed and
 # enabled through Blender's preferences previews a saved scene, scrubbing back from rest
 # (check_install.py). Without blender the test is skipped (77), except under CI=true,
 # where tools/setup-debian.sh has installed it.
