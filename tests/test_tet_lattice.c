@@ -258,7 +258,8 @@ static void check_shell(const sw_tetmesh *t, const sw_lattice_report *rep, doubl
 }
 
 /* A surface with no inside (SimpleSkin is a flat strip) is meshed as a shell:
- * a flat sheet (the unit box squashed to z = 0) and one tilted triangle. */
+ * a flat sheet (the unit box squashed to z = 0), the same flat but for rounding, and one
+ * tilted triangle. */
 TEST(a_surface_without_inside_becomes_a_shell) {
     double lo[1][3] = {{0, 0, 0}};
     sw_trimesh box = boxes(1, lo, 1, -1);
@@ -272,6 +273,12 @@ TEST(a_surface_without_inside_becomes_a_shell) {
             rep.shell, rep.spacing, rep.components);
     ENSURE(rep.shell > 0 && fabs(rep.shell - 0.04 * sqrt(2.0)) < 1e-12);
     ENSURE(t.ntets >= 20000 / 1.5 && t.ntets <= 1.5 * 20000 && rep.components == 1);
+    check_shell(&t, &rep, 1.0);
+    sw_tetmesh_free(&t);
+    for (int32_t v = 0; v < box.nverts; v += 2) /* flat to rounding: Blender's round trip */
+        box.X[3 * v + 2] = 2.4e-7;
+    ENSUREF(sw_tetmesh_from_surface(&box, 20000, NULL, &t, &rep, &e) == SINEW_OK, "%s", e.msg);
+    ENSURE(rep.shell > 0 && t.ntets >= 20000 / 1.5 && t.ntets <= 1.5 * 20000);
     check_shell(&t, &rep, 1.0);
     sw_tetmesh_free(&t);
     sw_trimesh tri = boxes(1, lo, 1, -1);

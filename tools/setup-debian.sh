@@ -27,6 +27,8 @@ packages=(
     ffmpeg           # sinew-view --record
     slurm-wlm        # the farm test: a single-node Slurm cluster (tests/slurm.sh, tools/slurm/)
     munge            # Slurm's authentication daemon
+    blender          # the Blender add-on's tests (samples/blender/, Debian 12: Blender 3.4)
+    python3-numpy    # Blender's glTF importer needs it (only a recommendation of blender)
 )
 
 installed() {

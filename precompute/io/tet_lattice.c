@@ -251,6 +251,10 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
             hi[a] = fmax(hi[a], surf->X[3 * (size_t)v + a]);
         }
     double box = (hi[0] - lo[0]) * (hi[1] - lo[1]) * (hi[2] - lo[2]), area = 0;
+    /* a sheet flat but for rounding (an exporter's axis turn leaves float noise across it)
+       is a sheet: its box would ask for a spacing that no memory holds */
+    double thinnest = fmin(hi[0] - lo[0], fmin(hi[1] - lo[1], hi[2] - lo[2]));
+    if (thinnest <= 1e-6 * sw_v3_dist(lo, hi)) box = 0;
     for (int32_t t = 0; t < surf->ntris; ++t) {
         const int32_t *f = surf->tris + 3 * t;
         const double *A = surf->X + 3 * (size_t)f[0], *B = surf->X + 3 * (size_t)f[1],
