@@ -33,14 +33,21 @@ static const char *usage =
     "  --frames N          render N frames, then exit (the clock advances 1/render-hz a frame)\n"
     "  --screenshot OUT    write the last frame to OUT.png (with --frames)\n"
     "  --record OUT        pipe every frame to ffmpeg, writing OUT (.mp4)\n"
+    "  --debug-draw LIST   draw sinew's debug draw over its view: a comma-separated list of\n"
+    "                      contacts, patch, colliders and bones (key g cycles)\n"
+    "  --record-calls FILE record every call the first instance receives into FILE, for\n"
+    "                      sinew-replay --blob B --recording FILE\n"
     "  --script FILE       timed events, one a line: SECONDS KEY (space, period or a key's\n"
     "                      letter), SECONDS press|move X Y (X, Y fractions of the window: a\n"
     "                      press picks a world collider, a move drags it), SECONDS release\n"
     "  --json              print frames, steps, mean step and render ms, fps, the first\n"
-    "                      character's world contacts (most in a step, first time) and where\n"
-    "                      its actor stands (x, z, heading in degrees) at exit\n"
+    "                      character's world contacts (most in a step, first time), where\n"
+    "                      its actor stands (x, z, heading in degrees) at exit and the debug\n"
+    "                      draw's figures (its contact lines: most, before the first press,\n"
+    "                      frames where they differ from the step's world contacts)\n"
     "keys: space pause, . single step, s slow motion, d dynamic/quasistatic, t teleport,\n"
-    "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion, q quit;\n"
+    "      1 sinew, 2 skinning, 3 both, c colour by correction, l linear/dual-quaternion,\n"
+    "      g debug draw (off, contacts and patch, everything), q quit;\n"
     "      left drag: a world collider\n";
 
 static int arg_int(const char *flag, const char *v, int lo, int hi, int *out) {
@@ -106,6 +113,10 @@ int vw_app_parse(vw_app *app, int argc, char **argv) {
             o->record = v;
         else if (!strcmp(a, "--script"))
             o->script = v;
+        else if (!strcmp(a, "--record-calls"))
+            o->record_calls = v;
+        else if (!strcmp(a, "--debug-draw"))
+            ok = vw_debug_parse(v, &app->debug.flags);
         else if (!strcmp(a, "--instances"))
             ok = arg_int(a, v, 1, 4096, &o->instances);
         else if (!strcmp(a, "--threads"))
@@ -200,7 +211,7 @@ static int parse_event(const char *line, const char *word, vw_event *ev) {
     }
     if (!strcmp(word, "release")) return ev->kind = VW_EV_RELEASE, 1;
     ev->key = !strcmp(word, "space") ? ' ' : !strcmp(word, "period") ? '.' : 0;
-    if (!ev->key && strlen(word) == 1 && strchr(" .sdt123clq", word[0])) ev->key = word[0];
+    if (!ev->key && strlen(word) == 1 && strchr(" .sdt123clgq", word[0])) ev->key = word[0];
     return ev->key != 0;
 }
 
@@ -357,6 +368,7 @@ int vw_app_load(vw_app *app, char *err, size_t errlen) {
     if (!vw_sim_create(&app->sim, app->blob, a, &app->motion, o->instances, o->threads, o->dynamic,
                        app->world.world, app->world.rest_pose, err, errlen))
         return 0;
+    if (o->record_calls && !vw_sim_record(&app->sim, o->record_calls, err, errlen)) return 0;
     if (app->world.world) vw_world_move(&app->world, 0);
     vw_sim_step(&app->sim, 0, (float)app->step_dt); /* a surface to draw before the first step */
     return 1;
@@ -406,6 +418,9 @@ void vw_app_key(vw_app *app, char key) {
     case 'l':
         app->opt.dqs = !app->opt.dqs;
         break;
+    case 'g':
+        vw_debug_cycle(app);
+        break;
     case 'q':
         app->opt.frames = (int)app->frames + 1;
         break;
@@ -426,17 +441,21 @@ void vw_app_script(vw_app *app, double clock) {
 
 void vw_app_print_json(const vw_app *app) {
     const vw_planar *a = &app->sim.ch[0].actor; /* the first actor: x, z, heading in degrees */
+    const vw_debug *d = &app->debug;
     double fps = app->wall_s > 0 ? (double)app->frames / app->wall_s : 0;
     printf("{\"frames\": %lld, \"steps\": %lld, \"instances\": %d, \"threads\": %d, "
            "\"mean_step_ms\": %.3f, \"mean_render_ms\": %.3f, \"mean_frame_ms\": %.3f, "
            "\"fps\": %.1f, \"world_contacts_max\": %u, \"first_contact_s\": %.3f, "
-           "\"first_press_s\": %.3f, \"actor\": [%.4g, %.4g, %.4g]}\n",
+           "\"first_press_s\": %.3f, \"actor\": [%.4g, %.4g, %.4g], \"debug_lines_max\": %u, "
+           "\"debug_contact_lines_max\": %u, \"debug_contact_lines_before_press\": %u, "
+           "\"debug_contact_mismatch_frames\": %lld}\n",
            (long long)app->frames, (long long)app->steps, app->sim.n, app->sim.threads,
            app->step_frames ? app->step_ms_sum / (double)app->step_frames : 0,
            app->frames ? app->render_ms_sum / (double)app->frames : 0,
            app->frames ? 1000 * app->wall_s / (double)app->frames : 0, fps, app->contacts_max,
            app->first_contact_s, app->poke.first_press_s, a->x, a->z,
-           a->yaw * 180 / 3.14159265358979323846);
+           a->yaw * 180 / 3.14159265358979323846, d->lines_max, d->contact_lines_max,
+           d->contact_lines_before_press, (long long)d->mismatch_frames);
 }
 
 void vw_app_free(vw_app *app) {

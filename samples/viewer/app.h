@@ -15,6 +15,7 @@ enum { VW_VIEW_SINEW = 1, VW_VIEW_SKIN = 2, VW_VIEW_BOTH = 3 };
 typedef struct vw_options {
     const char *blob, *asset, *scene, *clip, *world, *screenshot, *record, *script;
     const char *fade_to, *root_bone;
+    const char *record_calls; /* --record-calls: the first instance's recording */
     int instances, threads, frames, width, height, json, view, dqs, dynamic, colour;
     double step_hz, render_hz, colour_scale, fade_at, fade_time, walk, turn_deg;
 } vw_options;
@@ -35,6 +36,15 @@ typedef struct vw_lines {
     float *pos, *col; /* 3 a vertex, 2 vertices a segment */
     int32_t n, cap;
 } vw_lines;
+
+/* sinew's debug draw (debugdraw.c): what it draws, and its figures this frame and over
+ * the run (contact lines: the first character's, SINEW_DEBUG_COLOR_WORLD_CONTACT). */
+typedef struct vw_debug {
+    uint32_t flags; /* SINEW_DEBUG_DRAW_*; 0 off */
+    uint32_t lines, points, contact_lines;
+    uint32_t lines_max, contact_lines_max, contact_lines_before_press;
+    int64_t mismatch_frames; /* contact lines other than the step's world contacts */
+} vw_debug;
 
 /* The camera as last drawn, and the collider being dragged. */
 typedef struct vw_poke {
@@ -69,6 +79,7 @@ typedef struct vw_app {
     int nevents, next_event;
     vw_poke poke;
     vw_lines lines;
+    vw_debug debug;
     uint32_t contacts_max;  /* the first character's world contacts: the most in a step */
     double first_contact_s; /* and the simulation time of the first, or -1 */
     /* figures */
@@ -96,6 +107,17 @@ void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_m
 /* A segment or a point (a cross of three segments `size` across) drawn with this frame. */
 void vw_draw_line(vw_app *app, const float a[3], const float b[3], uint32_t rgb);
 void vw_draw_point(vw_app *app, const float p[3], float size, uint32_t rgb);
+/* Where character i (skin 1: its plain skinning) is drawn on the grid: its offset. */
+void vw_layout(const vw_app *app, int32_t i, int skin, float *off);
+/* --debug-draw's list (contacts,patch,colliders,bones) as SINEW_DEBUG_DRAW_* bits; 0 and a
+ * message for a bad one. */
+int vw_debug_parse(const char *list, uint32_t *flags);
+/* The g key: off, contacts and patch, everything. */
+void vw_debug_cycle(vw_app *app);
+/* The line buffer, reserved once at setup. */
+int vw_debug_reserve(vw_app *app);
+/* After a frame's steps: each shown instance's debug draw into the frame's lines. */
+void vw_debug_collect(vw_app *app);
 int vw_app_capture(vw_app *app, int w, int h, int last_frame);
 void vw_app_print_json(const vw_app *app);
 void vw_app_free(vw_app *app);

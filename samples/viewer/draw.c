@@ -31,7 +31,8 @@ int vw_app_gl_setup(vw_app *app, char *err, size_t errlen) {
             return snprintf(err, errlen, "cannot create the GL buffers"), 0;
     }
     app->col_collider = malloc(sizeof(float) * 3 * (size_t)most);
-    if (!app->col_collider) return snprintf(err, errlen, "out of memory"), 0;
+    if (!app->col_collider || !vw_debug_reserve(app))
+        return snprintf(err, errlen, "out of memory"), 0;
     for (int32_t v = 0; v < most; ++v)
         app->col_collider[3 * v] = 0.45f, app->col_collider[3 * v + 1] = 0.6f,
                               app->col_collider[3 * v + 2] = 0.45f;
@@ -106,7 +107,7 @@ static int side_on(const vw_app *app) {
     return app->rest_hi[2] - app->rest_lo[2] > app->rest_hi[0] - app->rest_lo[0];
 }
 
-static void layout(const vw_app *app, int32_t i, int skin, float *off) {
+void vw_layout(const vw_app *app, int32_t i, int skin, float *off) {
     int side = side_on(app), across = side ? 2 : 0;
     float e_across = app->rest_hi[across] - app->rest_lo[across];
     float cell = fmaxf(e_across, 0.3f * app->size) * 1.15f;
@@ -126,7 +127,7 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
                 continue;
             const float *p = skin ? app->sim.ch[i].skin_pos : app->sim.ch[i].pos;
             float off[3];
-            layout(app, i, skin, off);
+            vw_layout(app, i, skin, off);
             for (int32_t v = 0; v < app->asset.nverts; ++v)
                 for (int k = 0; k < 3; ++k)
                     lo[k] = fminf(lo[k], p[3 * v + k] + off[k]),
@@ -146,7 +147,7 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
     vw_poke *p = &app->poke; /* what a mouse press is cast from */
     memcpy(p->eye, eye, sizeof eye), memcpy(p->at, at, sizeof at);
     p->fovy = fovy, p->aspect = aspect, p->valid = 1;
-    layout(app, 0, app->view == VW_VIEW_SKIN, p->off);
+    vw_layout(app, 0, app->view == VW_VIEW_SKIN, p->off);
 }
 
 /* The HUD's lines: frame and step times, the first character's phases and flags. */
@@ -184,6 +185,11 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
     if (m->root_bone >= 0 || m->walk != 0 || m->turn != 0)
         snprintf(lines[3] + n, 160 - (size_t)n, "  ACTOR %.1f %.1f %.0f DEG", a->x, a->z,
                  a->yaw * 180 / 3.14159265358979323846);
+    const vw_debug *d = &app->debug;
+    n = (int)strlen(lines[3]);
+    if (d->flags)
+        snprintf(lines[3] + n, 160 - (size_t)n, "  DRAW %u LINES %u POINTS (G)", d->lines,
+                 d->points);
 }
 
 static void draw_hud(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms) {
@@ -255,12 +261,12 @@ void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_m
         if (app->view != VW_VIEW_SKIN) {
             correction_colours(app, c, app->col_sinew);
             vw_glmesh_update(&app->mesh_sinew[i], c->pos, c->nrm, app->col_sinew);
-            layout(app, i, 0, off);
+            vw_layout(app, i, 0, off);
             vw_gl_draw(&app->mesh_sinew[i], vp, off);
         }
         if (app->view != VW_VIEW_SINEW) {
             vw_glmesh_update(&app->mesh_skin[i], c->skin_pos, c->skin_nrm, app->col_skin);
-            layout(app, i, 1, off);
+            vw_layout(app, i, 1, off);
             vw_gl_draw(&app->mesh_skin[i], vp, off);
         }
     }
@@ -275,14 +281,14 @@ void vw_app_draw(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_m
                 if ((skin && app->view == VW_VIEW_SINEW) || (!skin && app->view == VW_VIEW_SKIN))
                     continue;
                 float off[3];
-                layout(app, i, skin, off);
+                vw_layout(app, i, skin, off);
                 vw_gl_draw(&app->mesh_col[k], vp, off);
             }
     }
     held_colliders(app);
     if (app->lines.n) {
         float off[3];
-        layout(app, 0, app->view == VW_VIEW_SKIN, off);
+        vw_layout(app, 0, app->view == VW_VIEW_SKIN, off);
         vw_gl_lines(app->lines.pos, app->lines.col, app->lines.n, vp, off);
         app->lines.n = 0;
     }

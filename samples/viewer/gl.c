@@ -92,6 +92,7 @@ static const char *hud_fs =
 
 static unsigned mesh_prog, hud_prog, hud_tex, hud_vao, line_vao, line_vbo[3];
 static size_t line_cap; /* vertices line_vbo holds */
+static float *line_nrm; /* and their normals, as many (grown with it, not each frame) */
 static int loc_vp, loc_off, loc_rect, loc_tex;
 
 static unsigned compile(unsigned type, const char *src, char *err, size_t errlen) {
@@ -174,6 +175,7 @@ void vw_gl_shutdown(void) {
     p_glDeleteBuffers(3, line_vbo);
     p_glDeleteVertexArrays(1, &line_vao);
     line_cap = 0;
+    free(line_nrm), line_nrm = NULL;
 }
 
 int vw_glmesh_create(vw_glmesh *m, int32_t nverts, const uint32_t *tris, int32_t ntris) {
@@ -234,26 +236,32 @@ void vw_gl_lines(const float *pos, const float *col, int32_t nverts, const float
                  const float off[3]) {
     if (nverts < 2) return;
     /* the mesh shader, with every normal towards its light: the colours come out unshaded */
-    float *nrm = malloc(sizeof(float) * 3 * (size_t)nverts);
-    if (!nrm) return;
-    for (int32_t v = 0; v < nverts; ++v)
-        nrm[3 * v] = 0.3f, nrm[3 * v + 1] = 0.8f, nrm[3 * v + 2] = 0.6f;
-    const float *src[3] = {pos, nrm, col};
+    const int grow = (size_t)nverts > line_cap;
+    if (grow) {
+        float *nrm = realloc(line_nrm, sizeof(float) * 3 * (size_t)nverts);
+        if (!nrm) return;
+        line_nrm = nrm;
+        for (int32_t v = 0; v < nverts; ++v)
+            nrm[3 * v] = 0.3f, nrm[3 * v + 1] = 0.8f, nrm[3 * v + 2] = 0.6f;
+    }
+    const float *src[3] = {pos, line_nrm, col};
     const GLsizeiptr bytes = (GLsizeiptr)(sizeof(float) * 3 * (size_t)nverts);
     p_glBindVertexArray(line_vao);
     for (int k = 0; k < 3; ++k) {
         p_glBindBuffer(GL_ARRAY_BUFFER, line_vbo[k]);
-        if ((size_t)nverts > line_cap)
+        if (grow)
             p_glBufferData(GL_ARRAY_BUFFER, bytes, src[k], GL_STREAM_DRAW);
         else
             p_glBufferSubData(GL_ARRAY_BUFFER, 0, bytes, src[k]);
     }
-    if ((size_t)nverts > line_cap) line_cap = (size_t)nverts;
-    free(nrm);
+    if (grow) line_cap = (size_t)nverts;
     p_glUseProgram(mesh_prog);
     p_glUniformMatrix4fv(loc_vp, 1, GL_FALSE, vp);
     p_glUniform3fv(loc_off, 1, off);
+    /* over everything: a contact inside the flesh or behind a collider is still seen */
+    p_glDisable(GL_DEPTH_TEST);
     p_glDrawArrays(GL_LINES, 0, nverts & ~1);
+    p_glEnable(GL_DEPTH_TEST);
     p_glBindVertexArray(0);
 }
 

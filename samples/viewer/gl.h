@@ -24,7 +24,7 @@ void vw_gl_begin(int w, int h);
 /* Draws m with the column-major view-projection vp, shifted by off. */
 void vw_gl_draw(const vw_glmesh *m, const float vp[16], const float off[3]);
 /* Draws line segments (vertices 2k, 2k + 1; per-vertex colours, unlit) with vp, shifted by
- * off. */
+ * off, over what is drawn (no depth test). */
 void vw_gl_lines(const float *pos, const float *col, int32_t nverts, const float vp[16],
                  const float off[3]);
 /* Draws an RGB image (top row first) at the top-left of the frame; black is transparent. */

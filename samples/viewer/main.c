@@ -95,7 +95,9 @@ static int run(vw_app *app, GLFWwindow *win) {
         vw_app_script(app, clock);
         if (app->reinit && !(ok = vw_app_reinit(app))) break;
         double step_ms = advance(app, frame_dt);
+        vw_sim_flush(&app->sim); /* the recording's writes, between frames */
         double r0 = now_s();
+        vw_debug_collect(app);
         int fb_w, fb_h;
         glfwGetFramebufferSize(win, &fb_w, &fb_h);
         vw_app_draw(app, fb_w, fb_h, wall_dt * 1000, step_ms);

@@ -62,7 +62,48 @@ int vw_sim_create(vw_sim *s, const sinew_blob *blob, const vw_asset *a, const vw
     return create_instances(s, err, errlen);
 }
 
+int vw_sim_record(vw_sim *s, const char *path, char *err, size_t errlen) {
+    sinew_recorder_def rd = sinew_recorder_def_default();
+    rd.path = path;
+    sinew_result r = sinew_recorder_open(&rd, &s->rec);
+    if (r != SINEW_OK) {
+        s->rec = NULL;
+        return snprintf(err, errlen, "--record-calls %s: cannot create it: %s", path,
+                        sinew_result_string(r)),
+               0;
+    }
+    /* (the world, if any, was attached at creation: its colliders are in the recording) */
+    r = sinew_instance_set_recorder(s->ch[0].inst, s->rec);
+    if (r != SINEW_OK) {
+        sinew_recorder_close(s->rec), s->rec = NULL;
+        return snprintf(err, errlen, "--record-calls %s: the instance refuses it: %s", path,
+                        sinew_result_string(r)),
+               0;
+    }
+    s->rec_path = path;
+    return 1;
+}
+
+void vw_sim_flush(vw_sim *s) {
+    if (s->rec) sinew_recorder_flush(s->rec);
+}
+
+/* Detaches and closes the recording; says so if the file is incomplete. */
+static void stop_recording(vw_sim *s, const char *why) {
+    if (!s->rec) return;
+    sinew_instance_set_recorder(s->ch[0].inst, NULL);
+    sinew_result r = sinew_recorder_close(s->rec);
+    s->rec = NULL;
+    if (r != SINEW_OK)
+        fprintf(stderr, "sinew-view: --record-calls %s: writing it failed: %s\n", s->rec_path,
+                sinew_result_string(r));
+    else if (why)
+        fprintf(stderr, "sinew-view: --record-calls %s: the recording ends here (%s)\n",
+                s->rec_path, why);
+}
+
 int vw_sim_set_mode(vw_sim *s, int dynamic, char *err, size_t errlen) {
+    stop_recording(s, "the instances are recreated in the other step mode");
     for (int32_t i = 0; i < s->n; ++i)
         sinew_instance_destroy(s->ch[i].inst), s->ch[i].inst = NULL;
     s->dynamic = dynamic;
@@ -94,6 +135,10 @@ static int moves(const vw_sim *s) {
 static void to_world(const vw_sim *s, const vw_char *c, float *pos, float *nrm) {
     for (int32_t v = 0; moves(s) && v < s->asset->nverts; ++v)
         vw_planar_apply(&c->actor, pos + 3 * v, 1), vw_planar_apply(&c->actor, nrm + 3 * v, 0);
+}
+
+void vw_sim_actor_point(const vw_sim *s, int32_t i, float p[3]) {
+    if (moves(s)) vw_planar_apply(&s->ch[i].actor, p, 1);
 }
 
 static void step_one(vw_sim *s, vw_char *c, double t, float dt) {
@@ -159,6 +204,7 @@ void vw_sim_skin(vw_sim *s, int dqs) {
 }
 
 void vw_sim_destroy(vw_sim *s) {
+    if (s->ch) stop_recording(s, NULL);
     for (int32_t i = 0; s->ch && i < s->n; ++i) {
         vw_char *c = &s->ch[i];
         sinew_instance_destroy(c->inst);

@@ -7,7 +7,7 @@
 set -euo pipefail
 build=$1 data=$2 what=$3
 here=$(cd "$(dirname "$0")" && pwd)
-view=$build/tools/sinew-view bake=$build/tools/sinew-bake
+view=$build/tools/sinew-view bake=$build/tools/sinew-bake replay=$build/tools/sinew-replay
 tmp=$(mktemp -d)
 trap 'rm -rf "$tmp"' EXIT
 
@@ -89,6 +89,16 @@ if [ "$what" = finger ]; then # a world file: the table rises into the finger
     rc=$?
     set -e
     refused "$rc" "shape 'cone'" "an unknown collider shape"
+    # a debug-draw list with a kind the runtime has not, a recording that cannot be created
+    set +e
+    "$view" "${args[@]}" --debug-draw contacts,hull --frames 1 2>"$tmp/err"; rc=$?
+    set -e
+    [ "$rc" = 2 ] && grep -q "got 'hull'" "$tmp/err" || {
+        cat "$tmp/err"; echo "FAIL: --debug-draw contacts,hull (exit $rc)"; exit 1; }
+    set +e
+    "$view" "${args[@]}" --record-calls "$tmp/no/such/dir.rec" --frames 1 2>"$tmp/err"; rc=$?
+    set -e
+    refused "$rc" "record-calls .*cannot create it" "a recording that cannot be created"
 else
     # a cross-fade into the held-out Run while the actor walks a quarter circle (50 units a
     # second turning 90 degrees a second: radius 31.8, so 45 from the start after 1 s)
@@ -122,8 +132,10 @@ EOS
 1.5 move 0.45 0.45
 2.5 release
 EOS
+    # with the contacts' debug draw, recording the instance's calls
     "${run[@]}" "$view" "${args[@]}" --view sinew --world "$here/../worlds/fox_poke.json" \
-        --script "$tmp/poke" --frames 100 --screenshot "$tmp/poke.png" --json >"$tmp/poke.json"
+        --script "$tmp/poke" --frames 100 --screenshot "$tmp/poke.png" --json \
+        --debug-draw contacts --record-calls "$tmp/poke.rec" >"$tmp/poke.json"
     cat "$tmp/poke.json"
     python3 "$here/check_shot.py" present "$tmp/poke.png"
     python3 - "$tmp/poke.json" <<'EOS'
@@ -133,6 +145,22 @@ press, first, most = j["first_press_s"], j["first_contact_s"], j["world_contacts
 if not (press >= 0 and most > 0 and first >= press):
     sys.exit("FAIL: the poke (pressed at %g s) should make the first world contact (%g s; "
              "most %d in a step)" % (press, first, most))
+# one contact line a world contact in force, frame by frame; none before the press
+lines, before = j["debug_contact_lines_max"], j["debug_contact_lines_before_press"]
+if not (0 < lines <= most and before == 0 and j["debug_contact_mismatch_frames"] == 0):
+    sys.exit("FAIL: the debug draw's contact lines (most %d, %d before the press, %d frames "
+             "off the step's world contacts) should follow the world contacts (most %d)"
+             % (lines, before, j["debug_contact_mismatch_frames"], most))
+EOS
+    # the viewer's recording replays bitwise
+    "$replay" --blob "$tmp/c.blob" --recording "$tmp/poke.rec" --json >"$tmp/replay.json" || {
+        cat "$tmp/replay.json"; echo "FAIL: sinew-replay of the viewer's recording"; exit 1; }
+    tail -1 "$tmp/replay.json"
+    python3 - "$tmp/replay.json" <<'EOS'
+import json, sys
+j = json.loads(open(sys.argv[1]).read().strip().splitlines()[-1])
+if not (j["steps"] >= 90 and j["differing"] == 0):
+    sys.exit("FAIL: the replay: %d steps, %d differ" % (j["steps"], j["differing"]))
 EOS
 fi
 if command -v ffmpeg >/dev/null 2>&1; then
