@@ -448,7 +448,7 @@ void vw_app_print_json(const vw_app *app) {
            "\"fps\": %.1f, \"world_contacts_max\": %u, \"first_contact_s\": %.3f, "
            "\"first_press_s\": %.3f, \"actor\": [%.4g, %.4g, %.4g], \"debug_lines_max\": %u, "
            "\"debug_contact_lines_max\": %u, \"debug_contact_lines_before_press\": %u, "
-           "\"debug_contact_mismatch_frames\": %lld}\n",
+           "\"debug_contact_mismatch_frames\": %lld, ",
            (long long)app->frames, (long long)app->steps, app->sim.n, app->sim.threads,
            app->step_frames ? app->step_ms_sum / (double)app->step_frames : 0,
            app->frames ? app->render_ms_sum / (double)app->frames : 0,
@@ -456,6 +456,13 @@ void vw_app_print_json(const vw_app *app) {
            app->first_contact_s, app->poke.first_press_s, a->x, a->z,
            a->yaw * 180 / 3.14159265358979323846, d->lines_max, d->contact_lines_max,
            d->contact_lines_before_press, (long long)d->mismatch_frames);
+    char hud[4][160];
+    vw_hud_text(app, 0, 0, hud);
+    sinew_step_stats st = {.struct_size = sizeof st};
+    if (app->sim.n > 0) sinew_instance_get_stats(app->sim.ch[0].inst, &st);
+    printf("\"hud_phases\": \"%s\", \"stats\": {\"newton_iterations\": %u, "
+           "\"world_contacts\": %u, \"patch_vertices\": %u, \"ms_solve\": %.2f}}\n",
+           hud[1], st.newton_iterations, st.world_contacts, st.patch_vertices, st.ms_solve);
 }
 
 void vw_app_free(vw_app *app) {

@@ -119,6 +119,10 @@ int vw_debug_reserve(vw_app *app);
 /* After a frame's steps: each shown instance's debug draw into the frame's lines. */
 void vw_debug_collect(vw_app *app);
 int vw_app_capture(vw_app *app, int w, int h, int last_frame);
+/* The HUD's four lines of text (the figures drawn on screen). */
+void vw_hud_text(const vw_app *app, double frame_ms, double step_ms, char lines[4][160]);
+/* The run's figures as one JSON line; with the HUD's phases line and the first
+ * character's stats read again from the library, so a test can hold one to the other. */
 void vw_app_print_json(const vw_app *app);
 void vw_app_free(vw_app *app);
 

@@ -151,7 +151,7 @@ static void camera(vw_app *app, int fb_w, int fb_h, float *vp) {
 }
 
 /* The HUD's lines: frame and step times, the first character's phases and flags. */
-static void hud_text(const vw_app *app, double frame_ms, double step_ms, char lines[4][160]) {
+void vw_hud_text(const vw_app *app, double frame_ms, double step_ms, char lines[4][160]) {
     const sinew_step_stats *s = &app->sim.ch[0].stats;
     const char *view = app->view == VW_VIEW_SINEW  ? "SINEW"
                        : app->view == VW_VIEW_SKIN ? "SKIN"
@@ -194,7 +194,7 @@ static void hud_text(const vw_app *app, double frame_ms, double step_ms, char li
 
 static void draw_hud(vw_app *app, int fb_w, int fb_h, double frame_ms, double step_ms) {
     char lines[4][160];
-    hud_text(app, frame_ms, step_ms, lines);
+    vw_hud_text(app, frame_ms, step_ms, lines);
     int scale = fb_w >= 1200 ? 2 : 1, lh = 9 * scale, w = fb_w, h = 4 * lh + 2 * scale;
     if (app->hud_w != w || app->hud_h != h) {
         free(app->hud);

@@ -83,6 +83,20 @@ if [ "$what" = finger ]; then # a world file: the table rises into the finger
         --json >"$tmp/props.json"
     grep -q '"world_contacts_max": [1-9]' "$tmp/props.json" || {
         cat "$tmp/props.json"; echo "FAIL: the mesh and hull colliders make no contact"; exit 1; }
+    # the HUD shows the library's own figures: its phases line against the stats read again
+    python3 - "$tmp/props.json" <<'EOS'
+import json, re, sys
+j = json.load(open(sys.argv[1]))
+hud, st = j["hud_phases"], j["stats"]
+got = {k: int(re.search(p, hud).group(1)) for k, p in
+       (("newton_iterations", r"NEWTON (\d+)"), ("world_contacts", r"WORLD CONTACTS (\d+)"),
+        ("patch_vertices", r"PATCH (\d+)"))}
+solve = float(re.search(r"SOLVE ([0-9.]+)", hud).group(1))
+bad = [k for k in got if got[k] != st[k]] + (["ms_solve"] if abs(solve - st["ms_solve"]) > 0.006 else [])
+if bad or st["world_contacts"] == 0:
+    sys.exit("FAIL: the HUD (%s) is not the stats %s: %s" % (hud, st, bad or "no contact"))
+print("HUD = stats:", hud)
+EOS
     sed 's/"sphere"/"cone"/' "$here/../worlds/fox_poke.json" >"$tmp/cone.json"
     set +e
     "${run[@]}" "$view" "${args[@]}" --world "$tmp/cone.json" --frames 1 2>"$tmp/err"
