@@ -270,8 +270,12 @@ static int read_collider(const cJSON *o, const char *dir, vw_collider *c, int i,
         d->shape = SINEW_SHAPE_MESH;
         if (!cJSON_IsString(obj)) return FAIL("collider %d (mesh): \"obj\" names no file", i);
         /* (relative to the world file, as the tools read it) */
-        snprintf(path, sizeof path, "%s%.900s", obj->valuestring[0] == '/' ? "" : dir,
-                 obj->valuestring);
+        size_t nd = obj->valuestring[0] == '/' ? 0 : strlen(dir), nf = strlen(obj->valuestring);
+        if (nd + nf >= sizeof path)
+            return FAIL("collider %d (mesh): the path of \"%.64s...\" is too long", i,
+                        obj->valuestring);
+        memcpy(path, dir, nd);
+        memcpy(path + nd, obj->valuestring, nf + 1);
         if (!read_obj(path, c, err, errlen)) return 0;
     } else {
         return FAIL("collider %d: shape '%s' (sphere, capsule, box, plane, hull or mesh)", i, s);
