@@ -186,7 +186,7 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
     const double *bb = nv->cl_now + 6 * b;
     int32_t lb = nv->layer_ptr[b], ln = nv->layer_ptr[b + 1] - lb;
     const double *boxes = nv->layer_box + 6 * (int64_t)lb;
-    const double g = nv->cl_grow[a], *D0 = wc->bone_motion + 13 * wc->cl_bone0[a];
+    const double g = nv->cl_grow[a], *D0 = wc->bone_motion + 12 * wc->cl_bone0[a];
     for (int32_t i = wc->cl_begin[a]; i < wc->cl_begin[a + 1]; ++i) {
         int32_t gv = sw_blob_surf_copy_vertex(v, wc->cl_copy[i]);
         if (nv->held[gv] == nv->stamp) continue;

@@ -187,13 +187,12 @@ void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v) {
 /* ---- detection ------------------------------------------------------------------- */
 
 /* Each bone's rigid motion since the last output, D = T1 T0^-1 (12 doubles: R row-major,
- * t) and ||dR - I||_2 = sqrt(3 - tr dR), once per detection into wc->bone_motion (13 per
- * bone). */
+ * t), once per detection into wc->bone_motion. */
 void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const double *T,
                               const double *T0) {
     for (int32_t b = 0; b < nbones; ++b) {
         const double *A = T0 + 12 * b, *B = T + 12 * b;
-        double *D = wc->bone_motion + 13 * b;
+        double *D = wc->bone_motion + 12 * b;
         for (int r = 0; r < 3; ++r)
             for (int k = 0; k < 3; ++k) {
                 double acc = 0;
@@ -207,7 +206,6 @@ void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const doubl
                 acc -= D[3 * r + k] * A[9 + k];
             D[9 + r] = acc;
         }
-        D[12] = sqrt(fmax(0.0, 3 - (D[0] + D[4] + D[8])));
     }
 }
 
@@ -301,7 +299,7 @@ static double motion_apart(const double *A, const double *B, const double c[3], 
  * its bones move little relative to each other. */
 double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
                             double box[6]) {
-    const double *b = wc->cl_box + 6 * c, *D0 = wc->bone_motion + 13 * wc->cl_bone0[c];
+    const double *b = wc->cl_box + 6 * c, *D0 = wc->bone_motion + 12 * wc->cl_bone0[c];
     double ctr[3], half[3], rho = 0, grow = 0;
     for (int k = 0; k < 3; ++k) {
         ctr[k] = 0.5 * (b[k] + b[3 + k]);
@@ -311,7 +309,7 @@ double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, 
     rho = sqrt(rho);
     for (int32_t bone = 0; bone < v->nbones; ++bone)
         if (wc->cl_bones[c] >> (bone < 64 ? bone : 63) & 1)
-            grow = sw_max(grow, motion_apart(D0, wc->bone_motion + 13 * bone, ctr, rho));
+            grow = sw_max(grow, motion_apart(D0, wc->bone_motion + 12 * bone, ctr, rho));
     /* a dual-quaternion blend of bone motions lands a point about no further from the
      * dominant bone's than the furthest of them; 1.25 x leaves room for the blend and the
      * correction's change */

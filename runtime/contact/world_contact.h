@@ -53,7 +53,7 @@ typedef struct sw_world_contacts {
     double *dom_umax;         /* ndomains: the largest |U rows|_F of a surface copy */
     unsigned char *dom_moved; /* ndomains: moved by the radius since detection */
     double *q_detect;         /* R: the state of the last detection */
-    double *bone_motion;      /* 13 per bone: each bone's motion since the last output */
+    double *bone_motion;      /* 12 per bone: each bone's motion since the last output */
     double *copy_x;           /* 3 per copy: positions at the last output */
     int32_t *cl_pass;         /* ncl: the clusters the last broad phase passed */
     int32_t npass;

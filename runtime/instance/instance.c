@@ -121,7 +121,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(wc->dom_umax, nd);
     TAKE(wc->dom_moved, nd);
     TAKE(wc->q_detect, R);
-    TAKE(wc->bone_motion, 13 * nb);
+    TAKE(wc->bone_motion, 12 * nb);
     TAKE(wc->copy_x, 3 * nc);
     /* subspace condensation: the patch's budget, and per vertex and tet stamps */
     sw_cond *c = &in->cond;

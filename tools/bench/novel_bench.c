@@ -5,6 +5,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bbox.h"
 #include "blob_load.h"
 #include "instance.h"
 #include "mesh_io.h"
@@ -67,14 +68,10 @@ sinew_result sw_novel_bench_run(const sinew_blob *blob, const sw_character *ch, 
     for (int32_t t = 0; r == SINEW_OK && t < v->ntets; ++t) /* lumped: a quarter a corner */
         for (int k = 0; k < 4; ++k)
             mass[v->tets[4 * (int64_t)t + k]] += 0.25 * v->tet_vol[t];
-    double lo[3] = {INFINITY, INFINITY, INFINITY}, hi[3] = {-INFINITY, -INFINITY, -INFINITY};
-    for (int32_t i = 0; i < v->nverts; ++i)
-        for (int k = 0; k < 3; ++k) {
-            lo[k] = fmin(lo[k], v->rest[3 * i + k]);
-            hi[k] = fmax(hi[k], v->rest[3 * i + k]);
-        }
-    out->size = sqrt((hi[0] - lo[0]) * (hi[0] - lo[0]) + (hi[1] - lo[1]) * (hi[1] - lo[1]) +
-                     (hi[2] - lo[2]) * (hi[2] - lo[2]));
+    double lo[3], hi[3];
+    sw_bbox_empty(lo, hi);
+    sw_bbox_add(lo, hi, v->nverts, v->rest);
+    out->size = sw_bbox_diagonal(lo, hi);
     for (int k = 0; r == SINEW_OK && k < SW_NOVEL_CONFIGS; ++k) {
         sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
                              .dt = 1.0f / 30,
