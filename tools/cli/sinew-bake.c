@@ -163,180 +163,140 @@ static int measure(bake *b, sw_error *err) {
 
 /* The blob written (unless absurd without --force) and with --report the report. */
 static int write_outputs(const bake *b) {
-    const char *out_path = b->o.out_path;
-    const char *report_dir = b->o.report_dir;
-    const char *source = b->source;
-    const sw_character_args *ca = &b->o.ca;
-    const sw_bake_params *p = &b->o.p;
-    const sw_fullsim_params *reference = &b->o.reference;
-    const sw_adaptive_params *ad = &b->o.ad;
-    const sw_adaptive_report *arep = &b->arep;
-    const sw_character *ch = &b->ch;
-    const sw_clip_split *clips = &b->clips;
-    const sw_scene_character_info *info = &b->info;
-    const sw_bake_result *res = &b->res;
-    const sinew_blob *blob = b->blob;
-    const sw_eval_result *et = &b->et;
-    const sw_eval_result *eh = &b->eh;
-    const sw_bake_spread *spread = &b->spread;
-    const double *frame_err = b->frame_err;
-    const double *mode_err = b->mode_err;
-    const double bake_seconds = b->bake_seconds;
-    const double eval_seconds = b->eval_seconds;
-    const double model_err = b->model_err;
-    const int force = b->o.force;
-    const int spread_every = b->o.spread_every;
-    const int absurd = b->absurd;
     const sw_bake_result *shipped = b->ship_whole ? &b->whole : &b->res;
     sw_error err;
     sinew_result r;
-    if (absurd && !force && et->failed > 0) {
+    if (b->absurd && !b->o.force && b->et.failed > 0) {
         fprintf(stderr,
                 "%s: error: %d of the blob's steps through its own %d training poses failed (a "
                 "non-finite state: check the material and --spring-k); %s not written, or "
                 "--force to write it anyway\n",
-                tool, et->failed, res->ntrain, out_path);
+                tool, b->et.failed, b->res.ntrain, b->o.out_path);
         return 1;
     }
-    if (absurd && !force) {
+    if (b->absurd && !b->o.force) {
         fprintf(stderr,
                 "%s: error: the bake's training error is %.4f (at least %.2f: the subspace misses "
                 "that share of the physics correction on its own training poses without the "
                 "equilibrium force; a sound bake misses a few percent); %s not written. Give a "
                 "clip with more frames or joint motion or a higher --max-rank, or --force to "
                 "write it anyway\n",
-                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, out_path);
+                tool, b->model_err, SW_BAKE_MAX_TRAIN_ERROR, b->o.out_path);
         return 1;
     }
-    if ((r = sw_blob_write(out_path, &shipped->view, &err)) != SINEW_OK) {
-        sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, out_path);
+    if ((r = sw_blob_write(b->o.out_path, &shipped->view, &err)) != SINEW_OK) {
+        sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, b->o.out_path);
         return 1;
     }
-    if (report_dir) {
-        int scene_clips = p->ntrain_clips > 0;
-        sw_bake_report_input ri = {source,
-                                   ch,
-                                   res,
-                                   blob,
-                                   scene_clips ? (const char(*)[64])clips->train_names : NULL,
-                                   scene_clips ? clips->ntrain : 0,
-                                   scene_clips ? (const char(*)[64])clips->heldout_names : NULL,
-                                   scene_clips ? clips->nheldout : 0,
-                                   frame_err,
-                                   frame_err + res->ntrain,
-                                   et->correction_error,
-                                   eh->correction_error,
-                                   et->failed + eh->failed,
-                                   bake_seconds,
-                                   eval_seconds,
+    if (b->o.report_dir) {
+        int scene_clips = b->o.p.ntrain_clips > 0;
+        sw_bake_report_input ri = {b->source,
+                                   &b->ch,
+                                   &b->res,
+                                   b->blob,
+                                   scene_clips ? (const char(*)[64])b->clips.train_names : NULL,
+                                   scene_clips ? b->clips.ntrain : 0,
+                                   scene_clips ? (const char(*)[64])b->clips.heldout_names : NULL,
+                                   scene_clips ? b->clips.nheldout : 0,
+                                   b->frame_err,
+                                   b->frame_err + b->res.ntrain,
+                                   b->et.correction_error,
+                                   b->eh.correction_error,
+                                   b->et.failed + b->eh.failed,
+                                   b->bake_seconds,
+                                   b->eval_seconds,
                                    1,
-                                   ad->rounds > 0 ? arep : NULL,
-                                   et,
-                                   eh,
-                                   !ca->file                               ? NULL
-                                   : info->mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
-                                                                           : "lattice",
-                                   mode_err,
-                                   spread_every > 0 ? spread : NULL,
-                                   sw_linear_solver_name(reference->solver),
-                                   sw_hessian_mode_name(reference->hessian),
-                                   ad->rounds > 0 ? ad->target : 0};
-        if ((r = sw_bake_report_write(report_dir, &ri, &err)) != SINEW_OK) {
-            sw_tool_failed(r, &err, "%s: --report %s: ", tool, report_dir);
+                                   b->o.ad.rounds > 0 ? &b->arep : NULL,
+                                   &b->et,
+                                   &b->eh,
+                                   !b->o.ca.file                             ? NULL
+                                   : b->info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen"
+                                                                             : "lattice",
+                                   b->mode_err,
+                                   b->o.spread_every > 0 ? &b->spread : NULL,
+                                   sw_linear_solver_name(b->o.reference.solver),
+                                   sw_hessian_mode_name(b->o.reference.hessian),
+                                   b->o.ad.rounds > 0 ? b->o.ad.target : 0};
+        if ((r = sw_bake_report_write(b->o.report_dir, &ri, &err)) != SINEW_OK) {
+            sw_tool_failed(r, &err, "%s: --report %s: ", tool, b->o.report_dir);
             return 1;
         }
         fprintf(stderr, "%s: wrote the report %s/report.html and %s/report.json\n", tool,
-                report_dir, report_dir);
+                b->o.report_dir, b->o.report_dir);
     }
     return 0;
 }
 
 /* The bake's summary on stderr. */
 static void print_summary(const bake *b) {
-    const char *out_path = b->o.out_path;
-    const sw_bake_params *p = &b->o.p;
-    const sw_fullsim_params *reference = &b->o.reference;
-    const sw_character *ch = &b->ch;
-    const sw_bake_result *res = &b->res;
-    const sw_eval_result *et = &b->et;
-    const sw_eval_result *eh = &b->eh;
-    const sw_bake_spread *spread = &b->spread;
-    const double *mode_err = b->mode_err;
-    const double bake_seconds = b->bake_seconds;
-    const double model_err = b->model_err;
-    const int spread_every = b->o.spread_every;
-    const int absurd = b->absurd;
-    const int32_t kept = b->kept;
-    const int32_t nbeyond = b->nbeyond;
-    const int32_t nbeyond_all = b->nbeyond_all;
-    const sw_joint_reach *beyond = b->beyond;
     char num[32];
-    const sw_blob_view *v = &res->view;
-    fprintf(stderr, "%s: wrote %s\n", tool, out_path);
+    const sw_blob_view *v = &b->res.view;
+    fprintf(stderr, "%s: wrote %s\n", tool, b->o.out_path);
     fprintf(stderr, "  stages (s):");
     for (int k = 0; k < SW_BAKE_NSTAGES; ++k) /* the bake's table (bake.h) */
-        fprintf(stderr, "%s %s %.2f", k ? "," : "", sw_bake_stages[k].name, res->stage_seconds[k]);
-    fprintf(stderr, "; total %.2f\n", bake_seconds);
+        fprintf(stderr, "%s %s %.2f", k ? "," : "", sw_bake_stages[k].name,
+                b->res.stage_seconds[k]);
+    fprintf(stderr, "; total %.2f\n", b->bake_seconds);
     fprintf(stderr, "  domains %d, total rank %d (", v->ndomains, v->rank_total);
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].rank);
     fprintf(stderr, "), cubature tets %d (", v->ncub);
     for (int32_t d = 0; d < v->ndomains; ++d)
         fprintf(stderr, "%s%d", d ? " " : "", v->domains[d].cub_count);
-    fprintf(stderr, "), worst cubature fit %.4f\n", res->cubature_error_max);
+    fprintf(stderr, "), worst cubature fit %.4f\n", b->res.cubature_error_max);
     /* random held-out poses (no clip) come on a path: say what the count is made of */
     char held_how[128] = "";
-    if (res->nheldout > 0 && res->heldout_clip[0] < 0)
+    if (b->res.nheldout > 0 && b->res.heldout_clip[0] < 0)
         snprintf(held_how, sizeof held_how,
                  " (%d random combined poses, each reached in %d steps, %s)",
-                 res->nheldout / p->heldout_steps, p->heldout_steps,
-                 ch->range.nframes > 0 ? "the joints within --joint-range"
-                                       : "every joint within 90 degrees");
+                 b->res.nheldout / b->o.p.heldout_steps, b->o.p.heldout_steps,
+                 b->ch.range.nframes > 0 ? "the joints within --joint-range"
+                                         : "every joint within 90 degrees");
     char pair_how[64] = ""; /* on by default only with a range: say when they ran */
-    if (res->pair_sweep_poses > 0)
+    if (b->res.pair_sweep_poses > 0)
         snprintf(pair_how, sizeof pair_how, " (%d of joints swept with their parents)",
-                 res->pair_sweep_poses);
+                 b->res.pair_sweep_poses);
     fprintf(stderr,
             "  poses: %d training%s, %d held-out%s; basis projection error train %.4f held-out "
             "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
-            res->ntrain, pair_how, res->nheldout, held_how, res->train_proj_error,
-            res->heldout_proj_error, res->train_galerkin_error, res->heldout_galerkin_error);
+            b->res.ntrain, pair_how, b->res.nheldout, held_how, b->res.train_proj_error,
+            b->res.heldout_proj_error, b->res.train_galerkin_error, b->res.heldout_galerkin_error);
     fprintf(stderr, "  references solved by: solver %s, %s Hessians, at most %d contact rounds\n",
-            sw_linear_solver_name(reference->solver), sw_hessian_mode_name(reference->hessian),
-            reference->contact_rounds);
+            sw_linear_solver_name(b->o.reference.solver),
+            sw_hessian_mode_name(b->o.reference.hessian), b->o.reference.contact_rounds);
     fprintf(stderr,
             "  self-contact: %d contact pairs over the training poses in %d pairs of domains; "
             "the per-pair cubature keeps %d (--contact-tol %g)\n",
-            v->ncontacts, v->npair_groups, kept, p->contact_cubature_tol);
+            v->ncontacts, v->npair_groups, b->kept, b->o.p.contact_cubature_tol);
     if (v->nrender_verts > 0)
         fprintf(stderr,
                 "  output: the render mesh, %d vertices (%d welded duplicates), %d triangles, "
                 "embedded in %d tets in %.1f ms; %d vertices outside the tets, by %.4g at most; "
                 "|barycentric| <= %.3g\n",
-                v->nrender_verts, res->render_welded, v->nrender_tris, v->nembed_tets,
-                1e3 * res->embed_seconds, res->render_outside, res->render_max_outside,
-                res->render_max_bary);
-    if (res->train_unsettled + res->heldout_unsettled > 0)
-        fprintf(
-            stderr,
-            "  reference: the contact round cap left the contact set unsettled in %d training and "
-            "%d held-out solutions (their fold depends on the cap)\n",
-            res->train_unsettled, res->heldout_unsettled);
+                v->nrender_verts, b->res.render_welded, v->nrender_tris, v->nembed_tets,
+                1e3 * b->res.embed_seconds, b->res.render_outside, b->res.render_max_outside,
+                b->res.render_max_bary);
+    if (b->res.train_unsettled + b->res.heldout_unsettled > 0)
+        fprintf(stderr,
+                "  reference: the contact round cap left the contact set unsettled in %d "
+                "training and "
+                "%d held-out solutions (their fold depends on the cap)\n",
+                b->res.train_unsettled, b->res.heldout_unsettled);
     fprintf(stderr,
             "  correction error (subspace vs full, share of the correction missed, on the bake's "
             "poses): train %.4f, held-out %.4f (%d failed steps)\n",
-            et->correction_error, eh->correction_error, et->failed + eh->failed);
-    if (res->model_train_error >= 0)
+            b->et.correction_error, b->eh.correction_error, b->et.failed + b->eh.failed);
+    if (b->res.model_train_error >= 0)
         fprintf(stderr,
                 "  equilibrium force at %d of %d training poses; the training error without it "
                 "%.4f\n",
-                res->force_poses, res->ntrain, res->model_train_error);
+                b->res.force_poses, b->res.ntrain, b->res.model_train_error);
     fprintf(stderr,
             "  seams (the domains' copies of a vertex apart, share of the correction; largest "
             "gap over the rest diagonal): train %.4f, %.2e; held-out %.4f, %.2e\n",
-            et->seam, et->seam_max, eh->seam, eh->seam_max);
+            b->et.seam, b->et.seam_max, b->eh.seam, b->eh.seam_max);
     for (int set = 0; set < 2; ++set) {
-        const sw_eval_result *e = set ? eh : et;
+        const sw_eval_result *e = set ? &b->eh : &b->et;
         if (e->nregions < 1) continue;
         fprintf(stderr,
                 "  %s error by region (strongest bone: share of the error / of the "
@@ -344,79 +304,57 @@ static void print_summary(const bake *b) {
                 set ? "held-out" : "training");
         for (int32_t k = 0; k < e->nregions; ++k)
             fprintf(stderr, " bone %d%s%s %.3f / %.3f%s", e->region_bone[k],
-                    ch->bone_names ? " " : "",
-                    ch->bone_names ? ch->bone_names[e->region_bone[k]] : "", e->region_err[k],
+                    b->ch.bone_names ? " " : "",
+                    b->ch.bone_names ? b->ch.bone_names[e->region_bone[k]] : "", e->region_err[k],
                     e->region_corr[k], k + 1 < e->nregions ? "," : "\n");
     }
     fprintf(stderr, "  held-out error by self-contact mode:");
     for (int k = 0; k < SW_BAKE_MODES; ++k)
         fprintf(stderr, " %s %s%s", sw_self_contact_names[k],
-                isfinite(mode_err[k]) ? json_number(mode_err[k], num) : "-",
+                isfinite(b->mode_err[k]) ? json_number(b->mode_err[k], num) : "-",
                 k + 1 < SW_BAKE_MODES ? "," : "\n");
-    if (spread_every > 0)
+    if (b->o.spread_every > 0)
         fprintf(stderr,
-                "  reference spread at %d held-out poses (every %d-th): runtime %.4f; full-space "
+                "  reference spread at %d held-out poses (every %d-th): runtime %.4f; "
+                "full-space "
                 "solves from plain skinning %.4f, from the reference %.4f, from the runtime's "
                 "state %.4f (moved it %.4f); %d unconverged, %d left out\n",
-                spread->poses, spread_every, spread->runtime, spread->from_skin,
-                spread->from_reference, spread->polished, spread->polish_move, spread->unconverged,
-                spread->failed);
-    if (nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
-        int32_t shown = nbeyond < 8 ? nbeyond : 8;
+                b->spread.poses, b->o.spread_every, b->spread.runtime, b->spread.from_skin,
+                b->spread.from_reference, b->spread.polished, b->spread.polish_move,
+                b->spread.unconverged, b->spread.failed);
+    if (b->nbeyond > 0) { /* where the basis extrapolates: what a training clip should reach */
+        int32_t shown = b->nbeyond < 8 ? b->nbeyond : 8;
         fprintf(stderr,
                 "  held-out poses bend %d joint%s beyond training (largest bend held-out "
                 "/ in training, degrees):",
-                nbeyond_all, nbeyond_all == 1 ? "" : "s");
+                b->nbeyond_all, b->nbeyond_all == 1 ? "" : "s");
         for (int32_t k = 0; k < shown; ++k) {
-            fprintf(stderr, " bone %d", beyond[k].bone);
-            if (ch->bone_names) fprintf(stderr, " %s", ch->bone_names[beyond[k].bone]);
-            fprintf(stderr, " %.1f / %.1f%s", beyond[k].heldout_deg, beyond[k].train_deg,
-                    k + 1 < shown     ? ","
-                    : nbeyond > shown ? ", ...\n"
-                                      : "\n");
+            fprintf(stderr, " bone %d", b->beyond[k].bone);
+            if (b->ch.bone_names) fprintf(stderr, " %s", b->ch.bone_names[b->beyond[k].bone]);
+            fprintf(stderr, " %.1f / %.1f%s", b->beyond[k].heldout_deg, b->beyond[k].train_deg,
+                    k + 1 < shown        ? ","
+                    : b->nbeyond > shown ? ", ...\n"
+                                         : "\n");
         }
     }
-    if (absurd)
+    if (b->absurd)
         fprintf(stderr,
                 "%s: WARNING: written with --force although its training error is %.4f (refused "
                 "at %.2f) with %d failed steps: this blob misses most of the physics correction\n",
-                tool, model_err, SW_BAKE_MAX_TRAIN_ERROR, et->failed);
-    if (p->compare_selectors) {
+                tool, b->model_err, SW_BAKE_MAX_TRAIN_ERROR, b->et.failed);
+    if (b->o.p.compare_selectors) {
         static const char *names[3] = {"greedy", "importance", "nnhtp"};
         for (int s = 0; s < 3; ++s)
             fprintf(stderr, "  selector %-10s %6d tets  %8.2f s  worst fit %.4f\n", names[s],
-                    res->selector_points[s], res->selector_seconds[s], res->selector_error[s]);
+                    b->res.selector_points[s], b->res.selector_seconds[s],
+                    b->res.selector_error[s]);
     }
 }
 
 /* The JSON line, with --json. */
 static void print_json(const bake *b) {
-    const char *out_path = b->o.out_path;
-    const sw_character_args *ca = &b->o.ca;
-    const sw_bake_params *p = &b->o.p;
-    const sw_fullsim_params *reference = &b->o.reference;
-    const sw_adaptive_params *ad = &b->o.ad;
-    const sw_adaptive_report *arep = &b->arep;
-    const sw_character *ch = &b->ch;
-    const sw_scene_character_info *info = &b->info;
-    const sw_quality *quality = &b->quality;
-    const sw_bake_result *res = &b->res;
-    const sw_eval_result *et = &b->et;
-    const sw_eval_result *eh = &b->eh;
-    const sw_bake_spread *spread = &b->spread;
-    const double *mode_err = b->mode_err;
-    const double bake_seconds = b->bake_seconds;
-    const double eval_seconds = b->eval_seconds;
-    const double model_err = b->model_err;
-    const int json = b->o.json;
-    const int spread_every = b->o.spread_every;
-    const int absurd = b->absurd;
-    const int32_t kept = b->kept;
-    const int32_t nbeyond = b->nbeyond;
-    const sw_joint_reach *beyond = b->beyond;
-    const sw_blob_view *v = &b->res.view;
     char num[32];
-    if (json) {
+    if (b->o.json) {
         char gt[32], gh[32];
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
                "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
@@ -425,50 +363,51 @@ static void print_json(const bake *b) {
                "heldout\":%.5f,"
                "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
                "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f",
-               out_path, ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones, v->ndomains,
-               v->rank_total, v->ncub, res->cubature_error_max, res->ntrain, res->return_poses,
-               res->pair_sweep_poses, res->nheldout, res->train_proj_error, res->heldout_proj_error,
-               et->correction_error, eh->correction_error, res->train_unsettled,
-               res->heldout_unsettled, bake_seconds, eval_seconds);
+               b->o.out_path, b->ch.mesh.ntets, b->ch.mesh.nverts, b->ch.skel.nbones,
+               b->res.view.ndomains, b->res.view.rank_total, b->res.view.ncub,
+               b->res.cubature_error_max, b->res.ntrain, b->res.return_poses,
+               b->res.pair_sweep_poses, b->res.nheldout, b->res.train_proj_error,
+               b->res.heldout_proj_error, b->et.correction_error, b->eh.correction_error,
+               b->res.train_unsettled, b->res.heldout_unsettled, b->bake_seconds, b->eval_seconds);
         printf(",\"stages\":["); /* the bake's table (bake.h), as the report's JSON */
         for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
             printf("%s{\"name\":\"%s\",\"seconds\":%.2f}", k ? "," : "", sw_bake_stages[k].name,
-                   res->stage_seconds[k]);
+                   b->res.stage_seconds[k]);
         printf("]");
         printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
                "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
-               res->force_poses, model_err, sw_linear_solver_name(reference->solver),
-               sw_hessian_mode_name(reference->hessian), ch->range.nframes,
-               (unsigned long long)p->seed);
+               b->res.force_poses, b->model_err, sw_linear_solver_name(b->o.reference.solver),
+               sw_hessian_mode_name(b->o.reference.hessian), b->ch.range.nframes,
+               (unsigned long long)b->o.p.seed);
         printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
-               json_number(res->train_galerkin_error, gt),
-               json_number(res->heldout_galerkin_error, gh));
-        printf(",\"spring_k\":%.6g,\"spring_tried\":[", res->spring_k);
-        for (int32_t k = 0; k < res->nspring_tried; ++k)
-            printf("%s[%.4g,%.5f]", k ? "," : "", res->spring_tried_mult[k],
-                   res->spring_tried_err[k]);
+               json_number(b->res.train_galerkin_error, gt),
+               json_number(b->res.heldout_galerkin_error, gh));
+        printf(",\"spring_k\":%.6g,\"spring_tried\":[", b->res.spring_k);
+        for (int32_t k = 0; k < b->res.nspring_tried; ++k)
+            printf("%s[%.4g,%.5f]", k ? "," : "", b->res.spring_tried_mult[k],
+                   b->res.spring_tried_err[k]);
         printf("]");
         printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
                "\"seam_max_heldout\":%.3e",
-               et->seam, eh->seam, et->seam_max, eh->seam_max);
+               b->et.seam, b->eh.seam, b->et.seam_max, b->eh.seam_max);
         printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
                "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
                "\"embed_seconds\":%.4f",
-               sw_blob_output_verts(v), sw_blob_output_ntris(v),
-               v->nrender_verts > 0 ? "true" : "false", res->render_outside,
-               res->render_max_outside, res->render_max_bary, res->embed_seconds);
-        if (ca->file)
+               sw_blob_output_verts(&b->res.view), sw_blob_output_ntris(&b->res.view),
+               b->res.view.nrender_verts > 0 ? "true" : "false", b->res.render_outside,
+               b->res.render_max_outside, b->res.render_max_bary, b->res.embed_seconds);
+        if (b->o.ca.file)
             printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
-                   info->mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
-                   quality->min_dihedral_deg, quality->slivers);
-        if (p->compare_selectors)
+                   b->info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
+                   b->quality.min_dihedral_deg, b->quality.slivers);
+        if (b->o.p.compare_selectors)
             printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
                    "\"nnhtp\":[%d,%.3f,%.4f]}",
-                   res->selector_points[0], res->selector_seconds[0], res->selector_error[0],
-                   res->selector_points[1], res->selector_seconds[1], res->selector_error[1],
-                   res->selector_points[2], res->selector_seconds[2], res->selector_error[2]);
-        for (int k = 0; ad->rounds > 0 && k < arep->nrounds; ++k) {
-            const sw_adaptive_round *a = &arep->round[k];
+                   b->res.selector_points[0], b->res.selector_seconds[0], b->res.selector_error[0],
+                   b->res.selector_points[1], b->res.selector_seconds[1], b->res.selector_error[1],
+                   b->res.selector_points[2], b->res.selector_seconds[2], b->res.selector_error[2]);
+        for (int k = 0; b->o.ad.rounds > 0 && k < b->arep.nrounds; ++k) {
+            const sw_adaptive_round *a = &b->arep.round[k];
             printf("%s{\"train_poses\":%d,\"added\":%d,\"rank\":%d,\"err_train\":%.5f,"
                    "\"err_heldout\":%.5f,\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,"
                    "\"score_mean\":%.4f,\"score_max\":%.4f,\"picks_score\":%.4f,"
@@ -476,12 +415,12 @@ static void print_json(const bake *b) {
                    k == 0 ? ",\"adaptive\":[" : ",", a->ntrain, a->added, a->rank_total,
                    a->err_train, a->err_heldout, a->proj_train, a->proj_heldout, a->score_mean,
                    a->score_max, a->picks_score, a->picks_error, a->solved, a->seconds,
-                   k + 1 == arep->nrounds ? "]" : "");
+                   k + 1 == b->arep.nrounds ? "]" : "");
         }
-        printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d", v->ncontacts,
-               v->npair_groups, kept);
+        printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d",
+               b->res.view.ncontacts, b->res.view.npair_groups, b->kept);
         for (int set = 0; set < 2; ++set) { /* [bone, share of the error, of the correction] */
-            const sw_eval_result *e = set ? eh : et;
+            const sw_eval_result *e = set ? &b->eh : &b->et;
             printf(",\"err_regions_%s\":[", set ? "heldout" : "train");
             for (int32_t k = 0; k < e->nregions; ++k)
                 printf("%s[%d,%.4f,%.4f]", k ? "," : "", e->region_bone[k], e->region_err[k],
@@ -491,36 +430,36 @@ static void print_json(const bake *b) {
         printf(",\"err_heldout_by_mode\":{");
         for (int k = 0; k < SW_BAKE_MODES; ++k)
             printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k],
-                   json_number(mode_err[k], num));
+                   json_number(b->mode_err[k], num));
         printf("}");
-        if (spread_every > 0)
+        if (b->o.spread_every > 0)
             printf(",\"ref_spread\":{\"every\":%d,\"poses\":%d,\"runtime\":%.5f,"
                    "\"from_skin\":%.5f,\"from_reference\":%.5f,\"polished\":%.5f,"
                    "\"polish_move\":%.5f,\"unconverged\":%d,\"failed\":%d}",
-                   spread_every, spread->poses, spread->runtime, spread->from_skin,
-                   spread->from_reference, spread->polished, spread->polish_move,
-                   spread->unconverged, spread->failed);
-        for (int32_t k = 0; spread_every > 0 && k < spread->poses; ++k) {
+                   b->o.spread_every, b->spread.poses, b->spread.runtime, b->spread.from_skin,
+                   b->spread.from_reference, b->spread.polished, b->spread.polish_move,
+                   b->spread.unconverged, b->spread.failed);
+        for (int32_t k = 0; b->o.spread_every > 0 && k < b->spread.poses; ++k) {
             /* [held-out pose, runtime, from_skin, from_reference, polished, correction] */
-            const sw_bake_spread_pose *q = &spread->per_pose[k];
+            const sw_bake_spread_pose *q = &b->spread.per_pose[k];
             printf("%s[%d,%.5f,%.5f,%.5f,%.5f,%.4g]%s", k ? "," : ",\"ref_spread_poses\":[",
                    q->heldout, q->runtime, q->from_skin, q->from_reference, q->polished,
-                   q->correction, k + 1 == spread->poses ? "]" : "");
+                   q->correction, k + 1 == b->spread.poses ? "]" : "");
         }
         printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
-        for (int32_t k = 0; k < nbeyond; ++k) {
-            printf("%s[%d,", k ? "," : "", beyond[k].bone);
-            if (ch->bone_names)
-                sw_tool_json_string(ch->bone_names[beyond[k].bone]);
+        for (int32_t k = 0; k < b->nbeyond; ++k) {
+            printf("%s[%d,", k ? "," : "", b->beyond[k].bone);
+            if (b->ch.bone_names)
+                sw_tool_json_string(b->ch.bone_names[b->beyond[k].bone]);
             else
                 printf("null");
-            printf(",%.2f,%.2f]", beyond[k].heldout_deg, beyond[k].train_deg);
+            printf(",%.2f,%.2f]", b->beyond[k].heldout_deg, b->beyond[k].train_deg);
         }
         printf("]");
         printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s,"
                "\"shipped\":\"%s\"}\n",
-               res->simulate_cached ? "true" : "false", res->simulate_solved,
-               absurd ? "true" : "false", b->ship_whole ? "whole_clip" : "as_measured");
+               b->res.simulate_cached ? "true" : "false", b->res.simulate_solved,
+               b->absurd ? "true" : "false", b->ship_whole ? "whole_clip" : "as_measured");
     }
 }
 
