@@ -288,6 +288,8 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
         out->render_source[2 * i] = ic->render_source[i];
         out->render_source[2 * i + 1] = ic->render_source_vertex[i];
     }
+    out->render_stiffness = ic->render_stiffness; /* moved, NULL when nothing is painted */
+    ic->render_stiffness = NULL;
     out->render = ic->render; /* moved: the bake embeds it (sw_character.render) */
     memset(&ic->render, 0, sizeof ic->render);
     info->size = cbrt(sw_tetmesh_volume(&out->mesh));

@@ -745,6 +745,7 @@ void sw_imported_character_free(sw_imported_character *c) {
     free(c->render_source);
     free(c->render_source_vertex);
     free(c->source_mesh_verts);
+    free(c->render_stiffness);
     free(c->bone_bind);
     sw_skeleton_free(&c->skel);
     free(c->bone_names);

@@ -38,6 +38,9 @@ typedef struct sw_imported_character {
     int32_t *render_source_vertex; /* render.nverts: its index within that aiMesh */
     int32_t nsource_meshes;        /* the aiScene's meshes */
     int32_t *source_mesh_verts;    /* nsource_meshes: each one's vertex count */
+    /* render.nverts: the painted stiffness multiplier (a glTF primitive's _SINEW_STIFFNESS
+     * attribute, 1 where a primitive has none), or NULL when no primitive has one */
+    double *render_stiffness;
     double *bone_bind;      /* 12 skel.nbones: bind global transforms (3x3 row-major, t), scaled */
     sw_skeleton skel;       /* joints 0..nb-1 are bone heads, nb..2nb-1 their tails */
     char (*bone_names)[64]; /* skel.nbones node names, cut to 63 bytes */

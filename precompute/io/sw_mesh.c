@@ -72,6 +72,8 @@ void sw_character_free(sw_character *c) {
     free(c->bone_bind);
     free(c->render_source);
     free(c->source_mesh_verts);
+    free(c->render_stiffness);
+    free(c->tet_stiffness);
     memset(c, 0, sizeof *c);
 }
 

@@ -78,6 +78,11 @@ typedef struct sw_character {
     double youngs;  /* Young's modulus E */
     double poisson; /* Poisson ratio nu */
     double density; /* mass per unit rest volume */
+    /* Painted material (NULL: uniform). A multiplier of E (mu and lambda alike, so nu is
+     * kept) per render vertex as the artist painted it, and per tet as the simulation
+     * uses it (sw_character_paint carries the first onto the second). */
+    double *render_stiffness; /* render.nverts, > 0, or NULL */
+    double *tet_stiffness;    /* mesh.ntets, > 0, or NULL */
     /* Optional render mesh (render.nverts 0: none). When set, the bake embeds it in the
      * tets and the runtime's output surface is this mesh in its own vertex order;
      * otherwise the output surface is the tet mesh's boundary. */
