@@ -228,6 +228,20 @@ typedef struct cond_fixture {
     int32_t cub_tet_id[NCUB];
 } cond_fixture;
 
+/* Painted material over a fixture with its tet mesh (fixture_add_cond): tet t's multiplier
+ * 0.25 + t / 8, each cubature tet its tet's. */
+typedef struct paint_fixture {
+    double cub_stiffness[NCUB], tet_stiffness[NCT];
+} paint_fixture;
+static inline void fixture_add_paint(fixture *f, const cond_fixture *c, paint_fixture *p) {
+    for (int32_t t = 0; t < NCT; ++t)
+        p->tet_stiffness[t] = 0.25 + t / 8.0;
+    for (int32_t k = 0; k < NCUB; ++k)
+        p->cub_stiffness[k] = p->tet_stiffness[c->cub_tet_id[k]];
+    f->v.cub_stiffness = p->cub_stiffness;
+    f->v.tet_stiffness = p->tet_stiffness;
+}
+
 /* Gives f's view the tet mesh held in c: tet 0 on domain 0's local vertices 0..3, tet 1 on
  * domain 2's 0, 1, 2, 4 (vertices 8, 9, 10, 0), and cubature tet k as tet NCT - 1 - k; the
  * vertices in no tet have mass 0. */
@@ -394,6 +408,14 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
         SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_ASSET_COUNTS);
         SINEW_BLOB_ASSET_ARRAY_SECTIONS(SAME_ARRAY)
     }
+    if (!a->cub_stiffness != !b->cub_stiffness || !a->tet_stiffness != !b->tet_stiffness)
+        return "painted material";
+    if (a->cub_stiffness &&
+        memcmp(a->cub_stiffness, b->cub_stiffness, (size_t)a->ncub * sizeof(double)))
+        return "cub_stiffness";
+    if (a->tet_stiffness &&
+        memcmp(a->tet_stiffness, b->tet_stiffness, (size_t)a->ntets * sizeof(double)))
+        return "tet_stiffness";
 #undef SAME_ARRAY
     return NULL;
 }

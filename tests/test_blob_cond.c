@@ -324,8 +324,8 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     free(b);
 }
 
-/* The same character with per-pair sections, equilibrium forces and the asset description
- * as well (all 56):
+/* The same character with per-pair sections, equilibrium forces, the asset description and
+ * painted material as well (all 58, format version 3):
  * written, parsed back the same, and the fuzz seed
  * tests/fuzz/corpus/blob_fixed/synth_pairs.blob is these bytes (SINEW_WRITE_SEEDS=1
  * rewrites it), so the blob fuzzers start from every optional section. */
@@ -335,11 +335,13 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     static cond_fixture c;
     static pair_fixture p;
     static asset_fixture a;
+    static paint_fixture pf;
     fixture_init(&f, 3);
     fixture_add_render(&f, &r);
     fixture_add_cond(&f, &c);
     fixture_add_pairs(&f, &p);
     fixture_add_asset(&f, &a);
+    fixture_add_paint(&f, &c, &pf);
     static double force[4096];
     const int64_t nforce = (int64_t)f.v.ntrain * f.v.rank_total;
     ENSURE(nforce <= 4096);
@@ -379,6 +381,25 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     forged = copy_exact(b, size);
     entry(forged, SINEW_SECTION_TRAIN_FORCE)->count -= 1;
     ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "TRAIN_FORCE", "ntrain rank_total"));
+    free(forged);
+    /* painted material: a cubature tet's multiplier not its tet's, one out of range, a count
+       off, and the sections in a blob whose header says version 2 */
+    ENSURE(hdr(b)->version == 3);
+    forged = copy_exact(b, size);
+    ((double *)section(forged, SINEW_SECTION_CUB_STIFFNESS))[1] *= 2;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "CUB_STIFFNESS", "TET_STIFFNESS"));
+    free(forged);
+    forged = copy_exact(b, size);
+    ((double *)section(forged, SINEW_SECTION_TET_STIFFNESS))[0] = 0;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "TET_STIFFNESS", "outside"));
+    free(forged);
+    forged = copy_exact(b, size);
+    entry(forged, SINEW_SECTION_TET_STIFFNESS)->count -= 1;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "TET_STIFFNESS", "ntets"));
+    free(forged);
+    forged = copy_exact(b, size);
+    hdr(forged)->version = 2; /* outside the checksum */
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "STIFFNESS", "version 3"));
     free(forged);
     ENSURE(seed_is("synth_pairs.blob", b, size));
     free(b);

@@ -69,8 +69,9 @@ static double force2(scorer *s, const double *x) {
         const int32_t *tv = v->tets + 4 * (int64_t)t;
         for (int k = 0; k < 4; ++k)
             memcpy(xe + 3 * k, x + 3 * (int64_t)tv[k], 3 * sizeof(double));
-        sw_corot_eval(xe, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, fe, NULL,
-                      0);
+        const double st = sw_blob_stiffness(v->tet_stiffness, t);
+        sw_corot_eval(xe, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], st * v->mu, st * v->lambda,
+                      fe, NULL, 0);
         for (int k = 0; k < 4; ++k)
             for (int i = 0; i < 3; ++i)
                 s->f[3 * (int64_t)tv[k] + i] += fe[3 * k + i];

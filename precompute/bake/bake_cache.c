@@ -58,6 +58,8 @@ static uint64_t character_key(sw_bake_state *s) {
     MIX(h, s->rig.ch.youngs);
     MIX(h, s->rig.ch.poisson);
     MIX(h, s->rig.ch.density);
+    if (s->rig.ch.tet_stiffness) /* painted (an unpainted character's key is as it was) */
+        h = sw_fnv1a(h, s->rig.ch.tet_stiffness, (size_t)nt * sizeof(double));
     sw_fullsim_params fp = sw_bake_sim_params(s->p); /* field by field: no padding bytes */
     int32_t ints[] = {(int32_t)fp.integrator, fp.self_contact,    fp.ground,
                       (int32_t)fp.hessian,    (int32_t)fp.solver, fp.contact_rounds,

@@ -93,6 +93,14 @@ sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err) 
     v->tet_local = tet_local;
     v->tet_dminv = dminv;
     v->tet_vol = vol;
+    if (s->rig.ch.tet_stiffness) { /* painted: the patches' full tets carry it too */
+        double *stiff;
+        if (!OWN(stiff, nt, double))
+            return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                                "out of memory for the painted material's section");
+        memcpy(stiff, s->rig.ch.tet_stiffness, (size_t)nt * sizeof(double));
+        v->tet_stiffness = stiff;
+    }
     v->vert_tet_ptr = ptr;
     v->vert_tets = vert_tets;
     v->vert_mass = mass;

@@ -314,6 +314,18 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->cub_weight = cub_weight;
     v->cub_dminv = cub_dminv;
     v->cub_vol = cub_vol;
+    if (s->rig.ch.tet_stiffness) { /* painted: each cubature tet's multiplier */
+        double *stiff;
+        if (!OWN(stiff, ncub, double)) {
+            r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+            goto done;
+        }
+        for (int32_t d = 0, c = 0; d < nd; ++d)
+            for (int32_t i = 0; i < s->cubature.n[d]; ++i)
+                stiff[c++] = s->rig.ch.tet_stiffness[s->domains.dom_tets[s->domains.dom_tet_ptr[d] +
+                                                                         s->cubature.local[d][i]]];
+        v->cub_stiffness = stiff;
+    }
     v->spring_hessian = s->reduce.spring = spring; /* the springs stage scales it */
     v->mass = mass;
     v->inertia_s = ins;

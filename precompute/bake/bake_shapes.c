@@ -10,7 +10,7 @@
 #include "fem_corot.h"
 
 void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
-                         double *dminv, double *vol) {
+                         double *dminv, double *evol) {
     int32_t base = s->domains.dom_vert_ptr[dm], t0 = s->domains.dom_tet_ptr[dm],
             ntd = s->domains.dom_tet_ptr[dm + 1] - t0;
     for (int32_t k = base; k < s->domains.dom_vert_ptr[dm + 1]; ++k)
@@ -22,10 +22,12 @@ void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, 
             tet_local[4 * i + k] = local_of[tet[k]];
             memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)tet[k], 24);
         }
-        if (!sw_tet_rest(Xe, dminv + 9 * i, vol + i)) { /* a degenerate tet weighs nothing */
+        if (!sw_tet_rest(Xe, dminv + 9 * i, evol + i)) { /* a degenerate tet weighs nothing */
             memset(dminv + 9 * i, 0, 9 * sizeof(double));
-            vol[i] = 0;
+            evol[i] = 0;
         }
+        /* the energy is linear in (mu, lambda): its painted multiplier scales its volume */
+        evol[i] *= sw_character_stiffness(&s->rig.ch, s->domains.dom_tets[t0 + i]);
     }
 }
 

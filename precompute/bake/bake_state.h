@@ -143,10 +143,11 @@ void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R 
 
 /* Helpers of the stages after domains and basis (bake_shapes.c). */
 /* Rest data of domain dm's tets in dom_tets order: each corner's copy in the domain
- * (tet_local, 4 a tet), Dm^-1 (9 a tet; zero for a degenerate tet) and rest volume (0 for
- * a degenerate tet). local_of: nverts ints of scratch. */
+ * (tet_local, 4 a tet), Dm^-1 (9 a tet; zero for a degenerate tet) and the weight of its
+ * elastic energy at the character's mu and lambda, evol: its rest volume times its painted
+ * stiffness multiplier (0 for a degenerate tet). local_of: nverts ints of scratch. */
 void sw_bake_domain_tets(const sw_bake_state *s, int32_t dm, int32_t *local_of, int32_t *tet_local,
-                         double *dminv, double *vol);
+                         double *dminv, double *evol);
 /* The reference simulator's parameters of the simulate stage (threads aside). */
 sw_fullsim_params sw_bake_sim_params(const sw_bake_params *p);
 /* The simulate stage's cache (bake_cache.c; sw_bake_params.cache_dir, nothing without

@@ -40,7 +40,8 @@ typedef struct group_metas {
 
 /* The sections of a validated view, in id order, into s; returns their number (26, plus 8
  * with a render mesh, plus 10 with the condensation tet mesh, plus 6 with per-pair
- * self-contact, plus 1 with the equilibrium force, plus 5 with the asset description). `meta` and
+ * self-contact, plus 1 with the equilibrium force, plus 5 with the asset description, plus
+ * 1 or 2 with painted material). `meta` and
  * `g` must outlive the result. */
 static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
                          section_src s[SINEW_SECTION_ID_MAX]) {
@@ -81,6 +82,13 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
                                      SINEW_BLOB_ASSET_ARRAY_SECTIONS(SOURCE)};
         memcpy(s + n, asset, sizeof asset);
         n += (int)(sizeof asset / sizeof asset[0]);
+    }
+    if (v->cub_stiffness) {
+        SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_COND_COUNTS);
+        const section_src stiff[] = {SINEW_BLOB_STIFFNESS_SECTIONS(SOURCE)};
+        const int nstiff = v->tet_stiffness ? 2 : 1; /* TET_STIFFNESS with the cond mesh */
+        memcpy(s + n, stiff, (size_t)nstiff * sizeof stiff[0]);
+        n += nstiff;
     }
     return n;
 }
@@ -150,7 +158,8 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     sinew_blob_header h;
     memset(&h, 0, sizeof h);
     memcpy(h.magic, SINEW_BLOB_MAGIC, sizeof h.magic);
-    h.version = SINEW_BLOB_VERSION;
+    /* a blob without painted material stays readable by a version-2 runtime */
+    h.version = view->cub_stiffness ? SINEW_BLOB_VERSION : SINEW_BLOB_VERSION_MIN;
     h.header_size = (uint32_t)sizeof h;
     h.file_size = total;
     h.section_count = (uint32_t)nsec;

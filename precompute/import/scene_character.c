@@ -1,6 +1,8 @@
 /* A simulation character from a glTF/FBX file (scene_character.h). */
 #include "scene_character.h"
 
+#include "character_paint.h"
+
 #include "hash.h"
 
 #include "character_io.h"
@@ -292,6 +294,7 @@ static sinew_result build_character(const char *path, sw_imported_character *ic,
     ic->render_stiffness = NULL;
     out->render = ic->render; /* moved: the bake embeds it (sw_character.render) */
     memset(&ic->render, 0, sizeof ic->render);
+    if ((rc = sw_character_paint(out, NULL, err))) return rc; /* the file's painting */
     info->size = cbrt(sw_tetmesh_volume(&out->mesh));
     sw_scene_material(info->size, &out->youngs, &out->poisson, &out->density);
     sw_file_stem(path, out->name, sizeof out->name);

@@ -96,6 +96,11 @@ typedef struct sw_character {
     uint64_t source_hash;       /* FNV-1a 64 of the file's bytes (0: none) */
 } sw_character;
 
+/* Tet t's multiplier of the character's E (1 where nothing is painted). */
+static inline double sw_character_stiffness(const sw_character *c, int64_t t) {
+    return c->tet_stiffness ? c->tet_stiffness[t] : 1.0;
+}
+
 void sw_tetmesh_free(sw_tetmesh *m);
 void sw_trimesh_free(sw_trimesh *m);
 void sw_surface_free(sw_surface *s);

@@ -2,6 +2,8 @@
  * formulation, fullsim_internal.h for how the files divide it). */
 #include "fullsim_internal.h"
 
+#include "blob_view.h" /* SW_STIFFNESS_MIN, _MAX */
+
 #include "bbox.h"
 
 #include <math.h>
@@ -122,6 +124,13 @@ static sinew_result check_character(const sw_character *c, sw_error *err) {
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
                             "character '%s': material E = %g, nu = %g, density = %g out of range",
                             c->name, c->youngs, c->poisson, c->density);
+    for (int32_t t = 0; c->tet_stiffness && t < c->mesh.ntets; ++t)
+        if (!(c->tet_stiffness[t] >= SW_STIFFNESS_MIN && c->tet_stiffness[t] <= SW_STIFFNESS_MAX))
+            return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                                "character '%s': tet %d's painted stiffness multiplier %g is "
+                                "outside [%g, %g]",
+                                c->name, t, c->tet_stiffness[t], SW_STIFFNESS_MIN,
+                                SW_STIFFNESS_MAX);
     int32_t driven = 0;
     for (int32_t v = 0; v < c->mesh.nverts; ++v) {
         int32_t b = c->bone_of_vertex[v];

@@ -25,8 +25,9 @@ static void eval_elements(void *vctx, int64_t begin, int64_t end, int worker) {
         double xe[12];
         for (int k = 0; k < 4; ++k)
             memcpy(xe + 3 * k, ctx->x + 3 * (int64_t)tets[4 * t + k], 24);
+        const double st = sw_character_stiffness(sim->c, t); /* painted multiplier */
         sim->ee[t] =
-            sw_corot_eval(xe, sim->DmInv + 9 * t, sim->vol[t], sim->mu, sim->lambda,
+            sw_corot_eval(xe, sim->DmInv + 9 * t, sim->vol[t], st * sim->mu, st * sim->lambda,
                           ctx->want >= EVAL_FORCE ? sim->fe + 12 * t : NULL,
                           ctx->want >= EVAL_HESSIAN ? sim->Ke + 144 * t : NULL, sim->hess_flags);
     }

@@ -33,6 +33,13 @@ sinew_result sw_anchor_free_components(const sw_tetmesh *m, const sw_skeleton *s
                                        const sw_weights *w, int32_t *bone_of_vertex,
                                        int32_t *anchored, sw_error *err);
 
+/* Per-vertex data of a render surface carried onto tet mesh m: out[v * ncols ..] is the
+ * barycentric interpolation of vals' rows (one per surf vertex, ncols each) at v's closest
+ * point on the surface, zero-area triangles skipped. The inputs are those
+ * sw_weights_from_surface checks. */
+sinew_result sw_surface_interpolate(const sw_tetmesh *m, const sw_trimesh *surf, int32_t ncols,
+                                    const double *vals, double *out, sw_error *err);
+
 /* Skin weights of tet mesh m transferred from a render surface's (surf_w: one row per
  * surf vertex): each vertex takes the barycentric interpolation of the weights at its
  * closest point on the surface (zero-area triangles skipped). Rows sum to 1. */

@@ -1,9 +1,9 @@
-/* Skin weights of a simulation mesh transferred from an artist's render mesh:
- * each simulation vertex takes the weights at its closest point on the render surface,
- * interpolated barycentrically over that triangle. This follows the artist's intent
- * (joint blends, props bound to one joint) where heat diffusion over the generated tets
- * would only guess it. The interpolation is a convex combination of rows that sum to 1,
- * so the result's rows do too; the bake keeps each row's 4 largest. */
+/* Per-vertex data of an artist's render mesh carried onto the simulation mesh: each
+ * simulation vertex takes the data at its closest point on the render surface, interpolated
+ * barycentrically over that triangle. Skin weights so follow the artist's intent (joint
+ * blends, props bound to one joint) where heat diffusion over the generated tets would only
+ * guess it: a convex combination of rows that sum to 1, their rows do too, and the bake
+ * keeps each row's 4 largest. Painted material goes the same way (character_paint.c). */
 #include "rig.h"
 
 #include "bbox.h"
@@ -51,27 +51,21 @@ static sinew_result check_transfer_inputs(const sw_tetmesh *m, const sw_trimesh 
     return SINEW_OK;
 }
 
-sinew_result sw_weights_from_surface(const sw_tetmesh *m, const sw_trimesh *surf,
-                                     const sw_weights *surf_w, sw_weights *out, sw_error *err) {
-    if (!out)
-        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "weight transfer: out is NULL");
-    memset(out, 0, sizeof *out);
-    sinew_result rc = check_transfer_inputs(m, surf, surf_w, err);
-    if (rc) return rc;
-    int32_t nb = surf_w->nbones;
+sinew_result sw_surface_interpolate(const sw_tetmesh *m, const sw_trimesh *surf, int32_t ncols,
+                                    const double *vals, double *out, sw_error *err) {
     int32_t *keep = malloc(sizeof(int32_t) * (size_t)(surf->ntris > 0 ? surf->ntris : 1));
     int32_t *tris = malloc(sizeof(int32_t) * 3 * (size_t)(surf->ntris > 0 ? surf->ntris : 1));
     double *boxes = malloc(sizeof(double) * 6 * (size_t)(surf->ntris > 0 ? surf->ntris : 1));
-    double *w = calloc((size_t)m->nverts * (size_t)nb, sizeof(double));
     sw_bvh bvh = {0};
-    if (!keep || !tris || !boxes || !w) {
-        rc = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "weight transfer: out of memory");
+    sinew_result rc = SINEW_OK;
+    if (!keep || !tris || !boxes) {
+        rc = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "surface transfer: out of memory");
         goto done;
     }
     int32_t nt = proper_triangles(surf, keep);
     if (nt == 0) {
         rc = sw_error_set(err, SINEW_ERROR_DEGENERATE,
-                          "weight transfer: the render surface has no triangle of positive area");
+                          "surface transfer: the render surface has no triangle of positive area");
         goto done;
     }
     for (int32_t t = 0; t < nt; ++t)
@@ -88,15 +82,39 @@ sinew_result sw_weights_from_surface(const sw_tetmesh *m, const sw_trimesh *surf
         sw_bvh_closest c;
         if (!sw_bvh_closest_triangle(&bvh, surf->X, tris, m->X + 3 * (size_t)v, reach, &c)) {
             rc = sw_error_set(err, SINEW_ERROR_DEGENERATE,
-                              "weight transfer: no render triangle near vertex %d", v);
+                              "surface transfer: no render triangle near vertex %d", v);
             goto done;
         }
-        double *row = w + (size_t)v * nb, sum = 0;
+        double *row = out + (size_t)v * ncols;
+        for (int32_t b = 0; b < ncols; ++b)
+            row[b] = 0;
         for (int k = 0; k < 3; ++k) {
-            const double *src = surf_w->w + (size_t)tris[3 * (size_t)c.tri + k] * nb;
-            for (int32_t b = 0; b < nb; ++b)
+            const double *src = vals + (size_t)tris[3 * (size_t)c.tri + k] * ncols;
+            for (int32_t b = 0; b < ncols; ++b)
                 row[b] += c.beta[k] * src[b];
         }
+    }
+done:
+    sw_bvh_free(&bvh);
+    free(keep);
+    free(tris);
+    free(boxes);
+    return rc;
+}
+
+sinew_result sw_weights_from_surface(const sw_tetmesh *m, const sw_trimesh *surf,
+                                     const sw_weights *surf_w, sw_weights *out, sw_error *err) {
+    if (!out)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT, "weight transfer: out is NULL");
+    memset(out, 0, sizeof *out);
+    sinew_result rc = check_transfer_inputs(m, surf, surf_w, err);
+    if (rc) return rc;
+    int32_t nb = surf_w->nbones;
+    double *w = calloc((size_t)m->nverts * (size_t)nb, sizeof(double));
+    if (!w) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "weight transfer: out of memory");
+    if ((rc = sw_surface_interpolate(m, surf, nb, surf_w->w, w, err))) goto done;
+    for (int32_t v = 0; v < m->nverts; ++v) {
+        double *row = w + (size_t)v * nb, sum = 0;
         for (int32_t b = 0; b < nb; ++b)
             sum += row[b] = row[b] > 0 ? row[b] : 0; /* barycentric round-off */
         if (!(sum > 0)) {
@@ -113,10 +131,6 @@ sinew_result sw_weights_from_surface(const sw_tetmesh *m, const sw_trimesh *surf
     out->w = w;
     w = NULL;
 done:
-    sw_bvh_free(&bvh);
-    free(keep);
-    free(tris);
-    free(boxes);
     free(w);
     return rc;
 }

@@ -131,6 +131,18 @@ sinew_result sw_blob_force_fill(const uint8_t *bytes, const sinew_blob_section *
 /* Layer 2: every force finite (nothing when train_force is NULL). */
 sinew_result sw_blob_force_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
+/* Layer 1 of the painted material (blob_stiffness.c): CUB_STIFFNESS absent (and
+ * TET_STIFFNESS with it) or of META's ncub doubles, TET_STIFFNESS then present exactly when
+ * the condensation mesh is, with its ntets; present exactly in a blob of format `version` 3.
+ * Points the view's fields at them (NULL when absent). After the condensation mesh's fill. */
+sinew_result sw_blob_stiffness_fill(const uint8_t *bytes, const sinew_blob_section *s,
+                                    const int found[], uint32_t version, sw_blob_view *v, char *msg,
+                                    size_t msg_size);
+
+/* Layer 2: every multiplier in [1e-6, 1e6] and each cubature tet's equal to its tet's
+ * (nothing when cub_stiffness is NULL); after the condensation mesh's checks. */
+sinew_result sw_blob_stiffness_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
 /* Layer 1 of the asset description (blob_asset.c): the five optional sections all present or
  * all absent, ASSET_META's counts and reserved words, every section's count against them and
  * META's; points the view's fields at them (left 0 / NULL when absent). After META. */

@@ -27,13 +27,15 @@ SINEW_BLOB_COND_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_PAIR_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_FORCE_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_ASSET_SECTIONS(SIZE_MATCHES)
+SINEW_BLOB_STIFFNESS_SECTIONS(SIZE_MATCHES)
 #undef SIZE_MATCHES
 /* The optional groups follow the version-1 sections with no gap (the all-or-none loops). */
 _Static_assert(SINEW_SECTION_RENDER_FIRST == SINEW_SECTION_COUNT_V1 + 1 &&
                    SINEW_SECTION_COND_FIRST == SINEW_SECTION_RENDER_LAST + 1 &&
                    SINEW_SECTION_PAIR_FIRST == SINEW_SECTION_COND_LAST + 1 &&
                    SINEW_SECTION_TRAIN_FORCE == SINEW_SECTION_PAIR_LAST + 1 &&
-                   SINEW_SECTION_ASSET_FIRST == SINEW_SECTION_TRAIN_FORCE + 1,
+                   SINEW_SECTION_ASSET_FIRST == SINEW_SECTION_TRAIN_FORCE + 1 &&
+                   SINEW_SECTION_CUB_STIFFNESS == SINEW_SECTION_ASSET_LAST + 1,
                "section ids run on without gaps");
 /* SW_BLOB_META_FIELDS covers every byte of META: no field is left uncopied. */
 #define META_FIELD_SIZE(field) +sizeof(((sinew_blob_meta *)0)->field)
@@ -55,7 +57,8 @@ static const struct {
     [0] = {"unknown", 0},
     SINEW_BLOB_SECTIONS(SECTION_INFO) SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)
         SINEW_BLOB_COND_SECTIONS(SECTION_INFO) SINEW_BLOB_PAIR_SECTIONS(SECTION_INFO)
-            SINEW_BLOB_FORCE_SECTIONS(SECTION_INFO) SINEW_BLOB_ASSET_SECTIONS(SECTION_INFO)};
+            SINEW_BLOB_FORCE_SECTIONS(SECTION_INFO) SINEW_BLOB_ASSET_SECTIONS(SECTION_INFO)
+                SINEW_BLOB_STIFFNESS_SECTIONS(SECTION_INFO)};
 #undef SECTION_INFO
 
 /* Not instrumented for fuzzing coverage: its loop has no branch worth a fuzzer's
@@ -473,6 +476,7 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
     if ((r = sw_blob_cond_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_pair_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_force_validate(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_stiffness_validate(v, msg, ms)) != SINEW_OK) return r;
     return sw_blob_asset_validate(v, msg, ms);
 }
 
@@ -481,10 +485,11 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
 static sinew_result check_header(const sinew_blob_header *h, size_t size, char *msg, size_t ms) {
     if (memcmp(h->magic, SINEW_BLOB_MAGIC, sizeof h->magic) != 0)
         return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob header: bad magic, not a sinew blob");
-    if (h->version != SINEW_BLOB_VERSION)
+    if (h->version < SINEW_BLOB_VERSION_MIN || h->version > SINEW_BLOB_VERSION)
         return fail(msg, ms, SINEW_ERROR_VERSION,
-                    "blob header: format version %u, this runtime reads version %u",
-                    (unsigned)h->version, SINEW_BLOB_VERSION);
+                    "blob header: format version %u, this runtime reads version %u, and %u "
+                    "with painted material",
+                    (unsigned)h->version, SINEW_BLOB_VERSION_MIN, SINEW_BLOB_VERSION);
     if (h->endian_tag != SINEW_BLOB_ENDIAN_TAG)
         return fail(msg, ms, SINEW_ERROR_CORRUPT,
                     "blob header: endian tag 0x%08x, expected 0x%08x (little-endian blob on a "
@@ -709,7 +714,8 @@ sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, ch
         (r = sw_blob_cond_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_pair_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_force_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
-        (r = sw_blob_asset_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK)
+        (r = sw_blob_asset_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
+        (r = sw_blob_stiffness_fill(bytes, s, found, h.version, &v, msg, ms)) != SINEW_OK)
         return r;
     if ((r = sw_blob_validate_view(&v, msg, ms)) != SINEW_OK) return r;
     *view = v;

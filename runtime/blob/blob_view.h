@@ -191,7 +191,23 @@ typedef struct sw_blob_view {
     const double *bone_bind;
     const int32_t *source_mesh_verts;
     const int32_t *output_source;
+
+    /* the optional painted material (cub_stiffness NULL: uniform, tet_stiffness NULL too):
+     * each cubature tet's and each condensation tet's multiplier of mu and lambda */
+    const double *cub_stiffness; /* ncub */
+    const double *tet_stiffness; /* ntets, or NULL when ntets is 0 */
 } sw_blob_view;
+
+/* The painted multipliers a blob may hold (the bake refuses the same range): one further
+ * from 1 is no painting but a broken file, whose Newton matrices would mix stiffnesses
+ * 10^12 apart. */
+#define SW_STIFFNESS_MIN 1e-6
+#define SW_STIFFNESS_MAX 1e6
+
+/* Tet t's multiplier of the material (1 where nothing is painted). */
+static inline double sw_blob_stiffness(const double *stiffness, int64_t t) {
+    return stiffness ? stiffness[t] : 1.0;
+}
 
 /* The simulation vertex of surface copy i (a (domain, local vertex) pair). */
 static inline int32_t sw_blob_surf_copy_vertex(const sw_blob_view *v, int32_t i) {

@@ -184,8 +184,9 @@ static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t 
     tet_positions(c, x, e, x12);
     if (!is_pair) {
         int32_t t = c->ft[e];
-        phi = sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, f,
-                            want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
+        const double st = sw_blob_stiffness(v->tet_stiffness, t); /* painted multiplier */
+        phi = sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], st * v->mu,
+                            st * v->lambda, f, want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
     } else {
         phi = patch_pair(c, e - c->nt, x12, f, want_hess ? K : NULL);
     }

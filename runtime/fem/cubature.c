@@ -263,7 +263,9 @@ static void cub_domains(uint32_t begin, uint32_t end, uint32_t worker, void *ctx
         }
         for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c) {
             double x[12], f[12];
-            double w = m->cub_w[c];
+            /* the weight of its energy at the character's material, times its painted
+               multiplier (the cubature was fitted to the painted energy) */
+            double w = m->cub_w[c] * sw_blob_stiffness(v->cub_stiffness, c);
             if (w == 0.0) { /* in a condensation patch: its tet is evaluated in full space */
                 m->ecub[c] = 0;
                 continue;
@@ -316,8 +318,9 @@ void sw_cubature_rest_hessian(sw_reduced *m, double *blocks) {
                 for (int i = 0; i < 3; ++i)
                     x[3 * n + i] = X[i];
             }
-            (void)tet_with_hessian(&tm, r, x, v->cub_dminv + 9 * c, v->cub_vol[c], v, V,
-                                   SW_COROT_PROJECT_PSD, v->cub_weight[c], blocks, r, m->hm);
+            (void)tet_with_hessian(
+                &tm, r, x, v->cub_dminv + 9 * c, v->cub_vol[c], v, V, SW_COROT_PROJECT_PSD,
+                v->cub_weight[c] * sw_blob_stiffness(v->cub_stiffness, c), blocks, r, m->hm);
         }
         mirror_upper(blocks, r, r);
         blocks += (int64_t)r * r;

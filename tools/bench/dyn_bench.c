@@ -55,6 +55,25 @@ static void overshoot(const double *hs, int H, const double *m, int32_t ns, doub
     *settle = rms_m(hs + (size_t)(H - 2) * 3 * ns, last, m, ns);
 }
 
+/* When the hold's surfaces (hs, H of them) first swing through the last one: the frame,
+ * interpolated, at which their displacement from the last frame, measured along the first
+ * hold frame's (mass-weighted), first changes sign; NaN when it never does (overdamped).
+ * A softer character swings back later: a quarter of its period after the stop. */
+static double first_crossing(const double *hs, int H, const double *m, int32_t ns) {
+    const double *last = hs + (size_t)(H - 1) * 3 * ns;
+    double prev = 0;
+    for (int f = 0; f < H - 1; ++f) {
+        double s = 0;
+        for (int32_t i = 0; i < ns; ++i)
+            for (int k = 0; k < 3; ++k)
+                s += m[i] * (hs[(size_t)f * 3 * ns + 3 * i + k] - last[3 * i + k]) *
+                     (hs[3 * i + k] - last[3 * i + k]);
+        if (f > 0 && s <= 0 && prev > 0) return f - 1 + prev / (prev - s);
+        prev = s;
+    }
+    return NAN;
+}
+
 static double mass_total(const double *m, int32_t n) {
     double s = 0;
     for (int32_t i = 0; i < n; ++i)
@@ -235,6 +254,8 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
     overshoot(r.hs_sub, H, r.sm, ns, &out->overshoot_sub, &out->settle_sub);
     overshoot(r.hs_full, H, r.sm, ns, &out->overshoot_full, &out->settle_full);
     out->overshoot_ratio = out->overshoot_full > 0 ? out->overshoot_sub / out->overshoot_full : NAN;
+    out->swing_sub = first_crossing(r.hs_sub, H, r.sm, ns);
+    out->swing_full = first_crossing(r.hs_full, H, r.sm, ns);
     out->err_increment = r.inc_den > 0 ? sqrt(r.inc_num / r.inc_den) : NAN;
     out->increment_rms = sqrt(r.inc_den / (N - 1) / mass_total(mass, nv));
     out->full_ms = sw_median(r.full_ms, nstep);

@@ -20,6 +20,9 @@ typedef struct sw_dyn_bench {
     double err_dynamic;                       /* correction error over the clip's frames */
     double err_dynamic_hold;                  /* the same over the hold frames */
     double overshoot_sub, overshoot_full, overshoot_ratio;
+    /* the hold frame at which the surface first swings back through its rest at the held
+       pose (interpolated; NaN: it never does), about a quarter of its period after the stop */
+    double swing_sub, swing_full;
     double settle_sub, settle_full; /* the surface's mass-weighted RMS motion over the last
                                        hold step: how far from settled the end still is */
     double err_increment;           /* with the reference's quasistatic clip: |d_sub - d_full|_M /

@@ -23,8 +23,9 @@ static void terms(sinew_instance *in, const double *q, double o[4]) {
         for (int k = 0; k < 4; ++k)
             sw_cond_copy_position(&in->red, v->tets[4 * (int64_t)t + k], v->tet_domain[t],
                                   v->tet_local[4 * (int64_t)t + k], q, x + 3 * k, NULL);
-        o[1] += sw_corot_eval(x, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda,
-                              NULL, NULL, 0);
+        const double st = sw_blob_stiffness(v->tet_stiffness, t);
+        o[1] += sw_corot_eval(x, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], st * v->mu,
+                              st * v->lambda, NULL, NULL, 0);
     }
     o[2] = sw_pose_contact_eval(&in->red, &in->ps, q, 0, 0);
     if (in->self_mode == SINEW_SELF_CONTACT_EXHAUSTIVE) {

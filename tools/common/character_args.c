@@ -1,8 +1,10 @@
 #include "character_args.h"
 
+#include <math.h>
 #include <stdio.h>
 #include <string.h>
 
+#include "character_paint.h"
 #include "mesh_io.h"
 #include "samples.h"
 #include "tool_args.h"
@@ -14,6 +16,7 @@ void sw_character_args_init(sw_character_args *c, const char *tool) {
     c->tool = tool;
     c->data_dir = sw_tool_data_dir();
     c->tets = 20000;
+    c->poisson = NAN; /* the character's own */
 }
 
 /* --mesher lattice | tetgen */
@@ -65,6 +68,18 @@ size_t sw_character_flags(sw_character_args *c, sw_flag *f) {
                 "largest turn in a .dmat pose or .txt bone animation bounds the\n"
                 "joint sweeps and random combined poses (default: 90 degrees across\n"
                 "every bone)")},
+        {SW_REAL("--youngs", &c->youngs, 0, 1e15, "in 0 < E < 1e15", "E",
+                 "Young's modulus of the flesh (default: a FILE's or a surface's relative\n"
+                 "to its size, a scene's or tet mesh's its own)")},
+        {SW_REAL("--poisson", &c->poisson, -1, 0.5, "in -1 < NU < 0.5", "NU",
+                 "Poisson ratio of the flesh, -1 < NU < 0.5 (default as --youngs)")},
+        {SW_REAL("--density", &c->density, 0, 1e15, "in 0 < RHO < 1e15", "RHO",
+                 "mass per unit volume of the flesh (default as --youngs)")},
+        {SW_STR("--stiffness-map", &c->stiffness_map, "FILE",
+                "painted material: a .dmat of one multiplier of E per render vertex\n"
+                "(a FILE's, in the blob's output order) or per tet-mesh vertex (--mesh,\n"
+                "--scene); 0.25 is four times softer. A glTF FILE's own painting, a\n"
+                "_SINEW_STIFFNESS vertex attribute, is read without it")},
     };
     memcpy(f, flags, sizeof flags);
     return SW_CHARACTER_NFLAGS;
@@ -232,6 +247,17 @@ void sw_tool_bake_clips(const sw_character_args *c, const sw_clip_split *clips, 
     p->nheldout_clips = clips->nheldout;
 }
 
+/* The material flags over what the character came with; on failure ch is freed. */
+static sinew_result material(const sw_character_args *c, sw_character *ch, sw_error *err) {
+    if (c->youngs > 0) ch->youngs = c->youngs;
+    if (!isnan(c->poisson)) ch->poisson = c->poisson;
+    if (c->density > 0) ch->density = c->density;
+    sinew_result r =
+        c->stiffness_map ? sw_character_read_stiffness(c->stiffness_map, ch, err) : SINEW_OK;
+    if (r) sw_character_free(ch);
+    return r;
+}
+
 sinew_result sw_character_args_make(const sw_character_args *c, sw_character *ch,
                                     sw_clip_split *clips, sw_scene_character_info *info,
                                     sw_error *err) {
@@ -239,14 +265,15 @@ sinew_result sw_character_args_make(const sw_character_args *c, sw_character *ch
     sw_error_clear(err);
     memset(ch, 0, sizeof *ch);
     if (clips) memset(clips, 0, sizeof *clips);
+    sinew_result r;
     if (c->file) {
         sw_scene_character_options o = {
             c->tets,        c->fps,           c->height,
             c->train_clips, c->heldout_clips, c->tetgen ? SW_MESHER_TETGEN : SW_MESHER_LATTICE};
-        return sw_character_from_scene(c->file, &o, ch, clips, info, err);
+        r = sw_character_from_scene(c->file, &o, ch, clips, info, err);
+        return r ? r : material(c, ch, err);
     }
-    sinew_result r =
-        c->scene ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
+    r = c->scene ? sw_scene_make(c->scene, c->tets, c->frames, c->data_dir, ch, &computed, err)
         : sw_tool_has_ext(c->mesh, "obj")
             ? sw_character_from_surface(c->mesh, c->tets,
                                         c->tetgen ? SW_MESHER_TETGEN : SW_MESHER_LATTICE, c->tgf,
@@ -255,5 +282,5 @@ sinew_result sw_character_args_make(const sw_character_args *c, sw_character *ch
     if (r == SINEW_OK && (computed || (c->mesh && !c->weights))) sw_weights_free(&ch->weights);
     if (r == SINEW_OK && c->joint_range && (r = sw_character_read_range(c->joint_range, ch, err)))
         sw_character_free(ch);
-    return r;
+    return r ? r : material(c, ch, err);
 }

@@ -19,11 +19,15 @@ typedef struct sw_character_args {
     int tets, frames;
     int tets_given, data_given;
     int tetgen, mesher_given; /* --mesher tetgen; --mesher at all (surfaces only) */
+    /* the material: --youngs, --poisson, --density (0 / NAN: the character's own), and
+     * --stiffness-map, painted multipliers of E */
+    double youngs, poisson, density;
+    const char *stiffness_map;
 } sw_character_args;
 
 /* The least --frames: the fewest clip frames a bake trains on (bake.h). */
 #define SW_CHARACTER_MIN_FRAMES 4
-#define SW_CHARACTER_NFLAGS 14
+#define SW_CHARACTER_NFLAGS 18
 /* The usage's lines before the character flags: what FILE is (the first bare argument). */
 #define SW_CHARACTER_FILE_USAGE                                                                    \
     "  FILE             a rigged glTF 2.0 (.gltf, .glb) or FBX character: its render surface\n"    \

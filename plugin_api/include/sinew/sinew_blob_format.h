@@ -101,6 +101,15 @@
  *   OUTPUT_SOURCE  per output vertex (the render mesh's when embedded, else the tet
  *                  boundary's), the source mesh and the vertex within it, or (-1, -1) for
  *                  a vertex that has none (a tet boundary's)
+ *
+ * Optional sections (SINEW_BLOB_STIFFNESS_SECTIONS, ids 57, 58): painted material, only in
+ * a blob of version 3 (a runtime that predates them refuses the
+ * blob rather than step it unpainted). Each tet's elastic energy is its multiplier times
+ * the energy at META's mu and lambda (the Poisson ratio is the character's):
+ *   CUB_STIFFNESS  per cubature tet, its multiplier (finite, > 0)
+ *   TET_STIFFNESS  per tet of the condensation mesh (ntets of COND_META; absent, with
+ *                  CUB_STIFFNESS still present, when the blob has no such mesh), its
+ *                  multiplier; a cubature tet's equals its COND_CUB_TET_ID tet's
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -108,7 +117,11 @@
 #include <stdint.h>
 
 #define SINEW_BLOB_MAGIC "SINEWBLB" /* 8 bytes, no terminator in the file */
-#define SINEW_BLOB_VERSION 2u       /* 2: pose features measure roots from the first root */
+/* 2: pose features measure roots from the first root; 3: the blob has painted material
+ * (SINEW_BLOB_STIFFNESS_SECTIONS), which a version-2 runtime would skip and step the
+ * character as if unpainted. A blob without painted material is written as version 2. */
+#define SINEW_BLOB_VERSION 3u
+#define SINEW_BLOB_VERSION_MIN 2u
 #define SINEW_BLOB_ALIGN 64u
 #define SINEW_BLOB_ENDIAN_TAG 0x01020304u
 
@@ -251,6 +264,13 @@ typedef struct sinew_blob_section {
     X(55, SOURCE_MESH_VERTS,  4, int32_t, source_mesh_verts, 1, nsource_meshes, "nsource_meshes") \
     X(56, OUTPUT_SOURCE,      4, int32_t, output_source, 1, 2 * noutput_verts, "2 noutput_verts")
 
+/* The optional painted material (ids 57, 58; blob version 3): each tet's multiplier of
+ * META's mu and lambda. TET_STIFFNESS (count: COND_META's ntets) is present exactly when
+ * CUB_STIFFNESS and the condensation tet mesh both are. */
+#define SINEW_BLOB_STIFFNESS_SECTIONS(X)                                                           \
+    X(57, CUB_STIFFNESS,      8, double,  cub_stiffness, 1, ncub,        "ncub")                   \
+    X(58, TET_STIFFNESS,      8, double,  tet_stiffness, 1, ntets,       "ntets")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
@@ -260,7 +280,8 @@ typedef struct sinew_blob_section {
  * SINEW_SECTION_COND_FIRST .. _COND_LAST the optional condensation tet mesh's,
  * SINEW_SECTION_PAIR_FIRST .. _PAIR_LAST the optional per-pair self-contact's,
  * SINEW_SECTION_TRAIN_FORCE the optional pose-space equilibrium force,
- * SINEW_SECTION_ASSET_FIRST .. _ASSET_LAST the optional asset description;
+ * SINEW_SECTION_ASSET_FIRST .. _ASSET_LAST the optional asset description,
+ * SINEW_SECTION_CUB_STIFFNESS and _TET_STIFFNESS the optional painted material;
  * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
@@ -281,7 +302,8 @@ enum sinew_blob_section_id {
     SINEW_BLOB_ASSET_SECTIONS(SINEW_BLOB_ENUM_ROW_)
     SINEW_SECTION_ASSET_FIRST = SINEW_SECTION_ASSET_META,
     SINEW_SECTION_ASSET_LAST = SINEW_SECTION_OUTPUT_SOURCE,
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_ASSET_LAST
+    SINEW_BLOB_STIFFNESS_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_TET_STIFFNESS
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
