@@ -12,9 +12,13 @@
  *    tet takes its corners' mean, and multipliers out of range are refused by name.
  * Measured (Release, 2 threads): see the fprintf lines. */
 #include <math.h>
+#include <stdio.h>
+#include <stdlib.h>
+#include <unistd.h>
 
 #include "bake_eval.h"
 #include "bake_fixture.h"
+#include "bake_report.h"
 #include "blob_view.h"
 #include "character_paint.h"
 #include "dyn_bench.h"
@@ -197,6 +201,21 @@ TEST(the_painting_reaches_the_tets_and_bad_values_are_refused) {
     char line[160];
     sw_character_paint_summary(&c, line, sizeof line);
     ENSUREF(strstr(line, "2 of 2 tets painted") != NULL, "summary '%s'", line);
+    /* the report's picture of it, and none of an unpainted character */
+    char dir[] = "/tmp/sinew_paintXXXXXX", path[64];
+    ENSURE(mkdtemp(dir) != NULL);
+    snprintf(path, sizeof path, "%s/%s", dir, SW_BAKE_REPORT_PAINT_NAME);
+    ENSURE(sw_bake_report_paint(dir, &c, &err) == SINEW_OK);
+    FILE *png = fopen(path, "rb");
+    unsigned char magic[8] = {0};
+    ENSURE(png && fread(magic, 1, 8, png) == 8 && magic[1] == 'P' && magic[2] == 'N');
+    fclose(png);
+    remove(path);
+    double *keep = c.tet_stiffness;
+    c.tet_stiffness = NULL;
+    ENSURE(sw_bake_report_paint(dir, &c, &err) == SINEW_OK && fopen(path, "rb") == NULL);
+    c.tet_stiffness = keep;
+    rmdir(dir);
     /* out of range or not finite: refused, naming the render vertex, the tets untouched */
     c.render_stiffness[2] = 0;
     ENSURE(sw_character_paint(&c, NULL, &err) == SINEW_ERROR_INVALID_ARGUMENT &&

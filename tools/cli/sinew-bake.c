@@ -39,6 +39,7 @@
 #include "samples.h"
 #include "subspace_eval.h"
 #include "bake_cli.h"
+#include "character_paint.h"
 
 static const char *const tool = "sinew-bake";
 
@@ -90,6 +91,9 @@ static int load_character(bake *b, sw_error *err) {
     fprintf(stderr, "%s: %s: %d tets, %d vertices, %d bones, %d clip frames\n", tool,
             ch->name[0] ? ch->name : b->source, ch->mesh.ntets, ch->mesh.nverts, ch->skel.nbones,
             ch->clip.nframes);
+    char paint[160];
+    sw_character_paint_summary(ch, paint, sizeof paint);
+    if (paint[0]) fprintf(stderr, "%s: painted material: %s\n", tool, paint);
     if (ca->file) {
         sw_tetmesh_quality(&ch->mesh, 0, &b->quality);
         sw_tool_print_scene(tool, ch, &b->clips, &b->info, &b->quality);

@@ -448,12 +448,15 @@ sinew_result sw_bake_report_write(const char *dir, const sw_bake_report_input *i
                             strerror(errno ? errno : EACCES));
     report r;
     memset(&r, 0, sizeof r);
+    sinew_result sr0;
     if (in->contact_sheet && in->res->nheldout > 0) {
         sinew_result sr = sw_bake_report_sheet(dir, in->ch, in->res, in->blob,
                                                SW_BAKE_REPORT_SHEET_ROWS, &r.sheet_info, err);
         if (sr != SINEW_OK) return sr;
         r.sheet = 1;
     }
+    if (in->ch->tet_stiffness && (sr0 = sw_bake_report_paint(dir, in->ch, err)) != SINEW_OK)
+        return sr0;
     if (!gather(in, &r)) {
         report_free(&r);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "report: out of memory");

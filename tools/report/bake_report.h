@@ -116,4 +116,10 @@ void sw_bake_report_ramp(double t, float srgb[3]);
 void sw_bake_report_diff_colors(int32_t nv, const double *X, const double *ref, int32_t ntris,
                                 const int32_t *tris, double scale, float *rgb);
 
+/* The painted material's picture (bake_report_paint.c): the simulation mesh at rest
+ * coloured by each vertex's stiffness multiplier, written as dir/SW_BAKE_REPORT_PAINT_NAME;
+ * nothing when ch is unpainted. */
+#define SW_BAKE_REPORT_PAINT_NAME "painted_stiffness.png"
+sinew_result sw_bake_report_paint(const char *dir, const sw_character *ch, sw_error *err);
+
 #endif

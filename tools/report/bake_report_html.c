@@ -8,6 +8,8 @@
 #include <string.h>
 
 #include "bake_report_internal.h"
+
+#include "character_paint.h"
 #include "blob_load.h"
 #include "mesh_io.h"
 #include "pose_space.h"
@@ -47,6 +49,15 @@ static void html_character(FILE *f, const sw_bake_report_input *in) {
               "density");
     fprintf(f, "<td>stiffness E %.4g, &nu; %.3g, density %.4g</td></tr>", ch->youngs, ch->poisson,
             ch->density);
+    if (ch->tet_stiffness) {
+        char line[160];
+        sw_character_paint_summary(ch, line, sizeof line);
+        html_term(f, "painted material",
+                  "the artist's stiffness multipliers carried onto the simulation tets "
+                  "(--stiffness-map, a glTF _SINEW_STIFFNESS attribute)");
+        fprintf(f, "<td>%s<br><img src=\"%s\" alt=\"painted stiffness\"></td></tr>", line,
+                SW_BAKE_REPORT_PAINT_NAME);
+    }
     html_term(f, "error (share of the flesh movement missed)",
               "correction error: the share of the physics correction (the full simulation "
               "minus plain skinning) the runtime misses");
