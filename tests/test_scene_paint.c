@@ -2,7 +2,8 @@
  * precompute/import/gltf_attribute.c beside assimp) on the render vertices, from a GLB
  * built here: a skinned mesh of two primitives (the second painted, FLOAT) and a painted
  * rigid prop (normalized UNSIGNED_BYTE) that comes first in the file but last in assimp's
- * meshes; the same as a .gltf with a data: URI and from a file; and the errors: a count,
+ * meshes; the same as a .gltf with a data: URI, as a .gltf with a .bin beside it and
+ * from a file; and the errors: a count,
  * type or view that does not fit, a value that is not finite or not > 0, a sparse
  * accessor, an index out of range. */
 #include <math.h>
@@ -258,6 +259,37 @@ TEST(gltf_data_uri_and_glb_file) {
     ENSURE(ok);
 }
 
+/* The .gltf of a separate .bin (Blender's "glTF Separate"), from a path: the .bin is read
+ * beside it; missing, it is an error. */
+TEST(gltf_with_a_bin_file_beside_it) {
+    bin B;
+    make_bin(&B, paint1);
+    char buffer[128];
+    snprintf(buffer, sizeof buffer, "{\"byteLength\":%zu,\"uri\":\"paint_buffer.bin\"}", B.n);
+    char *j = make_json(&B, buffer);
+    ENSURE(j);
+    const char *gltf = SINEW_BINARY_DIR "/tests/test_scene_paint.gltf";
+    const char *bin_path = SINEW_BINARY_DIR "/tests/paint_buffer.bin";
+    FILE *f = fopen(gltf, "wb"), *g = fopen(bin_path, "wb");
+    int wrote = f && g && fwrite(j, 1, strlen(j), f) == strlen(j) && fwrite(B.b, 1, B.n, g) == B.n;
+    if (f) fclose(f);
+    if (g) fclose(g);
+    free(j);
+    ENSURE(wrote);
+    sw_imported_character c;
+    sw_error e;
+    sw_error_clear(&e);
+    sinew_result rc = sw_scene_import(gltf, NULL, &c, &e);
+    int ok = rc == SINEW_OK && painted_right(&c);
+    if (rc) fprintf(stderr, "  %s\n", e.msg);
+    sw_imported_character_free(&c);
+    remove(bin_path);
+    rc = sw_scene_import(gltf, NULL, &c, &e); /* assimp itself needs the .bin */
+    ok = ok && rc != SINEW_OK && c.render.nverts == 0;
+    remove(gltf);
+    ENSURE(ok);
+}
+
 /* An error `want` naming `what`, and no character. */
 static int fails_with(sinew_result rc, sinew_result want, const sw_imported_character *c,
                       const sw_error *e, const char *what) {
@@ -334,21 +366,23 @@ TEST(reader_checks_against_assimps_meshes) {
     double *out = NULL;
     sw_error e;
     const int32_t right[3] = {3, 4, 3}, wrong[3] = {3, 3, 4}, few[2] = {3, 4};
-    sinew_result rc =
-        sw_gltf_float_attribute(g, len, 1, "_SINEW_STIFFNESS", "t.glb", 3, right, NULL, &out, &e);
+    sinew_result rc = sw_gltf_float_attribute(g, len, 1, NULL, "_SINEW_STIFFNESS", "t.glb", 3,
+                                              right, NULL, &out, &e);
     int ok = rc == SINEW_OK && out && out[3] == 0.25 && out[6] == 2 && out[2] == 1;
     free(out);
-    rc = sw_gltf_float_attribute(g, len, 1, "_SINEW_STIFFNESS", "t.glb", 3, wrong, NULL, &out, &e);
+    rc = sw_gltf_float_attribute(g, len, 1, NULL, "_SINEW_STIFFNESS", "t.glb", 3, wrong, NULL, &out,
+                                 &e);
     ok = ok && rc == SINEW_ERROR_UNSUPPORTED && !out && strstr(e.msg, "does not match");
-    rc = sw_gltf_float_attribute(g, len, 1, "_SINEW_STIFFNESS", "t.glb", 2, few, NULL, &out, &e);
+    rc = sw_gltf_float_attribute(g, len, 1, NULL, "_SINEW_STIFFNESS", "t.glb", 2, few, NULL, &out,
+                                 &e);
     ok = ok && rc == SINEW_ERROR_UNSUPPORTED && !out && strstr(e.msg, "3 glTF primitives");
-    rc = sw_gltf_float_attribute(g, len, 1, "_OTHER", "t.glb", 3, right, NULL, &out, &e);
+    rc = sw_gltf_float_attribute(g, len, 1, NULL, "_OTHER", "t.glb", 3, right, NULL, &out, &e);
     ok = ok && rc == SINEW_OK && !out;
     free(g);
     char *j2 = j ? swap(j, "\"_SINEW_STIFFNESS\":6", "\"_SINEW_STIFFNESS\":99") : NULL;
     g = j2 ? make_glb(j2, &B, &len) : NULL;
-    rc = g ? sw_gltf_float_attribute(g, len, 1, "_SINEW_STIFFNESS", "t.glb", 3, right, NULL, &out,
-                                     &e)
+    rc = g ? sw_gltf_float_attribute(g, len, 1, NULL, "_SINEW_STIFFNESS", "t.glb", 3, right, NULL,
+                                     &out, &e)
            : SINEW_OK;
     ok = ok && rc == SINEW_ERROR_PARSE && !out && strstr(e.msg, "not an accessor");
     free(g), free(j), free(j2);
@@ -356,5 +390,6 @@ TEST(reader_checks_against_assimps_meshes) {
 }
 
 SW_TEST_MAIN(CASE(glb_paint_lands_on_the_render_vertices), CASE(nothing_painted_is_null),
-             CASE(gltf_data_uri_and_glb_file), CASE(bad_attributes_are_errors),
-             CASE(values_must_be_finite_and_positive), CASE(reader_checks_against_assimps_meshes))
+             CASE(gltf_data_uri_and_glb_file), CASE(gltf_with_a_bin_file_beside_it),
+             CASE(bad_attributes_are_errors), CASE(values_must_be_finite_and_positive),
+             CASE(reader_checks_against_assimps_meshes))

@@ -16,6 +16,7 @@
 #include <cjson/cJSON.h>
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -29,8 +30,9 @@ typedef struct gltf_doc {
     const unsigned char *bin; /* the GLB's BIN chunk, or NULL */
     size_t nbin;
     int binary;
+    const char *dir; /* the folder of a .gltf's buffer files, or NULL (bytes in memory) */
     int nbuf;
-    unsigned char **decoded; /* per buffer: its data: URI decoded, once */
+    unsigned char **decoded; /* per buffer: its data: URI decoded or its file read, once */
     size_t *ndecoded;
     const char *name;
     sw_error *err;
@@ -127,7 +129,35 @@ static unsigned char *b64_decode(const char *s, size_t n, size_t *out_n, int *ba
     return o;
 }
 
-/* Buffer b's bytes: the BIN chunk (a GLB's buffer 0 without uri) or its base64 data: URI. */
+/* The file `uri` in the folder `dir`, whole, into a new buffer. The uri is taken as it is,
+ * as assimp 5.2.5 takes it (it does not decode percent-escapes): the same file. */
+static sinew_result read_buffer_file(gltf_doc *d, int b, const char *uri, unsigned char **out,
+                                     size_t *n) {
+    const size_t np = strlen(d->dir) + strlen(uri) + 2;
+    char *path = malloc(np);
+    if (!path) return sw_error_set(d->err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", d->name);
+    snprintf(path, np, "%s/%s", d->dir, uri);
+    FILE *f = fopen(path, "rb");
+    long len = -1;
+    if (f && fseek(f, 0, SEEK_END) == 0) len = ftell(f);
+    *out = f && len >= 0 && len <= (1L << 30) && fseek(f, 0, SEEK_SET) == 0
+               ? malloc(len ? (size_t)len : 1)
+               : NULL;
+    sinew_result rc = SINEW_OK;
+    if (!*out || fread(*out, 1, (size_t)len, f) != (size_t)len) {
+        rc =
+            sw_error_set(d->err, SINEW_ERROR_IO, "%s: buffer %d: cannot read %s", d->name, b, path);
+        free(*out);
+        *out = NULL;
+    }
+    *n = (size_t)(len > 0 ? len : 0);
+    if (f) fclose(f);
+    free(path);
+    return rc;
+}
+
+/* Buffer b's bytes: the BIN chunk (a GLB's buffer 0 without uri), its base64 data: URI, or
+ * the file its relative uri names beside the .gltf. */
 static sinew_result buffer_bytes(gltf_doc *d, int b, const unsigned char **p, size_t *n) {
     const cJSON *buf = cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(d->root, "buffers"), b);
     const cJSON *uri = cJSON_GetObjectItemCaseSensitive(buf, "uri");
@@ -144,11 +174,16 @@ static sinew_result buffer_bytes(gltf_doc *d, int b, const unsigned char **p, si
         return SINEW_OK;
     }
     const char *s = cJSON_IsString(uri) ? uri->valuestring : NULL;
+    if (s && d->dir && strncmp(s, "data:", 5) && !strchr(s, ':') && s[0] != '/' && s[0]) {
+        sinew_result rc = read_buffer_file(d, b, s, &d->decoded[b], &d->ndecoded[b]);
+        if (!rc) *p = d->decoded[b], *n = d->ndecoded[b];
+        return rc;
+    }
     const char *comma = s && !strncmp(s, "data:", 5) ? strchr(s, ',') : NULL;
     if (!comma || comma - s < 12 || memcmp(comma - 7, ";base64", 7))
         return sw_error_set(d->err, SINEW_ERROR_UNSUPPORTED,
-                            "%s: buffer %d: a vertex attribute is read from the GLB's BIN chunk "
-                            "or a base64 data: URI only, not an external file (save as .glb)",
+                            "%s: buffer %d: a vertex attribute is read from the GLB's BIN chunk, "
+                            "a base64 data: URI or a file beside a .gltf read from a path",
                             d->name, b);
     int bad = 0;
     d->decoded[b] = b64_decode(comma + 1, strlen(comma + 1), &d->ndecoded[b], &bad);
@@ -448,11 +483,12 @@ done:
     return rc;
 }
 
-sinew_result sw_gltf_float_attribute(const void *data, size_t len, int binary, const char *attr,
-                                     const char *name, int32_t nprims, const int32_t *prim_verts,
-                                     const float *const *prim_xyz, double **out, sw_error *err) {
+sinew_result sw_gltf_float_attribute(const void *data, size_t len, int binary, const char *dir,
+                                     const char *attr, const char *name, int32_t nprims,
+                                     const int32_t *prim_verts, const float *const *prim_xyz,
+                                     double **out, sw_error *err) {
     *out = NULL;
-    gltf_doc d = {.binary = binary, .name = name, .err = err};
+    gltf_doc d = {.binary = binary, .dir = dir, .name = name, .err = err};
     const char *json = data;
     size_t jlen = len;
     if (nprims < 0 || (nprims > 0 && !prim_verts) || !attr)

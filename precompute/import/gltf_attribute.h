@@ -18,12 +18,15 @@
  * mesh 0's vertices, then mesh 1's..., 1 where a primitive lacks the attribute. A value
  * must be finite, > 0 and <= 1e6 (SINEW_ERROR_INVALID_ARGUMENT naming mesh, primitive and
  * vertex). The accessor is FLOAT, or normalized UNSIGNED_BYTE/SHORT, in the GLB's BIN
- * chunk or a base64 data: URI; SINEW_ERROR_UNSUPPORTED for a sparse accessor, an external
- * buffer, or primitives that do not match assimp's meshes; SINEW_ERROR_PARSE for a
- * reference, offset, count or type out of place. Every read is bounds-checked (the bytes
- * are outside data). Messages start "name: ". */
-sinew_result sw_gltf_float_attribute(const void *data, size_t len, int binary, const char *attr,
-                                     const char *name, int32_t nprims, const int32_t *prim_verts,
-                                     const float *const *prim_xyz, double **out, sw_error *err);
+ * chunk, a base64 data: URI or, when `dir` is not NULL, a file named by a relative uri in
+ * the folder `dir` (the .gltf's); SINEW_ERROR_UNSUPPORTED for a sparse accessor, another
+ * uri, or primitives that do not match assimp's meshes; SINEW_ERROR_IO for a buffer file
+ * that cannot be read; SINEW_ERROR_PARSE for a reference, offset, count or type out of
+ * place. Every read is bounds-checked (the bytes are outside data). Messages start
+ * "name: ". */
+sinew_result sw_gltf_float_attribute(const void *data, size_t len, int binary, const char *dir,
+                                     const char *attr, const char *name, int32_t nprims,
+                                     const int32_t *prim_verts, const float *const *prim_xyz,
+                                     double **out, sw_error *err);
 
 #endif

@@ -42,7 +42,8 @@ typedef struct scene_state {
     double *B, *Binv;   /* per bone: 16, bind global transform and its inverse */
     const void *bytes;  /* a glTF's bytes (NULL for other formats), for what assimp drops */
     size_t nbytes;
-    int binary; /* the bytes are a .glb */
+    int binary;      /* the bytes are a .glb */
+    const char *dir; /* the folder of a .gltf read from a path (its buffer files), or NULL */
 } scene_state;
 
 static void state_free(scene_state *s) {
@@ -627,8 +628,9 @@ static sinew_result paint_stiffness(scene_state *s, sw_imported_character *out, 
         xyz[m] = (const float *)sc->mMeshes[m]->mVertices; /* x, y, z floats (asserted above) */
         first[m + 1] = first[m] + out->source_mesh_verts[m];
     }
-    rc = sw_gltf_float_attribute(s->bytes, s->nbytes, s->binary, "_SINEW_STIFFNESS", s->name,
-                                 out->nsource_meshes, out->source_mesh_verts, xyz, &per, err);
+    rc =
+        sw_gltf_float_attribute(s->bytes, s->nbytes, s->binary, s->dir, "_SINEW_STIFFNESS", s->name,
+                                out->nsource_meshes, out->source_mesh_verts, xyz, &per, err);
     if (rc || !per) goto done;
     out->render_stiffness = malloc(sizeof(double) * (size_t)out->render.nverts);
     if (!out->render_stiffness) {
@@ -691,9 +693,10 @@ static unsigned ai_flags(int gltf) {
     return gltf ? f : f | aiProcess_JoinIdenticalVertices;
 }
 
-/* `bytes`: the glTF file read again for what assimp drops (NULL for other formats). */
+/* `bytes`: the glTF file read again for what assimp drops (NULL for other formats); `dir`:
+ * its folder when it was read from a path. */
 static sinew_result run(const struct aiScene *sc, const char *name, const void *bytes,
-                        size_t nbytes, int binary, const sw_import_options *o,
+                        size_t nbytes, int binary, const char *dir, const sw_import_options *o,
                         sw_imported_character *out, sw_error *err) {
     if (!sc)
         return sw_error_set(err, SINEW_ERROR_PARSE, "%s: assimp could not read it: %s", name,
@@ -707,7 +710,8 @@ static sinew_result run(const struct aiScene *sc, const char *name, const void *
                          .gltf = bytes != NULL,
                          .bytes = bytes,
                          .nbytes = nbytes,
-                         .binary = binary};
+                         .binary = binary,
+                         .dir = dir};
         rc = import_scene(&s, o, out, err);
         state_free(&s);
     }
@@ -769,8 +773,15 @@ sinew_result sw_scene_import(const char *path, const sw_import_options *o,
     rc = gltf ? precheck_file(f, binary, name, &bytes, &nbytes, err) : SINEW_OK;
     fclose(f);
     if (rc) return rc;
-    rc = run(aiImportFile(path, ai_flags(gltf)), name, bytes, nbytes, binary, &use, out, err);
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, (size_t)(slash - path + (slash == path))) : strdup(".");
+    if (!dir) {
+        free(bytes);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    rc = run(aiImportFile(path, ai_flags(gltf)), name, bytes, nbytes, binary, dir, &use, out, err);
     free(bytes);
+    free(dir);
     return rc;
 }
 
@@ -793,7 +804,7 @@ sinew_result sw_scene_import_memory(const void *data, size_t len, const char *hi
     memcpy(copy, data, len);
     memset(copy + len, 0, 16);
     rc = run(aiImportFileFromMemory(copy, (unsigned)len, ai_flags(gltf), hint ? hint : ""), name,
-             gltf ? data : NULL, len, is_glb(hint), &use, out, err);
+             gltf ? data : NULL, len, is_glb(hint), NULL, &use, out, err);
     free(copy);
     return rc;
 }
