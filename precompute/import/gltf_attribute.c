@@ -3,10 +3,11 @@
  * Which aiMesh is which primitive. assimp 5.2.5 makes one aiMesh per primitive, mesh by
  * mesh, but its meshes come in the order its lazy dictionary first *loads* them, not the
  * file's order: the default scene's root nodes depth-first with a node's children read
- * before its own mesh, a node's skin read (its joints' nodes) after its mesh, then every
- * skin, then every animation channel's target node; a mesh no node reaches is not
+ * before its own mesh, then every skin's joints (a node only names its skin, to avoid a
+ * recursion), then every animation channel's target node; a mesh no node reaches is not
  * imported. (Checked against assimp 5.2.5 on hand-written files where the file order and
- * that order differ, and on the robot's 14 meshes of 1 to 3 primitives.) load_order()
+ * that order differ, a skin's joints reaching a mesh first, and on the robot's 14 meshes
+ * of 1 to 3 primitives.) load_order()
  * replays this; the vertex counts, and the positions when given, confirm it.
  * A primitive's vertices are the POSITION accessor's, in its order (5.2.5 keeps unused
  * vertices and does not reorder by the indices).
@@ -266,40 +267,37 @@ static sinew_result read_accessor(gltf_doc *d, int a, int64_t count, const char 
 /* A node or skin being read, and where in its children or joints. */
 typedef struct load_frame {
     int skin; /* 0: a node, 1: a skin */
-    int idx, phase, i;
+    int idx, i;
 } load_frame;
 
 /* Pushes node/skin idx when it has not been read (state 0); state 1: being read, 2: read. */
 static void load_push(load_frame *st, int *sp, unsigned char *state, int skin, int idx) {
     if (idx < 0 || state[idx]) return;
     state[idx] = 1;
-    st[(*sp)++] = (load_frame){skin, idx, 0, 0};
+    st[(*sp)++] = (load_frame){skin, idx, 0};
 }
 
-/* Runs the stack down: assimp's Node::Read (children, then mesh, then skin) and Skin::Read
- * (its joints), appending each mesh to `order` the first time one is read. */
+/* Runs the stack down: assimp's Node::Read (its children, then its mesh; its skin only
+ * named, read later) and Skin::Read (its joints), appending each mesh to `order` the first
+ * time one is read. */
 static void load_run(const cJSON *root, load_frame *st, int *sp, unsigned char *nstate,
-                     unsigned char *sstate, unsigned char *mseen, int *order, int *norder) {
+                     unsigned char *mseen, int *order, int *norder) {
     const cJSON *nodes = cJSON_GetObjectItemCaseSensitive(root, "nodes");
     const cJSON *skins = cJSON_GetObjectItemCaseSensitive(root, "skins");
-    const int nnode = count_of(root, "nodes"), nskin = count_of(root, "skins"),
-              nmesh = count_of(root, "meshes");
+    const int nnode = count_of(root, "nodes"), nmesh = count_of(root, "meshes");
     while (*sp > 0) {
         load_frame *f = &st[*sp - 1];
         const cJSON *o = cJSON_GetArrayItem(f->skin ? skins : nodes, f->idx);
         const cJSON *list = cJSON_GetObjectItemCaseSensitive(o, f->skin ? "joints" : "children");
-        if (f->phase == 0 && cJSON_IsArray(list) && f->i < cJSON_GetArraySize(list)) {
+        if (cJSON_IsArray(list) && f->i < cJSON_GetArraySize(list)) {
             load_push(st, sp, nstate, 0, index_in(cJSON_GetArrayItem(list, f->i++), nnode));
             continue;
         }
-        if (!f->skin && f->phase == 0) {
-            f->phase = 1;
+        if (!f->skin) {
             int m = index_of(o, "mesh", nmesh);
             if (m >= 0 && !mseen[m]) mseen[m] = 1, order[(*norder)++] = m;
-            load_push(st, sp, sstate, 1, index_of(o, "skin", nskin));
-            continue;
+            nstate[f->idx] = 2;
         }
-        (f->skin ? sstate : nstate)[f->idx] = 2;
         (*sp)--;
     }
 }
@@ -329,17 +327,17 @@ static sinew_result load_order(const cJSON *root, int *order, int *norder, const
             cJSON_GetObjectItemCaseSensitive(
                 cJSON_GetArrayItem(cJSON_GetObjectItemCaseSensitive(root, "scenes"), s), "nodes")) {
             load_push(st, &sp, nstate, 0, index_in(e, nnode));
-            load_run(root, st, &sp, nstate, sstate, mseen, order, norder);
+            load_run(root, st, &sp, nstate, mseen, order, norder);
         }
     for (int k = 0; k < nskin; ++k) {
         load_push(st, &sp, sstate, 1, k);
-        load_run(root, st, &sp, nstate, sstate, mseen, order, norder);
+        load_run(root, st, &sp, nstate, mseen, order, norder);
     }
     cJSON_ArrayForEach(a, cJSON_GetObjectItemCaseSensitive(root, "animations")) {
         cJSON_ArrayForEach(e, cJSON_GetObjectItemCaseSensitive(a, "channels")) {
             const cJSON *t = cJSON_GetObjectItemCaseSensitive(e, "target");
             load_push(st, &sp, nstate, 0, index_of(t, "node", nnode));
-            load_run(root, st, &sp, nstate, sstate, mseen, order, norder);
+            load_run(root, st, &sp, nstate, mseen, order, norder);
         }
     }
 done:
