@@ -12,7 +12,10 @@
 # edited mesh, a failed bake) is refused with its reason and the bake's progress lines are
 # read as the status bar shows them (check_errors.py); the add-on zipped, installed and
 # enabled through Blender's preferences previews a saved scene, scrubbing back from rest
-# (check_install.py). Without blender the test is skipped (77), except under CI=true,
+# (check_install.py); a soft region painted at 0.25 (the vertices weighted >= 0.5 on the
+# Fox's b_Spine02_03) reaches the bake as the glTF attribute _SINEW_STIFFNESS in one more
+# bake at ~2,000 tets, and leaves the scene unpainted (with SINEW_TEST_PAINT=1 the region
+# must also bend further from Blender's skinning than unpainted). Without blender the test is skipped (77), except under CI=true,
 # where tools/setup-debian.sh has installed it.
 #   bash tests/blender.sh BUILD_DIR SOURCE_DIR DATA_DIR
 set -uo pipefail
@@ -42,8 +45,9 @@ run_blender() {
         { grep -v '^$' "$log" | tail -25; fail "blender $*"; }
 }
 
+soft=(--soft-bone b_Spine02_03) # the region measured in both bakes
 run_blender "$tmp/run.log" -P "$src/samples/blender/run.py" -- "$fox" --tets 3500 \
-    --out "$tmp/fox" --train Survey,Walk --heldout Run --frames 30
+    --out "$tmp/fox" --train Survey,Walk --heldout Run --frames 30 "${soft[@]}" --softness 1
 python3 - "$tmp/fox/run.json" <<'PY' || fail "run.json's figures"
 import json, os, sys
 r = json.load(open(sys.argv[1]))
@@ -73,6 +77,51 @@ sys.exit(0 if all(ok for _, ok in checks) else 1)
 PY
 python3 "$src/samples/blender/check_replay.py" "$tmp/fox/preview_record.json" --tol 1e-6 ||
     fail "the preview's positions are not the runtime's"
+
+# Painted: the same poses, the region four times softer (docs/blender.md, Painting).
+run_blender "$tmp/paint.log" -P "$src/samples/blender/run.py" -- "$fox" --tets 2000 \
+    --out "$tmp/paint" --train Survey,Walk --heldout Run --frames 30 "${soft[@]}" --softness 0.25 \
+    --no-gltf --no-render
+python3 - "$tmp/paint/run.json" "$tmp/fox/run.json" <<'PY' || fail "the painted bake's figures"
+import json, os, struct, sys
+r, plain = json.load(open(sys.argv[1])), json.load(open(sys.argv[2]))
+
+
+def stiffness(path):
+    """The _SINEW_STIFFNESS values of every primitive of the GLB at `path` (None: not FLOAT)."""
+    raw = open(path, "rb").read()  # its JSON and BIN chunks
+    n = struct.unpack_from("<I", raw, 12)[0]
+    doc, body, values = json.loads(raw[20 : 20 + n]), raw[28 + n :], []
+    for m in doc["meshes"]:
+        for p in m["primitives"]:
+            if "_SINEW_STIFFNESS" in p["attributes"]:
+                a = doc["accessors"][p["attributes"]["_SINEW_STIFFNESS"]]
+                v = doc["bufferViews"][a["bufferView"]]
+                ok = a["type"] == "SCALAR" and a["componentType"] == 5126 and "byteStride" not in v
+                off = v.get("byteOffset", 0) + a.get("byteOffset", 0)
+                values += struct.unpack_from(f"<{a['count']}f", body, off) if ok else [None]
+    return values
+
+
+values = stiffness(r["soft_glb"])
+gain = (r["soft_dist_from_skinning"] or 0) / (plain["soft_dist_from_skinning"] or 1)
+checks = [
+    ("tets in 1500..2500", 1500 <= r["tets"] <= 2500),
+    ("no failed step", r["failed_steps"] == 0),
+    ("the soft region has vertices", r["soft_vertices"] > 0),
+    ("the exported GLB has _SINEW_STIFFNESS, 0.25 in the region and 1 elsewhere",
+     set(values) == {0.25, 1.0} and values.count(0.25) >= r["soft_vertices"]),
+    ("the scene left unpainted after the export", r["soft_paint_left_behind"] == []),
+    ("softness 1 paints nothing", stiffness(plain["soft_glb"]) == []),
+]
+if os.environ.get("SINEW_TEST_PAINT") == "1":  # once the bake's physics reads the paint
+    checks.append(("the painted region bends further from the skinning (x1.1)", gain > 1.1))
+for name, ok in checks:
+    print(("ok   " if ok else "FAIL ") + name)
+print({"soft_vertices": r["soft_vertices"], "painted": r["soft_dist_from_skinning"],
+       "unpainted": plain["soft_dist_from_skinning"], "gain": gain, "bake_seconds": r["bake_seconds"]})
+sys.exit(0 if all(ok for _, ok in checks) else 1)
+PY
 
 "$SINEW_BAKE" --scene finger --tets 1000 --out "$tmp/finger.blob" >/dev/null 2>&1 || fail "the finger's bake"
 run_blender "$tmp/errors.log" -P "$src/samples/blender/check_errors.py" -- "$tmp/fox/scene.blend" "$tmp/finger.blob"

@@ -17,6 +17,7 @@
 #include <errno.h>
 #include <string.h>
 
+#include "gltf_attribute.h"
 #include "gltf_precheck.h"
 #include "scene_internal.h"
 
@@ -39,6 +40,10 @@ typedef struct scene_state {
     int32_t nbones;
     int32_t *bone_node; /* per bone */
     double *B, *Binv;   /* per bone: 16, bind global transform and its inverse */
+    const void *bytes;  /* a glTF's bytes (NULL for other formats), for what assimp drops */
+    size_t nbytes;
+    int binary;      /* the bytes are a .glb */
+    const char *dir; /* the folder of a .gltf read from a path (its buffer files), or NULL */
 } scene_state;
 
 static void state_free(scene_state *s) {
@@ -603,6 +608,44 @@ static sinew_result apply_scale(scene_state *s, const sw_import_options *o,
     return SINEW_OK;
 }
 
+_Static_assert(sizeof(struct aiVector3D) == 3 * sizeof(float), "assimp built with float vertices");
+
+/* A glTF's painted stiffness multiplier (the _SINEW_STIFFNESS attribute, which assimp drops;
+ * gltf_attribute.h) onto each render vertex, through the aiMesh and vertex it came from. */
+static sinew_result paint_stiffness(scene_state *s, sw_imported_character *out, sw_error *err) {
+    const struct aiScene *sc = s->sc;
+    const unsigned nm = sc->mNumMeshes;
+    const float **xyz = malloc(sizeof *xyz * (nm ? nm : 1));
+    int64_t *first = malloc(sizeof *first * ((size_t)nm + 1));
+    double *per = NULL;
+    sinew_result rc = SINEW_OK;
+    if (!xyz || !first) {
+        rc = oom(s, err);
+        goto done;
+    }
+    first[0] = 0;
+    for (unsigned m = 0; m < nm; ++m) {
+        xyz[m] = (const float *)sc->mMeshes[m]->mVertices; /* x, y, z floats (asserted above) */
+        first[m + 1] = first[m] + out->source_mesh_verts[m];
+    }
+    rc =
+        sw_gltf_float_attribute(s->bytes, s->nbytes, s->binary, s->dir, "_SINEW_STIFFNESS", s->name,
+                                out->nsource_meshes, out->source_mesh_verts, xyz, &per, err);
+    if (rc || !per) goto done;
+    out->render_stiffness = malloc(sizeof(double) * (size_t)out->render.nverts);
+    if (!out->render_stiffness) {
+        rc = oom(s, err);
+        goto done;
+    }
+    for (int32_t i = 0; i < out->render.nverts; ++i)
+        out->render_stiffness[i] = per[first[out->render_source[i]] + out->render_source_vertex[i]];
+done:
+    free(xyz);
+    free(first);
+    free(per);
+    return rc;
+}
+
 static sinew_result import_scene(scene_state *s, const sw_import_options *o,
                                  sw_imported_character *out, sw_error *err) {
     sinew_result rc;
@@ -610,6 +653,7 @@ static sinew_result import_scene(scene_state *s, const sw_import_options *o,
         (rc = build_render(s, out, err)) || (rc = build_skeleton(s, out, err)) ||
         (rc = apply_scale(s, o, out, err)))
         return rc;
+    if (s->bytes && (rc = paint_stiffness(s, out, err))) return rc;
     const struct aiScene *sc = s->sc;
     out->clips = calloc(sc->mNumAnimations ? sc->mNumAnimations : 1, sizeof *out->clips);
     if (!out->clips) return oom(s, err);
@@ -649,8 +693,11 @@ static unsigned ai_flags(int gltf) {
     return gltf ? f : f | aiProcess_JoinIdenticalVertices;
 }
 
-static sinew_result run(const struct aiScene *sc, const char *name, int gltf,
-                        const sw_import_options *o, sw_imported_character *out, sw_error *err) {
+/* `bytes`: the glTF file read again for what assimp drops (NULL for other formats); `dir`:
+ * its folder when it was read from a path. */
+static sinew_result run(const struct aiScene *sc, const char *name, const void *bytes,
+                        size_t nbytes, int binary, const char *dir, const sw_import_options *o,
+                        sw_imported_character *out, sw_error *err) {
     if (!sc)
         return sw_error_set(err, SINEW_ERROR_PARSE, "%s: assimp could not read it: %s", name,
                             aiGetErrorString());
@@ -658,7 +705,13 @@ static sinew_result run(const struct aiScene *sc, const char *name, int gltf,
     if (!sc->mRootNode || (sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         rc = sw_error_set(err, SINEW_ERROR_PARSE, "%s: assimp read an incomplete scene", name);
     } else {
-        scene_state s = {.sc = sc, .name = name, .gltf = gltf};
+        scene_state s = {.sc = sc,
+                         .name = name,
+                         .gltf = bytes != NULL,
+                         .bytes = bytes,
+                         .nbytes = nbytes,
+                         .binary = binary,
+                         .dir = dir};
         rc = import_scene(&s, o, out, err);
         state_free(&s);
     }
@@ -680,8 +733,10 @@ static sinew_result check_options(const sw_import_options *o, const char *name,
     return SINEW_OK;
 }
 
-/* sw_gltf_precheck over a whole glTF file (at most 1 GiB). */
-static sinew_result precheck_file(FILE *f, int binary, const char *name, sw_error *err) {
+/* sw_gltf_precheck over a whole glTF file (at most 1 GiB), read into *bytes (the caller
+ * frees it) for what assimp drops. */
+static sinew_result precheck_file(FILE *f, int binary, const char *name, char **bytes,
+                                  size_t *nbytes, sw_error *err) {
     if (fseek(f, 0, SEEK_END) != 0)
         return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot seek", name);
     long n = ftell(f);
@@ -692,8 +747,12 @@ static sinew_result precheck_file(FILE *f, int binary, const char *name, sw_erro
     sinew_result rc = fread(buf, 1, (size_t)n, f) == (size_t)n
                           ? sw_gltf_precheck(buf, (size_t)n, binary, name, err)
                           : sw_error_set(err, SINEW_ERROR_IO, "%s: cannot read", name);
-    free(buf);
-    return rc;
+    if (rc) {
+        free(buf);
+        return rc;
+    }
+    *bytes = buf, *nbytes = (size_t)n;
+    return SINEW_OK;
 }
 
 sinew_result sw_scene_import(const char *path, const sw_import_options *o,
@@ -708,11 +767,22 @@ sinew_result sw_scene_import(const char *path, const sw_import_options *o,
         return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot open: %s", name,
                             strerror(path ? errno : EINVAL));
     const char *dot = strrchr(path, '.');
-    int gltf = is_gltf_ext(dot ? dot + 1 : NULL);
-    rc = gltf ? precheck_file(f, is_glb(dot + 1), name, err) : SINEW_OK;
+    int gltf = is_gltf_ext(dot ? dot + 1 : NULL), binary = gltf && is_glb(dot + 1);
+    char *bytes = NULL;
+    size_t nbytes = 0;
+    rc = gltf ? precheck_file(f, binary, name, &bytes, &nbytes, err) : SINEW_OK;
     fclose(f);
     if (rc) return rc;
-    return run(aiImportFile(path, ai_flags(gltf)), name, gltf, &use, out, err);
+    const char *slash = strrchr(path, '/');
+    char *dir = slash ? strndup(path, (size_t)(slash - path + (slash == path))) : strdup(".");
+    if (!dir) {
+        free(bytes);
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
+    }
+    rc = run(aiImportFile(path, ai_flags(gltf)), name, bytes, nbytes, binary, dir, &use, out, err);
+    free(bytes);
+    free(dir);
+    return rc;
 }
 
 sinew_result sw_scene_import_memory(const void *data, size_t len, const char *hint,
@@ -734,7 +804,7 @@ sinew_result sw_scene_import_memory(const void *data, size_t len, const char *hi
     memcpy(copy, data, len);
     memset(copy + len, 0, 16);
     rc = run(aiImportFileFromMemory(copy, (unsigned)len, ai_flags(gltf), hint ? hint : ""), name,
-             gltf, &use, out, err);
+             gltf ? data : NULL, len, is_glb(hint), NULL, &use, out, err);
     free(copy);
     return rc;
 }

@@ -59,7 +59,10 @@ typedef struct sw_imported_character {
  * (defaults). On failure `out` is zeroed and `err` names the file: SINEW_ERROR_IO (cannot
  * read), SINEW_ERROR_PARSE (assimp rejected it), SINEW_ERROR_INVALID_ARGUMENT (no skin,
  * unweighted vertices, a bone without a node, bad options), SINEW_ERROR_NOT_FINITE (a NaN
- * or infinity in the data), SINEW_ERROR_CAPACITY (too big), SINEW_ERROR_OUT_OF_MEMORY. */
+ * or infinity in the data), SINEW_ERROR_CAPACITY (too big), SINEW_ERROR_OUT_OF_MEMORY. A
+ * glTF's painted stiffness (gltf_attribute.h) adds SINEW_ERROR_INVALID_ARGUMENT (a value
+ * not finite in (0, 1e6]), SINEW_ERROR_PARSE (its accessor out of place) and
+ * SINEW_ERROR_UNSUPPORTED (sparse, or primitives that cannot be matched to assimp's). */
 sinew_result sw_scene_import(const char *path, const sw_import_options *o,
                              sw_imported_character *out, sw_error *err);
 

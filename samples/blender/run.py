@@ -3,6 +3,7 @@
     blender -b --factory-startup --python-exit-code 1 -P samples/blender/run.py -- \\
         ASSET --tets N --out DIR [--frames F] [--train A,B] [--heldout C] [--play CLIP]
         [--dynamic] [--lib libsinew.so] [--bake sinew-bake] [--blob F] [--no-gltf] [--no-render]
+        [--soft-group NAME | --soft-bone BONE] [--softness X]
 
 imports ASSET (glTF or FBX, Blender's importers), bakes it through the add-on, plays F
 frames of a clip through the preview, exports them (PC2, MDD, shape keys, glTF morph
@@ -10,6 +11,9 @@ targets), reads the caches and the glTF back, renders one frame with Workbench t
 DIR/frame.png, plays the frames again against a sphere collider pressed into the
 character's back, and writes DIR/run.json with the figures and DIR/preview_record.json
 with the poses the preview stepped (check_replay.py steps them again outside Blender).
+A soft region (--soft-group, or --soft-bone: the vertices weighted >= 0.5 on that bone) is
+baked --softness times as stiff; the glTF the bake read is kept as DIR/baked.glb and
+run.json says how far the region's flesh sits from Blender's skinning.
 """
 
 import argparse
@@ -44,7 +48,30 @@ def parse():
     ap.add_argument("--blob", default="", help="preview this blob instead of baking (--tets is then ignored)")
     ap.add_argument("--no-gltf", action="store_true")
     ap.add_argument("--no-render", action="store_true")
+    ap.add_argument("--soft-group", default="", help="the vertex group of a soft region")
+    ap.add_argument("--soft-bone", default="", help="a soft region made of the vertices weighted >= 0.5 on this bone")
+    ap.add_argument("--softness", type=float, default=0.25, help="the soft region's stiffness multiplier")
     return ap.parse_args(argv)
+
+
+def soft_region(mesh_obj, group, bone):
+    """The soft region's vertex group: `group`, or one made from the vertices whose weight
+    on `bone` is >= 0.5 (weight 1 in it); its name and a mask of its vertices."""
+    if bone:
+        src = mesh_obj.vertex_groups.get(bone)
+        if src is None:
+            raise SystemExit(f"run.py: {mesh_obj.name} has no vertex group for bone {bone}")
+        group = f"sinew_soft_{bone}"
+        vg = mesh_obj.vertex_groups.new(name=group)
+        idx = [v.index for v in mesh_obj.data.vertices for g in v.groups if g.group == src.index and g.weight >= 0.5]
+        vg.add(idx, 1.0, "REPLACE")
+    vg = mesh_obj.vertex_groups.get(group)
+    if vg is None:
+        raise SystemExit(f"run.py: {mesh_obj.name} has no vertex group {group}")
+    mask = np.zeros(len(mesh_obj.data.vertices), bool)
+    for v in mesh_obj.data.vertices:
+        mask[v.index] = any(g.group == vg.index and g.weight > 0 for g in v.groups)
+    return group, mask
 
 
 def import_asset(path):
@@ -264,6 +291,14 @@ def main():
     bpy.ops.wm.save_as_mainfile(filepath=os.path.join(out, "scene.blend"))  # the blob goes beside it
     s = mesh_obj.sinew
     s.tets, s.dynamic = a.tets, a.dynamic
+    soft_mask, soft_glb = None, None
+    if a.soft_group or a.soft_bone:
+        s.soft_group, soft_mask = soft_region(mesh_obj, a.soft_group, a.soft_bone)
+        s.softness = a.softness
+        soft_glb = os.path.join(out, "baked.glb")  # what the bake reads, to look at
+        meshes = sinew.character_meshes(mesh_obj)
+        bake.export_for_bake(s, sinew.armature_of(mesh_obj), meshes, soft_glb)
+        left = [m.name for m in meshes if m.data.attributes.get(bake.STIFFNESS_ATTRIBUTE) is not None]
     choose_clips(mesh_obj, [n for n in a.train.split(",") if n], [n for n in a.heldout.split(",") if n])
     if a.blob:  # baked before (for this asset through Blender): no bake, the preview's figures
         s.blob_path = os.path.abspath(a.blob)
@@ -283,6 +318,12 @@ def main():
     scale = float(np.cbrt(np.linalg.det(p.b.A[:3, :3])))  # mesh units -> blob units
     from_skin = max(float(np.linalg.norm(p.frames[f] - k, axis=1).mean()) for f, k in zip(frames, skin))
     from_skin *= scale / p.b.size
+    soft_from_skin = None
+    if soft_mask is not None and soft_mask.any():  # the soft region's flesh alone, mean over the frames
+        soft_from_skin = statistics.mean(
+            float(np.linalg.norm(p.frames[f][soft_mask] - k[soft_mask], axis=1).mean()) for f, k in zip(frames, skin)
+        )
+        soft_from_skin *= scale / p.b.size
     size_m = p.b.size / scale  # the size in the mesh's units
     lib_path = sinew_lib.find_library(os.environ.get("SINEW_LIB", ""))
     dev = replay_runtime(p, lib_path)
@@ -348,6 +389,12 @@ def main():
         "render": os.path.join(out, "frame.png") if centre is not None else None,
         "render_centre_share": centre,
         "exported": exported,
+        "soft_group": s.soft_group or None,
+        "softness": s.softness if s.soft_group else None,
+        "soft_vertices": int(soft_mask.sum()) if soft_mask is not None else 0,
+        "soft_glb": soft_glb,
+        "soft_paint_left_behind": left if soft_mask is not None else [],
+        "soft_dist_from_skinning": soft_from_skin,
     }
     with open(os.path.join(out, "run.json"), "w") as f:
         json.dump(fig, f, indent=1)

@@ -2,19 +2,23 @@
  * fuzz harness for every loader), through sw_scene_import_memory with the hint "glb".
  * tests/CMakeLists.txt builds it with clang when clang has libFuzzer and runs it for a few
  * seconds on tests/fuzz/corpus/scene_import (two_bones.glb: a hand-written 4-vertex,
- * 2-joint skin with a 2-key rotation clip, 1.8 KB) as the test fuzz_scene_import. assimp
+ * 2-joint skin with a 2-key rotation clip, 1.8 KB; painted_two_primitives.glb:
+ * test_scene_paint's skin of two primitives and a rigid prop with the _SINEW_STIFFNESS
+ * attribute, FLOAT and normalized UNSIGNED_BYTE, 2.4 KB) as the test fuzz_scene_import. assimp
  * itself is Debian's uninstrumented build: ASan sees our reads, not assimp's. By hand:
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/core -Iprecompute/io -Iprecompute/import \
  *     tests/fuzz/fuzz_scene_import.c precompute/import/scene_import.c \
- *     precompute/import/scene_clip.c precompute/io/sw_mesh.c runtime/core/sw_error.c \
- *     -lassimp -lm -o build-fuzz-scene
+ *     precompute/import/scene_clip.c precompute/import/gltf_precheck.c \
+ *     precompute/import/gltf_attribute.c precompute/io/sw_mesh.c runtime/core/sw_error.c \
+ *     -lassimp -lcjson -lm -o build-fuzz-scene
  *   cp -r tests/fuzz/corpus/scene_import /tmp/scene-corpus && ./build-fuzz-scene /tmp/scene-corpus
  *
  * An accepted character is checked for the importer's promises (counts, indices in range,
  * finite positions and transforms, weight rows of at most 4 summing to 1, parents in
- * range); a failure must leave its code, a message naming "memory.glb" and a zeroed result. */
+ * range, a painted stiffness finite in (0, 1e6]); a failure must leave its code, a message
+ * naming "memory.glb" and a zeroed result. */
 #include <math.h>
 #include <stdint.h>
 #include <stdlib.h>
@@ -63,6 +67,8 @@ static void check(const sw_imported_character *c) {
     }
     for (int32_t b = 0; b < nb; ++b)
         if (c->skel.parent[b] < -1 || c->skel.parent[b] >= b) abort();
+    for (int32_t v = 0; c->render_stiffness && v < m->nverts; ++v)
+        if (!(c->render_stiffness[v] > 0 && c->render_stiffness[v] <= 1e6)) abort();
     for (int32_t i = 0; i < c->nclips; ++i) {
         const sw_clip *k = &c->clips[i].clip;
         if (k->nbones != nb || k->nframes < 1 || !memchr(c->clips[i].name, 0, 64)) abort();

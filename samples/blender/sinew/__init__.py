@@ -101,6 +101,18 @@ class SinewSettings(bpy.types.PropertyGroup):
     report_path: bpy.props.StringProperty(name="Report", subtype="FILE_PATH")
     last_bake: bpy.props.StringProperty(name="Last bake")
     export_dir: bpy.props.StringProperty(name="Export to", subtype="DIR_PATH", default="//")
+    soft_group: bpy.props.StringProperty(
+        name="Soft region", description="A vertex group where the flesh is softer (its weights blend to Softness)"
+    )
+    softness: bpy.props.FloatProperty(
+        name="Softness",
+        default=0.25,
+        min=0.001,
+        max=1000.0,
+        soft_min=0.05,
+        soft_max=4.0,
+        description="Stiffness multiplier in the soft region: 0.25 is four times softer than the rest, 2 twice as stiff",
+    )
 
 
 def refresh_clips(mesh_obj):
@@ -396,6 +408,9 @@ class SINEW_PT_panel(bpy.types.Panel):
             row = col.row()
             row.label(text=c.name)
             row.prop(c, "use", expand=True)
+        col.prop_search(s, "soft_group", obj, "vertex_groups")
+        if s.soft_group:
+            col.prop(s, "softness")
         col.prop(s, "blob_path")
         col.operator("sinew.bake", icon="PHYSICS")
         if s.last_bake:

@@ -11,6 +11,7 @@ import threading
 import time
 
 import bpy
+import numpy as np
 
 # "sinew-bake: simulate   40% (99/246), 7 s, about 10 s left" (tools/common/tool_run.c)
 _PROGRESS = re.compile(r"^sinew-bake: (\w+)\s+(\d+)% \((\d+)/(\d+)\)")
@@ -46,9 +47,60 @@ def clip_name(arm_obj, action_name):
     return action_name
 
 
-def export_gltf(arm_obj, meshes, path):
+# The painted stiffness multiplier as a mesh attribute. Blender 3.4's exporter writes a
+# generic attribute as "_" + its name in capitals (export_attributes=True), which is the
+# glTF vertex attribute sinew-bake reads: _SINEW_STIFFNESS (precompute/import/gltf_attribute.c).
+STIFFNESS_ATTRIBUTE = "sinew_stiffness"
+
+
+def paint_stiffness(meshes, group, multiplier):
+    """Writes the stiffness multiplier 1 + w (multiplier - 1) (w: the vertex's weight in the
+    vertex group `group`, 0 outside it) as the FLOAT POINT attribute STIFFNESS_ATTRIBUTE on
+    each of `meshes` that has the group and not the attribute already (the artist's own
+    painting is left as it is). Returns the mesh data it was added to, for unpaint()."""
+    painted = []
+    if not group or multiplier == 1.0:
+        return painted
+    for obj in meshes:
+        vg = obj.vertex_groups.get(group)
+        me = obj.data
+        if vg is None or me in painted or me.attributes.get(STIFFNESS_ATTRIBUTE) is not None:
+            continue
+        w = np.zeros(len(me.vertices), np.float32)
+        for v in me.vertices:
+            for g in v.groups:
+                if g.group == vg.index:
+                    w[v.index] = g.weight
+        attr = me.attributes.new(STIFFNESS_ATTRIBUTE, "FLOAT", "POINT")
+        attr.data.foreach_set("value", 1.0 + np.clip(w, 0.0, 1.0) * (multiplier - 1.0))
+        painted.append(me)
+    return painted
+
+
+def unpaint(painted):
+    """Removes what paint_stiffness() added: the scene is as the artist left it."""
+    for me in painted:
+        attr = me.attributes.get(STIFFNESS_ATTRIBUTE)
+        if attr is not None:
+            me.attributes.remove(attr)
+
+
+def export_for_bake(settings, arm_obj, meshes, path):
+    """The glTF the bake reads: the meshes painted from the soft region (settings.soft_group,
+    settings.softness) for the export only."""
+    painted = paint_stiffness(meshes, settings.soft_group, settings.softness)
+    try:
+        with_paint = any(m.data.attributes.get(STIFFNESS_ATTRIBUTE) is not None for m in meshes)
+        export_gltf(arm_obj, meshes, path, attributes=with_paint)
+    finally:
+        unpaint(painted)
+    return painted
+
+
+def export_gltf(arm_obj, meshes, path, attributes=False):
     """Writes the armature and its meshes, with every action, to `path` (.glb) through
-    Blender's exporter; the selection is put back afterwards."""
+    Blender's exporter (with the meshes' generic attributes when `attributes`); the selection
+    is put back afterwards."""
     selected = [o for o in bpy.context.view_layer.objects if o.select_get()]
     active = bpy.context.view_layer.objects.active
     for o in selected:
@@ -69,6 +121,7 @@ def export_gltf(arm_obj, meshes, path):
             export_apply=False,
             export_materials="NONE",
             export_texcoords=False,
+            export_attributes=attributes,
         )
     finally:
         arm_obj.select_set(False)
@@ -162,6 +215,6 @@ def start(settings, arm_obj, meshes, bake_exe, blob_path, report_dir):
     heldout = [clip_name(arm_obj, c.name) for c in settings.clips if c.use == "HELDOUT"]
     tmp = tempfile.mkdtemp(prefix="sinew-bake-")
     glb = os.path.join(tmp, bpy.path.clean_name(meshes[0].name) + ".glb")
-    export_gltf(arm_obj, meshes, glb)
+    export_for_bake(settings, arm_obj, meshes, glb)
     cmd = command(bake_exe, glb, blob_path, report_dir, settings.tets, train, heldout, settings.dynamic)
     return BakeProcess(cmd, tmp), tmp
