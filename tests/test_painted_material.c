@@ -161,6 +161,22 @@ TEST(the_painted_finger_swings_back_later_as_the_reference_does) {
     bake_fixture_free(&soft);
 }
 
+/* The character's damping (--damping) is the blob's, the default the thesis's. */
+TEST(the_damping_given_is_the_blob_s) {
+    bake_fixture f;
+    memset(&f, 0, sizeof f);
+    sw_error err;
+    ENSURE(sw_sample_make("finger", TETS, FRAMES, &f.ch, &err) == SINEW_OK);
+    sw_bake_params p = bake_fixture_params(0, 2);
+    ENSURE(p.rayleigh_alpha == 0.01 && p.rayleigh_beta == 0.001);
+    p.rayleigh_alpha = 0.2;
+    p.rayleigh_beta = 0.003;
+    ENSURE(bake_fixture_bake(&f, &p));
+    const sw_blob_view *v = sw_blob_get_view(f.blob);
+    ENSURE(v->rayleigh_alpha == 0.2 && v->rayleigh_beta == 0.003);
+    bake_fixture_free(&f);
+}
+
 /* A two-tet bar under a one-triangle-pair render surface: what the carrying does. */
 TEST(the_painting_reaches_the_tets_and_bad_values_are_refused) {
     sw_character c;
@@ -228,4 +244,5 @@ TEST(the_painting_reaches_the_tets_and_bad_values_are_refused) {
 
 SW_TEST_MAIN(CASE(the_painting_reaches_the_tets_and_bad_values_are_refused),
              CASE(the_painted_region_is_softer_in_the_reference_and_the_runtime),
-             CASE(the_painted_finger_swings_back_later_as_the_reference_does))
+             CASE(the_painted_finger_swings_back_later_as_the_reference_does),
+             CASE(the_damping_given_is_the_blob_s))

@@ -44,6 +44,15 @@ expect bench_frames_3 2 "--frames wants an integer in 4\.\.1000000" \
 "$bake" --help | grep >/dev/null "the bake trains on the first 60% and holds out" ||
     { echo "FAIL bake_help_frames: --help does not say why --frames starts at 4" >&2; fails=$((fails + 1)); }
 
+# the material: out of range, and a painting of the wrong size or value (docs/baking.md)
+expect bake_damping_one 2 "--damping wants ALPHA,BETA" \
+    "$bake" "${small[@]}" --damping 0.2 --out "$tmp/a.blob"
+expect bake_poisson_half 2 "--poisson wants" \
+    "$bake" "${small[@]}" --poisson 0.5 --out "$tmp/a.blob"
+printf '1 3\n1\n1\n1\n' >"$tmp/three.dmat"
+expect bake_paint_rows 1 "three\.dmat: 3 x 1 stiffness multipliers, expected [0-9]+ x 1 \(one per simulation vertex\)" \
+    "$bake" "${small[@]}" --stiffness-map "$tmp/three.dmat" --out "$tmp/a.blob"
+
 # flags that do not apply to the input
 expect bake_clip_with_scene 2 "--clip does not apply to --scene" \
     "$bake" "${small[@]}" --clip x.txt --out "$tmp/a.blob"

@@ -13,7 +13,8 @@
 
 /* The options that shape the blob, field by field (the struct has pointers and padding).
  * Not the springs' stiffness: 0 asks the bake to choose one, and the blob baked with the
- * chosen one given is the same blob (its SPRING_HESSIAN holds it). Not the thread count:
+ * chosen one given is the same blob (its SPRING_HESSIAN holds it). Not the damping: META
+ * holds it, and no other section depends on it. Not the thread count:
  * the blob is the same for any. */
 static uint64_t options_hash(const sw_bake_params *p) {
     uint64_t h = SW_FNV_START;

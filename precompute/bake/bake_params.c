@@ -26,6 +26,8 @@ sw_bake_params sw_bake_params_default(void) {
     p.random_poses = 10;
     p.heldout_steps = 4;
     p.self_contact = 1;
+    p.rayleigh_alpha = 0.01;
+    p.rayleigh_beta = 0.001;
     p.spring_k = 0;
     p.cache_dir = NULL;
     p.threads = 0;

@@ -90,6 +90,9 @@ typedef struct sw_bake_params {
        (bake_cache.c). A re-bake that changes only the cubature, the rank or the report
        then takes seconds, not minutes. */
     const char *cache_dir;
+    /* the dynamic step's Rayleigh damping, C = alpha M + beta K (thesis §2.1.3; defaults
+       0.01 and 0.001); beta K follows painted material, damping soft flesh less */
+    double rayleigh_alpha, rayleigh_beta;
     double spring_k; /* interface springs per copy pair; 0 (default): the bake chooses among
                         SW_SPRING_CHOICES multiples of E h (h the mean rest edge) the one the
                         training poses prefer (bake_springs.c) */

@@ -298,8 +298,8 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->nsurf_verts = surf.nverts;
     v->nsurf_tris = surf.ntris;
     sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &v->mu, &v->lambda);
-    v->rayleigh_alpha = 0.01; /* thesis §2.1.3 */
-    v->rayleigh_beta = 0.001;
+    v->rayleigh_alpha = s->p->rayleigh_alpha; /* thesis §2.1.3 */
+    v->rayleigh_beta = s->p->rayleigh_beta;
     v->contact_k = 1e6; /* the training simulations' penalty (fullsim default) */
     v->rest = rest;
     v->skin_bone = skin_bone;

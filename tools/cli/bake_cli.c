@@ -65,6 +65,23 @@ static int take_shard(const char *tool, const char *flag, const char *v, void *t
     return 1;
 }
 
+/* --damping ALPHA,BETA: the dynamic step's Rayleigh damping. */
+static int take_damping(const char *tool, const char *flag, const char *v, void *target) {
+    sw_bake_params *p = target;
+    double a = NAN, b = NAN;
+    int used = 0;
+    if (sscanf(v, "%lf,%lf%n", &a, &b, &used) != 2 || v[used] != 0 || !(a >= 0 && a <= 1e3) ||
+        !(b >= 0 && b <= 1e3)) {
+        fprintf(stderr,
+                "%s: %s wants ALPHA,BETA, each in 0..1000 (C = ALPHA M + BETA K), got '%s'\n", tool,
+                flag, v);
+        return 0;
+    }
+    p->rayleigh_alpha = a;
+    p->rayleigh_beta = b;
+    return 1;
+}
+
 /* The bake's own flags (what every bake may want), bound to o, into f; returns their
  * count. */
 static size_t bake_flags(bake_options *o, sw_flag *f) {
@@ -92,6 +109,9 @@ static size_t bake_flags(bake_options *o, sw_flag *f) {
                 "ship the blob trained on the split of a character's only\n"
                 "clip, the one the held-out figures measure (default: baked\n"
                 "again on the whole clip once measured)")},
+        {SW_CALL("--damping", take_damping, p, "A,B",
+                 "the dynamic step's Rayleigh damping C = A M + B K, each 0..1000\n"
+                 "(default 0.01,0.001); B K follows painted material")},
         {SW_INT("--threads", &p->threads, 0, 256, "T", "0..256 (default 0: all cores)")},
         {SW_SET("--force", &o->force, 1,
                 "write the blob even when its training error is " TEXT(
