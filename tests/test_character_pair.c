@@ -45,15 +45,23 @@ static double thickness(const sw_character *c, int *axis) {
     return hi[*axis] - lo[*axis];
 }
 
+/* The finger and a copy `apart` thicknesses away along its thinnest axis *ax (*w thick,
+ * offset off). */
+static int make_pair(double apart, sw_character *pair, int *ax, double *w, double off[3]) {
+    sw_error err;
+    if (!fixture()) return 0;
+    *w = thickness(&g_ch, ax);
+    off[0] = off[1] = off[2] = 0;
+    off[*ax] = apart * *w;
+    return sw_character_pair(&g_ch, off, pair, &err) == SINEW_OK;
+}
+
 TEST(two_copies_apart_are_each_the_lone_character) {
-    ENSURE(fixture());
     int ax;
-    const double w = thickness(&g_ch, &ax);
-    double off[3] = {0, 0, 0};
-    off[ax] = 4 * w;
+    double w, off[3];
     sw_character pair;
     sw_error err;
-    ENSURE(sw_character_pair(&g_ch, off, &pair, &err) == SINEW_OK);
+    ENSURE(make_pair(4, &pair, &ax, &w, off));
     ENSURE(pair.mesh.nverts == 2 * g_ch.mesh.nverts && pair.skel.nbones == 2 * g_ch.skel.nbones);
     sw_fullsim_params p = params();
     sw_fullsim *one, *two;
@@ -91,14 +99,11 @@ TEST(two_copies_apart_are_each_the_lone_character) {
 }
 
 TEST(two_copies_pushed_together_hold_each_other_out) {
-    ENSURE(fixture());
     int ax;
-    const double w = thickness(&g_ch, &ax);
-    double off[3] = {0, 0, 0};
-    off[ax] = 3 * w;
+    double w, off[3];
     sw_character pair;
     sw_error err;
-    ENSURE(sw_character_pair(&g_ch, off, &pair, &err) == SINEW_OK);
+    ENSURE(make_pair(3, &pair, &ax, &w, off));
     sw_fullsim_params p = params();
     sw_fullsim *sim;
     ENSURE(sw_fullsim_create(&pair, &p, &sim, &err) == SINEW_OK);
