@@ -12,8 +12,11 @@
 #include "bake_fixture.h"
 #include "character_io.h"
 #include "instance.h"
+#include "instance_internal.h"
 #include "invariance.h"
+#include "mat3.h"
 #include "props_fixture.h"
+#include "sw_mesh.h"
 #include "sinew/sinew_world.h"
 #include "sw_test.h"
 
@@ -59,7 +62,7 @@ TEST(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_
     const char *names[] = {"pose-space", "pose-pairs", "exhaustive"};
     sw_move m = far_rigid();
     for (int k = 0; k < 3; ++k) {
-        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, modes[k], NULL, NULL, 0, 0};
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, modes[k], NULL, NULL, 0, 0, 0};
         sw_invariance_result res = measure(&run, &m);
         ENSURE_INVARIANT(res, names[k]);
         ENSUREF(res.self_contacts > 0, "%s: the fold never touched", names[k]);
@@ -68,14 +71,14 @@ TEST(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_
 
 TEST(a_character_turning_every_frame_deforms_as_one_standing_still) {
     sw_move m = {SW_MOVE_TURNING, {0.1, 1, 0.2}, 4 * PI / 180, {0.05, 0, 0.08}, 0, 0, 0};
-    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0};
+    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
     sw_invariance_result res = measure(&run, &m);
     ENSURE_INVARIANT(res, "turning");
 }
 
 TEST(dynamic_flesh_carried_by_a_constant_rigid_motion_is_the_same_motion) {
     sw_move m = far_rigid();
-    sw_invariance_run run = {SINEW_STEP_DYNAMIC, 0, NULL, NULL, 1.0f / 30, 0};
+    sw_invariance_run run = {SINEW_STEP_DYNAMIC, 0, NULL, NULL, 1.0f / 30, 0, 0};
     sw_invariance_result res = measure(&run, &m);
     ENSURE_INVARIANT(res, "dynamic");
 }
@@ -84,7 +87,7 @@ TEST(an_actor_far_from_the_origin_keeps_the_origins_shape_in_its_frame) {
     sw_move m = far_rigid();
     m.kind = SW_MOVE_ACTOR;
     m.float_poses = m.float_output = 1; /* as a host hands them in and reads them */
-    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0};
+    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
     sw_invariance_result res = measure(&run, &m);
     ENSURE_INVARIANT(res, "far actor");
     m.scale = 0.01; /* an actor scaled as well: its frame holds the unscaled shape */
@@ -96,11 +99,69 @@ TEST(a_uniformly_scaled_pose_gives_the_scaled_shape) {
     const double scales[] = {0.01, 100, 1.0005};
     for (int k = 0; k < 3; ++k) {
         sw_move m = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, scales[k], 1, 1};
-        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0};
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
         sw_invariance_result res = measure(&run, &m);
         char what[32];
         snprintf(what, sizeof what, "scale %g", scales[k]);
         ENSURE_INVARIANT(res, what);
+    }
+}
+
+/* ---- self-contact nobody trained ------------------------------------------------- */
+
+enum { FOLD_STEPS = 16 };
+
+/* The finger folded on past its training into self-contact the bake never saw
+ * (test_novel_contact's fold): every joint bent about its sweep axis from rest to 2.6
+ * times the largest trained bend (at most 170 degrees) in FOLD_STEPS frames, into T. */
+static void deep_fold_clip(const bake_fixture *f, double *T) {
+    const sw_skeleton *sk = &f->ch.skel;
+    double trained = 0, local[9 * 8];
+    for (int32_t b = 0; b < sk->nbones; ++b)
+        trained = fmax(trained, f->blob->poses.joint_bend[b]);
+    const double fold = fmin(2.6 * trained, 170 * PI / 180);
+    for (int k = 1; k <= FOLD_STEPS; ++k) {
+        for (int32_t b = 0; b < sk->nbones; ++b)
+            sw_m3_axis_angle(f->res.sweep_axis + 3 * b,
+                             sk->parent[b] >= 0 ? fold * k / FOLD_STEPS : 0, local + 9 * b);
+        sw_forward_kinematics(sk, local, NULL, T + (size_t)12 * sk->nbones * (k - 1));
+    }
+}
+
+/* The novel contact's broad phase (boxes carried by the dominant bones, a sweep on one
+ * axis), its narrow phase and the contact it applies through the subspace give the same
+ * flesh turned and far away, walking and turning, as a far actor and scaled; and both
+ * instances did find novel contact (else nothing was checked). */
+TEST(self_contact_nobody_trained_is_found_and_held_alike_wherever_the_finger_is) {
+    const bake_fixture *f = finger();
+    ENSURE(f && f->ch.skel.nbones <= 8);
+    double T[12 * 8 * FOLD_STEPS];
+    deep_fold_clip(f, T);
+    sw_move rigid = far_rigid(), actor = far_rigid(),
+            turning = {SW_MOVE_TURNING, {0.1, 1, 0.2}, 4 * PI / 180, {0.05, 0, 0.08}, 0, 0, 0},
+            small = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 0.01, 1, 1},
+            big = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, 100, 1, 1};
+    actor.kind = SW_MOVE_ACTOR;
+    actor.float_poses = actor.float_output = 1;
+    const struct {
+        const char *name;
+        const sw_move *m;
+    } cases[] = {{"rigid", &rigid},
+                 {"turning", &turning},
+                 {"far actor", &actor},
+                 {"scale 0.01", &small},
+                 {"scale 100", &big}};
+    for (int k = 0; k < 5; ++k) {
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 1};
+        sw_invariance_result res = {0};
+        ENSURE(sw_invariance_measure(f->blob, T, f->ch.skel.nbones, FOLD_STEPS, &run, cases[k].m,
+                                     &res) == SINEW_OK);
+        fprintf(stderr, "  novel, %s: %.3e of the size, %lld / %lld novel contacts\n",
+                cases[k].name, res.err, (long long)res.novel_contacts, (long long)res.novel_moved);
+        ENSURE_INVARIANT(res, cases[k].name);
+        ENSUREF(res.novel_contacts > 0 && res.novel_moved > 0,
+                "%s: novel contacts %lld and %lld: the fold found none", cases[k].name,
+                (long long)res.novel_contacts, (long long)res.novel_moved);
     }
 }
 
@@ -155,7 +216,7 @@ TEST(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the
     const sinew_step_mode modes[] = {SINEW_STEP_QUASISTATIC, SINEW_STEP_DYNAMIC};
     for (int b = 0; b < 2; ++b)
         for (int k = 0; k < 2; ++k) {
-            sw_invariance_run run = {modes[k], 0, w, wg, 1.0f / 30, budgets[b]};
+            sw_invariance_run run = {modes[k], 0, w, wg, 1.0f / 30, budgets[b], 0};
             sw_invariance_result res = measure(&run, &m);
             char what[64];
             snprintf(what, sizeof what, "world, %s, patch budget %u", k ? "dynamic" : "quasistatic",
@@ -297,7 +358,7 @@ TEST(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh) {
                  {"far actor", SINEW_STEP_QUASISTATIC, 0, &actor},
                  {"scale 0.01", SINEW_STEP_QUASISTATIC, 0, &scaled}};
     for (int k = 0; k < 5; ++k) {
-        sw_invariance_run run = {cases[k].mode, cases[k].sc, NULL, NULL, 0.01f, 0};
+        sw_invariance_run run = {cases[k].mode, cases[k].sc, NULL, NULL, 0.01f, 0, 0};
         sw_invariance_result res;
         ENSURE(sw_invariance_measure(e.blob, e.ch.clip.T, e.ch.skel.nbones, e.ch.clip.nframes, &run,
                                      cases[k].m, &res) == SINEW_OK);
@@ -318,6 +379,7 @@ SW_TEST_MAIN(
     CASE(dynamic_flesh_carried_by_a_constant_rigid_motion_is_the_same_motion),
     CASE(an_actor_far_from_the_origin_keeps_the_origins_shape_in_its_frame),
     CASE(a_uniformly_scaled_pose_gives_the_scaled_shape),
+    CASE(self_contact_nobody_trained_is_found_and_held_alike_wherever_the_finger_is),
     CASE(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the_moved_flesh),
     CASE(dt_zero_is_a_paused_frame),
     CASE(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it),

@@ -130,8 +130,58 @@ static void next_stamp(sw_novel *nv, int32_t nverts) {
     nv->stamp++;
 }
 
-/* This step's box of every cluster: the last output's grown by the bones' motion, or,
- * without one, the copies at q. */
+/* x (the step's frame) in bone 0's frame this step, nv->frame: R^T (x - t). Every box
+ * of the detection is taken there. A rigid motion of the whole pose carries bone 0 too,
+ * so it leaves these boxes, the sweep's order and every box test as they were (to
+ * rounding); boxes on the step's axes change shape with the heading, and with them
+ * which copies near the edge of another cluster's layer are tested at all. */
+static void to_frame(const double F[12], const double x[3], double y[3]) {
+    const double d[3] = {x[0] - F[9], x[1] - F[10], x[2] - F[11]};
+    for (int r = 0; r < 3; ++r)
+        y[r] = F[r] * d[0] + F[3 + r] * d[1] + F[6 + r] * d[2];
+}
+
+/* Where rigid motion D (12: R row-major, t) takes x, in bone 0's frame. */
+static void carry_to_frame(const double F[12], const double *D, const double x[3], double y[3]) {
+    double z[3];
+    for (int r = 0; r < 3; ++r)
+        z[r] = D[9 + r] + D[3 * r] * x[0] + D[3 * r + 1] * x[1] + D[3 * r + 2] * x[2];
+    to_frame(F, z, y);
+}
+
+/* Cluster c's box in bone 0's frame: its copies' last output positions carried by its
+ * dominant bone's motion, grown by how far the other bones move them apart from that
+ * (about their centroid: a ball, which no axis choice changes); returns that growth. */
+static double carried_box(const sw_novel *nv, const sw_world_contacts *wc, const sw_blob_view *v,
+                          int32_t c, double b[6]) {
+    const double *D0 = wc->bone_motion + 12 * wc->cl_bone0[c];
+    double ctr[3] = {0, 0, 0}, rho2 = 0;
+    const int32_t i0 = wc->cl_begin[c], i1 = wc->cl_begin[c + 1];
+    box_empty(b);
+    for (int32_t i = i0; i < i1; ++i) {
+        const double *xl = wc->copy_x + 3 * (int64_t)wc->cl_copy[i];
+        double y[3];
+        carry_to_frame(nv->frame, D0, xl, y);
+        box_add(b, y);
+        for (int k = 0; k < 3; ++k)
+            ctr[k] += xl[k];
+    }
+    for (int k = 0; k < 3; ++k)
+        ctr[k] /= (double)(i1 - i0);
+    for (int32_t i = i0; i < i1; ++i) {
+        const double *xl = wc->copy_x + 3 * (int64_t)wc->cl_copy[i];
+        double d2 = 0;
+        for (int k = 0; k < 3; ++k)
+            d2 += (xl[k] - ctr[k]) * (xl[k] - ctr[k]);
+        rho2 = fmax(rho2, d2);
+    }
+    const double g = sw_world_cluster_spread(wc, v, c, ctr, sqrt(rho2));
+    box_grow(b, g);
+    return g;
+}
+
+/* This step's box of every cluster in bone 0's frame: the last output's carried by the
+ * bones' motion, or, without one, the copies at q. */
 static void cluster_boxes(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *wc,
                           const sw_reduced *red, const double *q, const double *T,
                           const double *T_last) {
@@ -141,16 +191,21 @@ static void cluster_boxes(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts 
     for (int32_t c = 0; c < nv->ncl; ++c) {
         double *b = nv->cl_now + 6 * c;
         if (use_boxes) {
-            nv->cl_grow[c] = sw_world_cluster_box(wc, v, c, b);
+            nv->cl_grow[c] = carried_box(nv, wc, v, c, b);
             continue;
         }
         nv->cl_grow[c] = -1; /* no last output: the copies are mapped */
         box_empty(b);
-        for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i)
-            box_add(b, sw_self_contacts_map(sc, q, sw_blob_surf_copy_vertex(v, wc->cl_copy[i])));
+        for (int32_t i = wc->cl_begin[c]; i < wc->cl_begin[c + 1]; ++i) {
+            double y[3];
+            to_frame(nv->frame,
+                     sw_self_contacts_map(sc, q, sw_blob_surf_copy_vertex(v, wc->cl_copy[i])), y);
+            box_add(b, y);
+        }
         box_grow(b, wc->radius);
     }
-    /* insertion sort by the low x: the order of the last step is almost this one's */
+    /* insertion sort by the low x (of bone 0's frame): the order of the last step is
+     * almost this one's */
     for (int32_t a = 1; a < nv->ncl; ++a)
         for (int32_t j = a;
              j > 0 && nv->cl_now[6 * nv->order[j - 1]] > nv->cl_now[6 * nv->order[j]]; --j) {
@@ -191,24 +246,27 @@ static void narrow(sw_novel *nv, sw_self_contacts *sc, const sw_world_contacts *
         int32_t gv = sw_blob_surf_copy_vertex(v, wc->cl_copy[i]);
         if (nv->held[gv] == nv->stamp) continue;
         if (g >= 0) { /* where its last output and the bones' motion put it, before mapping */
-            const double *xl = wc->copy_x + 3 * (int64_t)wc->cl_copy[i];
+            double y[3];
+            carry_to_frame(nv->frame, D0, wc->copy_x + 3 * (int64_t)wc->cl_copy[i], y);
             int out = 0;
-            for (int r = 0; r < 3 && !out; ++r) {
-                double y =
-                    D0[9 + r] + D0[3 * r] * xl[0] + D0[3 * r + 1] * xl[1] + D0[3 * r + 2] * xl[2];
-                out = y < bb[r] - g || y > bb[3 + r] + g;
-            }
+            for (int r = 0; r < 3 && !out; ++r)
+                out = y[r] < bb[r] - g || y[r] > bb[3 + r] + g;
             if (out) continue;
         }
-        const double *x = sw_self_contacts_map(sc, q, gv);
+        double x[3];
+        to_frame(nv->frame, sw_self_contacts_map(sc, q, gv), x);
         if (!box_holds(bb, x)) continue;
         if (nv->cl_boxed[b] != nv->stamp) { /* the layer's tet boxes, once a step */
             for (int32_t k = 0; k < ln; ++k) {
-                double *tb = nv->layer_box + 6 * (int64_t)(lb + k);
+                double *tb = nv->layer_box + 6 * (int64_t)(lb + k), y[3];
                 box_empty(tb);
-                for (int c = 0; c < 4; ++c)
-                    box_add(tb, sw_self_contacts_map(
-                                    sc, q, v->tets[4 * (int64_t)nv->layer_tets[lb + k] + c]));
+                for (int c = 0; c < 4; ++c) {
+                    to_frame(nv->frame,
+                             sw_self_contacts_map(sc, q,
+                                                  v->tets[4 * (int64_t)nv->layer_tets[lb + k] + c]),
+                             y);
+                    box_add(tb, y);
+                }
             }
             nv->cl_boxed[b] = nv->stamp;
         }
@@ -233,6 +291,7 @@ int32_t sw_novel_detect(sw_novel *nv, sw_self_contacts *sc, sw_world_contacts *w
     next_stamp(nv, v->nverts);
     nv->nhits = nv->dropped = nv->cluster_pairs = 0;
     nv->tests = 0;
+    memcpy(nv->frame, T, sizeof nv->frame);  /* bone 0's pose: the boxes' frame */
     for (int32_t i = 0; i < ps->npairs; ++i) /* the vertices the trained pairs hold */
         nv->held[red->act_vert[red->contact_act[4 * (int64_t)ps->pairs[i]]]] = nv->stamp;
     cluster_boxes(nv, sc, wc, red, q, T, T_last);

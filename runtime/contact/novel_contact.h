@@ -4,8 +4,9 @@
  * together (a fist past its sweeps, a forelimb against the chest), nothing does. This
  * detection finds such contact at a cost that follows what is near, not the mesh:
  *  - broad: the output surface's clusters (world_contact.h, median splits of each
- *    domain's surface copies) with their boxes from the last step's output grown by the
- *    bones' motion since; a sweep along x over those boxes gives the pairs of clusters of
+ *    domain's surface copies) with their boxes from the last step's output carried by the
+ *    bones' motion since, taken in bone 0's frame (so that no heading changes them); a
+ *    sweep along that frame's x over those boxes gives the pairs of clusters of
  *    different domains that overlap. Clusters that are neighbours in the rest pose (their
  *    rest boxes within the reach of the reference's neighbour rule: one stretch of skin
  *    across a joint) overlap whenever the joint bends; the skin folding there is the
@@ -34,6 +35,7 @@
 
 typedef struct sw_novel {
     int32_t ncl;         /* the surface clusters (those of wc) */
+    double frame[12];    /* bone 0's pose this step: the frame the boxes are taken in */
     int32_t *cl_dom;     /* ncl: each cluster's domain */
     double *cl_now;      /* 6 ncl: this step's broad-phase boxes */
     double *cl_grow;     /* ncl: their growth past the carried last output (-1: mapped) */

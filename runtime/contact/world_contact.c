@@ -297,23 +297,30 @@ static double motion_apart(const double *A, const double *B, const double c[3], 
  * move its points apart from that, and by the detection radius. Carried, not grown by
  * the whole motion: a character running or turning moves every box far in a step, while
  * its bones move little relative to each other. */
-double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
-                            double box[6]) {
-    const double *b = wc->cl_box + 6 * c, *D0 = wc->bone_motion + 12 * wc->cl_bone0[c];
-    double ctr[3], half[3], rho = 0, grow = 0;
-    for (int k = 0; k < 3; ++k) {
-        ctr[k] = 0.5 * (b[k] + b[3 + k]);
-        half[k] = 0.5 * (b[3 + k] - b[k]);
-        rho += half[k] * half[k];
-    }
-    rho = sqrt(rho);
+double sw_world_cluster_spread(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                               const double ctr[3], double rho) {
+    const double *D0 = wc->bone_motion + 12 * wc->cl_bone0[c];
+    double grow = 0;
     for (int32_t bone = 0; bone < v->nbones; ++bone)
         if (wc->cl_bones[c] >> (bone < 64 ? bone : 63) & 1)
             grow = sw_max(grow, motion_apart(D0, wc->bone_motion + 12 * bone, ctr, rho));
     /* a dual-quaternion blend of bone motions lands a point about no further from the
      * dominant bone's than the furthest of them; 1.25 x leaves room for the blend and the
      * correction's change */
-    grow = 1.25 * grow + wc->radius;
+    return 1.25 * grow + wc->radius;
+}
+
+double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                            double box[6]) {
+    const double *b = wc->cl_box + 6 * c, *D0 = wc->bone_motion + 12 * wc->cl_bone0[c];
+    double ctr[3], half[3], rho = 0;
+    for (int k = 0; k < 3; ++k) {
+        ctr[k] = 0.5 * (b[k] + b[3 + k]);
+        half[k] = 0.5 * (b[3 + k] - b[k]);
+        rho += half[k] * half[k];
+    }
+    rho = sqrt(rho);
+    const double grow = sw_world_cluster_spread(wc, v, c, ctr, rho);
     for (int r = 0; r < 3; ++r) { /* the box of the carried box */
         double cr = D0[9 + r], hr = 0;
         for (int k = 0; k < 3; ++k) {

@@ -122,6 +122,10 @@ void sw_world_clusters_motion(sw_world_contacts *wc, int32_t nbones, const doubl
                               const double *T0);
 double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
                             double box[6]);
+/* That growth alone, for cluster c's points within rho of ctr at the last output (world
+ * units; a ball, so the growth does not depend on the axes the box is taken on). */
+double sw_world_cluster_spread(const sw_world_contacts *wc, const sw_blob_view *v, int32_t c,
+                               const double ctr[3], double rho);
 
 /* Takes the cluster boxes from the copies' output positions wc->copy_x. */
 void sw_world_contacts_update_boxes(sw_world_contacts *wc);

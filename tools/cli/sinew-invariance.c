@@ -3,10 +3,12 @@
  *
  *   sinew-invariance (FILE.glb [--tets N] ... | --scene NAME [--tets N] [--frames F] |
  *                     --mesh ... as sinew-bake) --blob FILE [--frames-max K] [--seed S]
- *                    [--reach D] [--angle A] [--world FILE] [--json]
+ *                    [--reach D] [--angle A] [--world FILE] [--fold S] [--novel-contact]
+ *                    [--json]
  *
  * Plays the character's clip (and a glTF/FBX FILE's held-out clips after it, at most K
- * frames in all, default 120) in two instances of the blob, the second carried by a
+ * frames in all, default 120; with --fold S then 16 frames bending the joints of its most
+ * bent frame on to S times as far) in two instances of the blob, the second carried by a
  * motion of the whole pose, and prints for each case the largest distance of an output
  * vertex from where it should be, as a share of the character's size:
  *   rigid_<mode>     quasistatic, one random rigid motion (any axis, up to 180 degrees,
@@ -21,6 +23,10 @@
  * motion of the same turn moved by at most 10 units: float collider placements):
  *   world_quasistatic, world_dynamic, world_patch  quasistatic, dynamic, and quasistatic
  *                    with condensation patches (a budget of a quarter of the vertices)
+ * With --novel-contact every case runs with sinew_instance_def.novel_contact on (the
+ * pose-pairs and exhaustive cases, which refuse it, are left out), and each line counts
+ * the novel contacts both instances found: a case where neither found any says nothing
+ * about the novel path.
  * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <math.h>
 #include <stdio.h>
@@ -37,8 +43,8 @@ static const char *const TOOL = "sinew-invariance";
 
 typedef struct {
     const char *blob_path, *world_path;
-    int kmax, seed, json;
-    double far, angle;
+    int kmax, seed, json, novel;
+    double far, angle, fold;
 } options;
 
 static const char *const SYNOPSIS =
@@ -46,7 +52,8 @@ static const char *const SYNOPSIS =
     "                         --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
     "                         --mesh FILE --skeleton FILE.tgf [--weights FILE.dmat]\n"
     "                         [--clip FILE [--frames F]])\n"
-    "                        --blob FILE [--frames-max K] [--seed S] [--json]\n";
+    "                        --blob FILE [--frames-max K] [--seed S] [--novel-contact]\n"
+    "                        [--json]\n";
 
 static int parse_args(int argc, char **argv, sw_character_args *ca, options *o) {
     *o = (options){.kmax = 120, .seed = 1, .far = 1e5, .angle = -1};
@@ -65,6 +72,14 @@ static int parse_args(int argc, char **argv, sw_character_args *ca, options *o) 
         {SW_STR("--world", &o->world_path, "FILE",
                 "also with this world file's colliders (at frame 0), carried\n"
                 "by the motion: world_quasistatic, world_dynamic, world_patch")},
+        {SW_REAL("--fold", &o->fold, 1, 4.0000001, "in 1 < S <= 4", "S",
+                 "after the clip, 16 frames bending the joints of its most\n"
+                 "bent frame on to S times as far (at most 170 degrees a\n"
+                 "joint): self-contact past the training (default: none)")},
+        {SW_SET("--novel-contact", &o->novel, 1,
+                "every case with novel self-contact detection on\n"
+                "(sinew_instance_def.novel_contact; the pose-pairs and\n"
+                "exhaustive cases are left out)")},
         {SW_SET("--json", &o->json, 1, "the figures as one JSON object on the last line")},
     };
     sw_flag character[SW_CHARACTER_NFLAGS];
@@ -132,19 +147,101 @@ static int load_worlds(const char *path, const sw_move *m, sinew_world **w, sine
     return ok;
 }
 
+enum { FOLD_FRAMES = 16 };
+
+/* The rotation angle of R (row-major) and its unit axis (any when the angle is 0). */
+static double rotation_angle(const double R[9], double k[3]) {
+    k[0] = R[7] - R[5], k[1] = R[2] - R[6], k[2] = R[3] - R[1];
+    double s = sqrt(k[0] * k[0] + k[1] * k[1] + k[2] * k[2]);
+    double a = atan2(0.5 * s, 0.5 * (R[0] + R[4] + R[8] - 1));
+    for (int i = 0; i < 3; ++i)
+        k[i] = s > 0 ? k[i] / s : (i == 2);
+    return a;
+}
+
+/* Bone b of frame T bent `by` times as far at its head joint, its parent already in out
+ * (done[] marks the bones written): out_b = out_p (h + L^by (x - h)), L the joint's
+ * rotation (R_p^T R_b), h the head joint's rest position; a root stays as it is. */
+static void fold_bone(const sw_skeleton *sk, const double *T, double by, int32_t b, char *done,
+                      double *out) {
+    if (done[b]) return;
+    const double *Tb = T + 12 * b;
+    double *o = out + 12 * b;
+    int32_t p = sk->parent[b];
+    done[b] = 1;
+    if (p < 0) {
+        memcpy(o, Tb, 12 * sizeof(double));
+        return;
+    }
+    fold_bone(sk, T, by, p, done, out);
+    const double *Tp = T + 12 * p, *h = sk->joints + 3 * sk->bones[2 * b];
+    double L[9], k[3], R[9];
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            L[3 * i + j] = Tp[i] * Tb[j] + Tp[3 + i] * Tb[3 + j] + Tp[6 + i] * Tb[6 + j];
+    double a = fmin(by * rotation_angle(L, k), 170 * 3.141592653589793 / 180);
+    double c = cos(a), s = sin(a), C = 1 - c, u[3];
+    double M[9] = {
+        c + k[0] * k[0] * C,        k[0] * k[1] * C - k[2] * s, k[0] * k[2] * C + k[1] * s,
+        k[1] * k[0] * C + k[2] * s, c + k[1] * k[1] * C,        k[1] * k[2] * C - k[0] * s,
+        k[2] * k[0] * C - k[1] * s, k[2] * k[1] * C + k[0] * s, c + k[2] * k[2] * C};
+    for (int i = 0; i < 3; ++i) /* the bent joint's map: M x + u, u = h - M h */
+        u[i] = h[i] - (M[3 * i] * h[0] + M[3 * i + 1] * h[1] + M[3 * i + 2] * h[2]);
+    const double *Op = out + 12 * p;
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+            R[3 * i + j] = Op[3 * i] * M[j] + Op[3 * i + 1] * M[3 + j] + Op[3 * i + 2] * M[6 + j];
+        o[9 + i] = Op[9 + i] + Op[3 * i] * u[0] + Op[3 * i + 1] * u[1] + Op[3 * i + 2] * u[2];
+    }
+    memcpy(o, R, sizeof R);
+}
+
+/* FOLD_FRAMES frames after frame n - 1 of T taking the most bent of the n frames (the
+ * largest sum of joint angles) from once to `by` times its bends (at most 170 degrees a
+ * joint): past any training, into self-contact the bake never saw. */
+static void fold_frames(const sw_skeleton *sk, double *T, int32_t n, double by) {
+    int32_t nb = sk->nbones, most = 0;
+    size_t per = (size_t)12 * nb;
+    double best = -1;
+    for (int32_t f = 0; f < n; ++f) {
+        double sum = 0, k[3], L[9];
+        for (int32_t b = 0; b < nb; ++b) {
+            const double *Tb = T + per * f + 12 * b, *Tp = T + per * f + 12 * sk->parent[b];
+            if (sk->parent[b] < 0) continue;
+            for (int i = 0; i < 3; ++i)
+                for (int j = 0; j < 3; ++j)
+                    L[3 * i + j] = Tp[i] * Tb[j] + Tp[3 + i] * Tb[3 + j] + Tp[6 + i] * Tb[6 + j];
+            sum += rotation_angle(L, k);
+        }
+        if (sum > best) best = sum, most = f;
+    }
+    char *done = calloc((size_t)nb, 1);
+    for (int32_t s = 1; done && s <= FOLD_FRAMES; ++s) {
+        memset(done, 0, (size_t)nb);
+        for (int32_t b = 0; b < nb; ++b)
+            fold_bone(sk, T + per * most, 1 + (by - 1) * s / FOLD_FRAMES, b, done,
+                      T + per * (n + s - 1));
+    }
+    free(done);
+}
+
 /* The clip the runs play: the character's, then a FILE's held-out clips, at most kmax
- * frames (malloc'd, *frames set). */
-static double *play_clip(const sw_character *ch, const sw_clip_split *clips, int kmax,
+ * frames, then the fold (fold > 1: FOLD_FRAMES more) (malloc'd, *frames set). */
+static double *play_clip(const sw_character *ch, const sw_clip_split *clips, int kmax, double fold,
                          int32_t *frames) {
     int32_t nb = ch->skel.nbones, n = 0;
     size_t per = (size_t)12 * nb;
-    double *T = malloc((size_t)kmax * per * sizeof(double));
+    double *T = malloc(((size_t)kmax + FOLD_FRAMES) * per * sizeof(double));
     if (!T) return NULL;
     for (int32_t f = 0; f < ch->clip.nframes && n < kmax; ++f)
         memcpy(T + per * n++, ch->clip.T + per * f, per * sizeof(double));
     for (int32_t c = 0; clips && c < clips->nheldout; ++c)
         for (int32_t f = 0; f < clips->heldout[c].nframes && n < kmax; ++f)
             memcpy(T + per * n++, clips->heldout[c].T + per * f, per * sizeof(double));
+    if (fold > 1 && n > 0) {
+        fold_frames(&ch->skel, T, n, fold);
+        n += FOLD_FRAMES;
+    }
     *frames = n;
     return T;
 }
@@ -165,7 +262,7 @@ int main(int argc, char **argv) {
     sinew_blob *blob = NULL;
     if (sw_tool_blob_load(TOOL, o.blob_path, bd, &blob) != SINEW_OK) return 1;
     int32_t frames = 0, nb = ch.skel.nbones;
-    double *clip = play_clip(&ch, &clips, o.kmax, &frames);
+    double *clip = play_clip(&ch, &clips, o.kmax, o.fold, &frames);
     if (!clip || frames < 1) {
         fprintf(stderr, "%s: the character has no clip to play\n", TOOL);
         return 1;
@@ -214,30 +311,42 @@ int main(int argc, char **argv) {
     row rows[NCASES];
     double worst = 0;
     long failed = 0;
-    int ncases = world ? NCASES : NCASES - 3;
+    int ncases = world ? NCASES : NCASES - 3, nrows = 0;
+    int64_t novel_least = -1; /* the fewest novel contacts either instance of a case found */
     for (int c = 0; c < ncases; ++c) {
-        sw_invariance_run run = {cases[c].mode, cases[c].sc, cases[c].w,
-                                 cases[c].wm,   dt,          cases[c].patch};
-        rows[c].name = cases[c].name;
-        r = sw_invariance_measure(blob, clip, nb, frames, &run, cases[c].m, &rows[c].res);
+        if (o.novel && cases[c].sc != 0 && cases[c].sc != SINEW_SELF_CONTACT_POSE_SPACE)
+            continue; /* novel contact adds to pose-space self-contact alone */
+        sw_invariance_run run = {cases[c].mode,  cases[c].sc,      cases[c].w, cases[c].wm, dt,
+                                 cases[c].patch, (uint32_t)o.novel};
+        row *w = &rows[nrows++];
+        w->name = cases[c].name;
+        r = sw_invariance_measure(blob, clip, nb, frames, &run, cases[c].m, &w->res);
         if (r != SINEW_OK) {
             fprintf(stderr, "%s: case %s failed: %s\n", TOOL, cases[c].name,
                     sinew_result_string(r));
             return 1;
         }
-        worst = fmax(worst, rows[c].res.err);
-        failed += rows[c].res.failed;
+        worst = fmax(worst, w->res.err);
+        failed += w->res.failed;
         fprintf(stderr,
                 "%s: %-18s %.3e of the size (frame %d of %d), %d failed steps, %d short of "
-                "tolerance, %lld world contacts, largest patch %u\n",
-                TOOL, cases[c].name, rows[c].res.err, rows[c].res.worst_frame, frames,
-                rows[c].res.failed, rows[c].res.unconverged, (long long)rows[c].res.world_contacts,
-                rows[c].res.patch_vertices);
+                "tolerance, %lld world contacts, largest patch %u",
+                TOOL, w->name, w->res.err, w->res.worst_frame, frames, w->res.failed,
+                w->res.unconverged, (long long)w->res.world_contacts, w->res.patch_vertices);
+        if (o.novel) {
+            fprintf(stderr, ", novel contacts %lld / %lld", (long long)w->res.novel_contacts,
+                    (long long)w->res.novel_moved);
+            int64_t least = w->res.novel_contacts < w->res.novel_moved ? w->res.novel_contacts
+                                                                       : w->res.novel_moved;
+            if (novel_least < 0 || least < novel_least) novel_least = least;
+        }
+        fprintf(stderr, "\n");
     }
     if (o.json) {
         printf("{\"frames\":%d,\"size\":%.9g,\"worst\":%.4e,\"failed_steps\":%ld", frames,
                rows[0].res.size, worst, failed);
-        for (int c = 0; c < ncases; ++c)
+        if (o.novel) printf(",\"novel_contacts_least\":%lld", (long long)novel_least);
+        for (int c = 0; c < nrows; ++c)
             printf(",\"%s\":%.4e", rows[c].name, rows[c].res.err);
         printf("}\n");
     }

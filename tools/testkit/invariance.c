@@ -111,6 +111,7 @@ static sinew_result make_instance(const sinew_blob *blob, const sw_invariance_ru
     d.mode = run->mode;
     if (run->self_contact) d.self_contact = run->self_contact;
     d.max_patch_vertices = run->max_patch_vertices;
+    d.novel_contact = run->novel_contact;
     sinew_result r = sinew_instance_create(blob, &d, out);
     if (r == SINEW_OK && world) r = sinew_instance_set_world(*out, world);
     return r;
@@ -186,8 +187,12 @@ sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, i
         sinew_instance_get_stats(a, &st);
         out->world_contacts += st.world_contacts;
         out->self_contacts += st.self_contacts;
+        out->novel_contacts += st.novel_contacts;
         if (st.patch_vertices > out->patch_vertices) out->patch_vertices = st.patch_vertices;
         out->unconverged += !(st.status & SINEW_STEP_CONVERGED);
+        sinew_step_stats sb = {.struct_size = sizeof sb};
+        sinew_instance_get_stats(b, &sb);
+        out->novel_moved += sb.novel_contacts;
         read_surface(a, ns, m->float_output, fs, xa);
         read_surface(b, ns, m->float_output, fs, xb);
         double worst = 0;

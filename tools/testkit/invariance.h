@@ -45,6 +45,7 @@ typedef struct sw_invariance_run {
     const sinew_world *world_moved;  /* the second's: the same colliders carried by G */
     float dt;                        /* the step (0: 1/30 s) */
     uint32_t max_patch_vertices;     /* condensation's budget (0: off) */
+    uint32_t novel_contact;          /* sinew_instance_def.novel_contact (0: off) */
 } sw_invariance_run;
 
 typedef struct sw_invariance_result {
@@ -54,6 +55,8 @@ typedef struct sw_invariance_result {
     int32_t failed;          /* steps that did not return SINEW_OK (either instance) */
     int64_t world_contacts;  /* the first instance's, summed over the frames */
     int64_t self_contacts;   /* the same of its self-contact pairs */
+    int64_t novel_contacts;  /* the same of its novel contacts (novel_contact on) */
+    int64_t novel_moved;     /* the second instance's novel contacts, summed */
     uint32_t patch_vertices; /* its largest condensation patch */
     int32_t unconverged;     /* its steps that ended short of the solve's tolerance */
 } sw_invariance_result;
