@@ -142,6 +142,16 @@ SINEW_API sinew_result sinew_world_remove_collider(sinew_world *world, sinew_col
 SINEW_API sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collider_id id,
                                                           const sinew_transform *transform);
 
+/** Moves the vertices of mesh collider `id` (`vertex_count` xyz triples; vertex_count must
+ * equal its count at creation; the triangles stay), e.g. another character's surface after
+ * its step, and refits its BVH and pseudonormals. In the collider's frame. Non-finite
+ * input is refused (NOT_FINITE) and the old vertices kept; a wrong count, a collider that
+ * is not a mesh or a stale id is INVALID_ARGUMENT. A triangle the motion collapsed to zero
+ * area is not an error (queries skip it until it opens again). Same thread contract as
+ * sinew_world_set_collider_transform: never while an instance using the world steps. */
+SINEW_API sinew_result sinew_world_set_mesh_vertices(sinew_world *world, sinew_collider_id id,
+                                                     const float *xyz, uint32_t vertex_count);
+
 /** Live colliders in the world. Any thread, while no change runs. */
 SINEW_API uint32_t sinew_world_collider_count(const sinew_world *world);
 
