@@ -161,6 +161,12 @@ SINEW_API uint32_t sinew_world_collider_count(const sinew_world *world);
  * thread of the instance; never while it steps. */
 SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sinew_world *world);
 
+/** The instance ignores collider `id` from its next step on (its own surface in the
+ * world, for contact between characters: sinew_world_set_mesh_vertices); 0 clears it.
+ * One collider at a time; the id is kept across sinew_instance_set_world. An id that is
+ * not live in the attached world is INVALID_ARGUMENT. Owner thread, never while it steps. */
+SINEW_API sinew_result sinew_instance_ignore_collider(sinew_instance *inst, sinew_collider_id id);
+
 /** The total force and the torque about the collider's origin (its transform's position)
  * that the instance's flesh exerted on collider `id` in its last step, in world units.
  * Zero for a collider it did not touch. Owner thread of the instance, after its step. */
