@@ -124,10 +124,10 @@ TEST(a_moved_mesh_is_queried_where_it_is_now) {
 }
 
 /* Every query of a grid of points around [lo, hi] answers the same bits in both worlds'
- * first colliders. */
-static int same_queries(const sinew_world *a, const sinew_world *b, const float lo[3],
-                        const float hi[3], int *hits) {
-    const sw_collider *ca = sw_world_slot(a, 0), *cb = sw_world_slot(b, 0);
+ * colliders in `slot`. */
+static int same_queries(const sinew_world *a, const sinew_world *b, uint32_t slot,
+                        const float lo[3], const float hi[3], int *hits) {
+    const sw_collider *ca = sw_world_slot(a, slot), *cb = sw_world_slot(b, slot);
     *hits = 0;
     for (int i = 0; i <= 12; ++i)
         for (int j = 0; j <= 12; ++j)
@@ -153,23 +153,95 @@ static int same_queries(const sinew_world *a, const sinew_world *b, const float 
     return 1;
 }
 
+/* An icosphere of radius 1 at the origin, subdivided twice (162 vertices, 320 triangles,
+ * counter-clockwise seen from outside): enough triangles for Embree's BVH to have inner
+ * nodes, so a stale tree would cull where the mesh is now. */
+enum { ICO_V = 162, ICO_T = 320 };
+
+static uint32_t ico_mid(float *v, uint32_t *nv, uint32_t a, uint32_t b) {
+    float m[3];
+    double r = 0;
+    for (int k = 0; k < 3; ++k) {
+        m[k] = 0.5f * (v[3 * a + k] + v[3 * b + k]);
+        r += (double)m[k] * m[k];
+    }
+    for (int k = 0; k < 3; ++k)
+        m[k] = (float)(m[k] / sqrt(r));
+    for (uint32_t i = 0; i < *nv && i < ICO_V; ++i)
+        if (v[3 * i] == m[0] && v[3 * i + 1] == m[1] && v[3 * i + 2] == m[2]) return i;
+    if (*nv >= ICO_V) { /* more than an icosphere has: icosphere() reports it */
+        *nv = ICO_V + 1;
+        return 0;
+    }
+    memcpy(v + 3 * *nv, m, sizeof m);
+    return (*nv)++;
+}
+
+static uint32_t icosphere(float v[3 * ICO_V], uint32_t t[3 * ICO_T]) {
+    static const uint32_t t0[60] = {0, 11, 5, 0, 5,  1,  0,  1,  7,  0,  7, 10, 0, 10, 11,
+                                    1, 5,  9, 5, 11, 4,  11, 10, 2,  10, 7, 6,  7, 1,  8,
+                                    3, 9,  4, 3, 4,  2,  3,  2,  6,  3,  6, 8,  3, 8,  9,
+                                    4, 9,  5, 2, 4,  11, 6,  2,  10, 8,  6, 7,  9, 8,  1};
+    const float p = 1.6180339887f, s = 1 / sqrtf(1 + p * p), q = p * s;
+    const float c[36] = {-s, q,  0,  s, q, 0,  -s, -q, 0,  s, -q, 0, 0,  -s, q,  0,  s, q,
+                         0,  -s, -q, 0, s, -q, q,  0,  -s, q, 0,  s, -q, 0,  -s, -q, 0, s};
+    uint32_t nv = 12, nt = 20, tmp[3 * ICO_T];
+    memcpy(v, c, sizeof c);
+    memcpy(t, t0, sizeof t0);
+    for (int level = 0; level < 2; ++level) {
+        uint32_t n = 0;
+        for (uint32_t i = 0; i < nt; ++i) {
+            uint32_t a = t[3 * i], b = t[3 * i + 1], d = t[3 * i + 2];
+            uint32_t ab = ico_mid(v, &nv, a, b), bd = ico_mid(v, &nv, b, d),
+                     da = ico_mid(v, &nv, d, a);
+            uint32_t f[12] = {a, ab, da, b, bd, ab, d, da, bd, ab, bd, da};
+            memcpy(tmp + 3 * n, f, sizeof f);
+            n += 4;
+        }
+        nt = n;
+        memcpy(t, tmp, sizeof(uint32_t) * 3 * nt);
+    }
+    return nv == ICO_V && nt == ICO_T ? nv : 0;
+}
+
 TEST(a_moved_mesh_answers_as_one_added_there) {
     const bake_fixture *f = fixture();
     ENSURE(f);
     int nb = f->ch.skel.nbones;
     float v0[24], v[24];
-    static const float ulo[3] = {-1, -1, -1}, uhi[3] = {1, 1, 1};
-    box_vertices(ulo, uhi, v0); /* a unit box at the origin, then the sheared table */
     table_vertices(0, v);
+    for (int j = 0; j < 8; ++j) { /* added turned a quarter about z: every normal differs */
+        v0[3 * j] = -v[3 * j + 1];
+        v0[3 * j + 1] = v[3 * j];
+        v0[3 * j + 2] = v[3 * j + 2];
+    }
     sinew_world *moved = new_world(), *fresh = new_world();
     ENSURE(moved && fresh);
-    sinew_collider_id a, b;
+    sinew_collider_id a, b, sa, sb;
     ENSURE(add_mesh(moved, v0, 8, box_tris, 12, &a) && add_mesh(fresh, v, 8, box_tris, 12, &b));
+    /* an icosphere far away, then squashed into an ellipsoid beside the table, turned */
+    static float s0[3 * ICO_V], s1[3 * ICO_V];
+    static uint32_t st[3 * ICO_T];
+    ENSURE(icosphere(s0, st) == ICO_V);
+    for (int j = 0; j < ICO_V; ++j) {
+        float x = s0[3 * j], y = s0[3 * j + 1], z = s0[3 * j + 2];
+        s1[3 * j] = 6 + 1.5f * (0.8f * x - 0.6f * y);
+        s1[3 * j + 1] = 0.5f * (0.6f * x + 0.8f * y);
+        s1[3 * j + 2] = z;
+        s0[3 * j] = x - 20;
+    }
+    ENSURE(add_mesh(moved, s0, ICO_V, st, ICO_T, &sa) &&
+           add_mesh(fresh, s1, ICO_V, st, ICO_T, &sb));
     ENSURE(sinew_world_set_mesh_vertices(moved, a, v, 8) == SINEW_OK);
+    ENSURE(sinew_world_set_mesh_vertices(moved, sa, s1, ICO_V) == SINEW_OK);
     static const float tlo[3] = {-0.7f, -0.9f, -1.1f}, thi[3] = {4.3f, 0, 1.1f};
-    int hits;
-    ENSURE(same_queries(moved, fresh, tlo, thi, &hits));
-    ENSURE(hits > 100);
+    static const float slo[3] = {4.5f, -0.5f, -1}, shi[3] = {7.5f, 0.5f, 1};
+    int hits, shits;
+    ENSURE(same_queries(moved, fresh, 0, tlo, thi, &hits));
+    ENSURE(same_queries(moved, fresh, 1, slo, shi, &shits));
+    fprintf(stderr, "    %d and %d of 2197 grid points hit the box and the ellipsoid\n", hits,
+            shits);
+    ENSURE(hits > 100 && shits > 100);
     /* collapsed: corner 7 onto corner 6 leaves triangles of zero area (skipped, no error);
        then open again, the same as fresh */
     float c[24];
@@ -186,7 +258,7 @@ TEST(a_moved_mesh_answers_as_one_added_there) {
     }
     ENSURE(finite);
     ENSURE(sinew_world_set_mesh_vertices(moved, a, v, 8) == SINEW_OK);
-    ENSURE(same_queries(moved, fresh, tlo, thi, &hits));
+    ENSURE(same_queries(moved, fresh, 0, tlo, thi, &hits));
     /* and the steps against them: the same surface and force, bit for bit */
     sinew_instance *ia, *ib;
     ENSURE(sinew_instance_create(f->blob, NULL, &ia) == SINEW_OK);
