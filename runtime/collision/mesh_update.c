@@ -95,14 +95,17 @@ void sw_mesh_feature_normals(sw_mesh *m) {
 }
 
 /* The new vertices into Embree's own buffer, and the BVH refitted: the first move
- * switches the geometry from the add's high-quality build to refitting (the triangles
- * stay, so the tree's topology stays valid; queries cull with it and pick the closest
- * triangle exactly, so its quality changes their cost, never their answer). */
+ * switches the scene from the add's high-quality build to a dynamic one whose geometry
+ * refits (the triangles stay, so the tree's topology stays valid; docs/notes/world.md
+ * has the costs). Queries cull with the tree and pick the closest triangle exactly, so
+ * its quality changes their cost, never their answer. */
 static sinew_result refit(sinew_world *w, sw_mesh *m) {
     rtcGetDeviceError(w->device); /* clear an earlier error */
     for (size_t i = 0; i < (size_t)3 * m->nverts; ++i)
         m->vb[i] = (float)m->X[i];
     if (!m->refits) {
+        rtcSetSceneFlags(m->scene, RTC_SCENE_FLAG_DYNAMIC);
+        rtcSetSceneBuildQuality(m->scene, RTC_BUILD_QUALITY_LOW);
         rtcSetGeometryBuildQuality(m->geom, RTC_BUILD_QUALITY_REFIT);
         m->refits = 1;
     }
