@@ -5,6 +5,7 @@
  * push each other apart; the steps with deforming meshes allocate and lock nothing; the
  * error paths keep the old vertices. */
 #include <math.h>
+#include <pthread.h>
 #include <stdint.h>
 #include <time.h>
 
@@ -457,8 +458,90 @@ TEST(two_fingers_push_each_other_apart) {
     free(pose);
 }
 
+/* One finger's step of a frame (set_pose, step), on whichever thread runs it. */
+typedef struct step_job {
+    sinew_instance *inst;
+    const float *pose;
+    uint32_t nb;
+    sinew_result r;
+} step_job;
+
+static void *step_job_run(void *p) {
+    step_job *j = p;
+    j->r = sinew_instance_set_pose(j->inst, j->pose, j->nb);
+    if (j->r == SINEW_OK) j->r = sinew_instance_step(j->inst, 1.0f / 30);
+    return NULL;
+}
+
+/* The two fingers' frame loop (as above, 8 frames) with the steps of each frame run A then
+ * B (order 0), B then A (1) or on two threads at once (2); the last surfaces into out. */
+static int run_fingers(const bake_fixture *f, int order, float *out[2]) {
+    uint32_t nb = (uint32_t)f->ch.skel.nbones, ns = sinew_blob_surface_vertex_count(f->blob),
+             nt = sinew_blob_surface_triangle_count(f->blob);
+    uint32_t *tris = malloc(sizeof(uint32_t) * 3 * nt);
+    float *pose[2] = {malloc(sizeof(float) * 12 * nb), malloc(sizeof(float) * 12 * nb)};
+    sinew_world *w = new_world();
+    sinew_instance *in[2] = {NULL, NULL};
+    sinew_collider_id id[2];
+    int ok = tris && pose[0] && pose[1] && w &&
+             sinew_blob_surface_triangles(f->blob, tris, 3 * nt) == SINEW_OK;
+    for (int i = 0; i < 2 && ok; ++i) {
+        moved_rest_pose((int)nb, 0, i ? 1.2f : 0, pose[i]);
+        ok = sinew_instance_create(f->blob, NULL, &in[i]) == SINEW_OK &&
+             sinew_instance_set_pose(in[i], pose[i], nb) == SINEW_OK &&
+             sinew_instance_step(in[i], 1.0f / 30) == SINEW_OK &&
+             sinew_instance_read_surface(in[i], out[i], NULL, ns) == SINEW_OK &&
+             add_mesh(w, out[i], ns, tris, nt, &id[i]);
+    }
+    for (int i = 0; i < 2 && ok; ++i)
+        ok = sinew_instance_set_world(in[i], w) == SINEW_OK &&
+             sinew_instance_ignore_collider(in[i], id[i]) == SINEW_OK;
+    for (int s = 0; s < 8 && ok; ++s) {
+        moved_rest_pose((int)nb, 0, 1.2f - 0.06f * (float)s, pose[1]);
+        step_job job[2] = {{in[0], pose[0], nb, SINEW_OK}, {in[1], pose[1], nb, SINEW_OK}};
+        if (order == 2) {
+            pthread_t t;
+            ok = pthread_create(&t, NULL, step_job_run, &job[1]) == 0;
+            step_job_run(&job[0]);
+            if (ok) pthread_join(t, NULL);
+        } else {
+            step_job_run(&job[order]);
+            step_job_run(&job[1 - order]);
+        }
+        ok = ok && job[0].r == SINEW_OK && job[1].r == SINEW_OK;
+        for (int i = 0; i < 2 && ok; ++i)
+            ok = sinew_instance_read_surface(in[i], out[i], NULL, ns) == SINEW_OK &&
+                 sinew_world_set_mesh_vertices(w, id[i], out[i], ns) == SINEW_OK;
+    }
+    for (int i = 0; i < 2; ++i) {
+        sinew_instance_destroy(in[i]);
+        free(pose[i]);
+    }
+    sinew_world_destroy(w);
+    free(tris);
+    return ok;
+}
+
+/* The world is read-only during the steps and holds the last frame's surfaces: the order
+ * and the threads of a frame's steps do not change a bit. */
+TEST(two_fingers_are_the_same_whatever_the_step_order) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    size_t n = 3 * (size_t)sinew_blob_surface_vertex_count(f->blob);
+    float *x = malloc(sizeof(float) * 4 * n);
+    ENSURE(x);
+    for (int order = 0; order < 3; ++order) {
+        float *out[2] = {x + 2 * n * (order > 0), x + 2 * n * (order > 0) + n};
+        ENSURE(run_fingers(f, order, out));
+        if (order > 0) ENSURE(memcmp(x, out[0], sizeof(float) * 2 * n) == 0);
+    }
+    free(x);
+}
+
 SW_TEST_MAIN({"a_moved_mesh_is_queried_where_it_is_now", a_moved_mesh_is_queried_where_it_is_now},
              {"a_moved_mesh_answers_as_one_added_there", a_moved_mesh_answers_as_one_added_there},
              {"an_ignored_collider_gives_no_contact", an_ignored_collider_gives_no_contact},
              {"errors_keep_the_old_vertices", errors_keep_the_old_vertices},
-             {"two_fingers_push_each_other_apart", two_fingers_push_each_other_apart})
+             {"two_fingers_push_each_other_apart", two_fingers_push_each_other_apart},
+             {"two_fingers_are_the_same_whatever_the_step_order",
+              two_fingers_are_the_same_whatever_the_step_order})
