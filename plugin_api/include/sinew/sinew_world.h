@@ -3,15 +3,17 @@
  * MPR (hulls), each with a rigid transform the host may move every frame.
  *
  * Thread-safety contract (in the manner of Embree's "never commit while queries run"):
- *  - A world is built and changed (create, add, remove, set_transform, destroy) by one
- *    thread at a time, and never while an instance that uses it is stepping.
+ *  - A world is built and changed (create, add, remove, set_transform, set_mesh_vertices,
+ *    destroy) by one thread at a time, and never while an instance that uses it is
+ *    stepping.
  *  - While no such change runs, any number of instances on any number of threads step
  *    against one world at once: a step only reads it (no allocation, no lock, no commit).
  *  - The contact forces an instance exerted are the instance's own (read them from the
  *    instance's owner thread after its step).
  *
  * Colliders live in their own frame: the host moves them by their transform, which never
- * rebuilds anything. Units are the character's: lengths in its units, stiffness in the
+ * rebuilds anything; a mesh's vertices may move too (another character's surface), which
+ * refits its BVH. Units are the character's: lengths in its units, stiffness in the
  * blob's penalty units (force per length per area, as the blob's contact stiffness). */
 #ifndef SINEW_WORLD_H
 #define SINEW_WORLD_H
