@@ -34,11 +34,19 @@ typedef struct sw_mesh {
     double *X;      /* 3 * nverts */
     uint32_t *tris; /* 3 * ntris */
     uint32_t nverts, ntris;
-    double *face_n;  /* 3 * ntris unit face normals */
-    double *edge_n;  /* 9 * ntris: triangle t's edge e (from corner e to e+1) pseudonormal */
-    double *vert_n;  /* 3 * nverts angle-weighted vertex pseudonormals (unit) */
-    double diagonal; /* of the local box: the radius that reaches every triangle */
-    RTCScene scene;  /* committed at add time, only read by queries */
+    double *face_n; /* 3 * ntris unit face normals */
+    double *edge_n; /* 9 * ntris: triangle t's edge e (from corner e to e+1) pseudonormal */
+    double *vert_n; /* 3 * nverts angle-weighted vertex pseudonormals (unit) */
+    uint32_t *twin; /* 3 * ntris: the other use 3 t' + e' of triangle t's edge e, or
+                       UINT32_MAX on a boundary (the edge map, kept for moves) */
+    uint8_t *dead;  /* ntris: zero area at the current vertices (only after a move):
+                       skipped by queries, zero in the pseudonormals */
+    uint32_t ndead;
+    double diagonal;  /* of the local box: the radius that reaches every triangle */
+    RTCScene scene;   /* committed at add time and at each move, only read by queries */
+    RTCGeometry geom; /* its one geometry (retained) and that geometry's vertex buffer */
+    float *vb;
+    int refits; /* the geometry refits its BVH: set at its first move */
 } sw_mesh;
 
 struct sw_collider {
@@ -100,6 +108,15 @@ int sw_hull_query(const sw_collider *c, const double y[3], double radius, sw_col
 sinew_result sw_mesh_build(sinew_world *w, const sinew_collider_def *d, sw_collider *c);
 void sw_mesh_release(sinew_world *w, sw_collider *c);
 int sw_mesh_query(const sw_collider *c, const double y[3], double radius, sw_collider_hit *h);
+
+/* What a mesh's vertices determine (mesh_update.c), at add time and at each move: the
+ * local box and diagonal from m->X; the unit face normals, zero for the dead triangles
+ * (returns how many are dead); the edge and vertex pseudonormals from those (the edge
+ * map, m->twin, built); the move itself, on checked input (finite, within 1e15). */
+void sw_mesh_bounds(sw_collider *c);
+uint32_t sw_mesh_face_normals(sw_mesh *m);
+void sw_mesh_feature_normals(sw_mesh *m);
+sinew_result sw_mesh_move(sinew_world *w, sw_collider *c, const float *xyz);
 
 /* Logs an error of the world (SINEW_MSG_WORLD_* id from the result) and returns `code`. */
 sinew_result sw_world_fail(const sinew_world *w, sinew_result code, const char *fmt, ...)

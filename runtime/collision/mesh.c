@@ -2,10 +2,12 @@
  * zero-area triangle, each undirected edge on at most two triangles and oriented
  * oppositely by them), their angle-weighted pseudonormals precomputed (Bærentzen and
  * Aanæs 2005: the sign of (x - c) . n_feature is the inside/outside test for the closest
- * feature of a closed mesh), and an Embree scene committed once. The query is one
- * rtcPointQuery with a finite radius: Embree culls the BVH, our callback computes the
- * exact closest point on each candidate triangle (Ericson, Real-Time Collision Detection
- * §5.1.5) in double precision and shrinks the radius. */
+ * feature of a closed mesh), and an Embree scene committed at add time and again when
+ * the host moves the vertices (mesh_update.c; a triangle a move collapsed is skipped
+ * here). Queries pick the closest triangle exactly, whatever the BVH, so a moved mesh
+ * answers as one added where it is now. The query is one rtcPointQuery with a finite radius: Embree
+ * culls the BVH, our callback computes the exact closest point on each candidate triangle (Ericson,
+ * Real-Time Collision Detection §5.1.5) in double precision and shrinks the radius. */
 #include <float.h>
 #include <math.h>
 #include <stdlib.h>
@@ -75,6 +77,7 @@ static bool on_triangle(struct RTCPointQueryFunctionArguments *args) {
     closest *q = args->userPtr;
     const sw_mesh *m = q->m;
     uint32_t t = args->primID;
+    if (m->dead[t]) return false; /* collapsed by a move (mesh_update.c) */
     const uint32_t *v = m->tris + 3 * t;
     double c[3];
     int f = closest_on_triangle(q->p, m->X + 3 * v[0], m->X + 3 * v[1], m->X + 3 * v[2], c);

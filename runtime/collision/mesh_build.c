@@ -1,7 +1,7 @@
 /* A mesh collider's add-time work (mesh.c queries it): validation of the def's
- * triangles, the edge map that proves them edge-manifold and consistently oriented,
- * the face, edge and vertex pseudonormals (Bærentzen and Aanæs 2005), and the Embree
- * scene, committed here and only read afterwards. */
+ * triangles, the edge map that proves them edge-manifold and consistently oriented (kept
+ * as each edge's twin), the pseudonormals (mesh_update.c, which also moves the mesh), and
+ * the Embree scene, committed here and at each move, only read by queries. */
 #include <math.h>
 #include <stdlib.h>
 #include <string.h>
@@ -26,8 +26,8 @@ static int edge_cmp(const void *pa, const void *pb) {
 
 static const char *add_fail_prefix = "sinew_world_add_collider: mesh";
 
-/* Counts, pointers, finite vertices of sane magnitude, indices in range; the box. */
-static sinew_result check_arrays(sinew_world *w, const sinew_collider_def *d, sw_collider *c) {
+/* Counts, pointers, finite vertices of sane magnitude, indices in range. */
+static sinew_result check_arrays(sinew_world *w, const sinew_collider_def *d) {
     if (!d->vertices || !d->indices || d->triangle_count < 1 ||
         d->triangle_count > SW_MESH_MAX_TRIANGLES || d->vertex_count < 3 ||
         d->vertex_count > SW_MESH_MAX_VERTICES)
@@ -36,8 +36,6 @@ static sinew_result check_arrays(sinew_world *w, const sinew_collider_def *d, sw
                              "vertices (got %u triangles, %u vertices)",
                              add_fail_prefix, (unsigned)d->triangle_count,
                              (unsigned)d->vertex_count);
-    for (int k = 0; k < 3; ++k)
-        c->lo[k] = HUGE_VAL, c->hi[k] = -HUGE_VAL;
     for (uint32_t i = 0; i < 3 * d->vertex_count; ++i) {
         double x = d->vertices[i];
         if (!isfinite(x))
@@ -46,8 +44,6 @@ static sinew_result check_arrays(sinew_world *w, const sinew_collider_def *d, sw
         if (!(fabs(x) <= SW_COLLIDER_MAX_SIZE))
             return sw_world_fail(w, SINEW_ERROR_INVALID_ARGUMENT, "%s vertex %u is beyond 1e15",
                                  add_fail_prefix, (unsigned)(i / 3));
-        c->lo[i % 3] = fmin(c->lo[i % 3], x);
-        c->hi[i % 3] = fmax(c->hi[i % 3], x);
     }
     for (uint32_t i = 0; i < 3 * d->triangle_count; ++i)
         if (d->indices[i] >= d->vertex_count)
@@ -58,38 +54,23 @@ static sinew_result check_arrays(sinew_world *w, const sinew_collider_def *d, sw
     return SINEW_OK;
 }
 
-/* Unit face normals; a triangle whose area is below 1e-12 of its longest edge squared
- * (a repeated vertex, collinear corners) is degenerate. */
+/* Unit face normals (mesh_update.c): a triangle whose area is below 1e-12 of its longest
+ * edge squared (a repeated vertex, collinear corners) is degenerate at add time. */
 static sinew_result face_normals(sinew_world *w, sw_mesh *m) {
-    for (uint32_t t = 0; t < m->ntris; ++t) {
-        const uint32_t *v = m->tris + 3 * t;
-        const double *a = m->X + 3 * v[0], *b = m->X + 3 * v[1], *c = m->X + 3 * v[2];
-        double e0[3], e1[3], e2[3], *n = m->face_n + 3 * t;
-        sw_v3_sub(b, a, e0);
-        sw_v3_sub(c, a, e1);
-        sw_v3_sub(c, b, e2);
-        double l2 = fmax(fmax(sw_v3_dot(e0, e0), sw_v3_dot(e1, e1)), sw_v3_dot(e2, e2));
-        sw_v3_cross(e0, e1, n);
-        double a2 = sw_v3_normalize(n);
-        if (!(a2 > 1e-12 * l2) || !(l2 > 0))
-            return sw_world_fail(w, SINEW_ERROR_DEGENERATE,
-                                 "%s triangle %u (%u %u %u) has zero area", add_fail_prefix,
-                                 (unsigned)t, (unsigned)v[0], (unsigned)v[1], (unsigned)v[2]);
-    }
-    return SINEW_OK;
+    if (sw_mesh_face_normals(m) == 0) return SINEW_OK;
+    uint32_t t = 0;
+    while (!m->dead[t])
+        ++t;
+    const uint32_t *v = m->tris + 3 * t;
+    return sw_world_fail(w, SINEW_ERROR_DEGENERATE, "%s triangle %u (%u %u %u) has zero area",
+                         add_fail_prefix, (unsigned)t, (unsigned)v[0], (unsigned)v[1],
+                         (unsigned)v[2]);
 }
 
-/* The pseudonormal of edge group g[0..k) (k = 1: a boundary edge, its face's normal;
- * k = 2: the sum of both faces' normals, each of weight pi), into both triangles. */
-static void edge_pseudonormal(sw_mesh *m, const edge_use *g, size_t k) {
-    double n[3] = {0, 0, 0};
+/* The two uses of an undirected edge as each other's twin (one use: a boundary edge). */
+static void edge_twins(sw_mesh *m, const edge_use *g, size_t k) {
     for (size_t j = 0; j < k; ++j)
-        for (int i = 0; i < 3; ++i)
-            n[i] += m->face_n[3 * g[j].tri + i];
-    /* Two faces folded flat onto each other cancel: keep the first face's normal. */
-    if (!(sw_v3_normalize(n) > 1e-12)) memcpy(n, m->face_n + 3 * g[0].tri, sizeof n);
-    for (size_t j = 0; j < k; ++j)
-        memcpy(m->edge_n + 9 * g[j].tri + 3 * g[j].e, n, sizeof n);
+        m->twin[3 * g[j].tri + g[j].e] = k == 2 ? 3 * g[1 - j].tri + g[1 - j].e : UINT32_MAX;
 }
 
 /* Sorts the 3 * ntris edge uses by vertex pair: more than two uses of a pair, or two
@@ -123,29 +104,10 @@ static sinew_result edges(sinew_world *w, sw_mesh *m) {
                               add_fail_prefix, (unsigned)u[i].tri, (unsigned)u[i + 1].tri,
                               (unsigned)u[i].lo, (unsigned)u[i].hi);
         else
-            edge_pseudonormal(m, u + i, j - i);
+            edge_twins(m, u + i, j - i);
     }
     sw_free(&w->allocator, u);
     return r;
-}
-
-/* Angle-weighted vertex pseudonormals: sum over incident faces of the face normal times
- * the face's angle at the vertex. */
-static void vertex_normals(sw_mesh *m) {
-    for (uint32_t t = 0; t < m->ntris; ++t)
-        for (int k = 0; k < 3; ++k) {
-            const uint32_t *v = m->tris + 3 * t;
-            double e0[3], e1[3];
-            sw_v3_sub(m->X + 3 * v[(k + 1) % 3], m->X + 3 * v[k], e0);
-            sw_v3_sub(m->X + 3 * v[(k + 2) % 3], m->X + 3 * v[k], e1);
-            double x[3];
-            sw_v3_cross(e0, e1, x);
-            double angle = atan2(sw_v3_norm(x), sw_v3_dot(e0, e1));
-            for (int i = 0; i < 3; ++i)
-                m->vert_n[3 * v[k] + i] += angle * m->face_n[3 * t + i];
-        }
-    for (uint32_t i = 0; i < m->nverts; ++i)
-        sw_v3_normalize(m->vert_n + 3 * i); /* unused vertices stay zero, never queried */
 }
 
 /* Embree's result as ours (its error callback has logged the details). */
@@ -167,21 +129,19 @@ static sinew_result build_scene(sinew_world *w, sw_mesh *m) {
         return embree_result(w, "create a scene");
     }
     rtcSetSceneBuildQuality(m->scene, RTC_BUILD_QUALITY_HIGH);
+    m->geom = g; /* kept for moves (sinew_world_set_mesh_vertices) */
     float *vb = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_VERTEX, 0, RTC_FORMAT_FLOAT3,
                                         3 * sizeof(float), m->nverts);
     unsigned *ib = rtcSetNewGeometryBuffer(g, RTC_BUFFER_TYPE_INDEX, 0, RTC_FORMAT_UINT3,
                                            3 * sizeof(unsigned), m->ntris);
-    if (!vb || !ib) {
-        rtcReleaseGeometry(g);
-        return embree_result(w, "allocate its buffers");
-    }
+    if (!vb || !ib) return embree_result(w, "allocate its buffers");
+    m->vb = vb;
     for (size_t i = 0; i < (size_t)3 * m->nverts; ++i)
         vb[i] = (float)m->X[i];
     for (size_t i = 0; i < (size_t)3 * m->ntris; ++i)
         ib[i] = m->tris[i];
     rtcCommitGeometry(g);
     rtcAttachGeometry(m->scene, g);
-    rtcReleaseGeometry(g);
     rtcCommitScene(m->scene);
     if (rtcGetDeviceError(w->device) != RTC_ERROR_NONE) return embree_result(w, "build its BVH");
     return SINEW_OK;
@@ -195,13 +155,16 @@ static sinew_result alloc_arrays(sinew_world *w, sw_mesh *m) {
     m->tris = sw_alloc(a, sizeof(uint32_t) * 3 * (size_t)m->ntris, SW_ALLOC_ALIGN);
     m->face_n = sw_alloc(a, sizeof(double) * 3 * (size_t)m->ntris, SW_ALLOC_ALIGN);
     m->edge_n = sw_alloc(a, sizeof(double) * 9 * (size_t)m->ntris, SW_ALLOC_ALIGN);
-    if (m->X && m->vert_n && m->tris && m->face_n && m->edge_n) return SINEW_OK;
+    m->twin = sw_alloc(a, sizeof(uint32_t) * 3 * (size_t)m->ntris, SW_ALLOC_ALIGN);
+    m->dead = sw_alloc(a, m->ntris, SW_ALLOC_ALIGN);
+    if (m->X && m->vert_n && m->tris && m->face_n && m->edge_n && m->twin && m->dead)
+        return SINEW_OK;
     return sw_world_fail(w, SINEW_ERROR_OUT_OF_MEMORY, "%s: no memory for %u triangles",
                          add_fail_prefix, (unsigned)m->ntris);
 }
 
 sinew_result sw_mesh_build(sinew_world *w, const sinew_collider_def *d, sw_collider *c) {
-    sinew_result r = check_arrays(w, d, c);
+    sinew_result r = check_arrays(w, d);
     if (r != SINEW_OK) return r;
     sw_mesh *m = &c->mesh;
     m->nverts = d->vertex_count;
@@ -210,13 +173,11 @@ sinew_result sw_mesh_build(sinew_world *w, const sinew_collider_def *d, sw_colli
         for (size_t i = 0; i < (size_t)3 * m->nverts; ++i)
             m->X[i] = d->vertices[i];
         memcpy(m->tris, d->indices, sizeof(uint32_t) * 3 * (size_t)m->ntris);
-        double ext[3];
-        sw_v3_sub(c->hi, c->lo, ext);
-        m->diagonal = sw_v3_norm(ext);
+        sw_mesh_bounds(c);
     }
     if (r == SINEW_OK) r = face_normals(w, m);
     if (r == SINEW_OK) r = edges(w, m);
-    if (r == SINEW_OK) vertex_normals(m);
+    if (r == SINEW_OK) sw_mesh_feature_normals(m);
     if (r == SINEW_OK) r = build_scene(w, m);
     if (r != SINEW_OK) sw_mesh_release(w, c);
     return r;
@@ -224,6 +185,7 @@ sinew_result sw_mesh_build(sinew_world *w, const sinew_collider_def *d, sw_colli
 
 void sw_mesh_release(sinew_world *w, sw_collider *c) {
     sw_mesh *m = &c->mesh;
+    if (m->geom) rtcReleaseGeometry(m->geom);
     if (m->scene) rtcReleaseScene(m->scene);
     const sinew_allocator *a = &w->allocator;
     sw_free(a, m->X);
@@ -231,5 +193,7 @@ void sw_mesh_release(sinew_world *w, sw_collider *c) {
     sw_free(a, m->face_n);
     sw_free(a, m->edge_n);
     sw_free(a, m->vert_n);
+    sw_free(a, m->twin);
+    sw_free(a, m->dead);
     memset(m, 0, sizeof *m);
 }

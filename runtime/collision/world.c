@@ -253,6 +253,32 @@ sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collid
     return SINEW_OK;
 }
 
+sinew_result sinew_world_set_mesh_vertices(sinew_world *world, sinew_collider_id id,
+                                           const float *xyz, uint32_t vertex_count) {
+    const char *fn = "sinew_world_set_mesh_vertices";
+    int32_t s = world ? sw_world_slot_of(world, id) : -1;
+    if (s < 0 || !xyz)
+        return sw_world_fail(world, SINEW_ERROR_INVALID_ARGUMENT,
+                             "%s: id 0x%08x is not a live collider or xyz is NULL", fn,
+                             (unsigned)id);
+    sw_collider *c = world->slots[s];
+    if (c->shape != SINEW_SHAPE_MESH || vertex_count != c->mesh.nverts)
+        return sw_world_fail(world, SINEW_ERROR_INVALID_ARGUMENT,
+                             "%s: collider 0x%08x is not a mesh of %u vertices (shape %d, %u)", fn,
+                             (unsigned)id, (unsigned)vertex_count, (int)c->shape,
+                             (unsigned)c->mesh.nverts);
+    /* checked whole before anything changes: a refused move keeps the old vertices */
+    for (size_t i = 0; i < (size_t)3 * vertex_count; ++i) {
+        if (!isfinite(xyz[i]))
+            return sw_world_fail(world, SINEW_ERROR_NOT_FINITE, "%s: vertex %zu is not finite", fn,
+                                 i / 3);
+        if (!(fabs(xyz[i]) <= SW_COLLIDER_MAX_SIZE))
+            return sw_world_fail(world, SINEW_ERROR_INVALID_ARGUMENT,
+                                 "%s: vertex %zu is beyond 1e15", fn, i / 3);
+    }
+    return sw_mesh_move(world, c, xyz);
+}
+
 uint32_t sinew_world_collider_count(const sinew_world *world) {
     return world ? world->live : 0;
 }

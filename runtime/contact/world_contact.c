@@ -268,10 +268,11 @@ static void try_candidate(sw_world_contacts *wc, int32_t i, const double x[3], u
     wc->copy_first[i] = wc->ncand - 1;
 }
 
-/* The world box of slot s grown by the detection radius; 0 for an empty slot. */
+/* The world box of slot s grown by the detection radius; 0 for an empty slot and for the
+ * collider the instance ignores (every query of the world passes here first). */
 static int collider_box(const sw_world_contacts *wc, uint32_t s, double box[6]) {
     const sw_collider *c = sw_world_slot(wc->world, s);
-    if (!c) return 0;
+    if (!c || (wc->ignore && sw_collider_id_of(wc->world, s) == wc->ignore)) return 0;
     sw_collider_bounds(c, wc->radius, box, box + 3);
     return 1;
 }

@@ -40,6 +40,7 @@ typedef struct sw_world_cand {
 
 typedef struct sw_world_contacts {
     const sinew_world *world;
+    sinew_collider_id ignore; /* a collider the instance never touches (its own surface), or 0 */
     int32_t max_cand, ncand, dropped;
     sw_world_cand *cand;      /* max_cand */
     int32_t ncl;              /* clusters */

@@ -25,6 +25,18 @@ SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sine
     return SINEW_OK;
 }
 
+SINEW_API sinew_result sinew_instance_ignore_collider(sinew_instance *inst, sinew_collider_id id) {
+    if (!inst) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (id && inst->wc.world && sw_world_slot_of(inst->wc.world, id) < 0) {
+        sw_log(&inst->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
+               "sinew_instance_ignore_collider: id 0x%08x is not a live collider of the world",
+               (unsigned)id);
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    }
+    inst->wc.ignore = id;
+    return SINEW_OK;
+}
+
 /* The candidates of collider `id` hold the flesh's force on it: minus each copy's
  * contact force, applied at the copy's contact point (its frozen surface point). */
 SINEW_API sinew_result sinew_instance_collider_force(const sinew_instance *inst,

@@ -105,6 +105,9 @@ typedef sinew_result (*sw_abi_debug_draw_fn)(const sinew_instance *, const sinew
 typedef sinew_result (*sw_abi_recorder_open_fn)(const sinew_recorder_def *, sinew_recorder **);
 typedef sinew_result (*sw_abi_recorder_fn)(sinew_recorder *);
 typedef sinew_result (*sw_abi_set_recorder_fn)(sinew_instance *, sinew_recorder *);
+typedef sinew_result (*sw_abi_set_mesh_vertices_fn)(sinew_world *, sinew_collider_id, const float *,
+                                                    uint32_t);
+typedef sinew_result (*sw_abi_ignore_collider_fn)(sinew_instance *, sinew_collider_id);
 
 static int sw_abi_log_calls;
 
@@ -170,6 +173,12 @@ TEST(functions_have_the_pinned_signatures) {
         ENSURE(flush(NULL) == SINEW_ERROR_INVALID_ARGUMENT && close_rec(NULL) == SINEW_OK);
         ENSURE(set_rec(NULL, NULL) == SINEW_ERROR_INVALID_ARGUMENT);
         ENSURE(rd.struct_size == sizeof(sinew_recorder_def));
+    }
+    {
+        sw_abi_set_mesh_vertices_fn set_vertices = &sinew_world_set_mesh_vertices;
+        sw_abi_ignore_collider_fn ignore = &sinew_instance_ignore_collider;
+        ENSURE(set_vertices(NULL, 1, NULL, 3) == SINEW_ERROR_INVALID_ARGUMENT);
+        ENSURE(ignore(NULL, 0) == SINEW_ERROR_INVALID_ARGUMENT);
     }
     /* Calls through the pointers reach the same code as direct calls. */
     ENSURE(version() == sinew_version());

@@ -63,6 +63,13 @@ static_assert(std::is_same<decltype(&sinew_blob_output_sources),
 static_assert(std::is_same<decltype(&sinew_blob_get_provenance),
                            sinew_result (*)(const sinew_blob *, sinew_blob_provenance *)>::value,
               "sig");
+static_assert(std::is_same<decltype(&sinew_world_set_mesh_vertices),
+                           sinew_result (*)(sinew_world *, sinew_collider_id, const float *,
+                                            uint32_t)>::value,
+              "sig");
+static_assert(std::is_same<decltype(&sinew_instance_ignore_collider),
+                           sinew_result (*)(sinew_instance *, sinew_collider_id)>::value,
+              "sig");
 
 namespace {
 

@@ -3,15 +3,17 @@
  * MPR (hulls), each with a rigid transform the host may move every frame.
  *
  * Thread-safety contract (in the manner of Embree's "never commit while queries run"):
- *  - A world is built and changed (create, add, remove, set_transform, destroy) by one
- *    thread at a time, and never while an instance that uses it is stepping.
+ *  - A world is built and changed (create, add, remove, set_transform, set_mesh_vertices,
+ *    destroy) by one thread at a time, and never while an instance that uses it is
+ *    stepping.
  *  - While no such change runs, any number of instances on any number of threads step
  *    against one world at once: a step only reads it (no allocation, no lock, no commit).
  *  - The contact forces an instance exerted are the instance's own (read them from the
  *    instance's owner thread after its step).
  *
  * Colliders live in their own frame: the host moves them by their transform, which never
- * rebuilds anything. Units are the character's: lengths in its units, stiffness in the
+ * rebuilds anything; a mesh's vertices may move too (another character's surface), which
+ * refits its BVH. Units are the character's: lengths in its units, stiffness in the
  * blob's penalty units (force per length per area, as the blob's contact stiffness). */
 #ifndef SINEW_WORLD_H
 #define SINEW_WORLD_H
@@ -142,6 +144,16 @@ SINEW_API sinew_result sinew_world_remove_collider(sinew_world *world, sinew_col
 SINEW_API sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collider_id id,
                                                           const sinew_transform *transform);
 
+/** Moves the vertices of mesh collider `id` (`vertex_count` xyz triples; vertex_count must
+ * equal its count at creation; the triangles stay), e.g. another character's surface after
+ * its step, and refits its BVH and pseudonormals. In the collider's frame. Non-finite
+ * input is refused (NOT_FINITE) and the old vertices kept; a wrong count, a collider that
+ * is not a mesh or a stale id is INVALID_ARGUMENT. A triangle the motion collapsed to zero
+ * area is not an error (queries skip it until it opens again). Same thread contract as
+ * sinew_world_set_collider_transform: never while an instance using the world steps. */
+SINEW_API sinew_result sinew_world_set_mesh_vertices(sinew_world *world, sinew_collider_id id,
+                                                     const float *xyz, uint32_t vertex_count);
+
 /** Live colliders in the world. Any thread, while no change runs. */
 SINEW_API uint32_t sinew_world_collider_count(const sinew_world *world);
 
@@ -150,6 +162,12 @@ SINEW_API uint32_t sinew_world_collider_count(const sinew_world *world);
  * sinew_instance_set_actor or a scaled pose is refused (INVALID_ARGUMENT) for now. Owner
  * thread of the instance; never while it steps. */
 SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sinew_world *world);
+
+/** The instance ignores collider `id` from its next step on (its own surface in the
+ * world, for contact between characters: sinew_world_set_mesh_vertices); 0 clears it.
+ * One collider at a time; the id is kept across sinew_instance_set_world. An id that is
+ * not live in the attached world is INVALID_ARGUMENT. Owner thread, never while it steps. */
+SINEW_API sinew_result sinew_instance_ignore_collider(sinew_instance *inst, sinew_collider_id id);
 
 /** The total force and the torque about the collider's origin (its transform's position)
  * that the instance's flesh exerted on collider `id` in its last step, in world units.
