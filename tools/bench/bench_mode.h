@@ -11,6 +11,7 @@
 #include "gap_bench.h"
 #include "newton_bench.h"
 #include "novel_bench.h"
+#include "pair_bench.h"
 #include "sc_bench.h"
 #include "world_bench.h"
 
@@ -28,7 +29,7 @@ typedef struct sw_bench_ctx {
     /* the modes' flags */
     const char *world_path;
     const sw_cond_bench_params *cond;
-    int dynamic, hold_frames, instances, sc_compare, newton_compare, error_gap, novel;
+    int dynamic, hold_frames, instances, sc_compare, newton_compare, error_gap, novel, pair;
     /* found */
     long failed; /* the modes' failed steps */
     sw_world_bench wb;
@@ -38,6 +39,7 @@ typedef struct sw_bench_ctx {
     sw_newton_bench nwb;
     sw_gap_bench gap;
     sw_novel_bench nvb;
+    sw_pair_bench pb;
 } sw_bench_ctx;
 
 typedef struct sw_bench_mode {

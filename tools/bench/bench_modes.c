@@ -75,6 +75,24 @@ static void novel_json(const sw_bench_ctx *c) {
     sw_novel_bench_print(&c->nvb, stdout, 1);
 }
 
+/* ---- --pair: two copies pressed together, against the two-body reference ---- */
+
+static int pair_wanted(const sw_bench_ctx *c) {
+    return c->pair;
+}
+
+static sinew_result pair_run(sw_bench_ctx *c, sw_error *err) {
+    sinew_result r = sw_pair_bench_run(c->blob, c->ch, c->ch->clip.T, c->nf, c->fp, &c->pb, err);
+    if (r != SINEW_OK) return r;
+    c->failed += c->pb.sub_failed;
+    sw_pair_bench_print(&c->pb, stderr, 0);
+    return SINEW_OK;
+}
+
+static void pair_json(const sw_bench_ctx *c) {
+    sw_pair_bench_print(&c->pb, stdout, 1);
+}
+
 /* ---- --newton-compare: Newton on the current and on the rest Hessian ---- */
 
 static int newton_wanted(const sw_bench_ctx *c) {
@@ -246,5 +264,6 @@ const sw_bench_mode sw_bench_modes[] = {
     {"--world", world_wanted, world_run, world_json, "world run failed: "},
     {"--dynamic", dyn_wanted, dyn_run, dyn_json, "dynamic run failed: "},
     {"--novel", novel_wanted, novel_run, novel_json, "novel-contact run failed: "},
+    {"--pair", pair_wanted, pair_run, pair_json, "pair run failed: "},
 };
 const int sw_bench_nmodes = (int)(sizeof sw_bench_modes / sizeof sw_bench_modes[0]);

@@ -215,7 +215,7 @@ typedef struct {
     int json, full_frames, contract_steps, threads, bake_errors, timing_passes;
     int dynamic, hold_frames, instances, patch_budget;
     int self_mode; /* sinew_self_contact */
-    int sc_compare, error_gap, newton_compare, novel;
+    int sc_compare, error_gap, newton_compare, novel, pair;
     sw_cond_bench_params cond;
 } options;
 
@@ -231,7 +231,7 @@ static const char *const SYNOPSIS =
     "                   [--world FILE.json [--rho R] [--patch-budget N]]\n"
     "                   [--dynamic [--hold-frames H]] [--instances N]\n"
     "                   [--self-contact pose-space|exhaustive] [--sc-compare]\n"
-    "                   [--newton-compare] [--novel]\n"
+    "                   [--newton-compare] [--novel] [--pair]\n"
     "                   [--error-gap] [--json]\n";
 
 /* The bench's own flags, bound to o, into f; returns their count. */
@@ -286,6 +286,10 @@ static size_t bench_flags(options *o, sw_flag *f) {
         {SW_SET("--novel", &o->novel, 1,
                 "also the clip with novel self-contact (through the\n"
                 "subspace, and seeding patches): pen_self_*, err_clip_*")},
+        {SW_SET("--pair", &o->pair, 1,
+                "also two copies pressed together side by side over the clip,\n"
+                "against the two-body reference: pen_pair_*, err_pair_*,\n"
+                "pair_cost_vs_lone (the tet boundary as the output surface)")},
         {SW_SET("--newton-compare", &o->newton_compare, 1,
                 "also time the quasistatic step with Newton on the current\n"
                 "and starting on the rest Hessian over the clip: newton_*")},
@@ -657,6 +661,7 @@ static int run_modes(bench *b, sw_error *err) {
                         .instances = o->instances,
                         .sc_compare = o->sc_compare,
                         .novel = o->novel,
+                        .pair = o->pair,
                         .newton_compare = o->newton_compare,
                         .error_gap = o->error_gap};
     for (int k = 0; k < sw_bench_nmodes; ++k) {
