@@ -36,6 +36,7 @@ typedef struct sw_pair_bench {
     double pen_pair_full, pen_pair_sub, pen_pair_cond;
     double err_pair_sub, err_pair_cond;
     double full_ms, pair_ms, lone_ms, pair_cost_vs_lone;
+    double publish_ms; /* of pair_ms: the two surface copies into the colliders */
     double force_balance, patch_frac_max;
     int force_frames; /* frames (with patches) both exerted a force on the other */
     int ref_failed, sub_failed;
