@@ -229,7 +229,7 @@ static sinew_result pair_make(runtime_pair *p, const sinew_blob *blob, uint32_t 
 static sinew_result run_runtime(const sinew_blob *blob, scene *s, uint32_t patch, int lone,
                                 const double *x_full, const double *mass, double *pen,
                                 double *err_out, int *contact_frames, double *ms, double *pub_ms,
-                                sw_pair_bench *out, sw_error *err) {
+                                unsigned char *touched, sw_pair_bench *out, sw_error *err) {
     double *Tb = malloc(sizeof(double) * 12 * (size_t)s->nb), *cnt = malloc(sizeof(double) * s->nv);
     if (!Tb || !cnt) {
         free(Tb), free(cnt);
@@ -259,6 +259,13 @@ static sinew_result run_runtime(const sinew_blob *blob, scene *s, uint32_t patch
             sinew_step_stats st = {.struct_size = sizeof st};
             sinew_instance_get_stats(p.inst[k], &st);
             out->patch_frac_max = fmax(out->patch_frac_max, (double)st.patch_vertices / s->nv);
+            if (touched) touched[f] |= st.world_contacts > 0;
+            if (patch > 0 && !lone) { /* the touching pair's steps, phase by phase */
+                const double n = 2.0 * s->nf;
+                out->phase_ms[0] += st.ms_world / n, out->phase_ms[1] += st.ms_oracle / n;
+                out->phase_ms[2] += st.ms_solve / n, out->phase_ms[3] += st.ms_output / n;
+                out->pcg_iterations += st.pcg_iterations / n;
+            }
         }
         int touch;
         *pen = fmax(*pen, pair_depth(s, s->x2, &touch));
@@ -312,7 +319,8 @@ sinew_result sw_pair_bench_run(const sinew_blob *blob, const sw_character *ch, c
            *mass = malloc(sizeof(double) * 2 * (size_t)ch->mesh.nverts),
            *ms[4] = {malloc(sizeof(double) * nf), malloc(sizeof(double) * nf),
                      malloc(sizeof(double) * nf), malloc(sizeof(double) * nf)};
-    if (r == SINEW_OK && (!x_full || !mass || !ms[0] || !ms[1] || !ms[2] || !ms[3]))
+    unsigned char *touched = calloc((size_t)nf, 1);
+    if (r == SINEW_OK && (!x_full || !mass || !ms[0] || !ms[1] || !ms[2] || !ms[3] || !touched))
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "--pair: out of memory");
     out->frames = nf;
     out->thickness = s.w;
@@ -324,22 +332,31 @@ sinew_result sw_pair_bench_run(const sinew_blob *blob, const sw_character *ch, c
     const uint32_t budget = (uint32_t)(ch->mesh.nverts / 10 + 1);
     if (r == SINEW_OK)
         r = run_runtime(blob, &s, 0, 0, x_full, mass, &out->pen_pair_sub, &out->err_pair_sub,
-                        &out->contact_frames_sub, ms[0], NULL, out, err);
+                        &out->contact_frames_sub, ms[0], NULL, NULL, out, err);
     if (r == SINEW_OK)
         r = run_runtime(blob, &s, budget, 0, x_full, mass, &out->pen_pair_cond, &out->err_pair_cond,
-                        &out->contact_frames_cond, ms[1], ms[3], out, err);
+                        &out->contact_frames_cond, ms[1], ms[3], touched, out, err);
     double unused_pen = 0, unused_err = 0;
     int unused_frames = 0;
     if (r == SINEW_OK)
         r = run_runtime(blob, &s, budget, 1, x_full, mass, &unused_pen, &unused_err, &unused_frames,
-                        ms[2], NULL, out, err);
+                        ms[2], NULL, NULL, out, err);
     if (r == SINEW_OK) {
-        out->pair_ms = sw_median(ms[1], nf);
-        out->publish_ms = sw_median(ms[3], nf);
-        out->lone_ms = sw_median(ms[2], nf);
+        /* the frames the pair touches (either instance in contact with the other) */
+        int n = 0;
+        for (int f = 0; f < nf; ++f)
+            if (touched[f]) {
+                for (int k = 1; k < 4; ++k)
+                    ms[k][n] = ms[k][f];
+                ++n;
+            }
+        out->touch_frames = n;
+        out->pair_ms = n ? sw_median(ms[1], n) : NAN;
+        out->publish_ms = n ? sw_median(ms[3], n) : NAN;
+        out->lone_ms = n ? sw_median(ms[2], n) : NAN;
         out->pair_cost_vs_lone = out->lone_ms > 0 ? out->pair_ms / out->lone_ms : NAN;
     }
-    free(x_full), free(mass);
+    free(x_full), free(mass), free(touched);
     for (int k = 0; k < 4; ++k)
         free(ms[k]);
     scene_free(&s);
@@ -348,17 +365,21 @@ sinew_result sw_pair_bench_run(const sinew_blob *blob, const sw_character *ch, c
 
 void sw_pair_bench_print(const sw_pair_bench *b, FILE *f, int json) {
     if (!json) {
-        fprintf(f,
-                "sinew-bench: pair over %d frames (thickness %.4g): deepest penetration "
-                "reference %.4g (%d frames touching), subspace %.4g (%d), patches %.4g (%d); "
-                "error subspace %.4f, patches %.4f; pair frame %.3f ms against two lone "
-                "steps %.3f ms (%.2fx; the two surface copies %.3f ms); force balance %.3f over %d "
-                "frames; patch up to %.3f of the "
-                "vertices\n",
-                b->frames, b->thickness, b->pen_pair_full, b->contact_frames_full, b->pen_pair_sub,
-                b->contact_frames_sub, b->pen_pair_cond, b->contact_frames_cond, b->err_pair_sub,
-                b->err_pair_cond, b->pair_ms, b->lone_ms, b->pair_cost_vs_lone, b->publish_ms,
-                b->force_balance, b->force_frames, b->patch_frac_max);
+        fprintf(
+            f,
+            "sinew-bench: pair over %d frames (thickness %.4g): deepest penetration "
+            "reference %.4g (%d frames touching), subspace %.4g (%d), patches %.4g (%d); "
+            "error subspace %.4f, patches %.4f; pair frame %.3f ms against two lone "
+            "steps %.3f ms (%.2fx, medians over the %d frames the pair touches; the two surface "
+            "copies %.3f ms; a step's mean world %.3f, oracle %.3f, solve %.3f, output %.3f "
+            "ms, %.0f CG iterations); force balance %.3f over %d "
+            "frames; patch up to %.3f of the "
+            "vertices\n",
+            b->frames, b->thickness, b->pen_pair_full, b->contact_frames_full, b->pen_pair_sub,
+            b->contact_frames_sub, b->pen_pair_cond, b->contact_frames_cond, b->err_pair_sub,
+            b->err_pair_cond, b->pair_ms, b->lone_ms, b->pair_cost_vs_lone, b->touch_frames,
+            b->publish_ms, b->phase_ms[0], b->phase_ms[1], b->phase_ms[2], b->phase_ms[3],
+            b->pcg_iterations, b->force_balance, b->force_frames, b->patch_frac_max);
         return;
     }
     fprintf(f,
@@ -367,11 +388,15 @@ void sw_pair_bench_print(const sw_pair_bench *b, FILE *f, int json) {
             "\"pair_contact_frames_sub\":%d,\"pair_contact_frames_cond\":%d,"
             "\"err_pair_sub\":%.5f,\"err_pair_cond\":%.5f,\"pair_full_ms\":%.3f,"
             "\"pair_ms\":%.4f,\"pair_lone_ms\":%.4f,\"pair_cost_vs_lone\":%.4f,"
-            "\"pair_publish_ms\":%.4f,"
+            "\"pair_touch_frames\":%d,\"pair_publish_ms\":%.4f,\"pair_world_ms\":%.4f,\"pair_"
+            "oracle_ms\":%.4f,"
+            "\"pair_solve_ms\":%.4f,\"pair_output_ms\":%.4f,\"pair_pcg_iterations\":%.1f,"
             "\"pair_force_balance\":%.5f,\"pair_force_frames\":%d,\"patch_frac_max\":%.5f,"
             "\"pair_ref_failed\":%d",
             b->frames, b->thickness, b->pen_pair_full, b->pen_pair_sub, b->pen_pair_cond,
             b->contact_frames_full, b->contact_frames_sub, b->contact_frames_cond, b->err_pair_sub,
             b->err_pair_cond, b->full_ms, b->pair_ms, b->lone_ms, b->pair_cost_vs_lone,
-            b->publish_ms, b->force_balance, b->force_frames, b->patch_frac_max, b->ref_failed);
+            b->touch_frames, b->publish_ms, b->phase_ms[0], b->phase_ms[1], b->phase_ms[2],
+            b->phase_ms[3], b->pcg_iterations, b->force_balance, b->force_frames, b->patch_frac_max,
+            b->ref_failed);
 }

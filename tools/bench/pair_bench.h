@@ -17,7 +17,8 @@
  *       the other over the clip, by the reference's detector on every tet vertex
  *   err_pair_sub, err_pair_cond  correction error of both copies against the reference
  *   pair_cost_vs_lone  a touching pair's frame (two steps and the two surface copies, with
- *       patches) over two lone steps, medians over the clip, same run
+ *       patches) over two lone steps, medians over the frames the pair touches (either
+ *       instance in contact with the other: pair_touch_frames), same run
  *   force_balance  over the frames both exert a force on the other (force_frames; with
  *       patches), the mean |F_a + F_b| / (|F_a| + |F_b|) (0: equal and opposite, 1: the same
  *       direction; each side answers the other's surface of the frame before)
@@ -36,7 +37,11 @@ typedef struct sw_pair_bench {
     double pen_pair_full, pen_pair_sub, pen_pair_cond;
     double err_pair_sub, err_pair_cond;
     double full_ms, pair_ms, lone_ms, pair_cost_vs_lone;
+    int touch_frames; /* frames the pair touches (with patches): pair_ms's and lone_ms's */
     double publish_ms; /* of pair_ms: the two surface copies into the colliders */
+    /* the touching pair's mean step (with patches): world detection, oracle, solve and
+       output ms (sinew_step_stats), and conjugate-gradient iterations */
+    double phase_ms[4], pcg_iterations;
     double force_balance, patch_frac_max;
     int force_frames; /* frames (with patches) both exerted a force on the other */
     int ref_failed, sub_failed;
