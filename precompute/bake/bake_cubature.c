@@ -213,8 +213,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &c.mu, &c.lambda);
     /* the force weighted by each mode's stiffness (mode_weights) where some modes are far
        softer than others: the inertia modes, and painted flesh, whose soft modes turn the
-       same force error into a larger displacement (painted finger: held-out 0.046 -> 0.039,
-       docs/notes/blender.md) */
+       same force error into a larger displacement (docs/notes/blender.md, Painted material) */
     if (s->p->inertia_modes || s->rig.ch.tet_stiffness) {
         if (!(mode_w = malloc((size_t)r * sizeof(double)))) goto done;
         mode_weights(&c, ntd, mode_w);

@@ -1,4 +1,4 @@
-/* Two characters as one (issue 57's two-body reference): the full-space simulator solves
+/* Two characters as one (the two-body reference of character contact): the simulator solves
  * both in one system, and its self-contact, which detects any surface vertex inside any
  * tet not its own neighbour, is then the contact between them with the same penalty law
  * (thesis eqs. 3.4-3.6). The second body is a copy of the first moved by a rest offset

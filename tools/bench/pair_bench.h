@@ -1,5 +1,5 @@
-/* sinew-bench --pair: two copies of the character pressed together side by side (issue 57,
- * character-character contact), the runtime against the two-body reference.
+/* sinew-bench --pair: two copies of the character pressed together side by side (contact
+ * between characters), the runtime against the two-body reference.
  *
  * The scene: the second copy stands beside the first along the axis across the clip's
  * bending plane (the rest bounding box's axis, other than the longest, along which the
