@@ -37,7 +37,7 @@ typedef struct sw_pair_bench {
     double pen_pair_full, pen_pair_sub, pen_pair_cond;
     double err_pair_sub, err_pair_cond;
     double full_ms, pair_ms, lone_ms, pair_cost_vs_lone;
-    int touch_frames; /* frames the pair touches (with patches): pair_ms's and lone_ms's */
+    int touch_frames;  /* frames the pair touches (with patches): pair_ms's and lone_ms's */
     double publish_ms; /* of pair_ms: the two surface copies into the colliders */
     /* the touching pair's mean step (with patches): world detection, oracle, solve and
        output ms (sinew_step_stats), and conjugate-gradient iterations */
