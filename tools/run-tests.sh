@@ -6,6 +6,8 @@
 #            the files that are not formatted (fix: clang-format -i FILE)
 #   release  Release build in build/, warnings as errors, every CTest test
 #   asan     Debug build (-O1) in build-asan/ with ASan+UBSan (leaks too), every CTest test
+#            but those that cannot or need not run instrumented (the Blender add-on, the
+#            Slurm farm: tests/CMakeLists.txt says why)
 #   tsan     Debug build (-O1) in build-tsan/ with TSan, only the tests labelled "threads"
 # Every stage runs even when an earlier one failed; the script prints each stage's wall
 # time and status and exits non-zero if any stage failed.
