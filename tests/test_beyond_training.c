@@ -59,7 +59,9 @@ TEST(the_index_holds_each_joints_largest_training_bend) {
     const double *have = f->blob->poses.joint_bend;
     int bent = 0;
     for (int32_t b = 0; b < nb; ++b) {
-        ENSUREF(fabs(have[b] - want[b]) < 1e-9, "bone %d: %.12g rad, the bake measures %.12g", b,
+        /* the index is of the poses as the step sees them, snapped to 2^-24 (sw_pose_snap):
+           1e-7 rad from the clip's own */
+        ENSUREF(fabs(have[b] - want[b]) < 1e-7, "bone %d: %.12g rad, the bake measures %.12g", b,
                 have[b], want[b]);
         bent += want[b] > 10 * DEG;
     }
@@ -121,7 +123,7 @@ TEST(a_joint_bent_past_its_training_is_counted_and_named) {
                 "%.1fx: %u joints beyond, status %u", mult[k], st.joints_beyond_training,
                 st.status);
         ENSURE(st.beyond_training_bone == (beyond ? j : -1));
-        ENSUREF(fabs(st.beyond_training_deg - (beyond ? (bend - trained) / DEG : 0)) < 1e-6,
+        ENSUREF(fabs(st.beyond_training_deg - (beyond ? (bend - trained) / DEG : 0)) < 1e-5,
                 "%.1fx: %.9f degrees beyond, want %.9f", mult[k], st.beyond_training_deg,
                 beyond ? (bend - trained) / DEG : 0);
     }

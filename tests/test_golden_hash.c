@@ -23,7 +23,7 @@ enum { NINST = 4, STEPS = 24 };
 enum { MODE_EXHAUSTIVE = NINST, MODE_POSE_PAIRS, MODE_PATCH, MODE_TURNED, NMODES };
 
 /* FNV-1a 64 of the four instances' surfaces, instance after instance. */
-#define GOLDEN_SURFACE_HASH 0x9d38c3e29a0b905full
+#define GOLDEN_SURFACE_HASH 0x3ef82337ade6105dull
 
 typedef struct {
     const bake_fixture *f;
@@ -35,7 +35,7 @@ typedef struct {
 
 /* The modes' run (surface_hash_of_every_mode_is_golden): instances 4.. of the same
  * fixture, each with one more of the step's paths. */
-#define GOLDEN_MODES_HASH 0xcb61bb78f7926f1bull
+#define GOLDEN_MODES_HASH 0xcbd19a2d31785982ull
 
 static sinew_world *props_world; /* the patch instance's: the props pressing the finger */
 

@@ -69,6 +69,73 @@ TEST(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_
     }
 }
 
+static double urand(uint64_t *s) {
+    *s = *s * 6364136223846793005ULL + 1442695040888963407ULL;
+    return (double)(*s >> 11) * 0x1.0p-53;
+}
+
+/* GT = G T for rigid transforms (12: R row-major, t). */
+static void compose(const double *G, const double *T, double *GT) {
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+            GT[3 * i + j] = G[3 * i] * T[j] + G[3 * i + 1] * T[3 + j] + G[3 * i + 2] * T[6 + j];
+        GT[9 + i] = G[3 * i] * T[9] + G[3 * i + 1] * T[10] + G[3 * i + 2] * T[11] + G[9 + i];
+    }
+}
+
+/* The mechanism (pose.c, sw_pose_snap): a pose carried by any rigid motion reaches the
+ * step bit for bit, so the reduced state (bone-relative, free of the frame) is the same
+ * bits in every mode, quasistatic and dynamic: motions about random axes, up to 180
+ * degrees, up to 10^5 away. Detections on the edge of contact then decide alike. */
+TEST(the_step_sees_a_rigidly_moved_pose_bit_for_bit) {
+    const bake_fixture *f = finger();
+    ENSURE(f);
+    if (!f) return;
+    const int32_t nb = f->ch.skel.nbones, R = sw_blob_get_view(f->blob)->rank_total;
+    const struct {
+        sinew_step_mode mode;
+        sinew_self_contact sc;
+    } modes[] = {{SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_SPACE},
+                 {SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_PAIRS},
+                 {SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_EXHAUSTIVE},
+                 {SINEW_STEP_DYNAMIC, SINEW_SELF_CONTACT_EXHAUSTIVE}};
+    double Tb[12 * 8];
+    ENSURE(nb <= 8);
+    uint64_t seed = 0x5eedu;
+    for (int k = 0; k < 4; ++k)
+        for (int trial = 0; trial < 3; ++trial) {
+            sw_move m = {SW_MOVE_RIGID, {0, 0, 0}, 0, {0, 0, 0}, 0, 0, 0};
+            for (int i = 0; i < 3; ++i) {
+                m.axis[i] = 2 * urand(&seed) - 1 + 1e-3;
+                m.shift[i] = 2e5 * urand(&seed) - 1e5;
+            }
+            m.angle = PI * (0.05 + 0.95 * urand(&seed));
+            double G[12];
+            sw_move_transform(&m, 0, G);
+            sinew_instance_def d = sinew_instance_def_default();
+            d.mode = modes[k].mode;
+            d.self_contact = modes[k].sc;
+            sinew_instance *a = NULL, *b = NULL;
+            ENSURE(sinew_instance_create(f->blob, &d, &a) == SINEW_OK &&
+                   sinew_instance_create(f->blob, &d, &b) == SINEW_OK);
+            int same = 1, frame = 0;
+            for (; same && frame < f->ch.clip.nframes; ++frame) {
+                const double *T = f->ch.clip.T + (size_t)12 * nb * frame;
+                for (int32_t j = 0; j < nb; ++j)
+                    compose(G, T + 12 * j, Tb + 12 * j);
+                ENSURE(sw_instance_set_pose_d(a, T) == SINEW_OK &&
+                       sw_instance_set_pose_d(b, Tb) == SINEW_OK);
+                ENSURE(sinew_instance_step(a, 1.0f / 30) == SINEW_OK &&
+                       sinew_instance_step(b, 1.0f / 30) == SINEW_OK);
+                same = memcmp(sw_instance_q(a), sw_instance_q(b), (size_t)R * sizeof(double)) == 0;
+            }
+            ENSUREF(same, "mode %d, motion %d: the moved instance's state differs at frame %d", k,
+                    trial, frame - 1);
+            sinew_instance_destroy(a);
+            sinew_instance_destroy(b);
+        }
+}
+
 TEST(a_character_turning_every_frame_deforms_as_one_standing_still) {
     sw_move m = {SW_MOVE_TURNING, {0.1, 1, 0.2}, 4 * PI / 180, {0.05, 0, 0.08}, 0, 0, 0};
     sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
@@ -330,9 +397,9 @@ TEST(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it) {
 }
 
 /* A real character: the elephant (24 bones, its own clip), baked quickly, turned and carried
- * 10^5 units away, quasistatic (pose-space and pose-pairs) and dynamic, as a far actor and
- * scaled. (Its exhaustive mode amplifies rounding itself to 1e-2 of its size:
- * docs/notes/placement.md.) */
+ * 10^5 units away, quasistatic (every self-contact mode) and dynamic, as a far actor and
+ * scaled. Its exhaustive mode finds contacts on the edge of touching, where the rounding
+ * of a turned pose once decided which (docs/notes/placement.md). */
 TEST(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh) {
     NEED_DATA("elephant-cd/elephant.mesh");
     bake_fixture e;
@@ -354,10 +421,12 @@ TEST(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh) {
         const sw_move *m;
     } cases[] = {{"quasistatic", SINEW_STEP_QUASISTATIC, 0, &rigid},
                  {"pose-pairs", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_POSE_PAIRS, &rigid},
+                 {"exhaustive", SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_EXHAUSTIVE, &rigid},
+                 {"exhaustive, dynamic", SINEW_STEP_DYNAMIC, SINEW_SELF_CONTACT_EXHAUSTIVE, &rigid},
                  {"dynamic", SINEW_STEP_DYNAMIC, 0, &rigid},
                  {"far actor", SINEW_STEP_QUASISTATIC, 0, &actor},
                  {"scale 0.01", SINEW_STEP_QUASISTATIC, 0, &scaled}};
-    for (int k = 0; k < 5; ++k) {
+    for (int k = 0; k < (int)(sizeof cases / sizeof cases[0]); ++k) {
         sw_invariance_run run = {cases[k].mode, cases[k].sc, NULL, NULL, 0.01f, 0, 0};
         sw_invariance_result res;
         ENSURE(sw_invariance_measure(e.blob, e.ch.clip.T, e.ch.skel.nbones, e.ch.clip.nframes, &run,
@@ -375,6 +444,7 @@ TEST(release_fixture) {
 
 SW_TEST_MAIN(
     CASE(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_mode),
+    CASE(the_step_sees_a_rigidly_moved_pose_bit_for_bit),
     CASE(a_character_turning_every_frame_deforms_as_one_standing_still),
     CASE(dynamic_flesh_carried_by_a_constant_rigid_motion_is_the_same_motion),
     CASE(an_actor_far_from_the_origin_keeps_the_origins_shape_in_its_frame),

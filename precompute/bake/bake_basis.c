@@ -445,11 +445,16 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     s->basis.train_q = malloc((size_t)T * s->basis.rank_total * sizeof(double));
     s->basis.train_pose = malloc((size_t)T * 4 * s->rig.nb * sizeof(double));
     if (!s->basis.train_q || !s->basis.train_pose) goto oom;
+    double *L = malloc((size_t)12 * s->rig.nb * sizeof(double));
+    if (!L) goto oom;
     k = 0;
     for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
-        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k)
-            sw_pose_feature(s->poses.train[i].T + (size_t)j * 12 * s->rig.nb, s->rig.ch.skel.parent,
-                            s->rig.nb, s->basis.train_pose + (size_t)k * 4 * s->rig.nb);
+        for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k) {
+            sw_bake_pose_snapped(s, s->poses.train[i].T + (size_t)j * 12 * s->rig.nb, L);
+            sw_pose_feature(L, s->rig.ch.skel.parent, s->rig.nb,
+                            s->basis.train_pose + (size_t)k * 4 * s->rig.nb);
+        }
+    free(L);
     for (int32_t a = 0; a < T; ++a) {
         int32_t off = 0;
         for (int32_t dm = 0; dm < s->domains.nd; ++dm) {

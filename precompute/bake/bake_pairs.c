@@ -31,9 +31,14 @@
 #include "cubature_train.h"
 #include "penalty.h"
 
-/* The relative transform z = [vec(R); t] of bone b in bone a's frame for transforms T. */
-static void relative_z(const double *T, int32_t a, int32_t b, double z[12]) {
-    sw_relative_transform(T + 12 * (size_t)a, T + 12 * (size_t)b, z);
+/* The relative transform z = [vec(R); t] of bone b in bone a's frame for transforms T,
+ * taken as the step takes it (sw_pose_snap, grid: sw_bake_pose_grid), so that the step at
+ * a training pose has its feature bit for bit. */
+static void relative_z(const double *T, int32_t a, int32_t b, double grid, double z[12]) {
+    double La[12], Lb[12];
+    sw_pose_snap(T, T + 12 * (size_t)a, 1, grid, La);
+    sw_pose_snap(T, T + 12 * (size_t)b, 1, grid, Lb);
+    sw_relative_transform(La, Lb, z);
 }
 
 /* Training pose k (in stored order): its sequence, and k's index in it. */
@@ -108,7 +113,7 @@ static int complete_directions(const double Gh[144], double W[6][12], int kept) 
 
 /* Group g's 6 x 12 feature map (see above) from domain b's rest vertices and the training
  * poses' relative transforms. */
-static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map) {
+static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double grid, double *map) {
     double G[144] = {0}, S[144] = {0}, ev[12], H[144], Gh[144];
     memset(map, 0, 72 * sizeof(double));
     if (a == b) return 1;
@@ -138,7 +143,7 @@ static int feature_map(const sw_bake_state *s, int32_t a, int32_t b, double *map
         }
     for (int32_t t = 0; t < s->basis.ntrain; ++t) { /* S = G^1/2 (sum z z^T) G^1/2 */
         double z[12], u[12];
-        relative_z(train_T(s, t), s->domains.domain_bone[a], s->domains.domain_bone[b], z);
+        relative_z(train_T(s, t), s->domains.domain_bone[a], s->domains.domain_bone[b], grid, z);
         whiten(Gh, z, u);
         for (int i = 0; i < 12; ++i)
             for (int j = 0; j < 12; ++j)
@@ -260,6 +265,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     sw_blob_view *v = &out->view;
     if (v->ncontacts == 0) return SINEW_OK; /* no pose touches itself: no groups */
     const int32_t nd = v->ndomains, T = v->ntrain, R = v->rank_total;
+    const double grid = sw_bake_pose_grid(s);
     int32_t G = 0, *dom = find_groups(v, &G);
     int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t));
     int32_t *cv2 = malloc((size_t)v->ncontacts * 8 * sizeof(int32_t));
@@ -279,7 +285,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     memcpy(pd, dom, (size_t)G * 2 * sizeof(int32_t));
     for (int32_t g = 0; g < G; ++g) {
         gi[dom[2 * g] * nd + dom[2 * g + 1]] = g;
-        if (!feature_map(s, dom[2 * g], dom[2 * g + 1], map + 72 * (size_t)g)) {
+        if (!feature_map(s, dom[2 * g], dom[2 * g + 1], grid, map + 72 * (size_t)g)) {
             r = sw_error_set(err, SINEW_ERROR_NOT_CONVERGED,
                              "pose-space pairs: no eigenvectors for the feature of domains %d, %d",
                              dom[2 * g], dom[2 * g + 1]);
@@ -288,7 +294,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         for (int32_t t = 0; t < T; ++t) {
             double z[12];
             relative_z(train_T(s, t), s->domains.domain_bone[dom[2 * g]],
-                       s->domains.domain_bone[dom[2 * g + 1]], z);
+                       s->domains.domain_bone[dom[2 * g + 1]], grid, z);
             for (int k = 0; k < 6; ++k)
                 feat[6 * ((size_t)g * T + t) + k] = sw_dot(map + 72 * (size_t)g + 12 * k, z, 12);
         }

@@ -5,7 +5,20 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "bbox.h"
 #include "clock.h"
+#include "dqs.h"
+
+double sw_bake_pose_grid(const sw_bake_state *s) {
+    double lo[3], hi[3]; /* the runtime's size: the rest bounding box's diagonal */
+    sw_bbox_empty(lo, hi);
+    sw_bbox_add(lo, hi, s->rig.nv, s->rig.ch.mesh.X);
+    return sw_pose_grid(sw_bbox_diagonal(lo, hi));
+}
+
+void sw_bake_pose_snapped(const sw_bake_state *s, const double *T, double *L) {
+    sw_pose_snap(T, T, s->rig.nb, sw_bake_pose_grid(s), L);
+}
 
 void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R, double *t) {
     sw_dualquat dq[SW_MAX_BONES];

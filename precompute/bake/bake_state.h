@@ -137,6 +137,14 @@ void sw_bake_state_free(sw_bake_state *s);
 void sw_bake_progress_begin(sw_bake_state *s, const char *stage, int64_t total);
 void sw_bake_progress(sw_bake_state *s, int64_t units);
 
+/* Bone transforms T as the runtime's step sees them (sw_pose_snap: relative to bone 0,
+ * snapped to the grid of the rest mesh's size), into L (12 nb): what the pose features and
+ * the per-pair features are measured on, so that the step at a training pose finds it at
+ * distance 0. */
+void sw_bake_pose_snapped(const sw_bake_state *s, const double *T, double *L);
+/* The translations' grid of it (sw_pose_grid of the rest mesh's size). O(nv). */
+double sw_bake_pose_grid(const sw_bake_state *s);
+
 /* Per-vertex DQS transforms of all vertices for bone transforms T. */
 void sw_bake_skin_transforms(const sw_bake_state *s, const double *T, double *R /* 9 nv */,
                              double *t /* 3 nv */);

@@ -4,6 +4,7 @@
 #include <string.h>
 
 #include "collision.h"
+#include "dqs.h"
 #include "vec3.h"
 
 /* ---- creation: clusters and areas ------------------------------------------------ */
@@ -223,6 +224,50 @@ static void copy_position(const sw_reduced *red, int32_t i, const double *q, dou
     sw_reduced_position(red, D, v->surf_copies[2 * i + 1], red->copy_act[i], q + D->q_offset, x, J);
 }
 
+/* x of the step's frame in the world (wc->frame). */
+static void to_world(const sw_world_contacts *wc, const double x[3], double y[3]) {
+    const double *F = wc->frame;
+    for (int i = 0; i < 3; ++i)
+        y[i] = F ? F[3 * i] * x[0] + F[3 * i + 1] * x[1] + F[3 * i + 2] * x[2] + F[9 + i] : x[i];
+}
+
+/* A collider's answer (in the world) in the step's frame, snapped: the same world moved
+ * with the character answers within rounding, which the grid takes to the same value. */
+static void hit_to_step(const sw_world_contacts *wc, sw_collider_hit *hit) {
+    const double *F = wc->frame;
+    if (!F) return;
+    double d[3], n[3];
+    for (int k = 0; k < 3; ++k) {
+        d[k] = hit->point[k] - F[9 + k];
+        n[k] = hit->normal[k];
+    }
+    for (int i = 0; i < 3; ++i) {
+        hit->point[i] = sw_snap(F[i] * d[0] + F[3 + i] * d[1] + F[6 + i] * d[2], wc->grid);
+        hit->normal[i] = sw_snap(F[i] * n[0] + F[3 + i] * n[1] + F[6 + i] * n[2], 0x1p-24);
+    }
+    hit->phi = sw_snap(hit->phi, wc->grid);
+}
+
+/* The world box of a box of the step's frame. */
+static void box_to_world(const sw_world_contacts *wc, const double b[6], double w[6]) {
+    const double *F = wc->frame;
+    if (!F) {
+        memcpy(w, b, 6 * sizeof(double));
+        return;
+    }
+    double c[3], h[3], cw[3];
+    for (int k = 0; k < 3; ++k) {
+        c[k] = 0.5 * (b[k] + b[3 + k]);
+        h[k] = 0.5 * (b[3 + k] - b[k]);
+    }
+    to_world(wc, c, cw);
+    for (int i = 0; i < 3; ++i) {
+        double r = fabs(F[3 * i]) * h[0] + fabs(F[3 * i + 1]) * h[1] + fabs(F[3 * i + 2]) * h[2];
+        w[i] = cw[i] - r;
+        w[3 + i] = cw[i] + r;
+    }
+}
+
 static int is_candidate(const sw_world_contacts *wc, int32_t copy, int32_t slot) {
     for (int32_t j = wc->copy_first[copy]; j >= 0; j = wc->cand[j].next)
         if (wc->cand[j].slot == slot) return 1;
@@ -235,15 +280,16 @@ void sw_world_contacts_clear(sw_world_contacts *wc) {
     wc->ncand = 0;
 }
 
-/* Queries copy i at x against world slot s; a hit within the radius (or, with
- * penetrating_only, inside) becomes a candidate unless it is one already. */
-static void try_candidate(sw_world_contacts *wc, int32_t i, const double x[3], uint32_t s,
+/* Queries copy i at xw (the world's) against world slot s; a hit within the radius (or,
+ * with penetrating_only, inside) becomes a candidate unless it is one already. */
+static void try_candidate(sw_world_contacts *wc, int32_t i, const double xw[3], uint32_t s,
                           double blob_k, int penetrating_only) {
     const sw_collider *c = sw_world_slot(wc->world, s);
     sw_collider_hit hit;
     if (penetrating_only && is_candidate(wc, i, (int32_t)s)) return;
     wc->queries++;
-    if (!sw_collider_query(c, x, wc->radius, &hit)) return;
+    if (!sw_collider_query(c, xw, wc->radius, &hit)) return;
+    hit_to_step(wc, &hit);
     if (penetrating_only && !(hit.phi < 0)) return;
     if (wc->ncand >= wc->max_cand) {
         wc->dropped++;
@@ -338,17 +384,20 @@ double sw_world_cluster_box(const sw_world_contacts *wc, const sw_blob_view *v, 
  * all), the cluster's positions computed once (or, with copy_x, read from there). */
 static void narrow_cluster(sw_world_contacts *wc, const sw_reduced *red, const double *q, int32_t c,
                            const double *box, const double *copy_x, int penetrating_only) {
-    double x[SW_WORLD_CLUSTER][3];
+    double x[SW_WORLD_CLUSTER][3], bw[6];
     int32_t b = wc->cl_begin[c], n = wc->cl_begin[c + 1] - b, have = 0;
     uint32_t ns = sw_world_slot_count(wc->world);
+    if (box) box_to_world(wc, box, bw);
     for (uint32_t s = 0; s < ns; ++s) {
         double cb[6];
-        if (!collider_box(wc, s, cb) || (box && !boxes_overlap(box, cb))) continue;
-        for (int32_t j = 0; j < n && !have; ++j) {
+        if (!collider_box(wc, s, cb) || (box && !boxes_overlap(bw, cb))) continue;
+        for (int32_t j = 0; j < n && !have; ++j) { /* in the world */
+            double y[3];
             if (copy_x)
-                memcpy(x[j], copy_x + 3 * wc->cl_copy[b + j], sizeof x[j]);
+                memcpy(y, copy_x + 3 * wc->cl_copy[b + j], sizeof y);
             else
-                copy_position(red, wc->cl_copy[b + j], q, x[j], NULL);
+                copy_position(red, wc->cl_copy[b + j], q, y, NULL);
+            to_world(wc, y, x[j]);
         }
         have = 1;
         for (int32_t j = 0; j < n; ++j)
@@ -403,7 +452,7 @@ int32_t sw_world_contacts_add_missed(sw_world_contacts *wc, const sw_reduced *re
     return wc->ncand - before;
 }
 
-/* Candidate j's law taken again at x: the collider's normal at x's closest point, the
+/* Candidate j's law taken again at x (the world's): the collider's normal at x's closest point, the
  * friction cap from the normal force there, and the anchor (the friction's stick point)
  * either that closest point or, with keep_anchor, the old anchor projected onto the new
  * plane. A collider no longer within four detection radii leaves the law without
@@ -426,6 +475,7 @@ static void refresh_candidate(sw_world_contacts *wc, int32_t j, const double x[3
         cd->law.cap = 0;
         return;
     }
+    hit_to_step(wc, &hit);
     double e = 0; /* the old anchor's height over the new plane */
     for (int k = 0; k < 3; ++k)
         e += (cd->law.a[k] - hit.point[k]) * hit.normal[k];
@@ -436,9 +486,11 @@ static void refresh_candidate(sw_world_contacts *wc, int32_t j, const double x[3
     cd->law.cap = sw_collider_friction(c) * cd->law.k * fmax(0.0, -hit.phi);
 }
 
-int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double x[3], double blob_k,
+int32_t sw_world_contacts_at(sw_world_contacts *wc, int32_t i, const double xs[3], double blob_k,
                              sw_wc_at_mode mode) {
     int32_t before = wc->ncand;
+    double x[3]; /* in the world */
+    to_world(wc, xs, x);
     for (int32_t j = wc->copy_first[i]; mode != SW_WC_AT_MISSED && j >= 0; j = wc->cand[j].next)
         refresh_candidate(wc, j, x, mode == SW_WC_AT_REPLANE);
     int penetrating_only = mode == SW_WC_AT_MISSED;

@@ -62,7 +62,13 @@ typedef struct sw_world_contacts {
                               the candidates with patch >= 0 are (condense.h) */
     int boxes_valid;       /* cl_box holds the last output */
     double radius;         /* detection radius (world units) */
-    uint32_t queries;      /* collider queries of the last detection */
+    /* The step's frame in the world (12: R row-major, t; the instance's, pose.c), or NULL
+     * for the world's own: positions here (copies, laws, boxes) are in it, the colliders
+     * in the world; a query's answer comes back snapped to `grid` (sw_pose_grid), as the
+     * pose is, so a world moved with the character gives the step the same laws. */
+    const double *frame;
+    double grid;
+    uint32_t queries; /* collider queries of the last detection */
 } sw_world_contacts;
 
 /* Upper bound of the cluster count for a blob (sizes the instance's memory). */

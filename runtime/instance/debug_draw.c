@@ -15,10 +15,11 @@ typedef struct dd_ctx {
     float normal_len, point_size;
 } dd_ctx;
 
-/* A point of the simulation frame (or with direction, a vector) as the host's floats. */
+/* A point of the step's frame (or with direction, a vector) as the host's floats. */
 static void to_host(const dd_ctx *c, const double x[3], int direction, float y[3]) {
-    double a[3];
-    sw_instance_to_actor(c->in, x, direction, a);
+    double a[3], w[3];
+    sw_instance_from_step(c->in, x, direction, w);
+    sw_instance_to_actor(c->in, w, direction, a);
     for (int i = 0; i < 3; ++i)
         y[i] = (float)a[i];
 }
@@ -101,8 +102,12 @@ static void draw_colliders(const dd_ctx *c) {
         if (!col) continue;
         int n = sw_collider_outline(col, around, in->size, k);
         float p[8][3];
-        for (int j = 0; j < n; ++j)
-            to_host(c, k[j], 0, p[j]);
+        for (int j = 0; j < n; ++j) { /* in the world, not the step's frame */
+            double a[3];
+            sw_instance_to_actor(in, k[j], 0, a);
+            for (int i = 0; i < 3; ++i)
+                p[j][i] = (float)a[i];
+        }
         if (n == 4) {
             for (int j = 0; j < 4; ++j)
                 line(c, p[j], p[(j + 1) % 4], SINEW_DEBUG_COLOR_COLLIDER);

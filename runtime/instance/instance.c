@@ -49,6 +49,10 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(in->pose.T_cur, 12 * nb);
     TAKE(in->pose.T_prev, 12 * nb);
     TAKE(in->pose.T_prev2, 12 * nb);
+    TAKE(in->loc.T_cur, 12 * nb);
+    TAKE(in->loc.T_prev, 12 * nb);
+    TAKE(in->loc.T_prev2, 12 * nb);
+    TAKE(in->L_last, 12 * nb);
     /* the subspace map: active vertices and their skinning, accumulators, Jacobians */
     sw_reduced *m = &in->red;
     TAKE(m->act_vert, na);
@@ -529,6 +533,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sw_world_contacts_build(&in->wc, v);
     /* 2% of the character's size: what a surface vertex can travel in one step */
     in->wc.radius = 0.01 * in->size;
+    in->wc.frame = in->frame; /* the step's (pose.c) */
+    in->wc.grid = sw_pose_grid(in->size);
     in->ps.twin_next = blob->poses.twin_next; /* the blob's, computed once at its load */
     in->ps.reach = blob->poses.reach;
     in->ps.joint_bend = blob->poses.joint_bend;
@@ -593,6 +599,9 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     ph->history = 0;
     ph->h_prev = 0;
     ph->declared_jump = 0;
+    sw_instance_frame(inst);
+    memcpy(inst->L_last, inst->loc.T_cur, 12 * (size_t)nb * sizeof(double));
+    memcpy(inst->frame_last, inst->frame, sizeof inst->frame);
     sw_pose_space_reset(&inst->ps, nb);
     inst->wc.boxes_valid = 0;
     sw_world_contacts_clear(&inst->wc);

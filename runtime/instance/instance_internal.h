@@ -32,7 +32,19 @@ struct sinew_instance {
     double *pose_host;
     double actor[12];
     double actor_scale, pose_scale, scale;
-    sw_pose_history pose;         /* the current pose and the two before */
+    sw_pose_history pose; /* the current pose and the two before */
+    /* The step's frame (pose.c, sw_instance_frame): the step works in bone 0's frame F
+     * (frame: R row-major, t, in the simulation frame). loc holds the pose history there,
+     * each bone F^-1 T snapped to a grid (sw_pose_snap), and the world's answers come in
+     * snapped the same way (world_contact.c), so that the same pose carried by any rigid
+     * motion gives the step bitwise the same inputs and the decisions that flip with
+     * rounding (self-contact detection, ties, line searches) the same answers. The output
+     * surface is written back in the simulation frame. L_last: loc's T_cur of the last
+     * step, the frame of its output (the broad phases carry its boxes from there);
+     * frame_last: its F. */
+    sw_pose_history loc;
+    double *L_last;
+    double frame[12], frame_last[12];
     sw_reduced red;               /* the subspace map and the evaluation accumulators */
     sw_pose_space ps;             /* training poses near the current one, contact pairs */
     sw_solver solver;             /* state and Newton */
@@ -76,6 +88,14 @@ void sw_instance_actor_identity(sinew_instance *in);
 /* The rest pose where the actor stands: the host's bones the identity, composed into
  * pose.T_cur and bone_dq (reset). */
 void sw_instance_rest_pose(sinew_instance *in);
+
+/* The step's frame and loc from the pose history, and bone_dq from loc (pose.c). */
+void sw_instance_frame(sinew_instance *in);
+
+/* A point (or with direction, a vector) of the step's frame in the simulation frame, and
+ * back. */
+void sw_instance_from_step(const sinew_instance *in, const double x[3], int direction, double y[3]);
+void sw_instance_to_step(const sinew_instance *in, const double x[3], int direction, double y[3]);
 
 /* Surface vertex i (position, or with direction set a normal) of the simulation frame
  * in the actor's frame, as the host reads it. */

@@ -51,10 +51,13 @@ SINEW_API sinew_result sinew_instance_collider_force(const sinew_instance *inst,
     for (int32_t j = 0; j < wc->ncand; ++j) {
         const sw_world_cand *cd = &wc->cand[j];
         if (cd->id != id) continue;
-        double f[3] = {-cd->f[0], -cd->f[1], -cd->f[2]}, r[3];
+        double f[3], a[3], r[3]; /* in the world, from the step's frame */
+        sw_instance_from_step(inst, cd->f, 1, f);
+        sw_instance_from_step(inst, cd->law.a, 0, a);
         for (int k = 0; k < 3; ++k) {
+            f[k] = -f[k];
             F[k] += f[k];
-            r[k] = cd->law.a[k] - o[k];
+            r[k] = a[k] - o[k];
         }
         M[0] += r[1] * f[2] - r[2] * f[1];
         M[1] += r[2] * f[0] - r[0] * f[2];

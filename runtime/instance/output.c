@@ -61,7 +61,14 @@ void sw_instance_write_surface(sinew_instance *in) {
     } else {
         sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
     }
-    if (boxes) sw_world_contacts_update_boxes(&in->wc);
+    if (boxes) sw_world_contacts_update_boxes(&in->wc); /* (of copy_x, in the step's frame) */
+    for (int32_t i = 0; i < sw_blob_output_verts(v); ++i) {
+        double y[3];
+        sw_instance_from_step(in, in->surf_x + 3 * i, 0, y);
+        memcpy(in->surf_x + 3 * i, y, sizeof y);
+        sw_instance_from_step(in, in->surf_n + 3 * i, 1, y);
+        memcpy(in->surf_n + 3 * i, y, sizeof y);
+    }
 }
 
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
@@ -115,7 +122,16 @@ int32_t sw_instance_nearest_pose(const sinew_instance *inst) {
     return inst->ps.nearest;
 }
 
-/* Domain D's copy lv of its vertex (global gv) in world space, as the runtime's state
+/* n points of the step's frame moved to the simulation frame, in place. */
+static void to_sim(const sinew_instance *inst, int32_t n, double *x) {
+    for (int32_t i = 0; i < n; ++i) {
+        double y[3];
+        sw_instance_from_step(inst, x + 3 * i, 0, y);
+        memcpy(x + 3 * i, y, sizeof y);
+    }
+}
+
+/* Domain D's copy lv of its vertex (global gv) in the step's frame, as the runtime's state
  * places it: rest + U q skinned by the vertex's own DQS transform. */
 static void copy_position(const sinew_instance *inst, const sw_blob_domain *D, int32_t lv,
                           int32_t gv, double x[3]) {
@@ -164,6 +180,7 @@ void sw_instance_full_positions(const sinew_instance *inst, double *x, double *c
                 x[3 * gv + i] = R[3 * i] * X[0] + R[3 * i + 1] * X[1] + R[3 * i + 2] * X[2] + t[i];
         }
     }
+    to_sim(inst, v->nverts, x);
 }
 
 double sw_instance_copy_spread(const sinew_instance *inst, const double *x, double *spread) {
@@ -177,6 +194,7 @@ double sw_instance_copy_spread(const sinew_instance *inst, const double *x, doub
             if (sw_cond_position(&inst->cond, gv)) continue; /* solved in full space */
             double y[3], e = 0;
             copy_position(inst, D, lv, gv, y);
+            to_sim(inst, 1, y);
             for (int i = 0; i < 3; ++i)
                 e += (y[i] - x[3 * gv + i]) * (y[i] - x[3 * gv + i]);
             spread[gv] += e;
@@ -189,13 +207,14 @@ double sw_instance_copy_spread(const sinew_instance *inst, const double *x, doub
 void sw_instance_dqs_positions(const sinew_instance *inst, double *x) {
     const sw_blob_view *v = inst->v;
     sw_dqs_skin(v->nverts, v->rest, inst->bone_dq, v->skin_bone, v->skin_weight, 4, x);
+    to_sim(inst, v->nverts, x);
 }
 
 double sw_instance_potential(sinew_instance *inst, const double *q, double *g, double *H) {
     sw_dyn_coef dc = {1.0 / 30, 0, 0, 0, 0, 0};
     size_t R = (size_t)inst->red.R;
     sw_reduced_skin(&inst->red, inst->bone_dq);
-    sw_pose_space_lookup(&inst->ps, inst->v, inst->pose.T_cur);
+    sw_pose_space_lookup(&inst->ps, inst->v, inst->loc.T_cur);
     sw_pose_space_gather_pairs(&inst->ps, inst->v);
     sw_step_contacts ct = sw_instance_contacts(inst, NULL);
     double phi = sw_potential(&inst->red, &ct, &inst->solver, q, &dc, g || H, H != NULL);
@@ -208,7 +227,8 @@ void sw_instance_set_q(sinew_instance *inst, const double *q) {
     memcpy(inst->solver.q, q, (size_t)inst->red.R * sizeof(double));
 }
 
-/* Simulation vertex gv skinned at the current pose (no correction) into y. */
+/* Simulation vertex gv skinned at the current pose (no correction) into y, in the
+ * simulation frame. */
 static void skin_vertex(const sinew_instance *inst, int32_t gv, double y[3]) {
     const sw_blob_view *v = inst->v;
     double R[9], t[3];
@@ -216,6 +236,7 @@ static void skin_vertex(const sinew_instance *inst, int32_t gv, double y[3]) {
     sw_dqs_blend(inst->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, R, t);
     for (int k = 0; k < 3; ++k)
         y[k] = R[3 * k] * X[0] + R[3 * k + 1] * X[1] + R[3 * k + 2] * X[2] + t[k];
+    to_sim(inst, 1, y);
 }
 
 void sw_instance_skinned_surface(const sinew_instance *inst, double *x) {

@@ -4,8 +4,10 @@
  * in doubles). Both are checked before any is taken, and composed into the simulation
  * frame (instance_internal.h): the world divided by the whole scale, so that the flesh
  * is the physics of the rest-size character at any scale (DESIGN.md §3), with the
- * bones' rigid transforms there in double precision, so that 10^5 units from the
- * origin is the origin's shape to rounding. Never allocates or locks. */
+ * bones' rigid transforms there in double precision. The step itself works in bone 0's
+ * frame with the pose snapped to a grid there (sw_instance_frame): a turned or moved
+ * character gives it the same bits, and 10^5 units from the origin is the origin's
+ * shape. Never allocates or locks. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -58,13 +60,44 @@ static void compose_bone(const sinew_instance *in, int32_t b, double *T) {
     }
 }
 
-/* pose.T_cur and bone_dq from the host's bones and the actor. */
+/* pose.T_cur from the host's bones and the actor, and the step's frame from it. */
 static void compose(sinew_instance *in) {
     in->scale = in->actor_scale * in->pose_scale;
-    for (int32_t b = 0; b < in->v->nbones; ++b) {
+    for (int32_t b = 0; b < in->v->nbones; ++b)
         compose_bone(in, b, in->pose.T_cur + 12 * b);
-        sw_dq_from_transform(in->pose.T_cur + 12 * b, &in->bone_dq[b]);
-    }
+    sw_instance_frame(in);
+}
+
+void sw_instance_frame(sinew_instance *in) {
+    const int32_t nb = in->v->nbones;
+    sw_pose_history *P = &in->pose, *L = &in->loc;
+    L->history = P->history;
+    L->h_prev = P->h_prev;
+    L->declared_jump = P->declared_jump;
+    memcpy(in->frame, P->T_cur, sizeof in->frame); /* bone 0 */
+    const double g = sw_pose_grid(in->size);
+    sw_pose_snap(in->frame, P->T_cur, nb, g, L->T_cur);
+    sw_pose_snap(in->frame, P->T_prev, nb, g, L->T_prev);
+    sw_pose_snap(in->frame, P->T_prev2, nb, g, L->T_prev2);
+    for (int32_t b = 0; b < nb; ++b)
+        sw_dq_from_transform(L->T_cur + 12 * b, &in->bone_dq[b]);
+}
+
+void sw_instance_to_step(const sinew_instance *in, const double x[3], int direction, double y[3]) {
+    const double *F = in->frame;
+    double d[3];
+    for (int k = 0; k < 3; ++k)
+        d[k] = x[k] - (direction ? 0 : F[9 + k]);
+    for (int i = 0; i < 3; ++i)
+        y[i] = F[i] * d[0] + F[3 + i] * d[1] + F[6 + i] * d[2];
+}
+
+void sw_instance_from_step(const sinew_instance *in, const double x[3], int direction,
+                           double y[3]) {
+    const double *F = in->frame;
+    for (int i = 0; i < 3; ++i)
+        y[i] = F[3 * i] * x[0] + F[3 * i + 1] * x[1] + F[3 * i + 2] * x[2] +
+               (direction ? 0 : F[9 + i]);
 }
 
 void sw_instance_actor_identity(sinew_instance *in) {

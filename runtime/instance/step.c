@@ -55,11 +55,40 @@ static sw_dyn_coef step_coef(const sinew_instance *in, float dt) {
     return dc;
 }
 
+/* The last dynamic patch's state (patch_dynamics.c: positions, velocities, deviations
+ * and their rates, in the frame of the step that left them) moved into this step's
+ * frame: E = F^-1 F_last. O(last patch). */
+static void reframe_patch(sinew_instance *in) {
+    sw_cond *cd = &in->cond;
+    const double *F = in->frame, *G = in->frame_last;
+    if (cd->z.max_verts == 0 || cd->nf == 0 || memcmp(F, G, sizeof in->frame) == 0) return;
+    double E[12];
+    for (int i = 0; i < 3; ++i) {
+        for (int j = 0; j < 3; ++j)
+            E[3 * i + j] = F[i] * G[j] + F[3 + i] * G[3 + j] + F[6 + i] * G[6 + j];
+        E[9 + i] = F[i] * (G[9] - F[9]) + F[3 + i] * (G[10] - F[10]) + F[6 + i] * (G[11] - F[11]);
+    }
+    for (int32_t i = 0; i < cd->nf; ++i) {
+        int64_t gv = cd->fv[i];
+        if (cd->dyn_at[gv] != cd->stamp) continue;
+        double *vec[4] = {cd->px + 3 * gv, cd->pv + 3 * gv, cd->pdev + 3 * gv, cd->prate + 3 * gv};
+        for (int a = 0; a < 4; ++a) {
+            double y[3];
+            for (int k = 0; k < 3; ++k)
+                y[k] = E[3 * k] * vec[a][0] + E[3 * k + 1] * vec[a][1] + E[3 * k + 2] * vec[a][2] +
+                       (a == 0 ? E[9 + k] : 0);
+            memcpy(vec[a], y, sizeof y);
+        }
+    }
+}
+
 static void step_begin(sw_step_ctx *c, sinew_instance *in, float dt) {
     memset(c, 0, sizeof *c);
     c->in = in;
     c->st.struct_size = sizeof c->st;
     c->dc = step_coef(in, dt);
+    sw_instance_frame(in); /* the history moved on since the pose was set */
+    if (c->dc.dynamic) reframe_patch(in);
     memcpy(in->solver.qn, in->solver.q, (size_t)in->red.R * sizeof(double));
     in->solver.mat_at_qn = 0;
     c->t = sw_now_seconds();
@@ -85,7 +114,7 @@ sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) 
  * mode, their pairs. */
 static void phase_contact(sw_step_ctx *c) {
     sinew_instance *in = c->in;
-    sw_pose_space_lookup(&in->ps, in->v, in->pose.T_cur);
+    sw_pose_space_lookup(&in->ps, in->v, in->loc.T_cur);
     c->st.joints_beyond_training = (uint32_t)sw_pose_space_beyond(
         &in->ps, in->v, &c->st.beyond_training_bone, &c->st.beyond_training_deg);
     if (c->st.joints_beyond_training > 0) c->st.status |= SINEW_STEP_BEYOND_TRAINING;
@@ -93,7 +122,7 @@ static void phase_contact(sw_step_ctx *c) {
         in->ps.npairs = in->ps.dropped = 0;
     } else {
         if (in->self_mode == SINEW_SELF_CONTACT_POSE_PAIRS)
-            sw_pair_space_gather(&in->ps, in->v, in->pose.T_cur);
+            sw_pair_space_gather(&in->ps, in->v, in->loc.T_cur);
         else
             sw_pose_space_gather_pairs(&in->ps, in->v);
         c->st.self_contact_tests = c->st.self_contacts = (uint32_t)in->ps.npairs;
@@ -115,8 +144,8 @@ static void phase_contact(sw_step_ctx *c) {
 static void novel_self(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     double t = sw_now_seconds();
-    const double *T_last = in->pose.history >= 1 ? in->pose.T_prev : NULL;
-    sw_novel_detect(&in->novel, &in->sc, &in->wc, &in->red, in->solver.q, &in->ps, in->pose.T_cur,
+    const double *T_last = in->pose.history >= 1 ? in->L_last : NULL;
+    sw_novel_detect(&in->novel, &in->sc, &in->wc, &in->red, in->solver.q, &in->ps, in->loc.T_cur,
                     T_last, c->st.joints_beyond_training > 0);
     if (in->sc.npairs > 0) in->solver.mat_at_qn = 0; /* a dynamic step's part at q_n lacks them */
     c->st.novel_contacts = (uint32_t)in->sc.npairs;
@@ -211,14 +240,14 @@ static void phase_dynamics(sw_step_ctx *c) {
     int32_t R = in->red.R;
     if (in->pose.declared_jump ||
         (in->pose.history >= 1 &&
-         sw_pose_jump(in->v, &in->pose, in->bone_ball, in->size, c->dc.h))) {
+         sw_pose_jump(in->v, &in->loc, in->bone_ball, in->size, c->dc.h))) {
         memset(s->qdot, 0, (size_t)R * sizeof(double));
-        in->pose.history = 0;
+        in->pose.history = in->loc.history = 0;
         in->pose.declared_jump = 0;
         c->st.status |= SINEW_STEP_TELEPORT;
     }
     if (c->dc.dynamic) {
-        sw_inertial_forces(in->v, &in->pose, s, c->dc.h);
+        sw_inertial_forces(in->v, &in->loc, s, c->dc.h);
         /* H_n: the material and pose-space self-contact (the exhaustive mode's pairs are
            detected after the start state, phase_self); Newton's first evaluation, at q_n,
            starts from the same part instead of another cubature pass */
@@ -241,8 +270,8 @@ static void phase_world(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_world_contacts *wc = &in->wc;
     if (!wc->world) return;
-    const double *T_last = in->pose.history >= 1 ? in->pose.T_prev : NULL;
-    sw_world_contacts_detect(wc, &in->red, in->solver.q, in->pose.T_cur, T_last);
+    const double *T_last = in->pose.history >= 1 ? in->L_last : NULL;
+    sw_world_contacts_detect(wc, &in->red, in->solver.q, in->loc.T_cur, T_last);
     c->st.world_rounds = 1;
     c->st.ms_world = lap(c);
 }
@@ -266,7 +295,7 @@ static void phase_oracle(sw_step_ctx *c) {
     cd->g0_step = 0;
     if (sw_cond_oracle(cd, &in->red, wc, &in->ps, sc, in->novel_on, in->solver.q) > 0) {
         if (c->dc.dynamic) {
-            const sw_pose_history *ph = &in->pose;
+            const sw_pose_history *ph = &in->loc;
             for (int32_t b = 0; b < in->v->nbones; ++b) {
                 sw_dq_from_transform(ph->T_prev + 12 * b, &cd->dq_prev[b]);
                 sw_dq_from_transform(ph->T_prev2 + 12 * b, &cd->dq_prev2[b]);
@@ -417,6 +446,8 @@ static void phase_advance(sw_step_ctx *c) {
         }
     }
     sw_pose_history_advance(&in->pose, v->nbones, c->dc.h);
+    memcpy(in->L_last, in->loc.T_cur, 12 * (size_t)v->nbones * sizeof(double));
+    memcpy(in->frame_last, in->frame, sizeof in->frame);
     c->st.ms_dynamics += lap(c);
 }
 

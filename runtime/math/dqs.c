@@ -5,6 +5,7 @@
 #include "dqs.h"
 
 #include <math.h>
+#include <string.h>
 
 /* Shepperd (1978): of the four equivalent formulas for a quaternion from a rotation
  * matrix, use the one whose square root has the largest argument (the largest of
@@ -138,7 +139,10 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
         }
         sw_dualquat dq;
         sw_dq_from_transform(L, &dq);
-        double s = dq.r[0] < 0 ? -1.0 : 1.0;
+        /* unit: a snapped pose's rotations (sw_pose_snap) are orthonormal to 1e-8 only */
+        double n =
+            sqrt(dq.r[0] * dq.r[0] + dq.r[1] * dq.r[1] + dq.r[2] * dq.r[2] + dq.r[3] * dq.r[3]);
+        double s = (dq.r[0] < 0 ? -1.0 : 1.0) / n;
         for (int k = 0; k < 4; ++k)
             feature[4 * b + k] = s * dq.r[k];
     }
@@ -168,4 +172,32 @@ double sw_pose_distance(const double *fa, const double *fb, int32_t nbones) {
         d += 1.0 - c * c;
     }
     return d;
+}
+
+double sw_pose_grid(double size) {
+    double g = 0x1p-24, want = size * 0x1p-24;
+    if (!(size > 0) || !(size < 1e300)) return g;
+    while (g > want)
+        g *= 0.5;
+    while (2 * g <= want)
+        g *= 2;
+    return g;
+}
+
+void sw_pose_snap(const double F[12], const double *T, int32_t nb, double grid, double *L) {
+    double R[9], t[3]; /* F's own: F may be T_0, overwritten first */
+    memcpy(R, F, sizeof R);
+    memcpy(t, F + 9, sizeof t);
+    for (int32_t b = 0; b < nb; ++b) {
+        const double *Tb = T + 12 * (int64_t)b;
+        double *Lb = L + 12 * (int64_t)b;
+        for (int i = 0; i < 3; ++i) {
+            for (int j = 0; j < 3; ++j)
+                Lb[3 * i + j] =
+                    sw_snap(R[i] * Tb[j] + R[3 + i] * Tb[3 + j] + R[6 + i] * Tb[6 + j], 0x1p-24);
+            Lb[9 + i] = sw_snap(R[i] * (Tb[9] - t[0]) + R[3 + i] * (Tb[10] - t[1]) +
+                                    R[6 + i] * (Tb[11] - t[2]),
+                                grid);
+        }
+    }
 }

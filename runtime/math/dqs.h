@@ -8,6 +8,7 @@
 #ifndef SW_DQS_H
 #define SW_DQS_H
 
+#include <math.h>
 #include <stdint.h>
 
 typedef struct sw_dualquat {
@@ -45,6 +46,26 @@ double sw_pose_feature_bend(const double q[4]);
 /* z = [vec(R); t] (R row-major) of Tb in Ta's frame, Ta^-1 Tb, for rigid transforms Ta, Tb
  * (12 each): the per-pair contact feature's input (bake_pairs.c, pair_space.c). */
 void sw_relative_transform(const double Ta[12], const double Tb[12], double z[12]);
+
+/* x on the grid of spacing g (a power of two), to nearest. */
+static inline double sw_snap(double x, double g) {
+    return nearbyint(x / g) * g;
+}
+
+/* The grid a pose's translations are snapped to for a character of rest diagonal size:
+ * the power of two nearest below size 2^-24 (2^-24 for a size that is not positive). */
+double sw_pose_grid(double size);
+
+/* L_b = F^-1 T_b for each of nb bones (rigid transforms, R row-major and t), each
+ * rotation entry snapped to 2^-24 and each translation to grid (sw_pose_grid): the pose as
+ * the step sees it with F its bone 0 (runtime pose.c), and as the bake measures its
+ * training poses' features with, so that a training pose given again is the stored one
+ * bit for bit. The same bones carried by any rigid motion give F^-1 T within rounding
+ * (1e-16 of the distances involved), which the grid takes to the same value except
+ * within that rounding of a grid midpoint; 2^-24 of the size is an engine's float pose's
+ * resolution, so nothing a host sends is lost. F may be T itself (L_0 is then the
+ * identity). */
+void sw_pose_snap(const double F[12], const double *T, int32_t nb, double grid, double *L);
 
 /* Squared distance between two pose features: sum over bones of 1 - <q_a, q_b>^2
  * (0 for the same rotations, sign of each quaternion irrelevant). */

@@ -50,11 +50,12 @@ static void project(const sinew_instance *in, const double *x, double *q) {
         int32_t r = D->rank;
         for (int32_t lv = 0; lv < D->vert_count; ++lv) {
             int32_t gv = v->domain_verts[D->vert_begin + lv];
-            double R[9], t[3], e[3], d[3];
+            double R[9], t[3], e[3], d[3], xs[3];
             sw_dqs_blend(in->bone_dq, v->skin_bone + 4 * (int64_t)gv,
                          v->skin_weight + 4 * (int64_t)gv, 4, R, t);
+            sw_instance_to_step(in, x + 3 * (int64_t)gv, 0, xs); /* the skinning's frame */
             for (int i = 0; i < 3; ++i)
-                e[i] = x[3 * (int64_t)gv + i] - t[i];
+                e[i] = xs[i] - t[i];
             for (int i = 0; i < 3; ++i)
                 d[i] =
                     R[i] * e[0] + R[3 + i] * e[1] + R[6 + i] * e[2] - v->rest[3 * (int64_t)gv + i];
