@@ -414,6 +414,19 @@ if have_fox bake_fox; then
     else
         echo "ok   bake_fox_report_files"
     fi
+    # where the Fox stands, faces or how it is scaled does not change its flesh, in every
+    # self-contact mode and dynamic (tools/testkit/invariance.h): within 1e-5 of its size
+    "$build/tools/sinew-invariance" "$fox" --tets 2000 --train-clips Survey,Walk \
+        --heldout-clips Run --blob "$tmp/fox.blob" --frames-max 20 --json \
+        >"$tmp/fox_inv.out" 2>"$tmp/fox_inv.err"
+    worst=$(grep -Eo '"worst":[-0-9.e+]+' "$tmp/fox_inv.out" | cut -d: -f2)
+    if [ -z "$worst" ] || ! awk -v w="$worst" 'BEGIN { exit !(w <= 1e-5) }'; then
+        echo "FAIL invariance_fox: worst ${worst:-none} of the size (bound 1e-5)" >&2
+        tail -n 12 "$tmp/fox_inv.err" >&2
+        fails=$((fails + 1))
+    else
+        echo "ok   invariance_fox ($worst of the size)"
+    fi
 fi
 
 [ "$fails" -eq 0 ] || { echo "$fails failures" >&2; exit 1; }
