@@ -3,7 +3,9 @@
  * place, a declared teleport and a paused frame replays bitwise, step by step; recorded
  * steps allocate and lock nothing; a recording with one record left out replays but
  * differs from that step on; a damaged, cut or foreign recording is refused with a
- * message saying what is wrong. */
+ * message saying what is wrong. A session under a mesh collider whose vertices the host
+ * moves every step, ignoring another collider part of the time, replays bitwise too; a
+ * version-1 recording still reads and replays. */
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -91,11 +93,13 @@ static unsigned char *read_all(size_t *n) {
     return (unsigned char *)sw_test_read_file(g_path, n);
 }
 
-/* A recording of the records `stream` (size n) in one chunk, as the recorder writes them. */
-static unsigned char *rechunk(const unsigned char *stream, size_t n, size_t *out_n) {
+/* A recording of format `version` of the records `stream` (size n) in one chunk, as the
+ * recorder writes them. */
+static unsigned char *rechunk_as(uint32_t version, const unsigned char *stream, size_t n,
+                                 size_t *out_n) {
     unsigned char *d = malloc(SW_REC_PREAMBLE_BYTES + SW_REC_CHUNK_BYTES + n);
     static const unsigned char pre[8] = {'S', 'I', 'N', 'E', 'W', 'R', 'E', 'C'};
-    uint32_t u[4] = {SW_REC_VERSION, 0x01020304u, SW_REC_CHUNK_TAG, (uint32_t)n};
+    uint32_t u[4] = {version, 0x01020304u, SW_REC_CHUNK_TAG, (uint32_t)n};
     uint64_t h = sw_fnv1a(SW_FNV_START, stream, n);
     memcpy(d, pre, 8);
     memcpy(d + 8, u, 16);
@@ -103,6 +107,10 @@ static unsigned char *rechunk(const unsigned char *stream, size_t n, size_t *out
     memcpy(d + 32, stream, n);
     *out_n = 32 + n;
     return d;
+}
+
+static unsigned char *rechunk(const unsigned char *stream, size_t n, size_t *out_n) {
+    return rechunk_as(SW_REC_VERSION, stream, n, out_n);
 }
 
 TEST(a_session_with_pokes_and_a_teleport_replays_bitwise) {
@@ -267,8 +275,8 @@ TEST(a_recorder_attaches_only_to_a_fresh_instance) {
     remove(path);
 }
 
-/* The fuzzer's seed (SINEW_WRITE_SEEDS=1 rewrites it): three steps of the finger against
- * the table and the ball, a pose and a teleport. */
+/* The fuzzer's version-1 seed (SINEW_WRITE_SEEDS=1 rewrites it): three steps of the
+ * finger against the table and the ball, a pose and a teleport. */
 TEST(a_short_recording_is_the_fuzzers_seed) {
     moving_scene m;
     ENSURE(moving_scene_make(&m));
@@ -304,6 +312,14 @@ TEST(a_short_recording_is_the_fuzzers_seed) {
     sw_replay_report rep;
     ENSURE(sw_recording_replay(f->blob, &r, NULL, NULL, &rep) == SINEW_OK && rep.differing == 0);
     sw_recording_free(&r);
+    /* it has no record version 2 added, so it is a version-1 recording once its preamble
+       says so: it reads and replays the same, and the seed stays one of version 1 */
+    const uint32_t v1 = 1;
+    memcpy(d + 8, &v1, sizeof v1);
+    ENSUREF(sw_recording_parse(d, n, &r, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(r.version == 1 && r.steps == 3);
+    ENSURE(sw_recording_replay(f->blob, &r, NULL, NULL, &rep) == SINEW_OK && rep.differing == 0);
+    sw_recording_free(&r);
     if (getenv("SINEW_WRITE_SEEDS")) {
         FILE *fp = fopen(SINEW_SOURCE_DIR "/tests/fuzz/corpus/recording/short.rec", "wb");
         ENSURE(fp && fwrite(d, 1, n, fp) == n && fclose(fp) == 0);
@@ -311,6 +327,230 @@ TEST(a_short_recording_is_the_fuzzers_seed) {
     free(d);
     remove(path);
     sinew_world_destroy(m.w);
+}
+
+/* A closed box's 12 triangles, counter-clockwise seen from outside (vertex j takes hi on
+ * axis k when bit k of j is set). */
+static const uint32_t box_tris[36] = {0, 2, 1, 1, 2, 3, 4, 5, 6, 5, 7, 6, 0, 1, 4, 1, 5, 4,
+                                      2, 6, 3, 3, 6, 7, 0, 4, 2, 2, 4, 6, 1, 3, 5, 3, 7, 5};
+
+/* The lid at step s, as another character's surface would be given: a box over the finger
+ * that slides along it, presses into its top by a depth that changes, and shears. */
+static void lid_vertices(int s, float v[24]) {
+    float x0 = 0.3f + 0.1f * (float)(s % 12), depth = 0.03f + 0.01f * (float)(s % 4);
+    const float lo[3] = {x0, 0.45f - depth, -0.6f}, hi[3] = {x0 + 0.9f, 1.0f, 0.6f};
+    for (int j = 0; j < 8; ++j) {
+        for (int k = 0; k < 3; ++k)
+            v[3 * j + k] = (j >> k) & 1 ? hi[k] : lo[k];
+        v[3 * j + 2] += 0.02f * (float)(s % 5) * v[3 * j]; /* a shear of z along x */
+    }
+}
+
+/* What a run of the deforming session saw. */
+typedef struct deform_run {
+    uint64_t hash[60];
+    sw_rt_counts counts;
+    uint32_t lid_steps, table_steps; /* steps with a force on the lid, on the table */
+} deform_run;
+
+/* Whether the instance's last step pushed collider id. */
+static int pushed(const sinew_instance *inst, sinew_collider_id id) {
+    float F[3], M[3];
+    return sinew_instance_collider_force(inst, id, F, M) == SINEW_OK &&
+           (F[0] != 0 || F[1] != 0 || F[2] != 0);
+}
+
+/* The finger under a lid whose vertices move every step but every seventh, over the table
+ * it ignores except in steps [20, 40) (ignored before the recording starts, the world
+ * attached again at 30 and at 50) and a ball that moves; recorded into `path` unless
+ * NULL. 1 on success. */
+static int run_deforming(const char *path, int steps, deform_run *out) {
+    const bake_fixture *f = fixture();
+    sinew_collider_id table, lid, ball;
+    sinew_world *w = f ? table_world(0.05, 0.3f, &table) : NULL;
+    if (!w) return 0;
+    float v[24];
+    lid_vertices(0, v);
+    sinew_collider_def c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_MESH;
+    c.vertices = v;
+    c.vertex_count = 8;
+    c.indices = box_tris;
+    c.triangle_count = 12;
+    int ok = sinew_world_add_collider(w, &c, &lid) == SINEW_OK;
+    c = sinew_collider_def_default();
+    c.shape = SINEW_SHAPE_SPHERE;
+    c.radius = 0.2f;
+    ball_at(0, &c.transform);
+    ok &= sinew_world_add_collider(w, &c, &ball) == SINEW_OK;
+    sinew_instance_def d = sinew_instance_def_default();
+    d.mode = SINEW_STEP_DYNAMIC;
+    sinew_instance *inst = NULL;
+    ok &= sinew_instance_create(f->blob, &d, &inst) == SINEW_OK;
+    ok &= ok && sinew_instance_set_world(inst, w) == SINEW_OK;
+    ok &= ok && sinew_instance_ignore_collider(inst, table) == SINEW_OK;
+    sinew_recorder_def rd = sinew_recorder_def_default();
+    rd.path = path;
+    sinew_recorder *rec = NULL;
+    if (ok && path) ok &= sinew_recorder_open(&rd, &rec) == SINEW_OK;
+    if (rec) ok &= sinew_instance_set_recorder(inst, rec) == SINEW_OK;
+    uint32_t nb = (uint32_t)f->ch.skel.nbones;
+    float *pose = malloc(sizeof(float) * 12 * nb);
+    memset(out, 0, sizeof *out);
+    for (int s = 0; s < steps && ok; ++s) {
+        sinew_transform t;
+        ball_at(s, &t);
+        ok &= sinew_world_set_collider_transform(w, ball, &t) == SINEW_OK;
+        lid_vertices(s, v);
+        if (s % 7 != 3) ok &= sinew_world_set_mesh_vertices(w, lid, v, 8) == SINEW_OK;
+        if (s == 20 || s == 40)
+            ok &= sinew_instance_ignore_collider(inst, s == 20 ? 0 : table) == SINEW_OK;
+        if (s == 30 || s == 50) ok &= sinew_instance_set_world(inst, w) == SINEW_OK;
+        bake_fixture_pose(f, s, pose);
+        ok &= sinew_instance_set_pose(inst, pose, nb) == SINEW_OK;
+        sw_rt_count_begin();
+        sinew_instance_step(inst, 1.0f / 60);
+        sw_rt_counts k = sw_rt_count_end();
+        out->counts.allocs += k.allocs;
+        out->counts.frees += k.frees;
+        out->counts.locks += k.locks;
+        out->hash[s] = sw_instance_surface_hash(inst);
+        out->lid_steps += pushed(inst, lid);
+        out->table_steps += pushed(inst, table);
+    }
+    sinew_instance_destroy(inst); /* (detaches the recorder) */
+    if (rec) ok &= sinew_recorder_close(rec) == SINEW_OK;
+    free(pose);
+    sinew_world_destroy(w);
+    return ok;
+}
+
+/* The records of each type in a parsed recording. */
+static void count_records(const sw_recording *r, uint32_t n[SW_REC_IGNORE + 1]) {
+    memset(n, 0, sizeof(uint32_t) * (SW_REC_IGNORE + 1));
+    size_t pos = 0;
+    sw_rec_record one;
+    while (sw_recording_next(r, &pos, &one))
+        if (one.type <= SW_REC_IGNORE) n[one.type]++;
+}
+
+#define DEFORM_STEPS 60
+TEST(a_deforming_mesh_and_an_ignored_collider_replay_bitwise) {
+    char path[600];
+    snprintf(path, sizeof path, "%s.deforming", g_path);
+    static deform_run plain, recorded;
+    ENSURE(run_deforming(NULL, DEFORM_STEPS, &plain));
+    ENSURE(run_deforming(path, DEFORM_STEPS, &recorded));
+    fprintf(stderr, "    %u steps pushed the lid, %u the table (ignored in 40 of %d)\n",
+            recorded.lid_steps, recorded.table_steps, DEFORM_STEPS);
+    /* both matter: the lid is touched, and the table only while it is not ignored */
+    ENSURE(recorded.lid_steps > DEFORM_STEPS / 2);
+    ENSURE(recorded.table_steps > 0 && recorded.table_steps <= 20);
+    ENSURE(memcmp(plain.hash, recorded.hash, sizeof plain.hash) == 0);
+    unsigned active = sw_rt_interpose_active();
+    const sw_rt_counts *c = &recorded.counts;
+    if (active & SW_RT_CAT_ALLOCS)
+        ENSUREF(c->allocs == 0 && c->frees == 0, "allocs %llu", (unsigned long long)c->allocs);
+    if (active & SW_RT_CAT_LOCKS) ENSURE(c->locks == 0);
+    size_t n;
+    unsigned char *data = (unsigned char *)sw_test_read_file(path, &n);
+    ENSURE(data);
+    sw_recording rec;
+    sw_error err;
+    ENSUREF(sw_recording_parse(data, n, &rec, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(rec.version == SW_REC_VERSION && rec.steps == DEFORM_STEPS);
+    sw_replay_report rep;
+    ENSUREF(sw_recording_replay(fixture()->blob, &rec, NULL, NULL, &rep) == SINEW_OK, "%s",
+            rep.msg);
+    fprintf(stderr, "    replayed %u steps: %u differ (first %lld)\n", rep.steps, rep.differing,
+            (long long)rep.first_diff);
+    ENSURE(rep.steps == DEFORM_STEPS && rep.differing == 0 && rep.first_diff == -1);
+    uint32_t count[SW_REC_IGNORE + 1];
+    count_records(&rec, count);
+    fprintf(stderr, "    %u MESH, %u IGNORE, %u WORLD records\n", count[SW_REC_MESH],
+            count[SW_REC_IGNORE], count[SW_REC_WORLD]);
+    /* a MESH for every step whose lid moved (every one but 9), except the two that attach
+       the world again after the move (the WORLD record holds the vertices); an IGNORE at
+       attaching, at 20, 40 and 50 */
+    ENSURE(count[SW_REC_MESH] == DEFORM_STEPS - 9 - 2);
+    ENSURE(count[SW_REC_IGNORE] == 4 && count[SW_REC_WORLD] == 3);
+    size_t pos = 0;
+    sw_rec_record r;
+    int s = 0, same = 1;
+    while (sw_recording_next(&rec, &pos, &r))
+        if (r.type == SW_REC_STEP) same &= sw_rec_u64(r.p + 16) == recorded.hash[s++];
+    ENSURE(same && s == DEFORM_STEPS);
+    /* a version-1 reader knows neither record: a version-1 file holding them is refused */
+    size_t n1;
+    unsigned char *v1 = rechunk_as(1, rec.stream, rec.size, &n1);
+    ENSURE(parse_says(v1, n1, "does not add up"));
+    free(v1);
+    sw_recording_free(&rec);
+    free(data);
+    remove(path);
+}
+
+/* Version 1 (before MESH and IGNORE) still reads and replays; later versions are refused
+ * with the versions this library reads. */
+TEST(a_version_1_recording_still_replays) {
+    size_t n;
+    unsigned char *data = read_all(&n); /* the session's: no meshes, no ignored collider */
+    ENSURE(data);
+    sw_recording rec;
+    sw_error err;
+    ENSURE(sw_recording_parse(data, n, &rec, &err) == SINEW_OK);
+    size_t n1;
+    unsigned char *v1 = rechunk_as(1, rec.stream, rec.size, &n1);
+    sw_recording r1;
+    ENSUREF(sw_recording_parse(v1, n1, &r1, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(r1.version == 1 && r1.steps == FRAMES);
+    sw_replay_report rep;
+    ENSURE(sw_recording_replay(fixture()->blob, &r1, NULL, NULL, &rep) == SINEW_OK);
+    ENSURE(rep.steps == FRAMES && rep.differing == 0);
+    sw_recording_free(&r1);
+    /* the fuzzer's version-1 seed (a_short_recording_is_the_fuzzers_seed) */
+    size_t ns;
+    unsigned char *seed = (unsigned char *)sw_test_read_file(
+        SINEW_SOURCE_DIR "/tests/fuzz/corpus/recording/short.rec", &ns);
+    ENSURE(seed && sw_rec_u32(seed + 8) == 1);
+    ENSUREF(sw_recording_parse(seed, ns, &r1, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(r1.version == 1 && r1.steps == 3);
+    sw_recording_free(&r1);
+    free(seed);
+    free(v1);
+    v1 = rechunk_as(SW_REC_VERSION + 1, rec.stream, rec.size, &n1);
+    ENSURE(parse_says(v1, n1, "reads versions 1 to 2"));
+    free(v1);
+    sw_recording_free(&rec);
+    free(data);
+}
+
+/* The fuzzer's version-2 seed (SINEW_WRITE_SEEDS=1 rewrites it): three steps of the
+ * deforming session, so MESH and IGNORE records. */
+TEST(a_short_deforming_recording_is_a_fuzzer_seed) {
+    char path[600];
+    snprintf(path, sizeof path, "%s.short-deforming", g_path);
+    static deform_run run;
+    ENSURE(run_deforming(path, 3, &run));
+    size_t n;
+    unsigned char *d = (unsigned char *)sw_test_read_file(path, &n);
+    ENSURE(d && n < 4096);
+    sw_recording r;
+    sw_error err;
+    ENSUREF(sw_recording_parse(d, n, &r, &err) == SINEW_OK, "%s", err.msg);
+    uint32_t count[SW_REC_IGNORE + 1];
+    count_records(&r, count);
+    ENSURE(r.steps == 3 && count[SW_REC_MESH] == 3 && count[SW_REC_IGNORE] == 1);
+    sw_replay_report rep;
+    ENSURE(sw_recording_replay(fixture()->blob, &r, NULL, NULL, &rep) == SINEW_OK &&
+           rep.differing == 0);
+    sw_recording_free(&r);
+    if (getenv("SINEW_WRITE_SEEDS")) {
+        FILE *fp = fopen(SINEW_SOURCE_DIR "/tests/fuzz/corpus/recording/deforming.rec", "wb");
+        ENSURE(fp && fwrite(d, 1, n, fp) == n && fclose(fp) == 0);
+    }
+    free(d);
+    remove(path);
 }
 
 TEST(release_fixture) {
@@ -321,4 +561,7 @@ SW_TEST_MAIN(CASE(a_session_with_pokes_and_a_teleport_replays_bitwise),
              CASE(a_recording_without_one_pose_differs_from_there),
              CASE(damaged_recordings_are_refused_clearly),
              CASE(a_recorder_attaches_only_to_a_fresh_instance),
-             CASE(a_short_recording_is_the_fuzzers_seed), CASE(release_fixture))
+             CASE(a_short_recording_is_the_fuzzers_seed),
+             CASE(a_deforming_mesh_and_an_ignored_collider_replay_bitwise),
+             CASE(a_version_1_recording_still_replays),
+             CASE(a_short_deforming_recording_is_a_fuzzer_seed), CASE(release_fixture))

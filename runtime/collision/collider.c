@@ -25,6 +25,10 @@ void sw_collider_source(const sw_collider *c, sinew_collider_def *d) {
     *d = c->src;
 }
 
+uint32_t sw_collider_vertex_moves(const sw_collider *c) {
+    return c->shape == SINEW_SHAPE_MESH ? c->mesh.moves : 0;
+}
+
 const double *sw_collider_points(const sw_collider *c, uint32_t *count) {
     *count = c->shape == SINEW_SHAPE_HULL   ? c->hull.count
              : c->shape == SINEW_SHAPE_MESH ? c->mesh.nverts

@@ -58,6 +58,12 @@ void sw_collider_source(const sw_collider *c, sinew_collider_def *d);
 const double *sw_collider_points(const sw_collider *c, uint32_t *count);
 const uint32_t *sw_collider_triangles(const sw_collider *c, uint32_t *count);
 
+/* How many times sinew_world_set_mesh_vertices has moved a mesh's vertices since it was
+ * added (wrapping; 0 for the other shapes): a recorder writes the vertices again when it
+ * differs from the count it saw last. Only a move writes it, so any thread may read it
+ * in a step. */
+uint32_t sw_collider_vertex_moves(const sw_collider *c);
+
 /* Its outline in the world for a debug draw: the 8 corners of its local box placed by its
  * transform (corner j takes hi on axis k when bit k of j is set), returning 8; or for a
  * plane the 4 corners, in order round, of a square of half-side `extent` centred where

@@ -46,7 +46,9 @@ typedef struct sw_mesh {
     RTCScene scene;   /* committed at add time and at each move, only read by queries */
     RTCGeometry geom; /* its one geometry (retained) and that geometry's vertex buffer */
     float *vb;
-    int refits; /* the geometry refits its BVH: set at its first move */
+    int refits;     /* the geometry refits its BVH: set at its first move */
+    uint32_t moves; /* sinew_world_set_mesh_vertices calls that changed X: a recorder
+                       compares it with the count it last wrote (read-only in a step) */
 } sw_mesh;
 
 struct sw_collider {

@@ -123,6 +123,7 @@ sinew_result sw_mesh_move(sinew_world *w, sw_collider *c, const float *xyz) {
     sw_mesh *m = &c->mesh;
     for (size_t i = 0; i < (size_t)3 * m->nverts; ++i)
         m->X[i] = xyz[i];
+    m->moves++; /* X changed even if the refit below fails */
     sw_mesh_bounds(c);
     sw_mesh_face_normals(m);
     sw_mesh_feature_normals(m);

@@ -34,6 +34,7 @@ SINEW_API sinew_result sinew_instance_ignore_collider(sinew_instance *inst, sine
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
     inst->wc.ignore = id;
+    sw_rec_ignore(inst);
     return SINEW_OK;
 }
 

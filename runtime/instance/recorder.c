@@ -1,7 +1,13 @@
 /* The recorder (sinew.h, format in recording.h): the calls an instance receives, appended
  * to a buffer the recorder owns and written to its file one checksummed chunk at a time.
  * A recorded call only copies its arguments into the buffer, so a step allocates and
- * locks nothing; the one I/O a step can do is the write(2) of a buffer it filled. */
+ * locks nothing; the one I/O a step can do is the write(2) of a buffer it filled.
+ *
+ * The host moves a mesh collider's vertices through the world, not the instance, so no
+ * hook sees it: the step compares each mesh's move count with the one this recorder last
+ * wrote and writes the vertices of those that moved. The counts it saw are the
+ * recorder's own (sized when a world is recorded, outside the step), never a flag in the
+ * world: instances on other threads may step with the same world and record it too. */
 #include <fcntl.h>
 #include <stddef.h>
 #include <string.h>
@@ -28,6 +34,8 @@ struct sinew_recorder {
     sinew_result err;   /* the first I/O failure (SINEW_OK: none) */
     sinew_instance *inst;
     uint32_t steps;
+    uint32_t *moves; /* per world slot: its mesh's move count as last written */
+    uint32_t nmoves;
 };
 
 static sinew_result io_fail(sinew_recorder *rec, const char *what) {
@@ -102,7 +110,7 @@ SINEW_API sinew_result sinew_recorder_open(const sinew_recorder_def *def, sinew_
         sw_free(&d.allocator, rec);
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
-    *rec = (sinew_recorder){-1, d.allocator, d.logger, buf, cap, 0, SINEW_OK, NULL, 0};
+    *rec = (sinew_recorder){-1, d.allocator, d.logger, buf, cap, 0, SINEW_OK, NULL, 0, NULL, 0};
     rec->fd = open(d.path, O_WRONLY | O_CREAT | O_TRUNC, 0644);
     if (rec->fd < 0) {
         sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_RECORDER_IO,
@@ -139,6 +147,7 @@ SINEW_API sinew_result sinew_recorder_close(sinew_recorder *rec) {
     sinew_result r = rec->err;
     sinew_allocator a = rec->allocator;
     sw_free(&a, rec->buf);
+    sw_free(&a, rec->moves);
     sw_free(&a, rec);
     return r;
 }
@@ -212,10 +221,36 @@ static void put_collider(sinew_recorder *rec, uint32_t slot, const sw_collider *
     put(rec, T, 12 * (size_t)nt);
 }
 
+/* The move counts of the world's meshes as a WORLD record writes their vertices: room
+ * for every slot the world can have, so no step needs more. */
+static void note_moves(sinew_recorder *rec, const sinew_world *w) {
+    uint32_t cap = w ? sw_world_capacity(w) : 0;
+    if (cap > rec->nmoves) {
+        sw_free(&rec->allocator, rec->moves);
+        rec->nmoves = 0;
+        rec->moves = sw_alloc(&rec->allocator, sizeof(uint32_t) * cap, SW_ALLOC_ALIGN);
+        if (!rec->moves) {
+            if (rec->err == SINEW_OK)
+                sw_log(&rec->logger, SINEW_LOG_ERROR, SINEW_MSG_RECORDER_IO,
+                       "sinew_recorder: no memory for the move counts of %u colliders",
+                       (unsigned)cap);
+            rec->err = SINEW_ERROR_OUT_OF_MEMORY;
+            return;
+        }
+        rec->nmoves = cap;
+    }
+    uint32_t ns = sw_world_slot_count(w);
+    for (uint32_t s = 0; s < rec->nmoves; ++s) {
+        const sw_collider *c = s < ns ? sw_world_slot(w, s) : NULL;
+        rec->moves[s] = c ? sw_collider_vertex_moves(c) : 0;
+    }
+}
+
 void sw_rec_world(sinew_instance *in) {
     sinew_recorder *rec = in->rec;
     if (!rec) return;
     const sinew_world *w = in->wc.world;
+    note_moves(rec, w);
     uint32_t ns = sw_world_slot_count(w), live = 0;
     size_t bytes = 8;
     for (uint32_t s = 0; s < ns; ++s)
@@ -228,6 +263,34 @@ void sw_rec_world(sinew_instance *in) {
     put_u32(rec, live);
     for (uint32_t s = 0; s < ns; ++s)
         if (sw_world_slot(w, s)) put_collider(rec, s, sw_world_slot(w, s));
+    /* the replay's new world starts ignoring nothing; the id the instance keeps may name
+       a collider of this world too */
+    if (w && in->wc.ignore) sw_rec_ignore(in);
+}
+
+void sw_rec_ignore(sinew_instance *in) {
+    sinew_recorder *rec = in->rec;
+    if (!rec || !in->wc.world) return; /* without a world, the next WORLD record says it */
+    int32_t s = in->wc.ignore ? sw_world_slot_of(in->wc.world, in->wc.ignore) : -1;
+    put_header(rec, SW_REC_IGNORE, 4);
+    put_u32(rec, s < 0 ? SW_REC_NO_SLOT : (uint32_t)s);
+}
+
+/* A MESH record for each mesh moved since the recorder last wrote its vertices. */
+static void put_moved_meshes(sinew_recorder *rec, const sinew_world *w) {
+    uint32_t ns = sw_world_slot_count(w);
+    for (uint32_t s = 0; s < ns && s < rec->nmoves; ++s) {
+        const sw_collider *c = sw_world_slot(w, s);
+        if (!c || sw_collider_vertex_moves(c) == rec->moves[s]) continue;
+        uint32_t nv;
+        const double *X = sw_collider_points(c, &nv);
+        put_header(rec, SW_REC_MESH, 8 + 12 * (size_t)nv);
+        put_u32(rec, s);
+        put_u32(rec, nv);
+        for (uint32_t i = 0; i < 3 * nv; ++i)
+            put_f32(rec, (float)X[i]); /* the host's floats, held exactly */
+        rec->moves[s] = sw_collider_vertex_moves(c);
+    }
 }
 
 void sw_rec_actor(sinew_instance *in, const double transform[12]) {
@@ -255,6 +318,7 @@ void sw_rec_step(sinew_instance *in, float dt, sinew_result r) {
     uint32_t ns = sw_world_slot_count(w), live = 0;
     for (uint32_t s = 0; s < ns; ++s)
         live += sw_world_slot(w, s) != NULL;
+    put_moved_meshes(rec, w); /* the step saw them: nothing moves them during it */
     put_header(rec, SW_REC_STEP, SW_REC_STEP_BYTES + (size_t)live * SW_REC_MOVE_BYTES);
     put_f32(rec, dt);
     put_u32(rec, (uint32_t)r);

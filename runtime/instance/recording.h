@@ -23,7 +23,18 @@
  *   STEP      f32 dt, u32 result, u32 status, u32 colliders, u64 surface hash
  *             (sw_instance_surface_hash after the step), then per collider u32 slot,
  *             f32 position[3], rotation[4] (the transforms the step saw)
- *   END       u32 steps */
+ *   END       u32 steps
+ * Version 2 adds two records (a version-1 file has neither, and replays as before):
+ *   MESH      u32 slot, u32 vertices, f32 3 a vertex: a mesh collider's vertices as the
+ *             next step saw them, written just before that STEP for each mesh that
+ *             sinew_world_set_mesh_vertices moved since the recorder last wrote it (in a
+ *             WORLD or a MESH record). A record of its own rather than a part of STEP:
+ *             STEP keeps its fixed layout (and the version-1 reader of it), a mesh that
+ *             did not move costs nothing, and each record's size says its vertex count.
+ *   IGNORE    u32 slot in the last WORLD record, or SW_REC_NO_SLOT (ignores nothing):
+ *             sinew_instance_ignore_collider, written at the call when a world is
+ *             attached and after every WORLD record while an id is ignored (replay
+ *             clears the ignored collider when it rebuilds a world). */
 #ifndef SW_RECORDING_H
 #define SW_RECORDING_H
 
@@ -33,7 +44,8 @@
 #include "sinew/sinew.h"
 #include "sw_error.h"
 
-#define SW_REC_VERSION 1u
+#define SW_REC_VERSION 2u /* also reads 1 (no MESH, no IGNORE) */
+#define SW_REC_OLDEST_VERSION 1u
 #define SW_REC_PREAMBLE_BYTES 16u
 #define SW_REC_CHUNK_BYTES 16u
 #define SW_REC_CHUNK_TAG 0x4b435753u /* "SWCK" */
@@ -42,6 +54,7 @@
 #define SW_REC_COLLIDER_BYTES 92u
 #define SW_REC_STEP_BYTES 24u
 #define SW_REC_MOVE_BYTES 32u /* a collider's slot and transform in a STEP */
+#define SW_REC_NO_SLOT 0xffffffffu
 
 typedef enum sw_rec_type {
     SW_REC_BEGIN = 1,
@@ -51,7 +64,9 @@ typedef enum sw_rec_type {
     SW_REC_TELEPORT = 5,
     SW_REC_RESET = 6,
     SW_REC_STEP = 7,
-    SW_REC_END = 8
+    SW_REC_END = 8,
+    SW_REC_MESH = 9,   /* version 2 */
+    SW_REC_IGNORE = 10 /* version 2 */
 } sw_rec_type;
 
 /* The recorder's hooks: each appends its call's record when a recorder is attached (one
@@ -60,7 +75,8 @@ void sw_rec_actor(sinew_instance *in, const double transform[12]);
 void sw_rec_pose(sinew_instance *in, const float *transforms);
 void sw_rec_mark(sinew_instance *in, sw_rec_type type); /* TELEPORT, RESET */
 void sw_rec_world(sinew_instance *in);
-void sw_rec_step(sinew_instance *in, float dt, sinew_result r);
+void sw_rec_step(sinew_instance *in, float dt, sinew_result r); /* and its MESH records */
+void sw_rec_ignore(sinew_instance *in); /* the instance's ignored collider as it is now */
 
 /* FNV-1a 64 of the output surface's positions and normals as the step left them (the
  * simulation frame's doubles the host's floats come from). O(surface). */

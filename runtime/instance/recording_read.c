@@ -33,10 +33,11 @@ static sinew_result read_chunks(const unsigned char *d, size_t n, sw_recording *
         return sw_error_set(
             err, SINEW_ERROR_VERSION,
             "recorded on a host of the other byte order (replay it on one like it)");
-    if (out->version != SW_REC_VERSION)
+    if (out->version < SW_REC_OLDEST_VERSION || out->version > SW_REC_VERSION)
         return sw_error_set(err, SINEW_ERROR_VERSION,
-                            "recording format version %u; this library reads version %u",
-                            (unsigned)out->version, (unsigned)SW_REC_VERSION);
+                            "recording format version %u; this library reads versions %u to %u",
+                            (unsigned)out->version, (unsigned)SW_REC_OLDEST_VERSION,
+                            (unsigned)SW_REC_VERSION);
     out->stream = malloc(n); /* the payloads are smaller than the file */
     if (!out->stream) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     size_t at = SW_REC_PREAMBLE_BYTES;
@@ -101,6 +102,11 @@ static int record_fits(const sw_recording *r, const sw_rec_record *rec) {
                    SW_REC_STEP_BYTES + SW_REC_MOVE_BYTES * (uint64_t)sw_rec_u32(rec->p + 12);
     case SW_REC_END:
         return rec->bytes == 4;
+    case SW_REC_MESH: /* version 2 on */
+        return r->version >= 2 && rec->bytes >= 8 &&
+               rec->bytes == 8 + 12 * (uint64_t)sw_rec_u32(rec->p + 4);
+    case SW_REC_IGNORE:
+        return r->version >= 2 && rec->bytes == 4;
     }
     return 0;
 }

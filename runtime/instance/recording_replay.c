@@ -26,7 +26,10 @@ static sinew_result refuse(replay *rp, sinew_result r, const char *what, uint32_
 }
 
 static void drop_world(replay *rp) {
-    if (rp->inst) sinew_instance_set_world(rp->inst, NULL);
+    if (rp->inst) {
+        sinew_instance_set_world(rp->inst, NULL);
+        sinew_instance_ignore_collider(rp->inst, 0); /* an IGNORE after WORLD says it again */
+    }
     sinew_world_destroy(rp->world);
     free(rp->ids);
     rp->world = NULL;
@@ -155,6 +158,38 @@ static sinew_result replay_step(replay *rp, const sw_rec_record *rec, uint32_t k
     return SINEW_OK;
 }
 
+/* The replay world's id of a recorded slot (0 and a refusal when it holds none). */
+static sinew_collider_id slot_id(replay *rp, uint32_t slot, uint32_t k) {
+    if (slot < rp->nids && rp->ids[slot]) return rp->ids[slot];
+    refuse(rp, SINEW_ERROR_CORRUPT,
+           "a record names a collider the recorded world does not hold (added after the "
+           "world was attached)",
+           k);
+    return 0;
+}
+
+/* A MESH record: the vertices the host gave the mesh before the next step. */
+static sinew_result replay_mesh(replay *rp, const sw_rec_record *rec, uint32_t k) {
+    sinew_collider_id id = slot_id(rp, sw_rec_u32(rec->p), k);
+    if (!id) return SINEW_ERROR_CORRUPT;
+    uint32_t nv = sw_rec_u32(rec->p + 4);
+    float *xyz = malloc(12 * (size_t)nv + 1); /* the payload's floats may be unaligned */
+    if (!xyz) return refuse(rp, SINEW_ERROR_OUT_OF_MEMORY, "mesh vertices", k);
+    memcpy(xyz, rec->p + 8, 12 * (size_t)nv);
+    sinew_result r = sinew_world_set_mesh_vertices(rp->world, id, xyz, nv);
+    free(xyz);
+    return r == SINEW_OK ? r : refuse(rp, r, "recorded mesh vertices were refused", k);
+}
+
+/* An IGNORE record: the collider in that slot of the replay's world, or none. */
+static sinew_result replay_ignore(replay *rp, const sw_rec_record *rec, uint32_t k) {
+    uint32_t slot = sw_rec_u32(rec->p);
+    sinew_collider_id id = slot == SW_REC_NO_SLOT ? 0 : slot_id(rp, slot, k);
+    if (slot != SW_REC_NO_SLOT && !id) return SINEW_ERROR_CORRUPT;
+    sinew_result r = sinew_instance_ignore_collider(rp->inst, id);
+    return r == SINEW_OK ? r : refuse(rp, r, "a recorded ignore_collider was refused", k);
+}
+
 /* The instance of BEGIN's def. */
 static sinew_result replay_begin(replay *rp, const sw_recording *rec, const sw_rec_record *b) {
     uint64_t h = sinew_hash_bytes(rp->blob->data, rp->blob->size);
@@ -192,6 +227,10 @@ static sinew_result replay_record(replay *rp, const sw_rec_record *rec, uint32_t
         return replay_world(rp, rec, k);
     case SW_REC_STEP:
         return replay_step(rp, rec, k);
+    case SW_REC_MESH:
+        return replay_mesh(rp, rec, k);
+    case SW_REC_IGNORE:
+        return replay_ignore(rp, rec, k);
     case SW_REC_ACTOR: {
         double T[12];
         for (int i = 0; i < 12; ++i)

@@ -1,8 +1,9 @@
 /* libFuzzer harness for the recording reader (sw_recording_parse, runtime/instance/
  * recording.h): a recording arrives with a bug report, so it is outside data.
  * tests/CMakeLists.txt builds it with clang when clang has libFuzzer and runs it for a few
- * seconds on tests/fuzz/corpus/recording (the seed is test_record_replay's three-step
- * recording, SINEW_WRITE_SEEDS=1 rewrites it) as the test fuzz_recording;
+ * seconds on tests/fuzz/corpus/recording (the seeds are test_record_replay's three-step
+ * recordings, one of format version 1 and one of version 2 with MESH and IGNORE records;
+ * SINEW_WRITE_SEEDS=1 rewrites them) as the test fuzz_recording;
  * tools/scripts/run-fuzz.sh runs it for longer.
  *
  * Each input is read twice: as it is, and with every chunk's checksum fixed up (random
