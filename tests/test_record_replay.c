@@ -113,6 +113,25 @@ static unsigned char *rechunk(const unsigned char *stream, size_t n, size_t *out
     return rechunk_as(SW_REC_VERSION, stream, n, out_n);
 }
 
+/* The recorded steps allocated and locked nothing (where the interposer counts them). */
+static void ensure_no_allocs_or_locks(const sw_rt_counts *c) {
+    unsigned active = sw_rt_interpose_active();
+    if (active & SW_RT_CAT_ALLOCS)
+        ENSUREF(c->allocs == 0 && c->frees == 0, "allocs %llu", (unsigned long long)c->allocs);
+    if (active & SW_RT_CAT_LOCKS) ENSURE(c->locks == 0);
+}
+
+/* With SINEW_WRITE_SEEDS set, the recording d (n bytes) becomes the fuzzer's seed `name`
+ * (tests/fuzz/corpus/recording). Returns 0 when it could not be written. */
+static int write_seed(const char *name, const unsigned char *d, size_t n) {
+    if (!getenv("SINEW_WRITE_SEEDS")) return 1;
+    char path[512];
+    snprintf(path, sizeof path, "%s/tests/fuzz/corpus/recording/%s", SINEW_SOURCE_DIR, name);
+    FILE *fp = fopen(path, "wb");
+    int ok = fp && fwrite(d, 1, n, fp) == n;
+    return fp && fclose(fp) == 0 && ok;
+}
+
 TEST(a_session_with_pokes_and_a_teleport_replays_bitwise) {
     moving_scene m;
     ENSURE(moving_scene_make(&m));
@@ -131,11 +150,7 @@ TEST(a_session_with_pokes_and_a_teleport_replays_bitwise) {
     /* recording changes nothing the host sees */
     ENSURE(memcmp(plain.hash, recorded.hash, sizeof plain.hash) == 0);
     memcpy(g_hash, recorded.hash, sizeof g_hash);
-    unsigned active = sw_rt_interpose_active();
-    const sw_rt_counts *c = &recorded.counts;
-    if (active & SW_RT_CAT_ALLOCS)
-        ENSUREF(c->allocs == 0 && c->frees == 0, "allocs %llu", (unsigned long long)c->allocs);
-    if (active & SW_RT_CAT_LOCKS) ENSURE(c->locks == 0);
+    ensure_no_allocs_or_locks(&recorded.counts);
     size_t n;
     unsigned char *data = read_all(&n);
     ENSURE(data);
@@ -320,10 +335,7 @@ TEST(a_short_recording_is_the_fuzzers_seed) {
     ENSURE(r.version == 1 && r.steps == 3);
     ENSURE(sw_recording_replay(f->blob, &r, NULL, NULL, &rep) == SINEW_OK && rep.differing == 0);
     sw_recording_free(&r);
-    if (getenv("SINEW_WRITE_SEEDS")) {
-        FILE *fp = fopen(SINEW_SOURCE_DIR "/tests/fuzz/corpus/recording/short.rec", "wb");
-        ENSURE(fp && fwrite(d, 1, n, fp) == n && fclose(fp) == 0);
-    }
+    ENSURE(write_seed("short.rec", d, n));
     free(d);
     remove(path);
     sinew_world_destroy(m.w);
@@ -447,11 +459,7 @@ TEST(a_deforming_mesh_and_an_ignored_collider_replay_bitwise) {
     ENSURE(recorded.lid_steps > DEFORM_STEPS / 2);
     ENSURE(recorded.table_steps > 0 && recorded.table_steps <= 20);
     ENSURE(memcmp(plain.hash, recorded.hash, sizeof plain.hash) == 0);
-    unsigned active = sw_rt_interpose_active();
-    const sw_rt_counts *c = &recorded.counts;
-    if (active & SW_RT_CAT_ALLOCS)
-        ENSUREF(c->allocs == 0 && c->frees == 0, "allocs %llu", (unsigned long long)c->allocs);
-    if (active & SW_RT_CAT_LOCKS) ENSURE(c->locks == 0);
+    ensure_no_allocs_or_locks(&recorded.counts);
     size_t n;
     unsigned char *data = (unsigned char *)sw_test_read_file(path, &n);
     ENSURE(data);
@@ -545,10 +553,7 @@ TEST(a_short_deforming_recording_is_a_fuzzer_seed) {
     ENSURE(sw_recording_replay(fixture()->blob, &r, NULL, NULL, &rep) == SINEW_OK &&
            rep.differing == 0);
     sw_recording_free(&r);
-    if (getenv("SINEW_WRITE_SEEDS")) {
-        FILE *fp = fopen(SINEW_SOURCE_DIR "/tests/fuzz/corpus/recording/deforming.rec", "wb");
-        ENSURE(fp && fwrite(d, 1, n, fp) == n && fclose(fp) == 0);
-    }
+    ENSURE(write_seed("deforming.rec", d, n));
     free(d);
     remove(path);
 }
