@@ -142,7 +142,7 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
         /* unit: a snapped pose's rotations (sw_pose_snap) are orthonormal to 1e-8 only */
         double n =
             sqrt(dq.r[0] * dq.r[0] + dq.r[1] * dq.r[1] + dq.r[2] * dq.r[2] + dq.r[3] * dq.r[3]);
-        double s = (dq.r[0] < 0 ? -1.0 : 1.0) / n;
+        double s = (dq.r[0] < 0 ? -1.0 : 1.0) / (n > 0 ? n : 1);
         for (int k = 0; k < 4; ++k)
             feature[4 * b + k] = s * dq.r[k];
     }
