@@ -182,6 +182,22 @@ TEST(bad_transforms_and_sizes) {
     double R[9], tt[3];
     sw_collider_transform(sw_world_slot(w, 0), R, tt);
     ENSURE(tt[0] == 3 && R[0] == 1);
+    /* in doubles: kept as given (no float between), bad ones refused alike */
+    const double far[3] = {1e5 + 1e-6, -2.5e-9, 0}, turn[4] = {1, 0, 0, 0};
+    ENSURE(sinew_world_set_collider_transform_d(w, id, far, turn) == SINEW_OK);
+    sw_collider_transform(sw_world_slot(w, 0), R, tt);
+    ENSURE(tt[0] == far[0] && tt[1] == far[1] && R[0] == 1);
+    double pos[3], rot[4];
+    sw_collider_placement(sw_world_slot(w, 0), pos, rot);
+    ENSURE(pos[0] == far[0] && rot[0] == 1);
+    const double bad_pos[3] = {0, NAN, 0}, zero[4] = {0, 0, 0, 0};
+    ENSURE(sinew_world_set_collider_transform_d(w, id, bad_pos, turn) == SINEW_ERROR_NOT_FINITE);
+    ENSURE(sinew_world_set_collider_transform_d(w, id, far, zero) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sinew_world_set_collider_transform_d(w, id, NULL, turn) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sinew_world_set_collider_transform_d(w, 12345, far, turn) ==
+           SINEW_ERROR_INVALID_ARGUMENT);
+    sw_collider_transform(sw_world_slot(w, 0), R, tt);
+    ENSURE(tt[0] == far[0]); /* the refused ones left it */
     sinew_world_destroy(w);
     ENSURE(live_allocs == 0);
 }

@@ -412,7 +412,13 @@ static int run_deforming(const char *path, int steps, deform_run *out) {
     for (int s = 0; s < steps && ok; ++s) {
         sinew_transform t;
         ball_at(s, &t);
-        ok &= sinew_world_set_collider_transform(w, ball, &t) == SINEW_OK;
+        if (s % 2) { /* placed in doubles off the float grid: only a PLACE record holds it */
+            double pos[3] = {t.position[0] + 1e-9, t.position[1], t.position[2]};
+            double rot[4] = {t.rotation[0], t.rotation[1], t.rotation[2], t.rotation[3]};
+            ok &= sinew_world_set_collider_transform_d(w, ball, pos, rot) == SINEW_OK;
+        } else {
+            ok &= sinew_world_set_collider_transform(w, ball, &t) == SINEW_OK;
+        }
         lid_vertices(s, v);
         if (s % 7 != 3) ok &= sinew_world_set_mesh_vertices(w, lid, v, 8) == SINEW_OK;
         if (s == 20 || s == 40)
@@ -438,16 +444,16 @@ static int run_deforming(const char *path, int steps, deform_run *out) {
 }
 
 /* The records of each type in a parsed recording. */
-static void count_records(const sw_recording *r, uint32_t n[SW_REC_IGNORE + 1]) {
-    memset(n, 0, sizeof(uint32_t) * (SW_REC_IGNORE + 1));
+static void count_records(const sw_recording *r, uint32_t n[SW_REC_PLACE + 1]) {
+    memset(n, 0, sizeof(uint32_t) * (SW_REC_PLACE + 1));
     size_t pos = 0;
     sw_rec_record one;
     while (sw_recording_next(r, &pos, &one))
-        if (one.type <= SW_REC_IGNORE) n[one.type]++;
+        if (one.type <= SW_REC_PLACE) n[one.type]++;
 }
 
 #define DEFORM_STEPS 60
-TEST(a_deforming_mesh_and_an_ignored_collider_replay_bitwise) {
+TEST(a_deforming_mesh_a_double_placement_and_an_ignored_collider_replay_bitwise) {
     char path[600];
     snprintf(path, sizeof path, "%s.deforming", g_path);
     static deform_run plain, recorded;
@@ -473,7 +479,7 @@ TEST(a_deforming_mesh_and_an_ignored_collider_replay_bitwise) {
     fprintf(stderr, "    replayed %u steps: %u differ (first %lld)\n", rep.steps, rep.differing,
             (long long)rep.first_diff);
     ENSURE(rep.steps == DEFORM_STEPS && rep.differing == 0 && rep.first_diff == -1);
-    uint32_t count[SW_REC_IGNORE + 1];
+    uint32_t count[SW_REC_PLACE + 1];
     count_records(&rec, count);
     fprintf(stderr, "    %u MESH, %u IGNORE, %u WORLD records\n", count[SW_REC_MESH],
             count[SW_REC_IGNORE], count[SW_REC_WORLD]);
@@ -482,6 +488,8 @@ TEST(a_deforming_mesh_and_an_ignored_collider_replay_bitwise) {
        attaching, at 20, 40 and 50 */
     ENSURE(count[SW_REC_MESH] == DEFORM_STEPS - 9 - 2);
     ENSURE(count[SW_REC_IGNORE] == 4 && count[SW_REC_WORLD] == 3);
+    /* a PLACE before every odd step: the ball placed in doubles off the float grid */
+    ENSUREF(count[SW_REC_PLACE] == DEFORM_STEPS / 2, "%u PLACE records", count[SW_REC_PLACE]);
     size_t pos = 0;
     sw_rec_record r;
     int s = 0, same = 1;
@@ -546,7 +554,7 @@ TEST(a_short_deforming_recording_is_a_fuzzer_seed) {
     sw_recording r;
     sw_error err;
     ENSUREF(sw_recording_parse(d, n, &r, &err) == SINEW_OK, "%s", err.msg);
-    uint32_t count[SW_REC_IGNORE + 1];
+    uint32_t count[SW_REC_PLACE + 1];
     count_records(&r, count);
     ENSURE(r.steps == 3 && count[SW_REC_MESH] == 3 && count[SW_REC_IGNORE] == 1);
     sw_replay_report rep;
@@ -567,6 +575,6 @@ SW_TEST_MAIN(CASE(a_session_with_pokes_and_a_teleport_replays_bitwise),
              CASE(damaged_recordings_are_refused_clearly),
              CASE(a_recorder_attaches_only_to_a_fresh_instance),
              CASE(a_short_recording_is_the_fuzzers_seed),
-             CASE(a_deforming_mesh_and_an_ignored_collider_replay_bitwise),
+             CASE(a_deforming_mesh_a_double_placement_and_an_ignored_collider_replay_bitwise),
              CASE(a_version_1_recording_still_replays),
              CASE(a_short_deforming_recording_is_a_fuzzer_seed), CASE(release_fixture))

@@ -258,11 +258,13 @@ static sinew_world *shape_world(const double *G) {
     c[4] = props_def(0, props_at(2.2f, 0.65f)); /* props_fixture.h: the tent */
     c[5] = props_def(1, props_at(0.6f, 0));     /* and the wedge, beside the root */
     c[5].transform.position[2] = 0.6f;
-    for (int k = 0; k < 6 && G; ++k)
-        sw_move_collider(G, &c[k]);
     for (int k = 0; k < 6; ++k) {
+        double pos[3], rot[4]; /* carried in doubles, as a host with a double world */
+        int placed = G && sw_move_placement(G, &c[k], pos, rot);
+        if (G) sw_move_collider(G, &c[k]);
         sinew_collider_id id;
-        if (sinew_world_add_collider(w, &c[k], &id) != SINEW_OK) {
+        if (sinew_world_add_collider(w, &c[k], &id) != SINEW_OK ||
+            (placed && sinew_world_set_collider_transform_d(w, id, pos, rot) != SINEW_OK)) {
             fprintf(stderr, "  collider %d (shape %d) refused\n", k, (int)c[k].shape);
             sinew_world_destroy(w);
             return NULL;
@@ -273,7 +275,8 @@ static sinew_world *shape_world(const double *G) {
 
 TEST(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the_moved_flesh) {
     ENSURE(finger());
-    /* float collider placements: a modest move keeps their rounding below the bound */
+    /* the placements carried in doubles; the plane's normal and offset are floats, and a
+       modest move keeps their rounding below the bound */
     sw_move m = {SW_MOVE_RIGID, {0.3, -0.8, 0.5}, 120 * PI / 180, {3, -2, 5}, 0, 0, 0};
     double G[12];
     sw_move_transform(&m, 0, G);

@@ -25,6 +25,13 @@ void sw_collider_source(const sw_collider *c, sinew_collider_def *d) {
     *d = c->src;
 }
 
+void sw_collider_placement(const sw_collider *c, double position[3], double rotation[4]) {
+    for (int i = 0; i < 3; ++i)
+        position[i] = c->src_pos[i];
+    for (int i = 0; i < 4; ++i)
+        rotation[i] = c->src_rot[i];
+}
+
 uint32_t sw_collider_vertex_moves(const sw_collider *c) {
     return c->shape == SINEW_SHAPE_MESH ? c->mesh.moves : 0;
 }

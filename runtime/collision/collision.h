@@ -55,6 +55,8 @@ void sw_collider_bounds(const sw_collider *c, double margin, double lo[3], doubl
  * doubles holding the def's floats exactly), the mesh's triangles sw_collider_triangles
  * (3 each); NULL and 0 for the other shapes. */
 void sw_collider_source(const sw_collider *c, sinew_collider_def *d);
+/* The host's last placement as given, in doubles (a float one exactly). */
+void sw_collider_placement(const sw_collider *c, double position[3], double rotation[4]);
 const double *sw_collider_points(const sw_collider *c, uint32_t *count);
 const uint32_t *sw_collider_triangles(const sw_collider *c, uint32_t *count);
 

@@ -60,6 +60,7 @@ struct sw_collider {
     /* the def it was added with (arrays NULL) and the host's last transform, as given:
        what a recording (sinew_recorder) writes so a replay builds the same collider */
     sinew_collider_def src;
+    double src_pos[3], src_rot[4]; /* the host's last placement in doubles (exact either way) */
     union {
         struct {
             double n[3], offset;

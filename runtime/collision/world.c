@@ -133,13 +133,13 @@ void sinew_world_destroy(sinew_world *world) {
 
 /* R and t of a public transform: finite (NOT_FINITE) and a nonzero quaternion
  * (INVALID_ARGUMENT), normalised with a scale so that huge components do not overflow. */
-static sinew_result read_transform(const sinew_world *w, const sinew_transform *tf, const char *fn,
-                                   double R[9], double t[3]) {
+static sinew_result read_placement(const sinew_world *w, const double *pos, const double *rot,
+                                   const char *fn, double R[9], double t[3]) {
     double q[4], s = 0;
     for (int i = 0; i < 4; ++i)
-        s = fmax(s, fabs(q[i] = tf->rotation[i]));
+        s = fmax(s, fabs(q[i] = rot[i]));
     for (int i = 0; i < 3; ++i)
-        t[i] = tf->position[i];
+        t[i] = pos[i];
     if (!isfinite(s) || !sw_v3_isfinite(t))
         return sw_world_fail(w, SINEW_ERROR_NOT_FINITE, "%s: the transform is not finite", fn);
     if (!(s > 0))
@@ -153,6 +153,21 @@ static sinew_result read_transform(const sinew_world *w, const sinew_transform *
         q[i] /= n;
     sw_quat_to_matrix(q, R);
     return SINEW_OK;
+}
+
+/* The float transform's placement, in doubles. */
+static void placement_of(const sinew_transform *tf, double pos[3], double rot[4]) {
+    for (int i = 0; i < 3; ++i)
+        pos[i] = tf->position[i];
+    for (int i = 0; i < 4; ++i)
+        rot[i] = tf->rotation[i];
+}
+
+static sinew_result read_transform(const sinew_world *w, const sinew_transform *tf, const char *fn,
+                                   double R[9], double t[3]) {
+    double pos[3], rot[4];
+    placement_of(tf, pos, rot);
+    return read_placement(w, pos, rot, fn, R, t);
 }
 
 /* The common fields of a def: shape, stiffness, friction. */
@@ -210,6 +225,7 @@ sinew_result sinew_world_add_collider(sinew_world *world, const sinew_collider_d
     c->src = d;
     c->src.points = c->src.vertices = NULL;
     c->src.indices = NULL;
+    placement_of(&d.transform, c->src_pos, c->src_rot);
     if ((r = build_shape(world, &d, c)) != SINEW_OK) {
         sw_free(&world->allocator, c);
         return r;
@@ -250,6 +266,28 @@ sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collid
     if (r != SINEW_OK) return r; /* the old transform stays */
     sw_collider_place(world->slots[s], R, t);
     world->slots[s]->src.transform = *transform;
+    placement_of(transform, world->slots[s]->src_pos, world->slots[s]->src_rot);
+    return SINEW_OK;
+}
+
+sinew_result sinew_world_set_collider_transform_d(sinew_world *world, sinew_collider_id id,
+                                                  const double position[3],
+                                                  const double rotation[4]) {
+    const char *fn = "sinew_world_set_collider_transform_d";
+    int32_t s = world ? sw_world_slot_of(world, id) : -1;
+    if (s < 0 || !position || !rotation)
+        return sw_world_fail(world, SINEW_ERROR_INVALID_ARGUMENT,
+                             "%s: id 0x%08x is not a live collider or the placement is NULL", fn,
+                             (unsigned)id);
+    double R[9], t[3];
+    sinew_result r = read_placement(world, position, rotation, fn, R, t);
+    if (r != SINEW_OK) return r; /* the old transform stays */
+    sw_collider *c = world->slots[s];
+    sw_collider_place(c, R, t);
+    for (int i = 0; i < 3; ++i)
+        c->src.transform.position[i] = (float)(c->src_pos[i] = position[i]);
+    for (int i = 0; i < 4; ++i)
+        c->src.transform.rotation[i] = (float)(c->src_rot[i] = rotation[i]);
     return SINEW_OK;
 }
 

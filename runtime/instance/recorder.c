@@ -293,6 +293,28 @@ static void put_moved_meshes(sinew_recorder *rec, const sinew_world *w) {
     }
 }
 
+/* A PLACE record for each live collider placed in doubles that its float transform does
+ * not hold exactly (the STEP's floats would lose it). */
+static void put_placements(sinew_recorder *rec, const sinew_world *w) {
+    uint32_t ns = sw_world_slot_count(w);
+    for (uint32_t s = 0; s < ns; ++s) {
+        const sw_collider *c = sw_world_slot(w, s);
+        if (!c) continue;
+        double pos[3], rot[4];
+        sw_collider_placement(c, pos, rot);
+        int exact = 1;
+        for (int i = 0; i < 3; ++i)
+            exact &= pos[i] == (double)(float)pos[i];
+        for (int i = 0; i < 4; ++i)
+            exact &= rot[i] == (double)(float)rot[i];
+        if (exact) continue;
+        put_header(rec, SW_REC_PLACE, SW_REC_PLACE_BYTES);
+        put_u32(rec, s);
+        put(rec, pos, sizeof pos);
+        put(rec, rot, sizeof rot);
+    }
+}
+
 void sw_rec_actor(sinew_instance *in, const double transform[12]) {
     if (!in->rec) return;
     put_header(in->rec, SW_REC_ACTOR, 12 * sizeof(double));
@@ -319,6 +341,7 @@ void sw_rec_step(sinew_instance *in, float dt, sinew_result r) {
     for (uint32_t s = 0; s < ns; ++s)
         live += sw_world_slot(w, s) != NULL;
     put_moved_meshes(rec, w); /* the step saw them: nothing moves them during it */
+    put_placements(rec, w);
     put_header(rec, SW_REC_STEP, SW_REC_STEP_BYTES + (size_t)live * SW_REC_MOVE_BYTES);
     put_f32(rec, dt);
     put_u32(rec, (uint32_t)r);

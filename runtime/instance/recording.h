@@ -34,7 +34,11 @@
  *   IGNORE    u32 slot in the last WORLD record, or SW_REC_NO_SLOT (ignores nothing):
  *             sinew_instance_ignore_collider, written at the call when a world is
  *             attached and after every WORLD record while an id is ignored (replay
- *             clears the ignored collider when it rebuilds a world). */
+ *             clears the ignored collider when it rebuilds a world).
+ *   PLACE     u32 slot, f64 position[3], rotation[4]: a collider's placement in doubles
+ *             (sinew_world_set_collider_transform_d) as the next step saw it, written
+ *             just before that STEP for each collider whose placement is not its float
+ *             transform's; replay takes it instead of that STEP's floats. */
 #ifndef SW_RECORDING_H
 #define SW_RECORDING_H
 
@@ -53,7 +57,8 @@
 #define SW_REC_BEGIN_BYTES 56u
 #define SW_REC_COLLIDER_BYTES 92u
 #define SW_REC_STEP_BYTES 24u
-#define SW_REC_MOVE_BYTES 32u /* a collider's slot and transform in a STEP */
+#define SW_REC_MOVE_BYTES 32u  /* a collider's slot and transform in a STEP */
+#define SW_REC_PLACE_BYTES 60u /* a collider's slot and placement in doubles */
 #define SW_REC_NO_SLOT 0xffffffffu
 
 typedef enum sw_rec_type {
@@ -65,8 +70,9 @@ typedef enum sw_rec_type {
     SW_REC_RESET = 6,
     SW_REC_STEP = 7,
     SW_REC_END = 8,
-    SW_REC_MESH = 9,   /* version 2 */
-    SW_REC_IGNORE = 10 /* version 2 */
+    SW_REC_MESH = 9,    /* version 2 */
+    SW_REC_IGNORE = 10, /* version 2 */
+    SW_REC_PLACE = 11   /* version 2 */
 } sw_rec_type;
 
 /* The recorder's hooks: each appends its call's record when a recorder is attached (one

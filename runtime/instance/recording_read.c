@@ -107,6 +107,8 @@ static int record_fits(const sw_recording *r, const sw_rec_record *rec) {
                rec->bytes == 8 + 12 * (uint64_t)sw_rec_u32(rec->p + 4);
     case SW_REC_IGNORE:
         return r->version >= 2 && rec->bytes == 4;
+    case SW_REC_PLACE:
+        return r->version >= 2 && rec->bytes == SW_REC_PLACE_BYTES;
     }
     return 0;
 }

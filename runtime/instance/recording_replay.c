@@ -16,6 +16,7 @@ typedef struct replay {
     sinew_world *world;
     sinew_collider_id *ids; /* per recorded slot, 0: none */
     uint32_t nids;
+    unsigned char *placed; /* per slot: a PLACE set it for the next STEP */
     sw_replay_report *rep;
 } replay;
 
@@ -32,8 +33,10 @@ static void drop_world(replay *rp) {
     }
     sinew_world_destroy(rp->world);
     free(rp->ids);
+    free(rp->placed);
     rp->world = NULL;
     rp->ids = NULL;
+    rp->placed = NULL;
     rp->nids = 0;
 }
 
@@ -83,8 +86,9 @@ static sinew_result replay_world(replay *rp, const sw_rec_record *rec, uint32_t 
     sinew_result r = sinew_world_create(&wd, &rp->world);
     if (r != SINEW_OK) return refuse(rp, r, "the recorded world could not be created", k);
     rp->ids = calloc(cap, sizeof *rp->ids);
+    rp->placed = calloc(cap, 1);
     unsigned char *hole = calloc(cap, 1);
-    if (!rp->ids || !hole) {
+    if (!rp->ids || !rp->placed || !hole) {
         free(hole);
         return refuse(rp, SINEW_ERROR_OUT_OF_MEMORY, "world", k);
     }
@@ -136,6 +140,10 @@ static sinew_result replay_step(replay *rp, const sw_rec_record *rec, uint32_t k
                           "a step moves a collider the recorded world does not hold (added "
                           "after the world was attached)",
                           k);
+        if (rp->placed[slot]) { /* in doubles, by the PLACE before */
+            rp->placed[slot] = 0;
+            continue;
+        }
         sinew_transform t;
         for (int j = 0; j < 3; ++j)
             t.position[j] = sw_rec_f32(m + 4 + 4 * j);
@@ -179,6 +187,22 @@ static sinew_result replay_mesh(replay *rp, const sw_rec_record *rec, uint32_t k
     sinew_result r = sinew_world_set_mesh_vertices(rp->world, id, xyz, nv);
     free(xyz);
     return r == SINEW_OK ? r : refuse(rp, r, "recorded mesh vertices were refused", k);
+}
+
+/* A PLACE record: the collider's placement in doubles, which the next STEP keeps. */
+static sinew_result replay_place(replay *rp, const sw_rec_record *rec, uint32_t k) {
+    uint32_t slot = sw_rec_u32(rec->p);
+    sinew_collider_id id = slot_id(rp, slot, k);
+    if (!id) return SINEW_ERROR_CORRUPT;
+    double pos[3], rot[4];
+    for (int j = 0; j < 3; ++j)
+        pos[j] = sw_rec_f64(rec->p + 4 + 8 * j);
+    for (int j = 0; j < 4; ++j)
+        rot[j] = sw_rec_f64(rec->p + 28 + 8 * j);
+    sinew_result r = sinew_world_set_collider_transform_d(rp->world, id, pos, rot);
+    if (r != SINEW_OK) return refuse(rp, r, "a recorded placement was refused", k);
+    rp->placed[slot] = 1;
+    return SINEW_OK;
 }
 
 /* An IGNORE record: the collider in that slot of the replay's world, or none. */
@@ -231,6 +255,8 @@ static sinew_result replay_record(replay *rp, const sw_rec_record *rec, uint32_t
         return replay_mesh(rp, rec, k);
     case SW_REC_IGNORE:
         return replay_ignore(rp, rec, k);
+    case SW_REC_PLACE:
+        return replay_place(rp, rec, k);
     case SW_REC_ACTOR: {
         double T[12];
         for (int i = 0; i < 12; ++i)
@@ -266,7 +292,7 @@ sinew_result sw_recording_replay(const sinew_blob *blob, const sw_recording *rec
     memset(rep, 0, sizeof *rep);
     rep->first_diff = -1;
     sinew_logger quiet = sinew_logger_default();
-    replay rp = {blob, logger ? logger : &quiet, NULL, NULL, NULL, 0, rep};
+    replay rp = {blob, logger ? logger : &quiet, NULL, NULL, NULL, 0, NULL, rep};
     if (!blob || !rec || !rec->stream) return SINEW_ERROR_INVALID_ARGUMENT;
     size_t pos = 0;
     sw_rec_record r0;

@@ -138,9 +138,12 @@ static int load_worlds(const char *path, const sw_move *m, sinew_world **w, sine
     for (int32_t c = 0; ok && c < f.ncolliders; ++c) {
         sinew_collider_def d = f.colliders[c].def;
         sinew_collider_id id;
+        double pos[3], rot[4]; /* carried in doubles, as a host with a double world */
+        int placed = sw_move_placement(G, &d, pos, rot);
         ok = sinew_world_add_collider(*w, &d, &id) == SINEW_OK;
         sw_move_collider(G, &d);
         ok = ok && sinew_world_add_collider(*wm, &d, &id) == SINEW_OK;
+        if (ok && placed) ok = sinew_world_set_collider_transform_d(*wm, id, pos, rot) == SINEW_OK;
     }
     sw_world_file_free(&f);
     if (!ok) fprintf(stderr, "%s: %s: the world's colliders could not be built\n", TOOL, path);

@@ -44,8 +44,20 @@ void sw_move_collider(const double G[12], sinew_collider_def *c) {
         c->offset = c->normal[0] * p0[0] + c->normal[1] * p0[1] + c->normal[2] * p0[2];
         return;
     }
-    sinew_transform t = c->transform;
-    carry_float(G, t.position, 1, c->transform.position);
+    double pos[3], rot[4];
+    sw_move_placement(G, c, pos, rot);
+    for (int i = 0; i < 3; ++i)
+        c->transform.position[i] = (float)pos[i];
+    for (int i = 0; i < 4; ++i)
+        c->transform.rotation[i] = (float)rot[i];
+}
+
+int sw_move_placement(const double G[12], const sinew_collider_def *c, double pos[3],
+                      double rot[4]) {
+    if (c->shape == SINEW_SHAPE_PLANE) return 0;
+    const float *p = c->transform.position;
+    for (int i = 0; i < 3; ++i)
+        pos[i] = G[3 * i] * p[0] + G[3 * i + 1] * p[1] + G[3 * i + 2] * p[2] + G[9 + i];
     /* the quaternion of G's rotation (Shepperd: from its largest component), times q */
     const double tr = G[0] + G[4] + G[8];
     double g[4];
@@ -63,12 +75,12 @@ void sw_move_collider(const double G[12], sinew_collider_def *c) {
         g[1 + i] = (G[3 * i + k] + G[3 * k + i]) / r;
         g[1 + j] = (G[3 * j + k] + G[3 * k + j]) / r;
     }
-    const float *q = t.rotation;
-    float *o = c->transform.rotation;
-    o[0] = (float)(g[0] * q[0] - g[1] * q[1] - g[2] * q[2] - g[3] * q[3]);
-    o[1] = (float)(g[0] * q[1] + g[1] * q[0] + g[2] * q[3] - g[3] * q[2]);
-    o[2] = (float)(g[0] * q[2] - g[1] * q[3] + g[2] * q[0] + g[3] * q[1]);
-    o[3] = (float)(g[0] * q[3] + g[1] * q[2] - g[2] * q[1] + g[3] * q[0]);
+    const float *q = c->transform.rotation;
+    rot[0] = g[0] * q[0] - g[1] * q[1] - g[2] * q[2] - g[3] * q[3];
+    rot[1] = g[0] * q[1] + g[1] * q[0] + g[2] * q[3] - g[3] * q[2];
+    rot[2] = g[0] * q[2] - g[1] * q[3] + g[2] * q[0] + g[3] * q[1];
+    rot[3] = g[0] * q[3] + g[1] * q[2] - g[2] * q[1] + g[3] * q[0];
+    return 1;
 }
 
 static double move_scale(const sw_move *m) {

@@ -69,6 +69,12 @@ void sw_move_transform(const sw_move *m, int32_t f, double G[12]);
  * distance from the origin. */
 void sw_move_collider(const double G[12], sinew_collider_def *c);
 
+/* The placement (position, unit quaternion w x y z) of collider def c carried by G, in
+ * doubles: what sinew_world_set_collider_transform_d takes, so the moved world is the
+ * same world to rounding. 0 for a plane (no placement). */
+int sw_move_placement(const double G[12], const sinew_collider_def *c, double pos[3],
+                      double rot[4]);
+
 /* Plays frames of `clip` (12 doubles a bone a frame, nb bones) in two instances of blob,
  * the second carried by m, and measures *out. */
 sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, int32_t nb,

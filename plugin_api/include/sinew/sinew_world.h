@@ -144,6 +144,15 @@ SINEW_API sinew_result sinew_world_remove_collider(sinew_world *world, sinew_col
 SINEW_API sinew_result sinew_world_set_collider_transform(sinew_world *world, sinew_collider_id id,
                                                           const sinew_transform *transform);
 
+/** The same in double precision: position (xyz) and rotation (unit quaternion w, x, y,
+ * z, normalised on use), for hosts whose world is in doubles. A float placement rounds
+ * at 1e-7 of its distance from the origin (8 mm at 10^5 units); this one keeps what the
+ * host has, as `sinew_instance_set_actor` does for the character. */
+SINEW_API sinew_result sinew_world_set_collider_transform_d(sinew_world *world,
+                                                            sinew_collider_id id,
+                                                            const double position[3],
+                                                            const double rotation[4]);
+
 /** Moves the vertices of mesh collider `id` (`vertex_count` xyz triples; vertex_count must
  * equal its count at creation; the triangles stay), e.g. another character's surface after
  * its step, and refits its BVH and pseudonormals. In the collider's frame. Non-finite
