@@ -510,6 +510,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->allocator = d.allocator;
     in->mode = d.mode;
     in->size = rest_size(v);
+    in->grid = sw_pose_grid(in->size);
     state_bounds(in);
     in->red.v = v;
     in->red.R = v->rank_total;
@@ -534,7 +535,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     /* 2% of the character's size: what a surface vertex can travel in one step */
     in->wc.radius = 0.01 * in->size;
     in->wc.frame = in->frame; /* the step's (pose.c) */
-    in->wc.grid = sw_pose_grid(in->size);
+    in->wc.grid = in->grid;
     in->ps.twin_next = blob->poses.twin_next; /* the blob's, computed once at its load */
     in->ps.reach = blob->poses.reach;
     in->ps.joint_bend = blob->poses.joint_bend;

@@ -18,6 +18,7 @@ struct sinew_instance {
     sinew_logger logger;       /* the def's (or the blob's) */
     sinew_step_mode mode;
     double size;          /* rest bounding-box diagonal */
+    double grid;          /* the translations' snapping grid (sw_pose_grid of size) */
     double *bone_ball;    /* 4 nbones: the ball of the rest vertices each bone skins
                              (centre, radius; radius -1: none), sw_pose_jump's */
     double *q_bound;      /* ndomains: the largest |q_k| a step may leave (step.c) */

@@ -75,10 +75,9 @@ void sw_instance_frame(sinew_instance *in) {
     L->h_prev = P->h_prev;
     L->declared_jump = P->declared_jump;
     memcpy(in->frame, P->T_cur, sizeof in->frame); /* bone 0 */
-    const double g = sw_pose_grid(in->size);
-    sw_pose_snap(in->frame, P->T_cur, nb, g, L->T_cur);
-    sw_pose_snap(in->frame, P->T_prev, nb, g, L->T_prev);
-    sw_pose_snap(in->frame, P->T_prev2, nb, g, L->T_prev2);
+    sw_pose_snap(in->frame, P->T_cur, nb, in->grid, L->T_cur);
+    sw_pose_snap(in->frame, P->T_prev, nb, in->grid, L->T_prev);
+    sw_pose_snap(in->frame, P->T_prev2, nb, in->grid, L->T_prev2);
     for (int32_t b = 0; b < nb; ++b)
         sw_dq_from_transform(L->T_cur + 12 * b, &in->bone_dq[b]);
 }
