@@ -369,6 +369,37 @@ static inline void fixture_add_asset(fixture *f, asset_fixture *a) {
 #undef POINT
 }
 
+/* A pose-space level of detail (LOD sections) of rank 2 for at most NOUT_MAX output
+ * vertices: each vertex on bone i % NB alone at its rest position, two orthonormal modes
+ * (x of every vertex, then y, scaled), a map of small entries. */
+enum { LOD_RANK = 2 };
+typedef struct lod_fixture {
+    double rest[3 * NOUT_MAX], weight[4 * NOUT_MAX], map[LOD_RANK * (9 * NB + 1)];
+    int32_t bone[4 * NOUT_MAX];
+    float basis[LOD_RANK * 3 * NOUT_MAX];
+} lod_fixture;
+
+static inline void fixture_add_lod(fixture *f, lod_fixture *l) {
+    sw_blob_view *v = &f->v;
+    memset(l, 0, sizeof *l);
+    const int32_t n = sw_blob_output_verts(v);
+    const float e = (float)(1.0 / sqrt((double)(n > 0 ? n : 1)));
+    for (int32_t s = 0; s < n && s < NOUT_MAX; ++s) {
+        for (int k = 0; k < 3; ++k)
+            l->rest[3 * s + k] = 0.1 * (s + k);
+        for (int k = 0; k < 4; ++k)
+            l->bone[4 * s + k] = (s + k) % NB;
+        l->weight[4 * s] = 1;
+        l->basis[3 * s] = e;
+        l->basis[3 * n + 3 * s + 1] = e;
+    }
+    for (int32_t i = 0; i < LOD_RANK * (9 * NB + 1); ++i)
+        l->map[i] = 0.01 * (double)(i % 5) - 0.02;
+    v->nlod_verts = n, v->lod_rank = LOD_RANK;
+    v->lod_rest = l->rest, v->lod_bone = l->bone, v->lod_weight = l->weight;
+    v->lod_basis = l->basis, v->lod_map = l->map;
+}
+
 /* ---- helpers --------------------------------------------------------------------- */
 
 /* First field in which two views differ (counts, scalars bitwise, arrays bitwise, the
@@ -416,6 +447,11 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     if (a->tet_stiffness &&
         memcmp(a->tet_stiffness, b->tet_stiffness, (size_t)a->ntets * sizeof(double)))
         return "tet_stiffness";
+    if (a->lod_rank != b->lod_rank || a->nlod_verts != b->nlod_verts) return "lod counts";
+    if (a->lod_rank > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_LOD_COUNTS);
+        SINEW_BLOB_LOD_ARRAY_SECTIONS(SAME_ARRAY)
+    }
 #undef SAME_ARRAY
     return NULL;
 }

@@ -39,7 +39,8 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     const sw_tetmesh *m = &fx.ch.mesh;
     ENSURE(hdr(fx.data)->section_count ==
            SINEW_SECTION_COUNT_V1 + NCOND + (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
-               (v->train_force ? 1u : 0u) + (v->bone_names ? 5u : 0u));
+               (v->train_force ? 1u : 0u) + (v->bone_names ? 5u : 0u) +
+               (v->lod_rank > 0 ? 6u : 0u));
     ENSURE(v->ntets == m->ntets && v->nvert_tets == 4 * m->ntets && v->nverts == m->nverts);
     ENSURE(v->ndomains >= 2); /* tets in more than one domain, vertices with several copies */
     ENSURE(memcmp(v->tets, m->tets, 4 * sizeof(int32_t) * (size_t)m->ntets) == 0);
@@ -132,12 +133,13 @@ TEST(the_masses_are_the_reduced_masses) {
 TEST(a_view_without_the_tet_mesh_writes_the_blob_of_before) {
     ENSURE(capsule_fixture());
     sw_blob_view plain = fx.res.view;
-    plain.ntets = plain.nvert_tets = plain.npair_groups = 0;
+    plain.ntets = plain.nvert_tets = plain.npair_groups = plain.nlod_verts = plain.lod_rank = 0;
 #define CLEAR(id, NAME, elem_size, type, field, ...) plain.field = NULL;
     SINEW_BLOB_COND_ARRAY_SECTIONS(CLEAR)
     SINEW_BLOB_PAIR_ARRAY_SECTIONS(CLEAR)
     SINEW_BLOB_FORCE_SECTIONS(CLEAR)
     SINEW_BLOB_ASSET_ARRAY_SECTIONS(CLEAR)
+    SINEW_BLOB_LOD_ARRAY_SECTIONS(CLEAR)
 #undef CLEAR
     size_t size = 0;
     void *data = NULL;
@@ -342,6 +344,8 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     fixture_add_pairs(&f, &p);
     fixture_add_asset(&f, &a);
     fixture_add_paint(&f, &c, &pf);
+    static lod_fixture lf;
+    fixture_add_lod(&f, &lf);
     static double force[4096];
     const int64_t nforce = (int64_t)f.v.ntrain * f.v.rank_total;
     ENSURE(nforce <= 4096);

@@ -22,6 +22,7 @@
 
 static char g_path[512];
 static uint64_t g_hash[FRAMES]; /* the surface hash the session saw after each step */
+static int g_lod;               /* the session changes its level of detail */
 
 static void session_pose(const bake_fixture *f, int s, float *pose) {
     /* a jump of the clip at the teleport: frames from the other end */
@@ -63,6 +64,12 @@ static int run_session(moving_scene *m, int record, session *out) {
         actor[10] = s < 300 ? 0.0 : 0.01; /* the actor lifts a little at frame 300 */
         if (s == 0 || s == 300) ok &= sinew_instance_set_actor(inst, actor) == SINEW_OK;
         if (s == TELEPORT_AT) ok &= sinew_instance_mark_teleport(inst) == SINEW_OK;
+        /* levels of detail: cheaper for a while, back in the middle of a fade, and again */
+        static const int lod_at[] = {150, 180, 184, 450, 520};
+        static const sinew_lod lod_to[] = {SINEW_LOD_POSE_SPACE, SINEW_LOD_REDUCED, SINEW_LOD_FULL,
+                                           SINEW_LOD_POSE_SPACE, SINEW_LOD_FULL};
+        for (int k = 0; k < 5 && g_lod; ++k)
+            if (s == lod_at[k]) ok &= sinew_instance_set_lod(inst, lod_to[k]) == SINEW_OK;
         session_pose(f, s, pose);
         ok &= sinew_instance_set_pose(inst, pose, nb) == SINEW_OK;
         float dt = s == 700 ? 0.0f : (s % 3 ? 1.0f / 60 : 1.0f / 50); /* a pause, uneven dt */
@@ -87,6 +94,15 @@ static int run_session(moving_scene *m, int record, session *out) {
     free(pose);
     sinew_instance_destroy(inst);
     return ok;
+}
+
+/* The records of each type in a parsed recording. */
+static void count_records(const sw_recording *r, uint32_t n[SW_REC_LOD + 1]) {
+    memset(n, 0, sizeof(uint32_t) * (SW_REC_LOD + 1));
+    size_t pos = 0;
+    sw_rec_record one;
+    while (sw_recording_next(r, &pos, &one))
+        if (one.type <= SW_REC_LOD) n[one.type]++;
 }
 
 static unsigned char *read_all(size_t *n) {
@@ -186,6 +202,46 @@ TEST(a_session_with_pokes_and_a_teleport_replays_bitwise) {
     ENSURE(fp && fwrite(data, 1, n, fp) == n && fclose(fp) == 0);
     sw_recording_free(&rec);
     free(data);
+    sinew_world_destroy(m.w);
+}
+
+static int parse_says(const unsigned char *d, size_t n, const char *what);
+
+/* The session changing its level of detail: every change recorded (LOD records, format 3)
+ * and replayed bitwise, no allocation or lock in a step at any level. */
+TEST(a_session_changing_its_level_of_detail_replays_bitwise) {
+    moving_scene m;
+    ENSURE(moving_scene_make(&m));
+    char keep[512];
+    memcpy(keep, g_path, sizeof keep);
+    snprintf(g_path, sizeof g_path, "%s/tests/test_record_replay_lod.rec", SINEW_BINARY_DIR);
+    static session recorded;
+    g_lod = 1;
+    int ran = run_session(&m, 1, &recorded);
+    g_lod = 0;
+    ENSURE(ran);
+    ensure_no_allocs_or_locks(&recorded.counts);
+    size_t n;
+    unsigned char *data = read_all(&n);
+    ENSURE(data);
+    sw_recording rec;
+    sw_error err;
+    ENSUREF(sw_recording_parse(data, n, &rec, &err) == SINEW_OK, "%s", err.msg);
+    uint32_t count[SW_REC_LOD + 1];
+    count_records(&rec, count);
+    ENSURE(rec.version == 3 && count[SW_REC_LOD] == 5); /* every change of level */
+    sw_replay_report rep;
+    ENSUREF(sw_recording_replay(m.f->blob, &rec, NULL, NULL, &rep) == SINEW_OK, "%s", rep.msg);
+    ENSURE(rep.steps == FRAMES && rep.differing == 0);
+    /* a version-2 reader knows no LOD record: a version-2 file holding one is refused */
+    size_t n2;
+    unsigned char *v2 = rechunk_as(2, rec.stream, rec.size, &n2);
+    ENSURE(parse_says(v2, n2, "does not add up"));
+    free(v2);
+    sw_recording_free(&rec);
+    free(data);
+    remove(g_path);
+    memcpy(g_path, keep, sizeof keep);
     sinew_world_destroy(m.w);
 }
 
@@ -443,15 +499,6 @@ static int run_deforming(const char *path, int steps, deform_run *out) {
     return ok;
 }
 
-/* The records of each type in a parsed recording. */
-static void count_records(const sw_recording *r, uint32_t n[SW_REC_PLACE + 1]) {
-    memset(n, 0, sizeof(uint32_t) * (SW_REC_PLACE + 1));
-    size_t pos = 0;
-    sw_rec_record one;
-    while (sw_recording_next(r, &pos, &one))
-        if (one.type <= SW_REC_PLACE) n[one.type]++;
-}
-
 #define DEFORM_STEPS 60
 TEST(a_deforming_mesh_a_double_placement_and_an_ignored_collider_replay_bitwise) {
     char path[600];
@@ -479,7 +526,7 @@ TEST(a_deforming_mesh_a_double_placement_and_an_ignored_collider_replay_bitwise)
     fprintf(stderr, "    replayed %u steps: %u differ (first %lld)\n", rep.steps, rep.differing,
             (long long)rep.first_diff);
     ENSURE(rep.steps == DEFORM_STEPS && rep.differing == 0 && rep.first_diff == -1);
-    uint32_t count[SW_REC_PLACE + 1];
+    uint32_t count[SW_REC_LOD + 1];
     count_records(&rec, count);
     fprintf(stderr, "    %u MESH, %u IGNORE, %u WORLD records\n", count[SW_REC_MESH],
             count[SW_REC_IGNORE], count[SW_REC_WORLD]);
@@ -535,7 +582,7 @@ TEST(a_version_1_recording_still_replays) {
     free(seed);
     free(v1);
     v1 = rechunk_as(SW_REC_VERSION + 1, rec.stream, rec.size, &n1);
-    ENSURE(parse_says(v1, n1, "reads versions 1 to 2"));
+    ENSURE(parse_says(v1, n1, "reads versions 1 to 3"));
     free(v1);
     sw_recording_free(&rec);
     free(data);
@@ -554,7 +601,7 @@ TEST(a_short_deforming_recording_is_a_fuzzer_seed) {
     sw_recording r;
     sw_error err;
     ENSUREF(sw_recording_parse(d, n, &r, &err) == SINEW_OK, "%s", err.msg);
-    uint32_t count[SW_REC_PLACE + 1];
+    uint32_t count[SW_REC_LOD + 1];
     count_records(&r, count);
     ENSURE(r.steps == 3 && count[SW_REC_MESH] == 3 && count[SW_REC_IGNORE] == 1);
     sw_replay_report rep;
@@ -572,6 +619,7 @@ TEST(release_fixture) {
 
 SW_TEST_MAIN(CASE(a_session_with_pokes_and_a_teleport_replays_bitwise),
              CASE(a_recording_without_one_pose_differs_from_there),
+             CASE(a_session_changing_its_level_of_detail_replays_bitwise),
              CASE(damaged_recordings_are_refused_clearly),
              CASE(a_recorder_attaches_only_to_a_fresh_instance),
              CASE(a_short_recording_is_the_fuzzers_seed),

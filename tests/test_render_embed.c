@@ -335,6 +335,8 @@ TEST(the_loader_rejects_a_damaged_render_mesh) {
         entry(b, id)->id = 100 + id;
     for (uint32_t id = SINEW_SECTION_ASSET_FIRST; id <= SINEW_SECTION_ASSET_LAST; ++id)
         entry(b, id)->id = 100 + id;
+    for (uint32_t id = SINEW_SECTION_LOD_FIRST; id <= SINEW_SECTION_LOD_LAST; ++id)
+        if (entry(b, id)) entry(b, id)->id = 100 + id; /* (its vertices are the render mesh's) */
     fix_checksum(b, fx.size);
     sw_blob_view plain;
     char msg[512];

@@ -216,6 +216,16 @@ static int sum_equilibrium(const sw_bake_state *s, const sw_bake_result *o, char
     return 1;
 }
 
+static int sum_lod(const sw_bake_state *s, const sw_bake_result *o, char *m, size_t n) {
+    (void)s;
+    snprintf(m, n,
+             "pose-space level: %d modes (%.3f of the displacements dropped), ridge %g; held-out "
+             "surface error by level: full %.4f, reduced %.4f, pose-space %.4f",
+             o->view.lod_rank, o->lod_kept, o->lod_ridge, o->lod_heldout[0], o->lod_heldout[1],
+             o->lod_heldout[2]);
+    return 1;
+}
+
 /* The stages, in order. A stage reads the state groups of the stages before it
  * (bake_state.h) and writes its own group and its part of the result; "view" is the blob
  * view in sw_bake_result, whose sections reduce, render, cond and pairs assemble, and
@@ -261,6 +271,8 @@ const sw_bake_stage sw_bake_stages[SW_BAKE_NSTAGES] = {
     /* the pose-space equilibrium force of every training pose */
     {"equilibrium", sw_bake_equilibrium, sum_equilibrium, 0, "view, train_*",
      "view.train_force, force_poses, model_train_error"},
+    /* the pose-space level of detail, then every level's held-out error */
+    {"lod", sw_bake_lod, sum_lod, 0, "view, train_*, heldout_*", "view (lod), lod_*"},
 };
 
 /* Runs the stages (only those of sw_bake_solutions with `solutions`), timing each into

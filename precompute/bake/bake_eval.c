@@ -38,24 +38,41 @@ sinew_result sw_bake_train_error(const sinew_blob *blob, const sw_bake_result *r
                                      train_frames, train, err);
 }
 
-sinew_result sw_bake_heldout_error(const sinew_blob *blob, const sw_bake_result *res,
-                                   sinew_self_contact sc, sw_eval_frame_fn on_frame, void *ctx,
-                                   sw_eval_result *heldout, double *heldout_frames, sw_error *err) {
+/* The held-out path stepped with options o (its skip and frames filled here). */
+static sinew_result heldout_path(const sinew_blob *blob, const sw_bake_result *res,
+                                 sw_eval_options *o, sw_eval_result *heldout,
+                                 double *heldout_frames, sw_error *err) {
     memset(heldout, 0, sizeof *heldout);
     int32_t pre, n;
     double *T = sw_bake_heldout_path(res, sw_blob_get_view(blob)->nbones, &pre, &n);
     if (!T) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
-    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
-                         .dt = 1.0f / 30,
-                         .max_newton = SW_BAKE_EVAL_NEWTON,
-                         .skip = pre,
-                         .self_contact = sc,
-                         .on_frame = on_frame,
-                         .frame_ctx = ctx};
-    sinew_result r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, &o,
+    o->skip = pre;
+    sinew_result r = sw_eval_correction_frames(blob, res->mass, T, res->heldout_x, n, o,
                                                heldout_frames, heldout, err);
     free(T);
     return r;
+}
+
+sinew_result sw_bake_heldout_error(const sinew_blob *blob, const sw_bake_result *res,
+                                   sinew_self_contact sc, sw_eval_frame_fn on_frame, void *ctx,
+                                   sw_eval_result *heldout, double *heldout_frames, sw_error *err) {
+    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
+                         .dt = 1.0f / 30,
+                         .max_newton = SW_BAKE_EVAL_NEWTON,
+                         .self_contact = sc,
+                         .on_frame = on_frame,
+                         .frame_ctx = ctx};
+    return heldout_path(blob, res, &o, heldout, heldout_frames, err);
+}
+
+sinew_result sw_bake_heldout_level_error(const sinew_blob *blob, const sw_bake_result *res,
+                                         sinew_lod lod, sw_eval_result *heldout, sw_error *err) {
+    sw_eval_options o = {.mode = SINEW_STEP_QUASISTATIC,
+                         .dt = 1.0f / 30,
+                         .max_newton = SW_BAKE_EVAL_NEWTON,
+                         .self_contact = SINEW_SELF_CONTACT_POSE_SPACE,
+                         .lod = lod};
+    return heldout_path(blob, res, &o, heldout, NULL, err);
 }
 
 sinew_result sw_bake_errors_frames(const sinew_blob *blob, const sw_bake_result *res,

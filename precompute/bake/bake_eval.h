@@ -45,6 +45,11 @@ sinew_result sw_bake_heldout_error(const sinew_blob *blob, const sw_bake_result 
                                    sinew_self_contact sc, sw_eval_frame_fn on_frame, void *ctx,
                                    sw_eval_result *heldout, double *heldout_frames, sw_error *err);
 
+/* The held-out error of `blob` at level of detail `lod` (pose-space self-contact), its
+ * surface_error the figure the levels share (bake_lod.c). */
+sinew_result sw_bake_heldout_level_error(const sinew_blob *blob, const sw_bake_result *res,
+                                         sinew_lod lod, sw_eval_result *heldout, sw_error *err);
+
 /* How well the held-out references are defined (bake_spread.c; sinew-bake
  * --reference-spread): at every `every`-th held-out pose (every - 1, 2 every - 1, ...)
  * that the blob steps along the held-out path in self-contact mode sc, three full-space

@@ -11,7 +11,9 @@
 
 /* The stages of sw_bake, in the order it runs them (bake.c, sw_bake_stages; their names,
  * what each reads and writes are there): sw_bake_result.stage_seconds has one slot each. */
-#define SW_BAKE_NSTAGES 15
+#define SW_BAKE_NSTAGES 16
+/* The levels of detail a bake measures (sinew_lod). */
+#define SW_BAKE_LODS 3
 
 /* The interface springs' stiffnesses a bake chooses from (sw_bake_params.spring_k 0):
  * sw_bake_spring_mult(i) E h for i < SW_SPRING_CHOICES, stiffest first. */
@@ -185,6 +187,12 @@ typedef struct sw_bake_result {
        hides on the training poses, and what the bake's sanity limit reads
        (SW_BAKE_MAX_TRAIN_ERROR) */
     double model_train_error;
+    /* the pose-space level of detail (bake_lod.c): the share of its training displacements'
+       norm its modes drop, and each level's held-out error on the output surface
+       (sinew_lod's order; NaN: no held-out poses, or a failed step) */
+    double lod_kept;
+    double lod_ridge; /* the regression's ridge the validation chose (a share) */
+    double lod_heldout[SW_BAKE_LODS];
     double spring_tried_mult[SW_SPRING_CHOICES], spring_tried_err[SW_SPRING_CHOICES];
     /* the render mesh's embedding (sw_character.render; all 0 without one): render
        vertices outside every tet, the largest distance of one from the tets, the largest

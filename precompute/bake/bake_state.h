@@ -210,5 +210,7 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
 sinew_result sw_bake_springs(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_galerkin(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 sinew_result sw_bake_equilibrium(sw_bake_state *s, sw_bake_result *out, sw_error *err);
+/* The pose-space level of detail's sections and every level's held-out error (bake_lod.c). */
+sinew_result sw_bake_lod(sw_bake_state *s, sw_bake_result *out, sw_error *err);
 
 #endif

@@ -36,12 +36,13 @@ typedef struct group_metas {
     sinew_blob_cond_meta cond;
     sinew_blob_pair_meta pair;
     sinew_blob_asset_meta asset;
+    sinew_blob_lod_meta lod;
 } group_metas;
 
 /* The sections of a validated view, in id order, into s; returns their number (26, plus 8
  * with a render mesh, plus 10 with the condensation tet mesh, plus 6 with per-pair
  * self-contact, plus 1 with the equilibrium force, plus 5 with the asset description, plus
- * 1 or 2 with painted material). `meta` and
+ * 1 or 2 with painted material, plus 6 with the pose-space level). `meta` and
  * `g` must outlive the result. */
 static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
                          section_src s[SINEW_SECTION_ID_MAX]) {
@@ -90,6 +91,13 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
         memcpy(s + n, stiff, (size_t)nstiff * sizeof stiff[0]);
         n += nstiff;
     }
+    if (v->lod_rank > 0) {
+        SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_LOD_COUNTS);
+        const section_src lod[] = {{SINEW_SECTION_LOD_META, sizeof g->lod, &g->lod, 1},
+                                   SINEW_BLOB_LOD_ARRAY_SECTIONS(SOURCE)};
+        memcpy(s + n, lod, sizeof lod);
+        n += (int)(sizeof lod / sizeof lod[0]);
+    }
     return n;
 }
 #undef SOURCE
@@ -125,6 +133,9 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
 #define TO_ASSET_META(field) g.asset.field = view->field;
     SINEW_BLOB_ASSET_COUNTS(TO_ASSET_META)
 #undef TO_ASSET_META
+#define TO_LOD_META(field) g.lod.field = view->field;
+    SINEW_BLOB_LOD_COUNTS(TO_LOD_META)
+#undef TO_LOD_META
     g.asset.sinew_version = view->sinew_version;
     g.asset.source_hash = view->source_hash;
     g.asset.options_hash = view->options_hash;

@@ -39,7 +39,11 @@ sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const doub
     a->nbones = v->nbones;
     a->bone_num = calloc((size_t)v->nbones, sizeof(double));
     a->bone_den = calloc((size_t)v->nbones, sizeof(double));
-    if (!a->xs || !a->xd || !a->cnt || !a->bone_num || !a->bone_den) {
+    a->view = v;
+    size_t s3 = (size_t)sw_blob_output_verts(v) * 3 * sizeof(double);
+    a->sref = malloc(s3);
+    a->sdqs = malloc(s3);
+    if (!a->xs || !a->xd || !a->cnt || !a->bone_num || !a->bone_den || !a->sref || !a->sdqs) {
         sw_eval_acc_free(a);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     }
@@ -67,6 +71,14 @@ void sw_eval_acc_add(sw_eval_acc *a, const sinew_instance *inst, const double *x
         a->bone_num[a->skin_bone[4 * (int64_t)i]] += vn;
         a->bone_den[a->skin_bone[4 * (int64_t)i]] += vd;
     }
+    const sw_blob_view *v = a->view;
+    sw_output_from_full(v, xf, a->sref);
+    sw_output_from_full(v, a->xd, a->sdqs);
+    const double *y = sw_instance_surface(inst);
+    for (int64_t i = 0; i < 3 * (int64_t)sw_blob_output_verts(v); ++i) {
+        a->snum += (y[i] - a->sref[i]) * (y[i] - a->sref[i]);
+        a->sden += (a->sref[i] - a->sdqs[i]) * (a->sref[i] - a->sdqs[i]);
+    }
     a->frames++;
 }
 
@@ -77,6 +89,7 @@ void sw_eval_acc_result(const sw_eval_acc *a, sw_eval_result *out) {
     int none = !(a->den > a->den_floor * (a->frames > 0 ? a->frames : 1));
     out->no_correction = none && a->frames > 0;
     out->correction_error = none ? 0 : sqrt(a->num / a->den);
+    out->surface_error = none || !(a->sden > 0) ? 0 : sqrt(a->snum / a->sden);
     out->rel_l2 = a->l2d > 0 ? sqrt(a->l2n / a->l2d) : 0;
     out->frames = a->frames;
     out->seam = none ? 0 : sqrt(a->seam / a->den);
@@ -102,7 +115,9 @@ void sw_eval_acc_free(sw_eval_acc *a) {
     free(a->xd);
     free(a->bone_num);
     free(a->bone_den);
-    a->xs = a->cnt = a->xd = a->bone_num = a->bone_den = NULL;
+    free(a->sref);
+    free(a->sdqs);
+    a->xs = a->cnt = a->xd = a->bone_num = a->bone_den = a->sref = a->sdqs = NULL;
 }
 
 sinew_result sw_eval_correction(const sinew_blob *blob, const double *mass, const double *T,
@@ -138,8 +153,11 @@ sinew_result sw_eval_correction_frames(const sinew_blob *blob, const double *mas
     def.max_patch_vertices = o->patch_vertices;
     sinew_instance *inst;
     sinew_result r = sinew_instance_create(blob, &def, &inst);
-    if (r != SINEW_OK)
+    if (r == SINEW_OK && o->lod != SINEW_LOD_FULL) r = sinew_instance_set_lod(inst, o->lod);
+    if (r != SINEW_OK) {
+        sinew_instance_destroy(inst);
         return sw_error_set(err, r, "cannot create an instance: %s", sinew_result_string(r));
+    }
     sw_eval_acc acc;
     if ((r = sw_eval_acc_init(&acc, blob, mass, err)) != SINEW_OK) {
         sinew_instance_destroy(inst);

@@ -35,6 +35,10 @@ typedef struct sw_eval_result {
        diagonal, the total mass's worth: frames at rest): a share of nothing, so
        correction_error and seam are 0, and a caller says the error is not defined */
     int no_correction;
+    /* the same ratio on the output surface the host reads (each output vertex's weight 1,
+       the reference and skinning carried onto it as the runtime carries its own state,
+       sw_output_from_full): the one figure every level of detail has (sinew_lod) */
+    double surface_error;
 } sw_eval_result;
 
 /* The sums behind the correction error, one frame at a time, for a caller that steps
@@ -51,6 +55,9 @@ typedef struct sw_eval_acc {
     const int32_t *skin_bone; /* the blob's 4 influences a vertex, strongest first */
     int32_t nbones;
     double *bone_num, *bone_den; /* num and den by the vertices' strongest bone */
+    const void *view;            /* the blob's sw_blob_view */
+    double snum, sden;           /* the output surface's num and den (surface_error) */
+    double *sref, *sdqs;         /* scratch: the reference's and skinning's surfaces */
 } sw_eval_acc;
 
 sinew_result sw_eval_acc_init(sw_eval_acc *a, const sinew_blob *blob, const double *mass,
@@ -89,6 +96,7 @@ typedef struct sw_eval_options {
     sinew_self_contact self_contact;
     uint32_t novel_contact;  /* sinew_instance_def.novel_contact (0: off) */
     uint32_t patch_vertices; /* sinew_instance_def.max_patch_vertices (0: no patches) */
+    sinew_lod lod;           /* the level of detail every step runs (0: full) */
     sw_eval_frame_fn on_frame;
     void *frame_ctx;
 } sw_eval_options;

@@ -154,4 +154,22 @@ sinew_result sw_blob_asset_fill(const uint8_t *bytes, const sinew_blob_section *
  * (nothing when bone_names is NULL); after the render mesh has been checked. */
 sinew_result sw_blob_asset_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
+/* Every vertex's SW_BLOB_INFLUENCES (bone, weight) pairs (4 n each): bones in [0, nbones),
+ * weights >= 0 summing to 1 within SW_BLOB_WEIGHT_SUM_TOL; messages name the sections. */
+sinew_result sw_blob_check_influences(uint32_t bone_id, uint32_t weight_id, const int32_t *bone,
+                                      const double *weight, int32_t n, int32_t nbones, char *msg,
+                                      size_t msg_size);
+
+/* Layer 1 of the pose-space level of detail (blob_lod.c): the six optional sections all
+ * present or all absent, LOD_META's counts (nlod_verts the output surface's, lod_rank in
+ * [1, SINEW_BLOB_LOD_MAX_RANK]) and reserved words, every section's count against them and
+ * META's; points the view's fields at them (left 0 / NULL when absent). After the render
+ * mesh's fill. */
+sinew_result sw_blob_lod_fill(const uint8_t *bytes, const sinew_blob_section *s, const int found[],
+                              sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 2: finite rest positions and coefficients, influences as SKIN_BONE/SKIN_WEIGHT's,
+ * basis entries in [-1, 1] (nothing when lod_rank is 0). */
+sinew_result sw_blob_lod_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
 #endif

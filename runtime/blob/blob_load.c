@@ -58,7 +58,7 @@ static const struct {
     SINEW_BLOB_SECTIONS(SECTION_INFO) SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)
         SINEW_BLOB_COND_SECTIONS(SECTION_INFO) SINEW_BLOB_PAIR_SECTIONS(SECTION_INFO)
             SINEW_BLOB_FORCE_SECTIONS(SECTION_INFO) SINEW_BLOB_ASSET_SECTIONS(SECTION_INFO)
-                SINEW_BLOB_STIFFNESS_SECTIONS(SECTION_INFO)};
+                SINEW_BLOB_STIFFNESS_SECTIONS(SECTION_INFO) SINEW_BLOB_LOD_SECTIONS(SECTION_INFO)};
 #undef SECTION_INFO
 
 /* Not instrumented for fuzzing coverage: its loop has no branch worth a fuzzer's
@@ -348,28 +348,28 @@ static sinew_result check_bone_tree(const sw_blob_view *v, char *msg, size_t ms)
     return SINEW_OK;
 }
 
-static sinew_result check_skin(const sw_blob_view *v, char *msg, size_t ms) {
-    for (int32_t i = 0; i < v->nverts; ++i) {
+sinew_result sw_blob_check_influences(uint32_t bone_id, uint32_t weight_id, const int32_t *bone,
+                                      const double *weight, int32_t n, int32_t nbones, char *msg,
+                                      size_t ms) {
+    for (int32_t i = 0; i < n; ++i) {
         double sum = 0.0;
         for (int k = 0; k < SW_BLOB_INFLUENCES; ++k) {
-            int32_t b = v->skin_bone[4 * (int64_t)i + k];
-            double w = v->skin_weight[4 * (int64_t)i + k];
-            if (b < 0 || b >= v->nbones)
+            int32_t b = bone[4 * (int64_t)i + k];
+            double w = weight[4 * (int64_t)i + k];
+            if (b < 0 || b >= nbones)
                 return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                            "blob section SKIN_BONE: vertex %d influence %d: bone %d outside "
-                            "[0, %d)",
-                            i, k, b, v->nbones);
-            if (w < 0.0)
-                return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                            "blob section SKIN_WEIGHT: vertex %d influence %d: weight %g < 0", i, k,
-                            w);
+                            "blob section %s: vertex %d influence %d: bone %d outside [0, %d)",
+                            sw_blob_section_name(bone_id), i, k, b, nbones);
+            if (!(w >= 0.0))
+                return fail(msg, ms, isnan(w) ? SINEW_ERROR_NOT_FINITE : SINEW_ERROR_CORRUPT,
+                            "blob section %s: vertex %d influence %d: weight %g < 0",
+                            sw_blob_section_name(weight_id), i, k, w);
             sum += w;
         }
-        if (fabs(sum - 1.0) > SW_BLOB_WEIGHT_SUM_TOL)
-            return fail(msg, ms, SINEW_ERROR_CORRUPT,
-                        "blob section SKIN_WEIGHT: vertex %d: weights sum to %.9g, not 1 (tol "
-                        "%g)",
-                        i, sum, SW_BLOB_WEIGHT_SUM_TOL);
+        if (!(fabs(sum - 1.0) <= SW_BLOB_WEIGHT_SUM_TOL))
+            return fail(msg, ms, isfinite(sum) ? SINEW_ERROR_CORRUPT : SINEW_ERROR_NOT_FINITE,
+                        "blob section %s: vertex %d: weights sum to %.9g, not 1 (tol %g)",
+                        sw_blob_section_name(weight_id), i, sum, SW_BLOB_WEIGHT_SUM_TOL);
     }
     return SINEW_OK;
 }
@@ -460,7 +460,10 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
         return r;
     if ((r = check_all_finite(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_bone_tree(v, msg, ms)) != SINEW_OK) return r;
-    if ((r = check_skin(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_check_influences(SINEW_SECTION_SKIN_BONE, SINEW_SECTION_SKIN_WEIGHT,
+                                      v->skin_bone, v->skin_weight, v->nverts, v->nbones, msg,
+                                      ms)) != SINEW_OK)
+        return r;
     if ((r = check_domain_indices(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_surface(v, msg, ms)) != SINEW_OK) return r;
     if ((r = check_contacts(v, msg, ms)) != SINEW_OK) return r;
@@ -477,6 +480,7 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
     if ((r = sw_blob_pair_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_force_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_stiffness_validate(v, msg, ms)) != SINEW_OK) return r;
+    if ((r = sw_blob_lod_validate(v, msg, ms)) != SINEW_OK) return r;
     return sw_blob_asset_validate(v, msg, ms);
 }
 
@@ -715,7 +719,8 @@ sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, ch
         (r = sw_blob_pair_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_force_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_asset_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
-        (r = sw_blob_stiffness_fill(bytes, s, found, h.version, &v, msg, ms)) != SINEW_OK)
+        (r = sw_blob_stiffness_fill(bytes, s, found, h.version, &v, msg, ms)) != SINEW_OK ||
+        (r = sw_blob_lod_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK)
         return r;
     if ((r = sw_blob_validate_view(&v, msg, ms)) != SINEW_OK) return r;
     *view = v;

@@ -196,6 +196,19 @@ typedef struct sw_blob_view {
      * each cubature tet's and each condensation tet's multiplier of mu and lambda */
     const double *cub_stiffness; /* ncub */
     const double *tet_stiffness; /* ntets, or NULL when ntets is 0 */
+
+    /* the optional pose-space level of detail (lod_rank 0: none; SINEW_LOD_POSE_SPACE):
+     * output vertex s (of nlod_verts, the output surface's) skinned on its own from rest
+     * position lod_rest[3 s ..] by bones lod_bone[4 s ..] with weights lod_weight[4 s ..],
+     * displaced in its rest frame by d_s[i] = sum_j lod_basis[(3 s + i) lod_rank + j] c_j,
+     * c = W f of the pose's joint rotations f (sw_pose_rotation_feature), W = lod_map
+     * (lod_rank rows of 9 nbones + 1) */
+    int32_t nlod_verts, lod_rank;
+    const double *lod_rest;
+    const int32_t *lod_bone;
+    const double *lod_weight;
+    const float *lod_basis;
+    const double *lod_map;
 } sw_blob_view;
 
 /* The painted multipliers a blob may hold (the bake refuses the same range): one further

@@ -12,6 +12,7 @@
 #include "instance_internal.h"
 #include "recording.h"
 #include "log.h"
+#include "dqs.h"
 #include "mem_plan.h"
 #include "sorted.h"
 
@@ -207,6 +208,11 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(in->surf_n, 3 * ns);
     TAKE(in->node_x, 3 * (uint64_t)v->nrender_nodes);
     TAKE(in->weld_tris, 3 * (uint64_t)v->nrender_tris);
+    TAKE(in->lod_off, 3 * ns);
+    TAKE(in->lod_tmp, 3 * ns);
+    TAKE(in->lod_dq, v->lod_rank > 0 ? nb : 0);
+    TAKE(in->lod_feat, v->lod_rank > 0 ? SW_POSE_ROTATION_FEATURES(nb) : 0);
+    TAKE(in->lod_disp, v->lod_rank > 0 ? 3 * ns : 0);
     /* the state's bounds */
     TAKE(in->bone_ball, 4 * nb);
     TAKE(in->q_bound, nd);
@@ -509,6 +515,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->v = v;
     in->allocator = d.allocator;
     in->mode = d.mode;
+    in->lod = in->lod_last = in->lod_run = SINEW_LOD_FULL;
     in->size = rest_size(v);
     in->grid = sw_pose_grid(in->size);
     state_bounds(in);
@@ -618,8 +625,12 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     }
     /* Newton's reference Hessian back to the rest one (a cubature pass at rest) */
     if (inst->red.h_ref) sw_cubature_rest_hessian(&inst->red, inst->red.h_ref);
+    inst->lod_last = inst->lod; /* the level stays the host's; nothing to blend from */
+    inst->lod_w = 0;
+    inst->stepped = 0;
     memset(&inst->stats, 0, sizeof inst->stats);
     inst->stats.struct_size = sizeof inst->stats;
+    inst->stats.lod = (uint32_t)inst->lod;
     sw_rec_mark(inst, SW_REC_RESET);
     return SINEW_OK;
 }

@@ -43,6 +43,10 @@ double sw_instance_copy_spread(const sinew_instance *inst, const double *x, doub
  * known state. */
 void sw_instance_set_q(sinew_instance *inst, const double *q);
 
+/* The output surface (sw_instance_surface) of the reduced state q at the pose last set, as
+ * a step that ended at q leaves it (no patch): the pose-space level's table (bake_lod.c). */
+void sw_instance_surface_at(sinew_instance *inst, const double *q);
+
 /* Tests: the quasistatic reduced potential (cubature, springs and the pose-space
  * contact pairs in use) at q for the pose last set, with its gradient into g and its
  * (PSD-projected) Hessian into H (rank_total^2, row-major) when they are not NULL. */

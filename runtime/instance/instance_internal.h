@@ -58,7 +58,22 @@ struct sinew_instance {
     double *surf_x, *surf_n; /* 3 per output surface vertex each (sw_blob_output_verts) */
     double *node_x;          /* 3 per render node: the mean of its copies (render mesh only) */
     int32_t *weld_tris;      /* 3 per render triangle: its corners' weld representatives */
-    double *h_ref; /* Newton's reference Hessian's domain blocks (red.h_ref when in use) */
+    /* Levels of detail (lod.c): the level set for the next steps and the level the last
+     * output is of; after a change the surface shows lod_w (1 at the change, fading to 0
+     * as the character moves) times lod_off (3 per output vertex: the old level's surface
+     * less the new one's at the change, in bone 0's frame; lod_off_max its largest);
+     * lod_tmp holds the new level's last surface (what the fade measures the motion by),
+     * or a surface while the other is written; lod_dq the bones of the pose-space level
+     * (simulation frame), lod_feat its regressors. */
+    sinew_lod lod, lod_last;
+    double lod_w, lod_off_max;
+    sinew_lod lod_run; /* the level the step in progress runs (step.c) */
+    int stepped;       /* a step has written the surface since creation or the last reset */
+    double *lod_off, *lod_tmp;
+    sw_dualquat *lod_dq;
+    double *lod_feat; /* the pose's joint rotations (sw_pose_rotation_feature) */
+    float *lod_disp;  /* 3 per output vertex: the rest-frame displacements */
+    double *h_ref;    /* Newton's reference Hessian's domain blocks (red.h_ref when in use) */
     sinew_step_stats stats;
     sinew_task_callbacks tasks; /* the def's (red.tasks points here when they are set) */
     sinew_profiler profiler;    /* the def's zones (zone_begin NULL: none) */
@@ -104,6 +119,25 @@ void sw_instance_to_actor(const sinew_instance *in, const double x[3], int direc
 
 /* The output surface (positions and normals) of the state q (output.c). */
 void sw_instance_write_surface(sinew_instance *in);
+
+/* The output surface's normals from its positions (output.c). */
+void sw_instance_surface_normals(sinew_instance *in);
+
+/* The pose-space level (lod.c): the output surface (positions and normals, simulation
+ * frame) of the pose, each vertex skinned on its own and displaced by the modes at the
+ * coefficients the pose's joint rotations map to (0: a coefficient beyond bounds, and the
+ * surface plain skinning); the step of that level (no solve: the
+ * surface, the pose history), its figures into st. */
+int sw_lod_pose_surface(sinew_instance *in);
+sinew_result sw_lod_pose_step(sinew_instance *in, float dt, sinew_step_stats *st);
+/* Before the first solving step after the pose-space level: the state at the pose-space
+ * prediction with no velocity, no patch, the pose history afresh. */
+void sw_lod_leave_pose_space(sinew_instance *in);
+
+/* After a step that ran level `ran` (the old level `from` at a change to the pose-space
+ * level, otherwise the new `to`): the surface the change shows, the old level's, with the
+ * blend of the steps after it (lod.c). */
+void sw_lod_finish(sinew_instance *in, sinew_lod from, sinew_lod to, sinew_lod ran);
 
 /* The render mesh as output surface (output_render.c): positions x (3 per render vertex)
  * from the render nodes' positions node_x; normals n over the welded triangles

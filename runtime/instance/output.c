@@ -40,6 +40,14 @@ static void copies_mean(const sinew_instance *in, const int32_t *copies, const i
         x[k] = acc[k] / (double)(e - b);
 }
 
+void sw_instance_surface_normals(sinew_instance *in) {
+    const sw_blob_view *v = in->v;
+    if (v->nrender_verts > 0)
+        sw_render_normals(v, in->weld_tris, in->surf_x, in->surf_n);
+    else
+        sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
+}
+
 void sw_instance_write_surface(sinew_instance *in) {
     const sw_blob_view *v = in->v;
     /* the boundary is the output, or (under a render mesh) only what carries the world's
@@ -57,10 +65,8 @@ void sw_instance_write_surface(sinew_instance *in) {
             copies_mean(in, v->render_node_copies, in->red.node_copy_act, v->render_node_ptr[n],
                         v->render_node_ptr[n + 1], NULL, in->node_x + 3 * n);
         sw_render_positions(v, in->node_x, in->surf_x);
-        sw_render_normals(v, in->weld_tris, in->surf_x, in->surf_n);
-    } else {
-        sw_surface_normals(v->nsurf_verts, in->surf_x, v->nsurf_tris, v->surf_tris, in->surf_n);
     }
+    sw_instance_surface_normals(in);
     if (boxes) sw_world_contacts_update_boxes(&in->wc); /* (of copy_x, in the step's frame) */
     for (int32_t i = 0; i < sw_blob_output_verts(v); ++i) {
         double y[3];
@@ -76,6 +82,15 @@ SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, f
     if (!inst || (!positions && !normals) ||
         vertex_count != (uint32_t)sw_blob_output_verts(inst->v))
         return SINEW_ERROR_INVALID_ARGUMENT;
+    static const double identity[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
+    if (inst->scale == 1 && inst->actor_scale == 1 &&
+        memcmp(inst->actor, identity, sizeof identity) == 0) { /* the same numbers, sooner */
+        for (uint32_t i = 0; i < 3 * vertex_count; ++i) {
+            if (positions) positions[i] = (float)inst->surf_x[i];
+            if (normals) normals[i] = (float)inst->surf_n[i];
+        }
+        return SINEW_OK;
+    }
     for (uint32_t i = 0; i < vertex_count; ++i) {
         double y[3];
         if (positions) {
@@ -225,6 +240,12 @@ double sw_instance_potential(sinew_instance *inst, const double *q, double *g, d
 
 void sw_instance_set_q(sinew_instance *inst, const double *q) {
     memcpy(inst->solver.q, q, (size_t)inst->red.R * sizeof(double));
+}
+
+void sw_instance_surface_at(sinew_instance *inst, const double *q) {
+    sw_reduced_skin(&inst->red, inst->bone_dq);
+    sw_instance_set_q(inst, q);
+    sw_instance_write_surface(inst);
 }
 
 /* Simulation vertex gv skinned at the current pose (no correction) into y, in the

@@ -276,6 +276,13 @@ void sw_rec_ignore(sinew_instance *in) {
     put_u32(rec, s < 0 ? SW_REC_NO_SLOT : (uint32_t)s);
 }
 
+void sw_rec_lod(sinew_instance *in) {
+    sinew_recorder *rec = in->rec;
+    if (!rec) return;
+    put_header(rec, SW_REC_LOD, 4);
+    put_u32(rec, (uint32_t)in->lod);
+}
+
 /* A MESH record for each mesh moved since the recorder last wrote its vertices. */
 static void put_moved_meshes(sinew_recorder *rec, const sinew_world *w) {
     uint32_t ns = sw_world_slot_count(w);

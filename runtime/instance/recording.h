@@ -38,7 +38,9 @@
  *   PLACE     u32 slot, f64 position[3], rotation[4]: a collider's placement in doubles
  *             (sinew_world_set_collider_transform_d) as the next step saw it, written
  *             just before that STEP for each collider whose placement is not its float
- *             transform's; replay takes it instead of that STEP's floats. */
+ *             transform's; replay takes it instead of that STEP's floats.
+ * Version 3 adds one (a version-1 or -2 file has none, and replays as before):
+ *   LOD       u32 level: sinew_instance_set_lod, written at the call. */
 #ifndef SW_RECORDING_H
 #define SW_RECORDING_H
 
@@ -48,7 +50,7 @@
 #include "sinew/sinew.h"
 #include "sw_error.h"
 
-#define SW_REC_VERSION 2u /* also reads 1 (no MESH, no IGNORE) */
+#define SW_REC_VERSION 3u /* also reads 2 (no LOD) and 1 (no MESH, no IGNORE, no PLACE) */
 #define SW_REC_OLDEST_VERSION 1u
 #define SW_REC_PREAMBLE_BYTES 16u
 #define SW_REC_CHUNK_BYTES 16u
@@ -72,7 +74,8 @@ typedef enum sw_rec_type {
     SW_REC_END = 8,
     SW_REC_MESH = 9,    /* version 2 */
     SW_REC_IGNORE = 10, /* version 2 */
-    SW_REC_PLACE = 11   /* version 2 */
+    SW_REC_PLACE = 11,  /* version 2 */
+    SW_REC_LOD = 12     /* version 3 */
 } sw_rec_type;
 
 /* The recorder's hooks: each appends its call's record when a recorder is attached (one
@@ -83,6 +86,7 @@ void sw_rec_mark(sinew_instance *in, sw_rec_type type); /* TELEPORT, RESET */
 void sw_rec_world(sinew_instance *in);
 void sw_rec_step(sinew_instance *in, float dt, sinew_result r); /* and its MESH records */
 void sw_rec_ignore(sinew_instance *in); /* the instance's ignored collider as it is now */
+void sw_rec_lod(sinew_instance *in);    /* the level the host set */
 
 /* FNV-1a 64 of the output surface's positions and normals as the step left them (the
  * simulation frame's doubles the host's floats come from). O(surface). */

@@ -109,6 +109,8 @@ static int record_fits(const sw_recording *r, const sw_rec_record *rec) {
         return r->version >= 2 && rec->bytes == 4;
     case SW_REC_PLACE:
         return r->version >= 2 && rec->bytes == SW_REC_PLACE_BYTES;
+    case SW_REC_LOD:
+        return r->version >= 3 && rec->bytes == 4;
     }
     return 0;
 }

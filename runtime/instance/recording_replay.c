@@ -257,6 +257,10 @@ static sinew_result replay_record(replay *rp, const sw_rec_record *rec, uint32_t
         return replay_ignore(rp, rec, k);
     case SW_REC_PLACE:
         return replay_place(rp, rec, k);
+    case SW_REC_LOD:
+        r = sinew_instance_set_lod(rp->inst, (sinew_lod)sw_rec_u32(rec->p));
+        if (r != SINEW_OK) return refuse(rp, r, "a recorded set_lod was refused", k);
+        break;
     case SW_REC_ACTOR: {
         double T[12];
         for (int i = 0; i < 12; ++i)

@@ -105,7 +105,7 @@ static int exhaustive(const sinew_instance *in) {
 }
 
 sw_step_contacts sw_instance_contacts(sinew_instance *in, double *self_seconds) {
-    sw_step_contacts ct = {&in->ps, in->wc.world ? &in->wc : NULL,
+    sw_step_contacts ct = {&in->ps, in->wc.world && in->lod_run == SINEW_LOD_FULL ? &in->wc : NULL,
                            sw_instance_detects(in) ? &in->sc : NULL, self_seconds};
     return ct;
 }
@@ -184,7 +184,7 @@ static void phase_self(sw_step_ctx *c) {
             in->solver.mat_at_qn = 0;
         c->st.self_contact_tests += (uint32_t)(in->sc.tests - tests);
     }
-    if (in->novel_on) novel_self(c);
+    if (in->novel_on && in->lod_run == SINEW_LOD_FULL) novel_self(c);
     sw_step_contacts ct = sw_instance_contacts(in, NULL);
     sw_solver_block_pattern(&in->solver, in->v, &ct);
     double ms = lap(c);
@@ -269,7 +269,7 @@ static void phase_dynamics(sw_step_ctx *c) {
 static void phase_world(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_world_contacts *wc = &in->wc;
-    if (!wc->world) return;
+    if (!wc->world || in->lod_run != SINEW_LOD_FULL) return;
     const double *T_last = in->pose.history >= 1 ? in->L_last : NULL;
     sw_world_contacts_detect(wc, &in->red, in->solver.q, in->loc.T_cur, T_last);
     c->st.world_rounds = 1;
@@ -283,9 +283,10 @@ static void phase_oracle(sw_step_ctx *c) {
     sw_cond *cd = &in->cond;
     if (cd->z.max_verts == 0) return;
     if (c->st.status & SINEW_STEP_TELEPORT) sw_cond_forget(cd);
-    sw_world_contacts *wc = in->wc.world ? &in->wc : NULL;
+    sw_world_contacts *wc = in->wc.world && in->lod_run == SINEW_LOD_FULL ? &in->wc : NULL;
     sw_self_contacts *sc = sw_instance_detects(in) ? &in->sc : NULL;
-    if (!wc && !in->novel_on) { /* nothing seeds a patch */
+    if ((!wc && !in->novel_on) || in->lod_run != SINEW_LOD_FULL) { /* nothing seeds a patch */
+        if (in->lod_run != SINEW_LOD_FULL) sw_cond_forget(cd);     /* nor later, from here */
         cd->nf = cd->np = 0;
         in->ps.in_patch = NULL;
         if (sc) sc->in_patch = NULL;
@@ -357,7 +358,7 @@ static sinew_result phase_solve(sw_step_ctx *c) {
         }
     }
     double ms_aside = 0; /* the second detection and the output, counted as theirs */
-    if (r == SINEW_OK && wc->world) {
+    if (r == SINEW_OK && ct.wc) {
         write_output(c);
         double t = sw_now_seconds();
         int32_t added = sw_world_contacts_add_missed(wc, &in->red, in->solver.q);
@@ -499,24 +500,56 @@ static void phases_to_solve(sw_step_ctx *c, sinew_instance *inst, float dt) {
     ZONE(inst, "oracle", phase_oracle(c));
 }
 
-/* The step proper (sinew_instance_step records it when a recorder is attached). */
+/* The step of a solving level `run` (sinew_lod): the phases; the reduced level with one
+ * Newton update. */
+static sinew_result step_solve(sinew_instance *inst, float dt, sinew_lod run, sw_step_ctx *c) {
+    inst->lod_run = run;
+    sw_solver *s = &inst->solver;
+    uint32_t max_newton = s->max_newton;
+    if (run == SINEW_LOD_REDUCED) s->max_newton = 1;
+    phases_to_solve(c, inst, dt);
+    sinew_result r;
+    ZONE(inst, "solve", r = phase_solve(c)); /* a non-finite state is undone: nothing advances */
+    if (r == SINEW_OK) {
+        ZONE(inst, "advance", phase_advance(c));
+        ZONE(inst, "output", phase_output(c); r = check_output(c));
+    }
+    s->max_newton = max_newton;
+    /* a failed step's state, or the iterate the energy guard kept, is not its prediction's
+       solution: the next step starts from its own prediction alone */
+    if (r != SINEW_OK || (c->st.status & SINEW_STEP_GUARD)) s->pred_valid = 0;
+    return r;
+}
+
+/* The step proper (sinew_instance_step records it when a recorder is attached) at the
+ * level set (lod.c): at a change to the pose-space level the old level's step runs, so
+ * that its surface shows at the change; a change fades (sw_lod_finish). */
 static sinew_result step(sinew_instance *inst, float dt) {
     if (dt == 0) { /* a paused frame (an engine's pause passes dt = 0): nothing moves */
         memset(&inst->stats, 0, sizeof inst->stats);
         inst->stats.struct_size = sizeof inst->stats;
+        inst->stats.lod = (uint32_t)inst->lod_last;
         return SINEW_OK;
     }
+    const sinew_lod from = inst->lod_last, to = inst->lod;
+    const sinew_lod run = to == SINEW_LOD_POSE_SPACE && from != to ? from : to;
+    if (from == SINEW_LOD_POSE_SPACE && run != from) sw_lod_leave_pose_space(inst);
     sw_step_ctx c;
-    phases_to_solve(&c, inst, dt);
     sinew_result r;
-    ZONE(inst, "solve", r = phase_solve(&c)); /* a non-finite state is undone: nothing advances */
-    if (r == SINEW_OK) {
-        ZONE(inst, "advance", phase_advance(&c));
-        ZONE(inst, "output", phase_output(&c); r = check_output(&c));
+    if (run == SINEW_LOD_POSE_SPACE) {
+        memset(&c, 0, sizeof c);
+        c.st.struct_size = sizeof c.st;
+        ZONE(inst, "output", r = sw_lod_pose_step(inst, dt, &c.st));
+    } else {
+        r = step_solve(inst, dt, run, &c);
     }
-    /* a failed step's state, or the iterate the energy guard kept, is not its prediction's
-       solution: the next step starts from its own prediction alone */
-    if (r != SINEW_OK || (c.st.status & SINEW_STEP_GUARD)) inst->solver.pred_valid = 0;
+    if (r == SINEW_OK) {
+        sw_lod_finish(inst, from, to, run);
+        inst->lod_last = to;
+        inst->stepped = 1;
+    }
+    c.st.lod = (uint32_t)inst->lod_last;
+    c.st.lod_blend = (float)inst->lod_w;
     inst->stats = c.st;
     return r;
 }

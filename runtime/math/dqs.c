@@ -124,19 +124,35 @@ void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int
     }
 }
 
-void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature) {
-    int32_t root = 0; /* the first root: the frame every root is measured in */
+/* The first root: the frame every root is measured in. */
+static int32_t first_root(const int32_t *parent, int32_t nbones) {
+    int32_t root = 0;
     while (root < nbones - 1 && parent[root] >= 0)
         ++root;
+    return root;
+}
+
+/* L (3x3) = R_p^T R_b, p bone b's parent or (another root) the first root `root`; the
+ * identity for the first root. */
+static void joint_rotation(const double *T, const int32_t *parent, int32_t root, int32_t b,
+                           double L[9]) {
+    static const double I[9] = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+    const double *Rb = T + 12 * b;
+    if (b == root) {
+        memcpy(L, I, sizeof I);
+        return;
+    }
+    const double *Rp = T + 12 * (parent[b] >= 0 ? parent[b] : root);
+    for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+            L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
+}
+
+void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature) {
+    const int32_t root = first_root(parent, nbones);
     for (int32_t b = 0; b < nbones; ++b) {
-        const double *Rb = T + 12 * b;
-        double L[12] = {1, 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 0};
-        if (b != root) { /* L = R_p^T R_b, p the parent or (another root) the first root */
-            const double *Rp = T + 12 * (parent[b] >= 0 ? parent[b] : root);
-            for (int i = 0; i < 3; ++i)
-                for (int j = 0; j < 3; ++j)
-                    L[3 * i + j] = Rp[i] * Rb[j] + Rp[3 + i] * Rb[3 + j] + Rp[6 + i] * Rb[6 + j];
-        }
+        double L[12] = {0};
+        joint_rotation(T, parent, root, b, L);
         sw_dualquat dq;
         sw_dq_from_transform(L, &dq);
         /* unit: a snapped pose's rotations (sw_pose_snap) are orthonormal to 1e-8 only */
@@ -146,6 +162,17 @@ void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, dou
         for (int k = 0; k < 4; ++k)
             feature[4 * b + k] = s * dq.r[k];
     }
+}
+
+void sw_pose_rotation_feature(const double *T, const int32_t *parent, int32_t nbones,
+                              double *feature) {
+    const int32_t root = first_root(parent, nbones);
+    for (int32_t b = 0; b < nbones; ++b) {
+        double *L = feature + 9 * b;
+        joint_rotation(T, parent, root, b, L);
+        L[0] -= 1, L[4] -= 1, L[8] -= 1;
+    }
+    feature[9 * nbones] = 1;
 }
 
 double sw_pose_feature_bend(const double q[4]) {

@@ -39,6 +39,14 @@ void sw_dqs_skin(int32_t n, const double *X, const sw_dualquat *bones, const int
  * the character's placement and heading. */
 void sw_pose_feature(const double *T, const int32_t *parent, int32_t nbones, double *feature);
 
+/* The pose's joint rotations as the pose-space level's regressors (SMPL's pose feature):
+ * each bone's rotation in its parent's frame (a root's in the first root's, as
+ * sw_pose_feature) less the identity, 9 entries row-major a bone, then a 1. Writes
+ * SW_POSE_ROTATION_FEATURES(nbones) doubles; invariant to placement and heading. */
+#define SW_POSE_ROTATION_FEATURES(nbones) (9 * (nbones) + 1)
+void sw_pose_rotation_feature(const double *T, const int32_t *parent, int32_t nbones,
+                              double *feature);
+
 /* The angle (radians, [0, pi]) of the rotation a pose feature's unit quaternion q holds:
  * how far the bone is bent from its rest in its parent's frame. */
 double sw_pose_feature_bend(const double q[4]);

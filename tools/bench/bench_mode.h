@@ -9,6 +9,7 @@
 #include "crowd_bench.h"
 #include "dyn_bench.h"
 #include "gap_bench.h"
+#include "lod_bench.h"
 #include "newton_bench.h"
 #include "novel_bench.h"
 #include "pair_bench.h"
@@ -29,7 +30,9 @@ typedef struct sw_bench_ctx {
     /* the modes' flags */
     const char *world_path;
     const sw_cond_bench_params *cond;
-    int dynamic, hold_frames, instances, sc_compare, newton_compare, error_gap, novel, pair;
+    int dynamic, hold_frames, instances, sc_compare, newton_compare, error_gap, novel, pair, lod;
+    const sw_bake_result *err_res; /* the poses and solutions the errors are of (--lod) */
+    int timing_passes;
     /* found */
     long failed; /* the modes' failed steps */
     sw_world_bench wb;
@@ -40,6 +43,7 @@ typedef struct sw_bench_ctx {
     sw_gap_bench gap;
     sw_novel_bench nvb;
     sw_pair_bench pb;
+    sw_lod_bench lb;
 } sw_bench_ctx;
 
 typedef struct sw_bench_mode {

@@ -255,6 +255,25 @@ static void dyn_json(const sw_bench_ctx *c) {
            db->sub_teleport, db->sub_guard, db->sub_converged);
 }
 
+/* ---- --lod: every level of detail ---- */
+
+static int lod_wanted(const sw_bench_ctx *c) {
+    return c->lod;
+}
+
+static sinew_result lod_run(sw_bench_ctx *c, sw_error *err) {
+    sinew_result r = sw_lod_bench_run(c->blob, &c->ch->clip, c->nf, clip_dt(c), c->timing_passes,
+                                      c->err_res, &c->lb, err);
+    if (r != SINEW_OK) return r;
+    c->failed += c->lb.failed;
+    sw_lod_bench_print(&c->lb, stderr, 0);
+    return SINEW_OK;
+}
+
+static void lod_json(const sw_bench_ctx *c) {
+    sw_lod_bench_print(&c->lb, stdout, 1);
+}
+
 /* In the order of the JSON line's members. */
 const sw_bench_mode sw_bench_modes[] = {
     {"--instances", crowd_wanted, crowd_run, crowd_json, "crowd run failed: "},
@@ -265,5 +284,6 @@ const sw_bench_mode sw_bench_modes[] = {
     {"--dynamic", dyn_wanted, dyn_run, dyn_json, "dynamic run failed: "},
     {"--novel", novel_wanted, novel_run, novel_json, "novel-contact run failed: "},
     {"--pair", pair_wanted, pair_run, pair_json, "pair run failed: "},
+    {"--lod", lod_wanted, lod_run, lod_json, "level-of-detail run failed: "},
 };
 const int sw_bench_nmodes = (int)(sizeof sw_bench_modes / sizeof sw_bench_modes[0]);

@@ -100,9 +100,9 @@
  * Always: instance_bytes (sinew_instance_memory_size with the default def) and
  * blob_bytes (the blob file's size with --blob, else the size of the blob just baked).
  * The optional runs (--instances, --sc-compare, --newton-compare, --error-gap, --world,
- * --dynamic) are the modes of bench/bench_mode.h, run in its table's order after the contract
- * count, each adding its members to the JSON line after the bench's own.
- * The last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
+ * --dynamic, --novel, --pair, --lod) are the modes of bench/bench_mode.h, run in its table's order
+ * after the contract count, each adding its members to the JSON line after the bench's own. The
+ * last stdout line is one JSON object. Exit status: 0 done, 1 failed, 2 bad arguments. */
 #include <errno.h>
 #include <math.h>
 #include <stdio.h>
@@ -215,7 +215,7 @@ typedef struct {
     int json, full_frames, contract_steps, threads, bake_errors, timing_passes;
     int dynamic, hold_frames, instances, patch_budget;
     int self_mode; /* sinew_self_contact */
-    int sc_compare, error_gap, newton_compare, novel, pair;
+    int sc_compare, error_gap, newton_compare, novel, pair, lod;
     sw_cond_bench_params cond;
 } options;
 
@@ -290,6 +290,10 @@ static size_t bench_flags(options *o, sw_flag *f) {
                 "also two copies pressed together side by side over the clip,\n"
                 "against the two-body reference: pen_pair_*, err_pair_*,\n"
                 "pair_cost_vs_lone (the tet boundary as the output surface)")},
+        {SW_SET("--lod", &o->lod, 1,
+                "also every level of detail the blob holds over the clip:\n"
+                "each one's step against DQS and its held-out surface error\n"
+                "(the errors' poses as err_heldout's): lod_*")},
         {SW_SET("--newton-compare", &o->newton_compare, 1,
                 "also time the quasistatic step with Newton on the current\n"
                 "and starting on the rest Hessian over the clip: newton_*")},
@@ -406,8 +410,9 @@ typedef struct {
     double *sub, *phase, sub_ms, phase_ms[NPHASES], evals, factors, beyond_deg, d_ms;
     int beyond_frames, beyond_bone;
     long failed_steps, allocs, locks;
-    /* the correction errors */
+    /* the correction errors, and the poses they are of when the clip's (clip_errors) */
     sw_eval_result et, eh;
+    sw_bake_result clip;
     int clip_errors, ref_unsettled;
     const char *err_source;
     sw_bench_ctx modes;
@@ -593,6 +598,7 @@ static int measure_errors(bench *b, sw_error *err) {
         /* borrows the clip's poses and the solutions above: never sw_bake_result_free'd */
         sw_bake_result clip;
         memset(&clip, 0, sizeof clip);
+        b->clip.nheldout = 0;
         int kf = b->kf;
         /* a file's held-out clip (the character's clip then) is held out whole */
         int ntr = b->bp.nheldout_clips > 0 ? 0 : (int)floor(kf * (1.0 - b->bp.heldout_fraction));
@@ -608,6 +614,7 @@ static int measure_errors(bench *b, sw_error *err) {
         if ((r = sw_bake_errors(b->blob, &clip, mode, &b->et, &b->eh, err)) != SINEW_OK)
             return sw_tool_failed(r, err, "%s: cannot evaluate the blob: ", tool);
         b->ref_unsettled = b->full_unsettled;
+        b->clip = clip;
     } else {
         if (o->blob_path && (r = sw_bake_solutions(&b->ch, &b->bp, &b->res, err)) != SINEW_OK)
             return sw_tool_failed(r, err, "%s: the bake's reference solutions: ", tool);
@@ -652,6 +659,7 @@ static int run_modes(bench *b, sw_error *err) {
                         .kf = b->kf,
                         .clip_frames = o->ca.frames,
                         .threads = o->threads,
+                        .timing_passes = o->timing_passes,
                         .contract_steps = o->contract_steps,
                         .self_mode = (sinew_self_contact)o->self_mode,
                         .world_path = o->world_path,
@@ -663,6 +671,8 @@ static int run_modes(bench *b, sw_error *err) {
                         .novel = o->novel,
                         .pair = o->pair,
                         .newton_compare = o->newton_compare,
+                        .lod = o->lod,
+                        .err_res = b->clip_errors ? &b->clip : &b->res,
                         .error_gap = o->error_gap};
     for (int k = 0; k < sw_bench_nmodes; ++k) {
         const sw_bench_mode *m = &sw_bench_modes[k];

@@ -150,6 +150,27 @@ SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst);
  * the pose counts as the last one for the next step's jump test. */
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt);
 
+/** The levels of detail `blob` holds: 3 when it has the pose-space level (sinew-bake
+ * writes it), else 2 (SINEW_LOD_FULL and SINEW_LOD_REDUCED); 0 for NULL. */
+SINEW_API uint32_t sinew_blob_lod_count(const sinew_blob *blob);
+
+/** The level for a character covering `screen_fraction` of the screen's height (its
+ * projected bounding-box height over the viewport's): SINEW_LOD_FULL from 0.25,
+ * SINEW_LOD_REDUCED from 0.08, below that SINEW_LOD_POSE_SPACE (SINEW_LOD_REDUCED when
+ * the blob lacks it). A NaN fraction gives SINEW_LOD_FULL. Thread-safe. */
+SINEW_API sinew_lod sinew_lod_for_screen_size(const sinew_blob *blob, float screen_fraction);
+
+/** Sets the level of detail of the next steps. The step at which the level changes shows
+ * the old level's surface; the difference to the new one's, carried in bone 0's frame,
+ * then fades as the character moves: each step by at most half the largest move the
+ * surface makes in it, and over SINEW_LOD_BLEND_FRAMES steps at the fastest, so a change
+ * moves no vertex by more than half of what the frame moves it anyway, and a character
+ * standing still does not change; sinew_step_stats reports the level and the fade. Leaving
+ * SINEW_LOD_POSE_SPACE starts the solve afresh from the pose-space start (no velocity: a
+ * dynamic instance settles from there). INVALID_ARGUMENT for a level the blob does not hold
+ * (sinew_blob_lod_count). Never allocates or locks. */
+SINEW_API sinew_result sinew_instance_set_lod(sinew_instance *inst, sinew_lod level);
+
 /** Copies the output surface of the last step into host buffers of `vertex_count`
  * (= sinew_blob_surface_vertex_count) xyz triples, in the actor's frame (the world's when
  * no actor transform was set); either buffer may be NULL. */

@@ -110,6 +110,19 @@
  *   TET_STIFFNESS  per tet of the condensation mesh (ntets of COND_META; absent, with
  *                  CUB_STIFFNESS still present, when the blob has no such mesh), its
  *                  multiplier; a cubature tet's equals its COND_CUB_TET_ID tet's
+ *
+ * Optional sections (SINEW_BLOB_LOD_SECTIONS, ids 59..64): the pose-space level of detail
+ * (SINEW_LOD_POSE_SPACE), all six present or none; a runtime that predates them skips them.
+ * Each output vertex s is skinned on its own, x_s = DQS_s(X_s + d_s), its rest-frame
+ * displacement d_s = V_s c, c = W f linear in the pose's joint rotations (f: each bone's
+ * rotation relative to its parent's, less the identity, 9 entries row-major a bone, zero
+ * for a root; then 1), no solve:
+ *   LOD_REST       per output vertex, X_s (3 doubles, finite)
+ *   LOD_BONE       per output vertex, 4 bone ids in [0, nbones)
+ *   LOD_WEIGHT     per output vertex, 4 weights (finite, >= 0, summing to 1 within 1e-6)
+ *   LOD_BASIS      lod_rank modes, each 3 floats per output vertex (in [-1, 1]: the
+ *                  modes are orthonormal)
+ *   LOD_MAP        W, lod_rank rows of 9 nbones + 1 (finite)
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -271,6 +284,21 @@ typedef struct sinew_blob_section {
     X(57, CUB_STIFFNESS,      8, double,  cub_stiffness, 1, ncub,        "ncub")                   \
     X(58, TET_STIFFNESS,      8, double,  tet_stiffness, 1, ntets,       "ntets")
 
+/* The optional pose-space level of detail (ids 59..64): counts named by
+ * SINEW_BLOB_LOD_COUNTS from LOD_META, with META's ntrain; rows as in SINEW_BLOB_SECTIONS. */
+#define SINEW_BLOB_LOD_COUNTS(X) X(nlod_verts) X(lod_rank)
+#define SINEW_BLOB_LOD_SECTIONS(X)                                                                 \
+    X(59, LOD_META,          32, sinew_blob_lod_meta, lod_meta, 1, 1, "1")                         \
+    SINEW_BLOB_LOD_ARRAY_SECTIONS(X)
+#define SINEW_BLOB_LOD_ARRAY_SECTIONS(X)                                                           \
+    X(60, LOD_REST,           8, double,  lod_rest,   1, 3 * nlod_verts,  "3 nlod_verts")          \
+    X(61, LOD_BONE,           4, int32_t, lod_bone,   1, 4 * nlod_verts,  "4 nlod_verts")          \
+    X(62, LOD_WEIGHT,         8, double,  lod_weight, 1, 4 * nlod_verts,  "4 nlod_verts")          \
+    X(63, LOD_BASIS,          4, float,   lod_basis,  1, lod_rank * 3 * nlod_verts,                \
+      "lod_rank 3 nlod_verts")                                                                     \
+    X(64, LOD_MAP,            8, double,  lod_map,    1, lod_rank * (9 * nbones + 1),          \
+      "lod_rank (9 nbones + 1)")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
@@ -281,7 +309,8 @@ typedef struct sinew_blob_section {
  * SINEW_SECTION_PAIR_FIRST .. _PAIR_LAST the optional per-pair self-contact's,
  * SINEW_SECTION_TRAIN_FORCE the optional pose-space equilibrium force,
  * SINEW_SECTION_ASSET_FIRST .. _ASSET_LAST the optional asset description,
- * SINEW_SECTION_CUB_STIFFNESS and _TET_STIFFNESS the optional painted material;
+ * SINEW_SECTION_CUB_STIFFNESS and _TET_STIFFNESS the optional painted material,
+ * SINEW_SECTION_LOD_FIRST .. _LOD_LAST the optional pose-space level of detail;
  * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
@@ -303,7 +332,10 @@ enum sinew_blob_section_id {
     SINEW_SECTION_ASSET_FIRST = SINEW_SECTION_ASSET_META,
     SINEW_SECTION_ASSET_LAST = SINEW_SECTION_OUTPUT_SOURCE,
     SINEW_BLOB_STIFFNESS_SECTIONS(SINEW_BLOB_ENUM_ROW_)
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_TET_STIFFNESS
+    SINEW_BLOB_LOD_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_LOD_FIRST = SINEW_SECTION_LOD_META,
+    SINEW_SECTION_LOD_LAST = SINEW_SECTION_LOD_MAP,
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_LOD_MAP
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_
@@ -352,6 +384,16 @@ typedef struct sinew_blob_asset_meta {
     uint64_t options_hash;  /**< of the bake's options that shape the blob */
     int32_t reserved[8];    /**< zero */
 } sinew_blob_asset_meta;
+
+/** Section LOD_META: the pose-space level of detail's counts (32 bytes). */
+typedef struct sinew_blob_lod_meta {
+    int32_t nlod_verts;  /**< output surface vertices (the render mesh's or the boundary's) */
+    int32_t lod_rank;    /**< displacement modes, 1 .. SINEW_BLOB_LOD_MAX_RANK */
+    int32_t reserved[6]; /**< zero */
+} sinew_blob_lod_meta;
+
+/** The most displacement modes the pose-space level holds. */
+#define SINEW_BLOB_LOD_MAX_RANK 64
 
 /** Section DOMAINS: one record per domain (48 bytes). */
 typedef struct sinew_blob_domain_record {

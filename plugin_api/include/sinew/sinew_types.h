@@ -70,8 +70,9 @@ static inline sinew_blob_def sinew_blob_def_default(void) {
     0x0202u /**< error: a def field this version lacks (none today) */
 #define SINEW_MSG_INSTANCE_CREATED 0x0203u /**< info: created, with its memory */
 #define SINEW_MSG_INSTANCE_POSE                                                                    \
-    0x0204u /**< error: a pose or actor transform refused (says                                    \
-                 which bone and why) */
+    0x0204u                            /**< error: a pose or actor transform refused (says         \
+                                            which bone and why) */
+#define SINEW_MSG_INSTANCE_LOD 0x0205u /**< error: a level of detail the blob lacks */
 
 /** A range task of the library: items [begin, end) on the host's worker `worker`. */
 typedef void sinew_task_fn(uint32_t begin, uint32_t end, uint32_t worker, void *task_context);
@@ -155,6 +156,26 @@ typedef struct sinew_profiler {
     void (*zone_end)(const char *name, void *user);
     void *user;
 } sinew_profiler;
+
+/** Levels of detail of a step (sinew_instance_set_lod), from the dearest to the cheapest.
+ * A host picks one per instance per frame, or lets sinew_lod_for_screen_size pick it from
+ * how much of the screen the character covers. */
+typedef enum sinew_lod {
+    /** the step as the instance def configures it: the subspace solve with its contact,
+     * the collision world, condensation patches and novel contact */
+    SINEW_LOD_FULL = 0,
+    /** the subspace solve alone: one Newton update from the pose-space start with the
+     * trained self-contact; no collision world, no patches, no novel contact */
+    SINEW_LOD_REDUCED = 1,
+    /** no solve: each output vertex skinned on its own, displaced by the training poses'
+     * shapes blended at the pose (what a learned deformer costs); quasistatic, no world.
+     * Needs a blob that holds it (sinew_blob_lod_count 3) */
+    SINEW_LOD_POSE_SPACE = 2
+} sinew_lod;
+
+/** The fewest steps over which a change of level fades from the old level's surface to
+ * the new one's (sinew_instance_set_lod). */
+#define SINEW_LOD_BLEND_FRAMES 8u
 
 /** How to create an instance of a blob. All memory is reserved at creation. */
 typedef struct sinew_instance_def {
@@ -378,6 +399,11 @@ typedef struct sinew_step_stats {
     uint32_t novel_cluster_pairs;
     /** wall-clock milliseconds of that detection (inside ms_self_contact) */
     double ms_novel;
+    /** the level of detail this step ran at (sinew_lod) */
+    uint32_t lod;
+    /** the share of the last level's surface the surface still shows after a change of
+     * level (1 at the change, fading to 0 as the character moves; 0: none) */
+    float lod_blend;
 } sinew_step_stats;
 
 /** What sinew_instance_debug_draw draws (sinew_debug_draw.flags). */
