@@ -16,6 +16,10 @@
 #include "sc_bench.h"
 #include "world_bench.h"
 
+/* --lod: off, every level's figures, and (with --instances) the crowd's levels by
+ * distance too. */
+enum { SW_BENCH_LOD_OFF, SW_BENCH_LOD_LEVELS, SW_BENCH_LOD_AUTO };
+
 /* What the modes read (set by sinew-bench before they run) and what they found. */
 typedef struct sw_bench_ctx {
     const sw_character *ch;

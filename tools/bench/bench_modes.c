@@ -12,7 +12,8 @@ static int crowd_wanted(const sw_bench_ctx *c) {
 
 static sinew_result crowd_run(sw_bench_ctx *c, sw_error *err) {
     sw_crowd_bench *cb = &c->cb;
-    sinew_result r = sw_crowd_bench_run(c->ch, c->blob, c->instances, c->threads, cb, err);
+    sinew_result r = sw_crowd_bench_run(c->ch, c->blob, c->instances, c->threads,
+                                        c->lod == SW_BENCH_LOD_AUTO, cb, err);
     if (r != SINEW_OK) return r;
     c->failed += cb->failed;
     fprintf(stderr,
@@ -21,6 +22,11 @@ static sinew_result crowd_run(sw_bench_ctx *c, sw_error *err) {
             "instance %.4f ms, crowd/lone %.2f\n",
             cb->instances, cb->threads, cb->frames, cb->warmup_frames, cb->ms, cb->us_per_instance,
             cb->ms_1thread, cb->scaling, cb->lone_ms, cb->vs_lone);
+    if (cb->lod_auto)
+        fprintf(stderr,
+                "sinew-bench: crowd levels by distance: %.1f full, %.1f reduced, %.1f "
+                "pose-space instances a frame\n",
+                cb->at_level[0], cb->at_level[1], cb->at_level[2]);
     return SINEW_OK;
 }
 
@@ -32,6 +38,9 @@ static void crowd_json(const sw_bench_ctx *c) {
            "\"crowd_lone_median_ms\":%.4f",
            cb->instances, cb->threads, cb->frames, cb->ms, cb->us_per_instance, cb->scaling,
            cb->vs_lone, cb->ms_1thread, cb->lone_ms, cb->lone_median_ms);
+    if (cb->lod_auto)
+        printf(",\"crowd_lod\":\"auto\",\"crowd_at_level\":[%.2f,%.2f,%.2f]", cb->at_level[0],
+               cb->at_level[1], cb->at_level[2]);
 }
 
 /* ---- --sc-compare: self-contact, pose-space against exhaustive ---- */

@@ -3,6 +3,7 @@
  * frame's start and end), as a game's job system would around its skinning jobs. */
 #include "crowd_bench.h"
 
+#include <math.h>
 #include <pthread.h>
 #include <stdatomic.h>
 #include <stdlib.h>
@@ -55,10 +56,28 @@ typedef struct member {
     sinew_instance *inst;
     float *pos, *nrm;
     int offset; /* clip frames it plays ahead of instance 0 */
+    double k0;  /* its distance from the camera path's start, in character sizes */
 } member;
+
+/* Levels by distance (--lod auto): the instances stand from CROWD_NEAR to CROWD_FAR
+ * character sizes from the camera, evenly, and the camera walks CROWD_WALK sizes a frame
+ * through them (distances wrap), so levels change every few frames; a 60 degree field of
+ * view makes a character k sizes away 1 / (2 k tan 30) of the screen high. */
+#define CROWD_NEAR 1.0
+#define CROWD_FAR 40.0
+#define CROWD_WALK 0.25
+
+/* The level member m's screen size picks at `frame`. */
+static sinew_lod member_lod(const sinew_blob *blob, const member *m, int frame) {
+    double span = CROWD_FAR - CROWD_NEAR;
+    double k = CROWD_NEAR + fmod(m->k0 - CROWD_NEAR + CROWD_WALK * frame, span);
+    return sinew_lod_for_screen_size(blob, (float)(1.0 / (2.0 * k * tan(0.5235987755982988))));
+}
 
 typedef struct crowd {
     const sw_character *ch;
+    const sinew_blob *blob;
+    int lod_auto; /* levels by distance */
     member *m;
     int n, nf;
     uint32_t ns;
@@ -77,6 +96,7 @@ typedef struct worker {
 /* An instance's frame: the work the bench times for a lone instance (sub_ms). */
 static int member_frame(const crowd *c, member *m, int frame) {
     int f = (frame + m->offset) % c->nf;
+    if (c->lod_auto) sinew_instance_set_lod(m->inst, member_lod(c->blob, m, frame));
     sw_instance_set_pose_d(m->inst, c->ch->clip.T + (size_t)f * 12 * c->ch->skel.nbones);
     int failed = sinew_instance_step(m->inst, c->dt) != SINEW_OK;
     sinew_instance_read_surface(m->inst, m->pos, m->nrm, c->ns);
@@ -157,10 +177,12 @@ static void crowd_free(crowd *c) {
     pthread_cond_destroy(&c->done.cv);
 }
 
-static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, int n, crowd *c,
-                               sw_error *err) {
+static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, int n, int lod_auto,
+                               crowd *c, sw_error *err) {
     memset(c, 0, sizeof *c);
     c->ch = ch;
+    c->blob = blob;
+    c->lod_auto = lod_auto;
     c->n = n;
     c->nf = ch->clip.nframes;
     c->ns = sinew_blob_surface_vertex_count(blob);
@@ -174,6 +196,7 @@ static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, i
     for (int i = 0; i < n; ++i) {
         member *m = &c->m[i];
         m->offset = (int)((long)i * c->nf / n);
+        m->k0 = CROWD_NEAR + (CROWD_FAR - CROWD_NEAR) * (i + 0.5) / n;
         m->pos = malloc(sizeof(float) * 3 * c->ns);
         m->nrm = malloc(sizeof(float) * 3 * c->ns);
         if (!m->pos || !m->nrm)
@@ -186,8 +209,17 @@ static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, i
     return SINEW_OK;
 }
 
+/* The instances at each level over the timed frames, a frame's mean. */
+static void level_counts(const crowd *c, int warm, int frames, double *at) {
+    for (int l = 0; l < 3; ++l)
+        at[l] = 0;
+    for (int f = warm; f < warm + frames; ++f)
+        for (int i = 0; i < c->n; ++i)
+            at[c->lod_auto ? member_lod(c->blob, &c->m[i], f) : SINEW_LOD_FULL] += 1.0 / frames;
+}
+
 sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, int instances,
-                                int threads, sw_crowd_bench *out, sw_error *err) {
+                                int threads, int lod_auto, sw_crowd_bench *out, sw_error *err) {
     memset(out, 0, sizeof *out);
     long nproc = sysconf(_SC_NPROCESSORS_ONLN);
     int T = threads > 0 ? threads : nproc > 0 ? (int)nproc : 1;
@@ -198,7 +230,7 @@ sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, 
     out->frames = frames;
     crowd c;
     double *ms = malloc(sizeof(double) * (size_t)frames);
-    sinew_result r = ms ? crowd_make(ch, blob, instances, &c, err)
+    sinew_result r = ms ? crowd_make(ch, blob, instances, lod_auto, &c, err)
                         : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     if (r == SINEW_OK) { /* a lone instance: instance 0's motion, nothing else running */
         member *m0 = &c.m[0];
@@ -224,6 +256,8 @@ sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, 
         out->us_per_instance = 1e3 * out->ms / instances;
         out->scaling = out->ms > 0 ? out->ms_1thread / out->ms : 0;
         out->vs_lone = out->lone_ms > 0 ? out->ms * T / instances / out->lone_ms : 0;
+        out->lod_auto = lod_auto;
+        level_counts(&c, CROWD_WARMUP, frames, out->at_level);
     }
     if (ms) crowd_free(&c);
     free(ms);

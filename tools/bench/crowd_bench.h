@@ -26,13 +26,17 @@ typedef struct sw_crowd_bench {
     double scaling;            /* ms_1thread / ms */
     double vs_lone;            /* (ms T / N) / lone_ms: an instance's time in the crowd */
     long failed;               /* steps that did not return SINEW_OK */
+    int lod_auto;              /* levels by distance from a walking camera */
+    double at_level[3];        /* instances at each level (sinew_lod), a frame's mean */
 } sw_crowd_bench;
 
 /* Runs the crowd of `instances` (1..4096) instances of `blob` over ch's clip on 1 thread
  * and on `threads` (0: all cores). Each instance's frame is the work the bench times for
  * sub_ms: set the pose, step (dt = 1 / clip fps), read the surface's positions and
- * normals. */
+ * normals; with lod_auto, first its level of detail from its screen size
+ * (sinew_lod_for_screen_size), the instances standing 1 to 40 character sizes from a
+ * camera that walks a quarter of a size a frame through them. */
 sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, int instances,
-                                int threads, sw_crowd_bench *out, sw_error *err);
+                                int threads, int lod_auto, sw_crowd_bench *out, sw_error *err);
 
 #endif

@@ -219,6 +219,9 @@ typedef struct {
     sw_cond_bench_params cond;
 } options;
 
+/* --lod's values (SW_BENCH_LOD_*, after "off", which is no flag). */
+static const char *const lod_names[] = {"off", "levels", "auto", NULL};
+
 static const char *const SYNOPSIS =
     "sinew-bench (FILE [--tets N] [--train-clips A,B] [--heldout-clips C] |\n"
     "                    --scene NAME [--tets N] [--frames F] [--data DIR] |\n"
@@ -290,10 +293,14 @@ static size_t bench_flags(options *o, sw_flag *f) {
                 "also two copies pressed together side by side over the clip,\n"
                 "against the two-body reference: pen_pair_*, err_pair_*,\n"
                 "pair_cost_vs_lone (the tet boundary as the output surface)")},
-        {SW_SET("--lod", &o->lod, 1,
-                "also every level of detail the blob holds over the clip:\n"
-                "each one's step against DQS and its held-out surface error\n"
-                "(the errors' poses as err_heldout's): lod_*")},
+        {SW_CHOICE("--lod", &o->lod, lod_names, "L",
+                   "levels: also every level of detail the blob holds over the\n"
+                   "clip, each one's step against DQS and its held-out surface\n"
+                   "error (the errors' poses as err_heldout's): lod_*; auto:\n"
+                   "that, and the crowd (--instances) picks each instance's\n"
+                   "level from its screen size, 1 to 40 character sizes from a\n"
+                   "walking camera: crowd_at_level"),
+         .range = "levels or auto"},
         {SW_SET("--newton-compare", &o->newton_compare, 1,
                 "also time the quasistatic step with Newton on the current\n"
                 "and starting on the rest Hessian over the clip: newton_*")},
