@@ -72,6 +72,13 @@ static void check_json(const char *dir, const sw_bake_result *res, const sw_blob
     ENSURE_NEAR(num(springs, "k"), res->spring_k, 1e-9 * res->spring_k);
     ENSURE(cJSON_GetArraySize(cJSON_GetObjectItemCaseSensitive(springs, "tried")) ==
            res->nspring_tried);
+    /* every level's held-out error, the pose-space level's modes */
+    const cJSON *lod = cJSON_GetObjectItemCaseSensitive(j, "levels_of_detail");
+    const cJSON *lerr = cJSON_GetObjectItemCaseSensitive(lod, "err_heldout_surface");
+    ENSURE(num(lod, "pose_space_modes") == res->view.lod_rank && res->view.lod_rank > 0);
+    ENSURE(cJSON_GetArraySize(lerr) == 3);
+    for (int l = 0; l < 3; ++l)
+        ENSURE_NEAR(cJSON_GetArrayItem(lerr, l)->valuedouble, res->lod_heldout[l], 1e-9);
     const cJSON *seams = cJSON_GetObjectItemCaseSensitive(j, "seams");
     ENSURE_NEAR(num(seams, "heldout"), eh->seam, 1e-12);
     ENSURE_NEAR(num(seams, "max_heldout"), eh->seam_max, 1e-12);

@@ -244,7 +244,7 @@ fi
 num() { key "$1" "$2" | grep -E '^[0-9]+(\.[0-9]+)?$'; }
 if [ -s "$tmp/f.blob" ] &&
     "$bench" --scene finger --tets 2000 --frames 6 --blob "$tmp/f.blob" --full-frames 1 \
-        --contract-steps 10 --instances 4 --threads 2 --json >"$tmp/crowd.json" \
+        --contract-steps 10 --instances 4 --threads 2 --lod auto --json >"$tmp/crowd.json" \
         2>"$tmp/crowd.err"; then
     ok=1
     for k in crowd_instances crowd_threads crowd_ms crowd_us_per_instance crowd_scaling \
@@ -262,6 +262,14 @@ if [ -s "$tmp/f.blob" ] &&
         { echo "FAIL crowd: failed steps" >&2; ok=0; }
     grep -q "sinew-bench: crowd of 4 instances on 2 threads" "$tmp/crowd.err" ||
         { echo "FAIL crowd: no crowd summary line" >&2; ok=0; }
+    # --lod auto: three levels timed, and the crowd's 4 instances spread over them
+    [ "$(key "$tmp/crowd.json" lod_levels)" = 3 ] ||
+        { echo "FAIL crowd: lod_levels is not 3" >&2; ok=0; }
+    tail -n 1 "$tmp/crowd.json" | grep -Eq '"lod_ms":\[[0-9.e+-]+,[0-9.e+-]+,[0-9.e+-]+\]' ||
+        { echo "FAIL crowd: lod_ms is not three times" >&2; ok=0; }
+    tail -n 1 "$tmp/crowd.json" | grep -o '"crowd_at_level":\[[^]]*\]' | tr -d '"a-z_:[]' |
+        awk -F, '{ exit !($1 > 0 && $3 > 0 && $1 + $2 + $3 > 3.99 && $1 + $2 + $3 < 4.01) }' ||
+        { echo "FAIL crowd: crowd_at_level does not spread 4 instances over the levels" >&2; ok=0; }
     ! tail -n 1 "$tmp/clip.json" | grep -q '"crowd_' ||
         { echo "FAIL crowd: crowd fields without --instances" >&2; ok=0; }
     if [ "$ok" -eq 1 ]; then echo "ok   crowd"; else fails=$((fails + 1)); fi

@@ -16,6 +16,9 @@
  *                      degenerate} (sw_tetmesh_quality)}
  *   err_train, err_heldout, proj_err_train, proj_err_heldout, galerkin_err_train,
  *   galerkin_err_heldout (null: not definite), cubature_fit, failed_steps
+ *   levels_of_detail {pose_space_modes, pose_space_dropped, pose_space_ridge,
+ *              err_heldout_surface [full, reduced, pose-space]}: each level's held-out
+ *              error on the output surface (bake_lod.c)
  *   springs {k, eh, tried [[E h multiple, training error]]}: the interface springs'
  *              stiffness and the choices the bake measured (bake_springs.c)
  *   seams {train, heldout, max_train, max_heldout}: the domains' copies of a vertex apart
@@ -353,6 +356,13 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
     cJSON_AddItemToObject(eq, "err_train_without",
                           res->model_train_error >= 0 ? json_number(res->model_train_error)
                                                       : cJSON_CreateNull());
+    cJSON *lod = cJSON_AddObjectToObject(j, "levels_of_detail");
+    cJSON_AddNumberToObject(lod, "pose_space_modes", res->view.lod_rank);
+    cJSON_AddNumberToObject(lod, "pose_space_dropped", res->lod_kept);
+    cJSON_AddNumberToObject(lod, "pose_space_ridge", res->lod_ridge);
+    cJSON *lerr = cJSON_AddArrayToObject(lod, "err_heldout_surface"); /* sinew_lod's order */
+    for (int l = 0; l < SW_BAKE_LODS; ++l)
+        cJSON_AddItemToArray(lerr, json_number(res->lod_heldout[l]));
     cJSON *sp = cJSON_AddObjectToObject(j, "springs");
     cJSON_AddNumberToObject(sp, "k", res->spring_k);
     cJSON_AddNumberToObject(sp, "eh", res->spring_eh);
