@@ -33,6 +33,7 @@ typedef struct {
     int detect;
     int novel; /* the def's novel_contact */
     int rest;  /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
+    int dynamic; /* the frozen damping Hessian H(q_n): SINEW_STEP_DYNAMIC only */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -97,7 +98,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->qn, R);
     TAKE(s->qdot, R);
     TAKE(s->fin, R);
-    TAKE(s->Hn, R * R);
+    TAKE(s->Hn, z->dynamic ? R * R : 0); /* (a quasistatic step never reads it) */
     TAKE(s->g_mat, R);
     TAKE(s->L, R * R);
     TAKE(s->dq, R);
@@ -399,6 +400,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
     z->cond = sw_cond_plan(v, d->max_patch_vertices, z->max_world, z->max_pairs, detected,
                            z->novel ? SW_NOVEL_MAX_CONTACTS : 0);
     z->rest = d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT;
+    z->dynamic = d->mode == SINEW_STEP_DYNAMIC;
     return SINEW_OK;
 }
 
