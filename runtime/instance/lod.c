@@ -42,6 +42,7 @@ SINEW_API sinew_result sinew_instance_set_lod(sinew_instance *inst, sinew_lod le
                (unsigned)level, (unsigned)sinew_blob_lod_count(inst->blob));
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
+    if (level == inst->lod) return SINEW_OK; /* (a host may say it every frame) */
     inst->lod = level;
     if (!inst->stepped) inst->lod_last = level; /* no surface shown yet: nothing to blend */
     inst->touched = 1;
