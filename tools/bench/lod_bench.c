@@ -68,7 +68,8 @@ sinew_result sw_lod_bench_run(const sinew_blob *blob, const sw_clip *clip, int n
             return r;
         out->failed += e.failed;
         out->err_frames = e.frames;
-        if (e.failed == 0 && e.frames > 0) out->err_heldout[l] = e.surface_error;
+        if (e.failed == 0 && e.frames > 0 && !e.no_correction)
+            out->err_heldout[l] = e.surface_error;
     }
     return SINEW_OK;
 }
