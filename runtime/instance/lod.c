@@ -1,9 +1,9 @@
 /* Levels of detail (sinew_lod): the pose-space level's step, which solves nothing (each
- * output vertex skinned on its own and displaced by the training poses' shapes blended at
- * the pose, the blob's LOD sections), and the blend that carries a change of level over
- * SINEW_LOD_BLEND_FRAMES steps. The other two levels are the step itself (step.c), the
- * reduced one with its world, patches and novel contact left out. Never allocates or
- * locks. */
+ * output vertex skinned on its own and displaced by the blob's LOD modes, their weights
+ * linear in the pose's joint rotations), and the fade that carries a change of level
+ * while the surface moves (SINEW_LOD_BLEND_FRAMES steps at the fastest). The other two
+ * levels are the step itself (step.c), the reduced one with its world, patches and novel
+ * contact left out and one Newton update. Never allocates or locks. */
 #include <math.h>
 #include <string.h>
 
