@@ -31,8 +31,8 @@ typedef struct {
     /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
        mode's fallback on novel contact when the blob has the tet mesh */
     int detect;
-    int novel; /* the def's novel_contact */
-    int rest;  /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
+    int novel;   /* the def's novel_contact */
+    int rest;    /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
     int dynamic; /* the frozen damping Hessian H(q_n): SINEW_STEP_DYNAMIC only */
 } layout_sizes;
 
