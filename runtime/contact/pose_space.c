@@ -184,3 +184,15 @@ double sw_pose_space_force(const sw_pose_space *ps, int32_t R, const double *q, 
     }
     return phi;
 }
+
+void sw_pose_space_blend(const sw_pose_space *ps, const double *rows, int32_t m, double *out) {
+    if (ps->nearest < 0) {
+        memset(out, 0, (size_t)m * sizeof(double));
+        return;
+    }
+    const double *r0 = rows + (size_t)m * ps->nearest;
+    const double *r1 = rows + (size_t)m * (ps->blend == 0 ? ps->nearest : ps->second);
+    const double b = ps->blend;
+    for (int32_t j = 0; j < m; ++j)
+        out[j] = b == 0 ? r0[j] : (1 - b) * r0[j] + b * r1[j];
+}

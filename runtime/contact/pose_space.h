@@ -63,6 +63,11 @@ void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);
  * blend and tangent. O(ntrain nbones). */
 void sw_pose_space_lookup(sw_pose_space *ps, const sw_blob_view *v, const double *T);
 
+/* The blend of the training poses the last lookup found, (1 - blend) on the nearest and
+ * blend on the second, of `rows` (m per training pose: the reduced solutions, say) into
+ * out (m); zeros when the blob has no training pose. */
+void sw_pose_space_blend(const sw_pose_space *ps, const double *rows, int32_t m, double *out);
+
 /* A joint is bent beyond training when its bend (radians) exceeds the largest a training
  * pose gives it (trained) by more than SW_BEYOND_RATIO times and SW_BEYOND_DEG degrees:
  * there the subspace extrapolates (the Fox's Run bends its hip 4 times as far as Survey

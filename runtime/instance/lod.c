@@ -50,21 +50,6 @@ SINEW_API sinew_result sinew_instance_set_lod(sinew_instance *inst, sinew_lod le
     return SINEW_OK;
 }
 
-/* The blend of the training poses the lookup found (sw_pose_space_lookup), with weights
- * (1 - b, b) on the nearest and the second: of the rows of `rows` (m per training pose)
- * into out (m), as the quasistatic step's start blends their solutions. */
-static void blend_rows(const sw_pose_space *ps, const double *rows, int32_t m, double *out) {
-    if (ps->nearest < 0) {
-        memset(out, 0, (size_t)m * sizeof(double));
-        return;
-    }
-    const double *r0 = rows + (size_t)m * ps->nearest;
-    const double *r1 = rows + (size_t)m * (ps->blend == 0 ? ps->nearest : ps->second);
-    const double b = ps->blend;
-    for (int32_t j = 0; j < m; ++j)
-        out[j] = b == 0 ? r0[j] : (1 - b) * r0[j] + b * r1[j];
-}
-
 /* The largest coefficient of a mode the level takes (a blob's map, finite but absurd,
  * can give more): with modes of entries in [-1, 1] no displacement leaves float range. */
 #define SW_LOD_COEF_MAX 1e30
@@ -136,7 +121,7 @@ void sw_lod_leave_pose_space(sinew_instance *in) {
     sw_solver *s = &in->solver;
     sw_instance_frame(in);
     sw_pose_space_lookup(&in->ps, v, in->loc.T_cur);
-    blend_rows(&in->ps, v->train_q, in->red.R, s->q);
+    sw_pose_space_blend(&in->ps, v->train_q, in->red.R, s->q);
     memset(s->qdot, 0, (size_t)in->red.R * sizeof(double));
     s->pred_valid = 0;
     if (in->cond.z.max_verts > 0) sw_cond_forget(&in->cond);

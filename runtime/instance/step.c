@@ -207,13 +207,8 @@ static void phase_self(sw_step_ctx *c) {
  * frames before within the solve's tolerance: a step ends within its last update,
  * SW_NEWTON_LAST_UPDATE |q|, of the stationary point (test_reduced_model). O(R). */
 static void pose_space_start(sinew_instance *in) {
-    const sw_blob_view *v = in->v;
     sw_solver *s = &in->solver;
     int32_t R = in->red.R;
-    const double *q0 = v->train_q + (size_t)R * in->ps.nearest;
-    const double *q1 =
-        v->train_q + (size_t)R * (in->ps.blend == 0 ? in->ps.nearest : in->ps.second);
-    double b = in->ps.blend;
     /* the last pose nearer than every training pose (s->q holds q_n). Not where the step
        detects self-contact (exhaustive, pose-pairs): a vertex on the edge of contact makes
        the step's answer jump with rounding, and the offset would carry every such jump
@@ -221,10 +216,11 @@ static void pose_space_start(sinew_instance *in) {
        another shape; from the prediction alone the shape is the pose's. */
     int offset = s->pred_valid && in->pose.history >= 1 && in->ps.d_last < in->ps.d_nearest &&
                  in->self_mode == SINEW_SELF_CONTACT_POSE_SPACE;
+    double *p = s->tmp;
+    sw_pose_space_blend(&in->ps, in->v->train_q, R, p);
     for (int32_t i = 0; i < R; ++i) {
-        double p = b == 0 ? q0[i] : (1 - b) * q0[i] + b * q1[i];
-        s->q[i] = offset ? p + (s->q[i] - s->q_pred[i]) : p;
-        s->q_pred[i] = p;
+        s->q[i] = offset ? p[i] + (s->q[i] - s->q_pred[i]) : p[i];
+        s->q_pred[i] = p[i];
     }
     s->pred_valid = 1;
 }
