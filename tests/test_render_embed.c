@@ -272,6 +272,120 @@ TEST(welded_duplicates_move_and_shade_as_one) {
     sinew_instance_destroy(in);
 }
 
+/* The collision surface under a render mesh: the tet boundary (closed: a world takes it as
+ * a mesh collider), at the solved positions of its vertices through the clip, in the
+ * actor's frame; skinned before the first step and at the pose-space level; refused,
+ * saying why, when the instance was not asked to write it. */
+TEST(the_collision_surface_is_the_boundary_under_a_render_mesh) {
+    ENSURE(finger_fixture());
+    const sw_blob_view *v = sw_blob_get_view(fx.blob);
+    const uint32_t nc = sinew_blob_collision_vertex_count(fx.blob),
+                   nt = sinew_blob_collision_triangle_count(fx.blob),
+                   nb = (uint32_t)fx.ch.skel.nbones;
+    ENSURE(nc == (uint32_t)v->nsurf_verts && nt == (uint32_t)v->nsurf_tris); /* manifold */
+    ENSURE(nc != sinew_blob_surface_vertex_count(fx.blob));
+    uint32_t *tris = malloc(sizeof(uint32_t) * 3 * nt);
+    ENSURE(sinew_blob_collision_triangles(fx.blob, tris, 3 * nt - 1) == SINEW_ERROR_CAPACITY);
+    ENSURE(sinew_blob_collision_triangles(fx.blob, tris, 3 * nt) == SINEW_OK);
+    sinew_instance *in[3]; /* asked, not asked, asked and placed */
+    sinew_instance_def d = sinew_instance_def_default();
+    ENSURE(sinew_instance_create(fx.blob, &d, &in[1]) == SINEW_OK);
+    d.collision_surface = 2;
+    ENSURE(sinew_instance_create(fx.blob, &d, &in[0]) == SINEW_ERROR_INVALID_ARGUMENT);
+    d.collision_surface = 1;
+    ENSURE(sinew_instance_create(fx.blob, &d, &in[0]) == SINEW_OK);
+    ENSURE(sinew_instance_create(fx.blob, &d, &in[2]) == SINEW_OK);
+    const double c = cos(2.0), sn = sin(2.0), far = 1e4;
+    const double actor[12] = {c, -sn, 0, sn, c, 0, 0, 0, 1, far, -far, 0.5 * far};
+    ENSURE(sinew_instance_set_actor(in[2], actor) == SINEW_OK);
+    float *T = malloc(sizeof(float) * 12 * nb), *p = malloc(sizeof(float) * 3 * nc),
+          *q = malloc(sizeof(float) * 3 * nc);
+    double *full = malloc(sizeof(double) * 3 * (size_t)v->nverts),
+           *cnt = malloc(sizeof(double) * (size_t)v->nverts);
+    /* before a step: the boundary skinned at the rest pose, the rest boundary */
+    ENSURE(sinew_instance_read_collision_surface(in[1], p, nc) == SINEW_OK);
+    double at_rest = 0;
+    for (uint32_t s = 0; s < nc; ++s)
+        for (int k = 0; k < 3; ++k)
+            at_rest = fmax(
+                at_rest,
+                fabs(p[3 * s + k] -
+                     v->rest[3 * (int64_t)sw_blob_surf_copy_vertex(v, v->surf_copy_ptr[s]) + k]));
+    ENSUREF(at_rest <= 1e-6, "before a step the collision surface is %g from the rest", at_rest);
+    ENSURE(sinew_instance_read_collision_surface(in[0], p, nc + 1) == SINEW_ERROR_INVALID_ARGUMENT);
+    ENSURE(sinew_instance_read_collision_surface(NULL, p, nc) == SINEW_ERROR_INVALID_ARGUMENT);
+    double solved = 0, placed = 0, moved = 0;
+    for (int f = 0; f < fx.ch.clip.nframes; ++f) {
+        pose_of(f, T);
+        for (int k = 0; k < 3; ++k) {
+            ENSURE(sinew_instance_set_pose(in[k], T, nb) == SINEW_OK);
+            ENSURE(sinew_instance_step(in[k], 1.0f / 30) == SINEW_OK);
+        }
+        ENSURE(sinew_instance_read_collision_surface(in[0], p, nc) == SINEW_OK);
+        ENSURE(sinew_instance_read_collision_surface(in[2], q, nc) == SINEW_OK);
+        sw_instance_full_positions(in[0], full, cnt);
+        for (uint32_t s = 0; s < nc; ++s) {
+            const double *x = full + 3 * (int64_t)sw_blob_surf_copy_vertex(v, v->surf_copy_ptr[s]);
+            for (int k = 0; k < 3; ++k) {
+                solved = fmax(solved, fabs(p[3 * s + k] - x[k]));
+                placed = fmax(placed, fabs(p[3 * s + k] - q[3 * s + k]));
+                moved = fmax(
+                    moved,
+                    fabs(p[3 * s + k] -
+                         v->rest[3 * (int64_t)sw_blob_surf_copy_vertex(v, v->surf_copy_ptr[s]) +
+                                 k]));
+            }
+        }
+    }
+    fprintf(stderr,
+            "    collision surface (%u vertices): moved %.3g, from the solved boundary %.2e, "
+            "placed far and turned %.2e\n",
+            nc, moved, solved, placed);
+    ENSURE(moved > 0.1);
+    ENSUREF(solved <= 1e-6, "the collision surface is %g from the solved boundary", solved);
+    ENSUREF(placed <= 1e-5, "placed far and turned, it is %g from the unplaced one", placed);
+    /* not asked: refused after a step */
+    ENSURE(sinew_instance_read_collision_surface(in[1], p, nc) == SINEW_ERROR_INVALID_ARGUMENT);
+    /* the pose-space level: skinned at the pose */
+    if (sinew_blob_lod_count(fx.blob) == 3) {
+        ENSURE(sinew_instance_set_lod(in[0], SINEW_LOD_POSE_SPACE) == SINEW_OK);
+        for (int f = 0; f < 2; ++f) { /* the change's step, then the level's at a bent pose */
+            pose_of(fx.ch.clip.nframes / 2 + f, T);
+            ENSURE(sinew_instance_set_pose(in[0], T, nb) == SINEW_OK);
+            ENSURE(sinew_instance_step(in[0], 1.0f / 30) == SINEW_OK);
+        }
+        ENSURE(sinew_instance_read_collision_surface(in[0], p, nc) == SINEW_OK);
+        double skinned = 0;
+        for (uint32_t s = 0; s < nc; ++s) {
+            int32_t gv = sw_blob_surf_copy_vertex(v, v->surf_copy_ptr[s]);
+            double Rm[9], t[3];
+            sw_dqs_blend(in[0]->bone_dq, v->skin_bone + 4 * gv, v->skin_weight + 4 * gv, 4, Rm, t);
+            for (int k = 0; k < 3; ++k) {
+                const double *X = v->rest + 3 * (int64_t)gv;
+                double y = Rm[3 * k] * X[0] + Rm[3 * k + 1] * X[1] + Rm[3 * k + 2] * X[2] + t[k];
+                skinned = fmax(skinned, fabs(p[3 * s + k] - y));
+            }
+        }
+        ENSUREF(skinned <= 1e-6, "at the pose-space level it is %g from its skinning", skinned);
+    }
+    /* closed and edge-manifold: a world takes it as a mesh collider */
+    sinew_world *w;
+    sinew_world_def wd = sinew_world_def_default();
+    ENSURE(sinew_world_create(&wd, &w) == SINEW_OK);
+    sinew_collider_def cd = sinew_collider_def_default();
+    cd.shape = SINEW_SHAPE_MESH;
+    cd.vertices = p;
+    cd.vertex_count = nc;
+    cd.indices = tris;
+    cd.triangle_count = nt;
+    sinew_collider_id id;
+    ENSURE(sinew_world_add_collider(w, &cd, &id) == SINEW_OK);
+    sinew_world_destroy(w);
+    for (int k = 0; k < 3; ++k)
+        sinew_instance_destroy(in[k]);
+    free(T), free(p), free(q), free(full), free(cnt), free(tris);
+}
+
 /* ---- the loader ------------------------------------------------------------------ */
 
 /* Parses the forged copy (checksum fixed) and checks the code and the message's words. */
@@ -547,6 +661,7 @@ TEST(release_fixture) {
 SW_TEST_MAIN(CASE(embedding_reproduces_the_arm_at_rest), CASE(embedding_refuses_what_does_not_fit),
              CASE(the_output_surface_is_the_render_mesh),
              CASE(welded_duplicates_move_and_shade_as_one),
+             CASE(the_collision_surface_is_the_boundary_under_a_render_mesh),
              CASE(the_loader_rejects_a_damaged_render_mesh),
              CASE(the_synthetic_render_blob_round_trips_and_seeds_the_fuzzer),
              CASE(the_step_with_a_render_mesh_allocates_and_locks_nothing),

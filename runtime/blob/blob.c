@@ -107,6 +107,14 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
     sw_pose_index_build(&view, (char *)blob + head, &blob->poses);
+    if (sw_coll_surface_build(&view, &d.allocator, &blob->coll) != SINEW_OK) {
+        sw_free(&d.allocator, blob);
+        if (map) munmap(map, size);
+        sw_log(lg, SINEW_LOG_ERROR, SINEW_MSG_BLOB_OUT_OF_MEMORY,
+               "sinew_blob_load: out of memory (the collision surface of %d triangles)",
+               view.nsurf_tris);
+        return SINEW_ERROR_OUT_OF_MEMORY;
+    }
     blob->view = view;
     blob->data = data;
     blob->size = size;
@@ -128,6 +136,7 @@ SINEW_API void sinew_blob_destroy(sinew_blob *blob) {
     if (!blob) return;
     if (blob->map) munmap(blob->map, blob->map_size);
     sinew_allocator a = blob->allocator;
+    sw_coll_surface_free(&a, &blob->coll);
     sw_free(&a, blob);
 }
 
@@ -157,6 +166,26 @@ SINEW_API sinew_result sinew_blob_surface_triangles(const sinew_blob *blob, uint
     /* Validated at load: every index is in [0, output vertices). */
     for (uint64_t i = 0; i < n; ++i)
         indices[i] = (uint32_t)tris[i];
+    return SINEW_OK;
+}
+
+/* The collision surface is the tet boundary split into sheets (blob_collision.h),
+ * whatever the output is. */
+SINEW_API uint32_t sinew_blob_collision_vertex_count(const sinew_blob *blob) {
+    return blob ? (uint32_t)blob->coll.nverts : 0u;
+}
+
+SINEW_API uint32_t sinew_blob_collision_triangle_count(const sinew_blob *blob) {
+    return blob ? (uint32_t)blob->coll.ntris : 0u;
+}
+
+SINEW_API sinew_result sinew_blob_collision_triangles(const sinew_blob *blob, uint32_t *indices,
+                                                      uint32_t capacity) {
+    if (!blob || !indices) return SINEW_ERROR_INVALID_ARGUMENT;
+    const uint64_t n = 3 * (uint64_t)blob->coll.ntris;
+    if (capacity < n) return SINEW_ERROR_CAPACITY;
+    for (uint64_t i = 0; i < n; ++i)
+        indices[i] = (uint32_t)blob->coll.tris[i];
     return SINEW_OK;
 }
 

@@ -27,6 +27,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "blob_collision.h"
 #include "blob_pose_index.h"
 #include "blob_view.h"
 #include "sinew/sinew.h"
@@ -56,7 +57,8 @@ struct sinew_blob {
     size_t map_size;           /* bytes mapped at `map` */
     sinew_allocator allocator; /* frees this struct */
     sinew_logger logger;
-    sw_pose_index poses; /* the training poses' neighbourhood, in this struct's block */
+    sw_pose_index poses;  /* the training poses' neighbourhood, in this struct's block */
+    sw_coll_surface coll; /* the collision surface (blob_collision.h), its own block */
 };
 
 /* FNV-1a 64 of n bytes (the blob checksum covers bytes [64, file_size)). */

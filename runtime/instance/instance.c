@@ -209,6 +209,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(in->surf_n, 3 * ns);
     TAKE(in->node_x, 3 * (uint64_t)v->nrender_nodes);
     TAKE(in->weld_tris, 3 * (uint64_t)v->nrender_tris);
+    TAKE(in->coll_x, v->nrender_verts > 0 ? 3 * (uint64_t)v->nsurf_verts : 0);
     TAKE(in->lod_off, 3 * ns);
     TAKE(in->lod_tmp, 3 * ns);
     TAKE(in->lod_dq, v->lod_rank > 0 ? nb : 0);
@@ -358,6 +359,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
         : d->novel_contact && d->self_contact != SINEW_SELF_CONTACT_POSE_SPACE
             ? "novel_contact adds to pose-space self-contact; the exhaustive and pose-pairs "
               "modes detect contact themselves"
+        : d->collision_surface > 1 ? "collision_surface is neither 0 nor 1"
         : d->newton_hessian != SINEW_NEWTON_HESSIAN_AUTO &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_REST_FIRST
@@ -567,7 +569,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     }
     in->novel_on = z.novel;
     /* the novel detection's broad phase reads the boundary's boxes of the last output */
-    if (z.novel) in->red.skin_surface = 1;
+    in->coll_on = d.collision_surface == 1;
+    if (z.novel || in->coll_on) in->red.skin_surface = 1;
     if (z.novel) sw_novel_build(&in->novel, v, &in->wc, &in->sc);
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
@@ -630,6 +633,7 @@ SINEW_API sinew_result sinew_instance_reset(sinew_instance *inst) {
     inst->lod_last = inst->lod; /* the level stays the host's; nothing to blend from */
     inst->lod_w = 0;
     inst->stepped = 0;
+    inst->coll_src = SW_COLL_SKINNED;
     memset(&inst->stats, 0, sizeof inst->stats);
     inst->stats.struct_size = sizeof inst->stats;
     inst->stats.lod = (uint32_t)inst->lod;

@@ -12,6 +12,16 @@
 #include "solver.h"
 #include "world_contact.h"
 
+/* Where the collision surface of the last step is: skinned at the pose (no step yet, or
+ * a pose-space step), surf_x (the output is the boundary), coll_x, or nowhere (a render
+ * mesh's boundary not asked for). */
+typedef enum sw_coll_source {
+    SW_COLL_SKINNED = 0,
+    SW_COLL_OUTPUT = 1,
+    SW_COLL_BOUNDARY = 2,
+    SW_COLL_NONE = 3
+} sw_coll_source;
+
 struct sinew_instance {
     const sw_blob_view *v;
     sinew_allocator allocator; /* frees the block */
@@ -58,6 +68,12 @@ struct sinew_instance {
     double *surf_x, *surf_n; /* 3 per output surface vertex each (sw_blob_output_verts) */
     double *node_x;          /* 3 per render node: the mean of its copies (render mesh only) */
     int32_t *weld_tris;      /* 3 per render triangle: its corners' weld representatives */
+    /* The collision surface (sinew_instance_read_collision_surface): coll_on the def's;
+     * coll_x (a blob with a render mesh only) the boundary of the last step, simulation
+     * frame, when coll_src says so. */
+    int coll_on;
+    sw_coll_source coll_src;
+    double *coll_x;
     /* Levels of detail (lod.c): the level set for the next steps and the level the last
      * output is of; after a change the surface shows lod_w (1 at the change, fading to 0
      * as the character moves) times lod_off (3 per output vertex: the old level's surface

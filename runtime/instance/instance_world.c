@@ -18,7 +18,8 @@ SINEW_API sinew_result sinew_instance_set_world(sinew_instance *inst, const sine
     }
     inst->wc.world = world;
     /* the world's contact reads the surface copies (instance.c's active vertices) */
-    inst->red.skin_surface = world != NULL || inst->v->nrender_verts == 0 || inst->novel_on;
+    inst->red.skin_surface =
+        world != NULL || inst->v->nrender_verts == 0 || inst->novel_on || inst->coll_on;
     sw_world_contacts_clear(&inst->wc);
     inst->wc.boxes_valid = 0; /* the next step's broad phase starts from every cluster */
     sw_rec_world(inst);

@@ -112,6 +112,7 @@ sinew_result sw_lod_pose_step(sinew_instance *in, float dt, sinew_step_stats *st
     sw_pose_history_advance(&in->pose, v->nbones, dt); /* the last step's frame and boxes
                                                           are renewed on leaving */
     st->status |= SINEW_STEP_POSE_SPACE;
+    in->coll_src = SW_COLL_SKINNED;
     st->ms_output = 1e3 * (sw_now_seconds() - t0);
     return r;
 }

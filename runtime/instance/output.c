@@ -8,6 +8,7 @@
 #include "instance.h"
 #include "hash.h"
 #include "instance_internal.h"
+#include "log.h"
 #include "recording.h"
 #include "surface_normals.h"
 
@@ -54,11 +55,18 @@ void sw_instance_write_surface(sinew_instance *in) {
      * and the novel self-contact's broad phase next step: without either it is skipped
      * (attaching a world invalidates the boxes, instance_world.c) */
     int boxes = in->wc.world || in->novel_on; /* a broad phase reads them next step */
-    for (int32_t s = 0; s < (v->nrender_verts == 0 || boxes ? v->nsurf_verts : 0); ++s) {
-        double x[3];
+    int boundary = v->nrender_verts == 0 || boxes || in->coll_on;
+    for (int32_t s = 0; s < (boundary ? v->nsurf_verts : 0); ++s)
         copies_mean(in, v->surf_copies, in->red.copy_act, v->surf_copy_ptr[s],
                     v->surf_copy_ptr[s + 1], in->wc.copy_x,
-                    v->nrender_verts ? x : in->surf_x + 3 * s);
+                    v->nrender_verts ? in->coll_x + 3 * s : in->surf_x + 3 * s);
+    in->coll_src = v->nrender_verts == 0 ? SW_COLL_OUTPUT
+                   : boundary            ? SW_COLL_BOUNDARY
+                                         : SW_COLL_NONE;
+    for (int32_t s = 0; in->coll_src == SW_COLL_BOUNDARY && s < v->nsurf_verts; ++s) {
+        double y[3];
+        sw_instance_from_step(in, in->coll_x + 3 * s, 0, y);
+        memcpy(in->coll_x + 3 * s, y, sizeof y);
     }
     if (v->nrender_verts > 0) {
         for (int32_t n = 0; n < v->nrender_nodes; ++n)
@@ -305,4 +313,43 @@ double sw_instance_bound_usage(const sinew_instance *inst) {
         if (inst->q_bound[k] > 0) use = fmax(use, sqrt(n2) / inst->q_bound[k]);
     }
     return use;
+}
+
+/* The boundary vertex s of the last step, or skinned at the pose, in the simulation
+ * frame (sw_coll_source). */
+static void collision_vertex(const sinew_instance *inst, int32_t s, double y[3]) {
+    const sw_blob_view *v = inst->v;
+    switch (inst->coll_src) {
+    case SW_COLL_OUTPUT:
+        memcpy(y, inst->surf_x + 3 * (int64_t)s, 3 * sizeof(double));
+        return;
+    case SW_COLL_BOUNDARY:
+        memcpy(y, inst->coll_x + 3 * (int64_t)s, 3 * sizeof(double));
+        return;
+    default: /* every copy of a vertex skins alike */
+        skin_vertex(inst, sw_blob_surf_copy_vertex(v, v->surf_copy_ptr[s]), y);
+    }
+}
+
+SINEW_API sinew_result sinew_instance_read_collision_surface(const sinew_instance *inst,
+                                                             float *positions,
+                                                             uint32_t vertex_count) {
+    if (!inst || !positions || vertex_count != (uint32_t)inst->blob->coll.nverts)
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    const sw_coll_surface *cs = &inst->blob->coll;
+    if (inst->coll_src == SW_COLL_NONE) {
+        sw_log(&inst->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
+               "sinew_instance_read_collision_surface: the blob's output is its render mesh and "
+               "the last step did not write the boundary (set sinew_instance_def."
+               "collision_surface, or attach a world)");
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    }
+    for (uint32_t i = 0; i < vertex_count; ++i) {
+        double x[3], y[3];
+        collision_vertex(inst, cs->vert[i], x);
+        sw_instance_to_actor(inst, x, 0, y);
+        for (int k = 0; k < 3; ++k)
+            positions[3 * i + k] = (float)y[k];
+    }
+    return SINEW_OK;
 }

@@ -175,11 +175,12 @@ static sinew_result step_both(runtime_pair *p, const scene *s, int f, double *Tb
     return r;
 }
 
-/* Each surface into the other's view: the colliders hold the last completed step's. */
+/* Each collision surface into the other's view: the colliders hold the last completed
+ * step's. */
 static sinew_result publish(runtime_pair *p) {
     sinew_result r = SINEW_OK;
     for (int k = 0; k < 2 && r == SINEW_OK; ++k) {
-        r = sinew_instance_read_surface(p->inst[k], p->pos, NULL, p->ns);
+        r = sinew_instance_read_collision_surface(p->inst[k], p->pos, p->ns);
         if (r == SINEW_OK) r = sinew_world_set_mesh_vertices(p->world, p->id[k], p->pos, p->ns);
     }
     return r;
@@ -190,26 +191,27 @@ static sinew_result pair_make(runtime_pair *p, const sinew_blob *blob, uint32_t 
     memset(p, 0, sizeof *p);
     sinew_instance_def d = sinew_instance_def_default();
     d.max_patch_vertices = patch;
+    d.collision_surface = 1; /* (a render mesh's boundary, read before a world is attached) */
     sinew_result r = SINEW_OK;
     for (int k = 0; k < 2 && r == SINEW_OK; ++k)
         r = sinew_instance_create(blob, &d, &p->inst[k]);
     if (r != SINEW_OK || lone)
         return r ? sw_error_set(err, r, "--pair: cannot create an instance") : r;
-    p->ns = sinew_blob_surface_vertex_count(blob);
-    p->nt = sinew_blob_surface_triangle_count(blob);
+    p->ns = sinew_blob_collision_vertex_count(blob);
+    p->nt = sinew_blob_collision_triangle_count(blob);
     p->pos = malloc(sizeof(float) * 3 * p->ns);
     p->tris = malloc(sizeof(uint32_t) * 3 * p->nt);
     if (!p->pos || !p->tris)
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "--pair: out of memory");
     sinew_world_def wd = sinew_world_def_default();
-    if ((r = sinew_blob_surface_triangles(blob, p->tris, 3 * p->nt)) ||
+    if ((r = sinew_blob_collision_triangles(blob, p->tris, 3 * p->nt)) ||
         (r = sinew_world_create(&wd, &p->world)) || (r = step_both(p, s, 0, Tb)))
         return sw_error_set(err, r, "--pair: cannot make the world");
     /* the colliders start as the first frame's surfaces, apart */
     for (int k = 0; k < 2 && r == SINEW_OK; ++k) {
         sinew_collider_def c = sinew_collider_def_default();
         c.shape = SINEW_SHAPE_MESH;
-        if ((r = sinew_instance_read_surface(p->inst[k], p->pos, NULL, p->ns))) break;
+        if ((r = sinew_instance_read_collision_surface(p->inst[k], p->pos, p->ns))) break;
         c.vertices = p->pos;
         c.vertex_count = p->ns;
         c.indices = p->tris;
@@ -308,10 +310,9 @@ sinew_result sw_pair_bench_run(const sinew_blob *blob, const sw_character *ch, c
                                sw_error *err) {
     memset(out, 0, sizeof *out);
     const sw_blob_view *v = sw_blob_get_view(blob);
-    if (!v || v->nverts != ch->mesh.nverts || nf < 2 || v->nrender_verts > 0)
+    if (!v || v->nverts != ch->mesh.nverts || nf < 2)
         return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
-                            "--pair needs the character's blob, with its tet boundary as the "
-                            "output surface, and 2 or more clip frames");
+                            "--pair needs the character's blob and 2 or more clip frames");
     scene s;
     sinew_result r = scene_init(&s, ch, T, nf, err);
     const size_t n6 = 6 * (size_t)ch->mesh.nverts;

@@ -37,6 +37,21 @@ SINEW_API uint32_t sinew_blob_surface_triangle_count(const sinew_blob *blob);
 SINEW_API sinew_result sinew_blob_surface_triangles(const sinew_blob *blob, uint32_t *indices,
                                                     uint32_t capacity);
 
+/** The collision surface: the simulation mesh's boundary, closed, edge-manifold and
+ * facing out, which another character collides with (a mesh collider of a shared world,
+ * sinew_world.h). Without a render mesh it is the output surface; with one it is not (a
+ * render mesh may be open, split at seams or self-intersecting). Its vertex and triangle
+ * counts (0 for NULL). Thread-safe. */
+SINEW_API uint32_t sinew_blob_collision_vertex_count(const sinew_blob *blob);
+SINEW_API uint32_t sinew_blob_collision_triangle_count(const sinew_blob *blob);
+
+/** Copies the collision surface's triangles (3 vertex indices each, counter-clockwise seen
+ * from outside) into `indices` of `capacity` uint32_t (at least 3 *
+ * sinew_blob_collision_triangle_count, else SINEW_ERROR_CAPACITY and nothing written).
+ * Thread-safe. */
+SINEW_API sinew_result sinew_blob_collision_triangles(const sinew_blob *blob, uint32_t *indices,
+                                                      uint32_t capacity);
+
 /** Name of bone `bone` (< sinew_blob_bone_count) as the bake imported it (a glTF joint's
  * node name; "bone N" when the source had none): zero-terminated, owned by the blob and
  * valid while it lives. NULL for a NULL blob, an out-of-range bone, or a blob baked without
@@ -176,6 +191,19 @@ SINEW_API sinew_result sinew_instance_set_lod(sinew_instance *inst, sinew_lod le
  * no actor transform was set); either buffer may be NULL. */
 SINEW_API sinew_result sinew_instance_read_surface(const sinew_instance *inst, float *positions,
                                                    float *normals, uint32_t vertex_count);
+
+/** Copies the collision surface (sinew_blob_collision_vertex_count xyz triples) of the last
+ * step into `positions`, in the actor's frame as sinew_instance_read_surface: hand it to
+ * sinew_world_set_mesh_vertices between frames, with the mesh collider placed at the
+ * actor's transform, and the other characters see this one's flesh. A step solved at
+ * SINEW_LOD_FULL or _REDUCED gives the solved boundary; before the first step (or after a
+ * reset) and after a step at SINEW_LOD_POSE_SPACE it is the boundary skinned at the pose
+ * (dual quaternions, no correction). A blob with a render mesh writes its boundary only
+ * when asked (sinew_instance_def.collision_surface, or a world attached, or novel contact
+ * on): otherwise INVALID_ARGUMENT, logged. Owner thread, after the step; never allocates. */
+SINEW_API sinew_result sinew_instance_read_collision_surface(const sinew_instance *inst,
+                                                             float *positions,
+                                                             uint32_t vertex_count);
 
 /** Figures of the last step; set out->struct_size first (fields it does not cover are
  * not written). */

@@ -230,6 +230,13 @@ typedef struct sinew_instance_def {
      * subspace. 0 (the default): off. Needs a blob with the tet mesh and pose-space
      * self-contact; INVALID_ARGUMENT otherwise. */
     uint32_t novel_contact;
+    /** The collision surface (sinew_instance_read_collision_surface): 1 has every step
+     * write the simulation mesh's closed boundary, which another character collides with
+     * (a mesh collider of a shared world). Only a blob with a render mesh needs it: without
+     * one the boundary is the output surface, and with a world attached or novel_contact
+     * on the step writes it anyway. It costs the boundary's mapping a step. 0 (the
+     * default): off. */
+    uint32_t collision_surface;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -254,6 +261,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.profiler.zone_end = NULL;
     d.profiler.user = NULL;
     d.novel_contact = 0;
+    d.collision_surface = 0;
     return d;
 }
 
