@@ -117,6 +117,8 @@ typedef struct sw_cond {
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
     double *gf;          /* 3 nf: gradient in x_f */
+    double *gf_el;       /* 3 nf: gf without the patch's world and inertia terms, and */
+    double phi_el;       /* Phi likewise, at the last evaluation (a law refresh's base) */
     double *Kt;          /* 144 per element: its PSD Hessian */
     double *Dw;          /* 9 nf: world-contact 3x3 Hessians of the patch vertices */
     double *Pf;          /* 9 nf: the inverted 3x3 diagonal blocks (preconditioner) */
@@ -191,6 +193,12 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
                          const sw_solver *s, const double *q, const double *x,
                          const sw_dyn_coef *dc, int want_hess);
 void sw_cond_hessian_apply(void *ctx, const double *z, double *y);
+/* Phi at the iterate of the last evaluation (which took the Hessian) once the patch's
+ * world laws were taken again and its undecided pairs reset: the elastic terms and the
+ * decided pairs kept, the undecided pairs, the world and the inertia evaluated, as
+ * sw_cond_potential would give them (to rounding: the new terms are summed last). */
+double sw_cond_potential_refreshed(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
+                                   const double *x, const sw_dyn_coef *dc);
 
 /* Dynamic steps (patch_dynamics.c): the patch vertices' start state x_n, v_n (their own
  * from the last step when they were in its patch, else the subspace's motion under the

@@ -208,6 +208,26 @@ static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t 
     return phi;
 }
 
+/* The patch vertices' world contact and, in a dynamic step, their inertia: the terms a
+ * refresh of the world's laws changes, into c->gf and, with want_hess, c->Dw. */
+static double patch_world(sw_cond *c, const sw_step_contacts *ct, const double *x,
+                          const sw_dyn_coef *dc, int want_hess) {
+    double phi = 0;
+    const sw_world_contacts *wc = ct->wc;
+    for (int32_t j = 0; wc && j < wc->ncand; ++j) {
+        const sw_world_cand *cd = &wc->cand[j];
+        if (cd->patch < 0) continue;
+        double f[3], H3[9];
+        phi += sw_world_penalty(&cd->law, x + 3 * (int64_t)cd->patch, f, want_hess ? H3 : NULL);
+        for (int i = 0; i < 3; ++i)
+            c->gf[3 * (int64_t)cd->patch + i] -= f[i];
+        for (int i = 0; want_hess && i < 9; ++i)
+            c->Dw[9 * (int64_t)cd->patch + i] += H3[i];
+    }
+    if (dc->dynamic) phi += sw_cond_inertia(c, dc, x, want_hess);
+    return phi;
+}
+
 /* Phi(q, x) (condense.h): the gradient into (red->g, c->gf), the Hessian's parts (red->H
  * with the ring blocks, Kt, Dw) with want_hess. */
 double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
@@ -240,19 +260,21 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
     for (int32_t e = 0; e < ne; ++e)
         phi += add_element(c, red, x, e, want_hess);
     if (want_hess) ring_blocks_flush(c, red, 0, c->nring_patch);
-    const sw_world_contacts *wc = ct->wc;
-    for (int32_t j = 0; wc && j < wc->ncand; ++j) {
-        const sw_world_cand *cd = &wc->cand[j];
-        if (cd->patch < 0) continue;
-        double f[3], H3[9];
-        phi += sw_world_penalty(&cd->law, x + 3 * (int64_t)cd->patch, f, want_hess ? H3 : NULL);
-        for (int i = 0; i < 3; ++i)
-            c->gf[3 * (int64_t)cd->patch + i] -= f[i];
-        for (int i = 0; want_hess && i < 9; ++i)
-            c->Dw[9 * (int64_t)cd->patch + i] += H3[i];
-    }
-    if (dc->dynamic) phi += sw_cond_inertia(c, dc, x, want_hess);
-    return phi;
+    c->phi_el = phi;
+    memcpy(c->gf_el, c->gf, 3 * (size_t)c->nf * sizeof(double));
+    return phi + patch_world(c, ct, x, dc, want_hess);
+}
+
+double sw_cond_potential_refreshed(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct,
+                                   const double *x, const sw_dyn_coef *dc) {
+    double phi = c->phi_el;
+    memcpy(c->gf, c->gf_el, 3 * (size_t)c->nf * sizeof(double));
+    memset(c->Dw, 0, 9 * (size_t)c->nf * sizeof(double));
+    for (int32_t j = 0; j < c->np; ++j) /* a pair the refresh reset decides here */
+        if (c->pp_active[j] < 0) phi += add_element(c, red, x, c->nt + j, 1);
+    c->phi_el = phi;
+    memcpy(c->gf_el, c->gf, 3 * (size_t)c->nf * sizeof(double));
+    return phi + patch_world(c, ct, x, dc, 1);
 }
 
 /* ---- the linear system of eq. 4.11 ------------------------------------------------- */
@@ -532,8 +554,8 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
             sw_cond_tag_candidates(c, wc);
             for (int32_t j = 0; j < c->np; ++j) /* and a pair now colliding joins */
                 if (c->pp_active[j] == 0) c->pp_active[j] = -1;
-            phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
-            st->potential_evals++;
+            /* only those terms changed: the elastic ones stay the last evaluation's */
+            phi = sw_cond_potential_refreshed(c, red, ct, c->x, dc);
         }
         gn = grad_norm(c, red);
     }

@@ -179,6 +179,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->xt, 3 * nf);
         TAKE(c->dx, 3 * nf);
         TAKE(c->gf, 3 * nf);
+        TAKE(c->gf_el, 3 * nf);
         TAKE(c->Kt, 144 * ntf);
         TAKE(c->Dw, 9 * nf);
         TAKE(c->Pf, 9 * nf);
