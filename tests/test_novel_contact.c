@@ -135,7 +135,9 @@ TEST(a_fold_no_training_pose_reached_is_found_and_held_in_a_patch) {
             a.novel, b.novel, c.novel);
     ENSUREF(a.patch == 0 && b.patch == 0 && c.patch > 0, "patch vertices: %u, %u, %u", a.patch,
             b.patch, c.patch);
-    ENSUREF(a.pen_sum > 0 && c.pen_sum < 0.5 * a.pen_sum && c.pen <= a.pen,
+    /* under a third: the patch's pairs are decided again as it moves, with no world too
+       (decided once, at its start, the sum was 0.37 of it) */
+    ENSUREF(a.pen_sum > 0 && c.pen_sum < 0.34 * a.pen_sum && c.pen <= a.pen,
             "self-penetration (sum of depths, deepest): %.4g, %.4g with the patch; %.4g, %.4g "
             "without novel contact; %.4g, %.4g through the subspace",
             c.pen_sum, c.pen, a.pen_sum, a.pen, b.pen_sum, b.pen);

@@ -544,14 +544,15 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
             break;
         }
         st->newton_iterations++;
-        if (wc && it < SW_COND_LAW_REFRESHES) {
+        if (it < SW_COND_LAW_REFRESHES) {
             /* the patch's world contact laws again at the iterate: taken at the start
                state, where the subspace went deep into the collider (the reference takes
                its own at its last solution, near the surface), their friction caps held
                the flesh (world_contact.c, refresh_candidate); no extra update. The
-               pose-space pairs' set grows as the reference's does between rounds. */
-            sw_cond_detect(c, wc, SW_WC_AT_REPLANE);
-            sw_cond_tag_candidates(c, wc);
+               pose-space pairs' set grows as the reference's does between rounds, with a
+               world or without one (a patch novel self-contact seeded). */
+            if (wc) sw_cond_detect(c, wc, SW_WC_AT_REPLANE);
+            if (wc) sw_cond_tag_candidates(c, wc);
             for (int32_t j = 0; j < c->np; ++j) /* and a pair now colliding joins */
                 if (c->pp_active[j] == 0) c->pp_active[j] = -1;
             /* only those terms changed: the elastic ones stay the last evaluation's */
