@@ -1,7 +1,8 @@
 /* What a step leaves for the host: the output surface (each boundary vertex the mean of
  * its domain copies, or the render mesh carried by its render nodes, output_render.c;
- * area-weighted normals), its float copy, the step's figures; and the O(N) evaluation
- * helpers of tools and tests, which are never part of a step. */
+ * area-weighted normals), its float copy, the collision surface (the boundary, which
+ * another character collides with), the step's figures; and the O(N) evaluation helpers
+ * of tools and tests, which are never part of a step. */
 #include <math.h>
 #include <string.h>
 
@@ -51,9 +52,10 @@ void sw_instance_surface_normals(sinew_instance *in) {
 
 void sw_instance_write_surface(sinew_instance *in) {
     const sw_blob_view *v = in->v;
-    /* the boundary is the output, or (under a render mesh) only what carries the world's
-     * and the novel self-contact's broad phase next step: without either it is skipped
-     * (attaching a world invalidates the boxes, instance_world.c) */
+    /* the boundary is the output, or (under a render mesh) what carries the world's and
+     * the novel self-contact's broad phase next step and the collision surface the host
+     * asked for: without any of them it is skipped (attaching a world invalidates the
+     * boxes, instance_world.c) */
     int boxes = in->wc.world || in->novel_on; /* a broad phase reads them next step */
     int boundary = v->nrender_verts == 0 || boxes || in->coll_on;
     for (int32_t s = 0; s < (boundary ? v->nsurf_verts : 0); ++s)
