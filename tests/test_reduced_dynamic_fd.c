@@ -4,11 +4,13 @@
  * (sw_instance_step_prepare / sw_instance_step_potential, instance.h):
  *   cubature material energy, interface springs, pose-space self-contact pairs (a folded
  *   pose), a world collider the finger is pressed into (a table), and the backward-Euler
- *   terms cm/2 |q - q_n - h qdot_n|_M^2 + cd/2 |q - q_n|_(alpha M + beta H(q_n))^2 - q.f_in
+ *   terms cm/2 |q - q_n - h qdot_n|_M^2 + cd/2 |q - q_n|_(alpha M + beta H(q_s))^2 - q.f_in
  *   with a real velocity and real inertial forces (the finger stepped along its clip).
  * The inertial forces f_in are explicit (evaluated at q_n, qdot_n and the bones' motion)
- * and H(q_n) is frozen for the step, so neither depends on q: they enter Phi as a linear
- * and a quadratic term whose derivatives the differences check like any other.
+ * and H(q_s) (at the step's predicted start; the reference Hessian there for a rest-first
+ * instance) is frozen for the step, so neither depends on q: they enter Phi as a linear
+ * and a quadratic term whose derivatives the differences check like any other. Both
+ * kinds of instance are checked.
  *
  * At random q around the step's start state (and around a deeper fold):
  *   gradient  g_i against (Phi(q + h e_i) - Phi(q - h e_i)) / 2h,
@@ -23,10 +25,11 @@
  * Hessian 1.5e-10 of |H|_inf, Hp - He >= -4.3e-17 |H| (20 states on frames 2-11: 1.6e-8,
  * 2.7e-10, -4.7e-17); bounds 1e-7, 1e-8 and -1e-12
  * (the rounding estimate with a margin, far below a wrong term: measured, f_in scaled by
- * 0.99 in the gradient gives a gradient error of 1.6e-3, beta H(q_n) scaled by 0.9 in
+ * 0.99 in the gradient gives a gradient error of 1.6e-3, beta H(q_s) scaled by 0.9 in
  * the Hessian a Hessian error of 2.9e-3). */
 #include <math.h>
 #include <stdint.h>
+#include <string.h>
 
 #include "bake_fixture.h"
 #include "instance.h"
@@ -48,31 +51,40 @@ static double inf_norm(const double *x, int64_t n) {
     return m;
 }
 
-/* The step's first Newton evaluation, at q_n from the material part the damping Hessian's
- * pass left (no cubature pass of its own), against a fresh evaluation of the prepared
- * step's potential at q_n: the same value, gradient and Newton matrix (to the rounding of a
- * second SVD warm-started at the same point: measured 0 for Phi, up to 8.4e-16 of |g|_inf
- * and 9.3e-17 of |H|_inf; bounds 1e-12), and only once. */
-static void check_start(sinew_instance *inst, float dt) {
+/* The step's first Newton evaluation, at its predicted start q_s from the material part
+ * the damping Hessian's pass left (no cubature pass of its own), against a fresh
+ * evaluation of the prepared step's potential at q_s: the same value, gradient and (when
+ * the part's Hessian is the current one, not the rest-first reference) Newton matrix (to
+ * the rounding of a second SVD warm-started at the same point: measured 0 for Phi, up to
+ * 8.4e-16 of |g|_inf and 9.3e-17 of |H|_inf; bounds 1e-12), and only once. */
+static void check_start(sinew_instance *inst, float dt, int *reused) {
     int32_t R = inst->red.R;
     double *g = malloc(sizeof(double) * R), *H = malloc(sizeof(double) * R * R),
-           *g1 = malloc(sizeof(double) * R), *H1 = malloc(sizeof(double) * R * R);
-    int pass = -1;
+           *g1 = malloc(sizeof(double) * R), *H1 = malloc(sizeof(double) * R * R),
+           *qs = malloc(sizeof(double) * R);
+    memcpy(qs, inst->solver.q, sizeof(double) * R);
+    /* pose-space pairs that came apart at q_s were dropped after the part was evaluated
+       (phase_self): then the part is stale and the start must make its own pass */
+    int pass = -1, current = inst->solver.mat_hess == 1, valid = inst->solver.mat_at_start;
     double e = sw_instance_step_start_potential(inst, dt, g, H, &pass);
-    ENSUREF(pass == 0, "the start made a cubature pass of its own");
-    double e1 = sw_instance_step_potential(inst, dt, inst->solver.qn, g1, H1, 0), gd = 0, hd = 0;
+    ENSUREF(pass == !valid, "the start made %d cubature passes, its part %s", pass,
+            valid ? "valid" : "stale");
+    *reused += valid;
+    double e1 = sw_instance_step_potential(inst, dt, qs, g1, H1, 0), gd = 0, hd = 0;
     for (int32_t i = 0; i < R; ++i)
         gd = fmax(gd, fabs(g[i] - g1[i]));
-    for (int64_t i = 0; i < (int64_t)R * R; ++i)
+    for (int64_t i = 0; i < (int64_t)R * R && current; ++i)
         hd = fmax(hd, fabs(H[i] - H1[i]));
-    fprintf(stderr, "  start from the damping pass: |dPhi| %.2e, |dg| %.2e, |dH| %.2e\n",
-            fabs(e - e1) / fabs(e1), gd / inf_norm(g1, R), hd / inf_norm(H1, (int64_t)R * R));
+    fprintf(stderr,
+            "  start from the damping pass (%s Hessian): |dPhi| %.2e, |dg| %.2e, |dH| %.2e\n",
+            current ? "current" : "reference", fabs(e - e1) / fabs(e1), gd / inf_norm(g1, R),
+            hd / inf_norm(H1, (int64_t)R * R));
     ENSUREF(fabs(e - e1) <= 1e-12 * fabs(e1), "Phi %.17g against %.17g", e, e1);
     ENSUREF(gd <= 1e-12 * inf_norm(g1, R), "gradient differs by %.3g", gd);
     ENSUREF(hd <= 1e-12 * inf_norm(H1, (int64_t)R * R), "Newton matrix differs by %.3g", hd);
     sw_instance_step_start_potential(inst, dt, g, H, &pass);
     ENSUREF(pass == 1, "the part was used twice");
-    free(g), free(H), free(g1), free(H1);
+    free(g), free(H), free(g1), free(H1), free(qs);
 }
 
 /* Checks the prepared step's potential at q (R coordinates); prints and returns the
@@ -123,7 +135,7 @@ static void check_at(sinew_instance *inst, float dt, double *q, double *gerr, do
     free(g), free(He), free(Hp), free(gp), free(gm);
 }
 
-TEST(dynamic_step_potential_matches_finite_differences) {
+static void check_dynamic_potential(sinew_newton_hessian kind) {
     const bake_fixture *f = fixture(); /* finger, 2,000 tets (world_fixture.h) */
     ENSURE(f);
     const sw_blob_view *v = sw_blob_get_view(f->blob);
@@ -133,6 +145,7 @@ TEST(dynamic_step_potential_matches_finite_differences) {
     ENSURE(w);
     sinew_instance_def d = sinew_instance_def_default();
     d.mode = SINEW_STEP_DYNAMIC;
+    d.newton_hessian = kind;
     sinew_instance *inst;
     ENSURE(sinew_instance_create(f->blob, &d, &inst) == SINEW_OK);
     ENSURE(sinew_instance_set_world(inst, w) == SINEW_OK);
@@ -141,7 +154,7 @@ TEST(dynamic_step_potential_matches_finite_differences) {
     float *pose = malloc(sizeof(float) * 12 * nb);
     double *q = malloc(sizeof(double) * R);
     uint64_t seed = 7;
-    int checked = 0, with_pairs = 0;
+    int checked = 0, with_pairs = 0, reused = 0;
     double gworst = 0, hworst = 0, psd_worst = INFINITY;
     /* along the clip into its fold (frames 6 and 7: pose-space pairs; 6 in contact) and
        out (11: the most world candidates); the table under it all the way */
@@ -154,7 +167,7 @@ TEST(dynamic_step_potential_matches_finite_differences) {
             ENSURE(inst->pose.history == 2);
             ENSUREF(inf_norm(s->qdot, R) > 0 && inf_norm(s->fin, R) > 0,
                     "frame %d: no velocity or no inertial forces to check", frame);
-            check_start(inst, dt);
+            check_start(inst, dt, &reused);
             for (int rep = 0; rep < 2; ++rep) {
                 /* rep 0: near the start state; rep 1: 5% deeper into the correction */
                 for (int32_t i = 0; i < R; ++i)
@@ -185,6 +198,7 @@ TEST(dynamic_step_potential_matches_finite_differences) {
             "Hessian %.2e, Newton matrix %.2e\n",
             checked, with_pairs, gworst, hworst, psd_worst);
     ENSUREF(with_pairs >= 2, "only %d states with pose-space pairs in contact", with_pairs);
+    ENSUREF(reused >= 3, "the damping pass's part started only %d of 4 steps", reused);
     ENSUREF(gworst <= 1e-7, "gradient error %.3g of |g|_inf", gworst);
     ENSUREF(hworst <= 1e-8, "Hessian error %.3g of |H|_inf", hworst);
     ENSUREF(psd_worst >= -1e-12, "the Newton matrix is below the exact Hessian: %.3g", psd_worst);
@@ -193,8 +207,18 @@ TEST(dynamic_step_potential_matches_finite_differences) {
     sinew_world_destroy(w);
 }
 
+TEST(dynamic_step_potential_matches_finite_differences) {
+    check_dynamic_potential(SINEW_NEWTON_HESSIAN_CURRENT);
+}
+
+TEST(rest_first_dynamic_step_potential_matches_finite_differences) {
+    check_dynamic_potential(SINEW_NEWTON_HESSIAN_REST_FIRST);
+}
+
 TEST(release_fixture) {
     if (fx_ok > 0) bake_fixture_free(&fx);
 }
 
-SW_TEST_MAIN(CASE(dynamic_step_potential_matches_finite_differences), CASE(release_fixture))
+SW_TEST_MAIN(CASE(dynamic_step_potential_matches_finite_differences),
+             CASE(rest_first_dynamic_step_potential_matches_finite_differences),
+             CASE(release_fixture))

@@ -16,7 +16,7 @@
 #define SW_CUB_HESSIAN_EXACT 2
 /* want_hess == SW_CUB_HESSIAN_REF: a gradient pass, and the reference Hessian's domain
  * blocks (m->h_ref) added to m->H in place of the Hessian at q: the first updates of a
- * quasistatic Newton step (newton.c says why and when). With m->h_ref set, a pass with the
+ * Newton step (newton.c says why and when). With m->h_ref set, a pass with the
  * (projected) Hessian at q also stores its domain blocks there: the next steps' reference
  * is the Hessian last evaluated, which follows the pose far closer than the rest one. */
 #define SW_CUB_HESSIAN_REF 3

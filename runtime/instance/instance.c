@@ -33,7 +33,7 @@ typedef struct {
     int detect;
     int novel;   /* the def's novel_contact */
     int rest;    /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
-    int dynamic; /* the frozen damping Hessian H(q_n): SINEW_STEP_DYNAMIC only */
+    int dynamic; /* the frozen damping Hessian and its point: SINEW_STEP_DYNAMIC only */
 } layout_sizes;
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
@@ -100,6 +100,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->fin, R);
     TAKE(s->Hn, z->dynamic ? R * R : 0); /* (a quasistatic step never reads it) */
     TAKE(s->g_mat, R);
+    TAKE(s->q_mat, z->dynamic ? R : 0);
     TAKE(s->L, R * R);
     TAKE(s->dq, R);
     TAKE(s->qtrial, R);

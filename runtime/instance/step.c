@@ -90,7 +90,8 @@ static void step_begin(sw_step_ctx *c, sinew_instance *in, float dt) {
     sw_instance_frame(in); /* the history moved on since the pose was set */
     if (c->dc.dynamic) reframe_patch(in);
     memcpy(in->solver.qn, in->solver.q, (size_t)in->red.R * sizeof(double));
-    in->solver.mat_at_qn = 0;
+    in->solver.mat_at_start = 0;
+    in->solver.fallback_qn = 0;
     c->t = sw_now_seconds();
 }
 
@@ -147,7 +148,8 @@ static void novel_self(sw_step_ctx *c) {
     const double *T_last = in->pose.history >= 1 ? in->L_last : NULL;
     sw_novel_detect(&in->novel, &in->sc, &in->wc, &in->red, in->solver.q, &in->ps, in->loc.T_cur,
                     T_last, c->st.joints_beyond_training > 0);
-    if (in->sc.npairs > 0) in->solver.mat_at_qn = 0; /* a dynamic step's part at q_n lacks them */
+    if (in->sc.npairs > 0)
+        in->solver.mat_at_start = 0; /* a dynamic step's material part lacks them */
     c->st.novel_contacts = (uint32_t)in->sc.npairs;
     c->st.novel_cluster_pairs = (uint32_t)in->novel.cluster_pairs;
     c->st.self_contact_tests += (uint32_t)in->novel.tests;
@@ -163,7 +165,7 @@ static void phase_self(sw_step_ctx *c) {
     int32_t apart =
         exhaustive(in) ? 0 : sw_pose_contacts_drop_apart(&in->ps, &in->red, in->solver.q);
     if (apart > 0) {
-        in->solver.mat_at_qn = 0; /* a dynamic step's material part at q_n held them */
+        in->solver.mat_at_start = 0; /* a dynamic step's material part held them */
         c->st.contact_pairs = c->st.self_contacts = (uint32_t)in->ps.npairs;
         c->st.self_contacts_apart = (uint32_t)apart;
     }
@@ -179,9 +181,9 @@ static void phase_self(sw_step_ctx *c) {
         }
         /* the cubature vertices against the flesh around their trained triangles */
         int64_t tests = in->sc.tests;
-        /* a dynamic step's material part at q_n (phase_dynamics) held the moved pairs */
+        /* a dynamic step's material part (phase_dynamics) held the moved pairs */
         if (sw_self_contacts_retest(&in->sc, &in->red, in->solver.q, &in->ps) > 0)
-            in->solver.mat_at_qn = 0;
+            in->solver.mat_at_start = 0;
         c->st.self_contact_tests += (uint32_t)(in->sc.tests - tests);
     }
     if (in->novel_on && in->lod_run == SINEW_LOD_FULL) novel_self(c);
@@ -190,6 +192,20 @@ static void phase_self(sw_step_ctx *c) {
     double ms = lap(c);
     c->st.ms_contact += ms;
     c->st.ms_self_contact += ms;
+}
+
+/* s->q = p + (q_n - p_n) with offset, else p: p the blend of the two nearest training
+ * poses' reduced solutions, p_n the last step's (s->q_pred). O(R). */
+static void predicted_start(sinew_instance *in, int offset) {
+    sw_solver *s = &in->solver;
+    int32_t R = in->red.R;
+    double *p = s->tmp;
+    sw_pose_space_blend(&in->ps, in->v->train_q, R, p);
+    for (int32_t i = 0; i < R; ++i) {
+        s->q[i] = offset ? p[i] + (s->q[i] - s->q_pred[i]) : p[i];
+        s->q_pred[i] = p[i];
+    }
+    s->pred_valid = 1;
 }
 
 /* Pose-space start of a quasistatic step: the prediction p = the blend of the two
@@ -207,29 +223,39 @@ static void phase_self(sw_step_ctx *c) {
  * frames before within the solve's tolerance: a step ends within its last update,
  * SW_NEWTON_LAST_UPDATE |q|, of the stationary point (test_reduced_model). O(R). */
 static void pose_space_start(sinew_instance *in) {
-    sw_solver *s = &in->solver;
-    int32_t R = in->red.R;
     /* the last pose nearer than every training pose (s->q holds q_n). Not where the step
        detects self-contact (exhaustive, pose-pairs): a vertex on the edge of contact makes
        the step's answer jump with rounding, and the offset would carry every such jump
        into all later frames, so that a character turned by 1e-12 degrees ends a clip with
        another shape; from the prediction alone the shape is the pose's. */
-    int offset = s->pred_valid && in->pose.history >= 1 && in->ps.d_last < in->ps.d_nearest &&
-                 in->self_mode == SINEW_SELF_CONTACT_POSE_SPACE;
-    double *p = s->tmp;
-    sw_pose_space_blend(&in->ps, in->v->train_q, R, p);
-    for (int32_t i = 0; i < R; ++i) {
-        s->q[i] = offset ? p[i] + (s->q[i] - s->q_pred[i]) : p[i];
-        s->q_pred[i] = p[i];
-    }
-    s->pred_valid = 1;
+    sw_solver *s = &in->solver;
+    predicted_start(in, s->pred_valid && in->pose.history >= 1 &&
+                            in->ps.d_last < in->ps.d_nearest &&
+                            in->self_mode == SINEW_SELF_CONTACT_POSE_SPACE);
+}
+
+/* Start of a dynamic step: q_n moved by the change of the pose-space prediction, q_s =
+ * p + (q_n - p_n), the quasistatic start's offset taken always (a dynamic state is its
+ * history's: the offset holds its lag and swing). Newton from q_n spends its first
+ * updates following the pose; from q_s it is left with the dynamics' own change over a
+ * frame, and the rest-first updates serve it as they serve a quasistatic step
+ * (docs/notes/jiggle.md, The dynamic step's start). After a jump, a reset or
+ * a failed step, p alone; where Newton finds no descent from q_s it starts again from q_n
+ * (newton.c). The Rayleigh stiffness is frozen at q_s, where Newton's first evaluation is
+ * anyway: K(q_s) differs from the backward-Euler K(q_n) by a frame's motion, in a term
+ * that is beta / h (0.03 at the defaults and 30 Hz) of the stiffness. */
+static void dynamic_start(sinew_instance *in) {
+    sw_solver *s = &in->solver;
+    predicted_start(in, s->pred_valid && in->pose.history >= 1);
+    s->fallback_qn = 1;
 }
 
 /* A jump of the pose (sw_pose_jump: teleport, snap, or a small dt that implies a speed no
  * joint makes; or one the host declared, sinew_instance_mark_teleport) starts the pose history
  * afresh in either mode: no velocity and no inertia are taken from it, and the world's broad phase
- * does not reuse the last boxes. Dynamic: the inertial forces of the bones' motion, and the
- * Rayleigh stiffness H(q_n) frozen for the step. Quasistatic: the pose-space start. */
+ * does not reuse the last boxes. Dynamic: the inertial forces of the bones' motion, the
+ * predicted start and the Rayleigh stiffness frozen there for the step. Quasistatic: the
+ * pose-space start. */
 static void phase_dynamics(sw_step_ctx *c) {
     sinew_instance *in = c->in;
     sw_solver *s = &in->solver;
@@ -244,19 +270,23 @@ static void phase_dynamics(sw_step_ctx *c) {
     }
     if (c->dc.dynamic) {
         sw_inertial_forces(in->v, &in->loc, s, c->dc.h);
-        /* H_n: the material and pose-space self-contact (the exhaustive mode's pairs are
-           detected after the start state, phase_self); Newton's first evaluation, at q_n,
+        if (in->ps.nearest >= 0) dynamic_start(in);
+        /* H(q_s): the material and pose-space self-contact (the exhaustive mode's pairs are
+           detected after the start state, phase_self); Newton's first evaluation, at q_s,
            starts from the same part instead of another cubature pass */
-        s->phi_mat = sw_potential_material(&in->red, &in->ps, s->q, 1, 1, NULL);
+        s->mat_hess = s->rest_first && in->red.h_ref ? SW_CUB_HESSIAN_REF : 1;
+        s->phi_mat = sw_potential_material(&in->red, &in->ps, s->q, 1, s->mat_hess, NULL);
         c->st.potential_evals++;
         memcpy(s->Hn, in->red.H, (size_t)R * R * sizeof(double));
         memcpy(s->g_mat, in->red.g, (size_t)R * sizeof(double));
-        s->mat_at_qn = 1;
+        memcpy(s->q_mat, s->q, (size_t)R * sizeof(double));
+        s->mat_at_start = 1;
     } else if (in->ps.nearest >= 0) {
         pose_space_start(in);
         c->st.status |= SINEW_STEP_POSE_SPACE;
     }
-    if (!(c->st.status & SINEW_STEP_POSE_SPACE)) s->pred_valid = 0;
+    if (!(c->st.status & SINEW_STEP_POSE_SPACE) && !(c->dc.dynamic && in->ps.nearest >= 0))
+        s->pred_valid = 0;
     c->st.ms_dynamics = lap(c);
 }
 
@@ -580,7 +610,8 @@ double sw_instance_step_start_potential(sinew_instance *inst, float dt, double *
     sw_dyn_coef dc = step_coef(inst, dt);
     size_t R = (size_t)inst->red.R;
     sw_step_contacts ct = sw_instance_contacts(inst, NULL);
-    double phi = sw_potential_start(&inst->red, &ct, &inst->solver, &dc, cubature_pass);
+    double phi = sw_potential_start(&inst->red, &ct, &inst->solver, &dc, inst->solver.mat_hess,
+                                    cubature_pass);
     memcpy(g, inst->red.g, R * sizeof(double));
     memcpy(H, inst->red.H, R * R * sizeof(double));
     return phi;

@@ -3,7 +3,7 @@
  * minimum-degree order of the spring couplings (plus the fill and the contact pairs of
  * the step), chord updates on an earlier factor once the iterate converges fast, and an
  * energy guard: a trial point whose energy grows is halved, up to five times, and the
- * best iterate is kept. A quasistatic step may start with updates on a reference Hessian
+ * best iterate is kept. A step may start with updates on a reference Hessian
  * (rest_first_updates: the rest one, then the last one evaluated) before the current
  * Hessian's. */
 #include <math.h>
@@ -118,11 +118,12 @@ static double evaluate(sw_reduced *red, const sw_step_contacts *ct, const sw_sol
     return sw_potential(red, ct, s, q, dc, 1, want_hess);
 }
 
-/* Phi, g and H at the step's start, counted when it makes a cubature pass. */
+/* Phi, g and H (of kind want_hess) at the step's start, counted when it makes a cubature
+ * pass. */
 static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
-                             const sw_dyn_coef *dc, sinew_step_stats *st) {
+                             const sw_dyn_coef *dc, int want_hess, sinew_step_stats *st) {
     int pass = 0;
-    double phi = sw_potential_start(red, ct, s, dc, &pass);
+    double phi = sw_potential_start(red, ct, s, dc, want_hess, &pass);
     st->potential_evals += (uint32_t)pass;
     return phi;
 }
@@ -186,7 +187,7 @@ static sinew_result step_failed(sw_solver *s, int32_t R, sinew_step_stats *st) {
 /* What rest_first_updates left: the step done, or its iteration to go on from s->q. */
 enum rest_outcome { REST_DONE, REST_HAND_OVER, REST_NOT_FINITE };
 
-/* Quasistatic Newton updates on the reference Hessian (SW_CUB_HESSIAN_REF: the cubature's
+/* Newton updates on the reference Hessian (SW_CUB_HESSIAN_REF: the cubature's
  * Hessian kept in red->h_ref, with the contact pairs' and springs' Hessians at the
  * iterate), each factored at its iterate, each trial a gradient pass accepted when the
  * energy does not rise. The minimum is the same as the current Hessian's; only the path
@@ -268,8 +269,8 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
      * start alone. */
     double phi, gn, g0;
     uint32_t it0 = 0;
-    if (s->rest_first && red->h_ref && !dc->dynamic) {
-        phi = evaluate(red, ct, s, s->q, dc, SW_CUB_HESSIAN_REF, st);
+    if (s->rest_first && red->h_ref) {
+        phi = evaluate_start(red, ct, s, dc, SW_CUB_HESSIAN_REF, st);
         gn = g0 = sqrt(sw_dot(red->g, red->g, R));
         enum rest_outcome o = rest_first_updates(red, ct, s, dc, st, &phi, &gn, g0, &it0);
         if (o == REST_NOT_FINITE) return step_failed(s, R, st);
@@ -281,7 +282,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
         phi = evaluate(red, ct, s, s->q, dc, 1, st); /* hand over: the Hessian at q */
         gn = sqrt(sw_dot(red->g, red->g, R));
     } else {
-        phi = evaluate_start(red, ct, s, dc, st);
+        phi = evaluate_start(red, ct, s, dc, 1, st);
         gn = g0 = sqrt(sw_dot(red->g, red->g, R));
     }
     int have_h = 1; /* red->H is the Hessian at s->q, not yet factored */
@@ -348,6 +349,20 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
                 gn = gn0;
                 have_h = 1;
                 trust = 0;
+                continue;
+            }
+            if (s->fallback_qn) {
+                /* from a predicted start (step.c, dynamic_start) the path met a region
+                   where the potential curves far more than its Hessian says (a stiff
+                   contact engaging): a pose-space blend that switched training poses had
+                   moved the start off the motion's path. Newton starts again from q_n, the
+                   last state, as a step that starts there does. */
+                s->fallback_qn = 0;
+                memcpy(s->q, s->qn, (size_t)R * sizeof(double));
+                phi = evaluate(red, ct, s, s->q, dc, 1, st);
+                gn = g0 = sqrt(sw_dot(red->g, red->g, R));
+                have_h = 1;
+                trust = 1;
                 continue;
             }
             /* keep the best iterate (its energy and gradient norm are known) */

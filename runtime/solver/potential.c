@@ -1,8 +1,9 @@
 /* The potential of one step (thesis eqs. 2.11, 4.20 and the backward-Euler terms):
  *   Phi(q) = E_cub(q) + E_contact(q) + E_world(q) + 1/2 q^T H_s q
  *          [ + cm/2 |q - q_n - h qdot_n|_M^2 + cd/2 |q - q_n|_D^2 - q^T f_in ],
- * D = alpha M + beta H(q_n), H_s the constant interface-spring Hessian, M the constant
- * reduced mass, f_in the inertial forces of the domains riding their bones. */
+ * D = alpha M + beta H(q_s) (the material Hessian at the step's start, frozen), H_s the
+ * constant interface-spring Hessian, M the constant reduced mass, f_in the inertial forces
+ * of the domains riding their bones. */
 #include <string.h>
 
 #include "cubature.h"
@@ -16,7 +17,7 @@
 enum block_set {
     BLOCKS_DIAGONAL, /* the reduced mass (when block diagonal, sw_solver.mass_blockdiag) */
     BLOCKS_SPRINGS,  /* the interface springs' Hessian: the spring-coupled pairs */
-    BLOCKS_STEP      /* H(q_n): the step's factor pattern (springs, contact pairs, fill) */
+    BLOCKS_STEP      /* H(q_s): the step's factor pattern (springs, contact pairs, fill) */
 };
 
 static int block_in(const sw_solver *s, int32_t nd, enum block_set set, int32_t a, int32_t b) {
@@ -65,7 +66,7 @@ static void mass_matvec(const sw_blob_view *v, const sw_solver *s, const double 
         sw_matvec(v->mass, v->rank_total, x, y);
 }
 
-/* H += cm M + cd (alpha M + beta H(q_n)) over the blocks where M or H(q_n) may be nonzero
+/* H += cm M + cd (alpha M + beta H(q_s)) over the blocks where M or H(q_s) may be nonzero
  * (elsewhere both are exact zeros, and so is what the dense sum would add). */
 static void add_dynamic_hessian(const sw_blob_view *v, const sw_solver *s, const sw_dyn_coef *dc,
                                 double *H) {
@@ -149,13 +150,14 @@ double sw_potential(sw_reduced *red, const sw_step_contacts *ct, const sw_solver
 }
 
 double sw_potential_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
-                          const sw_dyn_coef *dc, int *cubature_pass) {
+                          const sw_dyn_coef *dc, int want_hess, int *cubature_pass) {
     int32_t R = red->R;
-    int at_qn = s->mat_at_qn && !memcmp(s->q, s->qn, (size_t)R * sizeof(double));
-    s->mat_at_qn = 0;
-    *cubature_pass = !at_qn;
-    if (!at_qn) return sw_potential(red, ct, s, s->q, dc, 1, 1);
+    int at = s->mat_at_start && s->mat_hess == want_hess &&
+             !memcmp(s->q, s->q_mat, (size_t)R * sizeof(double));
+    s->mat_at_start = 0;
+    *cubature_pass = !at;
+    if (!at) return sw_potential(red, ct, s, s->q, dc, 1, want_hess);
     memcpy(red->H, s->Hn, (size_t)R * R * sizeof(double));
     memcpy(red->g, s->g_mat, (size_t)R * sizeof(double));
-    return sw_potential_rest(red, ct, s, s->q, dc, s->phi_mat, 1, 1);
+    return sw_potential_rest(red, ct, s, s->q, dc, s->phi_mat, 1, want_hess);
 }

@@ -19,17 +19,24 @@
 typedef struct sw_solver {
     double *q, *qn, *qdot; /* R each: the state, its value at step start, its velocity */
     double *fin;           /* R: inertial forces of the step (inertia.h) */
-    double *Hn;            /* R x R: the Hessian at q_n (Rayleigh stiffness damping) */
-    /* The material part of Phi at q_n (sw_potential_material: its value, gradient and, in
-     * Hn, Hessian), valid for the step's first evaluation when mat_at_qn: a dynamic step
-     * evaluates it for Hn, and Newton starts at q_n. */
-    double *g_mat, phi_mat;
-    int mat_at_qn;
+    /* R x R: the material Hessian at the dynamic step's start q_s, of kind mat_hess (the
+     * Hessian at q_s, or with rest_first the reference Hessian): the Rayleigh stiffness
+     * damping, frozen for the step (step.c, dynamic_start) */
+    double *Hn;
+    /* The material part of Phi at q_mat = q_s (sw_potential_material: its value, gradient
+     * and, in Hn, Hessian), valid for the step's first evaluation when mat_at_start: a
+     * dynamic step evaluates it for Hn, and Newton starts there. */
+    double *g_mat, phi_mat, *q_mat;
+    int mat_at_start;
+    int mat_hess; /* 1, or SW_CUB_HESSIAN_REF (rest_first) */
+    /* the step started elsewhere than q_n (a dynamic step's predicted start): when an
+       update finds no descent however short, Newton starts again from q_n (newton.c) */
+    int fallback_qn;
     double *L;           /* R x R: the block Cholesky factor */
     double *dq, *qtrial; /* R each: Newton update, the iterate before it */
-    /* R: the pose-space prediction the last quasistatic step started from (step.c,
-     * pose_space_start), valid while the steps since it moved the pose continuously
-     * and did not fail */
+    /* R: the pose-space prediction the last step started from (step.c, pose_space_start
+     * and dynamic_start), valid while the steps since it moved the pose continuously and
+     * did not fail */
     double *q_pred;
     int pred_valid;
     double *tmp, *tmp2; /* R each: scratch */
@@ -40,7 +47,7 @@ typedef struct sw_solver {
     unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
     int mass_blockdiag;  /* the blob's reduced mass is zero outside the domains' blocks */
     uint32_t max_newton; /* Newton updates a step at most */
-    int rest_first;      /* quasistatic steps start on the reference Hessian (red->h_ref) */
+    int rest_first;      /* steps start on the reference Hessian (red->h_ref) */
     double dq_tiny;      /* an update shorter than this converged (1e-9 of the size) */
 } sw_solver;
 
@@ -82,13 +89,14 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
                          const double *q, const sw_dyn_coef *dc, double phi, int want_grad,
                          int want_hess);
 
-/* Phi, g and H at the step's start s->q, as sw_potential: a dynamic step's material part at
- * q_n is already known (phase_dynamics evaluates it for the damping Hessian), so while s->q
- * is still q_n only the rest is added, without a second cubature pass at the same point
- * (*cubature_pass 0; it is used once a step). The second pass at q_n gave bitwise the
- * same part, so the saving changes no result. */
+/* Phi, g and H (of kind want_hess: 1, or SW_CUB_HESSIAN_REF) at the step's start s->q,
+ * as sw_potential: a dynamic step's material part at its start is already known
+ * (phase_dynamics evaluates it for the damping Hessian), so while s->q is still there and
+ * the kind is the one asked for, only the rest is added, without a second cubature pass at
+ * the same point (*cubature_pass 0; it is used once a step). The second pass gave bitwise
+ * the same part, so the saving changes no result. */
 double sw_potential_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
-                          const sw_dyn_coef *dc, int *cubature_pass);
+                          const sw_dyn_coef *dc, int want_hess, int *cubature_pass);
 
 /* The structural block pattern of H for this step: spring-coupled domains and the
  * domains the self-contact pairs in use join (no scan of H's values). */

@@ -123,7 +123,7 @@ typedef enum sinew_self_contact {
     SINEW_SELF_CONTACT_POSE_PAIRS = 2
 } sinew_self_contact;
 
-/** The Hessian a quasistatic step's Newton updates start on (sinew_instance_def). */
+/** The Hessian a step's Newton updates start on (sinew_instance_def). */
 typedef enum sinew_newton_hessian {
     /** the library chooses per blob at creation: the rest Hessian first where a
      * factorisation of the reduced Hessian costs less than 0.3 of the multiply-adds the
@@ -140,8 +140,8 @@ typedef enum sinew_newton_hessian {
      * the step to SINEW_NEWTON_HESSIAN_CURRENT's iteration, whose Hessian becomes the
      * reference. The stationary point is the same, so the shape at a pose depends on the
      * frames before only within the solve's tolerance (replays from a reset are bitwise
-     * the same); dynamic steps always use the current Hessian (their damping needs it
-     * anyway). Reserves the reference Hessian's domain blocks */
+     * the same). A dynamic step's Rayleigh stiffness damping then takes the reference
+     * Hessian at the step's start. Reserves the reference Hessian's domain blocks */
     SINEW_NEWTON_HESSIAN_REST_FIRST = 2
 } sinew_newton_hessian;
 
