@@ -19,7 +19,8 @@ json=$(tail -n 1 "$tmp/out")
 fails=0
 for k in err_dynamic err_dynamic_hold overshoot_sub overshoot_full overshoot_ratio \
     settle_sub settle_full err_dyn_increment dyn_increment_rms dyn_dt dyn_rayleigh_alpha \
-    dyn_rayleigh_beta dyn_full_ms dyn_sub_ms; do
+    dyn_rayleigh_beta dyn_full_ms dyn_sub_ms dyn_step_ms dyn_qs_step_ms dyn_vs_qs dyn_step_evals \
+    dyn_qs_step_evals err_dynamic_ref err_dynamic_ref_hold err_dynamic_tight; do
     val=$(printf '%s' "$json" | grep -oE "\"$k\":[^,}]*" | head -n 1 | cut -d: -f2)
     if ! printf '%s' "$val" | grep -qE '^-?[0-9]+(\.[0-9]+)?([eE][-+]?[0-9]+)?$'; then
         echo "FAIL: $k is '${val:-missing}', not a finite number" >&2

@@ -41,6 +41,7 @@ typedef struct sw_bench_ctx {
     long failed; /* the modes' failed steps */
     sw_world_bench wb;
     sw_dyn_bench db;
+    sw_dyn_cost dcost;
     sw_crowd_bench cb;
     sw_sc_bench scb;
     sw_newton_bench nwb;

@@ -9,8 +9,13 @@
 #include "blob_load.h"
 #include "clock.h"
 #include "instance.h"
+#include "replay.h"
 #include "subspace_eval.h"
 #include "tool_common.h"
+
+/* The reference's own spread (sw_dyn_bench.err_dynamic_ref): a second reference whose
+ * Newton and PCG tolerances are this many times tighter. */
+#define SW_DYN_SPREAD_TIGHTER 100.0
 
 /* The reference's lumped mass at each output vertex (sm), as the output places the
  * vertex: a boundary vertex's own, a render vertex's barycentric blend of its tet's
@@ -83,16 +88,21 @@ static double mass_total(const double *m, int32_t n) {
 
 typedef struct dyn_run {
     sw_fullsim *ref;
+    sw_fullsim *ref2; /* the reference solved to tolerances SW_DYN_SPREAD_TIGHTER tighter */
+    double *xdqs;     /* plain skinning of every vertex at the frame's pose */
+    double spread_num[2], spread_den[2]; /* its distance from the reference: clip, hold */
     sinew_instance *inst;
-    sw_eval_acc clip, hold;
-    sinew_instance *qs;      /* quasistatic runtime alongside, for the increment */
-    double *xd, *xq, *cnt;   /* its and the dynamic instance's full positions */
-    double inc_num, inc_den; /* the dynamic increment's sums */
+    sw_eval_acc clip, hold, clip_tight; /* the runtime against the reference; the tighter */
+    sinew_instance *qs;                 /* quasistatic runtime alongside, for the increment */
+    double *xd, *xq, *cnt;              /* its and the dynamic instance's full positions */
+    double inc_num, inc_den;            /* the dynamic increment's sums */
     double *full_ms, *sub_ms, *hs_full, *hs_sub, *sm; /* per step; hold surfaces; masses */
 } dyn_run;
 
 static void run_free(dyn_run *r) {
     sw_fullsim_destroy(r->ref);
+    sw_fullsim_destroy(r->ref2);
+    free(r->xdqs);
     sinew_instance_destroy(r->inst);
     sinew_instance_destroy(r->qs);
     free(r->xd);
@@ -100,6 +110,7 @@ static void run_free(dyn_run *r) {
     free(r->cnt);
     sw_eval_acc_free(&r->clip);
     sw_eval_acc_free(&r->hold);
+    sw_eval_acc_free(&r->clip_tight);
     free(r->full_ms);
     free(r->sub_ms);
     free(r->hs_full);
@@ -121,7 +132,14 @@ static sinew_result start_settled(const sw_character *ch, const sinew_blob *blob
         res = sw_fullsim_create(ch, fd, &r->ref, err);
     else
         sw_error_set(err, res, "the reference's quasistatic start failed");
-    if (res == SINEW_OK) sw_fullsim_set_state(r->ref, T0, sw_fullsim_positions(qs), NULL);
+    sw_fullsim_params ft = *fd; /* the spread's reference */
+    ft.newton_rtol /= SW_DYN_SPREAD_TIGHTER;
+    ft.pcg_rtol /= SW_DYN_SPREAD_TIGHTER;
+    if (res == SINEW_OK) res = sw_fullsim_create(ch, &ft, &r->ref2, err);
+    if (res == SINEW_OK) {
+        sw_fullsim_set_state(r->ref, T0, sw_fullsim_positions(qs), NULL);
+        sw_fullsim_set_state(r->ref2, T0, sw_fullsim_positions(qs), NULL);
+    }
     sw_fullsim_destroy(qs);
     if (res != SINEW_OK) return res;
 
@@ -154,6 +172,18 @@ static void add_increment(dyn_run *r, const double *mass, int32_t nv, const doub
         double df = xf[i] - xfq[i], e = r->xd[i] - r->xq[i] - df;
         r->inc_num += mass[i / 3] * e * e;
         r->inc_den += mass[i / 3] * df * df;
+    }
+}
+
+/* Adds a frame to the reference's spread (k 0: clip, 1: hold): the tighter reference's
+ * distance from the reference, over the reference's correction. */
+static void add_spread(dyn_run *r, const double *mass, int32_t nv, int k) {
+    const double *x = sw_fullsim_positions(r->ref), *y = sw_fullsim_positions(r->ref2);
+    sw_instance_dqs_positions(r->inst, r->xdqs);
+    for (int64_t i = 0; i < 3 * (int64_t)nv; ++i) {
+        double e = y[i] - x[i], b = x[i] - r->xdqs[i];
+        r->spread_num[k] += mass[i / 3] * e * e;
+        r->spread_den[k] += mass[i / 3] * b * b;
     }
 }
 
@@ -200,10 +230,16 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         goto done;
     }
     if ((res = sw_eval_acc_init(&r.clip, blob, mass, err)) != SINEW_OK ||
-        (res = sw_eval_acc_init(&r.hold, blob, mass, err)) != SINEW_OK)
+        (res = sw_eval_acc_init(&r.hold, blob, mass, err)) != SINEW_OK ||
+        (res = sw_eval_acc_init(&r.clip_tight, blob, mass, err)) != SINEW_OK)
         goto done;
     sw_eval_acc_add(&r.clip, r.inst, sw_fullsim_positions(r.ref)); /* frame 0, settled */
+    sw_eval_acc_add(&r.clip_tight, r.inst, sw_fullsim_positions(r.ref2));
     int32_t nv = ch->mesh.nverts;
+    if (!(r.xdqs = malloc((size_t)nv * 3 * sizeof(double)))) {
+        res = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
+        goto done;
+    }
     if (full_qs) {
         r.xd = malloc((size_t)nv * 3 * sizeof(double));
         r.xq = malloc((size_t)nv * 3 * sizeof(double));
@@ -222,6 +258,8 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         out->ref_unconverged += rr == SINEW_ERROR_NOT_CONVERGED;
         out->ref_unsettled += st.contacts_unsettled;
         r.full_ms[nstep] = 1e3 * st.seconds;
+        rr = sw_fullsim_step(r.ref2, T, NULL);
+        out->ref_failed += rr != SINEW_OK && rr != SINEW_ERROR_NOT_CONVERGED;
         double t0 = sw_now_seconds();
         sw_instance_set_pose_d(r.inst, T);
         sinew_result sr = sinew_instance_step(r.inst, h);
@@ -236,6 +274,9 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
         }
         const double *x = sw_fullsim_positions(r.ref);
         if (sr == SINEW_OK) sw_eval_acc_add(f < F ? &r.clip : &r.hold, r.inst, x);
+        if (sr == SINEW_OK && f < F)
+            sw_eval_acc_add(&r.clip_tight, r.inst, sw_fullsim_positions(r.ref2));
+        add_spread(&r, mass, nv, f >= F);
         if (r.qs && sr == SINEW_OK && sw_instance_set_pose_d(r.qs, T) == SINEW_OK &&
             sinew_instance_step(r.qs, h) == SINEW_OK)
             add_increment(&r, mass, nv, x, full_qs + (size_t)(f < F ? f : F - 1) * 3 * nv);
@@ -251,6 +292,11 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
     out->err_dynamic = e.correction_error;
     sw_eval_acc_result(&r.hold, &e);
     out->err_dynamic_hold = e.correction_error;
+    sw_eval_acc_result(&r.clip_tight, &e);
+    out->err_dynamic_tight = e.correction_error;
+    for (int k = 0; k < 2; ++k)
+        out->err_dynamic_ref[k] =
+            r.spread_den[k] > 0 ? sqrt(r.spread_num[k] / r.spread_den[k]) : NAN;
     overshoot(r.hs_sub, H, r.sm, ns, &out->overshoot_sub, &out->settle_sub);
     overshoot(r.hs_full, H, r.sm, ns, &out->overshoot_full, &out->settle_full);
     out->overshoot_ratio = out->overshoot_full > 0 ? out->overshoot_sub / out->overshoot_full : NAN;
@@ -264,4 +310,69 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
 done:
     run_free(&r);
     return res;
+}
+
+/* One mode's timing run (sw_dyn_bench_cost): each clip frame's least ms, and the counts
+ * of the first timed play. */
+typedef struct cost_run {
+    double *ms;
+    int pass;
+    double evals, factors;
+} cost_run;
+
+static void cost_step(void *user, int step, int f, double ms, const sinew_step_stats *st) {
+    (void)step;
+    cost_run *c = user;
+    c->ms[f] = c->pass == 0 ? ms : fmin(c->ms[f], ms);
+    if (c->pass > 0) return;
+    c->evals += st->potential_evals;
+    c->factors += st->factorizations;
+}
+
+sinew_result sw_dyn_bench_cost(const sinew_blob *blob, const sw_clip *clip, int frames, int passes,
+                               sw_dyn_cost *out, sw_error *err) {
+    memset(out, 0, sizeof *out);
+    float h = 1.0f / (float)(clip->fps > 0 ? clip->fps : 30);
+    sinew_instance *in[2] = {NULL, NULL};
+    cost_run c[2] = {{malloc((size_t)frames * sizeof(double)), 0, 0, 0},
+                     {malloc((size_t)frames * sizeof(double)), 0, 0, 0}};
+    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (!c[0].ms || !c[1].ms) {
+        sw_error_set(err, r, "out of memory");
+        goto done;
+    }
+    for (int k = 0; k < 2; ++k) {
+        sinew_instance_def def = sinew_instance_def_default();
+        def.mode = k ? SINEW_STEP_DYNAMIC : SINEW_STEP_QUASISTATIC;
+        if ((r = sinew_instance_create(blob, &def, &in[k])) != SINEW_OK) {
+            sw_error_set(err, r, "cannot create an instance");
+            goto done;
+        }
+    }
+    /* the two modes take turns, a play of the clip each, so that both see the same machine;
+       the first play of each settles, untimed */
+    for (int p = 0; p <= (passes > 0 ? passes : 1); ++p)
+        for (int k = 0; k < 2; ++k) {
+            sw_replay rp = sw_replay_clip(in[k], clip->T, frames, clip->nbones, h);
+            rp.warmup = p == 0 ? frames : 0;
+            rp.steps = p == 0 ? 0 : frames;
+            c[k].pass = p - 1;
+            rp.on_step = cost_step;
+            rp.user = &c[k];
+            sw_replay_run(&rp);
+            out->failed += rp.warmup_failed + rp.failed;
+        }
+    out->qs_ms = sw_median(c[0].ms, frames);
+    out->dyn_ms = sw_median(c[1].ms, frames);
+    out->qs_evals = c[0].evals / frames;
+    out->dyn_evals = c[1].evals / frames;
+    out->qs_factors = c[0].factors / frames;
+    out->dyn_factors = c[1].factors / frames;
+    r = SINEW_OK;
+done:
+    for (int k = 0; k < 2; ++k) {
+        sinew_instance_destroy(in[k]);
+        free(c[k].ms);
+    }
+    return r;
 }

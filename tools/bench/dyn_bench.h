@@ -19,6 +19,12 @@ typedef struct sw_dyn_bench {
     double dt, rayleigh_alpha, rayleigh_beta; /* what both runs used */
     double err_dynamic;                       /* correction error over the clip's frames */
     double err_dynamic_hold;                  /* the same over the hold frames */
+    /* the reference's own spread, by the same formula: a reference solved to Newton and PCG
+       tolerances 100 times tighter, from the same start, against the reference (over the
+       clip, over the hold): how well the reference's trajectory is defined, a floor under
+       err_dynamic that no runtime can go below */
+    double err_dynamic_ref[2];
+    double err_dynamic_tight; /* err_dynamic against that tighter reference */
     double overshoot_sub, overshoot_full, overshoot_ratio;
     /* the hold frame at which the surface first swings back through its rest at the held
        pose (interpolated; NaN: it never does), about a quarter of its period after the stop */
@@ -31,7 +37,7 @@ typedef struct sw_dyn_bench {
                                        error of the dynamics alone, without the subspace's static
                                        error (NaN without it) */
     double increment_rms;           /* |d_full|_M RMS a frame per unit mass: how dynamic it is */
-    double full_ms, sub_ms;         /* median ms a dynamic step */
+    double full_ms, sub_ms;         /* median ms a dynamic step, beside the reference's */
     int ref_failed, ref_unconverged, ref_unsettled, sub_failed;
     /* the runtime's steps with each status flag: the bounds limited the state, a pose
        jump, the energy guard, Newton converged */
@@ -44,5 +50,19 @@ typedef struct sw_dyn_bench {
 sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
                               const sw_fullsim_params *fp, int hold_frames, const double *full_qs,
                               sw_dyn_bench *out, sw_error *err);
+
+/* The cost of a dynamic step against a quasistatic one of the same blob, in the same run:
+ * two instances, one in each mode, take turns playing the clip's first `frames` poses (a
+ * first play each untimed, then `passes` timed); each mode's median over the frames of
+ * each frame's least ms (pose and step), and its cubature passes and factorisations a
+ * step over the first timed play. */
+typedef struct sw_dyn_cost {
+    double qs_ms, dyn_ms;
+    double qs_evals, dyn_evals, qs_factors, dyn_factors;
+    long failed; /* steps of either instance that did not return SINEW_OK */
+} sw_dyn_cost;
+
+sinew_result sw_dyn_bench_cost(const sinew_blob *blob, const sw_clip *clip, int frames, int passes,
+                               sw_dyn_cost *out, sw_error *err);
 
 #endif

@@ -77,10 +77,16 @@
  *                     embedding and m_s is its barycentric blend of masses); it counts
  *                     the lag the flesh still has when the skeleton stops and every swing
  *                     past the settled shape after it
+ *   err_dynamic_ref, err_dynamic_ref_hold  the reference's own spread: a reference solved
+ *                     to tolerances 100 times tighter against it, by the same formula;
+ *                     err_dynamic_tight, err_dynamic against that tighter reference
  *   overshoot_ratio   overshoot_sub / overshoot_full (target |ratio - 1| <= 0.2)
  *   settle_sub, settle_full  the same distance between hold frames H-2 and H-1: motion
  *                     left at the end (small against the overshoot: H was long enough)
- *   dyn_full_ms, dyn_sub_ms  median ms of a dynamic step; dyn_ref_failed,
+ *   dyn_step_ms, dyn_qs_step_ms, dyn_vs_qs  a dynamic and a quasistatic instance timed
+ *                     taking turns over the clip (sw_dyn_bench_cost), and their ratio;
+ *                     dyn_step_evals, dyn_qs_step_evals their cubature passes a step
+ *   dyn_full_ms, dyn_sub_ms  median ms of a dynamic step beside the reference's; dyn_ref_failed,
  *                     dyn_ref_unconverged, dyn_ref_unsettled, dyn_sub_failed
  *   dyn_sub_limited, dyn_sub_teleport, dyn_sub_guard, dyn_sub_converged  the runtime's
  *                     dynamic steps with each SINEW_STEP_* flag (of frames + hold - 1)
