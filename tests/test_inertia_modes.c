@@ -1,15 +1,18 @@
 /* Inertia modes (sw_bake_params.inertia_modes, bake_basis.c): each domain's basis gains
- * the static responses of the rest shape to the bones' rigid accelerations. Checked on a
- * 1,000-tet finger baked with and without them:
- *  - the basis stays orthonormal per domain, bone-driven rows stay zero, the rank grows
- *    by at most max_rank a domain;
+ * the lowest vibration modes in the span of the static responses of the rest shape to the
+ * bones' rigid accelerations. Checked on a 1,000-tet finger baked with and without them:
+ *  - the basis stays orthonormal per domain, bone-driven rows stay zero, and a domain's
+ *    rank grows by at most the Ritz modes' count (SW_INERTIA_RITZ_PER_DOMAIN a domain:
+ *    the responses themselves, 6 a domain, added 40 here);
  *  - the claim itself: after the clip stops, the dynamic runtime's overshoot is the
  *    reference's backward Euler's within 20% with them, and the correction error over
  *    the hold falls (without them the runtime overshoots far too little: measured
  *    below);
  *  - the quasistatic training error stays that of a usable bake.
- * Measured (Release, 2 threads): rank 17 -> 57; overshoot ratio 0.679 -> 0.994; hold
- * error 0.417 -> 0.083; clip error 0.029 -> 0.045; training error 0.021 -> 0.033. */
+ * Measured (Release, 2 threads): rank 17 -> 37; overshoot ratio 0.670 -> 0.935; hold
+ * error 0.423 -> 0.235 (0.073 with every response, rank 57: the hold's phase wants the
+ * higher modes too, docs/notes/jiggle.md); clip error 0.026 -> 0.031; training error
+ * 0.0070 -> 0.0059. Broken on purpose: every response kept fails the rank bound. */
 #include <math.h>
 #include <stdint.h>
 
@@ -80,10 +83,12 @@ TEST(inertia_modes_give_the_reference_overshoot) {
     ENSURE(run(1, &with));
     const sw_blob_view *a = &without.f.res.view, *b = &with.f.res.view;
     ENSURE(a->ndomains == b->ndomains);
+    const int32_t ritz = SW_INERTIA_RITZ_PER_DOMAIN * a->ndomains;
     for (int32_t d = 0; d < a->ndomains; ++d)
         ENSUREF(b->domains[d].rank >= a->domains[d].rank &&
-                    b->domains[d].rank <= a->domains[d].rank + sw_bake_params_default().max_rank,
-                "domain %d: rank %d without, %d with", d, a->domains[d].rank, b->domains[d].rank);
+                    b->domains[d].rank <= a->domains[d].rank + ritz,
+                "domain %d: rank %d without, %d with (%d Ritz modes)", d, a->domains[d].rank,
+                b->domains[d].rank, ritz);
     ENSUREF(b->rank_total > a->rank_total, "no mode added (rank %d)", b->rank_total);
     int driven_ok;
     double defect = basis_defect(b, &with.f.ch, &driven_ok);
@@ -96,7 +101,7 @@ TEST(inertia_modes_give_the_reference_overshoot) {
             "overshoot ratio %.3f without: the test proves "
             "nothing",
             without.dyn.overshoot_ratio);
-    ENSUREF(with.dyn.err_dynamic_hold < 0.6 * without.dyn.err_dynamic_hold,
+    ENSUREF(with.dyn.err_dynamic_hold < 0.8 * without.dyn.err_dynamic_hold,
             "hold error %.3f with, %.3f without", with.dyn.err_dynamic_hold,
             without.dyn.err_dynamic_hold);
     ENSUREF(with.err_train < 0.08, "training error %.4f with inertia modes", with.err_train);

@@ -236,14 +236,61 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * (own loads only: 0.69 of the reference's overshoot; all: 1.04). A restriction joins
  * the basis as far as it lies outside it by SW_INERTIA_MODE_TOL of its response's whole
  * norm (a far domain's sliver of a response is no mode of its own), largest first, at
- * most max_rank of them a domain. */
+ * most max_rank of them a domain.
+ *
+ * The 6 nd responses are first reduced to the SW_INERTIA_RITZ_PER_DOMAIN nd lowest
+ * vibration modes in their span (a Rayleigh-Ritz step: K and M projected on the
+ * responses, u_i^T K u_j = u_i^T f_j needing no K, and the small generalised eigenproblem
+ * solved): the flesh's free motion after the skeleton stops is dominated by its lowest
+ * modes, and the higher combinations of the responses, which every domain took as well,
+ * cost rank without holding that motion (docs/notes/jiggle.md, Inertia Ritz modes). */
 #define SW_INERTIA_MODE_TOL 0.05
 
-/* The static responses of the rest shape to nl loads F (3 nverts each), every domain
- * taking the restriction of every response as far as it lies outside its basis by `tol`
- * of the response's whole norm, largest first, at most max_rank of them a domain. */
+/* The ritz lowest vibration modes in the span of the nl responses U (n3 each) to the loads
+ * F, written over U's first ritz rows, mass-weighted by the vertices' masses m: the
+ * generalised eigenproblem (U F^T) c = w^2 (U M U^T) c. Returns 0 when it has no solution
+ * (responses dependent to rounding: U is left as it was), -1 out of memory, else 1. */
+static int ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
+                      int32_t ritz) {
+    double *A = malloc((size_t)nl * nl * sizeof(double)),
+           *B = malloc((size_t)nl * nl * sizeof(double)), *w = malloc((size_t)nl * sizeof(double)),
+           *Y = calloc((size_t)ritz * n3, sizeof(double));
+    int ok = -1;
+    if (!A || !B || !w || !Y) goto done;
+    for (int32_t i = 0; i < nl; ++i)
+        for (int32_t j = 0; j <= i; ++j) {
+            const double *ui = U + (size_t)i * n3, *uj = U + (size_t)j * n3;
+            const double *fi = F + (size_t)i * n3, *fj = F + (size_t)j * n3;
+            double a = 0, b = 0;
+            for (int64_t t = 0; t < n3; ++t) {
+                a += ui[t] * fj[t] + uj[t] * fi[t];
+                b += ui[t] * m[t / 3] * uj[t];
+            }
+            A[i * nl + j] = A[j * nl + i] = 0.5 * a; /* K symmetric: the two agree to rounding */
+            B[i * nl + j] = B[j * nl + i] = b;
+        }
+    ok = 0;
+    if (LAPACKE_dsygv(LAPACK_ROW_MAJOR, 1, 'V', 'L', nl, A, nl, B, nl, w) != 0) goto done;
+    for (int32_t k = 0; k < ritz; ++k) /* eigenvalues ascending; column k its vector */
+        for (int32_t i = 0; i < nl; ++i) {
+            double c = A[i * nl + k];
+            const double *ui = U + (size_t)i * n3;
+            for (int64_t t = 0; t < n3; ++t)
+                Y[(size_t)k * n3 + t] += c * ui[t];
+        }
+    memcpy(U, Y, (size_t)ritz * n3 * sizeof(double));
+    ok = 1;
+done:
+    free(A), free(B), free(w), free(Y);
+    return ok;
+}
+
+/* The static responses of the rest shape to nl loads F (3 nverts each), reduced to the
+ * `ritz` lowest vibration modes in their span when 0 < ritz < nl (ritz_modes), every
+ * domain taking the restriction of every response (or mode) as far as it lies outside its
+ * basis by `tol` of its whole norm, largest first, at most max_rank of them a domain. */
 static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F, double tol,
-                                  sw_error *err) {
+                                  int32_t ritz, sw_error *err) {
     int64_t n3 = 3 * (int64_t)s->rig.nv;
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.self_contact = 0;
@@ -258,6 +305,11 @@ static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F,
         (r = sw_fullsim_rest_response(sim, nl, F, Uf, err)) != SINEW_OK)
         goto done;
     r = SINEW_ERROR_OUT_OF_MEMORY;
+    if (ritz > 0 && ritz < nl) {
+        int got = ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz);
+        if (got < 0) goto done;
+        if (got > 0) nl = ritz; /* else the responses themselves, as without it */
+    }
     if (!(gnorm = malloc((size_t)nl * sizeof(double)))) goto done;
     for (int32_t j = 0; j < nl; ++j) {
         double g = 0;
@@ -324,7 +376,8 @@ static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
             }
         }
     }
-    sinew_result r = add_responses(s, nl, F, SW_INERTIA_MODE_TOL, err);
+    sinew_result r =
+        add_responses(s, nl, F, SW_INERTIA_MODE_TOL, SW_INERTIA_RITZ_PER_DOMAIN * nd, err);
     free(F);
     return r;
 }
@@ -382,7 +435,7 @@ static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
     for (int32_t j = 0; j < nl; ++j) /* P is n3 x nl, row-major: load j is its column */
         for (int64_t e = 0; e < n3; ++e)
             F[(size_t)j * n3 + e] = P[e * nl + j];
-    r = nl > 0 ? add_responses(s, nl, F, SW_CONTACT_MODE_TOL, err) : SINEW_OK;
+    r = nl > 0 ? add_responses(s, nl, F, SW_CONTACT_MODE_TOL, 0, err) : SINEW_OK;
 done:
     if (r == SINEW_ERROR_OUT_OF_MEMORY) sw_error_set(err, r, "out of memory for contact modes");
     free(L);

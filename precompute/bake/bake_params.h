@@ -20,6 +20,10 @@
 #define SW_SPRING_CHOICES 4
 double sw_bake_spring_mult(int i);
 
+/* Inertia modes (sw_bake_params.inertia_modes): the static responses to the domains' six
+ * rigid accelerations are reduced to this many vibration modes a domain (bake_basis.c). */
+#define SW_INERTIA_RITZ_PER_DOMAIN 3
+
 typedef struct sw_bake_params {
     int32_t max_rank;              /* per domain (default 30) */
     double fold_share;             /* a bone whose tets hold less than this share of the
@@ -64,8 +68,10 @@ typedef struct sw_bake_params {
                                       to this tolerance (default 0.05; 0: every pair kept at
                                       weight 1) */
     int inertia_modes;             /* for the dynamic step: basis modes for the inertia of the
-                                      bones' accelerations and the cubature trained on them
-                                      (bake_basis.c; default 0: they more than double the
+                                      bones' accelerations, the lowest vibration modes of
+                                      their static responses (SW_INERTIA_RITZ_PER_DOMAIN a
+                                      domain), and the cubature trained on them
+                                      (bake_basis.c; default 0: they add about half the
                                       rank) */
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
     int ship_split;                /* the blob a tool ships from a character's own clip split
