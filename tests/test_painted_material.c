@@ -149,7 +149,7 @@ TEST(the_painted_finger_swings_back_later_as_the_reference_does) {
     ENSURE(sw_dyn_bench_run(&soft.ch, soft.blob, &fp, 30, NULL, &ds, &err) == SINEW_OK);
     fprintf(stderr,
             "  first swing back after the stop (hold frames): reference %.2f -> %.2f painted, "
-            "runtime %.2f -> %.2f; overshoot ratio %.3f -> %.3f\n",
+            "runtime %.4f -> %.4f; overshoot ratio %.3f -> %.3f\n",
             dp.swing_full, ds.swing_full, dp.swing_sub, ds.swing_sub, dp.overshoot_ratio,
             ds.overshoot_ratio);
     ENSURE(dp.sub_failed == 0 && ds.sub_failed == 0 && dp.ref_failed == 0 && ds.ref_failed == 0);

@@ -246,17 +246,26 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * cost rank without holding that motion (docs/notes/jiggle.md, Inertia Ritz modes). */
 #define SW_INERTIA_MODE_TOL 0.05
 
+/* Directions of the responses' mass matrix below this share of its largest eigenvalue are
+ * no part of their span: responses dependent to rounding, or the zero response to a
+ * domain whose vertices all ride bones. */
+#define SW_RITZ_DEPENDENT 1e-12
+
 /* The ritz lowest vibration modes in the span of the nl responses U (n3 each) to the loads
- * F, written over U's first ritz rows, mass-weighted by the vertices' masses m: the
- * generalised eigenproblem (U F^T) c = w^2 (U M U^T) c. Returns 0 when it has no solution
- * (responses dependent to rounding: U is left as it was), -1 out of memory, else 1. */
-static int ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
-                      int32_t ritz) {
+ * F, written over U's first rows, mass-weighted by the vertices' masses m: with
+ * B = U M U^T = V diag(l) V^T and W = V diag(l^-1/2) over its independent directions, the
+ * eigenvectors z of W^T (U F^T) W (u_i^T K u_j = u_i^T f_j), lowest first, give the modes
+ * (W z)^T U. Returns how many were written (fewer than ritz when the span is smaller), 0
+ * when the responses span nothing, -1 out of memory. */
+static int32_t ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
+                          int32_t ritz) {
     double *A = malloc((size_t)nl * nl * sizeof(double)),
-           *B = malloc((size_t)nl * nl * sizeof(double)), *w = malloc((size_t)nl * sizeof(double)),
+           *B = malloc((size_t)nl * nl * sizeof(double)),
+           *W = malloc((size_t)nl * nl * sizeof(double)),
+           *P = malloc((size_t)nl * nl * sizeof(double)), *l = malloc((size_t)nl * sizeof(double)),
            *Y = calloc((size_t)ritz * n3, sizeof(double));
-    int ok = -1;
-    if (!A || !B || !w || !Y) goto done;
+    int32_t got = -1;
+    if (!A || !B || !W || !P || !l || !Y) goto done;
     for (int32_t i = 0; i < nl; ++i)
         for (int32_t j = 0; j <= i; ++j) {
             const double *ui = U + (size_t)i * n3, *uj = U + (size_t)j * n3;
@@ -269,20 +278,41 @@ static int ritz_modes(double *U, const double *F, const double *m, int32_t nl, i
             A[i * nl + j] = A[j * nl + i] = 0.5 * a; /* K symmetric: the two agree to rounding */
             B[i * nl + j] = B[j * nl + i] = b;
         }
-    ok = 0;
-    if (LAPACKE_dsygv(LAPACK_ROW_MAJOR, 1, 'V', 'L', nl, A, nl, B, nl, w) != 0) goto done;
-    for (int32_t k = 0; k < ritz; ++k) /* eigenvalues ascending; column k its vector */
+    got = 0;
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', nl, B, nl, l) != 0 || !(l[nl - 1] > 0)) goto done;
+    int32_t kept = 0; /* W: nl x kept, row-major */
+    for (int32_t c = 0; c < nl; ++c)
+        if (l[c] > SW_RITZ_DEPENDENT * l[nl - 1]) {
+            for (int32_t i = 0; i < nl; ++i)
+                W[i * nl + kept] = B[i * nl + c] / sqrt(l[c]);
+            ++kept;
+        }
+    for (int32_t a = 0; a < kept; ++a) /* P = W^T A W, kept x kept */
+        for (int32_t b = 0; b <= a; ++b) {
+            double acc = 0;
+            for (int32_t i = 0; i < nl; ++i) {
+                double ai = 0;
+                for (int32_t j = 0; j < nl; ++j)
+                    ai += A[i * nl + j] * W[j * nl + b];
+                acc += W[i * nl + a] * ai;
+            }
+            P[a * kept + b] = P[b * kept + a] = acc;
+        }
+    if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', kept, P, kept, l) != 0) goto done;
+    got = ritz < kept ? ritz : kept;
+    for (int32_t k = 0; k < got; ++k) /* eigenvalues ascending; column k of P its vector */
         for (int32_t i = 0; i < nl; ++i) {
-            double c = A[i * nl + k];
+            double c = 0;
+            for (int32_t a = 0; a < kept; ++a)
+                c += W[i * nl + a] * P[a * kept + k];
             const double *ui = U + (size_t)i * n3;
             for (int64_t t = 0; t < n3; ++t)
                 Y[(size_t)k * n3 + t] += c * ui[t];
         }
-    memcpy(U, Y, (size_t)ritz * n3 * sizeof(double));
-    ok = 1;
+    memcpy(U, Y, (size_t)got * n3 * sizeof(double));
 done:
-    free(A), free(B), free(w), free(Y);
-    return ok;
+    free(A), free(B), free(W), free(P), free(l), free(Y);
+    return got;
 }
 
 /* The static responses of the rest shape to nl loads F (3 nverts each), reduced to the
@@ -306,9 +336,13 @@ static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F,
         goto done;
     r = SINEW_ERROR_OUT_OF_MEMORY;
     if (ritz > 0 && ritz < nl) {
-        int got = ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz);
+        int32_t got = ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz);
         if (got < 0) goto done;
-        if (got > 0) nl = ritz; /* else the responses themselves, as without it */
+        nl = got;
+        if (nl == 0) { /* the responses span nothing: no mode joins */
+            r = SINEW_OK;
+            goto done;
+        }
     }
     if (!(gnorm = malloc((size_t)nl * sizeof(double)))) goto done;
     for (int32_t j = 0; j < nl; ++j) {
