@@ -251,14 +251,9 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * domain whose vertices all ride bones. */
 #define SW_RITZ_DEPENDENT 1e-12
 
-/* The ritz lowest vibration modes in the span of the nl responses U (n3 each) to the loads
- * F, written over U's first rows, mass-weighted by the vertices' masses m: with
- * B = U M U^T = V diag(l) V^T and W = V diag(l^-1/2) over its independent directions, the
- * eigenvectors z of W^T (U F^T) W (u_i^T K u_j = u_i^T f_j), lowest first, give the modes
- * (W z)^T U. Returns how many were written (fewer than ritz when the span is smaller), 0
- * when the responses span nothing, -1 out of memory. */
-static int32_t ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
-                          int32_t ritz) {
+/* sw_bake_ritz_modes (bake_state.h). */
+int32_t sw_bake_ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
+                           int32_t ritz) {
     double *A = malloc((size_t)nl * nl * sizeof(double)),
            *B = malloc((size_t)nl * nl * sizeof(double)),
            *W = malloc((size_t)nl * nl * sizeof(double)),
@@ -316,7 +311,7 @@ done:
 }
 
 /* The static responses of the rest shape to nl loads F (3 nverts each), reduced to the
- * `ritz` lowest vibration modes in their span when 0 < ritz < nl (ritz_modes), every
+ * `ritz` lowest vibration modes in their span when 0 < ritz < nl (sw_bake_ritz_modes), every
  * domain taking the restriction of every response (or mode) as far as it lies outside its
  * basis by `tol` of its whole norm, largest first, at most max_rank of them a domain. */
 static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F, double tol,
@@ -336,7 +331,7 @@ static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F,
         goto done;
     r = SINEW_ERROR_OUT_OF_MEMORY;
     if (ritz > 0 && ritz < nl) {
-        int32_t got = ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz);
+        int32_t got = sw_bake_ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz);
         if (got < 0) goto done;
         nl = got;
         if (nl == 0) { /* the responses span nothing: no mode joins */

@@ -184,6 +184,16 @@ void sw_bake_unskin(const sw_bake_state *s, const double *T, const double *x, do
  * (sw_bake_params.pca_strain) and the Galerkin errors (bake_galerkin.c) take them. */
 int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A, int32_t na,
                             const double *B, int32_t nb, double *G);
+/* The ritz lowest vibration modes in the span of nl static responses U (n3 doubles each,
+ * U = K^-1 F with K the rest stiffness, driven vertices held) to the loads F, mass-weighted
+ * by the vertices' lumped masses m (n3 / 3): a Rayleigh-Ritz step, written over U's first
+ * rows, lowest first. With B = U M U^T = V diag(l) V^T and W = V diag(l^-1/2) over B's
+ * independent directions (l above SW_RITZ_DEPENDENT of the largest), the modes are
+ * (W z)^T U for the eigenvectors z of W^T (U F^T) W (u_i^T K u_j = u_i^T f_j: no K needed).
+ * Returns how many were written (fewer than ritz when the span is smaller), 0 when the
+ * responses span nothing, -1 out of memory. The inertia modes take them (bake_basis.c). */
+int32_t sw_bake_ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
+                           int32_t ritz);
 /* The pairs stage's cubature of one (pose, group): weights w (n) >= 0 for the columns of A
  * (m x n, column-major: each pair's reduced contact force) with |A w - A 1| <= tol |A 1|,
  * by the cubature trainer's greedy selector (cubature_train.h); a zero column keeps
