@@ -1,8 +1,8 @@
 #!/usr/bin/env bash
 # sinew-bench --dynamic on a tiny finger ("Dynamics measured, not assumed"):
 # the run finishes and its JSON line carries every dynamic figure as a finite number
-# (err_dyn_increment may be null only without the reference's quasistatic clip, which
-# this run has). No thresholds: the figures themselves are measured at full size; and
+# (err_dyn_increment, dyn_increment_ratio and dyn_increment_cos may be null only without
+# the reference's quasistatic clip, which this run has). No thresholds: the figures themselves are measured at full size; and
 # --hold-frames without --dynamic is refused.
 #   bash tests/bench_dynamic.sh BUILD_DIR
 set -uo pipefail
@@ -18,7 +18,8 @@ fi
 json=$(tail -n 1 "$tmp/out")
 fails=0
 for k in err_dynamic err_dynamic_hold overshoot_sub overshoot_full overshoot_ratio \
-    settle_sub settle_full err_dyn_increment dyn_increment_rms dyn_dt dyn_rayleigh_alpha \
+    settle_sub settle_full err_dyn_increment dyn_increment_rms dyn_increment_ratio \
+    dyn_increment_cos dyn_dt dyn_rayleigh_alpha \
     dyn_rayleigh_beta dyn_full_ms dyn_sub_ms dyn_step_ms dyn_qs_step_ms dyn_vs_qs dyn_step_evals \
     dyn_qs_step_evals err_dynamic_ref err_dynamic_ref_hold err_dynamic_tight; do
     val=$(printf '%s' "$json" | grep -oE "\"$k\":[^,}]*" | head -n 1 | cut -d: -f2)

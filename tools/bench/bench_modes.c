@@ -241,12 +241,13 @@ static sinew_result dyn_run(sw_bench_ctx *c, sw_error *err) {
             "sinew-bench: dynamic (dt %g, Rayleigh %g %g, %d + %d hold frames): err_dynamic "
             "%.4f (hold %.4f; the reference's own spread %.4f, hold %.4f; against the tighter "
             "reference %.4f); overshoot sub %.5g full %.5g ratio %.3f; settle sub %.3g "
-            "full %.3g; dynamic increment error %.4f (rms %.3g); %.2f / %.3f ms a step\n",
+            "full %.3g; dynamic increment error %.4f (rms %.3g; the runtime's %.3g of it, "
+            "cosine %.3f); %.2f / %.3f ms a step\n",
             db->dt, db->rayleigh_alpha, db->rayleigh_beta, db->frames, db->hold_frames,
             db->err_dynamic, db->err_dynamic_hold, db->err_dynamic_ref[0], db->err_dynamic_ref[1],
             db->err_dynamic_tight, db->overshoot_sub, db->overshoot_full, db->overshoot_ratio,
-            db->settle_sub, db->settle_full, db->err_increment, db->increment_rms, db->full_ms,
-            db->sub_ms);
+            db->settle_sub, db->settle_full, db->err_increment, db->increment_rms,
+            db->increment_ratio, db->increment_cos, db->full_ms, db->sub_ms);
     fprintf(stderr,
             "sinew-bench: dynamic step %.4f ms (%.2f cubature passes, %.2f factorisations) "
             "against quasistatic %.4f ms (%.2f, %.2f), timed in turns: %.2fx\n",
@@ -261,6 +262,10 @@ static void dyn_json(const sw_bench_ctx *c) {
     if (isfinite(db->overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db->overshoot_ratio);
     char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */
     if (isfinite(db->err_increment)) snprintf(inc, sizeof inc, "%.5f", db->err_increment);
+    char inc_ratio[32] = "null", inc_cos[32] = "null"; /* likewise */
+    if (isfinite(db->increment_ratio))
+        snprintf(inc_ratio, sizeof inc_ratio, "%.5f", db->increment_ratio);
+    if (isfinite(db->increment_cos)) snprintf(inc_cos, sizeof inc_cos, "%.5f", db->increment_cos);
     printf(",\"dyn_dt\":%.9g,\"dyn_rayleigh_alpha\":%g,\"dyn_rayleigh_beta\":%g,"
            "\"hold_frames\":%d,\"err_dynamic\":%.5f,\"err_dynamic_hold\":%.5f,"
            "\"err_dynamic_ref\":%.5f,\"err_dynamic_ref_hold\":%.5f,\"err_dynamic_tight\":%.5f,"
@@ -268,6 +273,7 @@ static void dyn_json(const sw_bench_ctx *c) {
            "\"settle_sub\":%.6g,\"settle_full\":%.6g,\"dyn_full_ms\":%.3f,"
            "\"dyn_sub_ms\":%.4f,\"dyn_ref_failed\":%d,\"dyn_ref_unconverged\":%d,"
            "\"dyn_ref_unsettled\":%d,\"dyn_sub_failed\":%d,\"err_dyn_increment\":%s,"
+           "\"dyn_increment_ratio\":%s,\"dyn_increment_cos\":%s,"
            "\"dyn_increment_rms\":%.6g,\"dyn_sub_limited\":%d,\"dyn_sub_teleport\":%d,"
            "\"dyn_sub_guard\":%d,\"dyn_sub_converged\":%d,\"dyn_step_ms\":%.4f,"
            "\"dyn_qs_step_ms\":%.4f,\"dyn_vs_qs\":%.3f,\"dyn_step_evals\":%.3f,"
@@ -276,9 +282,9 @@ static void dyn_json(const sw_bench_ctx *c) {
            db->err_dynamic_hold, db->err_dynamic_ref[0], db->err_dynamic_ref[1],
            db->err_dynamic_tight, db->overshoot_sub, db->overshoot_full, ratio, db->settle_sub,
            db->settle_full, db->full_ms, db->sub_ms, db->ref_failed, db->ref_unconverged,
-           db->ref_unsettled, db->sub_failed, inc, db->increment_rms, db->sub_limited,
-           db->sub_teleport, db->sub_guard, db->sub_converged, c->dcost.dyn_ms, c->dcost.qs_ms,
-           c->dcost.dyn_ms / c->dcost.qs_ms, c->dcost.dyn_evals, c->dcost.qs_evals);
+           db->ref_unsettled, db->sub_failed, inc, inc_ratio, inc_cos, db->increment_rms,
+           db->sub_limited, db->sub_teleport, db->sub_guard, db->sub_converged, c->dcost.dyn_ms,
+           c->dcost.qs_ms, c->dcost.dyn_ms / c->dcost.qs_ms, c->dcost.dyn_evals, c->dcost.qs_evals);
 }
 
 /* ---- --lod: every level of detail ---- */

@@ -95,7 +95,8 @@ typedef struct dyn_run {
     sw_eval_acc clip, hold, clip_tight; /* the runtime against the reference; the tighter */
     sinew_instance *qs;                 /* quasistatic runtime alongside, for the increment */
     double *xd, *xq, *cnt;              /* its and the dynamic instance's full positions */
-    double inc_num, inc_den;            /* the dynamic increment's sums */
+    double inc_num, inc_den;            /* the dynamic increment's sums: error, reference */
+    double inc_sub, inc_dot;            /* the runtime's, and its product with the reference's */
     double *full_ms, *sub_ms, *hs_full, *hs_sub, *sm; /* per step; hold surfaces; masses */
 } dyn_run;
 
@@ -169,9 +170,11 @@ static void add_increment(dyn_run *r, const double *mass, int32_t nv, const doub
     sw_instance_full_positions(r->inst, r->xd, r->cnt);
     sw_instance_full_positions(r->qs, r->xq, r->cnt);
     for (int64_t i = 0; i < 3 * (int64_t)nv; ++i) {
-        double df = xf[i] - xfq[i], e = r->xd[i] - r->xq[i] - df;
+        double df = xf[i] - xfq[i], ds = r->xd[i] - r->xq[i], e = ds - df;
         r->inc_num += mass[i / 3] * e * e;
         r->inc_den += mass[i / 3] * df * df;
+        r->inc_sub += mass[i / 3] * ds * ds;
+        r->inc_dot += mass[i / 3] * ds * df;
     }
 }
 
@@ -303,6 +306,9 @@ sinew_result sw_dyn_bench_run(const sw_character *ch, const sinew_blob *blob,
     out->swing_sub = first_crossing(r.hs_sub, H, r.sm, ns);
     out->swing_full = first_crossing(r.hs_full, H, r.sm, ns);
     out->err_increment = r.inc_den > 0 ? sqrt(r.inc_num / r.inc_den) : NAN;
+    out->increment_ratio = r.inc_den > 0 ? sqrt(r.inc_sub / r.inc_den) : NAN;
+    out->increment_cos =
+        r.inc_den > 0 && r.inc_sub > 0 ? r.inc_dot / sqrt(r.inc_sub * r.inc_den) : NAN;
     out->increment_rms = sqrt(r.inc_den / (N - 1) / mass_total(mass, nv));
     out->full_ms = sw_median(r.full_ms, nstep);
     out->sub_ms = sw_median(r.sub_ms, nstep);

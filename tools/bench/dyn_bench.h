@@ -37,7 +37,11 @@ typedef struct sw_dyn_bench {
                                        error of the dynamics alone, without the subspace's static
                                        error (NaN without it) */
     double increment_rms;           /* |d_full|_M RMS a frame per unit mass: how dynamic it is */
-    double full_ms, sub_ms;         /* median ms a dynamic step, beside the reference's */
+    /* |d_sub|_M / |d_full|_M and the cosine between them (M inner product, NaN without the
+       quasistatic clip): how much of the reference's dynamics the runtime makes, and whether
+       in its direction (err_increment mixes the two) */
+    double increment_ratio, increment_cos;
+    double full_ms, sub_ms; /* median ms a dynamic step, beside the reference's */
     int ref_failed, ref_unconverged, ref_unsettled, sub_failed;
     /* the runtime's steps with each status flag: the bounds limited the state, a pose
        jump, the energy guard, Newton converged */
