@@ -243,7 +243,8 @@ TEST(inertia_ritz_modes_are_the_lowest_vibration_modes_of_the_responses_span) {
         for (int t = 0; t < N3; ++t)
             U[l * N3 + t] = Ut[t * NL + l];
     memcpy(Y, U, sizeof U);
-    ENSURE(sw_bake_ritz_modes(Y, F, m, NL, N3, RITZ) == RITZ);
+    double got_lambda[RITZ];
+    ENSURE(sw_bake_ritz_modes(Y, F, m, NL, N3, RITZ, got_lambda) == RITZ);
 
     /* the expected: Q, an M-orthonormal basis of the independent responses (Gram-Schmidt),
        then the eigenvalues of Q^T K Q */
@@ -283,6 +284,7 @@ TEST(inertia_ritz_modes_are_the_lowest_vibration_modes_of_the_responses_span) {
                 yky += y[i] * K[i * N3 + j] * y[j];
         }
         worst_q = fmax(worst_q, fabs(yky / ymy - lam[k]) / lam[k]);
+        worst_q = fmax(worst_q, fabs(got_lambda[k] - lam[k]) / lam[k]);
         memcpy(r, y, sizeof r); /* y minus its M-projection on the span */
         for (int a = 0; a < NI; ++a) {
             double d = 0;
@@ -312,11 +314,33 @@ TEST(inertia_ritz_modes_are_the_lowest_vibration_modes_of_the_responses_span) {
     double Z[2 * N3], FZ[2 * N3];
     memset(Z, 0, sizeof Z);
     memset(FZ, 0, sizeof FZ);
-    ENSURE(sw_bake_ritz_modes(Z, FZ, m, 2, N3, 1) == 0);
+    ENSURE(sw_bake_ritz_modes(Z, FZ, m, 2, N3, 1, NULL) == 0);
+}
+
+/* Which vibration modes swing at a time step (sw_bake_ritz_swinging): the leading modes up
+ * to omega h = SW_INERTIA_MAX_OMEGA_H and up to SW_INERTIA_OMEGA_SPREAD times the lowest
+ * frequency, whichever stops first; frequencies as the hand's, the Fox's and the
+ * elephant's spectra put them (docs/notes/jiggle.md, Modes that swing). */
+TEST(only_the_modes_that_swing_at_the_time_step_join) {
+    const double h = 1.0 / 30, w = SW_INERTIA_MAX_OMEGA_H / h, s = SW_INERTIA_OMEGA_SPREAD;
+    double stiff[3] = {1.5 * w * w, 2 * w * w, 4 * w * w}; /* all past omega h: none */
+    ENSURE(sw_bake_ritz_swinging(stiff, 3, h) == 0);
+    double fox[4] = {0.2 * w * w, 0.9 * w * w, 1.01 * w * w, 0.5 * w * w}; /* the third stops it */
+    ENSURE(sw_bake_ritz_swinging(fox, 4, h) == 2);
+    double l0 = 1e-4 * w * w; /* soft: the spread stops it, far below omega h */
+    double soft[4] = {l0, 4 * l0, 0.99 * s * s * l0, 1.01 * s * s * l0};
+    ENSURE(sw_bake_ritz_swinging(soft, 4, h) == 3);
+    ENSURE(sw_bake_ritz_swinging(soft, 2, h) == 2);
+    ENSURE(sw_bake_ritz_swinging(soft, 0, h) == 0);
+    /* the same spectrum at 10 times the step: omega h now stops it after the first */
+    ENSURE(sw_bake_ritz_swinging(fox, 4, 10 * h) == 0);
+    double mid[2] = {0.2 * w * w / 100, 1.5 * w * w / 100};
+    ENSURE(sw_bake_ritz_swinging(mid, 2, 10 * h) == 1);
 }
 
 SW_TEST_MAIN(CASE(strain_gram_is_the_rest_stiffness_of_the_domain),
              CASE(a_rigid_motion_of_the_domain_costs_no_strain_energy),
              CASE(galerkin_errors_bound_the_projection_and_vanish_on_a_full_span),
              CASE(a_strain_share_outside_0_1_is_an_error),
-             CASE(inertia_ritz_modes_are_the_lowest_vibration_modes_of_the_responses_span))
+             CASE(inertia_ritz_modes_are_the_lowest_vibration_modes_of_the_responses_span),
+             CASE(only_the_modes_that_swing_at_the_time_step_join))

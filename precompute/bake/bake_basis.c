@@ -243,7 +243,11 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * responses, u_i^T K u_j = u_i^T f_j needing no K, and the small generalised eigenproblem
  * solved): the flesh's free motion after the skeleton stops is dominated by its lowest
  * modes, and the higher combinations of the responses, which every domain took as well,
- * cost rank without holding that motion (docs/notes/jiggle.md, Inertia Ritz modes). */
+ * cost rank without holding that motion (docs/notes/jiggle.md, Inertia Ritz modes). Of
+ * those, only the modes that swing at the clips' time step join (sw_bake_ritz_swinging): a
+ * stiff character's modes (the hand's) are gone within a frame of backward Euler, and far
+ * above the lowest one a mode holds little of the free motion (docs/notes/jiggle.md, Modes
+ * that swing). */
 #define SW_INERTIA_MODE_TOL 0.05
 
 /* Directions of the responses' mass matrix below this share of its largest eigenvalue are
@@ -253,7 +257,7 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
 
 /* sw_bake_ritz_modes (bake_state.h). */
 int32_t sw_bake_ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
-                           int32_t ritz) {
+                           int32_t ritz, double *lambda) {
     double *A = malloc((size_t)nl * nl * sizeof(double)),
            *B = malloc((size_t)nl * nl * sizeof(double)),
            *W = malloc((size_t)nl * nl * sizeof(double)),
@@ -295,6 +299,7 @@ int32_t sw_bake_ritz_modes(double *U, const double *F, const double *m, int32_t 
         }
     if (LAPACKE_dsyev(LAPACK_ROW_MAJOR, 'V', 'U', kept, P, kept, l) != 0) goto done;
     got = ritz < kept ? ritz : kept;
+    if (lambda) memcpy(lambda, l, (size_t)got * sizeof(double));
     for (int32_t k = 0; k < got; ++k) /* eigenvalues ascending; column k of P its vector */
         for (int32_t i = 0; i < nl; ++i) {
             double c = 0;
@@ -310,12 +315,24 @@ done:
     return got;
 }
 
+/* sw_bake_ritz_swinging (bake_state.h). */
+int32_t sw_bake_ritz_swinging(const double *lambda, int32_t n, double h) {
+    double top = SW_INERTIA_MAX_OMEGA_H / h;
+    top *= top;
+    int32_t k = 0;
+    while (k < n && lambda[k] <= top &&
+           lambda[k] <= SW_INERTIA_OMEGA_SPREAD * SW_INERTIA_OMEGA_SPREAD * lambda[0])
+        ++k;
+    return k;
+}
+
 /* The static responses of the rest shape to nl loads F (3 nverts each), reduced to the
- * `ritz` lowest vibration modes in their span when 0 < ritz < nl (sw_bake_ritz_modes), every
+ * `ritz` lowest vibration modes in their span when 0 < ritz < nl (sw_bake_ritz_modes), and of
+ * those to the ones that swing at time step h (sw_bake_ritz_swinging) when h > 0, every
  * domain taking the restriction of every response (or mode) as far as it lies outside its
  * basis by `tol` of its whole norm, largest first, at most max_rank of them a domain. */
 static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F, double tol,
-                                  int32_t ritz, sw_error *err) {
+                                  int32_t ritz, double h, sw_error *err) {
     int64_t n3 = 3 * (int64_t)s->rig.nv;
     sw_fullsim_params fp = sw_fullsim_params_default();
     fp.self_contact = 0;
@@ -323,17 +340,18 @@ static sinew_result add_responses(sw_bake_state *s, int32_t nl, const double *F,
     fp.pcg_max = 100000;
     fp.threads = sw_pool_size(s->pool);
     sw_fullsim *sim = NULL;
-    double *Uf = malloc((size_t)nl * n3 * sizeof(double)), *C = NULL, *gnorm = NULL;
+    double *Uf = malloc((size_t)nl * n3 * sizeof(double)), *C = NULL, *gnorm = NULL,
+           *lambda = malloc((size_t)nl * sizeof(double));
     sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
-    if (!Uf) goto done;
+    if (!Uf || !lambda) goto done;
     if ((r = sw_fullsim_create(&s->rig.ch, &fp, &sim, err)) != SINEW_OK ||
         (r = sw_fullsim_rest_response(sim, nl, F, Uf, err)) != SINEW_OK)
         goto done;
     r = SINEW_ERROR_OUT_OF_MEMORY;
     if (ritz > 0 && ritz < nl) {
-        int32_t got = sw_bake_ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz);
+        int32_t got = sw_bake_ritz_modes(Uf, F, sw_fullsim_masses(sim), nl, n3, ritz, lambda);
         if (got < 0) goto done;
-        nl = got;
+        nl = h > 0 ? sw_bake_ritz_swinging(lambda, got, h) : got;
         if (nl == 0) { /* the responses span nothing: no mode joins */
             r = SINEW_OK;
             goto done;
@@ -369,6 +387,7 @@ done:
     free(Uf);
     free(C);
     free(gnorm);
+    free(lambda);
     return r;
 }
 
@@ -405,8 +424,10 @@ static sinew_result add_inertia_modes(sw_bake_state *s, sw_error *err) {
             }
         }
     }
-    sinew_result r =
-        add_responses(s, nl, F, SW_INERTIA_MODE_TOL, SW_INERTIA_RITZ_PER_DOMAIN * nd, err);
+    /* the step the clips play at: the runtime's, unless a host steps otherwise */
+    double fps = s->rig.ch.clip.fps > 0 ? s->rig.ch.clip.fps : 30.0;
+    sinew_result r = add_responses(s, nl, F, SW_INERTIA_MODE_TOL, SW_INERTIA_RITZ_PER_DOMAIN * nd,
+                                   1.0 / fps, err);
     free(F);
     return r;
 }
@@ -464,7 +485,7 @@ static sinew_result add_contact_modes(sw_bake_state *s, sw_error *err) {
     for (int32_t j = 0; j < nl; ++j) /* P is n3 x nl, row-major: load j is its column */
         for (int64_t e = 0; e < n3; ++e)
             F[(size_t)j * n3 + e] = P[e * nl + j];
-    r = nl > 0 ? add_responses(s, nl, F, SW_CONTACT_MODE_TOL, 0, err) : SINEW_OK;
+    r = nl > 0 ? add_responses(s, nl, F, SW_CONTACT_MODE_TOL, 0, 0, err) : SINEW_OK;
 done:
     if (r == SINEW_ERROR_OUT_OF_MEMORY) sw_error_set(err, r, "out of memory for contact modes");
     free(L);
@@ -518,6 +539,10 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         if (!s->basis.U[dm]) goto oom;
     }
     r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
+    if (r == SINEW_OK && !(s->basis.rank_dynamic = malloc((size_t)s->domains.nd * sizeof(int32_t))))
+        goto oom;
+    if (r == SINEW_OK)
+        memcpy(s->basis.rank_dynamic, s->basis.rank, (size_t)s->domains.nd * sizeof(int32_t));
     if (r == SINEW_OK && s->p->inertia_modes) r = add_inertia_modes(s, err);
     if (r != SINEW_OK) goto done;
     for (int32_t dm = 0; dm < s->domains.nd; ++dm)

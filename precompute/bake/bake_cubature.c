@@ -198,13 +198,17 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
     if (sets == 3) {
         /* inertia modes (bake_basis.c) are barely in the snapshots, so the perturbations
            above hardly move them, and a fit blind to their force leaves them wrongly stiff
-           or soft: a third set perturbs every mode at the largest mode's amplitude */
+           or soft: a third set moves them, each at the largest mode's amplitude, from the
+           snapshots (moving the trained modes so far too costs the trained poses' fit:
+           docs/notes/jiggle.md, Modes that swing) */
         double rmax = 0;
         for (int32_t j = 0; j < r; ++j)
             rmax = fmax(rmax, sqrt(rms[j]));
         for (int32_t a = 0; a < T; ++a)
             for (int32_t j = 0; j < r; ++j)
-                q[(size_t)(2 * T + a) * r + j] = q[(size_t)a * r + j] + 0.5 * rmax * gauss(&seed);
+                q[(size_t)(2 * T + a) * r + j] =
+                    q[(size_t)a * r + j] +
+                    (j >= s->basis.rank_dynamic[dom] ? 0.5 * rmax * gauss(&seed) : 0);
     }
     free(rms);
     for (int32_t smp = 0; smp < ns; ++smp)

@@ -78,6 +78,7 @@ typedef struct sw_poses_state { /* poses; simulate fills the sequences' solution
 
 typedef struct sw_basis_state { /* basis: per domain 3 n_d x r_d, row-major */
     int32_t *rank;
+    int32_t *rank_dynamic; /* per domain: its columns from rank_dynamic on are inertia modes */
     double **U;
     int32_t rank_total;
     double *train_q;    /* ntrain x rank_total: projected training solutions */
@@ -191,9 +192,14 @@ int sw_bake_strain_products(const sw_bake_state *s, int32_t dm, const double *A,
  * independent directions (l above SW_RITZ_DEPENDENT of the largest), the modes are
  * (W z)^T U for the eigenvectors z of W^T (U F^T) W (u_i^T K u_j = u_i^T f_j: no K needed).
  * Returns how many were written (fewer than ritz when the span is smaller), 0 when the
- * responses span nothing, -1 out of memory. The inertia modes take them (bake_basis.c). */
+ * responses span nothing, -1 out of memory; lambda (ritz doubles, or NULL) takes their
+ * eigenvalues, the squared angular frequencies. The inertia modes take them (bake_basis.c). */
 int32_t sw_bake_ritz_modes(double *U, const double *F, const double *m, int32_t nl, int64_t n3,
-                           int32_t ritz);
+                           int32_t ritz, double *lambda);
+/* How many of n vibration modes, squared frequencies lambda ascending, swing at time step h:
+ * the leading ones with omega h <= SW_INERTIA_MAX_OMEGA_H and omega <= SW_INERTIA_OMEGA_SPREAD
+ * times the lowest (bake_params.h). */
+int32_t sw_bake_ritz_swinging(const double *lambda, int32_t n, double h);
 /* The pairs stage's cubature of one (pose, group): weights w (n) >= 0 for the columns of A
  * (m x n, column-major: each pair's reduced contact force) with |A w - A 1| <= tol |A 1|,
  * by the cubature trainer's greedy selector (cubature_train.h); a zero column keeps
