@@ -81,8 +81,8 @@ typedef struct sw_bake_params {
                                       bones' accelerations, the lowest vibration modes of
                                       their static responses (SW_INERTIA_RITZ_PER_DOMAIN a
                                       domain), and the cubature trained on them
-                                      (bake_basis.c; default 0: they add about half the
-                                      rank) */
+                                      (bake_basis.c; default 0: they move the quasistatic
+                                      shapes, docs/notes/jiggle.md) */
     double heldout_fraction;       /* last part of the clip held out (default 0.4) */
     int ship_split;                /* the blob a tool ships from a character's own clip split
                                       by heldout_fraction: 0 (default) re-baked on the whole

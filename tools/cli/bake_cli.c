@@ -218,8 +218,9 @@ static size_t research_flags(bake_options *o, sw_flag *f) {
         {SW_SET("--inertia-modes", &p->inertia_modes, 1,
                 "for the dynamic step: basis modes for the inertia of the\n"
                 "bones' accelerations (the lowest vibration modes of the static\n"
-                "responses to them, 3 a domain), so that the flesh lags and\n"
-                "overshoots as the reference does; about half the rank again")},
+                "responses to them that swing at the clips' frame rate, at most\n"
+                "3 a domain), so that the flesh lags and overshoots as the\n"
+                "reference does; a stiff character gets none")},
     };
     _Static_assert(SW_FLAGS_N(flags) <= RESEARCH_NFLAGS, "room for the flags");
     memcpy(f, flags, sizeof flags);
