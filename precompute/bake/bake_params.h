@@ -26,11 +26,10 @@ double sw_bake_spring_mult(int i);
 
 /* Of those, a mode joins only if it swings at the clips' time step h. Backward Euler shrinks
  * a free swing of frequency omega by 1 / sqrt(1 + (omega h)^2) a step: above omega h = 5 to
- * under a fifth within one frame, no jiggle anyone sees (the hand's lowest is 7.6, the Fox's
- * 2.4, the finger's 1.5 at 30 fps). And a mode above three times the lowest frequency
- * moves under a ninth as far as the lowest under the same modal load: the elephant's six whole-body
- * modes lie below 0.4 at 30 fps, the next 66 from 1.2 (docs/notes/jiggle.md, Modes that
- * swing). */
+ * under a fifth within one frame, no jiggle anyone sees, only rank (a stiff character's
+ * modes all lie there). And a mode above three times the lowest frequency moves under a
+ * ninth as far as the lowest under the same modal load (the spectra measured:
+ * docs/notes/jiggle.md, Modes that swing). */
 #define SW_INERTIA_MAX_OMEGA_H 5.0
 #define SW_INERTIA_OMEGA_SPREAD 3.0
 
