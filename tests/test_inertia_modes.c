@@ -90,6 +90,21 @@ TEST(inertia_modes_give_the_reference_overshoot) {
                 "domain %d: rank %d without, %d with (%d Ritz modes)", d, a->domains[d].rank,
                 b->domains[d].rank, ritz);
     ENSUREF(b->rank_total > a->rank_total, "no mode added (rank %d)", b->rank_total);
+    /* the report's split (sw_bake_result.rank_trained): the trained modes lead the basis, so
+       their held-out projection is the plain bake's own, and the added modes can only
+       lower it */
+    const sw_bake_result *ra = &without.f.res, *rb = &with.f.res;
+    ENSUREF(ra->rank_trained == a->rank_total && rb->rank_trained == a->rank_total,
+            "trained rank %d without, %d with; %d modes trained", ra->rank_trained,
+            rb->rank_trained, a->rank_total);
+    ENSUREF(fabs(rb->heldout_proj_error_trained - ra->heldout_proj_error) <=
+                1e-9 * ra->heldout_proj_error,
+            "held-out projection onto the trained modes %.9g with, %.9g without",
+            rb->heldout_proj_error_trained, ra->heldout_proj_error);
+    ENSURE(ra->heldout_proj_error_trained == ra->heldout_proj_error);
+    ENSUREF(rb->heldout_proj_error <= rb->heldout_proj_error_trained,
+            "held-out projection %.6f with the inertia modes, %.6f without", rb->heldout_proj_error,
+            rb->heldout_proj_error_trained);
     int driven_ok;
     double defect = basis_defect(b, &with.f.ch, &driven_ok);
     ENSUREF(defect < 1e-9, "basis not orthonormal: %.3g", defect);

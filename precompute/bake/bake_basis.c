@@ -157,11 +157,14 @@ static void project(const sw_bake_state *s, int32_t dm, const double *d, double 
     }
 }
 
-/* Relative projection error accumulators for the snapshots d (3 nv) of one pose. */
-static void projection_error(const sw_bake_state *s, const double *d, double *num, double *den) {
+/* Relative projection error accumulators for the snapshots d (3 nv) of one pose, onto each
+ * domain's first cols[dm] columns (orthonormal, so the projection onto a leading set is
+ * the truncated sum), or onto all of them when cols is NULL. */
+static void projection_error(const sw_bake_state *s, const double *d, const int32_t *cols,
+                             double *num, double *den) {
     for (int32_t dm = 0; dm < s->domains.nd; ++dm) {
         int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base,
-                r = s->basis.rank[dm];
+                r = cols ? cols[dm] : s->basis.rank[dm], ld = s->basis.rank[dm];
         const double *U = s->basis.U[dm];
         double q[1024];
         project(s, dm, d, q);
@@ -169,7 +172,7 @@ static void projection_error(const sw_bake_state *s, const double *d, double *nu
             for (int i = 0; i < 3; ++i) {
                 double p = 0;
                 for (int32_t k = 0; k < r; ++k)
-                    p += U[(size_t)(3 * j + i) * r + k] * q[k];
+                    p += U[(size_t)(3 * j + i) * ld + k] * q[k];
                 double dv = d[3 * s->domains.dom_verts[base + j] + i];
                 *num += (dv - p) * (dv - p);
                 *den += dv * dv;
@@ -538,6 +541,8 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         free(D);
         if (!s->basis.U[dm]) goto oom;
     }
+    if (!(s->basis.rank_trained = malloc((size_t)s->domains.nd * sizeof(int32_t)))) goto oom;
+    memcpy(s->basis.rank_trained, s->basis.rank, (size_t)s->domains.nd * sizeof(int32_t));
     r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
     if (r == SINEW_OK && !(s->basis.rank_dynamic = malloc((size_t)s->domains.nd * sizeof(int32_t))))
         goto oom;
@@ -572,15 +577,21 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     }
     double num = 0, den = 0;
     for (int32_t a = 0; a < T; ++a)
-        projection_error(s, dall + (size_t)a * n3, &num, &den);
+        projection_error(s, dall + (size_t)a * n3, NULL, &num, &den);
     out->train_proj_error = den > 0 ? sqrt(num / den) : 0;
     num = den = 0;
+    double num_t = 0, den_t = 0;
+    out->rank_trained = 0;
+    for (int32_t dm = 0; dm < s->domains.nd; ++dm)
+        out->rank_trained += s->basis.rank_trained[dm];
     for (int32_t j = 0; j < s->poses.heldout.npose; ++j) {
         sw_bake_unskin(s, s->poses.heldout.T + (size_t)j * 12 * s->rig.nb,
                        s->poses.heldout.x + (size_t)j * n3, R, t, dtmp);
-        projection_error(s, dtmp, &num, &den);
+        projection_error(s, dtmp, NULL, &num, &den);
+        projection_error(s, dtmp, s->basis.rank_trained, &num_t, &den_t);
     }
     out->heldout_proj_error = den > 0 ? sqrt(num / den) : 0;
+    out->heldout_proj_error_trained = den_t > 0 ? sqrt(num_t / den_t) : 0;
     goto done;
 oom:
     r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the basis");

@@ -185,6 +185,11 @@ typedef struct sw_bake_result {
                                   (sw_bake_params.pair_sweeps) */
     double train_proj_error;   /* basis projection error of the training snapshots */
     double heldout_proj_error; /* ... of the held-out snapshots (never used to build) */
+    /* the held-out projection error onto the trained modes alone, without the modes from
+       physics (--contact-modes, --inertia-modes), and their rank: what those modes add to
+       motion never seen (equal to the above, and rank_total, without them) */
+    double heldout_proj_error_trained;
+    int32_t rank_trained;
     /* the same snapshots projected in the reduced model's linearised energy, its domains
        coupled by the blob's springs: the minimum the step finds, before the cubature, the
        contact and the nonlinearity (bake_galerkin.c; NAN when that energy is not

@@ -86,6 +86,7 @@ void sw_bake_state_free(sw_bake_state *s) {
     free(s->basis.U);
     free(s->basis.rank);
     free(s->basis.rank_dynamic);
+    free(s->basis.rank_trained);
     free(s->basis.train_q);
     free(s->basis.train_pose);
     free(s->contacts.contact_ptr);

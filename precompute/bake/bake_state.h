@@ -78,6 +78,7 @@ typedef struct sw_poses_state { /* poses; simulate fills the sequences' solution
 
 typedef struct sw_basis_state { /* basis: per domain 3 n_d x r_d, row-major */
     int32_t *rank;
+    int32_t *rank_trained; /* per domain: its columns from rank_trained on are from physics */
     int32_t *rank_dynamic; /* per domain: its columns from rank_dynamic on are inertia modes */
     double **U;
     int32_t rank_total;

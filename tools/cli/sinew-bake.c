@@ -265,6 +265,12 @@ static void print_summary(const bake *b) {
             "%.4f; in the linearised model's energy (Galerkin) %.4f / %.4f\n",
             b->res.ntrain, pair_how, b->res.nheldout, held_how, b->res.train_proj_error,
             b->res.heldout_proj_error, b->res.train_galerkin_error, b->res.heldout_galerkin_error);
+    if (b->res.rank_trained < b->res.view.rank_total)
+        fprintf(stderr,
+                "  the modes from physics: held-out projection error %.4f with them (rank %d), "
+                "%.4f with the trained modes alone (rank %d)\n",
+                b->res.heldout_proj_error, b->res.view.rank_total,
+                b->res.heldout_proj_error_trained, b->res.rank_trained);
     fprintf(stderr, "  references solved by: solver %s, %s Hessians, at most %d contact rounds\n",
             sw_linear_solver_name(b->o.reference.solver),
             sw_hessian_mode_name(b->o.reference.hessian), b->o.reference.contact_rounds);
@@ -363,7 +369,8 @@ static void print_json(const bake *b) {
         printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
                "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
                "\"pair_sweep_poses\":%d,\"heldout_poses\":%d,"
-               "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"err_train\":%.5f,\"err_"
+               "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"rank_trained\":%d,"
+               "\"proj_err_heldout_trained\":%.5f,\"err_train\":%.5f,\"err_"
                "heldout\":%.5f,"
                "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
                "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f",
@@ -371,8 +378,9 @@ static void print_json(const bake *b) {
                b->res.view.ndomains, b->res.view.rank_total, b->res.view.ncub,
                b->res.cubature_error_max, b->res.ntrain, b->res.return_poses,
                b->res.pair_sweep_poses, b->res.nheldout, b->res.train_proj_error,
-               b->res.heldout_proj_error, b->et.correction_error, b->eh.correction_error,
-               b->res.train_unsettled, b->res.heldout_unsettled, b->bake_seconds, b->eval_seconds);
+               b->res.heldout_proj_error, b->res.rank_trained, b->res.heldout_proj_error_trained,
+               b->et.correction_error, b->eh.correction_error, b->res.train_unsettled,
+               b->res.heldout_unsettled, b->bake_seconds, b->eval_seconds);
         printf(",\"stages\":["); /* the bake's table (bake.h), as the report's JSON */
         for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
             printf("%s{\"name\":\"%s\",\"seconds\":%.2f}", k ? "," : "", sw_bake_stages[k].name,

@@ -348,6 +348,8 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
     cJSON_AddItemToObject(j, "err_heldout", json_number(in->err_heldout));
     cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
     cJSON_AddNumberToObject(j, "proj_err_heldout", res->heldout_proj_error);
+    cJSON_AddNumberToObject(j, "rank_trained", res->rank_trained);
+    cJSON_AddNumberToObject(j, "proj_err_heldout_trained", res->heldout_proj_error_trained);
     cJSON_AddItemToObject(j, "galerkin_err_train", json_number(res->train_galerkin_error));
     cJSON_AddItemToObject(j, "galerkin_err_heldout", json_number(res->heldout_galerkin_error));
     cJSON_AddNumberToObject(j, "cubature_fit", res->cubature_error_max);

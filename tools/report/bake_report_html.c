@@ -120,8 +120,12 @@ static void html_model(FILE *f, const sw_bake_report_input *in) {
     }
     html_term(f, "best the learnt flesh shapes can do",
               "basis projection error: the closest the basis comes to the reference");
-    fprintf(f, "<td>training %.4f, held-out %.4f</td></tr>", res->train_proj_error,
-            res->heldout_proj_error);
+    fprintf(f, "<td>training %.4f, held-out %.4f", res->train_proj_error, res->heldout_proj_error);
+    if (res->rank_trained < res->view.rank_total) /* what the modes from physics add */
+        fprintf(f, " (held-out %.4f with the %d trained modes alone, without the %d from physics)",
+                res->heldout_proj_error_trained, res->rank_trained,
+                res->view.rank_total - res->rank_trained);
+    fprintf(f, "</td></tr>");
     html_term(f, "best the runtime's solver can reach with them",
               "Galerkin projection error: the same, measured in the linearised model's energy, "
               "which is what the runtime's step minimises");
