@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # The bake in work items (docs/baking.md, "Baking on a farm"): shards of a small finger
 # solved into a shared cache in any number and order, then the plain bake with that
-# cache, give the local bake's blob byte for byte, the adaptive loop's rounds too; and
+# cache, give the local bake's blob byte for byte, the adaptive loop's rounds too (N = 1,
+# 2, 3 and 7 shards a round, each in a shuffled order); and
 # the shared cache's faults each end in the same bytes: a corrupted, truncated or
 # foreign entry (detected, redone, never read), a shard killed with SIGKILL mid-solve
 # and run again, two shards on the same items at once, a shard that never ran (the
@@ -84,12 +85,21 @@ done
 reduce "$tmp/bad" "$tmp/bad2.blob" # the reduce stored the redone entries
 grep -q "0 of them solved" "$tmp/bad2.blob.log" || fail "damaged entries not stored again"
 
-# a shard killed with SIGKILL mid-solve, then run again
-"$bake" "${finger[@]}" --shard 0/1 --cache "$tmp/kill" 2>/dev/null &
+# a shard killed with SIGKILL mid-solve, then run again: killed as soon as its first item
+# is in the cache, so that the others are still to solve (a fixed delay let a quiet
+# machine finish the whole shard first, and the case tested nothing)
+"$bake" "${finger[@]}" --threads 1 --shard 0/1 --cache "$tmp/kill" 2>/dev/null &
 pid=$!
-sleep 1.5
-kill -KILL "$pid"
+for _ in $(seq 1200); do # at most 2 minutes
+    ls "$tmp/kill" 2>/dev/null | grep -q '^simulate-[0-9a-f]*\.bin$' && break
+    sleep 0.1
+done
+kill -KILL "$pid" 2>/dev/null || fail "the shard to kill had finished: the case tested nothing"
 wait "$pid" 2>/dev/null
+done_items=$(ls "$tmp/kill" 2>/dev/null | grep -c '^simulate-[0-9a-f]*\.bin$')
+all_items=$(grep -o '"key":' "$tmp/plan.json" | wc -l)
+[ "$done_items" -lt "$all_items" ] ||
+    fail "killed shard: $done_items of $all_items items already done, nothing left mid-solve"
 [ -n "$(ls "$tmp/kill" 2>/dev/null | grep -v '^simulate-[0-9a-f]*\.bin$\|\.tmp-')" ] &&
     fail "killed shard left $(ls "$tmp/kill")"
 run_shards "$tmp/kill" 1 0
@@ -118,12 +128,18 @@ grep -q "work items not in the cache, solving them" "$tmp/half.blob.log" ||
 # the adaptive loop as rounds of items: each round's shards, then the reduce
 extra=(--adaptive 2)
 "$bake" "${finger[@]}" "${extra[@]}" --out "$tmp/ad.blob" >/dev/null 2>&1 || fail "local adaptive"
-for _ in 0 1 2 3; do # one round more than the loop has: its shards find nothing to do
-    run_shards "$tmp/cad" 3 2 0 1
+for order in "1:0" "2:1 0" "3:2 0 1" "7:6 3 0 5 2 4 1"; do # N: the shards in this order
+    n=${order%%:*}
+    : >"$tmp/shards.log"
+    for _ in 0 1 2 3; do # one round more than the loop has: its shards find nothing to do
+        # shellcheck disable=SC2086 # the order's shards, one word each
+        run_shards "$tmp/cad$n" "$n" ${order#*:}
+    done
+    grep -q "every round in the cache" "$tmp/shards.log" ||
+        fail "adaptive, $n shards: the rounds never ended"
+    reduce "$tmp/cad$n" "$tmp/ad$n.blob"
+    same "$tmp/ad$n.blob" "$tmp/ad.blob" "adaptive, $n shards"
 done
-grep -q "every round in the cache" "$tmp/shards.log" || fail "adaptive: the rounds never ended"
-reduce "$tmp/cad" "$tmp/ad3.blob"
-same "$tmp/ad3.blob" "$tmp/ad.blob" "adaptive, 3 shards"
 
 [ "$fails" -eq 0 ] && echo "farm: all cases passed"
 exit $((fails > 0))
