@@ -222,6 +222,7 @@ typedef struct {
     int dynamic, hold_frames, instances, patch_budget;
     int self_mode; /* sinew_self_contact */
     int sc_compare, error_gap, newton_compare, novel, pair, lod;
+    int ref_self_contact; /* the reference's self-contact: 1 (default) or 0 */
     sw_cond_bench_params cond;
 } options;
 
@@ -245,6 +246,7 @@ static const char *const SYNOPSIS =
 
 /* The bench's own flags, bound to o, into f; returns their count. */
 static size_t bench_flags(options *o, sw_flag *f) {
+    static const char *const off_on[] = {"off", "on", NULL};
     const sw_flag flags[] = {
         {SW_STR("--blob", &o->blob_path, "FILE",
                 "a blob sinew-bake wrote for this character (default: bake,\n"
@@ -290,6 +292,11 @@ static size_t bench_flags(options *o, sw_flag *f) {
                    "pose-space (default) or exhaustive: the runtime's mode\n"
                    "(sinew_instance_def.self_contact) for the timing and errors"),
          .range = "pose-space, exhaustive or pose-pairs"},
+        {SW_CHOICE("--ref-self-contact", &o->ref_self_contact, off_on, "C",
+                   "on (default) | off: the full-space reference's self-contact\n"
+                   "(off: what the reference does without it, e.g. how much of its\n"
+                   "dynamics is contact)"),
+         .range = "on or off"},
         {SW_SET("--sc-compare", &o->sc_compare, 1,
                 "also time self-contact in both modes over the clip: sc_*")},
         {SW_SET("--novel", &o->novel, 1,
@@ -375,6 +382,7 @@ static int parse_args(int argc, char **argv, options *o) {
     o->contract_steps = 10000;
     o->timing_passes = 1;
     o->self_mode = SINEW_SELF_CONTACT_POSE_SPACE;
+    o->ref_self_contact = 1;
     sw_flag character[SW_CHARACTER_NFLAGS], bench[32], reference[SW_REFERENCE_NFLAGS];
     const sw_flag_group groups[] = {
         {"character:\n" SW_CHARACTER_FILE_USAGE, character, sw_character_flags(&o->ca, character)},
@@ -502,6 +510,7 @@ static int run_reference(bench *b, sw_error *err) {
     b->fp = sw_fullsim_params_default();
     b->fp.threads = b->o.threads;
     sw_fullsim_params_take_solver(&b->fp, &b->o.ref_solver);
+    b->fp.self_contact = b->o.ref_self_contact;
     sw_fullsim *sim = NULL;
     int nf = b->nf, kf = b->o.full_frames > 0 && b->o.full_frames < nf ? b->o.full_frames : nf;
     b->kf = kf; /* default: the whole clip */
@@ -761,7 +770,8 @@ static void print_json(const bench *b, const char *e_tr, const char *e_ho) {
            "\"beyond_training_bone\":%d,\"timing_passes\":%d",
            b->factors, b->instance_bytes, b->blob_bytes, b->beyond_frames, b->beyond_deg,
            b->beyond_bone, b->o.timing_passes);
-    printf(",\"self_contact\":\"%s\"", sw_self_contact_keys[b->o.self_mode]);
+    printf(",\"self_contact\":\"%s\",\"ref_self_contact\":%d", sw_self_contact_keys[b->o.self_mode],
+           b->o.ref_self_contact);
     if (b->clip_errors)
         printf(",\"err_clip_train_frames\":%d,\"err_clip_heldout_frames\":%d",
                b->et.frames + b->et.failed, b->eh.frames + b->eh.failed);
