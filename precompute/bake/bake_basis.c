@@ -541,13 +541,14 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         free(D);
         if (!s->basis.U[dm]) goto oom;
     }
-    if (!(s->basis.rank_trained = malloc((size_t)s->domains.nd * sizeof(int32_t)))) goto oom;
-    memcpy(s->basis.rank_trained, s->basis.rank, (size_t)s->domains.nd * sizeof(int32_t));
+    /* where the modes from physics start in each domain's columns: contact, then inertia */
+    const size_t rank_bytes = (size_t)s->domains.nd * sizeof(int32_t);
+    s->basis.rank_trained = malloc(rank_bytes);
+    s->basis.rank_dynamic = malloc(rank_bytes);
+    if (!s->basis.rank_trained || !s->basis.rank_dynamic) goto oom;
+    memcpy(s->basis.rank_trained, s->basis.rank, rank_bytes);
     r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
-    if (r == SINEW_OK && !(s->basis.rank_dynamic = malloc((size_t)s->domains.nd * sizeof(int32_t))))
-        goto oom;
-    if (r == SINEW_OK)
-        memcpy(s->basis.rank_dynamic, s->basis.rank, (size_t)s->domains.nd * sizeof(int32_t));
+    memcpy(s->basis.rank_dynamic, s->basis.rank, rank_bytes);
     if (r == SINEW_OK && s->p->inertia_modes) r = add_inertia_modes(s, err);
     if (r != SINEW_OK) goto done;
     for (int32_t dm = 0; dm < s->domains.nd; ++dm)

@@ -256,16 +256,24 @@ static sinew_result dyn_run(sw_bench_ctx *c, sw_error *err) {
     return SINEW_OK;
 }
 
+/* v with `digits` decimals into b (32 chars), or null when it is not finite. */
+static const char *json_or_null(char b[32], double v, int digits) {
+    if (isfinite(v))
+        snprintf(b, 32, "%.*f", digits, v);
+    else
+        snprintf(b, 32, "null");
+    return b;
+}
+
 static void dyn_json(const sw_bench_ctx *c) {
     const sw_dyn_bench *db = &c->db;
-    char ratio[32] = "null"; /* no reference overshoot: no ratio */
-    if (isfinite(db->overshoot_ratio)) snprintf(ratio, sizeof ratio, "%.4f", db->overshoot_ratio);
-    char inc[32] = "null"; /* no reference quasistatic clip (--full-frames): no increment */
-    if (isfinite(db->err_increment)) snprintf(inc, sizeof inc, "%.5f", db->err_increment);
-    char inc_ratio[32] = "null", inc_cos[32] = "null"; /* likewise */
-    if (isfinite(db->increment_ratio))
-        snprintf(inc_ratio, sizeof inc_ratio, "%.5f", db->increment_ratio);
-    if (isfinite(db->increment_cos)) snprintf(inc_cos, sizeof inc_cos, "%.5f", db->increment_cos);
+    /* null: no reference overshoot (ratio), no reference quasistatic clip (the increment's
+       figures, --full-frames) */
+    char ratio[32], inc[32], inc_ratio[32], inc_cos[32];
+    json_or_null(ratio, db->overshoot_ratio, 4);
+    json_or_null(inc, db->err_increment, 5);
+    json_or_null(inc_ratio, db->increment_ratio, 5);
+    json_or_null(inc_cos, db->increment_cos, 5);
     printf(",\"dyn_dt\":%.9g,\"dyn_rayleigh_alpha\":%g,\"dyn_rayleigh_beta\":%g,"
            "\"hold_frames\":%d,\"err_dynamic\":%.5f,\"err_dynamic_hold\":%.5f,"
            "\"err_dynamic_ref\":%.5f,\"err_dynamic_ref_hold\":%.5f,\"err_dynamic_tight\":%.5f,"
