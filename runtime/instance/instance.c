@@ -16,31 +16,11 @@
 #include "mem_plan.h"
 #include "sorted.h"
 
-/* Sizes of the layout that the blob alone does not fix. */
-typedef struct {
-    int32_t nact;       /* active vertices (active_vertices) */
-    int32_t nact_step;  /* those the step itself reads (ACT_STEP) */
-    int32_t rmax;       /* the largest domain rank */
-    int32_t ncorner;    /* the cubature tets' corners (sw_cubature_corners) */
-    int32_t max_pairs;  /* the contact pair budget */
-    int32_t max_world;  /* the world candidate budget */
-    int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
-    sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
-    double rho;         /* its radius, in units of the rest diagonal */
-    int per_pair;       /* SINEW_SELF_CONTACT_POSE_PAIRS: the groups' samples */
-    /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
-       mode's fallback on novel contact when the blob has the tet mesh */
-    int detect;
-    int novel;   /* the def's novel_contact */
-    int rest;    /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
-    int dynamic; /* the frozen damping Hessian and its point: SINEW_STEP_DYNAMIC only */
-} layout_sizes;
-
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
  * sizes them: the one list of the instance's memory. The struct comes first, at the
  * block's start. */
 static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
-                   const layout_sizes *z) {
+                   const sw_layout_sizes *z) {
     const uint64_t R = (uint64_t)v->rank_total, nb = (uint64_t)v->nbones,
                    nd = (uint64_t)v->ndomains, na = (uint64_t)z->nact, rm = (uint64_t)z->rmax,
                    ns = (uint64_t)sw_blob_output_verts(v);
@@ -63,15 +43,10 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->corner_lv, (uint64_t)z->ncorner);
     TAKE(m->corner_act, (uint64_t)z->ncorner);
     TAKE(m->cub_corner, 4 * (uint64_t)v->ncub);
-    TAKE(m->corner_x, 3 * (uint64_t)z->ncorner);
-    TAKE(m->corner_f, 3 * (uint64_t)z->ncorner);
     TAKE(m->copy_act, (uint64_t)v->nsurf_copies);
     TAKE(m->contact_act, 4 * (uint64_t)v->ncontacts);
     TAKE(m->node_copy_act, (uint64_t)v->nrender_copies);
-    TAKE(m->act_R, 9 * na);
-    TAKE(m->act_t, 3 * na);
     TAKE(m->g, R);
-    TAKE(m->H, R * R);
     const uint64_t nw = (uint64_t)z->nworkers;
     TAKE(m->hm, 10 * rm * nw);
     TAKE(m->ecub, (uint64_t)v->ncub);
@@ -98,10 +73,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->qn, R);
     TAKE(s->qdot, R);
     TAKE(s->fin, R);
-    TAKE(s->Hn, z->dynamic ? R * R : 0); /* (a quasistatic step never reads it) */
     TAKE(s->g_mat, R);
     TAKE(s->q_mat, z->dynamic ? R : 0);
-    TAKE(s->L, R * R);
     TAKE(s->dq, R);
     TAKE(s->qtrial, R);
     TAKE(s->q_pred, R);
@@ -175,7 +148,6 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->ring_x, 3 * nr);
         TAKE(c->ring_dx, 3 * nr);
         TAKE(c->ring_M, 3 * (uint64_t)cz->rmax * nr);
-        TAKE(c->Hq, R * R);
         TAKE(c->x, 3 * nf);
         TAKE(c->xt, 3 * nf);
         TAKE(c->dx, 3 * nf);
@@ -206,6 +178,9 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
         TAKE(c->dq_prev2, nb);
         TAKE(c->keep_v, nf);
     }
+    /* the step's scratch, unless a workspace lends it */
+    memset(&in->own, 0, sizeof in->own);
+    if (!z->shared) sw_scratch_layout(p, &in->own, v, z);
     /* the output */
     TAKE(in->surf_x, 3 * ns);
     TAKE(in->surf_n, 3 * ns);
@@ -316,8 +291,8 @@ static void assign_active(void *ctx, int32_t gv, int32_t *slot) {
 /* ---- creation -------------------------------------------------------------------- */
 
 /* The def with its defaults, checked, and the layout's sizes; logs what it rejects. */
-static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instance_def *def,
-                                      sinew_instance_def *d, layout_sizes *z) {
+sinew_result sw_instance_read_def(const sinew_blob *blob, const sinew_instance_def *def,
+                                  const char *caller, sinew_instance_def *d, sw_layout_sizes *z) {
     const sw_blob_view *v = sw_blob_get_view(blob);
     if (!v) return SINEW_ERROR_INVALID_ARGUMENT;
     *d = sinew_instance_def_default();
@@ -325,7 +300,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
         sw_def_read(d, sizeof *d, def,
                     offsetof(sinew_instance_def, mode) + sizeof(sinew_step_mode)) != SINEW_OK) {
         sw_log(&blob->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
-               "sinew_instance_create: def->struct_size %u is not a sinew_instance_def's",
+               "%s: def->struct_size %u is not a sinew_instance_def's", caller,
                (unsigned)def->struct_size);
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
@@ -362,14 +337,15 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
             ? "novel_contact adds to pose-space self-contact; the exhaustive and pose-pairs "
               "modes detect contact themselves"
         : d->collision_surface > 1 ? "collision_surface is neither 0 nor 1"
+        : d->shared_workspace > 1  ? "shared_workspace is neither 0 nor 1"
         : d->newton_hessian != SINEW_NEWTON_HESSIAN_AUTO &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT &&
                 d->newton_hessian != SINEW_NEWTON_HESSIAN_REST_FIRST
             ? "newton_hessian is none of auto, current, rest-first"
             : NULL;
     if (bad) {
-        sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
-               "sinew_instance_create: %s", bad);
+        sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT, "%s: %s", caller,
+               bad);
         return SINEW_ERROR_INVALID_ARGUMENT;
     }
     z->nworkers = tasks ? (int32_t)d->tasks.worker_count : 1;
@@ -405,6 +381,7 @@ static sinew_result read_instance_def(const sinew_blob *blob, const sinew_instan
                            z->novel ? SW_NOVEL_MAX_CONTACTS : 0);
     z->rest = d->newton_hessian != SINEW_NEWTON_HESSIAN_CURRENT;
     z->dynamic = d->mode == SINEW_STEP_DYNAMIC;
+    z->shared = d->shared_workspace == 1;
     return SINEW_OK;
 }
 
@@ -412,8 +389,8 @@ SINEW_API sinew_result sinew_instance_memory_size(const sinew_blob *blob,
                                                   const sinew_instance_def *def, size_t *bytes) {
     if (!blob || !bytes) return SINEW_ERROR_INVALID_ARGUMENT;
     sinew_instance_def d;
-    layout_sizes z;
-    sinew_result r = read_instance_def(blob, def, &d, &z);
+    sw_layout_sizes z;
+    sinew_result r = sw_instance_read_def(blob, def, "sinew_instance_memory_size", &d, &z);
     if (r != SINEW_OK) return r;
     sinew_instance scratch;
     sw_mem_plan plan = {NULL, 0, 0};
@@ -501,8 +478,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     *out = NULL;
     if (!blob) return SINEW_ERROR_INVALID_ARGUMENT;
     sinew_instance_def d;
-    layout_sizes z;
-    sinew_result r = read_instance_def(blob, def, &d, &z);
+    sw_layout_sizes z;
+    sinew_result r = sw_instance_read_def(blob, def, "sinew_instance_create", &d, &z);
     if (r != SINEW_OK) return r;
     const sw_blob_view *v = sw_blob_get_view(blob);
     sinew_instance sized;
@@ -519,6 +496,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     plan = (sw_mem_plan){block, 0, 0};
     layout(&plan, in, v, &z);
     in->v = v;
+    in->shared = z.shared;
+    sw_scratch_bind(in, &in->own);
     in->allocator = d.allocator;
     in->mode = d.mode;
     in->lod = in->lod_last = in->lod_run = SINEW_LOD_FULL;

@@ -22,6 +22,48 @@ typedef enum sw_coll_source {
     SW_COLL_NONE = 3
 } sw_coll_source;
 
+/* The step's scratch (workspace.c): what a step computes afresh and no later call reads,
+ * the bulk of an instance's memory (the rank-squared Hessian and its factor). An instance
+ * holds its own (own) unless its def shares a workspace; the step binds one into the
+ * subsystems' views (sw_scratch_bind). */
+typedef struct sw_scratch {
+    double *H, *L;               /* R x R: the reduced Hessian (red.H) and its factor (solver.L) */
+    double *Hn;                  /* R x R: the step's damping Hessian (solver.Hn; dynamic only) */
+    double *Hq;                  /* R x R: the patch's copy of H (cond.Hq; condensation only) */
+    double *act_R, *act_t;       /* 9 and 3 per active vertex: their skinning (red) */
+    double *corner_x, *corner_f; /* 3 per cubature corner each (red) */
+} sw_scratch;
+
+/* Sizes of an instance's layout that the blob alone does not fix (instance.c). */
+typedef struct sw_layout_sizes {
+    int32_t nact;       /* active vertices (active_vertices) */
+    int32_t nact_step;  /* those the step itself reads (ACT_STEP) */
+    int32_t rmax;       /* the largest domain rank */
+    int32_t ncorner;    /* the cubature tets' corners (sw_cubature_corners) */
+    int32_t max_pairs;  /* the contact pair budget */
+    int32_t max_world;  /* the world candidate budget */
+    int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
+    sw_cond_sizes cond; /* the condensation patch's budget (all 0: off) */
+    double rho;         /* its radius, in units of the rest diagonal */
+    int per_pair;       /* SINEW_SELF_CONTACT_POSE_PAIRS: the groups' samples */
+    /* the exhaustive detection's arrays: SINEW_SELF_CONTACT_EXHAUSTIVE, or the pose-pairs
+       mode's fallback on novel contact when the blob has the tet mesh */
+    int detect;
+    int novel;   /* the def's novel_contact */
+    int rest;    /* the rest Hessian's blocks: SINEW_NEWTON_HESSIAN_AUTO or _REST_FIRST */
+    int dynamic; /* the frozen damping Hessian and its point: SINEW_STEP_DYNAMIC only */
+    int shared;  /* the def's shared_workspace: no scratch of its own */
+} sw_layout_sizes;
+
+/* The def resolved and checked (`caller` names the API function in messages), with the
+ * sizes of its layout. */
+sinew_result sw_instance_read_def(const sinew_blob *blob, const sinew_instance_def *def,
+                                  const char *caller, sinew_instance_def *d, sw_layout_sizes *z);
+
+/* Places a scratch's arrays in the plan (workspace.c; base NULL: sizes only). */
+void sw_scratch_layout(struct sw_mem_plan *p, sw_scratch *sc, const sw_blob_view *v,
+                       const sw_layout_sizes *z);
+
 struct sinew_instance {
     const sw_blob_view *v;
     sinew_allocator allocator; /* frees the block */
@@ -97,7 +139,18 @@ struct sinew_instance {
     sinew_instance_def def;     /* as resolved at creation (a recording's BEGIN) */
     sinew_recorder *rec;        /* the attached recorder, or NULL (recorder.c) */
     int touched;                /* posed, placed or stepped since creation */
+    /* The step's scratch of its own (all NULL with a shared workspace: shared set, and the
+     * step runs only through sinew_instance_step_in). */
+    sw_scratch own;
+    int shared;
 };
+
+/* Points the subsystems' views at a scratch (the instance's own, or a workspace's for
+ * one step). */
+void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc);
+
+/* The step proper, recorded when a recorder is attached (step.c), with the scratch bound. */
+sinew_result sw_instance_step_bound(sinew_instance *inst, float dt);
 
 /* The most task workers an instance reserves scratch for (sinew_task_callbacks). */
 #define SW_MAX_TASK_WORKERS 256u

@@ -26,6 +26,7 @@
 #include "cubature.h"
 #include "instance.h"
 #include "instance_internal.h"
+#include "log.h"
 #include "recording.h"
 
 typedef struct sw_step_ctx {
@@ -580,12 +581,23 @@ static sinew_result step(sinew_instance *inst, float dt) {
     return r;
 }
 
-SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
-    if (!inst || !(dt >= 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
+sinew_result sw_instance_step_bound(sinew_instance *inst, float dt) {
+    if (!(dt >= 0) || !(dt <= 1.0f)) return SINEW_ERROR_INVALID_ARGUMENT;
     sinew_result r = step(inst, dt);
     inst->touched = 1;
     sw_rec_step(inst, dt, r);
     return r;
+}
+
+SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt) {
+    if (!inst) return SINEW_ERROR_INVALID_ARGUMENT;
+    if (inst->shared) {
+        sw_log(&inst->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_INVALID_ARGUMENT,
+               "sinew_instance_step: the instance has no scratch of its own "
+               "(def.shared_workspace): step it with sinew_instance_step_in");
+        return SINEW_ERROR_INVALID_ARGUMENT;
+    }
+    return sw_instance_step_bound(inst, dt);
 }
 
 void sw_instance_step_prepare(sinew_instance *inst, float dt) {

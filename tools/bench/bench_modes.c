@@ -27,6 +27,10 @@ static sinew_result crowd_run(sw_bench_ctx *c, sw_error *err) {
                 "sinew-bench: crowd levels by distance: %.1f full, %.1f reduced, %.1f "
                 "pose-space instances a frame\n",
                 cb->at_level[0], cb->at_level[1], cb->at_level[2]);
+    fprintf(stderr,
+            "sinew-bench: crowd memory: %zu bytes an instance without scratch, %zu a thread's "
+            "workspace, %.1f MB in all\n",
+            cb->instance_bytes, cb->workspace_bytes, cb->crowd_bytes / 1e6);
     return SINEW_OK;
 }
 
@@ -35,9 +39,11 @@ static void crowd_json(const sw_bench_ctx *c) {
     printf(",\"crowd_instances\":%d,\"crowd_threads\":%d,\"crowd_frames\":%d,"
            "\"crowd_ms\":%.4f,\"crowd_us_per_instance\":%.3f,\"crowd_scaling\":%.3f,"
            "\"crowd_vs_lone\":%.3f,\"crowd_ms_1thread\":%.4f,\"crowd_lone_ms\":%.4f,"
-           "\"crowd_lone_median_ms\":%.4f",
+           "\"crowd_lone_median_ms\":%.4f,\"crowd_instance_bytes\":%zu,"
+           "\"crowd_workspace_bytes\":%zu,\"crowd_bytes\":%.0f",
            cb->instances, cb->threads, cb->frames, cb->ms, cb->us_per_instance, cb->scaling,
-           cb->vs_lone, cb->ms_1thread, cb->lone_ms, cb->lone_median_ms);
+           cb->vs_lone, cb->ms_1thread, cb->lone_ms, cb->lone_median_ms, cb->instance_bytes,
+           cb->workspace_bytes, cb->crowd_bytes);
     if (cb->lod_auto)
         printf(",\"crowd_lod\":\"auto\",\"crowd_at_level\":[%.2f,%.2f,%.2f]", cb->at_level[0],
                cb->at_level[1], cb->at_level[2]);

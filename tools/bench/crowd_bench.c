@@ -1,6 +1,8 @@
 /* sinew-bench --instances N (crowd_bench.h): the host side of a crowd. The library's step
  * stays lock-free; the workers here meet at a mutex/condition barrier twice a frame (the
- * frame's start and end), as a game's job system would around its skinning jobs. */
+ * frame's start and end), as a game's job system would around its skinning jobs. The
+ * instances keep no scratch (def.shared_workspace): each worker steps whichever it takes
+ * in its own workspace. */
 #include "crowd_bench.h"
 
 #include <math.h>
@@ -79,6 +81,8 @@ typedef struct crowd {
     const sinew_blob *blob;
     int lod_auto; /* levels by distance */
     member *m;
+    sinew_workspace **ws; /* one a thread */
+    int nws;
     int n, nf;
     uint32_t ns;
     float dt;
@@ -89,16 +93,17 @@ typedef struct crowd {
 
 typedef struct worker {
     crowd *c;
+    sinew_workspace *ws; /* the scratch of the instances this worker steps */
     long failed;
     pthread_t th;
 } worker;
 
 /* An instance's frame: the work the bench times for a lone instance (sub_ms). */
-static int member_frame(const crowd *c, member *m, int frame) {
+static int member_frame(const crowd *c, member *m, int frame, sinew_workspace *ws) {
     int f = (frame + m->offset) % c->nf;
     if (c->lod_auto) sinew_instance_set_lod(m->inst, member_lod(c->blob, m, frame));
     sw_instance_set_pose_d(m->inst, c->ch->clip.T + (size_t)f * 12 * c->ch->skel.nbones);
-    int failed = sinew_instance_step(m->inst, c->dt) != SINEW_OK;
+    int failed = sinew_instance_step_in(m->inst, ws, c->dt) != SINEW_OK;
     sinew_instance_read_surface(m->inst, m->pos, m->nrm, c->ns);
     return failed;
 }
@@ -108,7 +113,7 @@ static int member_frame(const crowd *c, member *m, int frame) {
 static void step_share(worker *w) {
     long failed = 0;
     for (int i; (i = atomic_fetch_add_explicit(&w->c->next, 1, memory_order_relaxed)) < w->c->n;)
-        failed += member_frame(w->c, &w->c->m[i], w->c->frame);
+        failed += member_frame(w->c, &w->c->m[i], w->c->frame, w->ws);
     w->failed += failed;
 }
 
@@ -124,10 +129,12 @@ static void *worker_main(void *p) {
 
 /* The crowd from rest on T threads (the main thread is worker 0): `warm` untimed frames,
  * then ms[0 .. frames-1], each frame's wall ms for all instances. */
-static sinew_result crowd_run(crowd *c, int T, int warm, int frames, double *ms, long *failed,
-                              sw_error *err) {
+static sinew_result crowd_run(crowd *c, int T, sinew_workspace **ws, int warm, int frames,
+                              double *ms, long *failed, sw_error *err) {
     worker *w = calloc((size_t)T, sizeof *w);
     if (!w) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
+    for (int t = 0; t < T; ++t)
+        w[t].ws = ws[t];
     for (int i = 0; i < c->n; ++i)
         sinew_instance_reset(c->m[i].inst);
     c->quit = 0;
@@ -165,6 +172,9 @@ static sinew_result crowd_run(crowd *c, int T, int warm, int frames, double *ms,
 }
 
 static void crowd_free(crowd *c) {
+    for (int t = 0; c->ws && t < c->nws; ++t)
+        sinew_workspace_destroy(c->ws[t]);
+    free(c->ws);
     for (int i = 0; c->m && i < c->n; ++i) {
         sinew_instance_destroy(c->m[i].inst);
         free(c->m[i].pos);
@@ -177,8 +187,8 @@ static void crowd_free(crowd *c) {
     pthread_cond_destroy(&c->done.cv);
 }
 
-static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, int n, int lod_auto,
-                               crowd *c, sw_error *err) {
+static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, int n, int T,
+                               int lod_auto, crowd *c, sw_error *err) {
     memset(c, 0, sizeof *c);
     c->ch = ch;
     c->blob = blob;
@@ -192,7 +202,17 @@ static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, i
     pthread_mutex_init(&c->done.mu, NULL);
     pthread_cond_init(&c->done.cv, NULL);
     c->m = calloc((size_t)n, sizeof *c->m);
-    if (!c->m) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
+    c->ws = calloc((size_t)T, sizeof *c->ws);
+    if (!c->m || !c->ws)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
+    sinew_instance_def d = sinew_instance_def_default();
+    d.shared_workspace = 1;
+    for (; c->nws < T; ++c->nws) {
+        sinew_result r = sinew_workspace_create(blob, &d, &c->ws[c->nws]);
+        if (r != SINEW_OK)
+            return sw_error_set(err, r, "cannot create crowd workspace %d of %d: %s", c->nws + 1, T,
+                                sinew_result_string(r));
+    }
     for (int i = 0; i < n; ++i) {
         member *m = &c->m[i];
         m->offset = (int)((long)i * c->nf / n);
@@ -201,7 +221,7 @@ static sinew_result crowd_make(const sw_character *ch, const sinew_blob *blob, i
         m->nrm = malloc(sizeof(float) * 3 * c->ns);
         if (!m->pos || !m->nrm)
             return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the crowd");
-        sinew_result r = sinew_instance_create(blob, NULL, &m->inst);
+        sinew_result r = sinew_instance_create(blob, &d, &m->inst);
         if (r != SINEW_OK)
             return sw_error_set(err, r, "cannot create crowd instance %d of %d: %s", i + 1, n,
                                 sinew_result_string(r));
@@ -230,14 +250,14 @@ sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, 
     out->frames = frames;
     crowd c;
     double *ms = malloc(sizeof(double) * (size_t)frames);
-    sinew_result r = ms ? crowd_make(ch, blob, instances, lod_auto, &c, err)
+    sinew_result r = ms ? crowd_make(ch, blob, instances, T, lod_auto, &c, err)
                         : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory");
     if (r == SINEW_OK) { /* a lone instance: instance 0's motion, nothing else running */
         member *m0 = &c.m[0];
         sinew_instance_reset(m0->inst);
         for (int f = 0; f < CROWD_WARMUP + frames; ++f) {
             double t0 = sw_now_seconds();
-            out->failed += member_frame(&c, m0, f);
+            out->failed += member_frame(&c, m0, f, c.ws[0]);
             if (f >= CROWD_WARMUP) ms[f - CROWD_WARMUP] = 1e3 * (sw_now_seconds() - t0);
         }
         double sum = 0;
@@ -245,13 +265,21 @@ sinew_result sw_crowd_bench_run(const sw_character *ch, const sinew_blob *blob, 
             sum += ms[f];
         out->lone_ms = sum / frames;
         out->lone_median_ms = sw_median(ms, frames);
-        r = crowd_run(&c, 1, CROWD_WARMUP, frames, ms, &out->failed, err);
+        r = crowd_run(&c, 1, c.ws, CROWD_WARMUP, frames, ms, &out->failed, err);
     }
     if (r == SINEW_OK) {
         out->ms_1thread = sw_median(ms, frames);
-        r = crowd_run(&c, T, CROWD_WARMUP, frames, ms, &out->failed, err);
+        r = crowd_run(&c, T, c.ws, CROWD_WARMUP, frames, ms, &out->failed, err);
     }
     if (r == SINEW_OK) {
+        sinew_instance_def d = sinew_instance_def_default();
+        d.shared_workspace = 1;
+        size_t ib = 0, wb = 0;
+        sinew_instance_memory_size(blob, &d, &ib);
+        sinew_workspace_memory_size(blob, &d, &wb);
+        out->instance_bytes = ib;
+        out->workspace_bytes = wb;
+        out->crowd_bytes = (double)ib * instances + (double)wb * T;
         out->ms = sw_median(ms, frames);
         out->us_per_instance = 1e3 * out->ms / instances;
         out->scaling = out->ms > 0 ? out->ms_1thread / out->ms : 0;

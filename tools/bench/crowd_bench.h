@@ -5,7 +5,8 @@
  * i * (clip frames) / N frames, so the crowd is not in lockstep (fixed shares left one
  * worker with more of the clip's costly contact frames than the other). The
  * crowd runs twice, on 1 thread and on T; a lone instance (instance 0's motion, alone)
- * is timed in the same run for comparison. */
+ * is timed in the same run for comparison. The instances keep no scratch of their own
+ * (def.shared_workspace): each thread steps those it takes in its workspace. */
 #ifndef SW_CROWD_BENCH_H
 #define SW_CROWD_BENCH_H
 
@@ -28,6 +29,9 @@ typedef struct sw_crowd_bench {
     long failed;               /* steps that did not return SINEW_OK */
     int lod_auto;              /* levels by distance from a walking camera */
     double at_level[3];        /* instances at each level (sinew_lod), a frame's mean */
+    size_t instance_bytes;     /* an instance without scratch (def.shared_workspace) */
+    size_t workspace_bytes;    /* a thread's workspace */
+    double crowd_bytes;        /* N instances and T workspaces */
 } sw_crowd_bench;
 
 /* Runs the crowd of `instances` (1..4096) instances of `blob` over ch's clip on 1 thread

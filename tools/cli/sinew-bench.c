@@ -103,6 +103,9 @@
  *                     instance stepped alone in the same run over the same clip frames
  *   crowd_ms_1thread, crowd_lone_ms, crowd_lone_median_ms, crowd_frames (timed frames,
  *                     after a warm-up)
+ *   crowd_instance_bytes, crowd_workspace_bytes  an instance without scratch of its own
+ *                     (def.shared_workspace) and a thread's workspace; crowd_bytes: N of
+ *                     the one and T of the other
  * Always: instance_bytes (sinew_instance_memory_size with the default def) and
  * blob_bytes (the blob file's size with --blob, else the size of the blob just baked).
  * The optional runs (--instances, --sc-compare, --newton-compare, --error-gap, --world,

@@ -162,8 +162,31 @@ SINEW_API sinew_result sinew_instance_mark_teleport(sinew_instance *inst);
  * (a non-finite solve, or an output surface beyond float range) is undone and reported
  * as SINEW_ERROR_NOT_FINITE with SINEW_STEP_FAILED: the reduced state goes back to the
  * step's start with no velocity, the surface is that state's at the current pose, and
- * the pose counts as the last one for the next step's jump test. */
+ * the pose counts as the last one for the next step's jump test. INVALID_ARGUMENT for an
+ * instance with a shared workspace (def.shared_workspace: sinew_instance_step_in). */
 SINEW_API sinew_result sinew_instance_step(sinew_instance *inst, float dt);
+
+/** Creates a step workspace for instances of `blob` (which must outlive it): the scratch
+ * a step computes afresh and no later call reads, reserved in one block through the
+ * def's allocator (or the blob's), sized for instances of `def` (NULL: the default;
+ * its max_patch_vertices decides whether patches fit). Instances created with
+ * def.shared_workspace = 1 step in it through sinew_instance_step_in; instances that
+ * share one must never step at the same time (one workspace per worker thread; any
+ * instance may step in any thread's workspace, with bitwise the same result). */
+SINEW_API sinew_result sinew_workspace_create(const sinew_blob *blob, const sinew_instance_def *def,
+                                              sinew_workspace **out);
+
+/** The bytes sinew_workspace_create reserves for `blob` under `def` (NULL: the default). */
+SINEW_API sinew_result sinew_workspace_memory_size(const sinew_blob *blob,
+                                                   const sinew_instance_def *def, size_t *bytes);
+
+/** Releases a workspace (NULL is allowed); no step may be using it. */
+SINEW_API void sinew_workspace_destroy(sinew_workspace *ws);
+
+/** sinew_instance_step in the workspace `ws` instead of the instance's own scratch (the
+ * only way to step an instance created with def.shared_workspace = 1). INVALID_ARGUMENT
+ * when `ws` was made for another blob, or without patches for an instance with them. */
+SINEW_API sinew_result sinew_instance_step_in(sinew_instance *inst, sinew_workspace *ws, float dt);
 
 /** The levels of detail `blob` holds: 3 when it has the pose-space level (sinew-bake
  * writes it), else 2 (SINEW_LOD_FULL and SINEW_LOD_REDUCED); 0 for NULL. */

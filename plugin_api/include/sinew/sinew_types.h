@@ -31,6 +31,10 @@ typedef struct sinew_blob sinew_blob;
 /** One simulated character: pose, state and all its scratch memory (opaque). */
 typedef struct sinew_instance sinew_instance;
 
+/** A step's scratch memory, lent to instances of one blob that never step at the same
+ * time (opaque; sinew_workspace_create): one per worker thread in a crowd. */
+typedef struct sinew_workspace sinew_workspace;
+
 /** The static and moving colliders instances collide with (opaque; sinew_world.h). */
 typedef struct sinew_world sinew_world;
 
@@ -237,6 +241,12 @@ typedef struct sinew_instance_def {
      * on the step writes it anyway. It costs the boundary's mapping a step. 0 (the
      * default): off. */
     uint32_t collision_surface;
+    /** The step's scratch: 0 (the default) reserves it in the instance; 1 reserves none
+     * (sinew_instance_memory_size then counts only the state, a small part of it at high
+     * rank: the reduced Hessian and its factor, rank squared each, are scratch) and the
+     * instance steps only through sinew_instance_step_in, in a workspace made for its
+     * blob with patches if it has them (sinew_workspace_create). */
+    uint32_t shared_workspace;
 } sinew_instance_def;
 
 /** A sinew_instance_def with every field at its default. */
@@ -262,6 +272,7 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
     d.profiler.user = NULL;
     d.novel_contact = 0;
     d.collision_surface = 0;
+    d.shared_workspace = 0;
     return d;
 }
 
