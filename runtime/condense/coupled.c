@@ -161,6 +161,7 @@ static void add_pair_ring_blocks(sw_cond *c, sw_reduced *red, int32_t e, const d
             const sw_blob_domain *Da = &c->v->domains[c->ring_d[ka]],
                                  *Db = &c->v->domains[c->ring_d[kb]];
             const double *Ja = ring_J(c, ka), *Jb = ring_J(c, kb);
+            sw_reduced_mark(red, Da, Db);
             for (int32_t p = 0; p < Da->rank; ++p)
                 for (int32_t q = 0; q < Db->rank; ++q) {
                     double acc = 0;

@@ -99,6 +99,7 @@ static double contact_pairs(sw_reduced *red, const sw_pair_set *set, const int32
                 const sw_blob_domain *Da = D[leads[a]], *Db = D[leads[b]];
                 int32_t ra = Da->rank, rb = Db->rank;
                 const double *Ga = red->Jc + 3 * leads[a] * rm, *Pb = red->hc + 3 * b * rm;
+                sw_reduced_mark(red, Da, Db);
                 for (int32_t i = 0; i < ra; ++i) {
                     double *Hi = red->H + (int64_t)(Da->q_offset + i) * red->R + Db->q_offset;
                     double g0 = kk * Ga[i], g1 = kk * Ga[ra + i], g2 = kk * Ga[2 * ra + i];

@@ -1,5 +1,7 @@
 #include "reduced_map.h"
 
+#include <string.h>
+
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq) {
     const sw_blob_view *v = m->v;
     m->bone_dq = bone_dq;
@@ -39,4 +41,27 @@ void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t l
     for (int i = 0; i < 3; ++i)
         x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
     if (J) sw_reduced_jacobian(m, D, lv, a, J);
+}
+
+void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *dst_nz,
+                            const double *src, const unsigned char *src_nz) {
+    const int32_t nd = v->ndomains;
+    const int64_t R = v->rank_total;
+    for (int32_t a = 0; a < nd; ++a) {
+        const sw_blob_domain *Da = &v->domains[a];
+        for (int32_t b = 0; b < nd; ++b) {
+            int from = a == b || src_nz[a * nd + b];
+            if (!from && !dst_nz[a * nd + b]) continue;
+            const sw_blob_domain *Db = &v->domains[b];
+            size_t bytes = (size_t)Db->rank * sizeof(double);
+            for (int64_t i = Da->q_offset; i < Da->q_offset + Da->rank; ++i) {
+                double *d = dst + i * R + Db->q_offset;
+                if (from)
+                    memcpy(d, src + i * R + Db->q_offset, bytes);
+                else
+                    memset(d, 0, bytes);
+            }
+        }
+    }
+    memcpy(dst_nz, src_nz, (size_t)nd * nd);
 }

@@ -41,6 +41,13 @@ typedef struct sw_reduced {
     double *act_R, *act_t;           /* 9 and 3 per active vertex: its skinning transform */
     double *g;                       /* R: gradient accumulator */
     double *H;                       /* R x R: Hessian accumulator */
+    /* ndomains^2: the domain blocks of H that may be nonzero; H is exact zeros in every
+     * other block, so that the Hessian starts from the springs' by copying their blocks
+     * and clearing those marked (sw_reduced_blocks_copy) instead of all R^2 entries.
+     * Diagonal blocks always may be. Whatever adds to an off-diagonal block marks it
+     * (sw_reduced_mark). spring_adj: the springs' off-diagonal blocks (sw_solver.blk_adj). */
+    unsigned char *H_nz;
+    const unsigned char *spring_adj;
     /* Scratch of each task worker w < nworkers (one without task callbacks): */
     double *hm;       /* 10 x rmax at hm + 10 rmax w: its J^T f and J^T g_k (cubature.c) */
     double *ecub;     /* ncub: each cubature tet's weighted energy */
@@ -69,6 +76,21 @@ void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
  * when J is not NULL. */
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J);
+
+/* dst := src for R x R matrices known to be exact zeros outside their domain blocks marked
+ * in dst_nz and src_nz (ndomains^2 each; diagonal blocks always count as marked): the
+ * blocks src_nz marks are copied, those dst_nz alone marks cleared, and dst_nz := src_nz.
+ * Bitwise a full copy, at the cost of the marked blocks. */
+void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *dst_nz,
+                            const double *src, const unsigned char *src_nz);
+
+/* Marks the blocks (a, b) and (b, a) of the Hessian as possibly nonzero (H_nz). */
+static inline void sw_reduced_mark(sw_reduced *m, const sw_blob_domain *a,
+                                   const sw_blob_domain *b) {
+    int32_t nd = m->v->ndomains, ia = (int32_t)(a - m->v->domains),
+            ib = (int32_t)(b - m->v->domains);
+    m->H_nz[ia * nd + ib] = m->H_nz[ib * nd + ia] = 1;
+}
 
 /* That copy's Jacobian J = R U alone (3 x r_d, row-major). */
 void sw_reduced_jacobian(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,

@@ -497,6 +497,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     layout(&plan, in, v, &z);
     in->v = v;
     in->shared = z.shared;
+    sw_scratch_clear(&in->own, v);
     sw_scratch_bind(in, &in->own);
     in->allocator = d.allocator;
     in->mode = d.mode;
@@ -556,6 +557,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->solver.max_newton = d.max_newton_iters ? d.max_newton_iters : 5;
     in->solver.dq_tiny = 1e-9 * in->size;
     sw_solver_order_blocks(&in->solver, v);
+    in->red.spring_adj = in->solver.blk_adj;
     double share;
     choose_newton_hessian(in, d.newton_hessian, &share);
     in->logger = d.logger;

@@ -32,7 +32,12 @@ typedef struct sw_scratch {
     double *Hq;                  /* R x R: the patch's copy of H (cond.Hq; condensation only) */
     double *act_R, *act_t;       /* 9 and 3 per active vertex: their skinning (red) */
     double *corner_x, *corner_f; /* 3 per cubature corner each (red) */
+    unsigned char *H_nz, *Hn_nz; /* ndomains^2: H's and Hn's blocks that may be nonzero */
 } sw_scratch;
+
+/* Marks every block of the scratch's matrices as possibly nonzero: their first copies
+ * write every block (a new scratch's memory holds anything). */
+void sw_scratch_clear(sw_scratch *sc, const sw_blob_view *v);
 
 /* Sizes of an instance's layout that the blob alone does not fix (instance.c). */
 typedef struct sw_layout_sizes {

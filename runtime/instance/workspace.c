@@ -28,6 +28,15 @@ void sw_scratch_layout(sw_mem_plan *p, sw_scratch *sc, const sw_blob_view *v,
     SW_PLAN_TAKE(p, sc->act_t, 3 * na);
     SW_PLAN_TAKE(p, sc->corner_x, 3 * nc);
     SW_PLAN_TAKE(p, sc->corner_f, 3 * nc);
+    const uint64_t nd = (uint64_t)v->ndomains;
+    SW_PLAN_TAKE(p, sc->H_nz, nd * nd);
+    SW_PLAN_TAKE(p, sc->Hn_nz, z->dynamic ? nd * nd : 0);
+}
+
+void sw_scratch_clear(sw_scratch *sc, const sw_blob_view *v) {
+    size_t n = (size_t)v->ndomains * (size_t)v->ndomains;
+    if (sc->H_nz) memset(sc->H_nz, 1, n);
+    if (sc->Hn_nz) memset(sc->Hn_nz, 1, n);
 }
 
 void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc) {
@@ -39,6 +48,8 @@ void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc) {
     in->red.act_t = sc->act_t;
     in->red.corner_x = sc->corner_x;
     in->red.corner_f = sc->corner_f;
+    in->red.H_nz = sc->H_nz;
+    in->solver.Hn_nz = sc->Hn_nz;
 }
 
 /* The workspace's layout: the struct, then its scratch. */
@@ -87,6 +98,7 @@ SINEW_API sinew_result sinew_workspace_create(const sinew_blob *blob, const sine
     plan = (sw_mem_plan){block, 0, 0};
     layout(&plan, ws, v, &z);
     ws->blob = blob;
+    sw_scratch_clear(&ws->sc, v);
     ws->allocator = d.allocator;
     *out = ws;
     return SINEW_OK;

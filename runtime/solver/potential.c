@@ -68,12 +68,14 @@ static void mass_matvec(const sw_blob_view *v, const sw_solver *s, const double 
 
 /* H += cm M + cd (alpha M + beta H(q_s)) over the blocks where M or H(q_s) may be nonzero
  * (elsewhere both are exact zeros, and so is what the dense sum would add). */
-static void add_dynamic_hessian(const sw_blob_view *v, const sw_solver *s, const sw_dyn_coef *dc,
-                                double *H) {
+static void add_dynamic_hessian(sw_reduced *red, const sw_solver *s, const sw_dyn_coef *dc) {
+    const sw_blob_view *v = red->v;
     int32_t R = v->rank_total, nd = v->ndomains;
+    double *H = red->H;
     for (int32_t a = 0; a < nd; ++a)
         for (int32_t b = 0; b < nd; ++b) {
             if (s->mass_blockdiag && !block_in(s, nd, BLOCKS_STEP, a, b)) continue;
+            sw_reduced_mark(red, &v->domains[a], &v->domains[b]);
             for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i)
                 for (int32_t j = s->blk_off[b]; j < s->blk_off[b] + s->blk_size[b]; ++j) {
                     int64_t k = (int64_t)i * R + j;
@@ -88,7 +90,7 @@ double sw_potential_material(sw_reduced *red, const sw_pose_space *ps, const dou
     int32_t R = red->R;
     const sw_blob_view *v = red->v;
     if (want_grad) memset(red->g, 0, (size_t)R * sizeof(double));
-    if (want_hess) memcpy(red->H, v->spring_hessian, (size_t)R * R * sizeof(double));
+    if (want_hess) sw_reduced_blocks_copy(v, red->H, red->H_nz, v->spring_hessian, red->spring_adj);
     double phi = sw_cubature_eval(red, q, want_grad, want_hess);
     double t0 = self_seconds ? sw_now_seconds() : 0;
     phi += sw_pose_contact_eval(red, ps, q, want_grad, want_hess);
@@ -139,7 +141,7 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
         for (int32_t i = 0; i < R; ++i)
             red->g[i] += dc->cd * dc->beta * s->tmp[i] - s->fin[i];
     phi += 0.5 * dc->cd * (dc->alpha * dm + dc->beta * dk) - sw_dot(q, s->fin, R);
-    if (want_hess) add_dynamic_hessian(v, s, dc, red->H);
+    if (want_hess) add_dynamic_hessian(red, s, dc);
     return phi;
 }
 
@@ -157,7 +159,7 @@ double sw_potential_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver
     s->mat_at_start = 0;
     *cubature_pass = !at;
     if (!at) return sw_potential(red, ct, s, s->q, dc, 1, want_hess);
-    memcpy(red->H, s->Hn, (size_t)R * R * sizeof(double));
+    sw_reduced_blocks_copy(red->v, red->H, red->H_nz, s->Hn, s->Hn_nz);
     memcpy(red->g, s->g_mat, (size_t)R * sizeof(double));
     return sw_potential_rest(red, ct, s, s->q, dc, s->phi_mat, 1, want_hess);
 }

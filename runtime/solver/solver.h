@@ -23,6 +23,7 @@ typedef struct sw_solver {
      * Hessian at q_s, or with rest_first the reference Hessian): the Rayleigh stiffness
      * damping, frozen for the step (step.c, dynamic_start) */
     double *Hn;
+    unsigned char *Hn_nz; /* ndomains^2: Hn's blocks that may be nonzero (sw_reduced.H_nz) */
     /* The material part of Phi at q_mat = q_s (sw_potential_material: its value, gradient
      * and, in Hn, Hessian), valid for the step's first evaluation when mat_at_start: a
      * dynamic step evaluates it for Hn, and Newton starts there. */
