@@ -2,12 +2,15 @@
  * pkg-config, see samples/host/CMakeLists.txt and README.md "Linking"), it checks that
  * the library it loaded accepts the headers it was compiled with, prints the version
  * and a result string, and, given a blob path, loads the blob, creates an instance,
- * steps it once in its rest pose, reads the surface back, and hands its collision
- * surface to a world as the mesh collider another character would collide with.
+ * steps it once in its rest pose, reads the surface back, steps a second instance that
+ * keeps no scratch of its own in a workspace (as a crowd's worker threads do) and checks
+ * it gives the same surface, and hands its collision surface to a world as the mesh
+ * collider another character would collide with.
  *
  * usage: sinew-host [BLOB]      exit 0 on success, 1 on any failure */
 #include <stdio.h>
 #include <stdlib.h>
+#include <string.h>
 
 #include <sinew/sinew.h>
 #include <sinew/sinew_world.h>
@@ -44,6 +47,42 @@ static int host_collider(const sinew_blob *blob, const sinew_instance *inst) {
     free(x);
     free(tris);
     return r == SINEW_OK;
+}
+
+/* An instance without scratch of its own (def.shared_workspace) stepped in a workspace,
+ * as a crowd's worker thread steps the instances it takes: the same surface, bitwise, as
+ * `positions` of the instance with its own scratch. */
+static int host_workspace(const sinew_blob *blob, const float *transforms, const float *positions) {
+    sinew_instance_def d = sinew_instance_def_default();
+    sinew_workspace *ws = NULL;
+    sinew_instance *inst = NULL;
+    uint32_t verts = sinew_blob_surface_vertex_count(blob), bones = sinew_blob_bone_count(blob);
+    size_t state = 0, scratch = 0;
+    float *x = calloc((size_t)verts * 3u + 1u, sizeof *x);
+    sinew_result r = x ? SINEW_OK : SINEW_ERROR_OUT_OF_MEMORY;
+    int same = 0;
+    d.collision_surface = 1;
+    d.shared_workspace = 1;
+    if (r == SINEW_OK) r = sinew_workspace_create(blob, &d, &ws);
+    if (r == SINEW_OK) r = sinew_instance_create(blob, &d, &inst);
+    if (r == SINEW_OK) r = sinew_instance_set_pose(inst, transforms, bones);
+    if (r == SINEW_OK) r = sinew_instance_step_in(inst, ws, 1.0f / 60.0f);
+    if (r == SINEW_OK) r = sinew_instance_read_surface(inst, x, NULL, verts);
+    if (r == SINEW_OK) r = sinew_instance_memory_size(blob, &d, &state);
+    if (r == SINEW_OK) r = sinew_workspace_memory_size(blob, &d, &scratch);
+    if (r == SINEW_OK) same = memcmp(x, positions, (size_t)verts * 3u * sizeof *x) == 0;
+    if (r != SINEW_OK)
+        fprintf(stderr, "host: workspace: %s\n", sinew_result_string(r));
+    else if (!same)
+        fprintf(stderr, "host: the instance stepped in a workspace gave another surface\n");
+    else
+        printf("host: stepped in a workspace: the same surface; %lu bytes an instance, %lu "
+               "the workspace\n",
+               (unsigned long)state, (unsigned long)scratch);
+    sinew_instance_destroy(inst);
+    sinew_workspace_destroy(ws);
+    free(x);
+    return r == SINEW_OK && same;
 }
 
 static int host_run_blob(const char *path) {
@@ -89,7 +128,7 @@ static int host_run_blob(const char *path) {
     }
     printf("host: %s: %u bones, %u surface vertices, stepped once\n", path, (unsigned)bones,
            (unsigned)verts);
-    ok = host_collider(blob, inst);
+    ok = host_workspace(blob, transforms, positions) && host_collider(blob, inst);
 done:
     free(positions);
     free(transforms);
