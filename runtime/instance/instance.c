@@ -385,6 +385,16 @@ sinew_result sw_instance_read_def(const sinew_blob *blob, const sinew_instance_d
     return SINEW_OK;
 }
 
+unsigned char *sw_instance_reserve(const sw_mem_plan *plan, const sinew_instance_def *d,
+                                   const char *caller) {
+    unsigned char *block =
+        plan->overflow ? NULL : sw_alloc(&d->allocator, sw_plan_size(plan), SW_ALLOC_ALIGN);
+    if (!block)
+        sw_log(&d->logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_OUT_OF_MEMORY,
+               "%s: out of memory (%zu bytes)", caller, sw_plan_size(plan));
+    return block;
+}
+
 SINEW_API sinew_result sinew_instance_memory_size(const sinew_blob *blob,
                                                   const sinew_instance_def *def, size_t *bytes) {
     if (!blob || !bytes) return SINEW_ERROR_INVALID_ARGUMENT;
@@ -485,13 +495,8 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     sinew_instance sized;
     sw_mem_plan plan = {NULL, 0, 0};
     layout(&plan, &sized, v, &z);
-    unsigned char *block =
-        plan.overflow ? NULL : sw_alloc(&d.allocator, sw_plan_size(&plan), SW_ALLOC_ALIGN);
-    if (!block) {
-        sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_OUT_OF_MEMORY,
-               "sinew_instance_create: out of memory (%zu bytes)", sw_plan_size(&plan));
-        return SINEW_ERROR_OUT_OF_MEMORY;
-    }
+    unsigned char *block = sw_instance_reserve(&plan, &d, "sinew_instance_create");
+    if (!block) return SINEW_ERROR_OUT_OF_MEMORY;
     sinew_instance *in = (sinew_instance *)(void *)block;
     plan = (sw_mem_plan){block, 0, 0};
     layout(&plan, in, v, &z);

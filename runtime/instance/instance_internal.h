@@ -65,6 +65,11 @@ typedef struct sw_layout_sizes {
 sinew_result sw_instance_read_def(const sinew_blob *blob, const sinew_instance_def *def,
                                   const char *caller, sinew_instance_def *d, sw_layout_sizes *z);
 
+/* The block a sized plan asks for, through the def's allocator; NULL when the plan
+ * overflowed or the allocator failed (logged as `caller`'s). */
+unsigned char *sw_instance_reserve(const struct sw_mem_plan *plan, const sinew_instance_def *d,
+                                   const char *caller);
+
 /* Places a scratch's arrays in the plan (workspace.c; base NULL: sizes only). */
 void sw_scratch_layout(struct sw_mem_plan *p, sw_scratch *sc, const sw_blob_view *v,
                        const sw_layout_sizes *z);

@@ -87,13 +87,8 @@ SINEW_API sinew_result sinew_workspace_create(const sinew_blob *blob, const sine
     sinew_workspace sized;
     sw_mem_plan plan = {NULL, 0, 0};
     layout(&plan, &sized, v, &z);
-    unsigned char *block =
-        plan.overflow ? NULL : sw_alloc(&d.allocator, sw_plan_size(&plan), SW_ALLOC_ALIGN);
-    if (!block) {
-        sw_log(&d.logger, SINEW_LOG_ERROR, SINEW_MSG_INSTANCE_OUT_OF_MEMORY,
-               "sinew_workspace_create: out of memory (%zu bytes)", sw_plan_size(&plan));
-        return SINEW_ERROR_OUT_OF_MEMORY;
-    }
+    unsigned char *block = sw_instance_reserve(&plan, &d, "sinew_workspace_create");
+    if (!block) return SINEW_ERROR_OUT_OF_MEMORY;
     sinew_workspace *ws = (sinew_workspace *)(void *)block;
     plan = (sw_mem_plan){block, 0, 0};
     layout(&plan, ws, v, &z);
