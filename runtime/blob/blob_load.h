@@ -27,6 +27,7 @@
 #include <stddef.h>
 #include <stdint.h>
 
+#include "blob_active.h"
 #include "blob_collision.h"
 #include "blob_pose_index.h"
 #include "blob_view.h"
@@ -58,6 +59,7 @@ struct sinew_blob {
     sinew_allocator allocator; /* frees this struct */
     sinew_logger logger;
     sw_pose_index poses;  /* the training poses' neighbourhood, in this struct's block */
+    sw_active_map act;    /* the subspace map's tables (blob_active.h), in the same block */
     sw_coll_surface coll; /* the collision surface (blob_collision.h), its own block */
 };
 

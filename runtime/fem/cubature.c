@@ -157,40 +157,6 @@ static double *ref_block(const sw_reduced *m, int32_t k) {
     return m->h_ref + off;
 }
 
-/* ---- the cubature tets' corners ---------------------------------------------------- */
-
-enum { CORNER_CHUNK = 1 << 16 };
-
-int32_t sw_cubature_corners(const sw_blob_view *v, sw_reduced *m) {
-    uint64_t bits[CORNER_CHUNK / 64];
-    int32_t n = 0;
-    for (int32_t k = 0; k < v->ndomains; ++k) {
-        const sw_blob_domain *D = &v->domains[k];
-        if (m) m->corner_begin[k] = n;
-        for (int32_t lo = 0; lo < D->vert_count; lo += CORNER_CHUNK) {
-            memset(bits, 0, sizeof bits);
-            for (int32_t i = 4 * D->cub_begin; i < 4 * (D->cub_begin + D->cub_count); ++i) {
-                int32_t lv = v->cub_tets[i] - lo;
-                if (lv >= 0 && lv < CORNER_CHUNK) bits[lv / 64] |= 1ull << (lv % 64);
-            }
-            for (int32_t i = 0; i < CORNER_CHUNK && lo + i < D->vert_count; ++i)
-                if (bits[i / 64] >> (i % 64) & 1) {
-                    if (m) m->corner_lv[n] = lo + i;
-                    n++;
-                }
-        }
-        if (!m) continue;
-        for (int32_t i = 4 * D->cub_begin; i < 4 * (D->cub_begin + D->cub_count); ++i) {
-            int32_t b = m->corner_begin[k],
-                    c = b + sw_sorted_index(m->corner_lv + b, n - b, v->cub_tets[i]);
-            m->cub_corner[i] = c;
-            m->corner_act[c] = m->cub_act[i]; /* the vertex's, whichever tet names it */
-        }
-    }
-    if (m) m->corner_begin[v->ndomains] = n;
-    return n;
-}
-
 /* Domain k's corners placed at its coordinates qd (corner_x), their summed forces zeroed. */
 static void place_corners(sw_reduced *m, int32_t k, const double *qd) {
     const sw_blob_domain *D = &m->v->domains[k];

@@ -22,12 +22,6 @@
 #define SW_CUB_HESSIAN_REF 3
 double sw_cubature_eval(sw_reduced *m, const double *q, int want_grad, int want_hess);
 
-/* The cubature tets' corners, each (domain, local vertex) once: returns their count, and
- * with m (whose cub_act is filled) lists them in m's corner arrays (reduced_map.h). Sizing
- * (m NULL) needs no memory: a chunk of a domain's vertices at a time in a bit set on the
- * stack. */
-int32_t sw_cubature_corners(const sw_blob_view *v, sw_reduced *m);
-
 /* The cubature's Hessian at the rest shape (q = 0, every skinning rotation the identity:
  * the elements' linear stiffness, eq. 2.12 at F = I), domain k's block (r_k x r_k,
  * row-major) at blocks + sum_{j<k} r_j^2. A tet whose corners turn with one rotation R

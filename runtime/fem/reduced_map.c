@@ -2,6 +2,21 @@
 
 #include <string.h>
 
+void sw_reduced_bind_active(sw_reduced *m, const sw_active_map *a) {
+    m->nact = a->nact;
+    m->nact_step = a->nact_step;
+    m->act_vert = a->act_vert;
+    m->cub_act = a->cub_act;
+    m->ncorner = a->ncorner;
+    m->corner_begin = a->corner_begin;
+    m->corner_lv = a->corner_lv;
+    m->corner_act = a->corner_act;
+    m->cub_corner = a->cub_corner;
+    m->copy_act = a->copy_act;
+    m->contact_act = a->contact_act;
+    m->node_copy_act = a->node_copy_act;
+}
+
 void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq) {
     const sw_blob_view *v = m->v;
     m->bone_dq = bone_dq;

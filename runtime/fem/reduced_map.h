@@ -6,41 +6,38 @@
  * follows those counts, not the mesh.
  *
  * sw_reduced is what every reduced evaluation (cubature, contact, potential) reads and
- * accumulates into; the instance owns its arrays (one memory plan, instance.c). */
+ * accumulates into; the instance owns its arrays (one memory plan, instance.c), except
+ * the active vertices' tables, which are the blob's (blob_active.h). */
 #ifndef SW_REDUCED_MAP_H
 #define SW_REDUCED_MAP_H
 
 #include <stdint.h>
 
+#include "blob_active.h"
 #include "blob_view.h"
 #include "dqs.h"
 #include "sinew/sinew_types.h"
 
 typedef struct sw_reduced {
     const sw_blob_view *v;
-    int32_t R;         /* rank_total: the length of q */
-    int32_t rmax;      /* the largest domain rank */
+    int32_t R;    /* rank_total: the length of q */
+    int32_t rmax; /* the largest domain rank */
+    /* The active vertices and where each reference finds its own: the blob's tables
+     * (blob_active.h, shared by its instances), bound by sw_reduced_bind_active. */
     int32_t nact;      /* active vertices */
-    int32_t nact_step; /* the first nact_step: those every step reads (instance.c) */
-    int32_t *act_vert; /* nact: the global vertex of each, ascending in both parts */
+    int32_t nact_step; /* the first nact_step: those every step reads */
+    const int32_t *act_vert;
     /* The rest, surface copies only, are skinned only when read: with a world attached or
      * (no render mesh) as the output. */
     int skin_surface;
-    int32_t *cub_act; /* 4 ncub: active index of each cubature tet corner */
-    /* The cubature tets' corners, each (domain, local vertex) once (sw_cubature_corners):
-     * a pass places each once and sums the forces of its tets on it (cubature.c). Domain
-     * k's are corner_begin[k] .. corner_begin[k + 1] - 1, in local vertex order. */
+    const int32_t *cub_act;
     int32_t ncorner;
-    int32_t *corner_begin;           /* ndomains + 1 */
-    int32_t *corner_lv, *corner_act; /* ncorner: local vertex and active index */
-    int32_t *cub_corner;             /* 4 ncub: the corner of each cubature tet corner */
-    double *corner_x, *corner_f;     /* 3 ncorner: a pass's positions and summed forces */
-    int32_t *copy_act;               /* nsurf_copies: active index of each surface copy */
-    int32_t *contact_act;            /* 4 ncontacts: active index of p, t0, t1, t2 */
-    int32_t *node_copy_act;          /* nrender_copies: active index of each render node copy */
-    double *act_R, *act_t;           /* 9 and 3 per active vertex: its skinning transform */
-    double *g;                       /* R: gradient accumulator */
-    double *H;                       /* R x R: Hessian accumulator */
+    const int32_t *corner_begin, *corner_lv, *corner_act, *cub_corner;
+    const int32_t *copy_act, *contact_act, *node_copy_act;
+    double *corner_x, *corner_f; /* 3 ncorner: a pass's positions and summed forces */
+    double *act_R, *act_t;       /* 9 and 3 per active vertex: its skinning transform */
+    double *g;                   /* R: gradient accumulator */
+    double *H;                   /* R x R: Hessian accumulator */
     /* ndomains^2: the domain blocks of H that may be nonzero; H is exact zeros in every
      * other block, so that the Hessian starts from the springs' by copying their blocks
      * and clearing those marked (sw_reduced_blocks_copy) instead of all R^2 entries.
@@ -65,6 +62,9 @@ typedef struct sw_reduced {
      * refreshes (cubature.c). NULL where the instance never starts Newton on them. */
     double *h_ref;
 } sw_reduced;
+
+/* Points m at the blob's active map a. */
+void sw_reduced_bind_active(sw_reduced *m, const sw_active_map *a);
 
 /* Skins the active vertices (the first nact_step, or all with skin_surface) with the
  * bones' dual quaternions (act_R, act_t), which m keeps (bone_dq) for vertices skinned on

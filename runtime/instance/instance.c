@@ -14,7 +14,6 @@
 #include "log.h"
 #include "dqs.h"
 #include "mem_plan.h"
-#include "sorted.h"
 
 /* Places the instance and every array it uses in the plan's block, or (base NULL) only
  * sizes them: the one list of the instance's memory. The struct comes first, at the
@@ -22,7 +21,7 @@
 static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
                    const sw_layout_sizes *z) {
     const uint64_t R = (uint64_t)v->rank_total, nb = (uint64_t)v->nbones,
-                   nd = (uint64_t)v->ndomains, na = (uint64_t)z->nact, rm = (uint64_t)z->rmax,
+                   nd = (uint64_t)v->ndomains, rm = (uint64_t)z->rmax,
                    ns = (uint64_t)sw_blob_output_verts(v);
 #define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
     (void)sw_plan_take(p, 1, sizeof *in);
@@ -37,15 +36,6 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(in->L_last, 12 * nb);
     /* the subspace map: active vertices and their skinning, accumulators, Jacobians */
     sw_reduced *m = &in->red;
-    TAKE(m->act_vert, na);
-    TAKE(m->cub_act, 4 * (uint64_t)v->ncub);
-    TAKE(m->corner_begin, nd + 1);
-    TAKE(m->corner_lv, (uint64_t)z->ncorner);
-    TAKE(m->corner_act, (uint64_t)z->ncorner);
-    TAKE(m->cub_corner, 4 * (uint64_t)v->ncub);
-    TAKE(m->copy_act, (uint64_t)v->nsurf_copies);
-    TAKE(m->contact_act, 4 * (uint64_t)v->ncontacts);
-    TAKE(m->node_copy_act, (uint64_t)v->nrender_copies);
     TAKE(m->g, R);
     const uint64_t nw = (uint64_t)z->nworkers;
     TAKE(m->hm, 10 * rm * nw);
@@ -199,95 +189,6 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
 #undef TAKE
 }
 
-/* ---- active vertices ------------------------------------------------------------- */
-
-/* The vertices the step skins: every cubature tet corner, render node copy and pose-space
- * contact vertex (ACT_STEP), and every boundary surface copy (ACT_SURFACE: read only by
- * the world's contact and by the output of a blob without a render mesh), each once.
- * visit() is called with the global vertex of every such reference of the tiers asked
- * for and the slot that receives its active index. */
-enum { ACT_STEP = 1, ACT_SURFACE = 2 };
-typedef void (*visit_fn)(void *ctx, int32_t gv, int32_t *slot);
-
-static void visit_active(const sw_blob_view *v, sw_reduced *m, int tiers, visit_fn visit,
-                         void *ctx) {
-    for (int32_t k = 0; k < v->ndomains && (tiers & ACT_STEP); ++k) {
-        const sw_blob_domain *D = &v->domains[k];
-        for (int32_t c = D->cub_begin; c < D->cub_begin + D->cub_count; ++c)
-            for (int j = 0; j < 4; ++j)
-                visit(ctx, v->domain_verts[D->vert_begin + v->cub_tets[4 * c + j]],
-                      m ? &m->cub_act[4 * c + j] : NULL);
-    }
-    for (int32_t i = 0; i < v->nsurf_copies && (tiers & ACT_SURFACE); ++i) {
-        const sw_blob_domain *D = &v->domains[v->surf_copies[2 * i]];
-        visit(ctx, v->domain_verts[D->vert_begin + v->surf_copies[2 * i + 1]],
-              m ? &m->copy_act[i] : NULL);
-    }
-    for (int32_t i = 0; i < v->nrender_copies && (tiers & ACT_STEP); ++i) {
-        const sw_blob_domain *D = &v->domains[v->render_node_copies[2 * i]];
-        visit(ctx, v->domain_verts[D->vert_begin + v->render_node_copies[2 * i + 1]],
-              m ? &m->node_copy_act[i] : NULL);
-    }
-    for (int32_t c = 0; c < v->ncontacts && (tiers & ACT_STEP); ++c)
-        for (int k = 0; k < 4; ++k) {
-            const sw_blob_domain *D = &v->domains[v->contact_verts[8 * c + 2 * k]];
-            visit(ctx, v->domain_verts[D->vert_begin + v->contact_verts[8 * c + 2 * k + 1]],
-                  m ? &m->contact_act[4 * c + k] : NULL);
-        }
-}
-
-/* Active vertices are found a chunk of the mesh's vertices at a time in bit sets on
- * the stack, so that sizing needs no memory at all. */
-enum { CHUNK = 1 << 16 };
-typedef struct {
-    int32_t lo;
-    uint64_t bits[CHUNK / 64];
-} chunk_marks;
-
-static void mark_in_chunk(void *ctx, int32_t gv, int32_t *slot) {
-    chunk_marks *c = ctx;
-    (void)slot;
-    if (gv >= c->lo && gv - c->lo < CHUNK)
-        c->bits[(gv - c->lo) / 64] |= 1ull << ((gv - c->lo) % 64);
-}
-
-/* The number of active vertices, and in *nstep those of ACT_STEP. With act_vert (and
- * nstep the count sizing found), also their global ids: ACT_STEP's ascending in
- * [0, nstep), then the surface copies' that are not among them, ascending. */
-static int32_t active_vertices(const sw_blob_view *v, int32_t *act_vert, int32_t *nstep) {
-    chunk_marks cs, cf;
-    int32_t ns = 0, nf = 0, base = act_vert ? *nstep : 0;
-    for (cs.lo = 0; cs.lo < v->nverts; cs.lo += CHUNK) {
-        cf.lo = cs.lo;
-        memset(cs.bits, 0, sizeof cs.bits);
-        memset(cf.bits, 0, sizeof cf.bits);
-        visit_active(v, NULL, ACT_STEP, mark_in_chunk, &cs);
-        visit_active(v, NULL, ACT_SURFACE, mark_in_chunk, &cf);
-        for (int32_t i = 0; i < CHUNK && cs.lo + i < v->nverts; ++i) {
-            int in_step = cs.bits[i / 64] >> (i % 64) & 1,
-                in_surf = cf.bits[i / 64] >> (i % 64) & 1;
-            if (in_step) {
-                if (act_vert) act_vert[ns] = cs.lo + i;
-                ns++;
-            } else if (in_surf) {
-                if (act_vert) act_vert[base + nf] = cs.lo + i;
-                nf++;
-            }
-        }
-    }
-    *nstep = ns;
-    return ns + nf;
-}
-
-/* The active index of global vertex gv: among ACT_STEP's, else among the rest. */
-static void assign_active(void *ctx, int32_t gv, int32_t *slot) {
-    const sw_reduced *m = ctx;
-    int32_t i = sw_sorted_index(m->act_vert, m->nact_step, gv);
-    *slot = i >= 0 ? i
-                   : m->nact_step +
-                         sw_sorted_index(m->act_vert + m->nact_step, m->nact - m->nact_step, gv);
-}
-
 /* ---- creation -------------------------------------------------------------------- */
 
 /* The def with its defaults, checked, and the layout's sizes; logs what it rejects. */
@@ -350,8 +251,9 @@ sinew_result sw_instance_read_def(const sinew_blob *blob, const sinew_instance_d
     }
     z->nworkers = tasks ? (int32_t)d->tasks.worker_count : 1;
     if (!d->allocator.alloc) d->allocator = blob->allocator;
-    z->nact = active_vertices(v, NULL, &z->nact_step);
-    z->ncorner = sw_cubature_corners(v, NULL);
+    z->nact = blob->act.nact;
+    z->nact_step = blob->act.nact_step;
+    z->ncorner = blob->act.ncorner;
     z->rmax = 0;
     for (int32_t k = 0; k < v->ndomains; ++k)
         if (v->domains[k].rank > z->rmax) z->rmax = v->domains[k].rank;
@@ -513,19 +415,15 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     in->red.v = v;
     in->red.R = v->rank_total;
     in->red.rmax = z.rmax;
-    in->red.nact = z.nact; /* counted for the layout; now listed */
     in->red.nworkers = z.nworkers;
     in->tasks = d.tasks;
     in->red.tasks = d.tasks.enqueue ? &in->tasks : NULL;
     in->profiler = d.profiler;
     in->def = d;
     in->blob = blob;
-    in->red.nact_step = z.nact_step;
-    (void)active_vertices(v, in->red.act_vert, &in->red.nact_step);
-    visit_active(v, &in->red, ACT_STEP | ACT_SURFACE, assign_active, &in->red);
+    sw_reduced_bind_active(&in->red, &blob->act);
     /* without a render mesh the surface copies are the output */
     in->red.skin_surface = v->nrender_verts == 0;
-    in->red.ncorner = sw_cubature_corners(v, &in->red); /* after cub_act */
     if (v->nrender_verts > 0) sw_render_weld_tris(v, in->weld_tris);
     in->ps.max_pairs = z.max_pairs;
     in->wc.max_cand = z.max_world;
