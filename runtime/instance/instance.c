@@ -39,7 +39,6 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(m->g, R);
     const uint64_t nw = (uint64_t)z->nworkers;
     TAKE(m->hm, 10 * rm * nw);
-    TAKE(m->ecub, (uint64_t)v->ncub);
     TAKE(m->Jc, 12 * rm);
     TAKE(m->hc, 12 * rm);
     TAKE(m->svd_V, 9 * (uint64_t)v->ncub);

@@ -32,6 +32,7 @@ typedef struct sw_scratch {
     double *Hq;                  /* R x R: the patch's copy of H (cond.Hq; condensation only) */
     double *act_R, *act_t;       /* 9 and 3 per active vertex: their skinning (red) */
     double *corner_x, *corner_f; /* 3 per cubature corner each (red) */
+    double *ecub;                /* ncub: each cubature tet's weighted energy (red) */
     unsigned char *H_nz, *Hn_nz; /* ndomains^2: H's and Hn's blocks that may be nonzero */
 } sw_scratch;
 
@@ -41,10 +42,10 @@ void sw_scratch_clear(sw_scratch *sc, const sw_blob_view *v);
 
 /* Sizes of an instance's layout that the blob alone does not fix (instance.c). */
 typedef struct sw_layout_sizes {
-    int32_t nact;       /* active vertices (active_vertices) */
-    int32_t nact_step;  /* those the step itself reads (ACT_STEP) */
+    int32_t nact;       /* active vertices (the blob's active map, blob_active.h) */
+    int32_t nact_step;  /* those the step itself reads */
     int32_t rmax;       /* the largest domain rank */
-    int32_t ncorner;    /* the cubature tets' corners (sw_cubature_corners) */
+    int32_t ncorner;    /* the cubature tets' corners (the same map's) */
     int32_t max_pairs;  /* the contact pair budget */
     int32_t max_world;  /* the world candidate budget */
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */

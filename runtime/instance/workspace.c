@@ -28,6 +28,7 @@ void sw_scratch_layout(sw_mem_plan *p, sw_scratch *sc, const sw_blob_view *v,
     SW_PLAN_TAKE(p, sc->act_t, 3 * na);
     SW_PLAN_TAKE(p, sc->corner_x, 3 * nc);
     SW_PLAN_TAKE(p, sc->corner_f, 3 * nc);
+    SW_PLAN_TAKE(p, sc->ecub, (uint64_t)v->ncub);
     const uint64_t nd = (uint64_t)v->ndomains;
     SW_PLAN_TAKE(p, sc->H_nz, nd * nd);
     SW_PLAN_TAKE(p, sc->Hn_nz, z->dynamic ? nd * nd : 0);
@@ -48,6 +49,7 @@ void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc) {
     in->red.act_t = sc->act_t;
     in->red.corner_x = sc->corner_x;
     in->red.corner_f = sc->corner_f;
+    in->red.ecub = sc->ecub;
     in->red.H_nz = sc->H_nz;
     in->solver.Hn_nz = sc->Hn_nz;
 }
