@@ -46,12 +46,13 @@ static void check_solve(int32_t nb, const int32_t *size, const unsigned char *co
     double *Ld = malloc(sizeof(double) * n * n), *x = malloc(sizeof(double) * n),
            *y = malloc(sizeof(double) * n);
     unsigned char nz[256];
+    double *pack = malloc(sizeof(double) * sw_block_cholesky_pack_size(17));
     make_spd(n, nb, off, size, couple, A);
     for (int32_t i = 0; i < n; ++i)
         x[i] = y[i] = urand();
     memcpy(Ld, A, sizeof(double) * n * n);
     sw_block_pattern(A, n, nb, off, size, order, nz);
-    int ok1 = sw_cholesky(Ld, n), ok2 = sw_block_cholesky(A, n, nb, off, size, order, nz, L);
+    int ok1 = sw_cholesky(Ld, n), ok2 = sw_block_cholesky(A, n, nb, off, size, order, nz, L, pack);
     if (ok1 && ok2) {
         sw_cholesky_solve(Ld, n, x);
         sw_block_cholesky_solve(L, n, nb, off, size, order, nz, y);
@@ -62,13 +63,15 @@ static void check_solve(int32_t nb, const int32_t *size, const unsigned char *co
     }
     free(A);
     free(L);
+    free(pack);
     free(Ld);
     free(x);
     free(y);
 }
 
 TEST(block_cholesky_matches_dense_on_chains_trees_and_fill) {
-    const int32_t size[6] = {3, 5, 1, 4, 6, 2};
+    /* blocks up to 17: the factor packs eight columns at a time (9 and 17 leave one over) */
+    const int32_t size[6] = {3, 9, 1, 4, 17, 2};
     unsigned char chain[36] = {0}, tree[36] = {0}, loop[36] = {0};
     for (int i = 1; i < 6; ++i)
         chain[i * 6 + i - 1] = chain[(i - 1) * 6 + i] = 1;
@@ -95,7 +98,8 @@ TEST(block_cholesky_rejects_indefinite) {
     double A[16] = {2, 0, 1, 0, 0, 2, 0, 0, 1, 0, -1, 0, 0, 0, 0, 1}, L[16];
     unsigned char nz[4];
     sw_block_pattern(A, 4, 2, off, size, order, nz);
-    ENSURE(sw_block_cholesky(A, 4, 2, off, size, order, nz, L) == 0);
+    double pack[16];
+    ENSURE(sw_block_cholesky(A, 4, 2, off, size, order, nz, L, pack) == 0);
 }
 
 SW_TEST_MAIN(CASE(block_cholesky_matches_dense_on_chains_trees_and_fill),

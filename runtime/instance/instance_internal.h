@@ -28,6 +28,7 @@ typedef enum sw_coll_source {
  * subsystems' views (sw_scratch_bind). */
 typedef struct sw_scratch {
     double *H, *L;               /* R x R: the reduced Hessian (red.H) and its factor (solver.L) */
+    double *pack;                /* the factor's packing scratch (solver.pack, dense.h) */
     double *Hn;                  /* R x R: the step's damping Hessian (solver.Hn; dynamic only) */
     double *Hq;                  /* R x R: the patch's copy of H (cond.Hq; condensation only) */
     double *act_R, *act_t;       /* 9 and 3 per active vertex: their skinning (red) */

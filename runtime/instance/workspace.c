@@ -7,6 +7,7 @@
  * runs in never changes its result. */
 #include <string.h>
 
+#include "dense.h"
 #include "instance_internal.h"
 #include "log.h"
 #include "mem_plan.h"
@@ -22,6 +23,7 @@ void sw_scratch_layout(sw_mem_plan *p, sw_scratch *sc, const sw_blob_view *v,
     const uint64_t R = (uint64_t)v->rank_total, na = (uint64_t)z->nact, nc = (uint64_t)z->ncorner;
     SW_PLAN_TAKE(p, sc->H, R * R);
     SW_PLAN_TAKE(p, sc->L, R * R);
+    SW_PLAN_TAKE(p, sc->pack, sw_block_cholesky_pack_size(z->rmax));
     SW_PLAN_TAKE(p, sc->Hn, z->dynamic ? R * R : 0);
     SW_PLAN_TAKE(p, sc->Hq, z->cond.max_verts > 0 ? R * R : 0);
     SW_PLAN_TAKE(p, sc->act_R, 9 * na);
@@ -43,6 +45,7 @@ void sw_scratch_clear(sw_scratch *sc, const sw_blob_view *v) {
 void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc) {
     in->red.H = sc->H;
     in->solver.L = sc->L;
+    in->solver.pack = sc->pack;
     in->solver.Hn = sc->Hn;
     in->cond.Hq = sc->Hq;
     in->red.act_R = sc->act_R;

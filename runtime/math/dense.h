@@ -3,6 +3,7 @@
 #ifndef SW_DENSE_H
 #define SW_DENSE_H
 
+#include <stddef.h>
 #include <stdint.h>
 
 /* In-place Cholesky A = L L^T (lower triangle of A overwritten by L; the upper triangle
@@ -21,9 +22,14 @@ void sw_cholesky_solve(const double *L, int32_t n, double *x);
  * bytes) holds on entry, at [a * nb + b] for elimination positions a > b, whether block
  * (order[a], order[b]) may be nonzero (see sw_block_pattern); fill is added to it. A is
  * read only in those blocks and the diagonal ones; L receives the factor in the same
- * positions. Returns 1 on success, 0 when a pivot is not positive. */
+ * positions. pack: scratch of sw_block_cholesky_pack_size(largest size) doubles. Returns
+ * 1 on success, 0 when a pivot is not positive. */
 int sw_block_cholesky(const double *A, int32_t n, int32_t nb, const int32_t *off,
-                      const int32_t *size, const int32_t *order, unsigned char *nz, double *L);
+                      const int32_t *size, const int32_t *order, unsigned char *nz, double *L,
+                      double *pack);
+
+/* The doubles sw_block_cholesky's pack (scratch) needs for blocks of at most max_size. */
+size_t sw_block_cholesky_pack_size(int32_t max_size);
 
 /* Fills nz for sw_block_cholesky from the values of A (a block is nonzero when any
  * entry is). O(n^2): callers that know the structure fill nz themselves. */

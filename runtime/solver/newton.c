@@ -62,8 +62,8 @@ int sw_solver_factor(sw_reduced *red, sw_solver *s) {
         tr += fabs(red->H[(int64_t)i * R + i]);
     double shift = 0;
     for (int attempt = 0; attempt < 8; ++attempt) {
-        if (sw_block_cholesky(red->H, R, nd, s->blk_off, s->blk_size, s->blk_order, s->blk_nz,
-                              s->L))
+        if (sw_block_cholesky(red->H, R, nd, s->blk_off, s->blk_size, s->blk_order, s->blk_nz, s->L,
+                              s->pack))
             return 1;
         double next = shift == 0 ? 1e-10 * tr / R + 1e-300 : shift * 100;
         for (int32_t i = 0; i < R; ++i)

@@ -34,6 +34,7 @@ typedef struct sw_solver {
        update finds no descent however short, Newton starts again from q_n (newton.c) */
     int fallback_qn;
     double *L;           /* R x R: the block Cholesky factor */
+    double *pack;        /* sw_block_cholesky_pack_size(rmax): the factor's scratch */
     double *dq, *qtrial; /* R each: Newton update, the iterate before it */
     /* R: the pose-space prediction the last step started from (step.c, pose_space_start
      * and dynamic_start), valid while the steps since it moved the pose continuously and
