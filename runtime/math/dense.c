@@ -3,6 +3,8 @@
 
 #include <math.h>
 
+#include "lanes.h"
+
 int sw_cholesky(double *A, int32_t n) {
     for (int32_t j = 0; j < n; ++j) {
         double d = A[(int64_t)j * n + j];
@@ -53,11 +55,6 @@ void sw_block_pattern(const double *A, int32_t n, int32_t nb, const int32_t *off
             nz[a * nb + b] = (unsigned char)any;
         }
 }
-
-/* Two doubles side by side: SSE2's width, which every x86-64 has, and a pair of lanes
- * elsewhere (GCC and clang vector extensions). Loads through it need only a double's
- * alignment. */
-typedef double sw_v2d __attribute__((vector_size(16), aligned(8)));
 
 size_t sw_block_cholesky_pack_size(int32_t max_size) {
     return (size_t)((max_size + 7) / 8 * 8) * (size_t)max_size;
