@@ -97,11 +97,12 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
         return r;
     }
 
-    /* the struct, then the pose index and the active map its instances share
-       (blob_pose_index.h, blob_active.h) */
+    /* the struct, then what its instances share: the pose index, the surface clusters and
+       the active map (blob_pose_index.h, blob_clusters.h, blob_active.h) */
     const size_t head = (sizeof(sinew_blob) + 7) / 8 * 8,
                  poses = (sw_pose_index_bytes(&view) + 7) / 8 * 8,
-                 bytes = head + poses + sw_active_map_bytes(&view);
+                 clusters = sw_surface_clusters_bytes(&view),
+                 bytes = head + poses + clusters + sw_active_map_bytes(&view);
     sinew_blob *blob = sw_alloc(&d.allocator, bytes, SW_ALLOC_ALIGN);
     if (!blob) {
         if (map) munmap(map, size);
@@ -110,7 +111,8 @@ SINEW_API sinew_result sinew_blob_load(const sinew_blob_def *def, sinew_blob **o
         return SINEW_ERROR_OUT_OF_MEMORY;
     }
     sw_pose_index_build(&view, (char *)blob + head, &blob->poses);
-    sw_active_map_build(&view, (char *)blob + head + poses, &blob->act);
+    sw_surface_clusters_build(&view, (char *)blob + head + poses, &blob->clusters);
+    sw_active_map_build(&view, (char *)blob + head + poses + clusters, &blob->act);
     if (sw_coll_surface_build(&view, &d.allocator, &blob->coll) != SINEW_OK) {
         sw_free(&d.allocator, blob);
         if (map) munmap(map, size);

@@ -28,6 +28,7 @@
 #include <stdint.h>
 
 #include "blob_active.h"
+#include "blob_clusters.h"
 #include "blob_collision.h"
 #include "blob_pose_index.h"
 #include "blob_view.h"
@@ -58,9 +59,10 @@ struct sinew_blob {
     size_t map_size;           /* bytes mapped at `map` */
     sinew_allocator allocator; /* frees this struct */
     sinew_logger logger;
-    sw_pose_index poses;  /* the training poses' neighbourhood, in this struct's block */
-    sw_active_map act;    /* the subspace map's tables (blob_active.h), in the same block */
-    sw_coll_surface coll; /* the collision surface (blob_collision.h), its own block */
+    sw_pose_index poses;          /* the training poses' neighbourhood, in this struct's block */
+    sw_active_map act;            /* the subspace map's tables (blob_active.h), in the same block */
+    sw_surface_clusters clusters; /* the output surface's clusters (blob_clusters.h), same */
+    sw_coll_surface coll;         /* the collision surface (blob_collision.h), its own block */
 };
 
 /* FNV-1a 64 of n bytes (the blob checksum covers bytes [64, file_size)). */

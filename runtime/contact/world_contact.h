@@ -19,12 +19,10 @@
 
 #include <stdint.h>
 
+#include "blob_clusters.h"
 #include "reduced_map.h"
 #include "sinew/sinew_world.h"
 #include "world_penalty.h"
-
-/* Copies per cluster at most. */
-#define SW_WORLD_CLUSTER 16
 
 /* One (surface copy, collider) candidate of the step. */
 typedef struct sw_world_cand {
@@ -42,16 +40,14 @@ typedef struct sw_world_contacts {
     const sinew_world *world;
     sinew_collider_id ignore; /* a collider the instance never touches (its own surface), or 0 */
     int32_t max_cand, ncand, dropped;
-    sw_world_cand *cand;      /* max_cand */
-    int32_t ncl;              /* clusters */
-    int32_t *cl_begin;        /* ncl + 1: cluster c holds cl_copy[cl_begin[c] .. cl_begin[c+1]) */
-    int32_t *cl_copy;         /* nsurf_copies, in cluster order */
-    uint64_t *cl_bones;       /* ncl: bits of the bones skinning the cluster (all when > 64) */
-    int32_t *cl_bone0;        /* ncl: the bone with the most of the cluster's skinning weight */
+    sw_world_cand *cand; /* max_cand */
+    /* the blob's clusters (blob_clusters.h), bound by sw_world_contacts_build */
+    int32_t ncl;
+    const int32_t *cl_begin, *cl_copy, *cl_bone0;
+    const uint64_t *cl_bones;
+    const double *copy_area, *dom_umax;
     double *cl_box;           /* 6 per cluster: its copies' box at the last output */
-    double *copy_area;        /* nsurf_copies: rest area per copy */
     int32_t *copy_first;      /* nsurf_copies: the copy's first candidate, or -1 */
-    double *dom_umax;         /* ndomains: the largest |U rows|_F of a surface copy */
     unsigned char *dom_moved; /* ndomains: moved by the radius since detection */
     double *q_detect;         /* R: the state of the last detection */
     double *bone_motion;      /* 12 per bone: each bone's motion since the last output */
@@ -71,12 +67,10 @@ typedef struct sw_world_contacts {
     uint32_t queries; /* collider queries of the last detection */
 } sw_world_contacts;
 
-/* Upper bound of the cluster count for a blob (sizes the instance's memory). */
-int32_t sw_world_cluster_bound(const sw_blob_view *v);
-
-/* Builds the clusters, their bone masks and the copies' rest areas into wc's arrays
- * (laid out by the instance). Creation time; no allocation. */
-void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v);
+/* Binds the blob's clusters cl and forgets every candidate (copy_first laid out by the
+ * instance). Creation time; no allocation. */
+void sw_world_contacts_build(sw_world_contacts *wc, const sw_blob_view *v,
+                             const sw_surface_clusters *cl);
 
 /* Forgets the candidates (O(candidates)). */
 void sw_world_contacts_clear(sw_world_contacts *wc);

@@ -55,7 +55,7 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     ps->novel_mask = NULL;
     if (z->per_pair && z->detect) TAKE(ps->novel_mask, nd * nd);
     if (z->detect) sw_self_contacts_take(p, v, &in->sc);
-    if (z->novel) sw_novel_take(p, v, sw_world_cluster_bound(v), &in->novel);
+    if (z->novel) sw_novel_take(p, v, z->ncl, &in->novel);
     /* the solver */
     sw_solver *s = &in->solver;
     TAKE(s->q, R);
@@ -77,17 +77,11 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->blk_adj, nd * nd);
     /* the collision world's candidates and the surface clusters of its broad phase */
     sw_world_contacts *wc = &in->wc;
-    const uint64_t ncl = (uint64_t)sw_world_cluster_bound(v), nc = (uint64_t)v->nsurf_copies;
+    const uint64_t ncl = (uint64_t)z->ncl, nc = (uint64_t)v->nsurf_copies;
     TAKE(wc->cand, (uint64_t)z->max_world);
-    TAKE(wc->cl_begin, ncl + 1);
-    TAKE(wc->cl_copy, nc);
-    TAKE(wc->cl_bones, ncl);
-    TAKE(wc->cl_bone0, ncl);
     TAKE(wc->cl_box, 6 * ncl);
     TAKE(wc->cl_pass, ncl);
-    TAKE(wc->copy_area, nc);
     TAKE(wc->copy_first, nc);
-    TAKE(wc->dom_umax, nd);
     TAKE(wc->dom_moved, nd);
     TAKE(wc->q_detect, R);
     TAKE(wc->bone_motion, 12 * nb);
@@ -253,6 +247,7 @@ sinew_result sw_instance_read_def(const sinew_blob *blob, const sinew_instance_d
     z->nact = blob->act.nact;
     z->nact_step = blob->act.nact_step;
     z->ncorner = blob->act.ncorner;
+    z->ncl = blob->clusters.ncl;
     z->rmax = 0;
     for (int32_t k = 0; k < v->ndomains; ++k)
         if (v->domains[k].rank > z->rmax) z->rmax = v->domains[k].rank;
@@ -426,7 +421,7 @@ SINEW_API sinew_result sinew_instance_create(const sinew_blob *blob, const sinew
     if (v->nrender_verts > 0) sw_render_weld_tris(v, in->weld_tris);
     in->ps.max_pairs = z.max_pairs;
     in->wc.max_cand = z.max_world;
-    sw_world_contacts_build(&in->wc, v);
+    sw_world_contacts_build(&in->wc, v, &blob->clusters);
     /* 2% of the character's size: what a surface vertex can travel in one step */
     in->wc.radius = 0.01 * in->size;
     in->wc.frame = in->frame; /* the step's (pose.c) */

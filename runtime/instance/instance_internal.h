@@ -47,6 +47,7 @@ typedef struct sw_layout_sizes {
     int32_t nact_step;  /* those the step itself reads */
     int32_t rmax;       /* the largest domain rank */
     int32_t ncorner;    /* the cubature tets' corners (the same map's) */
+    int32_t ncl;        /* the output surface's clusters (the blob's, blob_clusters.h) */
     int32_t max_pairs;  /* the contact pair budget */
     int32_t max_world;  /* the world candidate budget */
     int32_t nworkers;   /* the host's task workers, 1 without task callbacks */
