@@ -1,10 +1,11 @@
 /* Where the character is does not change its flesh (DESIGN.md §3): a pose carried by a
  * rigid motion G gives G applied to the surface, in every step mode and self-contact
  * mode, with a world whose colliders (every shape: box, sphere, capsule, plane, mesh,
- * hull) move with G and condensation patches; an actor 10^5 units from the origin keeps
- * the origin's shape; a uniformly scaled pose gives the scaled shape; dt = 0 is a pause;
- * a bone scaled unlike the others is refused naming it. The measure is invariance.h's,
- * the bound 1e-5 of the character's size. */
+ * hull) move with G and condensation patches, also with the moved instance stepping in
+ * workspaces as a crowd's does; an actor 10^5 units from the origin keeps the origin's
+ * shape; a uniformly scaled pose gives the scaled shape; dt = 0 is a pause; a bone scaled
+ * unlike the others is refused naming it. The measure is invariance.h's, the bound 1e-5 of
+ * the character's size. */
 #include <math.h>
 #include <stdio.h>
 #include <string.h>
@@ -62,7 +63,7 @@ TEST(a_rigid_motion_of_the_pose_moves_the_surface_rigidly_in_every_self_contact_
     const char *names[] = {"pose-space", "pose-pairs", "exhaustive"};
     sw_move m = far_rigid();
     for (int k = 0; k < 3; ++k) {
-        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, modes[k], NULL, NULL, 0, 0, 0};
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, modes[k], NULL, NULL, 0, 0, 0, 0};
         sw_invariance_result res = measure(&run, &m);
         ENSURE_INVARIANT(res, names[k]);
         ENSUREF(res.self_contacts > 0, "%s: the fold never touched", names[k]);
@@ -138,14 +139,14 @@ TEST(the_step_sees_a_rigidly_moved_pose_bit_for_bit) {
 
 TEST(a_character_turning_every_frame_deforms_as_one_standing_still) {
     sw_move m = {SW_MOVE_TURNING, {0.1, 1, 0.2}, 4 * PI / 180, {0.05, 0, 0.08}, 0, 0, 0};
-    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
+    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0, 0};
     sw_invariance_result res = measure(&run, &m);
     ENSURE_INVARIANT(res, "turning");
 }
 
 TEST(dynamic_flesh_carried_by_a_constant_rigid_motion_is_the_same_motion) {
     sw_move m = far_rigid();
-    sw_invariance_run run = {SINEW_STEP_DYNAMIC, 0, NULL, NULL, 1.0f / 30, 0, 0};
+    sw_invariance_run run = {SINEW_STEP_DYNAMIC, 0, NULL, NULL, 1.0f / 30, 0, 0, 0};
     sw_invariance_result res = measure(&run, &m);
     ENSURE_INVARIANT(res, "dynamic");
 }
@@ -154,7 +155,7 @@ TEST(an_actor_far_from_the_origin_keeps_the_origins_shape_in_its_frame) {
     sw_move m = far_rigid();
     m.kind = SW_MOVE_ACTOR;
     m.float_poses = m.float_output = 1; /* as a host hands them in and reads them */
-    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
+    sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0, 0};
     sw_invariance_result res = measure(&run, &m);
     ENSURE_INVARIANT(res, "far actor");
     m.scale = 0.01; /* an actor scaled as well: its frame holds the unscaled shape */
@@ -166,7 +167,7 @@ TEST(a_uniformly_scaled_pose_gives_the_scaled_shape) {
     const double scales[] = {0.01, 100, 1.0005};
     for (int k = 0; k < 3; ++k) {
         sw_move m = {SW_MOVE_SCALE, {0, 0, 1}, 0, {0, 0, 0}, scales[k], 1, 1};
-        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0};
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 0, 0};
         sw_invariance_result res = measure(&run, &m);
         char what[32];
         snprintf(what, sizeof what, "scale %g", scales[k]);
@@ -219,7 +220,7 @@ TEST(self_contact_nobody_trained_is_found_and_held_alike_wherever_the_finger_is)
                  {"scale 0.01", &small},
                  {"scale 100", &big}};
     for (int k = 0; k < 5; ++k) {
-        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 1};
+        sw_invariance_run run = {SINEW_STEP_QUASISTATIC, 0, NULL, NULL, 0, 0, 1, 0};
         sw_invariance_result res = {0};
         ENSURE(sw_invariance_measure(f->blob, T, f->ch.skel.nbones, FOLD_STEPS, &run, cases[k].m,
                                      &res) == SINEW_OK);
@@ -282,15 +283,18 @@ TEST(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the
     sw_move_transform(&m, 0, G);
     sinew_world *w = shape_world(NULL), *wg = shape_world(G);
     ENSURE(w && wg);
-    const uint32_t budgets[] = {0, 400};
+    /* the last: the moved instance steps as a crowd's does, in workspaces taken in turn */
+    const uint32_t budgets[] = {0, 400, 400};
     const sinew_step_mode modes[] = {SINEW_STEP_QUASISTATIC, SINEW_STEP_DYNAMIC};
-    for (int b = 0; b < 2; ++b)
+    for (int b = 0; b < 3; ++b)
         for (int k = 0; k < 2; ++k) {
-            sw_invariance_run run = {modes[k], 0, w, wg, 1.0f / 30, budgets[b], 0};
+            sw_invariance_run run = {modes[k], 0, w, wg, 1.0f / 30, budgets[b], 0, b == 2};
             sw_invariance_result res = measure(&run, &m);
-            char what[64];
-            snprintf(what, sizeof what, "world, %s, patch budget %u", k ? "dynamic" : "quasistatic",
-                     budgets[b]);
+            char what[80];
+            snprintf(what, sizeof what, "world, %s, patch budget %u%s",
+                     k ? "dynamic" : "quasistatic", budgets[b], b == 2 ? ", in workspaces" : "");
+            fprintf(stderr, "  %s: %.3e of the size, patch %u\n", what, res.err,
+                    res.patch_vertices);
             ENSURE_INVARIANT(res, what);
             /* the colliders do press, and with a budget a patch grows */
             ENSUREF(res.world_contacts > 0 && res.self_contacts > 0 &&
@@ -430,7 +434,7 @@ TEST(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh) {
                  {"far actor", SINEW_STEP_QUASISTATIC, 0, &actor},
                  {"scale 0.01", SINEW_STEP_QUASISTATIC, 0, &scaled}};
     for (int k = 0; k < (int)(sizeof cases / sizeof cases[0]); ++k) {
-        sw_invariance_run run = {cases[k].mode, cases[k].sc, NULL, NULL, 0.01f, 0, 0};
+        sw_invariance_run run = {cases[k].mode, cases[k].sc, NULL, NULL, 0.01f, 0, 0, 0};
         sw_invariance_result res;
         ENSURE(sw_invariance_measure(e.blob, e.ch.clip.T, e.ch.skel.nbones, e.ch.clip.nframes, &run,
                                      cases[k].m, &res) == SINEW_OK);

@@ -319,8 +319,8 @@ int main(int argc, char **argv) {
     for (int c = 0; c < ncases; ++c) {
         if (o.novel && cases[c].sc != 0 && cases[c].sc != SINEW_SELF_CONTACT_POSE_SPACE)
             continue; /* novel contact adds to pose-space self-contact alone */
-        sw_invariance_run run = {cases[c].mode,  cases[c].sc,      cases[c].w, cases[c].wm, dt,
-                                 cases[c].patch, (uint32_t)o.novel};
+        sw_invariance_run run = {cases[c].mode,  cases[c].sc,       cases[c].w, cases[c].wm, dt,
+                                 cases[c].patch, (uint32_t)o.novel, 0};
         row *w = &rows[nrows++];
         w->name = cases[c].name;
         r = sw_invariance_measure(blob, clip, nb, frames, &run, cases[c].m, &w->res);

@@ -117,13 +117,20 @@ static sinew_result set_pose(sinew_instance *in, const double *T, int32_t nb, in
     return sinew_instance_set_pose(in, scratch, (uint32_t)nb);
 }
 
-static sinew_result make_instance(const sinew_blob *blob, const sw_invariance_run *run,
-                                  const sinew_world *world, sinew_instance **out) {
+/* The run's def; shared: with no scratch of its own. */
+static sinew_instance_def run_def(const sw_invariance_run *run, int shared) {
     sinew_instance_def d = sinew_instance_def_default();
     d.mode = run->mode;
     if (run->self_contact) d.self_contact = run->self_contact;
     d.max_patch_vertices = run->max_patch_vertices;
     d.novel_contact = run->novel_contact;
+    d.shared_workspace = (uint32_t)shared;
+    return d;
+}
+
+static sinew_result make_instance(const sinew_blob *blob, const sw_invariance_run *run,
+                                  const sinew_world *world, int shared, sinew_instance **out) {
+    sinew_instance_def d = run_def(run, shared);
     sinew_result r = sinew_instance_create(blob, &d, out);
     if (r == SINEW_OK && world) r = sinew_instance_set_world(*out, world);
     return r;
@@ -164,13 +171,18 @@ sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, i
     if (nb != (int32_t)sinew_blob_bone_count(blob) || frames < 1 || ns == 0)
         return SINEW_ERROR_INVALID_ARGUMENT;
     sinew_instance *a = NULL, *b = NULL;
+    sinew_workspace *ws[2] = {NULL, NULL};
     double *xa = malloc((size_t)3 * ns * sizeof(double)),
            *xb = malloc((size_t)3 * ns * sizeof(double));
     double *Tb = malloc((size_t)12 * nb * sizeof(double));
     float *fs = malloc((size_t)3 * ns * sizeof(float) + (size_t)12 * nb * sizeof(float));
     sinew_result r = xa && xb && Tb && fs ? SINEW_OK : SINEW_ERROR_OUT_OF_MEMORY;
-    if (r == SINEW_OK) r = make_instance(blob, run, run->world, &a);
-    if (r == SINEW_OK) r = make_instance(blob, run, run->world_moved, &b);
+    if (r == SINEW_OK) r = make_instance(blob, run, run->world, 0, &a);
+    if (r == SINEW_OK) r = make_instance(blob, run, run->world_moved, run->workspaces != 0, &b);
+    for (int k = 0; k < 2 && run->workspaces && r == SINEW_OK; ++k) {
+        sinew_instance_def d = run_def(run, 0);
+        r = sinew_workspace_create(blob, &d, &ws[k]);
+    }
     if (r != SINEW_OK) goto done;
     sw_instance_skinned_surface(a, xa); /* at rest: the instance's first pose */
     out->size = rest_size(xa, ns);
@@ -194,7 +206,8 @@ sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, i
             (r = set_pose(b, Tb, nb, m->float_poses, fp)) != SINEW_OK)
             goto done;
         out->failed += sinew_instance_step(a, dt) != SINEW_OK;
-        out->failed += sinew_instance_step(b, dt) != SINEW_OK;
+        out->failed += (run->workspaces ? sinew_instance_step_in(b, ws[f % 2], dt)
+                                        : sinew_instance_step(b, dt)) != SINEW_OK;
         sinew_step_stats st = {.struct_size = sizeof st};
         sinew_instance_get_stats(a, &st);
         out->world_contacts += st.world_contacts;
@@ -227,6 +240,8 @@ sinew_result sw_invariance_measure(const sinew_blob *blob, const double *clip, i
 done:
     sinew_instance_destroy(a);
     sinew_instance_destroy(b);
+    sinew_workspace_destroy(ws[0]);
+    sinew_workspace_destroy(ws[1]);
     free(xa);
     free(xb);
     free(Tb);

@@ -46,6 +46,9 @@ typedef struct sw_invariance_run {
     float dt;                        /* the step (0: 1/30 s) */
     uint32_t max_patch_vertices;     /* condensation's budget (0: off) */
     uint32_t novel_contact;          /* sinew_instance_def.novel_contact (0: off) */
+    /* 1: the second instance keeps no scratch (shared_workspace) and steps in two
+       workspaces taken in turn (sinew_instance_step_in), as a crowd's does */
+    uint32_t workspaces;
 } sw_invariance_run;
 
 typedef struct sw_invariance_result {
