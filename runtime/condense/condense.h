@@ -104,16 +104,17 @@ typedef struct sw_cond {
     int32_t *ft_slot;       /* 4 per element: patch index >= 0, or -1 - ring copy */
     int32_t *ring_v;        /* per ring copy: global vertex, domain, local index, next copy */
     int32_t *ring_d, *ring_l, *ring_next;
-    double *ring_x0; /* 3 per ring copy: R rest + t (its position at q = 0) */
-    double *ring_J;  /* 3 rmax per ring copy: J = R U (3 x r_d) */
-    double *ring_x;  /* 3 per ring copy: its position at the iterate */
-    double *ring_dx; /* 3 per ring copy: scratch (J dq) */
-    double *ring_M;  /* 3 rmax per ring copy: its tets' K J gathered (coupled.c; kept 0) */
-    double *Hq;      /* R x R: the reduced potential's Hessian and the rest's ring blocks
-                        (without the patch's: the product applies those tet by tet) */
-    double *dom_fv;  /* ndomains: the patch's tets' volume (the oracle's), all of the
-                        domain's when its rest is evaluated at q */
-    double g0_step;  /* |grad| at the step's first coupled iterate (0: not solved yet) */
+    double *ring_x0;      /* 3 per ring copy: R rest + t (its position at q = 0) */
+    double *ring_J;       /* 3 rmax per ring copy: J = R U (3 x r_d) */
+    double *ring_x;       /* 3 per ring copy: its position at the iterate */
+    double *ring_dx;      /* 3 per ring copy: scratch (J dq) */
+    double *ring_M;       /* 3 rmax per ring copy: its tets' K J gathered (coupled.c; kept 0) */
+    double *Hq;           /* R x R: the reduced potential's Hessian and the rest's ring blocks
+                             (without the patch's: the product applies those tet by tet) */
+    unsigned char *Hq_nz; /* ndomains^2: Hq's blocks that may be nonzero (reduced_map.h) */
+    double *dom_fv;       /* ndomains: the patch's tets' volume (the oracle's), all of the
+                             domain's when its rest is evaluated at q */
+    double g0_step;       /* |grad| at the step's first coupled iterate (0: not solved yet) */
     /* the coupled Newton */
     double *x, *xt, *dx; /* 3 nf: patch positions, the iterate before an update, update */
     double *gf;          /* 3 nf: gradient in x_f */

@@ -58,6 +58,26 @@ void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t l
     if (J) sw_reduced_jacobian(m, D, lv, a, J);
 }
 
+void sw_reduced_blocks_matvec(const sw_blob_view *v, const double *A, const unsigned char *A_nz,
+                              const double *x, double *y) {
+    const int32_t nd = v->ndomains;
+    const int64_t R = v->rank_total;
+    for (int32_t a = 0; a < nd; ++a) {
+        const sw_blob_domain *Da = &v->domains[a];
+        for (int64_t i = Da->q_offset; i < Da->q_offset + Da->rank; ++i) {
+            const double *Ai = A + i * R;
+            double acc = 0;
+            for (int32_t b = 0; b < nd; ++b) {
+                if (a != b && !A_nz[a * nd + b]) continue;
+                const sw_blob_domain *Db = &v->domains[b];
+                for (int64_t j = Db->q_offset; j < Db->q_offset + Db->rank; ++j)
+                    acc += Ai[j] * x[j];
+            }
+            y[i] = acc;
+        }
+    }
+}
+
 void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *dst_nz,
                             const double *src, const unsigned char *src_nz) {
     const int32_t nd = v->ndomains;

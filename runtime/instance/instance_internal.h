@@ -35,6 +35,7 @@ typedef struct sw_scratch {
     double *corner_x, *corner_f; /* 3 per cubature corner each (red) */
     double *ecub;                /* ncub: each cubature tet's weighted energy (red) */
     unsigned char *H_nz, *Hn_nz; /* ndomains^2: H's and Hn's blocks that may be nonzero */
+    unsigned char *Hq_nz;        /* ndomains^2: the same of Hq (condensation only) */
 } sw_scratch;
 
 /* Marks every block of the scratch's matrices as possibly nonzero: their first copies

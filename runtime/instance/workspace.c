@@ -34,12 +34,14 @@ void sw_scratch_layout(sw_mem_plan *p, sw_scratch *sc, const sw_blob_view *v,
     const uint64_t nd = (uint64_t)v->ndomains;
     SW_PLAN_TAKE(p, sc->H_nz, nd * nd);
     SW_PLAN_TAKE(p, sc->Hn_nz, z->dynamic ? nd * nd : 0);
+    SW_PLAN_TAKE(p, sc->Hq_nz, z->cond.max_verts > 0 ? nd * nd : 0);
 }
 
 void sw_scratch_clear(sw_scratch *sc, const sw_blob_view *v) {
     size_t n = (size_t)v->ndomains * (size_t)v->ndomains;
     if (sc->H_nz) memset(sc->H_nz, 1, n);
     if (sc->Hn_nz) memset(sc->Hn_nz, 1, n);
+    if (sc->Hq_nz) memset(sc->Hq_nz, 1, n);
 }
 
 void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc) {
@@ -48,6 +50,7 @@ void sw_scratch_bind(sinew_instance *in, const sw_scratch *sc) {
     in->solver.pack = sc->pack;
     in->solver.Hn = sc->Hn;
     in->cond.Hq = sc->Hq;
+    in->cond.Hq_nz = sc->Hq_nz;
     in->red.act_R = sc->act_R;
     in->red.act_t = sc->act_t;
     in->red.corner_x = sc->corner_x;
