@@ -4,11 +4,12 @@
  * world_penalty.h in the reduced Newton.
  *
  * Detection is two-phase and its cost follows the copies near colliders, not the mesh:
- *  - broad: the surface copies are grouped at creation into clusters of at most
- *    SW_WORLD_CLUSTER copies (median splits of each domain's copies in rest space). Each
- *    cluster's box is taken from the last step's output, carried by its dominant bone's
- *    motion since and grown by how far the other bones that skin it move apart from it,
- *    plus the detection radius; only clusters whose grown box meets a collider's box go on.
+ *  - broad: the surface copies are grouped, when the blob loads, into clusters of at most
+ *    SW_WORLD_CLUSTER copies (median splits of each domain's copies in rest space;
+ *    blob_clusters.h). Each cluster's box is taken from the last step's output, carried
+ *    by its dominant bone's motion since and grown by how far the other bones that skin
+ *    it move apart from it, plus the detection radius; only clusters whose grown box
+ *    meets a collider's box go on.
  *  - narrow: each copy of those clusters, at the step's start state, is queried against
  *    each collider whose box holds it (collision.h); a copy within the detection radius
  *    becomes a candidate with its frozen law (world_penalty.h).

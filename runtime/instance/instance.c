@@ -75,7 +75,8 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(s->blk_pos, nd);
     TAKE(s->blk_nz, nd * nd);
     TAKE(s->blk_adj, nd * nd);
-    /* the collision world's candidates and the surface clusters of its broad phase */
+    /* the collision world's candidates and its broad phase's boxes (the clusters are the
+       blob's) */
     sw_world_contacts *wc = &in->wc;
     const uint64_t ncl = (uint64_t)z->ncl, nc = (uint64_t)v->nsurf_copies;
     TAKE(wc->cand, (uint64_t)z->max_world);
