@@ -68,7 +68,7 @@ void sw_reduced_blocks_matvec(const sw_blob_view *v, const double *A, const unsi
             const double *Ai = A + i * R;
             double acc = 0;
             for (int32_t b = 0; b < nd; ++b) {
-                if (a != b && !A_nz[a * nd + b]) continue;
+                if (a != b && (!A_nz || !A_nz[a * nd + b])) continue;
                 const sw_blob_domain *Db = &v->domains[b];
                 for (int64_t j = Db->q_offset; j < Db->q_offset + Db->rank; ++j)
                     acc += Ai[j] * x[j];

@@ -85,10 +85,10 @@ void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *d
                             const double *src, const unsigned char *src_nz);
 
 /* y = A x for an R x R matrix A known to be exact zeros outside its domain blocks marked
- * in A_nz (diagonal blocks always count as marked): each row sums its terms in column
- * order over the marked blocks alone. The terms skipped are exact zeros times finite
- * entries, so the result is bitwise the dense product's (sw_matvec), at the cost of the
- * marked blocks. */
+ * in A_nz (diagonal blocks always count as marked; A_nz NULL: block diagonal): each row
+ * sums its terms in column order over the marked blocks alone. The terms skipped are exact zeros
+ * times finite entries, so the result is bitwise the dense product's (sw_matvec), at the cost of
+ * the marked blocks. */
 void sw_reduced_blocks_matvec(const sw_blob_view *v, const double *A, const unsigned char *A_nz,
                               const double *x, double *y);
 

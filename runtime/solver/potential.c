@@ -13,55 +13,19 @@
 #include "solver.h"
 #include <stdlib.h>
 
-/* The block pairs (a, b) of domains where a matrix of the step may be nonzero. */
-enum block_set {
-    BLOCKS_DIAGONAL, /* the reduced mass (when block diagonal, sw_solver.mass_blockdiag) */
-    BLOCKS_SPRINGS,  /* the interface springs' Hessian: the spring-coupled pairs */
-    BLOCKS_STEP      /* H(q_s): the step's factor pattern (springs, contact pairs, fill) */
-};
-
-static int block_in(const sw_solver *s, int32_t nd, enum block_set set, int32_t a, int32_t b) {
+/* Whether domain block (a, b) is in the step's factor pattern (springs, contact pairs,
+ * fill): where H(q_s) may be nonzero. */
+static int step_block(const sw_solver *s, int32_t nd, int32_t a, int32_t b) {
     if (a == b) return 1;
-    if (set == BLOCKS_SPRINGS) return s->blk_adj[a * nd + b];
-    if (set == BLOCKS_STEP) {
-        int32_t pa = s->blk_pos[a], pb = s->blk_pos[b];
-        return pa > pb ? s->blk_nz[pa * nd + pb] : s->blk_nz[pb * nd + pa];
-    }
-    return 0;
-}
-
-/* y = A x for the R x R matrix A over the blocks of `set` only: each row sums its nonzero
- * terms in the same column order as the dense product, and the terms it skips are exact
- * zeros times finite entries, so the result is bitwise the dense one (sw_matvec). The
- * dynamic terms' Hessian is taken over the same blocks. */
-static void block_matvec(const sw_blob_view *v, const sw_solver *s, enum block_set set,
-                         const double *A, const double *x, double *y) {
-    int32_t R = v->rank_total, nd = v->ndomains;
-    for (int32_t a = 0; a < nd; ++a) {
-        int32_t i0 = s->blk_off[a], i1 = i0 + s->blk_size[a];
-        for (int32_t i = i0; i < i1; ++i)
-            y[i] = 0;
-        /* block by block, each row's terms still in column order (the set asked once a
-           block pair, not once a row) */
-        for (int32_t b = 0; b < nd; ++b) {
-            if (!block_in(s, nd, set, a, b)) continue;
-            int32_t j0 = s->blk_off[b], j1 = j0 + s->blk_size[b];
-            for (int32_t i = i0; i < i1; ++i) {
-                const double *Ai = A + (int64_t)i * R;
-                double acc = y[i];
-                for (int32_t j = j0; j < j1; ++j)
-                    acc += Ai[j] * x[j];
-                y[i] = acc;
-            }
-        }
-    }
+    int32_t pa = s->blk_pos[a], pb = s->blk_pos[b];
+    return pa > pb ? s->blk_nz[pa * nd + pb] : s->blk_nz[pb * nd + pa];
 }
 
 /* y = M x: over the diagonal blocks when the blob's mass is block diagonal (the bake's
  * always is; a blob whose is not takes the dense product). */
 static void mass_matvec(const sw_blob_view *v, const sw_solver *s, const double *x, double *y) {
     if (s->mass_blockdiag)
-        block_matvec(v, s, BLOCKS_DIAGONAL, v->mass, x, y);
+        sw_reduced_blocks_matvec(v, v->mass, NULL, x, y);
     else
         sw_matvec(v->mass, v->rank_total, x, y);
 }
@@ -74,7 +38,7 @@ static void add_dynamic_hessian(sw_reduced *red, const sw_solver *s, const sw_dy
     double *H = red->H;
     for (int32_t a = 0; a < nd; ++a)
         for (int32_t b = 0; b < nd; ++b) {
-            if (s->mass_blockdiag && !block_in(s, nd, BLOCKS_STEP, a, b)) continue;
+            if (s->mass_blockdiag && !step_block(s, nd, a, b)) continue;
             sw_reduced_mark(red, &v->domains[a], &v->domains[b]);
             for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i)
                 for (int32_t j = s->blk_off[b]; j < s->blk_off[b] + s->blk_size[b]; ++j) {
@@ -112,7 +76,7 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
     }
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
     phi += sw_pose_space_force(ct->ps, R, q, want_grad ? red->g : NULL);
-    block_matvec(v, s, BLOCKS_SPRINGS, v->spring_hessian, q, s->tmp);
+    sw_reduced_blocks_matvec(v, v->spring_hessian, s->blk_adj, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
@@ -135,7 +99,7 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
             red->g[i] += dc->cd * dc->alpha * s->tmp[i];
-    block_matvec(v, s, BLOCKS_STEP, s->Hn, e, s->tmp);
+    sw_reduced_blocks_matvec(v, s->Hn, s->Hn_nz, e, s->tmp);
     double dk = sw_dot(e, s->tmp, R);
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
