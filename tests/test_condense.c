@@ -49,6 +49,11 @@ static sinew_instance *pressed(const bake_fixture *f, sinew_world *w, uint32_t b
     return pressed_rho(f, w, budget, steps, RHO);
 }
 
+/* An instance whose patch may hold every vertex (radius the whole mesh), stepped steps times. */
+static sinew_instance *whole_mesh_patch(const bake_fixture *f, sinew_world *w, int steps) {
+    return pressed_rho(f, w, (uint32_t)f->ch.mesh.nverts, steps, 1.0);
+}
+
 /* An instance pressed onto the table for one step and prepared for the next, its patch
  * of radius rho set (the world into *w). */
 static sinew_instance *prepared_on_table(sinew_world **w, double rho) {
@@ -298,13 +303,14 @@ TEST(cubature_weights_follow_each_domains_volume_outside_the_patch) {
             nrest += rest;
         }
         ENSURE(nrest == c->nrest && (nexact > 0) == wide);
-        /* the cubature of the others scaled to their volume outside, of these none */
+        /* the cubature of the others scaled to their volume outside, of these the least share */
         sw_cond_weights_apply(c);
         int reached = 0;
         for (int32_t k = 0; k < v->ndomains; ++k) {
             const sw_blob_domain *D = &v->domains[k];
             double s = in_vol[k] > 0 ? (vol[k] - in_vol[k]) / vol[k] : 1;
             if (in_vol[k] > SW_COND_EXACT_SHARE * vol[k]) s = 0;
+            if (in_vol[k] > 0 && s < SW_COND_MIN_SHARE) s = SW_COND_MIN_SHARE;
             reached += in_vol[k] > 0;
             for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
                 ENSURE_NEAR(c->cub_w[i], s * v->cub_weight[i], 1e-12 * v->cub_weight[i]);
@@ -502,7 +508,7 @@ TEST(a_whole_mesh_patch_converges_to_the_reference) {
     sinew_collider_id id;
     sinew_world *w = table_world(0.08, 0.0f, &id);
     const uint32_t nv = (uint32_t)f->ch.mesh.nverts;
-    sinew_instance *sub = pressed(f, w, 0, 3), *whole = pressed_rho(f, w, nv, 3, 1.0);
+    sinew_instance *sub = pressed(f, w, 0, 3), *whole = whole_mesh_patch(f, w, 3);
     ENSURE(sub && whole);
     sw_fullsim_stats fs;
     sw_fullsim *sim = reference_at_rest(f, w, &fs);
@@ -523,6 +529,40 @@ TEST(a_whole_mesh_patch_converges_to_the_reference) {
     ENSURE(e_whole < 0.02 && e_whole < 0.1 * e_sub);
     sw_fullsim_destroy(sim);
     sinew_instance_destroy(sub);
+    sinew_instance_destroy(whole);
+    sinew_world_destroy(w);
+}
+
+/* A patch that holds whole domains: their vertices no longer depend on q, so only the
+ * cubature share a domain keeps (SW_COND_MIN_SHARE) holds the modes that move them. Over
+ * the clip, pressed by the table, no step may run a domain's coordinates to its bound. */
+TEST(a_patch_holding_whole_domains_keeps_their_coordinates_in_bounds) {
+    const bake_fixture *f = fixture();
+    ENSURE(f);
+    sinew_collider_id id;
+    sinew_world *w = table_world(0.08, 0.0f, &id);
+    sinew_instance *whole = whole_mesh_patch(f, w, 0);
+    ENSURE(whole);
+    const sw_blob_view *v = whole->v;
+    int nb = f->ch.skel.nbones, limited = 0, patched = 0;
+    double worst = 0; /* the largest |q_k| / bound_k over the clip */
+    for (int fr = 0; fr < f->ch.clip.nframes; ++fr) {
+        sw_instance_set_pose_d(whole, f->ch.clip.T + (size_t)fr * 12 * nb);
+        ENSURE(sinew_instance_step(whole, 1.0f / 30) == SINEW_OK);
+        limited += (whole->stats.status & SINEW_STEP_LIMITED) != 0;
+        patched += whole->stats.patch_vertices > 0;
+        for (int32_t k = 0; k < v->ndomains; ++k) {
+            const double *q = whole->solver.q + v->domains[k].q_offset;
+            double n = 0;
+            for (int32_t j = 0; j < v->domains[k].rank; ++j)
+                n += q[j] * q[j];
+            worst = fmax(worst, sqrt(n) / whole->q_bound[k]);
+        }
+    }
+    fprintf(stderr,
+            "    %d of %d frames with a patch, %d limited; largest |q_k| %.3g of its bound\n",
+            patched, f->ch.clip.nframes, limited, worst);
+    ENSURE(patched > 0 && limited == 0 && worst < 0.9);
     sinew_instance_destroy(whole);
     sinew_world_destroy(w);
 }
@@ -761,6 +801,7 @@ SW_TEST_MAIN(CASE(coupled_gradient_matches_finite_differences_and_its_hessian_is
              CASE(dynamic_patch_gradient_and_the_dynamics_oracle),
              CASE(patch_def_is_checked_and_sized),
              CASE(a_whole_mesh_patch_converges_to_the_reference),
+             CASE(a_patch_holding_whole_domains_keeps_their_coordinates_in_bounds),
              CASE(eq_4_12_matches_a_brute_force_projection_of_the_full_force),
              CASE(a_patch_grows_moves_and_shrinks_for_ten_thousand_steps_allocating_nothing),
              CASE(release_fixture))

@@ -35,7 +35,7 @@ typedef struct {
 
 /* The modes' run (surface_hash_of_every_mode_is_golden): instances 4.. of the same
  * fixture, each with one more of the step's paths. */
-#define GOLDEN_MODES_HASH 0xcbd19a2d31785982ull
+#define GOLDEN_MODES_HASH 0xf8d95edcaa5c5d74ull
 
 static sinew_world *props_world; /* the patch instance's: the props pressing the finger */
 

@@ -37,6 +37,10 @@
 
 /* The patch radius when the def leaves it 0, in units of the rest diagonal. */
 #define SW_COND_DEFAULT_RADIUS 0.05
+/* The least share of its cubature weight a domain the patch reaches keeps (coupled.c,
+ * sw_cond_weights_apply): the patch takes the place of its vertices, not the stiffness of
+ * the domain's reduced coordinates. */
+#define SW_COND_MIN_SHARE 0.1
 /* The share of a domain's rest volume in the patch past which the domain's other tets are
  * evaluated exactly at q instead of by its scaled cubature (oracle.c, exact_domains). */
 #define SW_COND_EXACT_SHARE 0.5

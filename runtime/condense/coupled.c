@@ -20,15 +20,19 @@
  * renormalising the rest (the first rule tried) fails once the patch holds the place
  * the cubature was fitted for: on the 100K capsule at rho 0.236 the patch held 78% of
  * the bent domain's volume but 97% of its cubature weight, and the 2 tets left, scaled
- * 7.8x, stood for the rest (err_world_cond 0.201; 0.144 with this rule, docs/notes/world.md). The
- * cached cubature Jacobians of those domains are refilled by the next gradient pass. */
+ * 7.8x, stood for the rest (err_world_cond 0.201; 0.144 with this rule, docs/notes/world.md).
+ * A domain keeps at least SW_COND_MIN_SHARE of it, even one the patch holds whole or whose
+ * other tets are exact (exact_domains): the patch's vertices no longer depend on q, so
+ * without it the modes that move them are stiff only through the ring, and the
+ * pose-space force or the ring's pull runs q to its bound (docs/notes/novel-contact.md).
+ * The cached cubature Jacobians of those domains are refilled by the next gradient pass. */
 void sw_cond_weights_apply(sw_cond *c) {
     const sw_blob_view *v = c->v;
     for (int32_t k = 0; k < v->ndomains; ++k) { /* dom_fv: the oracle's (exact_domains) */
         if (c->dom_fv[k] == 0) continue;
         const sw_blob_domain *D = &v->domains[k];
         double s = c->dom_vol[k] > 0 ? (c->dom_vol[k] - c->dom_fv[k]) / c->dom_vol[k] : 0;
-        if (!(s > 0)) s = 0;
+        if (!(s > SW_COND_MIN_SHARE)) s = SW_COND_MIN_SHARE;
         for (int32_t i = D->cub_begin; i < D->cub_begin + D->cub_count; ++i)
             c->cub_w[i] = s * v->cub_weight[i];
     }

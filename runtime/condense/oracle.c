@@ -269,10 +269,11 @@ static void full_tets(sw_cond *c, const sw_reduced *red) {
  * badly (the 100K capsule at rho 0.236 missed 0.124 of the correction against 0.093 at
  * rho 0.151, the difference outside the patch; docs/notes/world.md). Past SW_COND_EXACT_SHARE of
  * its volume in the patch, the domain's other tets become elements whose four corners are all ring
- * copies, evaluated exactly at q (its cubature's weights go to 0 with its volume outside): no more
- * tets than the patch holds of that domain, so no O(N) work. A domain the budget's arrays cannot
- * hold keeps its scaled cubature. Leaves each domain's volume in the patch in dom_fv (all of it for
- * these), the scale sw_cond_weights_apply reads. */
+ * copies, evaluated exactly at q (its cubature's weights go to SW_COND_MIN_SHARE, the least a
+ * domain keeps, with its volume outside): no more tets than the patch holds of that domain, so no
+ * O(N) work. A domain the budget's arrays cannot hold keeps its scaled cubature. Leaves each
+ * domain's volume in the patch in dom_fv (all of it for these), the scale sw_cond_weights_apply
+ * reads. */
 static void exact_domains(sw_cond *c, const sw_reduced *red) {
     const sw_blob_view *v = c->v;
     c->nring_patch = c->nring;
@@ -291,7 +292,7 @@ static void exact_domains(sw_cond *c, const sw_reduced *red) {
         for (int32_t i = 0; i < c->nring; ++i)
             copies -= c->ring_d[i] == k;
         if (c->nrest + tets > room || c->nring + copies > c->z.max_ring) continue;
-        c->dom_fv[k] = c->dom_vol[k]; /* all of it full or at q: no cubature (exactly 0) */
+        c->dom_fv[k] = c->dom_vol[k]; /* all of it full or at q: the least cubature */
         for (int32_t i = b; i < b + n; ++i) {
             int32_t t = c->dom_tets[i];
             if (c->tvis[t] == c->stamp) continue; /* a patch tet */
