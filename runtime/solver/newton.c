@@ -255,6 +255,118 @@ static enum rest_outcome rest_first_updates(sw_reduced *red, const sw_step_conta
     }
 }
 
+/* The chord-Newton iteration's state between updates. */
+typedef struct newton_iter {
+    double phi, gn, g0; /* the energy and |g| at s->q; |g| at the step's start */
+    int have_h;         /* red->H is the Hessian at s->q, not yet factored */
+    int fresh;          /* s->L was factored at s->q */
+    int trust;          /* trial points are evaluated without H (chord updates may follow) */
+    int probe;          /* the next update, from the factor at hand, is taken only if the last */
+} newton_iter;
+
+/* The energy, gradient and Hessian at s->q, the Hessian to be factored next. */
+static void evaluate_with_hessian(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                                  const sw_dyn_coef *dc, sinew_step_stats *st, newton_iter *n) {
+    n->phi = evaluate(red, ct, s, s->q, dc, 1, st);
+    n->have_h = 1;
+    n->trust = 0;
+}
+
+/* The step's start: rest-first updates when the step has a reference Hessian (which may
+ * end the step: returns 1, or fails it: *failed), else the Hessian at the start. */
+static int newton_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                        const sw_dyn_coef *dc, sinew_step_stats *st, newton_iter *n, uint32_t *it0,
+                        int *failed) {
+    int32_t R = red->R;
+    *n = (newton_iter){.have_h = 1, .trust = 1};
+    *it0 = 0;
+    *failed = 0;
+    if (!(s->rest_first && red->h_ref)) {
+        n->phi = evaluate_start(red, ct, s, dc, 1, st);
+        n->gn = n->g0 = sqrt(sw_dot(red->g, red->g, R));
+        return 0;
+    }
+    n->phi = evaluate_start(red, ct, s, dc, SW_CUB_HESSIAN_REF, st);
+    n->gn = n->g0 = sqrt(sw_dot(red->g, red->g, R));
+    enum rest_outcome o = rest_first_updates(red, ct, s, dc, st, &n->phi, &n->gn, n->g0, it0);
+    if (o == REST_NOT_FINITE) *failed = 1;
+    if (o != REST_HAND_OVER) return 1;
+    n->phi = evaluate(red, ct, s, s->q, dc, 1, st); /* hand over: the Hessian at q */
+    n->gn = sqrt(sw_dot(red->g, red->g, R));
+    return 0;
+}
+
+/* The trial points q_k + step dq (q_k in s->qtrial), the step halved up to five times
+ * while the factor is fresh (a stale direction is refactored rather than halved): 1 when
+ * one's energy does not rise (n->phi is its), 0 with s->q somewhere on the way. */
+static int line_search(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                       const sw_dyn_coef *dc, sinew_step_stats *st, newton_iter *n, int with_h,
+                       double phi0) {
+    double step = 1.0;
+    for (int ls = 0; ls < 5; ++ls, step *= 0.5) {
+        for (int32_t i = 0; i < red->R; ++i)
+            s->q[i] = s->qtrial[i] + step * s->dq[i];
+        n->phi = evaluate(red, ct, s, s->q, dc, with_h, st);
+        if (isfinite(n->phi) && n->phi <= phi0 + 1e-12 * fabs(phi0)) return 1;
+        if (!n->fresh) return 0;
+    }
+    return 0;
+}
+
+/* After no trial point was accepted, s->q back at q_k (energy phi0, |g| gn0): 1 to go on
+ * from a fresh evaluation, 0 when the step ends at q_k, GUARD. */
+static int rejected_update(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                           const sw_dyn_coef *dc, sinew_step_stats *st, newton_iter *n, double phi0,
+                           double gn0) {
+    int32_t R = red->R;
+    memcpy(s->q, s->qtrial, (size_t)R * sizeof(double));
+    if (!n->fresh) { /* back to q_k, with its Hessian this time */
+        evaluate_with_hessian(red, ct, s, dc, st, n);
+        n->gn = gn0;
+        return 1;
+    }
+    if (s->fallback_qn) {
+        /* from a predicted start (step.c, dynamic_start) the path met a region where the
+           potential curves far more than its Hessian says (a stiff contact engaging): a
+           pose-space blend that switched training poses had moved the start off the
+           motion's path. Newton starts again from q_n, the last state, as a step that
+           starts there does. */
+        s->fallback_qn = 0;
+        memcpy(s->q, s->qn, (size_t)R * sizeof(double));
+        n->phi = evaluate(red, ct, s, s->q, dc, 1, st);
+        n->gn = n->g0 = sqrt(sw_dot(red->g, red->g, R));
+        n->have_h = 1;
+        n->trust = 1;
+        return 1;
+    }
+    /* keep the best iterate (its energy and gradient norm are known) */
+    n->phi = phi0;
+    n->gn = gn0;
+    st->status |= SINEW_STEP_GUARD;
+    return 0;
+}
+
+/* After an accepted update (|g| was gn0 before it): what the next one is. A Newton
+ * update's end point had its Hessian: Newton next, chord updates after it when it shrank
+ * the gradient fast. A chord update that shrank it too slowly: the Hessian at the point
+ * (or, near the stationary point, first the factor at hand's probe). */
+static void after_update(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
+                         const sw_dyn_coef *dc, sinew_step_stats *st, newton_iter *n, int with_h,
+                         double gn0) {
+    n->gn = sqrt(sw_dot(red->g, red->g, red->R));
+    st->newton_iterations++;
+    if (with_h) {
+        n->have_h = 1;
+        n->trust = n->gn <= SW_CHORD_ENTER * gn0;
+    } else if (n->gn > (n->fresh ? SW_CHORD_ENTER : SW_CHORD_KEEP) * gn0 && n->gn > 1e-5 * n->g0) {
+        if (!n->trust)
+            n->probe = 1;
+        else
+            evaluate_with_hessian(red, ct, s, dc, st, n); /* the same phi and g, with H */
+    }
+    n->fresh = 0;
+}
+
 sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
                              const sw_dyn_coef *dc, sinew_step_stats *st) {
     int32_t R = red->R;
@@ -267,42 +379,25 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
      * until an update is near the stationary point (SW_NEWTON_NEAR). The stationary point
      * is the same: only the path to it changes, and it is still a function of the step's
      * start alone. */
-    double phi, gn, g0;
-    uint32_t it0 = 0;
-    if (s->rest_first && red->h_ref) {
-        phi = evaluate_start(red, ct, s, dc, SW_CUB_HESSIAN_REF, st);
-        gn = g0 = sqrt(sw_dot(red->g, red->g, R));
-        enum rest_outcome o = rest_first_updates(red, ct, s, dc, st, &phi, &gn, g0, &it0);
-        if (o == REST_NOT_FINITE) return step_failed(s, R, st);
-        if (o == REST_DONE) {
-            st->residual = g0 > 0 ? gn / g0 : 0;
-            st->energy = phi;
-            return SINEW_OK;
-        }
-        phi = evaluate(red, ct, s, s->q, dc, 1, st); /* hand over: the Hessian at q */
-        gn = sqrt(sw_dot(red->g, red->g, R));
-    } else {
-        phi = evaluate_start(red, ct, s, dc, 1, st);
-        gn = g0 = sqrt(sw_dot(red->g, red->g, R));
-    }
-    int have_h = 1; /* red->H is the Hessian at s->q, not yet factored */
-    int fresh = 0;  /* s->L was factored at s->q */
-    int trust = 1;  /* trial points are evaluated without H (chord updates may follow) */
-    int probe = 0;  /* the next update, from the factor at hand, is taken only if the last */
-    for (uint32_t it = it0;; ++it) {
-        if (!isfinite(phi) || !isfinite(gn)) return step_failed(s, R, st);
+    newton_iter n;
+    uint32_t it0;
+    int failed;
+    int done = newton_start(red, ct, s, dc, st, &n, &it0, &failed);
+    if (failed) return step_failed(s, R, st);
+    for (uint32_t it = it0; !done; ++it) {
+        if (!isfinite(n.phi) || !isfinite(n.gn)) return step_failed(s, R, st);
         /* 1e-5 of the step's first gradient: the position error it leaves is far below
          * the subspace's own (measured: tighter costs iterations, not accuracy) */
-        if (gn <= 1e-5 * g0 || gn == 0) {
+        if (n.gn <= 1e-5 * n.g0 || n.gn == 0) {
             st->status |= SINEW_STEP_CONVERGED;
             break;
         }
         if (it == s->max_newton) break;
-        if (have_h) {
+        if (n.have_h) {
             if (!sw_solver_factor(red, s)) break;
             st->factorizations++;
-            have_h = 0;
-            fresh = 1;
+            n.have_h = 0;
+            n.fresh = 1;
         }
         factored_direction(red, s);
         /* An update that moves the shape by less than 5% of its correction (the basis
@@ -318,76 +413,23 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
          * |q| > dq_tiny / SW_NEWTON_LAST_UPDATE it implies the relative test, so it changes nothing
          * else. */
         if (took_last_update(s, R, SW_NEWTON_LAST_UPDATE, st)) break;
-        double dqn = sqrt(sw_dot(s->dq, s->dq, R));
-        if (probe) { /* not the last: a Newton update from here, with its Hessian */
-            probe = 0;
-            phi = evaluate(red, ct, s, s->q, dc, 1, st);
-            have_h = 1;
-            trust = 0;
+        if (n.probe) { /* not the last: a Newton update from here, with its Hessian */
+            n.probe = 0;
+            evaluate_with_hessian(red, ct, s, dc, st, &n);
             continue;
         }
         /* the end point's Hessian is wanted unless chord updates may follow, or the update
          * is near the stationary point */
-        int with_h = !trust && dqn > SW_NEWTON_NEAR * sqrt(sw_dot(s->q, s->q, R));
+        double dqn = sqrt(sw_dot(s->dq, s->dq, R));
+        int with_h = !n.trust && dqn > SW_NEWTON_NEAR * sqrt(sw_dot(s->q, s->q, R));
         memcpy(s->qtrial, s->q, (size_t)R * sizeof(double)); /* keep q_k */
-        double phi0 = phi, gn0 = gn, step = 1.0;
-        int accepted = 0;
-        for (int ls = 0; ls < 5; ++ls, step *= 0.5) {
-            for (int32_t i = 0; i < R; ++i)
-                s->q[i] = s->qtrial[i] + step * s->dq[i];
-            phi = evaluate(red, ct, s, s->q, dc, with_h, st);
-            if (isfinite(phi) && phi <= phi0 + 1e-12 * fabs(phi0)) {
-                accepted = 1;
-                break;
-            }
-            if (!fresh) break; /* a stale direction: refactor rather than halve */
-        }
-        if (!accepted) {
-            memcpy(s->q, s->qtrial, (size_t)R * sizeof(double));
-            if (!fresh) { /* back to q_k, with its Hessian this time */
-                phi = evaluate(red, ct, s, s->q, dc, 1, st);
-                gn = gn0;
-                have_h = 1;
-                trust = 0;
-                continue;
-            }
-            if (s->fallback_qn) {
-                /* from a predicted start (step.c, dynamic_start) the path met a region
-                   where the potential curves far more than its Hessian says (a stiff
-                   contact engaging): a pose-space blend that switched training poses had
-                   moved the start off the motion's path. Newton starts again from q_n, the
-                   last state, as a step that starts there does. */
-                s->fallback_qn = 0;
-                memcpy(s->q, s->qn, (size_t)R * sizeof(double));
-                phi = evaluate(red, ct, s, s->q, dc, 1, st);
-                gn = g0 = sqrt(sw_dot(red->g, red->g, R));
-                have_h = 1;
-                trust = 1;
-                continue;
-            }
-            /* keep the best iterate (its energy and gradient norm are known) */
-            phi = phi0;
-            gn = gn0;
-            st->status |= SINEW_STEP_GUARD;
-            break;
-        }
-        gn = sqrt(sw_dot(red->g, red->g, R));
-        st->newton_iterations++;
-        if (with_h) { /* a Newton update next */
-            have_h = 1;
-            trust = gn <= SW_CHORD_ENTER * gn0;
-        } else if (gn > (fresh ? SW_CHORD_ENTER : SW_CHORD_KEEP) * gn0 && gn > 1e-5 * g0) {
-            if (!trust) { /* near: the factor at hand may show the next update is the last */
-                probe = 1;
-            } else {
-                phi = evaluate(red, ct, s, s->q, dc, 1, st); /* the same phi and g, with H */
-                have_h = 1;
-                trust = 0;
-            }
-        }
-        fresh = 0;
+        double phi0 = n.phi, gn0 = n.gn;
+        if (line_search(red, ct, s, dc, st, &n, with_h, phi0))
+            after_update(red, ct, s, dc, st, &n, with_h, gn0);
+        else
+            done = !rejected_update(red, ct, s, dc, st, &n, phi0, gn0);
     }
-    st->residual = g0 > 0 ? gn / g0 : 0;
-    st->energy = phi;
+    st->residual = n.g0 > 0 ? n.gn / n.g0 : 0;
+    st->energy = n.phi;
     return SINEW_OK;
 }
