@@ -177,6 +177,111 @@ static sinew_result pose_sections(const sw_bake_state *s, sw_bake_result *out, s
     return SINEW_OK;
 }
 
+/* The rig's sections: rest positions, skinning, the bones' parents and joints. */
+static sinew_result rig_sections(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    double *rest, *skin_weight, *joints;
+    int32_t *skin_bone, *parent;
+    OWN(rest, 3 * s->rig.nv, double);
+    OWN(skin_bone, 4 * s->rig.nv, int32_t);
+    OWN(skin_weight, 4 * s->rig.nv, double);
+    OWN(parent, s->rig.nb, int32_t);
+    OWN(joints, 6 * s->rig.nb, double);
+    if (!rest || !skin_bone || !skin_weight || !parent || !joints)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    memcpy(rest, s->rig.ch.mesh.X, (size_t)s->rig.nv * 3 * sizeof(double));
+    memcpy(skin_bone, s->rig.skin_bone, (size_t)s->rig.nv * 4 * sizeof(int32_t));
+    memcpy(skin_weight, s->rig.skin_weight, (size_t)s->rig.nv * 4 * sizeof(double));
+    for (int32_t b = 0; b < s->rig.nb; ++b) {
+        parent[b] = s->rig.ch.skel.parent[b];
+        memcpy(joints + 6 * b, s->rig.ch.skel.joints + 3 * s->rig.ch.skel.bones[2 * b],
+               3 * sizeof(double));
+        memcpy(joints + 6 * b + 3, s->rig.ch.skel.joints + 3 * s->rig.ch.skel.bones[2 * b + 1],
+               3 * sizeof(double));
+    }
+    v->nverts = s->rig.nv;
+    v->nbones = s->rig.nb;
+    v->rest = rest;
+    v->skin_bone = skin_bone;
+    v->skin_weight = skin_weight;
+    v->bone_parent = parent;
+    v->bone_joints = joints;
+    return SINEW_OK;
+}
+
+/* Each mesh vertex's copies (domain, local), in domain order: copy_list from
+ * copy_ptr_v[v] to copy_ptr_v[v + 1] (nv + 1 entries, zeroed); fill: nv scratch. */
+static void vertex_copies(const sw_bake_state *s, int32_t *copy_ptr_v, int32_t *copy_list,
+                          int32_t *fill) {
+    const int32_t nd = s->domains.nd;
+    for (int32_t d = 0; d < nd; ++d)
+        for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k)
+            copy_ptr_v[s->domains.dom_verts[k] + 1]++;
+    for (int32_t i = 0; i < s->rig.nv; ++i)
+        copy_ptr_v[i + 1] += copy_ptr_v[i];
+    memcpy(fill, copy_ptr_v, (size_t)s->rig.nv * sizeof(int32_t));
+    for (int32_t d = 0; d < nd; ++d)
+        for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k) {
+            int32_t gv = s->domains.dom_verts[k], at = fill[gv]++;
+            copy_list[2 * at] = d;
+            copy_list[2 * at + 1] = k - s->domains.dom_vert_ptr[d];
+        }
+}
+
+/* The output surface: the tet mesh's boundary, each vertex the mean of its copies
+ * (vertex_copies'); surf_index: nv scratch. */
+static sinew_result surface_sections(const sw_bake_state *s, const sw_surface *surf,
+                                     const int32_t *copy_ptr_v, const int32_t *copy_list,
+                                     int32_t *surf_index, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    int32_t *surf_tris, *copy_ptr, *copies;
+    OWN(surf_tris, 3 * surf->ntris, int32_t);
+    OWN(copy_ptr, surf->nverts + 1, int32_t);
+    if (!surf_tris || !copy_ptr)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    for (int32_t i = 0; i < s->rig.nv; ++i)
+        surf_index[i] = -1;
+    for (int32_t i = 0; i < surf->nverts; ++i)
+        surf_index[surf->verts[i]] = i;
+    for (int32_t i = 0; i < 3 * surf->ntris; ++i)
+        surf_tris[i] = surf_index[surf->tris[i]];
+    int32_t nsc = 0;
+    for (int32_t i = 0; i < surf->nverts; ++i) {
+        int32_t gv = surf->verts[i];
+        copy_ptr[i] = nsc;
+        nsc += copy_ptr_v[gv + 1] - copy_ptr_v[gv];
+    }
+    copy_ptr[surf->nverts] = nsc;
+    if (!OWN(copies, 2 * nsc, int32_t))
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    for (int32_t i = 0; i < surf->nverts; ++i) {
+        int32_t gv = surf->verts[i];
+        memcpy(copies + 2 * copy_ptr[i], copy_list + 2 * copy_ptr_v[gv],
+               (size_t)(copy_ptr_v[gv + 1] - copy_ptr_v[gv]) * 2 * sizeof(int32_t));
+    }
+    v->nsurf_verts = surf->nverts;
+    v->nsurf_tris = surf->ntris;
+    v->surf_tris = surf_tris;
+    v->surf_copy_ptr = copy_ptr;
+    v->surf_copies = copies;
+    v->nsurf_copies = nsc;
+    return SINEW_OK;
+}
+
+/* A painted character's stiffness multiplier of each cubature tet (none unpainted). */
+static sinew_result painted_cubature(const sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    if (!s->rig.ch.tet_stiffness) return SINEW_OK;
+    double *stiff;
+    if (!OWN(stiff, out->view.ncub, double))
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    for (int32_t d = 0, c = 0; d < s->domains.nd; ++d)
+        for (int32_t i = 0; i < s->cubature.n[d]; ++i)
+            stiff[c++] = s->rig.ch.tet_stiffness[s->domains.dom_tets[s->domains.dom_tet_ptr[d] +
+                                                                     s->cubature.local[d][i]]];
+    out->view.cub_stiffness = stiff;
+    return SINEW_OK;
+}
+
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sw_blob_view *v = &out->view;
     int32_t R = s->basis.rank_total, nd = s->domains.nd, ncopies = s->domains.dom_vert_ptr[nd];
@@ -197,15 +302,9 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
                   s->basis.rank[d];
         ninertia += 9 * (int64_t)s->basis.rank[d] * s->basis.rank[d];
     }
-    double *rest, *skin_weight, *joints, *basis, *cub_weight, *cub_dminv, *cub_vol, *spring, *mass;
-    double *ins, *inx, *inu;
-    int32_t *skin_bone, *parent, *dverts, *cub_tets, *surf_tris, *copy_ptr, *copies;
+    double *basis, *cub_weight, *cub_dminv, *cub_vol, *spring, *mass, *ins, *inx, *inu;
+    int32_t *dverts, *cub_tets;
     sw_blob_domain *doms;
-    OWN(rest, 3 * s->rig.nv, double);
-    OWN(skin_bone, 4 * s->rig.nv, int32_t);
-    OWN(skin_weight, 4 * s->rig.nv, double);
-    OWN(parent, s->rig.nb, int32_t);
-    OWN(joints, 6 * s->rig.nb, double);
     OWN(doms, nd, sw_blob_domain);
     OWN(dverts, ncopies, int32_t);
     OWN(basis, nbasis, double);
@@ -218,94 +317,35 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     OWN(ins, 3 * R, double);
     OWN(inx, 9 * R, double);
     OWN(inu, ninertia, double);
-    OWN(surf_tris, 3 * surf.ntris, int32_t);
-    OWN(copy_ptr, surf.nverts + 1, int32_t);
     int32_t *copy_ptr_v = calloc((size_t)s->rig.nv + 1, sizeof(int32_t)); /* copies per vertex */
     int32_t *copy_list = malloc((size_t)ncopies * 2 * sizeof(int32_t));
     int32_t *surf_index = malloc((size_t)s->rig.nv * sizeof(int32_t));
-    if (!rest || !skin_bone || !skin_weight || !parent || !joints || !doms || !dverts || !basis ||
-        !cub_tets || !cub_weight || !cub_dminv || !cub_vol || !spring || !mass || !ins || !inx ||
-        !inu || !surf_tris || !copy_ptr || !copy_ptr_v || !copy_list || !surf_index) {
+    if (!doms || !dverts || !basis || !cub_tets || !cub_weight || !cub_dminv || !cub_vol ||
+        !spring || !mass || !ins || !inx || !inu || !copy_ptr_v || !copy_list || !surf_index) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
         goto done;
     }
-    memcpy(rest, s->rig.ch.mesh.X, (size_t)s->rig.nv * 3 * sizeof(double));
-    memcpy(skin_bone, s->rig.skin_bone, (size_t)s->rig.nv * 4 * sizeof(int32_t));
-    memcpy(skin_weight, s->rig.skin_weight, (size_t)s->rig.nv * 4 * sizeof(double));
-    for (int32_t b = 0; b < s->rig.nb; ++b) {
-        parent[b] = s->rig.ch.skel.parent[b];
-        memcpy(joints + 6 * b, s->rig.ch.skel.joints + 3 * s->rig.ch.skel.bones[2 * b],
-               3 * sizeof(double));
-        memcpy(joints + 6 * b + 3, s->rig.ch.skel.joints + 3 * s->rig.ch.skel.bones[2 * b + 1],
-               3 * sizeof(double));
-    }
+    if ((r = rig_sections(s, out, err)) != SINEW_OK) goto done;
     memcpy(dverts, s->domains.dom_verts, (size_t)ncopies * sizeof(int32_t));
-
     fill_domains(s, doms, basis, cub_tets, cub_weight, cub_dminv, cub_vol, mass, ins, inx, inu,
                  surf_index);
-    /* copies of each vertex: (domain, local) */
-    for (int32_t d = 0; d < nd; ++d)
-        for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k)
-            copy_ptr_v[s->domains.dom_verts[k] + 1]++;
-    for (int32_t i = 0; i < s->rig.nv; ++i)
-        copy_ptr_v[i + 1] += copy_ptr_v[i];
-    {
-        int32_t *fill = surf_index;
-        memcpy(fill, copy_ptr_v, (size_t)s->rig.nv * sizeof(int32_t));
-        for (int32_t d = 0; d < nd; ++d)
-            for (int32_t k = s->domains.dom_vert_ptr[d]; k < s->domains.dom_vert_ptr[d + 1]; ++k) {
-                int32_t gv = s->domains.dom_verts[k], at = fill[gv]++;
-                copy_list[2 * at] = d;
-                copy_list[2 * at + 1] = k - s->domains.dom_vert_ptr[d];
-            }
-    }
+    vertex_copies(s, copy_ptr_v, copy_list, surf_index);
     if (!(s->reduce.spring_unit = calloc((size_t)R * R + 1, sizeof(double)))) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the springs");
         goto done;
     }
     add_interface_springs(s, doms, copy_ptr_v, copy_list, s->reduce.spring_unit);
-    /* output surface: the tet mesh's boundary; each vertex the mean of its copies */
-    for (int32_t i = 0; i < s->rig.nv; ++i)
-        surf_index[i] = -1;
-    for (int32_t i = 0; i < surf.nverts; ++i)
-        surf_index[surf.verts[i]] = i;
-    for (int32_t i = 0; i < 3 * surf.ntris; ++i)
-        surf_tris[i] = surf_index[surf.tris[i]];
-    int32_t nsc = 0;
-    for (int32_t i = 0; i < surf.nverts; ++i) {
-        int32_t gv = surf.verts[i];
-        copy_ptr[i] = nsc;
-        nsc += copy_ptr_v[gv + 1] - copy_ptr_v[gv];
-    }
-    copy_ptr[surf.nverts] = nsc;
-    OWN(copies, 2 * nsc, int32_t);
-    if (!copies) {
-        r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-        goto done;
-    }
-    for (int32_t i = 0; i < surf.nverts; ++i) {
-        int32_t gv = surf.verts[i];
-        memcpy(copies + 2 * copy_ptr[i], copy_list + 2 * copy_ptr_v[gv],
-               (size_t)(copy_ptr_v[gv + 1] - copy_ptr_v[gv]) * 2 * sizeof(int32_t));
-    }
+    r = surface_sections(s, &surf, copy_ptr_v, copy_list, surf_index, out, err);
+    if (r != SINEW_OK) goto done;
 
-    v->nverts = s->rig.nv;
-    v->nbones = s->rig.nb;
     v->ndomains = nd;
     v->rank_total = R;
     v->ndomain_verts = ncopies;
     v->ncub = ncub;
-    v->nsurf_verts = surf.nverts;
-    v->nsurf_tris = surf.ntris;
     sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &v->mu, &v->lambda);
     v->rayleigh_alpha = s->p->rayleigh_alpha; /* thesis §2.1.3 */
     v->rayleigh_beta = s->p->rayleigh_beta;
     v->contact_k = 1e6; /* the training simulations' penalty (fullsim default) */
-    v->rest = rest;
-    v->skin_bone = skin_bone;
-    v->skin_weight = skin_weight;
-    v->bone_parent = parent;
-    v->bone_joints = joints;
     v->domains = doms;
     v->domain_verts = dverts;
     v->basis = basis;
@@ -314,28 +354,13 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->cub_weight = cub_weight;
     v->cub_dminv = cub_dminv;
     v->cub_vol = cub_vol;
-    if (s->rig.ch.tet_stiffness) { /* painted: each cubature tet's multiplier */
-        double *stiff;
-        if (!OWN(stiff, ncub, double)) {
-            r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
-            goto done;
-        }
-        for (int32_t d = 0, c = 0; d < nd; ++d)
-            for (int32_t i = 0; i < s->cubature.n[d]; ++i)
-                stiff[c++] = s->rig.ch.tet_stiffness[s->domains.dom_tets[s->domains.dom_tet_ptr[d] +
-                                                                         s->cubature.local[d][i]]];
-        v->cub_stiffness = stiff;
-    }
+    if ((r = painted_cubature(s, out, err)) != SINEW_OK) goto done;
     v->spring_hessian = s->reduce.spring = spring; /* the springs stage scales it */
     v->mass = mass;
     v->inertia_s = ins;
     v->inertia_x = inx;
     v->inertia_u = inu;
     v->ninertia_u = ninertia;
-    v->surf_tris = surf_tris;
-    v->surf_copy_ptr = copy_ptr;
-    v->surf_copies = copies;
-    v->nsurf_copies = nsc;
     r = pose_sections(s, out, err);
 done:
     free(copy_ptr_v);

@@ -32,6 +32,7 @@
 
 #include <stdint.h>
 
+#include "mem_plan.h"
 #include "self_contact.h"
 #include "solver.h"
 
@@ -141,6 +142,9 @@ typedef struct sw_cond {
     int32_t *keep_v;                  /* max_verts: the last patch, kept while unsettled */
     int32_t nkeep, keep;
 } sw_cond;
+
+/* Lays out the patch's budget (cz, from sw_cond_plan) and its per vertex and tet stamps. */
+void sw_cond_take(sw_mem_plan *p, const sw_blob_view *v, const sw_cond_sizes *cz, sw_cond *c);
 
 /* The lists a patch's pair elements come from. */
 enum { SW_COND_TRAINED = 0, SW_COND_DETECTED = 1 };

@@ -45,6 +45,81 @@ sw_cond_sizes sw_cond_plan(const sw_blob_view *v, uint32_t max_verts, int32_t ma
     return z;
 }
 
+void sw_cond_take(sw_mem_plan *p, const sw_blob_view *v, const sw_cond_sizes *cz, sw_cond *c) {
+    const uint64_t R = (uint64_t)v->rank_total, nb = (uint64_t)v->nbones,
+                   nd = (uint64_t)v->ndomains, nv = (uint64_t)v->nverts, nt = (uint64_t)v->ntets,
+                   nf = (uint64_t)cz->max_verts, np = (uint64_t)cz->max_pairs,
+                   ntf = (uint64_t)cz->max_tets + np, nr = (uint64_t)cz->max_ring, m = R + 3 * nf;
+#define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
+    TAKE(c->seeds, 3 * (uint64_t)cz->max_seeds);
+    TAKE(c->vis, nv);
+    TAKE(c->in_patch, nv);
+    TAKE(c->vloc, nv);
+    TAKE(c->in_ring, nv);
+    TAKE(c->seeded, nv);
+    TAKE(c->pinned, nv);
+    TAKE(c->surf_of, nv);
+    TAKE(c->dev, 3 * nv);
+    TAKE(c->dev_at, nv);
+    TAKE(c->tvis, nt);
+    TAKE(c->dom_vol, nd);
+    TAKE(c->dom_fv, nd);
+    TAKE(c->dom_tet_ptr, nd + 1);
+    TAKE(c->dom_tets, nt);
+    TAKE(c->queue, (uint64_t)cz->max_cand);
+    TAKE(c->cand, (uint64_t)cz->max_cand);
+    TAKE(c->cand_d, (uint64_t)cz->max_cand);
+    TAKE(c->fv, nf);
+    TAKE(c->pp_id, np);
+    TAKE(c->pp_w, np);
+    TAKE(c->pp_alpha, np);
+    TAKE(c->pp_skip, np);
+    TAKE(c->pp_src, np);
+    TAKE(c->sc_skip, (uint64_t)cz->max_detected);
+    TAKE(c->pp_active, np);
+    TAKE(c->ft, ntf);
+    TAKE(c->ft_slot, 4 * ntf);
+    TAKE(c->ring_v, nr);
+    TAKE(c->ring_d, nr);
+    TAKE(c->ring_l, nr);
+    TAKE(c->ring_next, nr);
+    TAKE(c->ring_x0, 3 * nr);
+    TAKE(c->ring_J, 3 * (uint64_t)cz->rmax * nr);
+    TAKE(c->ring_x, 3 * nr);
+    TAKE(c->ring_dx, 3 * nr);
+    TAKE(c->ring_M, 3 * (uint64_t)cz->rmax * nr);
+    TAKE(c->x, 3 * nf);
+    TAKE(c->xt, 3 * nf);
+    TAKE(c->dx, 3 * nf);
+    TAKE(c->gf, 3 * nf);
+    TAKE(c->gf_el, 3 * nf);
+    TAKE(c->Kt, 144 * ntf);
+    TAKE(c->Dw, 9 * nf);
+    TAKE(c->Pf, 9 * nf);
+    TAKE(c->cg_r, m);
+    TAKE(c->cg_z, m);
+    TAKE(c->cg_p, m);
+    TAKE(c->cg_Ap, m);
+    TAKE(c->rhs, m);
+    TAKE(c->sol, m);
+    TAKE(c->cub_w, (uint64_t)v->ncub);
+    TAKE(c->px, 3 * nv);
+    TAKE(c->pv, 3 * nv);
+    TAKE(c->pdev, 3 * nv);
+    TAKE(c->prate, 3 * nv);
+    TAKE(c->dyn_at, nv);
+    TAKE(c->xn, 3 * nf);
+    TAKE(c->vn, 3 * nf);
+    TAKE(c->dev_n, 3 * nf);
+    TAKE(c->rate_n, 3 * nf);
+    TAKE(c->mass, nf);
+    TAKE(c->q_prev, R);
+    TAKE(c->dq_prev, nb);
+    TAKE(c->dq_prev2, nb);
+    TAKE(c->keep_v, nf);
+#undef TAKE
+}
+
 void sw_cond_build(sw_cond *c, const sw_blob_view *v, double rho) {
     c->v = v;
     c->rho = rho;

@@ -196,3 +196,16 @@ void sw_pose_space_blend(const sw_pose_space *ps, const double *rows, int32_t m,
     for (int32_t j = 0; j < m; ++j)
         out[j] = b == 0 ? r0[j] : (1 - b) * r0[j] + b * r1[j];
 }
+
+void sw_pose_space_take(sw_mem_plan *p, const sw_blob_view *v, int32_t max_pairs, int with_mask,
+                        sw_pose_space *ps) {
+    const uint64_t nb = (uint64_t)v->nbones, nd = (uint64_t)v->ndomains;
+    SW_PLAN_TAKE(p, ps->feature, 4 * nb);
+    SW_PLAN_TAKE(p, ps->feature_last, 4 * nb);
+    SW_PLAN_TAKE(p, ps->motion, 4 * nb);
+    SW_PLAN_TAKE(p, ps->pairs, (uint64_t)max_pairs);
+    SW_PLAN_TAKE(p, ps->pair_w, (uint64_t)max_pairs);
+    SW_PLAN_TAKE(p, ps->pair_tan, (uint64_t)max_pairs);
+    ps->novel_mask = NULL;
+    if (with_mask) SW_PLAN_TAKE(p, ps->novel_mask, nd * nd);
+}

@@ -7,6 +7,7 @@
 
 #include <stdint.h>
 
+#include "mem_plan.h"
 #include "blob_view.h"
 
 typedef struct sw_pose_space {
@@ -54,6 +55,11 @@ typedef struct sw_pose_space {
        applies them (sw_pose_space_force), else NULL */
     const double *force;
 } sw_pose_space;
+
+/* Lays out the pose features and the pair budget, and the novel-pair mask of a step that
+ * detects (with_mask). */
+void sw_pose_space_take(sw_mem_plan *p, const sw_blob_view *v, int32_t max_pairs, int with_mask,
+                        sw_pose_space *ps);
 
 /* Forgets the pose history: no motion, no nearest pose. */
 void sw_pose_space_reset(sw_pose_space *ps, int32_t nbones);

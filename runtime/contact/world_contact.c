@@ -409,3 +409,16 @@ void sw_world_contacts_update_boxes(sw_world_contacts *wc) {
     }
     wc->boxes_valid = 1;
 }
+
+void sw_world_contacts_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, int32_t max_world,
+                            sw_world_contacts *wc) {
+    const uint64_t nc = (uint64_t)v->nsurf_copies, nb = (uint64_t)v->nbones;
+    SW_PLAN_TAKE(p, wc->cand, (uint64_t)max_world);
+    SW_PLAN_TAKE(p, wc->cl_box, 6 * (uint64_t)ncl);
+    SW_PLAN_TAKE(p, wc->cl_pass, (uint64_t)ncl);
+    SW_PLAN_TAKE(p, wc->copy_first, nc);
+    SW_PLAN_TAKE(p, wc->dom_moved, (uint64_t)v->ndomains);
+    SW_PLAN_TAKE(p, wc->q_detect, (uint64_t)v->rank_total);
+    SW_PLAN_TAKE(p, wc->bone_motion, 12 * nb);
+    SW_PLAN_TAKE(p, wc->copy_x, 3 * nc);
+}

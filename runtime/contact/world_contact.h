@@ -20,6 +20,7 @@
 
 #include <stdint.h>
 
+#include "mem_plan.h"
 #include "blob_clusters.h"
 #include "reduced_map.h"
 #include "sinew/sinew_world.h"
@@ -67,6 +68,11 @@ typedef struct sw_world_contacts {
     double grid;
     uint32_t queries; /* collider queries of the last detection */
 } sw_world_contacts;
+
+/* Lays out the candidate budget and the broad phase's per-cluster boxes (the clusters are
+ * the blob's) and per-copy positions. */
+void sw_world_contacts_take(sw_mem_plan *p, const sw_blob_view *v, int32_t ncl, int32_t max_world,
+                            sw_world_contacts *wc);
 
 /* Binds the blob's clusters cl and forgets every candidate (copy_first laid out by the
  * instance). Creation time; no allocation. */

@@ -100,3 +100,13 @@ void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *d
     }
     memcpy(dst_nz, src_nz, (size_t)nd * nd);
 }
+
+void sw_reduced_take(sw_mem_plan *p, const sw_blob_view *v, int32_t rmax, int32_t nworkers,
+                     sw_reduced *m) {
+    const uint64_t rm = (uint64_t)rmax;
+    SW_PLAN_TAKE(p, m->g, (uint64_t)v->rank_total);
+    SW_PLAN_TAKE(p, m->hm, 10 * rm * (uint64_t)nworkers);
+    SW_PLAN_TAKE(p, m->Jc, 12 * rm);
+    SW_PLAN_TAKE(p, m->hc, 12 * rm);
+    SW_PLAN_TAKE(p, m->svd_V, 9 * (uint64_t)v->ncub);
+}

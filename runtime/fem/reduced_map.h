@@ -13,6 +13,7 @@
 
 #include <stdint.h>
 
+#include "mem_plan.h"
 #include "blob_active.h"
 #include "blob_view.h"
 #include "dqs.h"
@@ -62,6 +63,11 @@ typedef struct sw_reduced {
      * refreshes (cubature.c). NULL where the instance never starts Newton on them. */
     double *h_ref;
 } sw_reduced;
+
+/* Lays out (or sizes: mem_plan.h) the map's accumulators: the gradient, each worker's
+ * element-Hessian blocks, the Jacobians, and each cubature tet's SVD frame. */
+void sw_reduced_take(sw_mem_plan *p, const sw_blob_view *v, int32_t rmax, int32_t nworkers,
+                     sw_reduced *m);
 
 /* Points m at the blob's active map a. */
 void sw_reduced_bind_active(sw_reduced *m, const sw_active_map *a);

@@ -20,8 +20,7 @@
  * block's start. */
 static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
                    const sw_layout_sizes *z) {
-    const uint64_t R = (uint64_t)v->rank_total, nb = (uint64_t)v->nbones,
-                   nd = (uint64_t)v->ndomains, rm = (uint64_t)z->rmax,
+    const uint64_t nb = (uint64_t)v->nbones, nd = (uint64_t)v->ndomains,
                    ns = (uint64_t)sw_blob_output_verts(v);
 #define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
     (void)sw_plan_take(p, 1, sizeof *in);
@@ -35,133 +34,19 @@ static void layout(sw_mem_plan *p, sinew_instance *in, const sw_blob_view *v,
     TAKE(in->loc.T_prev2, 12 * nb);
     TAKE(in->L_last, 12 * nb);
     /* the subspace map: active vertices and their skinning, accumulators, Jacobians */
-    sw_reduced *m = &in->red;
-    TAKE(m->g, R);
-    const uint64_t nw = (uint64_t)z->nworkers;
-    TAKE(m->hm, 10 * rm * nw);
-    TAKE(m->Jc, 12 * rm);
-    TAKE(m->hc, 12 * rm);
-    TAKE(m->svd_V, 9 * (uint64_t)v->ncub);
+    sw_reduced_take(p, v, z->rmax, z->nworkers, &in->red);
     in->h_ref = NULL;
     if (z->rest) TAKE(in->h_ref, (uint64_t)sw_cubature_rest_hessian_size(v));
     /* the pose space */
-    sw_pose_space *ps = &in->ps;
-    TAKE(ps->feature, 4 * nb);
-    TAKE(ps->feature_last, 4 * nb);
-    TAKE(ps->motion, 4 * nb);
-    TAKE(ps->pairs, (uint64_t)z->max_pairs);
-    TAKE(ps->pair_w, (uint64_t)z->max_pairs);
-    TAKE(ps->pair_tan, (uint64_t)z->max_pairs);
-    ps->novel_mask = NULL;
-    if (z->per_pair && z->detect) TAKE(ps->novel_mask, nd * nd);
+    sw_pose_space_take(p, v, z->max_pairs, z->per_pair && z->detect, &in->ps);
     if (z->detect) sw_self_contacts_take(p, v, &in->sc);
     if (z->novel) sw_novel_take(p, v, z->ncl, &in->novel);
-    /* the solver */
-    sw_solver *s = &in->solver;
-    TAKE(s->q, R);
-    TAKE(s->qn, R);
-    TAKE(s->qdot, R);
-    TAKE(s->fin, R);
-    TAKE(s->g_mat, R);
-    TAKE(s->q_mat, z->dynamic ? R : 0);
-    TAKE(s->dq, R);
-    TAKE(s->qtrial, R);
-    TAKE(s->q_pred, R);
-    TAKE(s->tmp, R);
-    TAKE(s->tmp2, R);
-    TAKE(s->blk_off, nd);
-    TAKE(s->blk_size, nd);
-    TAKE(s->blk_order, nd);
-    TAKE(s->blk_pos, nd);
-    TAKE(s->blk_nz, nd * nd);
-    TAKE(s->blk_adj, nd * nd);
+    sw_solver_take(p, v, z->dynamic, &in->solver);
     /* the collision world's candidates and its broad phase's boxes (the clusters are the
        blob's) */
-    sw_world_contacts *wc = &in->wc;
-    const uint64_t ncl = (uint64_t)z->ncl, nc = (uint64_t)v->nsurf_copies;
-    TAKE(wc->cand, (uint64_t)z->max_world);
-    TAKE(wc->cl_box, 6 * ncl);
-    TAKE(wc->cl_pass, ncl);
-    TAKE(wc->copy_first, nc);
-    TAKE(wc->dom_moved, nd);
-    TAKE(wc->q_detect, R);
-    TAKE(wc->bone_motion, 12 * nb);
-    TAKE(wc->copy_x, 3 * nc);
+    sw_world_contacts_take(p, v, z->ncl, z->max_world, &in->wc);
     /* subspace condensation: the patch's budget, and per vertex and tet stamps */
-    sw_cond *c = &in->cond;
-    const sw_cond_sizes *cz = &z->cond;
-    if (cz->max_verts > 0) {
-        const uint64_t nv = (uint64_t)v->nverts, nt = (uint64_t)v->ntets,
-                       nf = (uint64_t)cz->max_verts, np = (uint64_t)cz->max_pairs,
-                       ntf = (uint64_t)cz->max_tets + np, nr = (uint64_t)cz->max_ring,
-                       m = R + 3 * nf;
-        TAKE(c->seeds, 3 * (uint64_t)cz->max_seeds);
-        TAKE(c->vis, nv);
-        TAKE(c->in_patch, nv);
-        TAKE(c->vloc, nv);
-        TAKE(c->in_ring, nv);
-        TAKE(c->seeded, nv);
-        TAKE(c->pinned, nv);
-        TAKE(c->surf_of, nv);
-        TAKE(c->dev, 3 * nv);
-        TAKE(c->dev_at, nv);
-        TAKE(c->tvis, nt);
-        TAKE(c->dom_vol, nd);
-        TAKE(c->dom_fv, nd);
-        TAKE(c->dom_tet_ptr, nd + 1);
-        TAKE(c->dom_tets, nt);
-        TAKE(c->queue, (uint64_t)cz->max_cand);
-        TAKE(c->cand, (uint64_t)cz->max_cand);
-        TAKE(c->cand_d, (uint64_t)cz->max_cand);
-        TAKE(c->fv, nf);
-        TAKE(c->pp_id, np);
-        TAKE(c->pp_w, np);
-        TAKE(c->pp_alpha, np);
-        TAKE(c->pp_skip, np);
-        TAKE(c->pp_src, np);
-        TAKE(c->sc_skip, (uint64_t)cz->max_detected);
-        TAKE(c->pp_active, np);
-        TAKE(c->ft, ntf);
-        TAKE(c->ft_slot, 4 * ntf);
-        TAKE(c->ring_v, nr);
-        TAKE(c->ring_d, nr);
-        TAKE(c->ring_l, nr);
-        TAKE(c->ring_next, nr);
-        TAKE(c->ring_x0, 3 * nr);
-        TAKE(c->ring_J, 3 * (uint64_t)cz->rmax * nr);
-        TAKE(c->ring_x, 3 * nr);
-        TAKE(c->ring_dx, 3 * nr);
-        TAKE(c->ring_M, 3 * (uint64_t)cz->rmax * nr);
-        TAKE(c->x, 3 * nf);
-        TAKE(c->xt, 3 * nf);
-        TAKE(c->dx, 3 * nf);
-        TAKE(c->gf, 3 * nf);
-        TAKE(c->gf_el, 3 * nf);
-        TAKE(c->Kt, 144 * ntf);
-        TAKE(c->Dw, 9 * nf);
-        TAKE(c->Pf, 9 * nf);
-        TAKE(c->cg_r, m);
-        TAKE(c->cg_z, m);
-        TAKE(c->cg_p, m);
-        TAKE(c->cg_Ap, m);
-        TAKE(c->rhs, m);
-        TAKE(c->sol, m);
-        TAKE(c->cub_w, (uint64_t)v->ncub);
-        TAKE(c->px, 3 * nv);
-        TAKE(c->pv, 3 * nv);
-        TAKE(c->pdev, 3 * nv);
-        TAKE(c->prate, 3 * nv);
-        TAKE(c->dyn_at, nv);
-        TAKE(c->xn, 3 * nf);
-        TAKE(c->vn, 3 * nf);
-        TAKE(c->dev_n, 3 * nf);
-        TAKE(c->rate_n, 3 * nf);
-        TAKE(c->mass, nf);
-        TAKE(c->q_prev, R);
-        TAKE(c->dq_prev, nb);
-        TAKE(c->dq_prev2, nb);
-        TAKE(c->keep_v, nf);
-    }
+    if (z->cond.max_verts > 0) sw_cond_take(p, v, &z->cond, &in->cond);
     /* the step's scratch, unless a workspace lends it */
     memset(&in->own, 0, sizeof in->own);
     if (!z->shared) sw_scratch_layout(p, &in->own, v, z);

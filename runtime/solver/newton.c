@@ -34,6 +34,29 @@ void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v) {
                     s->mass_blockdiag = 0;
 }
 
+void sw_solver_take(sw_mem_plan *p, const sw_blob_view *v, int dynamic, sw_solver *s) {
+    const uint64_t R = (uint64_t)v->rank_total, nd = (uint64_t)v->ndomains;
+#define TAKE(ptr, count) SW_PLAN_TAKE(p, ptr, count)
+    TAKE(s->q, R);
+    TAKE(s->qn, R);
+    TAKE(s->qdot, R);
+    TAKE(s->fin, R);
+    TAKE(s->g_mat, R);
+    TAKE(s->q_mat, dynamic ? R : 0);
+    TAKE(s->dq, R);
+    TAKE(s->qtrial, R);
+    TAKE(s->q_pred, R);
+    TAKE(s->tmp, R);
+    TAKE(s->tmp2, R);
+    TAKE(s->blk_off, nd);
+    TAKE(s->blk_size, nd);
+    TAKE(s->blk_order, nd);
+    TAKE(s->blk_pos, nd);
+    TAKE(s->blk_nz, nd * nd);
+    TAKE(s->blk_adj, nd * nd);
+#undef TAKE
+}
+
 /* The blocks a contact pair's four copies (cv: (domain, local) each) couple. */
 static void couple_pair(sw_solver *s, int32_t nd, const int32_t *cv) {
     for (int m = 0; m < 4; ++m)

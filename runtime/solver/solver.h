@@ -6,6 +6,7 @@
 
 #include <stdint.h>
 
+#include "mem_plan.h"
 #include "pose_space.h"
 #include "reduced_map.h"
 #include "self_contact.h"
@@ -52,6 +53,10 @@ typedef struct sw_solver {
     int rest_first;      /* steps start on the reference Hessian (red->h_ref) */
     double dq_tiny;      /* an update shorter than this converged (1e-9 of the size) */
 } sw_solver;
+
+/* Lays out the solver's vectors and its block layout; the frozen Hessian's point only for
+ * dynamic steps. */
+void sw_solver_take(sw_mem_plan *p, const sw_blob_view *v, int dynamic, sw_solver *s);
 
 /* The time discretisation of a step: quasistatic (dynamic = 0) or backward Euler with
  * cm = 1/h^2, cd = 1/h and Rayleigh damping alpha M + beta H(q_n). */
