@@ -150,30 +150,16 @@ static double gauss(uint64_t *state) {
     return sqrt(-2.0 * log(u1)) * cos(6.283185307179586 * u2);
 }
 
-/* Trains domain dom's cubature; fills s->cubature.n/local/w[dom]. */
-static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *dsnap, int32_t T,
-                                 const sw_dualquat *pose_dq, sw_bake_result *out, sw_error *err) {
+/* The training samples of domain dom (sets of T each, q: sets T x r zeroed; dq: their
+ * poses): the snapshots projected, q = U^T d; perturbed copies; with inertia modes a third
+ * set moving those. 0 out of memory. */
+static int training_samples(const sw_bake_state *s, int32_t dom, const double *dsnap, int32_t T,
+                            const sw_dualquat *pose_dq, int32_t sets, double *q, sw_dualquat *dq) {
     int32_t r = s->basis.rank[dom], base = s->domains.dom_vert_ptr[dom],
             nvd = s->domains.dom_vert_ptr[dom + 1] - base;
-    int32_t t0 = s->domains.dom_tet_ptr[dom], ntd = s->domains.dom_tet_ptr[dom + 1] - t0,
-            sets = s->p->inertia_modes ? 3 : 2, ns = sets * T;
     const double *U = s->basis.U[dom];
-    sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
-    int32_t *local_of = malloc((size_t)s->rig.nv * sizeof(int32_t));
-    int32_t *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t));
-    double *dminv = malloc((size_t)ntd * 9 * sizeof(double)),
-           *vol = malloc((size_t)ntd * sizeof(double));
-    double *q = calloc((size_t)ns * r, sizeof(double)),
-           *inv_norm = malloc((size_t)ns * sizeof(double));
-    sw_dualquat *dq = malloc((size_t)ns * s->rig.nb * sizeof(sw_dualquat));
-    double *b = NULL, *partial = NULL, *mode_w = NULL;
-    sw_cubature_result cr;
-    memset(&cr, 0, sizeof cr);
-    if (!local_of || !tet_local || !dminv || !vol || !q || !inv_norm || !dq) goto done;
-    sw_bake_domain_tets(s, dom, local_of, tet_local, dminv, vol);
-    /* samples: snapshots projected, then perturbed copies */
     double *rms = calloc((size_t)r, sizeof(double));
-    if (!rms) goto done;
+    if (!rms) return 0;
     for (int32_t a = 0; a < T; ++a) {
         for (int32_t j = 0; j < r; ++j) {
             double acc = 0;
@@ -185,9 +171,7 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
             q[(size_t)a * r + j] = acc;
             rms[j] += acc * acc / T;
         }
-        memcpy(dq + (size_t)a * s->rig.nb, pose_dq + (size_t)a * s->rig.nb,
-               (size_t)s->rig.nb * sizeof(sw_dualquat));
-        for (int k = 1; k < sets; ++k)
+        for (int k = 0; k < sets; ++k)
             memcpy(dq + (size_t)(k * T + a) * s->rig.nb, pose_dq + (size_t)a * s->rig.nb,
                    (size_t)s->rig.nb * sizeof(sw_dualquat));
     }
@@ -211,9 +195,115 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
                     (j >= s->basis.rank_dynamic[dom] ? 0.5 * rmax * gauss(&seed) : 0);
     }
     free(rms);
+    return 1;
+}
+
+/* b (nsamples x r): the domain's full reduced force per sample (Krysl projection), summed
+ * in parallel per chunk of tets and then in chunk order (SUM_CHUNK), each sample's
+ * normalised (c->inv_norm its 1 / |b_s|; 0 drops a force-free sample). 0 out of memory. */
+static int sample_forces(const sw_bake_state *s, cub_ctx *c, int32_t ntd, double *inv_norm,
+                         double *b) {
+    size_t block = (size_t)c->nsamples * c->r;
+    int64_t nchunks = ((int64_t)ntd + SUM_CHUNK - 1) / SUM_CHUNK;
+    double *partial = calloc((size_t)nchunks * block, sizeof(double));
+    if (!partial) return 0;
+    sum_ctx sc = {c, ntd, partial};
+    sw_pool_parallel_for(s->pool, nchunks, sum_worker, &sc);
+    for (int64_t k = 0; k < nchunks; ++k)
+        for (size_t i = 0; i < block; ++i)
+            b[i] += partial[(size_t)k * block + i];
+    free(partial);
+    double bmax = 0;
+    for (int32_t smp = 0; smp < c->nsamples; ++smp) {
+        double n2 = 0;
+        for (int32_t j = 0; j < c->r; ++j)
+            n2 += b[(size_t)smp * c->r + j] * b[(size_t)smp * c->r + j];
+        inv_norm[smp] = sqrt(n2);
+        bmax = fmax(bmax, inv_norm[smp]);
+    }
+    for (int32_t smp = 0; smp < c->nsamples; ++smp) { /* normalise; drop force-free samples */
+        double n = inv_norm[smp];
+        inv_norm[smp] = n > 1e-9 * bmax && n > 0 ? 1.0 / n : 0.0;
+        for (int32_t j = 0; j < c->r; ++j)
+            b[(size_t)smp * c->r + j] *= inv_norm[smp];
+    }
+    return 1;
+}
+
+/* The fit of the samples' forces b by cubature points, the chosen selector's result in cr
+ * (the others first, with compare_selectors, for the report). */
+static sinew_result fit_points(sw_bake_state *s, int32_t dom, cub_ctx *c, int32_t ntd, double *b,
+                               sw_cubature_result *cr, sw_bake_result *out, sw_error *err) {
+    sw_cubature_problem prob = {(int64_t)c->nsamples * c->r, ntd, b, column, c};
+    sw_cubature_params cp = sw_cubature_params_default();
+    cp.tol = s->p->cubature_tol;
+    cp.max_points = s->p->cubature_max < ntd ? s->p->cubature_max : ntd;
+    cp.seed = s->p->seed + (uint64_t)dom;
+    cp.threads = sw_pool_size(s->pool);
+    for (int sel = 0; sel < 3; ++sel) { /* the chosen selector last: its result is kept */
+        int which = sel == 2 ? (int)s->p->selector : (sel + (int)s->p->selector + 1) % 3;
+        if (sel < 2 && !s->p->compare_selectors) continue;
+        cp.selector = (sw_cubature_selector)which;
+        sw_cubature_result_free(cr);
+        sinew_result res = sw_cubature_train(&prob, &cp, cr, err);
+        if (res == SINEW_ERROR_NOT_CONVERGED && cr->n > 0) res = SINEW_OK; /* best set, reported */
+        if (res != SINEW_OK) return res;
+        out->selector_points[which] += cr->n;
+        out->selector_seconds[which] += cr->seconds;
+        out->selector_error[which] = fmax(out->selector_error[which], cr->rel_error);
+    }
+    return SINEW_OK;
+}
+
+/* s->cubature's points and weights of domain dom from the fit. */
+static sinew_result keep_points(sw_bake_state *s, int32_t dom, int32_t ntd,
+                                const sw_cubature_result *cr, sw_bake_result *out) {
+    /* No training pose deforms a domain whose fit chose nothing (a short bone of a coarse
+       generated mesh, its flesh all driven or moving rigidly with it): its snapshots carry
+       no force to fit. One tet standing for all of them keeps its unit mode's stiffness in
+       the reduced system instead of leaving the domain without cubature. */
+    int32_t n = cr->n > 0 ? (int32_t)cr->n : 1;
+    s->cubature.n[dom] = n;
+    s->cubature.local[dom] = malloc((size_t)n * sizeof(int32_t));
+    s->cubature.w[dom] = malloc((size_t)n * sizeof(double));
+    if (!s->cubature.local[dom] || !s->cubature.w[dom]) return SINEW_ERROR_OUT_OF_MEMORY;
+    if (cr->n == 0) {
+        s->cubature.local[dom][0] = 0;
+        s->cubature.w[dom][0] = (double)ntd;
+        return SINEW_OK;
+    }
+    for (int32_t i = 0; i < n; ++i) {
+        s->cubature.local[dom][i] = (int32_t)cr->ids[i];
+        s->cubature.w[dom][i] = cr->weights[i];
+    }
+    out->cubature_error_max = fmax(out->cubature_error_max, cr->rel_error);
+    return SINEW_OK;
+}
+
+/* Trains domain dom's cubature; fills s->cubature.n/local/w[dom]. */
+static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *dsnap, int32_t T,
+                                 const sw_dualquat *pose_dq, sw_bake_result *out, sw_error *err) {
+    int32_t r = s->basis.rank[dom];
+    int32_t t0 = s->domains.dom_tet_ptr[dom], ntd = s->domains.dom_tet_ptr[dom + 1] - t0,
+            sets = s->p->inertia_modes ? 3 : 2, ns = sets * T;
+    sinew_result res = SINEW_ERROR_OUT_OF_MEMORY;
+    int32_t *local_of = malloc((size_t)s->rig.nv * sizeof(int32_t));
+    int32_t *tet_local = malloc((size_t)ntd * 4 * sizeof(int32_t));
+    double *dminv = malloc((size_t)ntd * 9 * sizeof(double)),
+           *vol = malloc((size_t)ntd * sizeof(double));
+    double *q = calloc((size_t)ns * r, sizeof(double)),
+           *inv_norm = malloc((size_t)ns * sizeof(double)),
+           *b = calloc((size_t)ns * r, sizeof(double)), *mode_w = NULL;
+    sw_dualquat *dq = malloc((size_t)ns * s->rig.nb * sizeof(sw_dualquat));
+    sw_cubature_result cr;
+    memset(&cr, 0, sizeof cr);
+    if (!local_of || !tet_local || !dminv || !vol || !q || !inv_norm || !b || !dq) goto done;
+    sw_bake_domain_tets(s, dom, local_of, tet_local, dminv, vol);
+    if (!training_samples(s, dom, dsnap, T, pose_dq, sets, q, dq)) goto done;
     for (int32_t smp = 0; smp < ns; ++smp)
         inv_norm[smp] = 1.0;
-    cub_ctx c = {s, dom, r, ns, U, tet_local, dminv, vol, q, dq, inv_norm, NULL, 0, 0};
+    cub_ctx c = {s,        dom,  r, ns, s->basis.U[dom], tet_local, dminv, vol, q, dq,
+                 inv_norm, NULL, 0, 0};
     sw_lame(s->rig.ch.youngs, s->rig.ch.poisson, &c.mu, &c.lambda);
     /* the force weighted by each mode's stiffness (mode_weights) where some modes are far
        softer than others: the inertia modes, and painted flesh, whose soft modes turn the
@@ -223,79 +313,9 @@ static sinew_result train_domain(sw_bake_state *s, int32_t dom, const double *ds
         mode_weights(&c, ntd, mode_w);
         c.mode_w = mode_w;
     }
-    /* b: the domain's full reduced force per sample (Krysl projection), summed in
-     * parallel per chunk of tets and then in chunk order (SUM_CHUNK) */
-    int workers = sw_pool_size(s->pool);
-    size_t block = (size_t)ns * r;
-    int64_t nchunks = ((int64_t)ntd + SUM_CHUNK - 1) / SUM_CHUNK;
-    partial = calloc((size_t)nchunks * block, sizeof(double));
-    b = calloc(block, sizeof(double));
-    if (!partial || !b) goto done;
-    sum_ctx sc = {&c, ntd, partial};
-    sw_pool_parallel_for(s->pool, nchunks, sum_worker, &sc);
-    for (int64_t k = 0; k < nchunks; ++k)
-        for (size_t i = 0; i < block; ++i)
-            b[i] += partial[(size_t)k * block + i];
-    double bmax = 0;
-    for (int32_t smp = 0; smp < ns; ++smp) {
-        double n2 = 0;
-        for (int32_t j = 0; j < r; ++j)
-            n2 += b[(size_t)smp * r + j] * b[(size_t)smp * r + j];
-        inv_norm[smp] = sqrt(n2);
-        bmax = fmax(bmax, inv_norm[smp]);
-    }
-    for (int32_t smp = 0; smp < ns; ++smp) { /* normalise; drop force-free samples */
-        double n = inv_norm[smp];
-        inv_norm[smp] = n > 1e-9 * bmax && n > 0 ? 1.0 / n : 0.0;
-        for (int32_t j = 0; j < r; ++j)
-            b[(size_t)smp * r + j] *= inv_norm[smp];
-    }
-    sw_cubature_problem prob = {(int64_t)block, ntd, b, column, &c};
-    sw_cubature_params cp = sw_cubature_params_default();
-    cp.tol = s->p->cubature_tol;
-    cp.max_points = s->p->cubature_max < ntd ? s->p->cubature_max : ntd;
-    cp.seed = s->p->seed + (uint64_t)dom;
-    cp.threads = workers;
-    for (int sel = 0; sel < 3; ++sel) { /* the chosen selector last: its result is kept */
-        int which = sel == 2 ? (int)s->p->selector : (sel + (int)s->p->selector + 1) % 3;
-        if (sel < 2 && !s->p->compare_selectors) continue;
-        cp.selector = (sw_cubature_selector)which;
-        sw_cubature_result_free(&cr);
-        res = sw_cubature_train(&prob, &cp, &cr, err);
-        if (res == SINEW_ERROR_NOT_CONVERGED && cr.n > 0) res = SINEW_OK; /* best set, reported */
-        if (res != SINEW_OK) goto done;
-        out->selector_points[which] += cr.n;
-        out->selector_seconds[which] += cr.seconds;
-        out->selector_error[which] = fmax(out->selector_error[which], cr.rel_error);
-    }
-    if (cr.n == 0) {
-        /* No training pose deforms the domain (a short bone of a coarse generated mesh,
-           its flesh all driven or moving rigidly with it): its snapshots carry no force to
-           fit. One tet standing for all of them keeps its unit mode's stiffness in the
-           reduced system instead of leaving the domain without cubature. */
-        s->cubature.n[dom] = 1;
-        s->cubature.local[dom] = malloc(sizeof(int32_t));
-        s->cubature.w[dom] = malloc(sizeof(double));
-        if (!s->cubature.local[dom] || !s->cubature.w[dom]) {
-            res = SINEW_ERROR_OUT_OF_MEMORY;
-            goto done;
-        }
-        s->cubature.local[dom][0] = 0;
-        s->cubature.w[dom][0] = (double)ntd;
-        goto done;
-    }
-    s->cubature.n[dom] = cr.n;
-    s->cubature.local[dom] = malloc((size_t)cr.n * sizeof(int32_t));
-    s->cubature.w[dom] = malloc((size_t)cr.n * sizeof(double));
-    if (!s->cubature.local[dom] || !s->cubature.w[dom]) {
-        res = SINEW_ERROR_OUT_OF_MEMORY;
-        goto done;
-    }
-    for (int32_t i = 0; i < cr.n; ++i) {
-        s->cubature.local[dom][i] = (int32_t)cr.ids[i];
-        s->cubature.w[dom][i] = cr.weights[i];
-    }
-    out->cubature_error_max = fmax(out->cubature_error_max, cr.rel_error);
+    if (!sample_forces(s, &c, ntd, inv_norm, b)) goto done;
+    if ((res = fit_points(s, dom, &c, ntd, b, &cr, out, err)) != SINEW_OK) goto done;
+    res = keep_points(s, dom, ntd, &cr, out);
 done:
     if (res == SINEW_ERROR_OUT_OF_MEMORY)
         sw_error_set(err, res, "out of memory training domain %d's cubature", dom);
@@ -308,7 +328,6 @@ done:
     free(inv_norm);
     free(dq);
     free(b);
-    free(partial);
     free(mode_w);
     return res;
 }
