@@ -103,6 +103,14 @@ EOS
     rc=$?
     set -e
     refused "$rc" "shape 'cone'" "an unknown collider shape"
+    # a later key (the first is the collider's placement, which the world API checks)
+    sed 's/"rotation": \[1, 0, 0, 0\]}/&, {"frame": 10, "position": [0, 45, 100], "rotation": [0, 0, 0, 0]}/' \
+        "$here/../worlds/fox_poke.json" >"$tmp/zero.json"
+    set +e
+    "${run[@]}" "$view" "${args[@]}" --world "$tmp/zero.json" --frames 1 2>"$tmp/err"
+    rc=$?
+    set -e
+    refused "$rc" "zero quaternion" "a key whose rotation is the zero quaternion"
     # a debug-draw list with a kind the runtime has not, a recording that cannot be created
     set +e
     "$view" "${args[@]}" --debug-draw contacts,hull --frames 1 2>"$tmp/err"; rc=$?

@@ -31,6 +31,21 @@ static int read_float(const cJSON *o, const char *name, float *out) {
     return 1;
 }
 
+/* q scaled to unit length (by its largest component first, so that tiny or huge finite
+ * components do not underflow or overflow): 0 for the zero quaternion, as the tools' world
+ * reader refuses it. */
+static int unit_rotation(float q[4]) {
+    double m = 0, n2 = 0;
+    for (int k = 0; k < 4; ++k)
+        m = fmax(m, fabs(q[k]));
+    if (!(m > 1e-30)) return 0;
+    for (int k = 0; k < 4; ++k)
+        n2 += (q[k] / m) * (q[k] / m);
+    for (int k = 0; k < 4; ++k)
+        q[k] = (float)(q[k] / m / sqrt(n2));
+    return 1;
+}
+
 /* An OBJ's vertices and faces (fanned into triangles; negative indices count back). */
 static int read_obj(const char *path, vw_collider *c, char *err, size_t errlen) {
     FILE *f = fopen(path, "r");
@@ -294,6 +309,13 @@ static int read_collider(const cJSON *o, const char *dir, vw_collider *c, int i,
             return FAIL("collider %d: key %d needs frame, position and rotation [w, x, y, z]", i,
                         c->nkeys - 1);
         key->frame = f;
+        if (c->nkeys > 1 && !(key->frame > key[-1].frame))
+            return FAIL("collider %d: key %d's frame %g does not follow %g (frames must strictly "
+                        "increase)",
+                        i, c->nkeys - 1, key->frame, key[-1].frame);
+        if (!unit_rotation(key->rotation))
+            return FAIL("collider %d: key %d: the zero quaternion is no rotation (w, x, y, z)", i,
+                        c->nkeys - 1);
     }
     if (c->nkeys) {
         memcpy(d->transform.position, c->keys[0].position, sizeof d->transform.position);
