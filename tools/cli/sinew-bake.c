@@ -232,8 +232,9 @@ static int write_outputs(const bake *b) {
 }
 
 /* The bake's summary on stderr. */
-static void print_summary(const bake *b) {
-    char num[32];
+/* The blob's model: stages, domains and ranks, poses and bases, the references, contact
+ * and the output surface. */
+static void print_model(const bake *b) {
     const sw_blob_view *v = &b->res.view;
     fprintf(stderr, "%s: wrote %s\n", tool, b->o.out_path);
     fprintf(stderr, "  stages (s):");
@@ -286,6 +287,12 @@ static void print_summary(const bake *b) {
                 v->nrender_verts, b->res.render_welded, v->nrender_tris, v->nembed_tets,
                 1e3 * b->res.embed_seconds, b->res.render_outside, b->res.render_max_outside,
                 b->res.render_max_bary);
+}
+
+/* How well the blob reproduces its references: on the bake's poses, by region and by
+ * self-contact mode. */
+static void print_accuracy(const bake *b) {
+    char num[32];
     if (b->res.train_unsettled + b->res.heldout_unsettled > 0)
         fprintf(stderr,
                 "  reference: the contact round cap left the contact set unsettled in %d "
@@ -323,6 +330,11 @@ static void print_summary(const bake *b) {
         fprintf(stderr, " %s %s%s", sw_self_contact_names[k],
                 isfinite(b->mode_err[k]) ? json_number(b->mode_err[k], num) : "-",
                 k + 1 < SW_BAKE_MODES ? "," : "\n");
+}
+
+/* What to look at: the reference's own spread, joints bent beyond training, a forced
+ * blob, the cubature selectors compared. */
+static void print_advice(const bake *b) {
     if (b->o.spread_every > 0)
         fprintf(stderr,
                 "  reference spread at %d held-out poses (every %d-th): runtime %.4f; "
@@ -359,6 +371,12 @@ static void print_summary(const bake *b) {
                     b->res.selector_points[s], b->res.selector_seconds[s],
                     b->res.selector_error[s]);
     }
+}
+
+static void print_summary(const bake *b) {
+    print_model(b);
+    print_accuracy(b);
+    print_advice(b);
 }
 
 /* The JSON line, with --json. */
