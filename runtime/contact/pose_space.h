@@ -7,8 +7,8 @@
 
 #include <stdint.h>
 
-#include "mem_plan.h"
 #include "blob_view.h"
+#include "mem_plan.h"
 
 typedef struct sw_pose_space {
     double *feature;      /* 4 nbones: the current pose's feature */

@@ -20,8 +20,8 @@
 
 #include <stdint.h>
 
-#include "mem_plan.h"
 #include "blob_clusters.h"
+#include "mem_plan.h"
 #include "reduced_map.h"
 #include "sinew/sinew_world.h"
 #include "world_penalty.h"

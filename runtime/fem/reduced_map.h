@@ -13,10 +13,10 @@
 
 #include <stdint.h>
 
-#include "mem_plan.h"
 #include "blob_active.h"
 #include "blob_view.h"
 #include "dqs.h"
+#include "mem_plan.h"
 #include "sinew/sinew_types.h"
 
 typedef struct sw_reduced {

@@ -331,7 +331,7 @@ static int line_search(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s
             s->q[i] = s->qtrial[i] + step * s->dq[i];
         n->phi = evaluate(red, ct, s, s->q, dc, with_h, st);
         if (isfinite(n->phi) && n->phi <= phi0 + 1e-12 * fabs(phi0)) return 1;
-        if (!n->fresh) return 0;
+        if (!n->fresh) return 0; /* a stale direction: refactor rather than halve */
     }
     return 0;
 }
@@ -382,7 +382,7 @@ static void after_update(sw_reduced *red, const sw_step_contacts *ct, sw_solver 
         n->have_h = 1;
         n->trust = n->gn <= SW_CHORD_ENTER * gn0;
     } else if (n->gn > (n->fresh ? SW_CHORD_ENTER : SW_CHORD_KEEP) * gn0 && n->gn > 1e-5 * n->g0) {
-        if (!n->trust)
+        if (!n->trust) /* near: the factor at hand may show the next update is the last */
             n->probe = 1;
         else
             evaluate_with_hessian(red, ct, s, dc, st, n); /* the same phi and g, with H */
