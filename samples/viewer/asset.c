@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "gltf_precheck.h"
 #include "viewer.h"
 
 typedef struct imp {
@@ -231,9 +232,12 @@ static int place_outputs(const imp *s, const int32_t *pairs, mesh_map *mm, vw_as
         if (mm[m].wbone[4 * v] < 0) return FAIL("mesh %d, vertex %d has no skin weight", m, v);
         const struct aiVector3D *x = &s->sc->mMeshes[m]->mVertices[v];
         const double *W = mm[m].W, p[3] = {x->x, x->y, x->z};
-        for (int r = 0; r < 3; ++r)
+        for (int r = 0; r < 3; ++r) {
             a->rest[3 * i + r] = (float)(s->unit * (W[4 * r] * p[0] + W[4 * r + 1] * p[1] +
                                                     W[4 * r + 2] * p[2] + W[4 * r + 3]));
+            if (!isfinite(a->rest[3 * i + r]))
+                return FAIL("mesh %d, vertex %d is not finite in the bind pose", m, v);
+        }
         memcpy(a->wbone + 4 * i, mm[m].wbone + 4 * v, 4 * sizeof(int32_t));
         memcpy(a->wgt + 4 * i, mm[m].wgt + 4 * v, 4 * sizeof(float));
     }
@@ -499,49 +503,76 @@ static double file_unit(const struct aiScene *sc, int gltf) {
     return 1;
 }
 
+/* The whole file (at most 1 GiB; the caller frees it), or NULL. */
+static char *read_all(const char *path, size_t *n) {
+    FILE *f = fopen(path, "rb");
+    long len = f && !fseek(f, 0, SEEK_END) ? ftell(f) : -1;
+    char *data = len >= 0 && len <= (1L << 30) && !fseek(f, 0, SEEK_SET)
+                     ? malloc(len ? (size_t)len : 1)
+                     : NULL;
+    if (data && fread(data, 1, (size_t)len, f) != (size_t)len) free(data), data = NULL;
+    if (f) fclose(f);
+    *n = data ? (size_t)len : 0;
+    return data;
+}
+
 /* The file as shipped against the one the blob was baked from: a changed file plays, but
  * an engine would bake it again. */
-static void check_provenance(const char *path, const sinew_blob *blob) {
+static void check_provenance(const char *path, const char *data, size_t n, const sinew_blob *blob) {
     sinew_blob_provenance p;
     p.struct_size = sizeof p;
-    if (sinew_blob_get_provenance(blob, &p) != SINEW_OK) return;
-    FILE *f = fopen(path, "rb");
-    char *data = NULL;
-    long n = f && !fseek(f, 0, SEEK_END) ? ftell(f) : -1;
-    if (n > 0 && !fseek(f, 0, SEEK_SET) && (data = malloc((size_t)n)) &&
-        fread(data, 1, (size_t)n, f) == (size_t)n &&
-        sinew_hash_bytes(data, (size_t)n) != p.source_hash)
+    if (sinew_blob_get_provenance(blob, &p) == SINEW_OK &&
+        sinew_hash_bytes(data, n) != p.source_hash)
         fprintf(stderr,
                 "sinew-view: warning: %s differs from the file the blob was baked from "
                 "(bake it again)\n",
                 path);
-    free(data);
-    if (f) fclose(f);
+}
+
+/* Debian's assimp 5.2.5 crashes on some glTF structures that are legal or merely
+ * malformed (a skin without inverse bind matrices, an index past its array: see
+ * gltf_precheck.c); the bake refuses them before assimp reads the bytes, and so must a
+ * host importing through the same assimp (fuzz_view_asset found the first). */
+static int safe_for_assimp(const char *path, const char *data, size_t n, int binary, char *err,
+                           size_t errlen) {
+    sw_error e;
+    sw_error_clear(&e);
+    if (sw_gltf_precheck(data, n, binary, path, &e) == SINEW_OK) return 1;
+    snprintf(err, errlen, "%s", e.msg);
+    return 0;
 }
 
 int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *a, char *err,
                     size_t errlen) {
     memset(a, 0, sizeof *a);
-    FILE *f = fopen(path, "rb");
-    if (!f) return FAIL("%s: cannot open", path);
-    fclose(f);
+    size_t nbytes = 0;
+    char *bytes = read_all(path, &nbytes);
+    if (!bytes) return FAIL("%s: cannot read (or larger than 1 GiB)", path);
     const char *dot = strrchr(path, '.');
     char ext[8] = {0};
     for (int i = 0; dot && dot[i + 1] && i < 7; ++i)
         ext[i] = (char)tolower((unsigned char)dot[i + 1]);
     int gltf = !strcmp(ext, "gltf") || !strcmp(ext, "glb");
+    if (gltf && !safe_for_assimp(path, bytes, nbytes, !strcmp(ext, "glb"), err, errlen)) {
+        free(bytes);
+        return 0;
+    }
     unsigned flags = aiProcess_Triangulate | aiProcess_ValidateDataStructure;
     /* FBX is unrolled one vertex per face corner; the bake welds it back, and so must we
      * (the output map's vertex indices are the welded mesh's) */
     if (!gltf) flags |= aiProcess_JoinIdenticalVertices;
     imp *s = calloc(1, sizeof *s);
-    if (!s) return FAIL("out of memory");
+    if (!s) {
+        free(bytes);
+        return FAIL("out of memory");
+    }
     a->impl = s, a->release = asset_release, a->pose = asset_pose;
     a->sample = asset_sample, a->compose = asset_compose;
     s->sc = aiImportFile(path, flags);
     if (!s->sc || !s->sc->mRootNode || (s->sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         snprintf(err, errlen, "%s: assimp could not read it: %s", path, aiGetErrorString());
         vw_asset_free(a);
+        free(bytes);
         return 0;
     }
     s->unit = file_unit(s->sc, gltf);
@@ -553,8 +584,9 @@ int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *a, char 
          map_render(s, blob, a, why, sizeof why);
     if (why[0]) snprintf(err, errlen, "%s: %s", path, why);
     if (ok && (!build_clips(s, a) || !vw_asset_weld(a))) ok = FAIL("out of memory");
-    if (ok) check_provenance(path, blob);
+    if (ok) check_provenance(path, bytes, nbytes, blob);
     if (!ok) vw_asset_free(a);
+    free(bytes);
     return ok;
 }
 

@@ -44,8 +44,9 @@ typedef struct vw_asset {
 } vw_asset;
 
 /* Imports FILE with assimp and maps it onto `blob`: each blob bone to the file's node of
- * that name, each output vertex to its source mesh's vertex (the blob's output map). 0 on
- * success; otherwise writes a message into err (a name or a vertex the file lacks). */
+ * that name, each output vertex to its source mesh's vertex (the blob's output map). 1 on
+ * success; otherwise 0, a message in err (a name or a vertex the file lacks) and *out
+ * zeroed. */
 int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *out, char *err,
                     size_t errlen);
 
@@ -72,7 +73,7 @@ void vw_quat_matrix(const double *q, double *R);
 /* Slerp from a (u = 0) to b (u = 1) along the shorter arc, normalised. */
 void vw_quat_slerp(const double *a, const double *b, double u, double *o);
 
-/* 8-bit RGB PNG (zlib-compressed), rows top first. 0 on success. */
+/* 8-bit RGB PNG (zlib-compressed), rows top first. 1 on success, 0 on failure. */
 int vw_write_png(const char *path, int w, int h, const uint8_t *rgb);
 
 #endif

@@ -24,26 +24,11 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "fuzz_assimp.h"
 #include "fuzz_check.h"
 #include "scene_import.h"
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
-const char *__asan_default_options(void);
-const char *__lsan_default_suppressions(void);
-
-/* Debian's assimp 5.2.5 leaks a few objects of its own (allocated by operator new inside
- * libassimp) on some malformed glTF inputs. Only leaks whose allocation stack passes through
- * libassimp are suppressed; a leak of the importer's own malloc calls is still found. assimp
- * is built without frame pointers, so the fast unwinder stops at operator new and the stack
- * never shows libassimp (CI found such a leak reported as ours): unwind slowly instead. Both
- * live here, not in the environment, so ctest and tools/scripts/run-fuzz.sh run the harness
- * alike. */
-const char *__asan_default_options(void) {
-    return "fast_unwind_on_malloc=0";
-}
-const char *__lsan_default_suppressions(void) {
-    return "leak:libassimp.so\n";
-}
 
 static void check(const sw_imported_character *c) {
     const sw_trimesh *m = &c->render;
