@@ -213,24 +213,15 @@ static sinew_result newton_solve(sw_fullsim *sim, sw_fullsim_stats *st, double *
     }
 }
 
-sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats *stats) {
-    sw_fullsim_stats st;
-    memset(&st, 0, sizeof st);
-    double t0 = sw_now_seconds();
-    int fac0 = sim->chol ? sw_sparse_chol_get_stats(sim->chol).factorizations : 0;
+/* Warm start: driven vertices at their bone's pose, free flesh follows the change of the
+ * skinned shape since the last step. The last state is kept for a refused step. */
+static void warm_start(sw_fullsim *sim, const double *T) {
     const sw_character *c = sim->c;
-    int32_t nv = sim->nv;
-    int64_t m = 3 * (int64_t)nv;
-    size_t v3 = (size_t)m * sizeof(double);
-    if (!T || !sw_fullsim_all_finite(T, 12 * (int64_t)c->skel.nbones)) {
-        if (stats) *stats = st;
-        return SINEW_ERROR_NOT_FINITE;
-    }
+    const int32_t nv = sim->nv;
+    const size_t v3 = 3 * (size_t)nv * sizeof(double);
     memcpy(sim->xn, sim->x, v3);
     memcpy(sim->vn, sim->v, v3);
     memcpy(sim->an, sim->a, v3);
-    /* Warm start: driven vertices at their bone's pose, free flesh follows the change
-     * of the skinned shape since the last step. */
     sw_lbs(nv, c->mesh.X, &c->weights, T, sim->skin_now);
     for (int32_t v = 0; v < nv; ++v) {
         int32_t b = c->bone_of_vertex[v];
@@ -241,74 +232,102 @@ sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats 
                 sim->x[3 * v + i] += sim->skin_now[3 * v + i] - sim->skin_prev[3 * v + i];
     }
     set_integrator(sim);
+}
 
+/* Newton solves in rounds of contact detection until the contact set stops changing
+ * (thesis §3.3.1: contacts found at the solution, solved again), at most contact_rounds;
+ * *capped when the cap ended them. */
+static sinew_result solve_in_contact_rounds(sw_fullsim *sim, sw_fullsim_stats *st, int *capped) {
     sinew_result result = SINEW_ERROR_NOT_CONVERGED;
     double gref = -1;
     clear_contacts(sim);
-    int capped = 0, rounds = sim->p.self_contact || sim->world.world;
+    const int rounds = sim->p.self_contact || sim->world.world;
+    *capped = 0;
     sim->world.ncand = 0;
     for (int round = 0;; ++round) {
         int32_t changed = sim->p.self_contact ? contact_round(sim) : 0;
         if (sim->world.world) { /* world candidates at the current positions */
-            int32_t fresh = sw_ref_world_detect(&sim->world, nv, sim->x, sim->vert_area);
-            if (fresh < 0) {
-                result = SINEW_ERROR_OUT_OF_MEMORY;
-                break;
-            }
+            int32_t fresh = sw_ref_world_detect(&sim->world, sim->nv, sim->x, sim->vert_area);
+            if (fresh < 0) return SINEW_ERROR_OUT_OF_MEMORY;
             changed += fresh;
         }
         if (round > 0 && changed == 0) break; /* complete */
-        st.contact_rounds += rounds;
-        result = newton_solve(sim, &st, &gref, sim->p.newton_rtol);
+        st->contact_rounds += rounds;
+        result = newton_solve(sim, st, &gref, sim->p.newton_rtol);
         if (result == SINEW_ERROR_NOT_FINITE || !rounds) break;
         if (round + 1 >= sim->p.contact_rounds) {
-            capped = 1;
+            *capped = 1;
             break;
         }
     }
+    return result;
+}
+
+/* The world's side of the measurement: its deepest penetration, candidates and contacts
+ * pressing; capped with vertices inside colliders that are no candidates: unsettled. */
+static void measure_world(const sw_fullsim *sim, int capped, sw_fullsim_stats *st) {
+    int32_t fresh;
+    st->world_penetration = sw_world_max_penetration(sim->world.world, sim->nv, sim->x,
+                                                     sim->vert_area, sim->world.is_cand, &fresh);
+    st->world_candidates = sim->world.ncand;
+    for (int32_t i = 0; i < sim->world.ncand; ++i) {
+        const sw_ref_world_cand *wc = &sim->world.cand[i];
+        double d[3];
+        for (int k = 0; k < 3; ++k)
+            d[k] = wc->law.a[k] - sim->x[3 * wc->v + k];
+        st->world_contacts += sw_penalty_gap(wc->law.n, d) > 0;
+    }
+    if (capped && fresh > 0) st->contacts_unsettled = 1;
+}
+
+/* Measurement at the final positions: self-penetration, the world's and the ground's,
+ * the elastic and kinetic energies. */
+static void measure(sw_fullsim *sim, int capped, sw_fullsim_stats *st) {
+    const int32_t nv = sim->nv;
+    int32_t found;
+    sw_selfcontact_detect(sim->sc, sim->x, sim->pool);
+    st->max_penetration = sw_selfcontact_max_depth(sim->sc);
+    const sw_contact *pen = sw_selfcontact_list(sim->sc, &found);
+    st->contacts = found;
+    if (sim->p.self_contact && capped) /* would one more round have changed the set? */
+        st->contacts_unsettled = set_would_change(sim, pen, found);
+    if (sim->world.world) measure_world(sim, capped, st);
+    if (sim->p.ground)
+        for (int32_t v = 0; v < nv; ++v)
+            if (sim->vert_area[v] > 0)
+                st->ground_penetration =
+                    fmax(st->ground_penetration, sim->p.ground_height - sim->x[3 * v + 1]);
+    st->energy_elastic = sw_fullsim_evaluate(sim, sim->x, EVAL_ENERGY);
+    if (sw_fullsim_dynamic(sim))
+        for (int32_t v = 0; v < nv; ++v)
+            st->energy_kinetic +=
+                0.5 * sim->mass[v] *
+                (sim->v[3 * v] * sim->v[3 * v] + sim->v[3 * v + 1] * sim->v[3 * v + 1] +
+                 sim->v[3 * v + 2] * sim->v[3 * v + 2]);
+}
+
+sinew_result sw_fullsim_step(sw_fullsim *sim, const double *T, sw_fullsim_stats *stats) {
+    sw_fullsim_stats st;
+    memset(&st, 0, sizeof st);
+    double t0 = sw_now_seconds();
+    int fac0 = sim->chol ? sw_sparse_chol_get_stats(sim->chol).factorizations : 0;
+    const int64_t m = 3 * (int64_t)sim->nv;
+    if (!T || !sw_fullsim_all_finite(T, 12 * (int64_t)sim->c->skel.nbones)) {
+        if (stats) *stats = st;
+        return SINEW_ERROR_NOT_FINITE;
+    }
+    warm_start(sim, T);
+    int capped;
+    sinew_result result = solve_in_contact_rounds(sim, &st, &capped);
     if (result == SINEW_ERROR_NOT_FINITE || !sw_fullsim_all_finite(sim->x, m)) {
         restore(sim);
         result = SINEW_ERROR_NOT_FINITE;
     } else {
         if (sw_fullsim_dynamic(sim)) update_dynamics(sim);
-        memcpy(sim->skin_prev, sim->skin_now, v3);
+        memcpy(sim->skin_prev, sim->skin_now, (size_t)m * sizeof(double));
     }
     st.converged = result == SINEW_OK;
-    /* Measurement at the final positions: self-penetration and ground penetration. */
-    int32_t found;
-    sw_selfcontact_detect(sim->sc, sim->x, sim->pool);
-    st.max_penetration = sw_selfcontact_max_depth(sim->sc);
-    const sw_contact *pen = sw_selfcontact_list(sim->sc, &found);
-    st.contacts = found;
-    if (sim->p.self_contact && capped) /* would one more round have changed the set? */
-        st.contacts_unsettled = set_would_change(sim, pen, found);
-    if (sim->world.world) {
-        int32_t fresh;
-        st.world_penetration = sw_world_max_penetration(sim->world.world, nv, sim->x,
-                                                        sim->vert_area, sim->world.is_cand, &fresh);
-        st.world_candidates = sim->world.ncand;
-        for (int32_t i = 0; i < sim->world.ncand; ++i) {
-            const sw_ref_world_cand *wc = &sim->world.cand[i];
-            double d[3];
-            for (int k = 0; k < 3; ++k)
-                d[k] = wc->law.a[k] - sim->x[3 * wc->v + k];
-            st.world_contacts += sw_penalty_gap(wc->law.n, d) > 0;
-        }
-        /* capped with vertices inside colliders that are no candidates: unsettled */
-        if (capped && fresh > 0) st.contacts_unsettled = 1;
-    }
-    if (sim->p.ground)
-        for (int32_t v = 0; v < nv; ++v)
-            if (sim->vert_area[v] > 0)
-                st.ground_penetration =
-                    fmax(st.ground_penetration, sim->p.ground_height - sim->x[3 * v + 1]);
-    st.energy_elastic = sw_fullsim_evaluate(sim, sim->x, EVAL_ENERGY);
-    if (sw_fullsim_dynamic(sim))
-        for (int32_t v = 0; v < nv; ++v)
-            st.energy_kinetic +=
-                0.5 * sim->mass[v] *
-                (sim->v[3 * v] * sim->v[3 * v] + sim->v[3 * v + 1] * sim->v[3 * v + 1] +
-                 sim->v[3 * v + 2] * sim->v[3 * v + 2]);
+    measure(sim, capped, &st);
     st.solver = sim->chol ? SW_SOLVER_CHOLMOD : SW_SOLVER_PCG;
     if (sim->chol) st.factorizations = sw_sparse_chol_get_stats(sim->chol).factorizations - fac0;
     st.seconds = sw_now_seconds() - t0;
