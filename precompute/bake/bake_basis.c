@@ -500,30 +500,24 @@ done:
     return r;
 }
 
-sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    sinew_result r = SINEW_OK;
-    int32_t T = 0;
-    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
-        T += s->poses.train[i].npose;
-    int64_t n3 = 3 * (int64_t)s->rig.nv;
-    double *dall = malloc((size_t)T * n3 * sizeof(double));
-    double *R = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
-           *t = malloc((size_t)s->rig.nv * 3 * sizeof(double));
-    double *dtmp = malloc((size_t)n3 * sizeof(double));
-    s->basis.rank = calloc((size_t)s->domains.nd, sizeof(int32_t));
-    s->basis.U = calloc((size_t)s->domains.nd, sizeof(double *));
-    out->basis_energy = calloc((size_t)s->domains.nd + 1, sizeof(double));
-    if (!dall || !R || !t || !dtmp || !s->basis.rank || !s->basis.U || !out->basis_energy) goto oom;
+/* Every training pose's solution with its skinning taken out (T poses, 3 nv each, in dall). */
+static void unskinned_snapshots(sw_bake_state *s, double *dall, double *R, double *t) {
+    const int64_t n3 = 3 * (int64_t)s->rig.nv;
     int32_t k = 0;
     for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
         for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k)
             sw_bake_unskin(s, s->poses.train[i].T + (size_t)j * 12 * s->rig.nb,
                            s->poses.train[i].x + (size_t)j * n3, R, t, dall + (size_t)k * n3);
-    s->basis.rank_total = 0;
+}
+
+/* Each domain's trained modes: PCA of its vertices' snapshots (thesis §4.4.1); 0 when out
+ * of memory. */
+static int trained_modes(sw_bake_state *s, const double *dall, int32_t T, sw_bake_result *out) {
+    const int64_t n3 = 3 * (int64_t)s->rig.nv;
     for (int32_t dm = 0; dm < s->domains.nd; ++dm) {
         int32_t base = s->domains.dom_vert_ptr[dm], n = s->domains.dom_vert_ptr[dm + 1] - base;
         double *D = malloc((size_t)T * 3 * n * sizeof(double));
-        if (!D) goto oom;
+        if (!D) return 0;
         for (int32_t a = 0; a < T; ++a)
             for (int32_t j = 0; j < n; ++j)
                 memcpy(D + (size_t)a * 3 * n + 3 * j,
@@ -539,28 +533,42 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
                                         &out->basis_energy[dm]);
         free(G);
         free(D);
-        if (!s->basis.U[dm]) goto oom;
+        if (!s->basis.U[dm]) return 0;
     }
-    /* where the modes from physics start in each domain's columns: contact, then inertia */
+    return 1;
+}
+
+/* The modes from physics after the trained ones in each domain's columns: contact, then
+ * inertia; where each starts (rank_trained, rank_dynamic) and the total rank. */
+static sinew_result physics_modes(sw_bake_state *s, sw_error *err) {
     const size_t rank_bytes = (size_t)s->domains.nd * sizeof(int32_t);
     s->basis.rank_trained = malloc(rank_bytes);
     s->basis.rank_dynamic = malloc(rank_bytes);
-    if (!s->basis.rank_trained || !s->basis.rank_dynamic) goto oom;
+    if (!s->basis.rank_trained || !s->basis.rank_dynamic)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the basis");
     memcpy(s->basis.rank_trained, s->basis.rank, rank_bytes);
-    r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
+    sinew_result r = s->p->contact_modes ? add_contact_modes(s, err) : SINEW_OK;
     memcpy(s->basis.rank_dynamic, s->basis.rank, rank_bytes);
     if (r == SINEW_OK && s->p->inertia_modes) r = add_inertia_modes(s, err);
-    if (r != SINEW_OK) goto done;
+    s->basis.rank_total = 0;
     for (int32_t dm = 0; dm < s->domains.nd; ++dm)
         s->basis.rank_total += s->basis.rank[dm];
-    /* the pose-space warm start: every training pose's feature and projected solution */
+    return r;
+}
+
+/* The pose-space warm start: every training pose's feature and projected solution; 0
+ * when out of memory. */
+static int warm_start_table(sw_bake_state *s, const double *dall, int32_t T) {
+    const int64_t n3 = 3 * (int64_t)s->rig.nv;
     s->basis.ntrain = T;
     s->basis.train_q = malloc((size_t)T * s->basis.rank_total * sizeof(double));
     s->basis.train_pose = malloc((size_t)T * 4 * s->rig.nb * sizeof(double));
-    if (!s->basis.train_q || !s->basis.train_pose) goto oom;
     double *L = malloc((size_t)12 * s->rig.nb * sizeof(double));
-    if (!L) goto oom;
-    k = 0;
+    if (!s->basis.train_q || !s->basis.train_pose || !L) {
+        free(L);
+        return 0;
+    }
+    int32_t k = 0;
     for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
         for (int32_t j = 0; j < s->poses.train[i].npose; ++j, ++k) {
             sw_bake_pose_snapped(s, s->poses.train[i].T + (size_t)j * 12 * s->rig.nb, L);
@@ -576,6 +584,14 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
             off += s->basis.rank[dm];
         }
     }
+    return 1;
+}
+
+/* How much of the training and held-out corrections the basis can hold at all (with and
+ * without the modes from physics, held out). */
+static void projection_errors(sw_bake_state *s, const double *dall, int32_t T, double *R, double *t,
+                              double *dtmp, sw_bake_result *out) {
+    const int64_t n3 = 3 * (int64_t)s->rig.nv;
     double num = 0, den = 0;
     for (int32_t a = 0; a < T; ++a)
         projection_error(s, dall + (size_t)a * n3, NULL, &num, &den);
@@ -593,6 +609,28 @@ sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err)
     }
     out->heldout_proj_error = den > 0 ? sqrt(num / den) : 0;
     out->heldout_proj_error_trained = den_t > 0 ? sqrt(num_t / den_t) : 0;
+}
+
+sinew_result sw_bake_basis(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sinew_result r = SINEW_OK;
+    int32_t T = 0;
+    for (int32_t i = 0; i < s->poses.ntrain_seq; ++i)
+        T += s->poses.train[i].npose;
+    const int64_t n3 = 3 * (int64_t)s->rig.nv;
+    double *dall = malloc((size_t)T * n3 * sizeof(double));
+    double *R = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *t = malloc((size_t)s->rig.nv * 3 * sizeof(double));
+    double *dtmp = malloc((size_t)n3 * sizeof(double));
+    s->basis.rank = calloc((size_t)s->domains.nd, sizeof(int32_t));
+    s->basis.U = calloc((size_t)s->domains.nd, sizeof(double *));
+    out->basis_energy = calloc((size_t)s->domains.nd + 1, sizeof(double));
+    if (!dall || !R || !t || !dtmp || !s->basis.rank || !s->basis.U || !out->basis_energy) goto oom;
+    unskinned_snapshots(s, dall, R, t);
+    s->basis.rank_total = 0;
+    if (!trained_modes(s, dall, T, out)) goto oom;
+    if ((r = physics_modes(s, err)) != SINEW_OK) goto done;
+    if (!warm_start_table(s, dall, T)) goto oom;
+    projection_errors(s, dall, T, R, t, dtmp, out);
     goto done;
 oom:
     r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the basis");
