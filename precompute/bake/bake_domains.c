@@ -91,32 +91,16 @@ static int fold_bones(const sw_bake_state *s, int32_t *bone_of_tet) {
     return 1;
 }
 
-sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    (void)out;
+/* Each tet's domain: the bone it belongs to (folded, where fold_share asks), domains
+ * numbered in bone order over the bones that own tets; each domain's tet list. 0 when out
+ * of memory. */
+static int tet_domains(sw_bake_state *s, int32_t *domain_of_bone) {
     const int32_t *tets = s->rig.ch.mesh.tets;
-    int32_t *domain_of_bone = malloc((size_t)s->rig.nb * sizeof(int32_t));
-    int32_t *mark = malloc((size_t)s->rig.nv * sizeof(int32_t));
-    s->domains.tet_domain = malloc((size_t)s->rig.nt * sizeof(int32_t));
-    s->domains.domain_bone = malloc((size_t)s->rig.nb * sizeof(int32_t));
-    s->domains.dom_tet_ptr = calloc((size_t)s->rig.nb + 1, sizeof(int32_t));
-    s->domains.dom_tets = malloc((size_t)s->rig.nt * sizeof(int32_t));
-    s->domains.dom_vert_ptr = calloc((size_t)s->rig.nb + 1, sizeof(int32_t));
-    if (!domain_of_bone || !mark || !s->domains.tet_domain || !s->domains.domain_bone ||
-        !s->domains.dom_tet_ptr || !s->domains.dom_tets || !s->domains.dom_vert_ptr) {
-        free(domain_of_bone);
-        free(mark);
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
-    }
     for (int32_t b = 0; b < s->rig.nb; ++b)
         domain_of_bone[b] = -1;
     for (int32_t t = 0; t < s->rig.nt; ++t)
         s->domains.tet_domain[t] = tet_bone(s, tets + 4 * t);
-    if (s->p->fold_share > 0 && !fold_bones(s, s->domains.tet_domain)) {
-        free(domain_of_bone);
-        free(mark);
-        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
-    }
-    /* domains in bone order, only for bones that own tets */
+    if (s->p->fold_share > 0 && !fold_bones(s, s->domains.tet_domain)) return 0;
     for (int32_t t = 0; t < s->rig.nt; ++t)
         domain_of_bone[s->domains.tet_domain[t]] = 1;
     s->domains.nd = 0;
@@ -131,19 +115,19 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *er
     }
     for (int32_t d = 0; d < s->domains.nd; ++d)
         s->domains.dom_tet_ptr[d + 1] += s->domains.dom_tet_ptr[d];
-    {
-        int32_t *fill = malloc((size_t)s->domains.nd * sizeof(int32_t));
-        if (!fill) {
-            free(domain_of_bone);
-            free(mark);
-            return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
-        }
-        memcpy(fill, s->domains.dom_tet_ptr, (size_t)s->domains.nd * sizeof(int32_t));
-        for (int32_t t = 0; t < s->rig.nt; ++t)
-            s->domains.dom_tets[fill[s->domains.tet_domain[t]]++] = t;
-        free(fill);
-    }
-    /* vertex copies: two passes (count, fill), vertices ascending per domain */
+    int32_t *fill = malloc((size_t)s->domains.nd * sizeof(int32_t));
+    if (!fill) return 0;
+    memcpy(fill, s->domains.dom_tet_ptr, (size_t)s->domains.nd * sizeof(int32_t));
+    for (int32_t t = 0; t < s->rig.nt; ++t)
+        s->domains.dom_tets[fill[s->domains.tet_domain[t]]++] = t;
+    free(fill);
+    return 1;
+}
+
+/* Each domain's copies of the vertices of its tets: two passes (count, fill), vertices
+ * ascending per domain. */
+static sinew_result vertex_copies(sw_bake_state *s, int32_t *mark, sw_error *err) {
+    const int32_t *tets = s->rig.ch.mesh.tets;
     int64_t ncopies = 0;
     for (int pass = 0; pass < 2; ++pass) {
         ncopies = 0;
@@ -161,22 +145,21 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *er
                 }
         }
         if (pass == 0) {
-            if (ncopies > INT32_MAX) {
-                free(domain_of_bone);
-                free(mark);
+            if (ncopies > INT32_MAX)
                 return sw_error_set(err, SINEW_ERROR_UNSUPPORTED, "too many vertex copies");
-            }
             s->domains.dom_verts = malloc((size_t)ncopies * sizeof(int32_t));
             s->domains.copy_mass = calloc((size_t)ncopies, sizeof(double));
-            if (!s->domains.dom_verts || !s->domains.copy_mass) {
-                free(domain_of_bone);
-                free(mark);
+            if (!s->domains.dom_verts || !s->domains.copy_mass)
                 return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for copies");
-            }
         }
     }
     s->domains.dom_vert_ptr[s->domains.nd] = (int32_t)ncopies;
-    /* copy masses: lumped mass of each copy from its own domain's tets */
+    return SINEW_OK;
+}
+
+/* Each copy's lumped mass from its own domain's tets. */
+static void copy_masses(sw_bake_state *s, int32_t *mark) {
+    const int32_t *tets = s->rig.ch.mesh.tets;
     for (int32_t d = 0; d < s->domains.nd; ++d) {
         int32_t base = s->domains.dom_vert_ptr[d], n = s->domains.dom_vert_ptr[d + 1] - base;
         for (int32_t k = 0; k < n; ++k)
@@ -191,7 +174,25 @@ sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *er
                 s->domains.copy_mass[mark[q[k]]] += s->rig.ch.density * vol / 4.0;
         }
     }
+}
+
+sinew_result sw_bake_domains(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    (void)out;
+    int32_t *domain_of_bone = malloc((size_t)s->rig.nb * sizeof(int32_t));
+    int32_t *mark = malloc((size_t)s->rig.nv * sizeof(int32_t));
+    s->domains.tet_domain = malloc((size_t)s->rig.nt * sizeof(int32_t));
+    s->domains.domain_bone = malloc((size_t)s->rig.nb * sizeof(int32_t));
+    s->domains.dom_tet_ptr = calloc((size_t)s->rig.nb + 1, sizeof(int32_t));
+    s->domains.dom_tets = malloc((size_t)s->rig.nt * sizeof(int32_t));
+    s->domains.dom_vert_ptr = calloc((size_t)s->rig.nb + 1, sizeof(int32_t));
+    const int held = domain_of_bone && mark && s->domains.tet_domain && s->domains.domain_bone &&
+                     s->domains.dom_tet_ptr && s->domains.dom_tets && s->domains.dom_vert_ptr;
+    sinew_result r =
+        held && tet_domains(s, domain_of_bone)
+            ? vertex_copies(s, mark, err)
+            : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for domains");
+    if (r == SINEW_OK) copy_masses(s, mark);
     free(domain_of_bone);
     free(mark);
-    return SINEW_OK;
+    return r;
 }
