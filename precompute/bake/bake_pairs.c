@@ -261,36 +261,20 @@ static int32_t *find_groups(const sw_blob_view *v, int32_t *ng) {
     return dom;
 }
 
-sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
-    sw_blob_view *v = &out->view;
-    if (v->ncontacts == 0) return SINEW_OK; /* no pose touches itself: no groups */
-    const int32_t nd = v->ndomains, T = v->ntrain, R = v->rank_total;
+/* Each group's feature map and every training pose's feature in it; gi[d1 nd + d2] the
+ * group of a pair of domains. */
+static sinew_result group_features(sw_bake_state *s, const sw_blob_view *v, const int32_t *dom,
+                                   int32_t G, int32_t *gi, double *map, double *feat,
+                                   sw_error *err) {
+    const int32_t nd = v->ndomains, T = v->ntrain;
     const double grid = sw_bake_pose_grid(s);
-    int32_t G = 0, *dom = find_groups(v, &G);
-    int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t));
-    int32_t *cv2 = malloc((size_t)v->ncontacts * 8 * sizeof(int32_t));
-    double *cd2 = malloc((size_t)v->ncontacts * 7 * sizeof(double)), *A = NULL;
-    double *Rv = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
-           *tv = malloc((size_t)s->rig.nv * 24);
-    double *map, *feat, *wt;
-    int32_t *ptr, *pd;
-    sinew_result r = SINEW_ERROR_OUT_OF_MEMORY;
-    if (!dom || !gi || !cv2 || !cd2 || !Rv || !tv) goto oom;
-    map = sw_bake_own(out, calloc((size_t)G * 72, sizeof(double)));
-    feat = sw_bake_own(out, calloc((size_t)G * T * 6, sizeof(double)));
-    wt = sw_bake_own(out, calloc((size_t)v->ncontacts, sizeof(double)));
-    ptr = sw_bake_own(out, calloc((size_t)G * T + 1, sizeof(int32_t)));
-    pd = sw_bake_own(out, malloc((size_t)G * 2 * sizeof(int32_t)));
-    if (!map || !feat || !wt || !ptr || !pd) goto oom;
-    memcpy(pd, dom, (size_t)G * 2 * sizeof(int32_t));
     for (int32_t g = 0; g < G; ++g) {
         gi[dom[2 * g] * nd + dom[2 * g + 1]] = g;
-        if (!feature_map(s, dom[2 * g], dom[2 * g + 1], grid, map + 72 * (size_t)g)) {
-            r = sw_error_set(err, SINEW_ERROR_NOT_CONVERGED,
-                             "pose-space pairs: no eigenvectors for the feature of domains %d, %d",
-                             dom[2 * g], dom[2 * g + 1]);
-            goto fail;
-        }
+        if (!feature_map(s, dom[2 * g], dom[2 * g + 1], grid, map + 72 * (size_t)g))
+            return sw_error_set(
+                err, SINEW_ERROR_NOT_CONVERGED,
+                "pose-space pairs: no eigenvectors for the feature of domains %d, %d", dom[2 * g],
+                dom[2 * g + 1]);
         for (int32_t t = 0; t < T; ++t) {
             double z[12];
             relative_z(train_T(s, t), s->domains.domain_bone[dom[2 * g]],
@@ -299,7 +283,15 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
                 feat[6 * ((size_t)g * T + t) + k] = sw_dot(map + 72 * (size_t)g + 12 * k, z, 12);
         }
     }
-    /* each pose's contacts sorted by group (a counting sort keeps their order within one) */
+    return SINEW_OK;
+}
+
+/* Each pose's contacts sorted by group in the bake's own copies of the contact arrays (a
+ * counting sort keeps their order within one; cv2, cd2 scratch of their size); ptr the
+ * (pose, group) ranges. Returns the most contacts of one (pose, group). */
+static int32_t sort_by_group(sw_blob_view *v, const int32_t *gi, int32_t G, int32_t *cv2,
+                             double *cd2, int32_t *ptr) {
+    const int32_t nd = v->ndomains, T = v->ntrain;
     memcpy(cv2, v->contact_verts, (size_t)v->ncontacts * 8 * sizeof(int32_t));
     memcpy(cd2, v->contact_data, (size_t)v->ncontacts * 7 * sizeof(double));
     int32_t *cvo = (int32_t *)v->contact_verts; /* the bake's own copies (sw_bake_reduce) */
@@ -320,16 +312,27 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
         }
     }
     ptr[(size_t)G * T] = v->ncontacts;
-    /* the cubature of every (pose, group) */
-    A = malloc((size_t)R * most * sizeof(double));
-    if (!A) goto oom;
+    return most;
+}
+
+/* The cubature of every (pose, group): weights of its pairs that reproduce their reduced
+ * force at the reference's solution (every pair at weight 1 without a tolerance). */
+static sinew_result pair_weights(sw_bake_state *s, const sw_blob_view *v, int32_t G,
+                                 const int32_t *ptr, int32_t most, double *wt, sw_error *err) {
+    const int32_t T = v->ntrain, R = v->rank_total;
     const double tol = s->p->contact_cubature_tol;
-    for (int32_t t = 0; t < T; ++t) {
+    double *A = malloc((size_t)R * most * sizeof(double));
+    double *Rv = malloc((size_t)s->rig.nv * 9 * sizeof(double)),
+           *tv = malloc((size_t)s->rig.nv * 24);
+    sinew_result r = A && Rv && tv ? SINEW_OK
+                                   : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                                                  "out of memory for the pose-space pairs");
+    for (int32_t t = 0; t < T && r == SINEW_OK; ++t) {
         if (v->contact_ptr[t + 1] == v->contact_ptr[t]) continue;
         int32_t j;
         const double *x = train_seq(s, t, &j)->x + (size_t)j * 3 * s->rig.nv; /* the reference's */
         sw_bake_skin_transforms(s, train_T(s, t), Rv, tv);
-        for (int32_t g = 0; g < G; ++g) {
+        for (int32_t g = 0; g < G && r == SINEW_OK; ++g) {
             int32_t c0 = ptr[(size_t)t * G + g], n = ptr[(size_t)t * G + g + 1] - c0;
             if (n == 0) continue;
             if (tol <= 0) { /* no cubature: every pair at weight 1 */
@@ -339,26 +342,51 @@ sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err)
             }
             for (int32_t c = 0; c < n; ++c)
                 pair_force(s, v, c0 + c, x, Rv, A + (size_t)c * R);
-            if ((r = sw_bake_pair_cubature(A, R, n, tol, wt + c0, err)) != SINEW_OK) goto fail;
+            r = sw_bake_pair_cubature(A, R, n, tol, wt + c0, err);
         }
     }
-    v->npair_groups = G;
-    v->pair_domains = pd;
-    v->pair_map = map;
-    v->pair_feature = feat;
-    v->pair_ptr = ptr;
-    v->pair_weight = wt;
-    r = SINEW_OK;
-    goto fail;
-oom:
-    r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the pose-space pairs");
-fail:
+    free(A);
+    free(Rv);
+    free(tv);
+    return r;
+}
+
+sinew_result sw_bake_pairs(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    if (v->ncontacts == 0) return SINEW_OK; /* no pose touches itself: no groups */
+    const int32_t nd = v->ndomains, T = v->ntrain;
+    int32_t G = 0, *dom = find_groups(v, &G);
+    int32_t *gi = calloc((size_t)nd * nd, sizeof(int32_t));
+    int32_t *cv2 = malloc((size_t)v->ncontacts * 8 * sizeof(int32_t));
+    double *cd2 = malloc((size_t)v->ncontacts * 7 * sizeof(double));
+    double *map = NULL, *feat = NULL, *wt = NULL;
+    int32_t *ptr = NULL, *pd = NULL;
+    if (dom && gi && cv2 && cd2) {
+        map = sw_bake_own(out, calloc((size_t)G * 72, sizeof(double)));
+        feat = sw_bake_own(out, calloc((size_t)G * T * 6, sizeof(double)));
+        wt = sw_bake_own(out, calloc((size_t)v->ncontacts, sizeof(double)));
+        ptr = sw_bake_own(out, calloc((size_t)G * T + 1, sizeof(int32_t)));
+        pd = sw_bake_own(out, malloc((size_t)G * 2 * sizeof(int32_t)));
+    }
+    sinew_result r = map && feat && wt && ptr && pd
+                         ? group_features(s, v, dom, G, gi, map, feat, err)
+                         : sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
+                                        "out of memory for the pose-space pairs");
+    if (r == SINEW_OK) {
+        memcpy(pd, dom, (size_t)G * 2 * sizeof(int32_t));
+        r = pair_weights(s, v, G, ptr, sort_by_group(v, gi, G, cv2, cd2, ptr), wt, err);
+    }
+    if (r == SINEW_OK) {
+        v->npair_groups = G;
+        v->pair_domains = pd;
+        v->pair_map = map;
+        v->pair_feature = feat;
+        v->pair_ptr = ptr;
+        v->pair_weight = wt;
+    }
     free(dom);
     free(gi);
     free(cv2);
     free(cd2);
-    free(Rv);
-    free(tv);
-    free(A);
     return r;
 }
