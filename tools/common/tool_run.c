@@ -6,10 +6,16 @@
 #include <string.h>
 #include <unistd.h>
 
-/* The loader's last error message, kept by sw_tool_log_keep (a sinew_logger hook). */
-typedef struct sw_tool_log {
+/* The tools' logger (sw_tool_log_keep). A blob keeps its logger for its life, and the
+ * instances created from it without a logger of their own log through it too, from any
+ * thread: so the hook writes no caller's memory (it kept every message in the loader's
+ * stack frame, and an instance refused after the load wrote over sinew-invariance's
+ * stack). An error logged while this thread loads a blob is kept for the load's own
+ * message; any later message is printed as the default logger prints it. */
+static _Thread_local struct {
+    int loading;
     char msg[512];
-} sw_tool_log;
+} tool_log;
 
 double sw_step_ms(const sinew_step_stats *st) {
     return st->ms_skin + st->ms_contact + st->ms_dynamics + st->ms_world + st->ms_oracle +
@@ -40,22 +46,26 @@ int sw_tool_failed(sinew_result r, const sw_error *err, const char *prefix, ...)
 }
 
 static void sw_tool_log_keep(sinew_log_level level, uint32_t id, const char *message, void *user) {
-    (void)id;
-    sw_tool_log *l = (sw_tool_log *)user;
-    if (level == SINEW_LOG_ERROR && l && message) snprintf(l->msg, sizeof l->msg, "%s", message);
+    (void)id, (void)user;
+    if (!message) return;
+    if (!tool_log.loading)
+        fprintf(stderr, "sinew: %s: %s\n", level == SINEW_LOG_ERROR ? "error" : "warning", message);
+    else if (level == SINEW_LOG_ERROR)
+        snprintf(tool_log.msg, sizeof tool_log.msg, "%s", message);
 }
 
 sinew_result sw_tool_blob_load(const char *tool, const char *what, sinew_blob_def def,
                                sinew_blob **out) {
-    sw_tool_log log;
-    log.msg[0] = '\0';
+    tool_log.msg[0] = '\0';
     def.logger.log = sw_tool_log_keep;
-    def.logger.user = &log;
+    def.logger.user = NULL;
     def.logger.max_level = SINEW_LOG_WARNING;
+    tool_log.loading = 1;
     sinew_result r = sinew_blob_load(&def, out);
+    tool_log.loading = 0;
     if (r != SINEW_OK)
         fprintf(stderr, "%s: cannot load the blob %s: %s (%s)\n", tool, what,
-                log.msg[0] ? log.msg : "no reason given", sinew_result_string(r));
+                tool_log.msg[0] ? tool_log.msg : "no reason given", sinew_result_string(r));
     return r;
 }
 

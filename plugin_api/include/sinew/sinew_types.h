@@ -45,7 +45,10 @@ typedef struct sinew_blob_def {
     const void *data;          /**< host buffer, 64-byte aligned, outliving the blob */
     size_t data_size;          /**< bytes in `data` */
     sinew_allocator allocator; /**< memory hooks; zero means the C library */
-    sinew_logger logger;       /**< log hook; zero means silent */
+    /** Log hook (zero: errors to stderr; sinew_logger_silent: none). The blob keeps it for
+     * its life, and instances created without a logger of their own log through it, from
+     * any thread: `user` must outlive the blob. */
+    sinew_logger logger;
 } sinew_blob_def;
 
 /** A sinew_blob_def with every field at its default. */

@@ -29,7 +29,7 @@ typedef struct sinew_world_def {
     uint32_t struct_size;      /**< sizeof(sinew_world_def), set by the default */
     uint32_t max_colliders;    /**< capacity, reserved at creation; 0 means 256 */
     sinew_allocator allocator; /**< memory hooks; zero means the C library */
-    sinew_logger logger;       /**< log hook; zero means silent */
+    sinew_logger logger;       /**< log hook, kept for the world's life; zero: errors to stderr */
 } sinew_world_def;
 
 /** A sinew_world_def with every field at its default. */
