@@ -324,9 +324,9 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
 #define SINEW_STEP_LIMITED 64u
 /** the pose bends a joint beyond the bake's training: more than 1.25 times and 5 degrees
  * further than any training pose bends it (joints_beyond_training says how many). The
- * subspace then extrapolates, and the correction it gives misses more than on the motion
- * it was baked from (the Fox baked on its walk and played running: 0.27 of the correction
- * missed, against 0.008 on the walk); bake with motion that reaches those bends. */
+ * subspace then extrapolates, and the correction it gives can miss far more than on the
+ * motion it was baked from (the bake report measures it on held-out clips); bake with
+ * motion that reaches those bends. */
 #define SINEW_STEP_BEYOND_TRAINING 128u
 
 /** Budgets of an instance (sinew_step_stats.budget_exceeded bits). */
