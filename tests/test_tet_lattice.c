@@ -183,6 +183,35 @@ TEST(separate_pieces_stay_separate) {
     sw_trimesh_free(&two);
 }
 
+/* A thin shape (a tube one unit across, forty long) fills in steps as the spacing falls
+ * (one cube across, then four): the cube rule alone jumped back and forth over such
+ * targets and gave up, or kept the last count rather than the nearest. Every target gets
+ * the nearest count, within a factor of 2 where it falls between the steps. */
+TEST(a_thin_tube_fills_near_its_targets) {
+    double lo[40][3];
+    for (int i = 0; i < 40; ++i)
+        lo[i][0] = i, lo[i][1] = lo[i][2] = 0;
+    sw_trimesh tube = boxes(40, lo, 1.0, -1);
+    sw_pool *pool = sw_pool_create(2);
+    int filled = 0, tried = 0;
+    for (int32_t target = 400; target <= 4000; target += 200, ++tried) {
+        sw_tetmesh t;
+        sw_lattice_report rep;
+        sw_error e;
+        if (sw_tetmesh_from_surface(&tube, target, pool, &t, &rep, &e) != SINEW_OK) {
+            fprintf(stderr, "    %d: %s\n", target, e.msg);
+            continue;
+        }
+        filled++;
+        ENSURE(t.ntets <= 2 * target && t.ntets >= target / 2);
+        sw_tetmesh_free(&t);
+    }
+    sw_pool_destroy(pool);
+    sw_trimesh_free(&tube);
+    fprintf(stderr, "    filled %d of %d targets\n", filled, tried);
+    ENSURE(filled == tried);
+}
+
 TEST(real_render_surface) {
     char path[512];
     snprintf(path, sizeof path, "%s/arm-libigl/arm.obj", SINEW_SHARED_DATA_DIR);
@@ -295,5 +324,5 @@ SW_TEST_MAIN(CASE(winding_number_of_a_closed_and_an_open_box),
              CASE(winding_tree_matches_the_exact_sum),
              CASE(sphere_fills_to_its_volume_at_the_target_count),
              CASE(open_and_inside_out_surfaces_are_filled), CASE(separate_pieces_stay_separate),
-             CASE(real_render_surface), CASE(bad_surfaces_are_rejected),
-             CASE(a_surface_without_inside_becomes_a_shell))
+             CASE(a_thin_tube_fills_near_its_targets), CASE(real_render_surface),
+             CASE(bad_surfaces_are_rejected), CASE(a_surface_without_inside_becomes_a_shell))

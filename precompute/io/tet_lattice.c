@@ -236,6 +236,29 @@ static int64_t classify_shell(lattice *L, const sw_trimesh *surf, const double l
     return k;
 }
 
+/* The spacing search: the count of tets falls with the spacing as its cube where the
+ * shape is thick, in steps where it is thin (tubes a few cells across), where the cube
+ * rule can jump back and forth over the target. So the spacings known to give too many
+ * and too few bracket it, and a step that would leave the bracket halves it (in log h)
+ * instead; the nearest count seen is kept. */
+typedef struct lattice_search {
+    double h_many, h_few;     /* the largest spacing giving too many, the smallest too few */
+    double best_h, best_miss; /* the spacing of the nearest count, its |log(made/target)| */
+} lattice_search;
+
+static double next_spacing(lattice_search *ls, double h, double made, int32_t target) {
+    const double miss = fabs(log(made / target));
+    if (miss < ls->best_miss) ls->best_miss = miss, ls->best_h = h;
+    if (made > target)
+        ls->h_many = fmax(ls->h_many, h);
+    else
+        ls->h_few = fmin(ls->h_few, h);
+    const double next = h * cbrt(made / target);
+    if (ls->h_many > 0 && isfinite(ls->h_few) && !(next > ls->h_many && next < ls->h_few))
+        return sqrt(ls->h_many * ls->h_few);
+    return next;
+}
+
 sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets, sw_pool *pool,
                                      sw_tetmesh *out, sw_lattice_report *report, sw_error *err) {
     double t0 = sw_now_seconds();
@@ -273,6 +296,7 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
        inside: a thin shape the coarse lattice missed) */
     double h = cbrt(6.0 * 0.5 * box / target_tets);
     int64_t kept = 0;
+    lattice_search ls = {.h_many = 0, .h_few = INFINITY, .best_h = 0, .best_miss = INFINITY};
     for (int pass = 0, halvings = 0; box > 0 && pass < 8; ++pass) {
         kept = classify(&L, lo, hi, h, pool);
         if (kept < 0) break;
@@ -283,8 +307,12 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
             h *= 0.5;
             continue;
         }
-        h *= cbrt(made / target_tets);
+        h = next_spacing(&ls, h, made, target_tets);
     }
+    /* none within a fifth: the nearest seen, when it was not the last */
+    if (kept > 0 && fabs(6.0 * (double)kept - target_tets) > 0.2 * target_tets && ls.best_h > 0 &&
+        ls.best_h != L.h)
+        kept = classify(&L, lo, hi, ls.best_h, pool);
     sw_winding_tree_destroy(L.tree);
     if (kept == 0 && area > 0) {
         /* no inside (a flat sheet, an open strip): a shell of half-thickness r around the
@@ -310,14 +338,15 @@ sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets
                             "tet lattice: a lattice of spacing %g is too large", h);
     }
     double made = 6.0 * (double)kept;
-    /* a shell as thin as two cubes may hold more than asked of a small target */
-    if (kept == 0 || (made > 1.5 * target_tets && !(rep.shell > 0)) || made < target_tets / 1.5) {
+    /* a thin shape fills in steps (next_spacing): the nearest count within a factor of 2;
+       a shell as thin as two cubes may hold more than asked of a small target */
+    if (kept == 0 || (made > 2 * target_tets && !(rep.shell > 0)) || made < target_tets / 2.0) {
         free(L.inside);
         if (kept == 0)
             return sw_error_set(err, SINEW_ERROR_DEGENERATE,
                                 "tet lattice: the surface encloses no volume and has no area");
         return sw_error_set(err, SINEW_ERROR_DEGENERATE,
-                            "tet lattice: no spacing gives about %d tets (%.0f at best)",
+                            "tet lattice: no spacing gives about %d tets (%.0f at the nearest)",
                             target_tets, made);
     }
     r = build_tets(&L, kept, out, &rep.components, err);

@@ -36,12 +36,13 @@ typedef struct sw_lattice_report {
 } sw_lattice_report;
 
 /* Fills `surf` (triangles over its own vertices) with about `target_tets` tets
- * (100..5,000,000; the result is within a factor of 1.5 for any surface that
- * encloses volume). A surface that encloses none (a flat sheet, a single open strip) is
- * meshed as a shell around it instead (report->shell; at least two cubes through it, so
- * a small target may get more). pool may be NULL. Errors: INVALID_ARGUMENT for an empty
- * surface, out-of-range indices, non-finite coordinates or a target out of range;
- * DEGENERATE when the surface has no area; OUT_OF_MEMORY. */
+ * (100..5,000,000; within a fifth where the shape is thick; a thin one, a few cubes
+ * across, fills in steps as the spacing falls and gets the nearest count, within a factor
+ * of 2, or DEGENERATE naming it). A surface that encloses none (a flat sheet, a single open strip)
+ * is meshed as a shell around it instead (report->shell; at least two cubes through it, so a small
+ * target may get more). pool may be NULL. Errors: INVALID_ARGUMENT for an empty surface,
+ * out-of-range indices, non-finite coordinates or a target out of range; DEGENERATE when the
+ * surface has no area; OUT_OF_MEMORY. */
 sinew_result sw_tetmesh_from_surface(const sw_trimesh *surf, int32_t target_tets, sw_pool *pool,
                                      sw_tetmesh *out, sw_lattice_report *report, sw_error *err);
 
