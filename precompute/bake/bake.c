@@ -147,9 +147,18 @@ static int sum_simulate(const sw_bake_state *s, const sw_bake_result *o, char *m
     return 1;
 }
 
+/* " held-out E", or " held-out: no poses" when the bake holds none out (a blob baked on
+ * its whole clip): an error over no poses is no figure. */
+static const char *heldout_figure(const sw_bake_state *s, double e, char buf[32]) {
+    if (s->poses.heldout.npose == 0) return " held-out: no poses";
+    snprintf(buf, 32, " held-out %.4f", e);
+    return buf;
+}
+
 static int sum_basis(const sw_bake_state *s, const sw_bake_result *o, char *m, size_t n) {
-    snprintf(m, n, "total rank %d, projection error train %.4f held-out %.4f", s->basis.rank_total,
-             o->train_proj_error, o->heldout_proj_error);
+    char h[32];
+    snprintf(m, n, "total rank %d, projection error train %.4f%s", s->basis.rank_total,
+             o->train_proj_error, heldout_figure(s, o->heldout_proj_error, h));
     return 1;
 }
 
@@ -204,9 +213,9 @@ static int sum_springs(const sw_bake_state *s, const sw_bake_result *o, char *m,
 }
 
 static int sum_galerkin(const sw_bake_state *s, const sw_bake_result *o, char *m, size_t n) {
-    (void)s;
-    snprintf(m, n, "linearised projection error train %.4f held-out %.4f", o->train_galerkin_error,
-             o->heldout_galerkin_error);
+    char h[32];
+    snprintf(m, n, "linearised projection error train %.4f%s", o->train_galerkin_error,
+             heldout_figure(s, o->heldout_galerkin_error, h));
     return 1;
 }
 
@@ -217,12 +226,13 @@ static int sum_equilibrium(const sw_bake_state *s, const sw_bake_result *o, char
 }
 
 static int sum_lod(const sw_bake_state *s, const sw_bake_result *o, char *m, size_t n) {
-    (void)s;
-    snprintf(m, n,
-             "pose-space level: %d modes (%.3f of the displacements dropped), ridge %g; held-out "
-             "surface error by level: full %.4f, reduced %.4f, pose-space %.4f",
-             o->view.lod_rank, o->lod_kept, o->lod_ridge, o->lod_heldout[0], o->lod_heldout[1],
-             o->lod_heldout[2]);
+    int at =
+        snprintf(m, n, "pose-space level: %d modes (%.3f of the displacements dropped), ridge %g",
+                 o->view.lod_rank, o->lod_kept, o->lod_ridge);
+    if (at < 0 || (size_t)at >= n || s->poses.heldout.npose == 0) return 1;
+    snprintf(m + at, n - (size_t)at,
+             "; held-out surface error by level: full %.4f, reduced %.4f, pose-space %.4f",
+             o->lod_heldout[0], o->lod_heldout[1], o->lod_heldout[2]);
     return 1;
 }
 

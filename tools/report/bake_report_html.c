@@ -94,10 +94,15 @@ static void html_model(FILE *f, const sw_bake_report_input *in) {
         html_term(f, "levels of detail",
                   "the held-out error on the surface of each level a game can "
                   "pick per character (sinew_instance_set_lod)");
-        fprintf(f,
-                "<td>full %.4f, reduced %.4f, pose-space %.4f (%d modes, no solve: what a "
-                "learned deformer costs)</td></tr>",
-                res->lod_heldout[0], res->lod_heldout[1], res->lod_heldout[2], res->view.lod_rank);
+        if (isnan(res->lod_heldout[0])) /* no held-out poses, or a level failed a step */
+            fprintf(f, "<td>not measured; pose-space level of %d modes</td></tr>",
+                    res->view.lod_rank);
+        else
+            fprintf(f,
+                    "<td>full %.4f, reduced %.4f, pose-space %.4f (%d modes, no solve: what a "
+                    "learned deformer costs)</td></tr>",
+                    res->lod_heldout[0], res->lod_heldout[1], res->lod_heldout[2],
+                    res->view.lod_rank);
     }
     html_term(f, "glue between body parts",
               "interface springs: the stiffness holding the "
