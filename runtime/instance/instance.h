@@ -93,7 +93,8 @@ void sw_output_from_full(const sw_blob_view *v, const double *x_full, double *ou
 int32_t sw_render_node_vertex(const sw_blob_view *v, int32_t n);
 
 /* The state's bounds (sinew_types.h, status flags): the largest distance of an output
- * vertex from its skinned position the step allows, max_k max(4 u_k Q_k, L / 4), and
+ * vertex from its skinned position the step allows, max_k max(4 u_k Q_k, L / 4) (times
+ * the largest sum of a render vertex's barycentric magnitudes, with a render mesh), and
  * the largest |q_k| / bound_k of the current state (<= 1). */
 double sw_instance_displacement_bound(const sinew_instance *inst);
 double sw_instance_bound_usage(const sinew_instance *inst);

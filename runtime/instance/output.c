@@ -299,10 +299,18 @@ void sw_instance_skinned_surface(const sinew_instance *inst, double *x) {
 }
 
 double sw_instance_displacement_bound(const sinew_instance *inst) {
-    double D = 0;
-    for (int32_t k = 0; k < inst->v->ndomains; ++k)
+    const sw_blob_view *v = inst->v;
+    double D = 0, gain = 1;
+    for (int32_t k = 0; k < v->ndomains; ++k)
         D = fmax(D, inst->u_max[k] * inst->q_bound[k]);
-    return D;
+    /* a render vertex is its tet's corners weighted by its barycentrics, which extrapolate
+       (some negative) where it lies outside the tet: its displacement is at most the sum of
+       their magnitudes times the corners' */
+    for (int32_t i = 0; i < v->nrender_verts; ++i) {
+        const double *b = v->render_bary + 4 * (int64_t)i;
+        gain = fmax(gain, fabs(b[0]) + fabs(b[1]) + fabs(b[2]) + fabs(b[3]));
+    }
+    return D * gain;
 }
 
 double sw_instance_bound_usage(const sinew_instance *inst) {

@@ -287,7 +287,9 @@ static inline sinew_instance_def sinew_instance_def_default(void) {
  * blob's training solutions):
  *  - |q_k| <= max(4 Q_k, L / (4 u_k)): no vertex strays further from its skinned position
  *    than max(4 u_k Q_k, L / 4) (four times the largest correction the bake trained, at
- *    least a quarter of the size), so the elastic energy is bounded too;
+ *    least a quarter of the size; a vertex of an embedded render mesh by that times the
+ *    sum of its barycentric weights' magnitudes, 1 inside its tet), so the elastic energy
+ *    is bounded too;
  *  - dynamic: the flesh's speed relative to its bone, u_k |dq_k/dt| <= 200 L per second.
  * A pose jump (SINEW_STEP_TELEPORT) is any bone, between the last step's pose and this
  * one, turning by more than 120 degrees, moving a rest point it skins by more than L / 2,
