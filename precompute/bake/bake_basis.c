@@ -229,14 +229,13 @@ static double *append_columns(const double *U, int64_t m, int32_t *r, const doub
  * but a domain riding an accelerating bone is loaded by its own inertia, -M (a + alpha x
  * r) in the bone's frame (the inertial forces of blob_view.h), and the static response
  * to that lies largely outside them: the subspace bends too little under inertia and
- * overshoots too little when the motion stops (finger 3K: 0.49 of the reference's
- * overshoot). The loads are each domain's six rigid accelerations (its copies' masses
- * times a unit translation, or a unit rotation about its centroid); their static
- * responses of the rest shape are the first load-dependent Ritz vectors of structural
- * dynamics (Wilson, Yuan & Dickens 1982). Every domain takes the restriction of every
+ * overshoots too little when the motion stops (docs/notes/jiggle.md). The loads are each domain's
+ * six rigid accelerations (its copies' masses times a unit translation, or a unit rotation about
+ * its centroid); their static responses of the rest shape are the first load-dependent Ritz vectors
+ * of structural dynamics (Wilson, Yuan & Dickens 1982). Every domain takes the restriction of every
  * response, not of its own loads' only: a response crosses the interface, and unless
- * both domains' copies can follow it there the interface springs (eq. 4.20) stiffen it
- * (own loads only: 0.69 of the reference's overshoot; all: 1.04). A restriction joins
+ * both domains' copies can follow it there the interface springs (eq. 4.20) stiffen it,
+ * and the overshoot stays short of the reference's. A restriction joins
  * the basis as far as it lies outside it by SW_INERTIA_MODE_TOL of its response's whole
  * norm (a far domain's sliver of a response is no mode of its own), largest first, at
  * most max_rank of them a domain.

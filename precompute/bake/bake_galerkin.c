@@ -8,8 +8,8 @@
  * interfaces (thesis eqs. 2.11 and 4.20, linearised). Its error, measured as the
  * projection error is (each domain's copies against the snapshot, relative), shows how
  * much of the runtime's error the span and the springs already decide, before the
- * cubature, the contact and the nonlinearity: the Fox's Run 0.266 against a projection of
- * 0.185 and a runtime error of 0.283 (docs/notes/generalisation.md, The Galerkin projection). */
+ * cubature, the contact and the nonlinearity (docs/notes/generalisation.md, The Galerkin
+ * projection). */
 #include <lapacke.h>
 #include <math.h>
 #include <stdlib.h>

@@ -188,9 +188,8 @@ int32_t sw_bake_pose_beyond(const sw_skeleton *sk, const double *T, const double
  * clip, the largest in the character's joint range (sw_character.range) or else 90
  * degrees about an axis across the bone. A bare skeleton says nothing of its joints'
  * limits: the 90 degrees bend a hand's metacarpals into the palm independently, which
- * no hand does, and 70% of the bare hand's held-out error was there; the hand's own
- * pose as its range took it from 0.369 to 0.100 (docs/notes/generalisation.md, "Joint
- * ranges"). */
+ * no hand does, and most of the bare hand's held-out error was there; its own pose as
+ * its range removes most of it (docs/notes/generalisation.md, "Joint ranges"). */
 static void sweep_extents(const sw_bake_state *s, const clip_range *train, int32_t ntr,
                           double *sweep_axis, double *sweep_angle) {
     const sw_skeleton *sk = &s->rig.ch.skel;
@@ -327,9 +326,9 @@ static double joint_bend(const sw_skeleton *sk, const double *T) {
  * before it (the last included), so that the path goes home from where the clip left
  * the fold. A clip whose training part ends after its peak (the finger's: bend, then
  * part of the way back) would otherwise be re-bent to the peak first, and the reference
- * then unbends on a branch of its own: the finger 50K's held-out frames, which go on
- * unbending from the last training frame, lie 0.11-0.15 (their correction's share) from
- * any blend of two neighbouring samples of that re-bent path and as far from the way in.
+ * then unbends on a branch of its own: held-out frames that go on unbending from the
+ * last training frame lie far from any blend of two neighbouring samples of that re-bent
+ * path, and as far from the way in.
  * idx: at most n - 1 entries; returns how many. */
 static int32_t return_frames(const sw_skeleton *sk, const sw_pose_seq *q, int32_t n, int32_t nb,
                              int32_t *idx) {
@@ -378,10 +377,9 @@ static int flesh_meets(const sw_bake_state *s, int32_t a, int32_t b) {
 
 /* Whether every joint is also swept with its parent joint (sw_bake_params.pair_sweeps):
  * by default where the character's joint range bounds the sweeps. Within the rig's range
- * the combinations are what the single sweeps miss (the bare hand's default bake 0.100 ->
- * 0.045, docs/notes/generalisation.md Joint ranges); at the 90-degree default they bend two
- * joints into flesh no rig reaches and made it worse (at --max-rank 60 0.421 against
- * 0.379, docs/notes/accuracy.md). */
+ * the combinations are what the single sweeps miss (docs/notes/generalisation.md, Joint
+ * ranges); at the 90-degree default they bend two joints into flesh no rig reaches, and
+ * the held-out error grows (docs/notes/accuracy.md). */
 static int wants_pair_sweeps(const sw_bake_state *s) {
     return s->p->pair_sweeps > 0 || (s->p->pair_sweeps < 0 && s->rig.ch.range.nframes > 0);
 }

@@ -7,8 +7,8 @@
 
 #include "vec3.h"
 
-/* Clusters farther than this many radii count as one dipole (3 gave errors up to 0.012
- * on the test sphere, 4 gives 0.006). */
+/* Clusters farther than this many radii count as one dipole (the error falls as
+ * 1 / beta^2; docs/notes/outside-the-harness.md has the test sphere's figures). */
 #define SW_WINDING_BETA 4.0
 #define SW_WINDING_LEAF 8
 

@@ -71,9 +71,8 @@ static void clear_contacts(sw_fullsim *sim) {
 /* A pair leaves the set only once its vertex is in front of its surface point by more
  * than this share of the depth it was detected at (hysteresis). Dropping it as soon as
  * the gap reached 0 made the set cycle: the solve pushed a vertex just out, the round
- * dropped its pair, the next solve let it back in (measured on the 20K finger's 40-frame
- * fold: rounds ending "1 dropped, 1 added" until the cap, 6 frames unsettled; with 0.5,
- * none, and the deepest penetration fell from 0.055 to 0.025). */
+ * dropped its pair, the next solve let it back in, until the round cap (the finger's
+ * fold; docs/notes/outside-the-harness.md has the figures). */
 #define SW_CONTACT_HYSTERESIS 0.5
 
 /* Whether pair c stays in the set at positions x. */

@@ -229,12 +229,11 @@ static sinew_result solve_direct(sw_fullsim *sim) {
 /* Adaptive mode keeps a truncated PCG answer (Newton-CG: the iterate before the
  * direction of negative curvature, a descent direction of the quadratic model) when
  * it has brought the relative residual below this; one truncated at once is re-solved
- * with projected element Hessians. Measured on the finger's 40-frame fold, whose
- * compressed crease makes the exact Hessian indefinite in most iterations: projecting
- * every truncated iteration (the threshold 0) left Newton crawling along the crease's
- * soft modes (gradient flat or rising for 20 iterations; 2 of 40 frames unconverged at
- * 20K, deepest penetration 0.074), keeping every truncated answer (always exact) left
- * 8 of the elephant's frames unconverged, with 0.9: none in either, 0.020 at 20K. */
+ * with projected element Hessians. On a fold whose compressed crease makes the exact
+ * Hessian indefinite in most iterations, projecting every truncated iteration (the
+ * threshold 0) leaves Newton crawling along the crease's soft modes, and keeping every
+ * truncated answer (always exact) leaves some of the elephant's frames unconverged; 0.9
+ * converged both (docs/notes/outside-the-harness.md has the figures). */
 #define SW_TRUNCATED_PROGRESS 0.9
 
 sinew_result sw_fullsim_solve_system(sw_fullsim *sim, sw_fullsim_stats *st) {

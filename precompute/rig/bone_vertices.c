@@ -183,10 +183,9 @@ static int double_cmp(const void *pa, const void *pb) {
  * no dominated surface vertex beside its segment takes the median distance to the
  * surface vertices it dominates instead: its segment runs along an edge of its flesh or
  * outside it (a head whose bone sits at the neck), and the nearest of them is skin next
- * to the joint. From that nearest skin, the robot's box head (1,972 vertices) got one
- * driven tet: free flesh pinned at one point, 99% of the robot's correction error
- * (held-out 0.44; with the median, 89 driven vertices and 0.079). Falls back to any
- * surface vertex. dist: scratch of nverts doubles. */
+ * to the joint. From that nearest skin, the robot's box head got one driven tet: free
+ * flesh pinned at one point, and most of the robot's correction error was there. Falls
+ * back to any surface vertex. dist: scratch of nverts doubles. */
 static void flesh_radii(const sw_tetmesh *m, const sw_skeleton *s, const unsigned char *surf,
                         const int32_t *dom, double *radius, double *dist) {
     for (int32_t b = 0; b < s->nbones; ++b) {

@@ -18,9 +18,9 @@
  * evaluated at the subspace's positions, scaled to the domain's volume outside the
  * patch, s_d = (V_d - V_fd) / V_d. Dropping the cubature tets inside the patch and
  * renormalising the rest (the first rule tried) fails once the patch holds the place
- * the cubature was fitted for: on the 100K capsule at rho 0.236 the patch held 78% of
- * the bent domain's volume but 97% of its cubature weight, and the 2 tets left, scaled
- * 7.8x, stood for the rest (err_world_cond 0.201; 0.144 with this rule, docs/notes/world.md).
+ * the cubature was fitted for: the patch may hold most of a bent domain's cubature weight
+ * but less of its volume, and the few tets left, scaled up, stand for the rest
+ * (docs/notes/world.md).
  * A domain keeps at least SW_COND_MIN_SHARE of it, even one the patch holds whole or whose
  * other tets are exact (exact_domains): the patch's vertices no longer depend on q, so
  * without it the modes that move them are stiff only through the ring, and the
@@ -117,9 +117,9 @@ static void ring_blocks_flush(sw_cond *c, sw_reduced *red, int32_t k0, int32_t k
  * start, or at one of the solve's law refreshes (sw_cond_solve). Between those the set is
  * frozen (as within one of the reference's contact rounds): the law
  * jumps where a pair starts to collide (E = 1/2 kk alpha |d_t|^2 there, eq. 3.12's
- * Heaviside), and measured, a set re-decided at every iterate left the energy guard no
- * decrease (capsule 20K, rho 0.45: 5 of 5 contact frames stopped at 4-6% of the first
- * gradient, 0.50 of the correction missed). Its forces into f, its Hessian
+ * Heaviside), and a set re-decided at every iterate left the energy guard no decrease:
+ * contact frames stopped early, far from the minimum (docs/notes/world.md). Its forces
+ * into f, its Hessian
  * kk (c c^T kron N) into K (12 x 12) when not NULL. */
 static double patch_pair(sw_cond *c, int32_t j, const double x12[12], double f[12], double *K) {
     const sw_blob_view *v = c->v;

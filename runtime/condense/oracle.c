@@ -341,8 +341,8 @@ static void full_tets(sw_cond *c, const sw_reduced *red) {
 
 /* Eq. 4.12 where the patch covers most of a domain: the domain's cubature was fitted to
  * the whole domain, and scaled to the little volume left outside it stands for that rest
- * badly (the 100K capsule at rho 0.236 missed 0.124 of the correction against 0.093 at
- * rho 0.151, the difference outside the patch; docs/notes/world.md). Past SW_COND_EXACT_SHARE of
+ * badly: a larger patch missed more of the correction, outside the patch
+ * (docs/notes/world.md). Past SW_COND_EXACT_SHARE of
  * its volume in the patch, the domain's other tets become elements whose four corners are all ring
  * copies, evaluated exactly at q (its cubature's weights go to SW_COND_MIN_SHARE, the least a
  * domain keeps, with its volume outside): no more tets than the patch holds of that domain, so no

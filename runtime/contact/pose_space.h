@@ -76,9 +76,8 @@ void sw_pose_space_blend(const sw_pose_space *ps, const double *rows, int32_t m,
 
 /* A joint is bent beyond training when its bend (radians) exceeds the largest a training
  * pose gives it (trained) by more than SW_BEYOND_RATIO times and SW_BEYOND_DEG degrees:
- * there the subspace extrapolates (the Fox's Run bends its hip 4 times as far as Survey
- * and Walk, and misses 0.27 of its correction against 0.008 on those clips;
- * docs/notes/generalisation.md "The Fox's Run is beyond its training"). The one rule of the bake's
+ * there the subspace extrapolates (docs/notes/generalisation.md "The Fox's Run is beyond
+ * its training"). The one rule of the bake's
  * held-out list (sw_bake_beyond_training) and the step's stat. */
 #define SW_BEYOND_RATIO 1.25
 #define SW_BEYOND_DEG 5.0

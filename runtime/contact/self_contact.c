@@ -228,9 +228,7 @@ static void map_once(sw_self_contacts *sc, const sw_reduced *map, const double *
 /* The tets incident to triangle tv's corners into sc->cand, their corners mapped;
  * returns how many (at most SW_RETEST_CANDIDATES). A second ring (the tets incident to
  * those tets' corners, about 160 a pair against 30) found the same contacts on the
- * finger, the hand and the Fox (held-out errors within 0.0004) at three times the cost:
- * finger 50K 0.19 ms a step against exhaustive 9.4 (sc_pp_speedup_max 17.8), hand
- * 0.31 ms against 15.5. */
+ * finger, the hand and the Fox at three times the cost (docs/notes/accuracy.md). */
 static int32_t ring_tets(sw_self_contacts *sc, const sw_blob_view *v, const sw_reduced *map,
                          const double *q, const int32_t tv[3]) {
     int32_t n = 0;

@@ -217,7 +217,7 @@ enum rest_outcome { REST_DONE, REST_HAND_OVER, REST_NOT_FINITE };
  * changes. After a reset the reference is the rest Hessian: a tet that turns with its
  * bones without deforming has that very Hessian (cubature.h), so where the flesh follows
  * the skeleton an update costs a gradient pass and a factorisation instead of a Hessian
- * pass and a factorisation (the Fox: 0.28 and 0.12 ms against 1.2 and 0.12 ms). Where it
+ * pass and a factorisation, several times cheaper on the Fox. Where it
  * does not (stretched elements stiffen in their rotation modes), the first rejected
  * update or one that shrinks the gradient by less than SW_REST_KEEP hands the step to the
  * current Hessian's iteration at the best iterate, whose Hessian passes then become the
