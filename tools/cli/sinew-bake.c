@@ -380,117 +380,135 @@ static void print_summary(const bake *b) {
 }
 
 /* The JSON line, with --json. */
-static void print_json(const bake *b) {
-    char num[32];
-    if (b->o.json) {
-        char gt[32], gh[32];
-        printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
-               "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
-               "\"pair_sweep_poses\":%d,\"heldout_poses\":%d,"
-               "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"rank_trained\":%d,"
-               "\"proj_err_heldout_trained\":%.5f,\"err_train\":%.5f,\"err_"
-               "heldout\":%.5f,"
-               "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
-               "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f",
-               b->o.out_path, b->ch.mesh.ntets, b->ch.mesh.nverts, b->ch.skel.nbones,
-               b->res.view.ndomains, b->res.view.rank_total, b->res.view.ncub,
-               b->res.cubature_error_max, b->res.ntrain, b->res.return_poses,
-               b->res.pair_sweep_poses, b->res.nheldout, b->res.train_proj_error,
-               b->res.heldout_proj_error, b->res.rank_trained, b->res.heldout_proj_error_trained,
-               b->et.correction_error, b->eh.correction_error, b->res.train_unsettled,
-               b->res.heldout_unsettled, b->bake_seconds, b->eval_seconds);
-        printf(",\"stages\":["); /* the bake's table (bake.h), as the report's JSON */
-        for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
-            printf("%s{\"name\":\"%s\",\"seconds\":%.2f}", k ? "," : "", sw_bake_stages[k].name,
-                   b->res.stage_seconds[k]);
-        printf("]");
-        printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
-               "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
-               b->res.force_poses, b->model_err, sw_linear_solver_name(b->o.reference.solver),
-               sw_hessian_mode_name(b->o.reference.hessian), b->ch.range.nframes,
-               (unsigned long long)b->o.p.seed);
-        printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
-               json_number(b->res.train_galerkin_error, gt),
-               json_number(b->res.heldout_galerkin_error, gh));
-        printf(",\"spring_k\":%.6g,\"spring_tried\":[", b->res.spring_k);
-        for (int32_t k = 0; k < b->res.nspring_tried; ++k)
-            printf("%s[%.4g,%.5f]", k ? "," : "", b->res.spring_tried_mult[k],
-                   b->res.spring_tried_err[k]);
-        printf("]");
-        printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
-               "\"seam_max_heldout\":%.3e",
-               b->et.seam, b->eh.seam, b->et.seam_max, b->eh.seam_max);
-        printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
-               "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
-               "\"embed_seconds\":%.4f",
-               sw_blob_output_verts(&b->res.view), sw_blob_output_ntris(&b->res.view),
-               b->res.view.nrender_verts > 0 ? "true" : "false", b->res.render_outside,
-               b->res.render_max_outside, b->res.render_max_bary, b->res.embed_seconds);
-        if (b->o.ca.file)
-            printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
-                   b->info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
-                   b->quality.min_dihedral_deg, b->quality.slivers);
-        if (b->o.p.compare_selectors)
-            printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
-                   "\"nnhtp\":[%d,%.3f,%.4f]}",
-                   b->res.selector_points[0], b->res.selector_seconds[0], b->res.selector_error[0],
-                   b->res.selector_points[1], b->res.selector_seconds[1], b->res.selector_error[1],
-                   b->res.selector_points[2], b->res.selector_seconds[2], b->res.selector_error[2]);
-        for (int k = 0; b->o.ad.rounds > 0 && k < b->arep.nrounds; ++k) {
-            const sw_adaptive_round *a = &b->arep.round[k];
-            printf("%s{\"train_poses\":%d,\"added\":%d,\"rank\":%d,\"err_train\":%.5f,"
-                   "\"err_heldout\":%.5f,\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,"
-                   "\"score_mean\":%.4f,\"score_max\":%.4f,\"picks_score\":%.4f,"
-                   "\"picks_error\":%.5f,\"solved\":%d,\"seconds\":%.2f}%s",
-                   k == 0 ? ",\"adaptive\":[" : ",", a->ntrain, a->added, a->rank_total,
-                   a->err_train, a->err_heldout, a->proj_train, a->proj_heldout, a->score_mean,
-                   a->score_max, a->picks_score, a->picks_error, a->solved, a->seconds,
-                   k + 1 == b->arep.nrounds ? "]" : "");
-        }
-        printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d",
-               b->res.view.ncontacts, b->res.view.npair_groups, b->kept);
-        for (int set = 0; set < 2; ++set) { /* [bone, share of the error, of the correction] */
-            const sw_eval_result *e = set ? &b->eh : &b->et;
-            printf(",\"err_regions_%s\":[", set ? "heldout" : "train");
-            for (int32_t k = 0; k < e->nregions; ++k)
-                printf("%s[%d,%.4f,%.4f]", k ? "," : "", e->region_bone[k], e->region_err[k],
-                       e->region_corr[k]);
-            printf("]");
-        }
-        printf(",\"err_heldout_by_mode\":{");
-        for (int k = 0; k < SW_BAKE_MODES; ++k)
-            printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k],
-                   json_number(b->mode_err[k], num));
-        printf("}");
-        if (b->o.spread_every > 0)
-            printf(",\"ref_spread\":{\"every\":%d,\"poses\":%d,\"runtime\":%.5f,"
-                   "\"from_skin\":%.5f,\"from_reference\":%.5f,\"polished\":%.5f,"
-                   "\"polish_move\":%.5f,\"unconverged\":%d,\"failed\":%d}",
-                   b->o.spread_every, b->spread.poses, b->spread.runtime, b->spread.from_skin,
-                   b->spread.from_reference, b->spread.polished, b->spread.polish_move,
-                   b->spread.unconverged, b->spread.failed);
-        for (int32_t k = 0; b->o.spread_every > 0 && k < b->spread.poses; ++k) {
-            /* [held-out pose, runtime, from_skin, from_reference, polished, correction] */
-            const sw_bake_spread_pose *q = &b->spread.per_pose[k];
-            printf("%s[%d,%.5f,%.5f,%.5f,%.5f,%.4g]%s", k ? "," : ",\"ref_spread_poses\":[",
-                   q->heldout, q->runtime, q->from_skin, q->from_reference, q->polished,
-                   q->correction, k + 1 == b->spread.poses ? "]" : "");
-        }
-        printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
-        for (int32_t k = 0; k < b->nbeyond; ++k) {
-            printf("%s[%d,", k ? "," : "", b->beyond[k].bone);
-            if (b->ch.bone_names)
-                sw_tool_json_string(b->ch.bone_names[b->beyond[k].bone]);
-            else
-                printf("null");
-            printf(",%.2f,%.2f]", b->beyond[k].heldout_deg, b->beyond[k].train_deg);
-        }
-        printf("]");
-        printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s,"
-               "\"shipped\":\"%s\"}\n",
-               b->res.simulate_cached ? "true" : "false", b->res.simulate_solved,
-               b->absurd ? "true" : "false", b->ship_whole ? "whole_clip" : "as_measured");
+/* sinew-bake --json, one object in parts: the model, */
+static void json_model(const bake *b) {
+    char gt[32], gh[32];
+    printf("{\"blob\":\"%s\",\"tets\":%d,\"verts\":%d,\"bones\":%d,\"domains\":%d,\"rank\":%d,"
+           "\"cubature_tets\":%d,\"cubature_fit\":%.5f,\"train_poses\":%d,\"return_poses\":%d,"
+           "\"pair_sweep_poses\":%d,\"heldout_poses\":%d,"
+           "\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,\"rank_trained\":%d,"
+           "\"proj_err_heldout_trained\":%.5f,\"err_train\":%.5f,\"err_"
+           "heldout\":%.5f,"
+           "\"ref_unsettled_train\":%d,\"ref_unsettled_heldout\":%d,"
+           "\"bake_seconds\":%.2f,\"eval_seconds\":%.2f",
+           b->o.out_path, b->ch.mesh.ntets, b->ch.mesh.nverts, b->ch.skel.nbones,
+           b->res.view.ndomains, b->res.view.rank_total, b->res.view.ncub,
+           b->res.cubature_error_max, b->res.ntrain, b->res.return_poses, b->res.pair_sweep_poses,
+           b->res.nheldout, b->res.train_proj_error, b->res.heldout_proj_error, b->res.rank_trained,
+           b->res.heldout_proj_error_trained, b->et.correction_error, b->eh.correction_error,
+           b->res.train_unsettled, b->res.heldout_unsettled, b->bake_seconds, b->eval_seconds);
+    printf(",\"stages\":["); /* the bake's table (bake.h), as the report's JSON */
+    for (int k = 0; k < SW_BAKE_NSTAGES; ++k)
+        printf("%s{\"name\":\"%s\",\"seconds\":%.2f}", k ? "," : "", sw_bake_stages[k].name,
+               b->res.stage_seconds[k]);
+    printf("]");
+    printf(",\"pose_force_poses\":%d,\"err_train_model\":%.5f,\"ref_solver\":\"%s\","
+           "\"ref_hessian\":\"%s\",\"joint_range_frames\":%d,\"seed\":%llu",
+           b->res.force_poses, b->model_err, sw_linear_solver_name(b->o.reference.solver),
+           sw_hessian_mode_name(b->o.reference.hessian), b->ch.range.nframes,
+           (unsigned long long)b->o.p.seed);
+    printf(",\"galerkin_err_train\":%s,\"galerkin_err_heldout\":%s",
+           json_number(b->res.train_galerkin_error, gt),
+           json_number(b->res.heldout_galerkin_error, gh));
+    printf(",\"spring_k\":%.6g,\"spring_tried\":[", b->res.spring_k);
+    for (int32_t k = 0; k < b->res.nspring_tried; ++k)
+        printf("%s[%.4g,%.5f]", k ? "," : "", b->res.spring_tried_mult[k],
+               b->res.spring_tried_err[k]);
+    printf("]");
+    printf(",\"seam_train\":%.5f,\"seam_heldout\":%.5f,\"seam_max_train\":%.3e,"
+           "\"seam_max_heldout\":%.3e",
+           b->et.seam, b->eh.seam, b->et.seam_max, b->eh.seam_max);
+    printf(",\"surface_verts\":%d,\"surface_tris\":%d,\"render_mesh\":%s,"
+           "\"render_outside\":%d,\"render_max_outside\":%.6g,\"render_max_bary\":%.4g,"
+           "\"embed_seconds\":%.4f",
+           sw_blob_output_verts(&b->res.view), sw_blob_output_ntris(&b->res.view),
+           b->res.view.nrender_verts > 0 ? "true" : "false", b->res.render_outside,
+           b->res.render_max_outside, b->res.render_max_bary, b->res.embed_seconds);
+    if (b->o.ca.file)
+        printf(",\"mesher\":\"%s\",\"mesh_min_dihedral_deg\":%.4g,\"mesh_slivers\":%d",
+               b->info.mesh.mesher == SW_MESHER_TETGEN ? "tetgen" : "lattice",
+               b->quality.min_dihedral_deg, b->quality.slivers);
+}
+
+/* how it was trained (the selectors compared, the adaptive rounds, the contact kept), */
+static void json_training(const bake *b) {
+    if (b->o.p.compare_selectors)
+        printf(",\"selectors\":{\"greedy\":[%d,%.3f,%.4f],\"importance\":[%d,%.3f,%.4f],"
+               "\"nnhtp\":[%d,%.3f,%.4f]}",
+               b->res.selector_points[0], b->res.selector_seconds[0], b->res.selector_error[0],
+               b->res.selector_points[1], b->res.selector_seconds[1], b->res.selector_error[1],
+               b->res.selector_points[2], b->res.selector_seconds[2], b->res.selector_error[2]);
+    for (int k = 0; b->o.ad.rounds > 0 && k < b->arep.nrounds; ++k) {
+        const sw_adaptive_round *a = &b->arep.round[k];
+        printf("%s{\"train_poses\":%d,\"added\":%d,\"rank\":%d,\"err_train\":%.5f,"
+               "\"err_heldout\":%.5f,\"proj_err_train\":%.5f,\"proj_err_heldout\":%.5f,"
+               "\"score_mean\":%.4f,\"score_max\":%.4f,\"picks_score\":%.4f,"
+               "\"picks_error\":%.5f,\"solved\":%d,\"seconds\":%.2f}%s",
+               k == 0 ? ",\"adaptive\":[" : ",", a->ntrain, a->added, a->rank_total, a->err_train,
+               a->err_heldout, a->proj_train, a->proj_heldout, a->score_mean, a->score_max,
+               a->picks_score, a->picks_error, a->solved, a->seconds,
+               k + 1 == b->arep.nrounds ? "]" : "");
     }
+    printf(",\"contact_pairs\":%d,\"pair_groups\":%d,\"contact_pairs_kept\":%d",
+           b->res.view.ncontacts, b->res.view.npair_groups, b->kept);
+}
+
+/* where its error is (regions, self-contact modes, the reference's own spread), */
+static void json_errors(const bake *b) {
+    char num[32];
+    for (int set = 0; set < 2; ++set) { /* [bone, share of the error, of the correction] */
+        const sw_eval_result *e = set ? &b->eh : &b->et;
+        printf(",\"err_regions_%s\":[", set ? "heldout" : "train");
+        for (int32_t k = 0; k < e->nregions; ++k)
+            printf("%s[%d,%.4f,%.4f]", k ? "," : "", e->region_bone[k], e->region_err[k],
+                   e->region_corr[k]);
+        printf("]");
+    }
+    printf(",\"err_heldout_by_mode\":{");
+    for (int k = 0; k < SW_BAKE_MODES; ++k)
+        printf("%s\"%s\":%s", k ? "," : "", sw_self_contact_keys[k],
+               json_number(b->mode_err[k], num));
+    printf("}");
+    if (b->o.spread_every > 0)
+        printf(",\"ref_spread\":{\"every\":%d,\"poses\":%d,\"runtime\":%.5f,"
+               "\"from_skin\":%.5f,\"from_reference\":%.5f,\"polished\":%.5f,"
+               "\"polish_move\":%.5f,\"unconverged\":%d,\"failed\":%d}",
+               b->o.spread_every, b->spread.poses, b->spread.runtime, b->spread.from_skin,
+               b->spread.from_reference, b->spread.polished, b->spread.polish_move,
+               b->spread.unconverged, b->spread.failed);
+    for (int32_t k = 0; b->o.spread_every > 0 && k < b->spread.poses; ++k) {
+        /* [held-out pose, runtime, from_skin, from_reference, polished, correction] */
+        const sw_bake_spread_pose *q = &b->spread.per_pose[k];
+        printf("%s[%d,%.5f,%.5f,%.5f,%.5f,%.4g]%s", k ? "," : ",\"ref_spread_poses\":[", q->heldout,
+               q->runtime, q->from_skin, q->from_reference, q->polished, q->correction,
+               k + 1 == b->spread.poses ? "]" : "");
+    }
+}
+
+/* and the joints the held-out clips bend beyond training. */
+static void json_beyond(const bake *b) {
+    printf(",\"heldout_beyond_training\":["); /* [bone, name, held-out, training deg] */
+    for (int32_t k = 0; k < b->nbeyond; ++k) {
+        printf("%s[%d,", k ? "," : "", b->beyond[k].bone);
+        if (b->ch.bone_names)
+            sw_tool_json_string(b->ch.bone_names[b->beyond[k].bone]);
+        else
+            printf("null");
+        printf(",%.2f,%.2f]", b->beyond[k].heldout_deg, b->beyond[k].train_deg);
+    }
+    printf("]");
+}
+
+static void print_json(const bake *b) {
+    if (!b->o.json) return;
+    json_model(b);
+    json_training(b);
+    json_errors(b);
+    json_beyond(b);
+    printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s,"
+           "\"shipped\":\"%s\"}\n",
+           b->res.simulate_cached ? "true" : "false", b->res.simulate_solved,
+           b->absurd ? "true" : "false", b->ship_whole ? "whole_clip" : "as_measured");
 }
 
 /* The figures are the split's; a character's only clip then ships trained on the whole
