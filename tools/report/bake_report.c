@@ -337,13 +337,10 @@ static cJSON *json_sheet(const sw_bake_report_input *in, const report *r) {
     return o;
 }
 
-static char *report_json(const sw_bake_report_input *in, const report *r) {
+/* The report's JSON in parts: the model's figures (errors, projections, the equilibrium
+ * force, the levels, the springs), */
+static void json_model_figures(cJSON *j, const sw_bake_report_input *in) {
     const sw_bake_result *res = in->res;
-    cJSON *j = cJSON_CreateObject();
-    cJSON_AddNumberToObject(j, "sinew_bake_report", SW_BAKE_REPORT_VERSION);
-    cJSON_AddItemToObject(j, "verdict", report_verdict_json(in, r));
-    cJSON_AddStringToObject(j, "source", in->source ? in->source : "");
-    cJSON_AddItemToObject(j, "character", json_character(in));
     cJSON_AddItemToObject(j, "err_train", json_number(in->err_train));
     cJSON_AddItemToObject(j, "err_heldout", json_number(in->err_heldout));
     cJSON_AddNumberToObject(j, "proj_err_train", res->train_proj_error);
@@ -375,6 +372,11 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
         cJSON_AddItemToArray(pair, json_number(res->spring_tried_err[k]));
         cJSON_AddItemToArray(tried, pair);
     }
+}
+
+/* how the bake ran (seams, the reference's solver, the stages' times, the render mesh), */
+static void json_run(cJSON *j, const sw_bake_report_input *in) {
+    const sw_bake_result *res = in->res;
     if (in->eval_train && in->eval_heldout) {
         cJSON *o = cJSON_AddObjectToObject(j, "seams");
         cJSON_AddItemToObject(o, "train", json_number(in->eval_train->seam));
@@ -411,6 +413,11 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
         cJSON_AddNumberToObject(rd, "max_outside", res->render_max_outside);
     } else
         cJSON_AddNullToObject(j, "render");
+}
+
+/* and where the error is (clips, sweeps, domains, regions, modes, the reference's spread,
+ * the joints beyond training, the contact sheet). */
+static void json_where(cJSON *j, const sw_bake_report_input *in, const report *r) {
     cJSON_AddItemToObject(j, "clips", json_clips(r));
     cJSON *sw = cJSON_AddObjectToObject(j, "sweeps");
     cJSON_AddNumberToObject(sw, "poses", r->sweep_poses);
@@ -447,6 +454,17 @@ static char *report_json(const sw_bake_report_input *in, const report *r) {
         cJSON_AddNullToObject(j, "contact_sheet");
         cJSON_AddNullToObject(j, "contact_sheet_tiles");
     }
+}
+
+static char *report_json(const sw_bake_report_input *in, const report *r) {
+    cJSON *j = cJSON_CreateObject();
+    cJSON_AddNumberToObject(j, "sinew_bake_report", SW_BAKE_REPORT_VERSION);
+    cJSON_AddItemToObject(j, "verdict", report_verdict_json(in, r));
+    cJSON_AddStringToObject(j, "source", in->source ? in->source : "");
+    cJSON_AddItemToObject(j, "character", json_character(in));
+    json_model_figures(j, in);
+    json_run(j, in);
+    json_where(j, in, r);
     char *text = cJSON_Print(j);
     cJSON_Delete(j);
     return text;
