@@ -169,6 +169,7 @@ static inline void fixture_init(fixture *f, uint64_t seed) {
     v->mu = 1e5, v->lambda = 4e5, v->rayleigh_alpha = 0.1, v->rayleigh_beta = 0.01;
     v->contact_k = 1e3;
     v->nbasis = NBASIS, v->ninertia_u = NIU, v->nsurf_copies = nc;
+    v->nspring_hessian = v->nmass = RT * RT; /* dense: a version-2 blob */
     v->ntrain = NTR, v->ncontacts = 2;
     /* The fixture's arrays carry the view's field names. */
 #define POINT(id, NAME, elem_size, type, field, ...) v->field = f->field;
@@ -373,6 +374,29 @@ static inline void fixture_add_asset(fixture *f, asset_fixture *a) {
  * vertices: each vertex on bone i % NB alone at its rest position, two orthonormal modes
  * (x of every vertex, then y, scaled), a map of small entries. */
 enum { LOD_RANK = 2 };
+/* ---- the reduced matrices by domain blocks (sinew_blob_format.h, id 65; version 4) ----- */
+
+typedef struct blocks_fixture {
+    double mass[RT * RT], spring_hessian[RT * RT];
+    int32_t blocks[2 * ND * ND];
+} blocks_fixture;
+
+/* The fixture's mass and springs stored by blocks, as the bake stores them: the springs'
+ * block between the first and the last domain zeroed first (both ways), so that an
+ * off-diagonal block is left out. */
+static inline void fixture_add_blocks(fixture *f, blocks_fixture *k) {
+    sw_blob_view *v = &f->v;
+    const sw_blob_domain *first = &v->domains[0], *last = &v->domains[ND - 1];
+    for (int32_t i = 0; i < first->rank; ++i)
+        for (int32_t j = 0; j < last->rank; ++j)
+            f->spring_hessian[(first->q_offset + i) * RT + last->q_offset + j] =
+                f->spring_hessian[(last->q_offset + j) * RT + first->q_offset + i] = 0.0;
+    v->nmass = sw_blob_pack_blocks(v->domains, ND, RT, f->mass, k->blocks, k->mass);
+    v->nspring_hessian = sw_blob_pack_blocks(v->domains, ND, RT, f->spring_hessian,
+                                             k->blocks + ND * ND, k->spring_hessian);
+    v->mass = k->mass, v->spring_hessian = k->spring_hessian, v->reduced_blocks = k->blocks;
+}
+
 typedef struct lod_fixture {
     double rest[3 * NOUT_MAX], weight[4 * NOUT_MAX], map[LOD_RANK * (9 * NB + 1)];
     int32_t bone[4 * NOUT_MAX];
@@ -411,6 +435,8 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     SAME_BITS(nbasis)
     SAME_BITS(ninertia_u)
     SAME_BITS(nsurf_copies)
+    SAME_BITS(nspring_hessian)
+    SAME_BITS(nmass)
     SINEW_BLOB_RENDER_COUNTS(SAME_BITS)
     SINEW_BLOB_COND_COUNTS(SAME_BITS)
     SINEW_BLOB_PAIR_COUNTS(SAME_BITS)
@@ -447,6 +473,11 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
     if (a->tet_stiffness &&
         memcmp(a->tet_stiffness, b->tet_stiffness, (size_t)a->ntets * sizeof(double)))
         return "tet_stiffness";
+    if (!a->reduced_blocks != !b->reduced_blocks ||
+        (a->reduced_blocks &&
+         memcmp(a->reduced_blocks, b->reduced_blocks,
+                2 * (size_t)a->ndomains * (size_t)a->ndomains * sizeof(int32_t))))
+        return "reduced_blocks";
     if (a->lod_rank != b->lod_rank || a->nlod_verts != b->nlod_verts) return "lod counts";
     if (a->lod_rank > 0) {
         SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_LOD_COUNTS);
@@ -548,6 +579,9 @@ static inline int walk_view(const sw_blob_view *v, const uint8_t *base, size_t s
     };
     for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
         if (!inside(arrays[i].p, arrays[i].bytes, base, size)) return 0;
+    if (v->reduced_blocks &&
+        !inside(v->reduced_blocks, 8 * (int64_t)v->ndomains * v->ndomains, base, size))
+        return 0;
     double s = 0.0;
     for (int32_t d = 0; d < v->ndomains; ++d) {
         const sw_blob_domain *dom = &v->domains[d];
@@ -566,8 +600,8 @@ static inline int walk_view(const sw_blob_view *v, const uint8_t *base, size_t s
                     s += v->basis[dom->basis_offset + (3 * k + a) * dom->rank + i];
         }
         for (int32_t i = 0; i < dom->rank; ++i) {
-            s += v->mass[(dom->q_offset + i) * R + dom->q_offset + i];
-            s += v->spring_hessian[(dom->q_offset + i) * R + R - 1];
+            s += sw_blob_reduced_entry(v, SW_BLOB_MASS, dom->q_offset + i, dom->q_offset + i);
+            s += sw_blob_reduced_entry(v, SW_BLOB_SPRINGS, dom->q_offset + i, R - 1);
             s += v->inertia_s[3 * (dom->q_offset + i) + 2] +
                  v->inertia_x[9 * (dom->q_offset + i) + 8];
         }

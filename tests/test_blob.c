@@ -428,7 +428,78 @@ TEST(load_argument_errors) {
     free(blob);
 }
 
+/* Version 4 stores the mass and the springs by domain blocks (sinew_blob_format.h, id 65):
+ * the same character written dense (version 2) and by blocks reads back the same entries
+ * everywhere, zeros where a block is left out; the blocks' table is checked. */
+TEST(reduced_matrices_by_blocks_read_as_the_dense_ones) {
+    static fixture dense, packed;
+    static blocks_fixture k;
+    fixture_init(&packed, 5);
+    fixture_add_blocks(&packed, &k); /* zeroes a springs block of packed's dense arrays */
+    fixture_init(&dense, 5);
+    memcpy(dense.spring_hessian, packed.spring_hessian, sizeof dense.spring_hessian);
+    size_t nd_bytes = 0, np_bytes = 0;
+    sw_blob_view vd, vp;
+    uint8_t *bd = write_parsed(&dense, &nd_bytes, &vd), *bp = write_parsed(&packed, &np_bytes, &vp);
+    ENSURE(bd && bp);
+    ENSURE(hdr(bd)->version == SINEW_BLOB_VERSION_MIN && hdr(bp)->version == 4);
+    ENSURE(!vd.reduced_blocks && vp.reduced_blocks && entry(bp, SINEW_SECTION_REDUCED_BLOCKS));
+    ENSURE(vp.nmass < vd.nmass && vp.nspring_hessian < vd.nspring_hessian);
+    for (int m = SW_BLOB_MASS; m <= SW_BLOB_SPRINGS; ++m)
+        for (int32_t i = 0; i < RT; ++i)
+            for (int32_t j = 0; j < RT; ++j) {
+                double a = sw_blob_reduced_entry(&vd, m, i, j),
+                       b = sw_blob_reduced_entry(&vp, m, i, j);
+                ENSUREF(memcmp(&a, &b, sizeof a) == 0, "matrix %d (%d, %d): %g and %g", m, i, j, a,
+                        b);
+            }
+    ENSURE(!sw_blob_block_nonzero(&vp, SW_BLOB_SPRINGS, 0, ND - 1) &&
+           !sw_blob_block_nonzero(&vd, SW_BLOB_SPRINGS, 0, ND - 1));
+    ENSURE(sw_blob_block_nonzero(&vp, SW_BLOB_SPRINGS, 0, 1) &&
+           sw_blob_block_nonzero(&vd, SW_BLOB_SPRINGS, 0, 1));
+    int64_t ld;
+    ENSURE(!sw_blob_block(&vp, SW_BLOB_SPRINGS, 0, ND - 1, &ld) &&
+           sw_blob_block(&vd, SW_BLOB_SPRINGS, 0, ND - 1, &ld));
+    /* the table, forged: each refused with what is wrong */
+    int32_t *blk;
+    uint8_t *f = copy_exact(bp, np_bytes);
+    hdr(f)->version = 2; /* outside the checksum */
+    ENSURE(parse_refuses(f, np_bytes, SINEW_ERROR_CORRUPT, "REDUCED_BLOCKS", "version 4"));
+    memcpy(f, bp, np_bytes);
+    hdr(f)->version = 4;
+    blk = section(f, SINEW_SECTION_REDUCED_BLOCKS);
+    blk[0] = -1; /* the mass's first diagonal block */
+    ENSURE(parse_refuses(f, np_bytes, SINEW_ERROR_CORRUPT, "MASS diagonal block 0", "not stored"));
+    memcpy(f, bp, np_bytes);
+    blk = section(f, SINEW_SECTION_REDUCED_BLOCKS);
+    blk[1] = 0; /* the mass's block (0, 1), left out, said to be where block (0, 0) is */
+    ENSURE(parse_refuses(f, np_bytes, SINEW_ERROR_CORRUPT, "MASS block (0, 1) at 0", "end at"));
+    memcpy(f, bp, np_bytes);
+    blk = section(f, SINEW_SECTION_REDUCED_BLOCKS);
+    blk[ND * ND + ND - 1] = -7;
+    ENSURE(parse_refuses(f, np_bytes, SINEW_ERROR_CORRUPT, "SPRING_HESSIAN block (0, 2)",
+                         "offset or -1"));
+    memcpy(f, bp, np_bytes);
+    entry(f, SINEW_SECTION_SPRING_HESSIAN)->count -= 1;
+    ENSURE(parse_refuses(f, np_bytes, SINEW_ERROR_CORRUPT, "SPRING_HESSIAN", "stored blocks"));
+    memcpy(f, bp, np_bytes);
+    ((double *)section(f, SINEW_SECTION_MASS))[0] = 0.0; /* a diagonal entry */
+    ENSURE(parse_refuses(f, np_bytes, SINEW_ERROR_CORRUPT, "MASS", "diagonal entry 0"));
+    free(f);
+    /* a dense blob must stay dense: a version-2 header on dense matrices of another size */
+    f = copy_exact(bd, nd_bytes);
+    hdr(f)->version = 4;
+    ENSURE(parse_refuses(f, nd_bytes, SINEW_ERROR_CORRUPT, "version 4", "without REDUCED_BLOCKS"));
+    memcpy(f, bd, nd_bytes);
+    entry(f, SINEW_SECTION_MASS)->count -= 1;
+    ENSURE(parse_refuses(f, nd_bytes, SINEW_ERROR_CORRUPT, "MASS", "rank_total^2"));
+    free(f);
+    fprintf(stderr, "    dense %zu bytes, by blocks %zu\n", nd_bytes, np_bytes);
+    free(bd);
+    free(bp);
+}
+
 SW_TEST_MAIN(CASE(checksum_is_fnv1a_64), CASE(memory_round_trip_is_bit_exact),
              CASE(file_and_buffer_loads_match), CASE(writer_rejects_invalid_views),
              CASE(writer_file_errors_leave_nothing_behind), CASE(load_uses_hooks_and_logs_errors),
-             CASE(load_argument_errors))
+             CASE(load_argument_errors), CASE(reduced_matrices_by_blocks_read_as_the_dense_ones))

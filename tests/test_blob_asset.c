@@ -90,7 +90,8 @@ TEST(the_output_map_and_provenance_read_back) {
     ENSURE(sinew_blob_get_provenance(blob, &p) == SINEW_OK);
     ENSURE(p.struct_size == sizeof p && p.sinew_version == SINEW_VERSION);
     ENSURE(p.source_hash == 0x0123456789abcdefull && p.options_hash == 0xfedcba9876543210ull);
-    ENSURE(p.format_version == SINEW_BLOB_VERSION && p.reserved == 0);
+    /* the blob's own version: the synthetic one is dense and unpainted */
+    ENSURE(p.format_version == SINEW_BLOB_VERSION_MIN && p.reserved == 0);
     /* an older host's smaller struct: only its bytes are written */
     memset(&p, 0xaa, sizeof p);
     p.struct_size = 16;

@@ -40,7 +40,7 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     ENSURE(hdr(fx.data)->section_count ==
            SINEW_SECTION_COUNT_V1 + NCOND + (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
                (v->train_force ? 1u : 0u) + (v->bone_names ? 5u : 0u) +
-               (v->lod_rank > 0 ? 6u : 0u));
+               (v->lod_rank > 0 ? 6u : 0u) + (v->reduced_blocks ? 1u : 0u));
     ENSURE(v->ntets == m->ntets && v->nvert_tets == 4 * m->ntets && v->nverts == m->nverts);
     ENSURE(v->ndomains >= 2); /* tets in more than one domain, vertices with several copies */
     ENSURE(memcmp(v->tets, m->tets, 4 * sizeof(int32_t) * (size_t)m->ntets) == 0);
@@ -105,7 +105,6 @@ TEST(the_masses_are_the_reduced_masses) {
             copy_mass[v->domains[v->tet_domain[t]].vert_begin + v->tet_local[4 * t + k]] +=
                 rho * v->tet_vol[t] / 4;
     double err = 0, scale = 0;
-    const int64_t R = v->rank_total;
     for (int32_t d = 0; d < v->ndomains; ++d) {
         const sw_blob_domain *dom = &v->domains[d];
         const double *U = v->basis + dom->basis_offset;
@@ -116,7 +115,8 @@ TEST(the_masses_are_the_reduced_masses) {
                     for (int a = 0; a < 3; ++a)
                         mij += copy_mass[dom->vert_begin + l] * U[(3 * l + a) * dom->rank + i] *
                                U[(3 * l + a) * dom->rank + j];
-                const double stored = v->mass[(dom->q_offset + i) * R + dom->q_offset + j];
+                const double stored =
+                    sw_blob_reduced_entry(v, SW_BLOB_MASS, dom->q_offset + i, dom->q_offset + j);
                 err = fmax(err, fabs(mij - stored));
                 scale = fmax(scale, fabs(stored));
             }
@@ -128,8 +128,9 @@ TEST(the_masses_are_the_reduced_masses) {
 }
 
 /* Without the tet mesh (and the per-pair sections), a view writes the 26 sections it
- * always did, the very bytes they are in the blob with it; the synthetic character's seed,
- * written before the tet mesh existed, is still what the writer writes. */
+ * always did (and its reduced matrices' blocks), the very bytes they are in the blob with
+ * it; the synthetic character's seed, written before the tet mesh existed, is still what
+ * the writer writes. */
 TEST(a_view_without_the_tet_mesh_writes_the_blob_of_before) {
     ENSURE(capsule_fixture());
     sw_blob_view plain = fx.res.view;
@@ -146,7 +147,7 @@ TEST(a_view_without_the_tet_mesh_writes_the_blob_of_before) {
     sw_error err;
     ENSUREF(sw_blob_write_memory(&plain, &data, &size, &err) == SINEW_OK, "%s", err.msg);
     uint8_t *b = data, *full = fx.data;
-    ENSURE(hdr(b)->section_count == SINEW_SECTION_COUNT_V1 && size < fx.size);
+    ENSURE(hdr(b)->section_count == SINEW_SECTION_COUNT_V1 + 1 && size < fx.size);
     for (uint32_t id = 1; id <= SINEW_SECTION_COUNT_V1; ++id) {
         const sinew_blob_section *e = entry(b, id), *f = entry(full, id);
         ENSUREF(e->count == f->count &&
@@ -326,8 +327,9 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     free(b);
 }
 
-/* The same character with per-pair sections, equilibrium forces, the asset description and
- * painted material as well (all 58, format version 3):
+/* The same character with per-pair sections, equilibrium forces, the asset description,
+ * painted material, the pose-space level and its reduced matrices by blocks as well (all
+ * 65, format version 4):
  * written, parsed back the same, and the fuzz seed
  * tests/fuzz/corpus/blob_fixed/synth_pairs.blob is these bytes (SINEW_WRITE_SEEDS=1
  * rewrites it), so the blob fuzzers start from every optional section. */
@@ -346,6 +348,8 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     fixture_add_paint(&f, &c, &pf);
     static lod_fixture lf;
     fixture_add_lod(&f, &lf);
+    static blocks_fixture bf;
+    fixture_add_blocks(&f, &bf);
     static double force[4096];
     const int64_t nforce = (int64_t)f.v.ntrain * f.v.rank_total;
     ENSURE(nforce <= 4096);
@@ -388,7 +392,7 @@ TEST(the_synthetic_pair_sections_round_trip_and_seed_the_fuzzer) {
     free(forged);
     /* painted material: a cubature tet's multiplier not its tet's, one out of range, a count
        off, and the sections in a blob whose header says version 2 */
-    ENSURE(hdr(b)->version == 3);
+    ENSURE(hdr(b)->version == 4);
     forged = copy_exact(b, size);
     ((double *)section(forged, SINEW_SECTION_CUB_STIFFNESS))[1] *= 2;
     ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "CUB_STIFFNESS", "TET_STIFFNESS"));

@@ -345,7 +345,7 @@ TEST(forged_blobs_are_rejected_by_the_semantic_checks) {
         {"table entry reserved", f_entry_reserved, SINEW_ERROR_CORRUPT, "DOMAINS", "reserved"},
         {"domain reserved", f_dom_reserved, SINEW_ERROR_CORRUPT, "DOMAINS", "reserved"},
         {"huge section_count", f_table_huge, SINEW_ERROR_CORRUPT, "table", "1000"},
-        {"newer version", f_version_new, SINEW_ERROR_VERSION, "header", "version 2"},
+        {"newer version", f_version_new, SINEW_ERROR_VERSION, "header", "versions 2 to 4"},
         {"older version", f_version_old, SINEW_ERROR_VERSION, "header", "version 0"},
         {"magic", f_magic, SINEW_ERROR_CORRUPT, "header", "magic"},
         {"endian", f_endian, SINEW_ERROR_CORRUPT, "header", "endian"},

@@ -215,7 +215,7 @@ static void eq_412_gradient(sinew_instance *in, const double *q, const double *x
     for (int32_t i = 0; i < R; ++i) {
         g[i] = in->red.g[i];
         for (int32_t j = 0; j < R; ++j)
-            g[i] -= v->spring_hessian[(int64_t)i * R + j] * q[j];
+            g[i] -= sw_blob_reduced_entry(v, SW_BLOB_SPRINGS, i, j) * q[j];
     }
 }
 

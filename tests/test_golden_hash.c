@@ -14,6 +14,8 @@
 #include <string.h>
 
 #include "bake_fixture.h"
+#include "blob_load.h"
+#include "blob_write.h"
 #include "props_fixture.h"
 #include "hash.h"
 #include "sw_test.h"
@@ -166,5 +168,53 @@ TEST(surface_hash_of_every_mode_is_golden) {
             (unsigned long long)h1, (unsigned long long)GOLDEN_MODES_HASH);
 }
 
+/* The bake stores the reduced mass and springs by domain blocks (blob version 4); the same
+ * blob written with them dense (version 2, as blobs were before) steps bitwise alike:
+ * the golden hash, and every mode's. */
+TEST(a_dense_blob_of_before_steps_the_same) {
+    bake_fixture f;
+    ENSURE(bake_fixture_make(&f, "finger", 2000, 12, 1));
+    const sw_blob_view *v = sw_blob_get_view(f.blob);
+    ENSURE(v->reduced_blocks);
+    const int32_t R = v->rank_total;
+    double *mass = malloc(sizeof(double) * R * R), *spring = malloc(sizeof(double) * R * R);
+    ENSURE(mass && spring);
+    for (int32_t i = 0; i < R; ++i)
+        for (int32_t j = 0; j < R; ++j) {
+            mass[(int64_t)i * R + j] = sw_blob_reduced_entry(v, SW_BLOB_MASS, i, j);
+            spring[(int64_t)i * R + j] = sw_blob_reduced_entry(v, SW_BLOB_SPRINGS, i, j);
+        }
+    sw_blob_view dense = *v;
+    dense.mass = mass, dense.spring_hessian = spring, dense.reduced_blocks = NULL;
+    dense.nmass = dense.nspring_hessian = (int64_t)R * R;
+    void *data = NULL;
+    size_t size = 0;
+    sw_error err;
+    ENSUREF(sw_blob_write_memory(&dense, &data, &size, &err) == SINEW_OK, "%s", err.msg);
+    ENSURE(((const sinew_blob_header *)data)->version < 4);
+    fprintf(stderr, "  blob by blocks %zu bytes, dense %zu\n", f.size, size);
+    sinew_blob *packed = f.blob;
+    sinew_blob_def d = sinew_blob_def_default();
+    d.data = data;
+    d.data_size = size;
+    ENSURE(sinew_blob_load(&d, &f.blob) == SINEW_OK);
+    sinew_world_def wd = sinew_world_def_default();
+    sinew_collider_id tent, wedge;
+    ENSURE(sinew_world_create(&wd, &props_world) == SINEW_OK &&
+           props_add(props_world, 2.2f, 1.2f, &tent, &wedge));
+    uint64_t h = hash_on_threads(&f, 0, NINST, 1), hm = hash_on_threads(&f, NINST, NMODES, 1);
+    sinew_world_destroy(props_world);
+    sinew_blob_destroy(f.blob);
+    f.blob = packed;
+    bake_fixture_free(&f);
+    free(data);
+    free(mass);
+    free(spring);
+    ENSUREF(h == GOLDEN_SURFACE_HASH && hm == GOLDEN_MODES_HASH,
+            "dense: surface hash 0x%016llx, modes 0x%016llx", (unsigned long long)h,
+            (unsigned long long)hm);
+}
+
 SW_TEST_MAIN(CASE(surface_hash_is_golden_on_1_2_4_threads),
-             CASE(surface_hash_of_every_mode_is_golden))
+             CASE(surface_hash_of_every_mode_is_golden),
+             CASE(a_dense_blob_of_before_steps_the_same))

@@ -192,7 +192,7 @@ static void check_springs_follow_the_skeleton(const sinew_blob *blob) {
         for (int32_t i = 0; i < R; ++i) {
             Hq[i] = 0;
             for (int32_t j = 0; j < R; ++j)
-                Hq[i] += v->spring_hessian[(int64_t)i * R + j] * q[j];
+                Hq[i] += sw_blob_reduced_entry(v, SW_BLOB_SPRINGS, i, j) * q[j];
             Es += 0.5 * q[i] * Hq[i];
         }
         for (int32_t d = 0; d < nd; ++d)

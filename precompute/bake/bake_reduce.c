@@ -12,6 +12,7 @@
 #include <string.h>
 
 #include "bake_state.h"
+#include "blob_write.h"
 #include "fem_corot.h"
 #include "mesh_io.h"
 #include "vec3.h"
@@ -282,6 +283,36 @@ static sinew_result painted_cubature(const sw_bake_state *s, sw_bake_result *out
     return SINEW_OK;
 }
 
+/* The view's mass and springs by domain blocks (blob version 4), from the dense mass and
+ * the springs at unit stiffness: the springs stage scales s->reduce.spring_unit_packed
+ * into the view's s->reduce.spring. */
+static sinew_result reduced_blocks(sw_bake_state *s, const sw_blob_domain *doms, const double *mass,
+                                   sw_bake_result *out, sw_error *err) {
+    sw_blob_view *v = &out->view;
+    int32_t R = s->basis.rank_total, nd = s->domains.nd;
+    int32_t *blocks;
+    double *mass_packed, *spring;
+    OWN(blocks, 2 * (int64_t)nd * nd, int32_t);
+    if (!blocks) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    int64_t nmass = sw_blob_pack_blocks(doms, nd, R, mass, blocks, NULL),
+            nspring =
+                sw_blob_pack_blocks(doms, nd, R, s->reduce.spring_unit, blocks + nd * nd, NULL);
+    OWN(mass_packed, nmass, double);
+    OWN(spring, nspring, double);
+    s->reduce.spring_unit_packed = malloc((size_t)nspring * sizeof(double) + 1);
+    if (!mass_packed || !spring || !s->reduce.spring_unit_packed)
+        return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
+    sw_blob_pack_blocks(doms, nd, R, mass, blocks, mass_packed);
+    sw_blob_pack_blocks(doms, nd, R, s->reduce.spring_unit, blocks + nd * nd,
+                        s->reduce.spring_unit_packed);
+    v->reduced_blocks = blocks;
+    v->mass = mass_packed;
+    v->nmass = nmass;
+    v->spring_hessian = s->reduce.spring = spring;
+    v->nspring_hessian = s->reduce.nspring = nspring;
+    return SINEW_OK;
+}
+
 sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err) {
     sw_blob_view *v = &out->view;
     int32_t R = s->basis.rank_total, nd = s->domains.nd, ncopies = s->domains.dom_vert_ptr[nd];
@@ -302,7 +333,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
                   s->basis.rank[d];
         ninertia += 9 * (int64_t)s->basis.rank[d] * s->basis.rank[d];
     }
-    double *basis, *cub_weight, *cub_dminv, *cub_vol, *spring, *mass, *ins, *inx, *inu;
+    double *basis, *cub_weight, *cub_dminv, *cub_vol, *mass, *ins, *inx, *inu;
     int32_t *dverts, *cub_tets;
     sw_blob_domain *doms;
     OWN(doms, nd, sw_blob_domain);
@@ -312,16 +343,15 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     OWN(cub_weight, ncub, double);
     OWN(cub_dminv, 9 * ncub, double);
     OWN(cub_vol, ncub, double);
-    OWN(spring, (int64_t)R * R, double);
-    OWN(mass, (int64_t)R * R, double);
+    mass = calloc((size_t)R * R, sizeof(double)); /* dense here, by blocks in the view */
     OWN(ins, 3 * R, double);
     OWN(inx, 9 * R, double);
     OWN(inu, ninertia, double);
     int32_t *copy_ptr_v = calloc((size_t)s->rig.nv + 1, sizeof(int32_t)); /* copies per vertex */
     int32_t *copy_list = malloc((size_t)ncopies * 2 * sizeof(int32_t));
     int32_t *surf_index = malloc((size_t)s->rig.nv * sizeof(int32_t));
-    if (!doms || !dverts || !basis || !cub_tets || !cub_weight || !cub_dminv || !cub_vol ||
-        !spring || !mass || !ins || !inx || !inu || !copy_ptr_v || !copy_list || !surf_index) {
+    if (!doms || !dverts || !basis || !cub_tets || !cub_weight || !cub_dminv || !cub_vol || !mass ||
+        !ins || !inx || !inu || !copy_ptr_v || !copy_list || !surf_index) {
         r = sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "out of memory for the blob");
         goto done;
     }
@@ -335,6 +365,7 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
         goto done;
     }
     add_interface_springs(s, doms, copy_ptr_v, copy_list, s->reduce.spring_unit);
+    if ((r = reduced_blocks(s, doms, mass, out, err)) != SINEW_OK) goto done;
     r = surface_sections(s, &surf, copy_ptr_v, copy_list, surf_index, out, err);
     if (r != SINEW_OK) goto done;
 
@@ -355,14 +386,13 @@ sinew_result sw_bake_reduce(sw_bake_state *s, sw_bake_result *out, sw_error *err
     v->cub_dminv = cub_dminv;
     v->cub_vol = cub_vol;
     if ((r = painted_cubature(s, out, err)) != SINEW_OK) goto done;
-    v->spring_hessian = s->reduce.spring = spring; /* the springs stage scales it */
-    v->mass = mass;
     v->inertia_s = ins;
     v->inertia_x = inx;
     v->inertia_u = inu;
     v->ninertia_u = ninertia;
     r = pose_sections(s, out, err);
 done:
+    free(mass);
     free(copy_ptr_v);
     free(copy_list);
     free(surf_index);

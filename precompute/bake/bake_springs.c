@@ -43,8 +43,8 @@ static sinew_result set_springs(const sw_bake_state *s, sw_bake_result *out, dou
                                 sw_error *err) {
     double *spring = s->reduce.spring; /* the view's, owned by out (bake_reduce.c) */
     int finite = 1;
-    for (int64_t i = 0; i < (int64_t)s->basis.rank_total * s->basis.rank_total; ++i) {
-        spring[i] = k * s->reduce.spring_unit[i];
+    for (int64_t i = 0; i < s->reduce.nspring; ++i) {
+        spring[i] = k * s->reduce.spring_unit_packed[i];
         finite &= isfinite(spring[i]) != 0;
     }
     out->spring_k = k;

@@ -63,6 +63,7 @@ void sw_bake_state_free(sw_bake_state *s) {
     free(s->domains.dom_tets);
     free(s->domains.copy_mass);
     free(s->reduce.spring_unit);
+    free(s->reduce.spring_unit_packed);
     for (int32_t i = 0; i < s->poses.ntrain_seq; ++i) {
         free(s->poses.train[i].T);
         free(s->poses.train[i].x);

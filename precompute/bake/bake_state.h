@@ -107,7 +107,10 @@ typedef struct sw_reduce_state { /* reduce */
        and the stiffness of one vertex of the mesh, E h, the unit of the choice */
     double *spring_unit;
     double spring_eh;
-    double *spring; /* the view's spring Hessian (owned by the result): springs scales it */
+    /* the view's spring Hessian by domain blocks (nspring doubles, owned by the result):
+     * springs scales spring_unit_packed, the same blocks of spring_unit, into it */
+    double *spring, *spring_unit_packed;
+    int64_t nspring;
 } sw_reduce_state;
 
 typedef struct sw_bake_state {

@@ -42,7 +42,8 @@ typedef struct group_metas {
 /* The sections of a validated view, in id order, into s; returns their number (26, plus 8
  * with a render mesh, plus 10 with the condensation tet mesh, plus 6 with per-pair
  * self-contact, plus 1 with the equilibrium force, plus 5 with the asset description, plus
- * 1 or 2 with painted material, plus 6 with the pose-space level). `meta` and
+ * 1 or 2 with painted material, plus 6 with the pose-space level, plus 1 with packed
+ * reduced matrices). `meta` and
  * `g` must outlive the result. */
 static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, const group_metas *g,
                          section_src s[SINEW_SECTION_ID_MAX]) {
@@ -97,6 +98,11 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
                                    SINEW_BLOB_LOD_ARRAY_SECTIONS(SOURCE)};
         memcpy(s + n, lod, sizeof lod);
         n += (int)(sizeof lod / sizeof lod[0]);
+    }
+    if (v->reduced_blocks) {
+        const section_src blocks[] = {SINEW_BLOB_BLOCKS_SECTIONS(SOURCE)};
+        memcpy(s + n, blocks, sizeof blocks);
+        n += (int)(sizeof blocks / sizeof blocks[0]);
     }
     return n;
 }
@@ -169,8 +175,11 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     sinew_blob_header h;
     memset(&h, 0, sizeof h);
     memcpy(h.magic, SINEW_BLOB_MAGIC, sizeof h.magic);
-    /* a blob without painted material stays readable by a version-2 runtime */
-    h.version = view->cub_stiffness ? SINEW_BLOB_VERSION : SINEW_BLOB_VERSION_MIN;
+    /* packed reduced matrices need version 4; a blob with dense ones stays readable by a
+     * version-2 runtime unless painted (3) */
+    h.version = view->reduced_blocks  ? SINEW_BLOB_VERSION
+                : view->cub_stiffness ? 3u
+                                      : SINEW_BLOB_VERSION_MIN;
     h.header_size = (uint32_t)sizeof h;
     h.file_size = total;
     h.section_count = (uint32_t)nsec;
@@ -189,6 +198,25 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
     *data = buf;
     *size = total;
     return SINEW_OK;
+}
+
+int64_t sw_blob_pack_blocks(const sw_blob_domain *doms, int32_t nd, int32_t R, const double *A,
+                            int32_t *blocks, double *packed) {
+    int64_t at = 0;
+    for (int32_t a = 0; a < nd; ++a)
+        for (int32_t b = 0; b < nd; ++b) {
+            const double *B = A + (int64_t)doms[a].q_offset * R + doms[b].q_offset;
+            int32_t ra = doms[a].rank, rb = doms[b].rank, any = a == b;
+            for (int32_t i = 0; i < ra && !any; ++i)
+                for (int32_t j = 0; j < rb && !any; ++j)
+                    any = B[(int64_t)i * R + j] != 0.0;
+            blocks[a * nd + b] = any ? (int32_t)at : -1;
+            if (!any) continue;
+            for (int32_t i = 0; packed && i < ra; ++i)
+                memcpy(packed + at + (int64_t)i * rb, B + (int64_t)i * R, (size_t)rb * sizeof *B);
+            at += (int64_t)ra * rb;
+        }
+    return at;
 }
 
 static sinew_result io_error(sw_error *err, const char *what, const char *file, int e) {

@@ -25,6 +25,13 @@ sinew_result sw_blob_write_memory(const sw_blob_view *view, void **data, size_t 
  * the system's reason; other codes as sw_blob_write_memory. */
 sinew_result sw_blob_write(const char *path, const sw_blob_view *view, sw_error *err);
 
+/* A dense R x R matrix A (row-major) by the domains' blocks, as a version-4 blob stores
+ * MASS and SPRING_HESSIAN (sinew_blob_format.h): writes each block's offset into
+ * blocks[nd^2] (-1 for an off-diagonal block of zeros; diagonal blocks always stored) and,
+ * when packed is not NULL, the stored blocks into packed. Returns the doubles stored. */
+int64_t sw_blob_pack_blocks(const sw_blob_domain *doms, int32_t nd, int32_t R, const double *A,
+                            int32_t *blocks, double *packed);
+
 /* Whether `path` can be written as sw_blob_write writes it, before the work that makes
  * it: not a folder, and its path.tmp can be created in its folder (created and removed
  * again; a path.tmp already there is opened, not removed). SINEW_ERROR_IO names the file

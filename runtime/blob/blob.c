@@ -255,7 +255,9 @@ SINEW_API sinew_result sinew_blob_get_provenance(const sinew_blob *blob,
     p.sinew_version = v->sinew_version;
     p.source_hash = v->source_hash;
     p.options_hash = v->options_hash;
-    p.format_version = SINEW_BLOB_VERSION;
+    sinew_blob_header h; /* the blob's own version, which may predate the runtime's */
+    memcpy(&h, blob->data, sizeof h);
+    p.format_version = h.version;
     memcpy(out, &p, p.struct_size);
     return SINEW_OK;
 }

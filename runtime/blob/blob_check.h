@@ -133,7 +133,8 @@ sinew_result sw_blob_force_validate(const sw_blob_view *v, char *msg, size_t msg
 
 /* Layer 1 of the painted material (blob_stiffness.c): CUB_STIFFNESS absent (and
  * TET_STIFFNESS with it) or of META's ncub doubles, TET_STIFFNESS then present exactly when
- * the condensation mesh is, with its ntets; present exactly in a blob of format `version` 3.
+ * the condensation mesh is, with its ntets; present in every blob of format `version` 3,
+ * in none of version 2, and as painted in version 4.
  * Points the view's fields at them (NULL when absent). After the condensation mesh's fill. */
 sinew_result sw_blob_stiffness_fill(const uint8_t *bytes, const sinew_blob_section *s,
                                     const int found[], uint32_t version, sw_blob_view *v, char *msg,
@@ -171,5 +172,16 @@ sinew_result sw_blob_lod_fill(const uint8_t *bytes, const sinew_blob_section *s,
 /* Layer 2: finite rest positions and coefficients, influences as SKIN_BONE/SKIN_WEIGHT's,
  * basis entries in [-1, 1] (nothing when lod_rank is 0). */
 sinew_result sw_blob_lod_validate(const sw_blob_view *v, char *msg, size_t msg_size);
+
+/* Layer 1 of the reduced matrices' blocks (blob_blocks.c): REDUCED_BLOCKS present exactly in
+ * a blob of format `version` 4, of META's 2 ndomains^2; points the view at it (NULL when
+ * absent) and records MASS's and SPRING_HESSIAN's counts. */
+sinew_result sw_blob_blocks_fill(const uint8_t *bytes, const sinew_blob_section *s,
+                                 const int found[], uint32_t version, sw_blob_view *v, char *msg,
+                                 size_t msg_size);
+
+/* Layer 2: dense matrices of rank_total^2, or stored blocks packed without gaps with every
+ * diagonal block stored; the mass's diagonal > 0. After the domain records' checks. */
+sinew_result sw_blob_blocks_validate(const sw_blob_view *v, char *msg, size_t msg_size);
 
 #endif

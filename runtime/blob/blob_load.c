@@ -28,6 +28,8 @@ SINEW_BLOB_PAIR_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_FORCE_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_ASSET_SECTIONS(SIZE_MATCHES)
 SINEW_BLOB_STIFFNESS_SECTIONS(SIZE_MATCHES)
+SINEW_BLOB_LOD_SECTIONS(SIZE_MATCHES)
+SINEW_BLOB_BLOCKS_SECTIONS(SIZE_MATCHES)
 #undef SIZE_MATCHES
 /* The optional groups follow the version-1 sections with no gap (the all-or-none loops). */
 _Static_assert(SINEW_SECTION_RENDER_FIRST == SINEW_SECTION_COUNT_V1 + 1 &&
@@ -35,7 +37,8 @@ _Static_assert(SINEW_SECTION_RENDER_FIRST == SINEW_SECTION_COUNT_V1 + 1 &&
                    SINEW_SECTION_PAIR_FIRST == SINEW_SECTION_COND_LAST + 1 &&
                    SINEW_SECTION_TRAIN_FORCE == SINEW_SECTION_PAIR_LAST + 1 &&
                    SINEW_SECTION_ASSET_FIRST == SINEW_SECTION_TRAIN_FORCE + 1 &&
-                   SINEW_SECTION_CUB_STIFFNESS == SINEW_SECTION_ASSET_LAST + 1,
+                   SINEW_SECTION_CUB_STIFFNESS == SINEW_SECTION_ASSET_LAST + 1 &&
+                   SINEW_SECTION_REDUCED_BLOCKS == SINEW_SECTION_LOD_LAST + 1,
                "section ids run on without gaps");
 /* SW_BLOB_META_FIELDS covers every byte of META: no field is left uncopied. */
 #define META_FIELD_SIZE(field) +sizeof(((sinew_blob_meta *)0)->field)
@@ -58,7 +61,8 @@ static const struct {
     SINEW_BLOB_SECTIONS(SECTION_INFO) SINEW_BLOB_RENDER_SECTIONS(SECTION_INFO)
         SINEW_BLOB_COND_SECTIONS(SECTION_INFO) SINEW_BLOB_PAIR_SECTIONS(SECTION_INFO)
             SINEW_BLOB_FORCE_SECTIONS(SECTION_INFO) SINEW_BLOB_ASSET_SECTIONS(SECTION_INFO)
-                SINEW_BLOB_STIFFNESS_SECTIONS(SECTION_INFO) SINEW_BLOB_LOD_SECTIONS(SECTION_INFO)};
+                SINEW_BLOB_STIFFNESS_SECTIONS(SECTION_INFO) SINEW_BLOB_LOD_SECTIONS(SECTION_INFO)
+                    SINEW_BLOB_BLOCKS_SECTIONS(SECTION_INFO)};
 #undef SECTION_INFO
 
 /* Not instrumented for fuzzing coverage: its loop has no branch worth a fuzzer's
@@ -472,10 +476,7 @@ sinew_result sw_blob_validate_view(const sw_blob_view *v, char *msg, size_t ms) 
                                     ms)) ||
         (r = sw_blob_check_positive(SINEW_SECTION_CUB_VOL, v->cub_vol, v->ncub, 1, msg, ms)))
         return r;
-    /* Lumped mass projected on the basis: its diagonal is sum_v m_v |U_v col i|^2 > 0. */
-    if ((r = sw_blob_check_positive(SINEW_SECTION_MASS, v->mass, v->rank_total, v->rank_total + 1,
-                                    msg, ms)))
-        return r;
+    if ((r = sw_blob_blocks_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_cond_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_pair_validate(v, msg, ms)) != SINEW_OK) return r;
     if ((r = sw_blob_force_validate(v, msg, ms)) != SINEW_OK) return r;
@@ -491,8 +492,7 @@ static sinew_result check_header(const sinew_blob_header *h, size_t size, char *
         return fail(msg, ms, SINEW_ERROR_CORRUPT, "blob header: bad magic, not a sinew blob");
     if (h->version < SINEW_BLOB_VERSION_MIN || h->version > SINEW_BLOB_VERSION)
         return fail(msg, ms, SINEW_ERROR_VERSION,
-                    "blob header: format version %u, this runtime reads version %u, and %u "
-                    "with painted material",
+                    "blob header: format version %u, this runtime reads versions %u to %u",
                     (unsigned)h->version, SINEW_BLOB_VERSION_MIN, SINEW_BLOB_VERSION);
     if (h->endian_tag != SINEW_BLOB_ENDIAN_TAG)
         return fail(msg, ms, SINEW_ERROR_CORRUPT,
@@ -572,7 +572,7 @@ static sinew_result check_entries(const sinew_blob_section *s, uint32_t n, size_
 
 static sinew_result check_overlaps(const sinew_blob_section *s, uint32_t n, const uint64_t *end,
                                    char *msg, size_t ms) {
-    /* n <= SW_BLOB_MAX_SECTIONS, so the quadratic scan is bounded (2016 pairs). */
+    /* n <= SW_BLOB_MAX_SECTIONS, so the quadratic scan is bounded (4560 pairs). */
     char b1[32], b2[32];
     for (uint32_t i = 0; i < n; ++i)
         for (uint32_t j = i + 1; j < n; ++j)
@@ -648,7 +648,8 @@ static sinew_result fill_view(const uint8_t *bytes, const sinew_blob_section *s,
     if (r != SINEW_OK) return r;
     {
         /* The sections whose size follows from META alone (by_meta); the other rows' counts
-         * read nbasis, ninertia_u and nsurf_copies, still 0 here, and go unused. */
+         * read nbasis, ninertia_u, nsurf_copies, nspring_hessian and nmass, still 0 here,
+         * and go unused. */
         SW_BLOB_COUNT_LOCALS(v);
         const sw_blob_count_expect expect[] = {SINEW_BLOB_ARRAY_SECTIONS(SW_BLOB_EXPECT_ROW)};
         if ((r = sw_blob_check_counts(s, found, expect, sizeof expect / sizeof expect[0], "META",
@@ -720,6 +721,7 @@ sinew_result sw_blob_parse(const void *data, size_t size, sw_blob_view *view, ch
         (r = sw_blob_force_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_asset_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_stiffness_fill(bytes, s, found, h.version, &v, msg, ms)) != SINEW_OK ||
+        (r = sw_blob_blocks_fill(bytes, s, found, h.version, &v, msg, ms)) != SINEW_OK ||
         (r = sw_blob_lod_fill(bytes, s, found, &v, msg, ms)) != SINEW_OK)
         return r;
     if ((r = sw_blob_validate_view(&v, msg, ms)) != SINEW_OK) return r;

@@ -34,7 +34,7 @@
 #include "blob_view.h"
 #include "sinew/sinew.h"
 
-#define SW_BLOB_MAX_SECTIONS 64
+#define SW_BLOB_MAX_SECTIONS 96
 #define SW_BLOB_MAX_COUNT 50000000
 #define SW_BLOB_MAX_BONES 65536
 #define SW_BLOB_MAX_RANK 1024

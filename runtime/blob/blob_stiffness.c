@@ -14,11 +14,11 @@ sinew_result sw_blob_stiffness_fill(const uint8_t *bytes, const sinew_blob_secti
     const int cub = found[SINEW_SECTION_CUB_STIFFNESS] >= 0,
               tet = found[SINEW_SECTION_TET_STIFFNESS] >= 0;
     if (!cub && !tet) {
-        if (version < 3) return SINEW_OK; /* none: uniform material */
+        if (version != 3) return SINEW_OK; /* none: uniform material */
         /* the version says what the sections must hold: the header is outside the checksum */
         return fail(msg, ms, SINEW_ERROR_CORRUPT,
                     "blob header: format version %u without painted material (CUB_STIFFNESS "
-                    "missing; an unpainted blob is version 2)",
+                    "missing; an unpainted blob is version 2 or 4)",
                     (unsigned)version);
     }
     if (version < 3)

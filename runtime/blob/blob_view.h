@@ -87,9 +87,15 @@ typedef struct sw_blob_view {
     const double *cub_dminv;  /* 9 * ncub: rest Dm^-1 */
     const double *cub_vol;    /* ncub: rest volume */
 
-    /* constant reduced matrices, rank_total x rank_total, row-major */
+    /* constant reduced matrices, rank_total x rank_total, by domain blocks: read them with
+     * sw_blob_block. With reduced_blocks (blob version 4) each array holds its stored
+     * blocks back to back, reduced_blocks[m nd^2 + a nd + b] the offset of block (a, b)
+     * (-1: zero), m SW_BLOB_MASS or SW_BLOB_SPRINGS; without (NULL), each is dense and
+     * row-major. nspring_hessian and nmass count their doubles. */
     const double *spring_hessian; /* interface springs (eq. 4.20), symmetric PSD */
     const double *mass;           /* reduced lumped mass U^T M U, block diagonal */
+    const int32_t *reduced_blocks;
+    int64_t nspring_hessian, nmass;
     /* Inertial projections per domain (Kim & James 2011) for the domain's bone frame,
      * m_v the lumped masses, U_v the domain's 3 x r rows of vertex v:
      *   inertia_s: rank_total x 3, row i of domain d: sum_v m_v U_v[:, i]^T
@@ -221,6 +227,32 @@ typedef struct sw_blob_view {
 static inline double sw_blob_stiffness(const double *stiffness, int64_t t) {
     return stiffness ? stiffness[t] : 1.0;
 }
+
+/* The constant reduced matrices (sw_blob_view.mass and .spring_hessian), as sw_blob_block
+ * names them. */
+enum { SW_BLOB_MASS = 0, SW_BLOB_SPRINGS = 1 };
+
+/* Block (a, b) of reduced matrix m (SW_BLOB_MASS or SW_BLOB_SPRINGS): its entry (0, 0),
+ * with *ld the step from one of its rows to the next; NULL for a block the blob does not
+ * store (all zeros). A dense matrix (a blob before version 4) stores every block. */
+static inline const double *sw_blob_block(const sw_blob_view *v, int m, int32_t a, int32_t b,
+                                          int64_t *ld) {
+    const double *A = m == SW_BLOB_MASS ? v->mass : v->spring_hessian;
+    if (!v->reduced_blocks) {
+        *ld = v->rank_total;
+        return A + (int64_t)v->domains[a].q_offset * v->rank_total + v->domains[b].q_offset;
+    }
+    int32_t off = v->reduced_blocks[((int64_t)m * v->ndomains + a) * v->ndomains + b];
+    *ld = v->domains[b].rank;
+    return off < 0 ? (const double *)0 : A + off;
+}
+
+/* Entry (i, j) of reduced matrix m, i and j in [0, rank_total): for tools and tests (it
+ * searches the domains of i and j). */
+double sw_blob_reduced_entry(const sw_blob_view *v, int m, int32_t i, int32_t j);
+
+/* Whether block (a, b) of reduced matrix m holds a nonzero entry. */
+int sw_blob_block_nonzero(const sw_blob_view *v, int m, int32_t a, int32_t b);
 
 /* The simulation vertex of surface copy i (a (domain, local vertex) pair). */
 static inline int32_t sw_blob_surf_copy_vertex(const sw_blob_view *v, int32_t i) {

@@ -259,7 +259,7 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
         phi += add_element(c, red, x, e, want_hess);
     if (want_hess) {
         if (c->nrest > 0) ring_blocks_flush(c, red, 0, c->nring);
-        sw_reduced_blocks_copy(c->v, c->Hq, c->Hq_nz, red->H, red->H_nz);
+        sw_reduced_blocks_copy(c->v, c->Hq, c->Hq_nz, SW_DENSE_BLOCKS(red->H), red->H_nz);
     }
     for (int32_t e = 0; e < ne; ++e)
         phi += add_element(c, red, x, e, want_hess);
@@ -292,7 +292,7 @@ void sw_cond_hessian_apply(void *ctx, const double *z, double *y) {
     int32_t R = S->red->R;
     const double *dq = z, *dx = z + R;
     double *yq = y, *yx = y + R;
-    sw_reduced_blocks_matvec(v, c->Hq, c->Hq_nz, dq, yq);
+    sw_reduced_blocks_matvec(v, SW_DENSE_BLOCKS(c->Hq), c->Hq_nz, dq, yq);
     for (int32_t i = 0; i < c->nf; ++i) {
         const double *D = c->Dw + 9 * (int64_t)i, *a = dx + 3 * (int64_t)i;
         for (int k = 0; k < 3; ++k)

@@ -58,28 +58,37 @@ void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t l
     if (J) sw_reduced_jacobian(m, D, lv, a, J);
 }
 
-void sw_reduced_blocks_matvec(const sw_blob_view *v, const double *A, const unsigned char *A_nz,
+/* Block (a, b) of A and its row step; NULL for a block the blob does not store. */
+static const double *src_block(const sw_blob_view *v, sw_block_src A, int32_t a, int32_t b,
+                               int64_t *ld) {
+    if (!A.dense) return sw_blob_block(v, A.blob_matrix, a, b, ld);
+    *ld = v->rank_total;
+    return A.dense + (int64_t)v->domains[a].q_offset * v->rank_total + v->domains[b].q_offset;
+}
+
+void sw_reduced_blocks_matvec(const sw_blob_view *v, sw_block_src A, const unsigned char *A_nz,
                               const double *x, double *y) {
     const int32_t nd = v->ndomains;
-    const int64_t R = v->rank_total;
     for (int32_t a = 0; a < nd; ++a) {
         const sw_blob_domain *Da = &v->domains[a];
-        for (int64_t i = Da->q_offset; i < Da->q_offset + Da->rank; ++i) {
-            const double *Ai = A + i * R;
+        for (int32_t i = 0; i < Da->rank; ++i) {
             double acc = 0;
             for (int32_t b = 0; b < nd; ++b) {
                 if (a != b && (!A_nz || !A_nz[a * nd + b])) continue;
-                const sw_blob_domain *Db = &v->domains[b];
-                for (int64_t j = Db->q_offset; j < Db->q_offset + Db->rank; ++j)
-                    acc += Ai[j] * x[j];
+                int64_t ld;
+                const double *B = src_block(v, A, a, b, &ld);
+                if (!B) continue;
+                const double *Bi = B + i * ld, *xb = x + v->domains[b].q_offset;
+                for (int32_t j = 0; j < v->domains[b].rank; ++j)
+                    acc += Bi[j] * xb[j];
             }
-            y[i] = acc;
+            y[Da->q_offset + i] = acc;
         }
     }
 }
 
 void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *dst_nz,
-                            const double *src, const unsigned char *src_nz) {
+                            sw_block_src src, const unsigned char *src_nz) {
     const int32_t nd = v->ndomains;
     const int64_t R = v->rank_total;
     for (int32_t a = 0; a < nd; ++a) {
@@ -88,11 +97,13 @@ void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *d
             int from = a == b || src_nz[a * nd + b];
             if (!from && !dst_nz[a * nd + b]) continue;
             const sw_blob_domain *Db = &v->domains[b];
+            int64_t ld = 0;
+            const double *B = from ? src_block(v, src, a, b, &ld) : NULL;
             size_t bytes = (size_t)Db->rank * sizeof(double);
-            for (int64_t i = Da->q_offset; i < Da->q_offset + Da->rank; ++i) {
-                double *d = dst + i * R + Db->q_offset;
-                if (from)
-                    memcpy(d, src + i * R + Db->q_offset, bytes);
+            for (int32_t i = 0; i < Da->rank; ++i) {
+                double *d = dst + (Da->q_offset + i) * R + Db->q_offset;
+                if (B)
+                    memcpy(d, B + i * ld, bytes);
                 else
                     memset(d, 0, bytes);
             }

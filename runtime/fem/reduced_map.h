@@ -83,19 +83,30 @@ void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J);
 
+/* An R x R reduced matrix read by domain blocks: a dense row-major one (dense not NULL), or
+ * else the blob's constant matrix blob_matrix (SW_BLOB_MASS or SW_BLOB_SPRINGS, which may
+ * store only its nonzero blocks: sw_blob_block). */
+typedef struct sw_block_src {
+    const double *dense;
+    int blob_matrix;
+} sw_block_src;
+#define SW_DENSE_BLOCKS(A) ((sw_block_src){(A), 0})
+#define SW_BLOB_BLOCKS(m) ((sw_block_src){NULL, (m)})
+
 /* dst := src for R x R matrices known to be exact zeros outside their domain blocks marked
  * in dst_nz and src_nz (ndomains^2 each; diagonal blocks always count as marked): the
- * blocks src_nz marks are copied, those dst_nz alone marks cleared, and dst_nz := src_nz.
- * Bitwise a full copy, at the cost of the marked blocks. */
+ * blocks src_nz marks are copied (cleared where the blob stores none), those dst_nz alone
+ * marks cleared, and dst_nz := src_nz. Bitwise a full copy, at the cost of the marked
+ * blocks. */
 void sw_reduced_blocks_copy(const sw_blob_view *v, double *dst, unsigned char *dst_nz,
-                            const double *src, const unsigned char *src_nz);
+                            sw_block_src src, const unsigned char *src_nz);
 
 /* y = A x for an R x R matrix A known to be exact zeros outside its domain blocks marked
- * in A_nz (diagonal blocks always count as marked; A_nz NULL: block diagonal): each row
- * sums its terms in column order over the marked blocks alone. The terms skipped are exact zeros
- * times finite entries, so the result is bitwise the dense product's (sw_matvec), at the cost of
- * the marked blocks. */
-void sw_reduced_blocks_matvec(const sw_blob_view *v, const double *A, const unsigned char *A_nz,
+ * in A_nz (diagonal blocks always count as marked; A_nz NULL: block diagonal) and those a
+ * blob does not store: each row sums its terms in column order over those blocks alone.
+ * The terms skipped are exact zeros times finite entries, so the result is bitwise the
+ * dense product's (sw_matvec), at the cost of the marked blocks. */
+void sw_reduced_blocks_matvec(const sw_blob_view *v, sw_block_src A, const unsigned char *A_nz,
                               const double *x, double *y);
 
 /* Marks the blocks (a, b) and (b, a) of the Hessian as possibly nonzero (H_nz). */

@@ -278,7 +278,7 @@ static void phase_dynamics(sw_step_ctx *c) {
         s->mat_hess = s->rest_first && in->red.h_ref ? SW_CUB_HESSIAN_REF : 1;
         s->phi_mat = sw_potential_material(&in->red, &in->ps, s->q, 1, s->mat_hess, NULL);
         c->st.potential_evals++;
-        sw_reduced_blocks_copy(in->v, s->Hn, s->Hn_nz, in->red.H, in->red.H_nz);
+        sw_reduced_blocks_copy(in->v, s->Hn, s->Hn_nz, SW_DENSE_BLOCKS(in->red.H), in->red.H_nz);
         memcpy(s->g_mat, in->red.g, (size_t)R * sizeof(double));
         memcpy(s->q_mat, s->q, (size_t)R * sizeof(double));
         s->mat_at_start = 1;

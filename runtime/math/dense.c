@@ -223,20 +223,11 @@ void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32
 }
 #undef BLK
 
-void sw_block_order_min_degree(const double *A, int32_t n, int32_t nb, const int32_t *off,
-                               const int32_t *size, unsigned char *coupled, unsigned char *adj,
+void sw_block_order_min_degree(int32_t nb, const unsigned char *coupled, unsigned char *adj,
                                int32_t *order) {
     for (int32_t i = 0; i < nb; ++i)
-        for (int32_t j = 0; j < nb; ++j) {
-            int any = 0;
-            for (int32_t r = 0; r < size[i] && !any && i != j; ++r)
-                for (int32_t c = 0; c < size[j]; ++c)
-                    if (A[(int64_t)(off[i] + r) * n + off[j] + c] != 0.0) {
-                        any = 1;
-                        break;
-                    }
-            adj[i * nb + j] = coupled[i * nb + j] = (unsigned char)any;
-        }
+        for (int32_t j = 0; j < nb; ++j)
+            adj[i * nb + j] = (unsigned char)(i != j && coupled[i * nb + j]);
     /* 2 on the diagonal: eliminated */
     for (int32_t step = 0; step < nb; ++step) {
         int32_t best = -1, bestdeg = 0;

@@ -42,13 +42,12 @@ void sw_block_cholesky_solve(const double *L, int32_t n, int32_t nb, const int32
                              const int32_t *size, const int32_t *order, const unsigned char *nz,
                              double *x);
 
-/* Elimination order of the nb diagonal blocks of the symmetric matrix A (row-major
- * n x n, blocks as in sw_block_cholesky) for the block Cholesky: repeatedly the block
- * with the fewest remaining neighbours (ties: the lower index), connecting its
- * neighbours (the fill it creates). coupled (nb * nb) receives whether two blocks have
- * a nonzero entry; adj (nb * nb) is scratch. */
-void sw_block_order_min_degree(const double *A, int32_t n, int32_t nb, const int32_t *off,
-                               const int32_t *size, unsigned char *coupled, unsigned char *adj,
+/* Elimination order of the nb diagonal blocks of a symmetric matrix for the block
+ * Cholesky (sw_block_cholesky), coupled (nb * nb) marking the pairs of distinct blocks
+ * with a nonzero entry: repeatedly the block with the fewest remaining neighbours (ties:
+ * the lower index), connecting its neighbours (the fill it creates). adj (nb * nb) is
+ * scratch. */
+void sw_block_order_min_degree(int32_t nb, const unsigned char *coupled, unsigned char *adj,
                                int32_t *order);
 
 /* a . b over n entries, summed in index order. */

@@ -20,18 +20,19 @@ void sw_solver_order_blocks(sw_solver *s, const sw_blob_view *v) {
     }
     /* the block graph of the interface springs (with the fill it creates); springs follow
      * the skeleton, but vertices shared by three or more domains couple siblings too */
-    sw_block_order_min_degree(v->spring_hessian, v->rank_total, v->ndomains, s->blk_off,
-                              s->blk_size, s->blk_adj, s->blk_nz, s->blk_order);
-    for (int32_t e = 0; e < v->ndomains; ++e)
-        s->blk_pos[s->blk_order[e]] = e;
-    /* the bake's mass is U^T M U per domain; a blob whose is not gets dense products */
+    const int32_t nd = v->ndomains;
     s->mass_blockdiag = 1;
-    for (int32_t a = 0; a < v->ndomains; ++a)
-        for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i)
-            for (int32_t j = 0; j < v->rank_total; ++j)
-                if ((j < s->blk_off[a] || j >= s->blk_off[a] + s->blk_size[a]) &&
-                    v->mass[(int64_t)i * v->rank_total + j] != 0)
-                    s->mass_blockdiag = 0;
+    for (int32_t a = 0; a < nd; ++a)
+        for (int32_t b = 0; b < nd; ++b) {
+            s->blk_adj[a * nd + b] = a != b && sw_blob_block_nonzero(v, SW_BLOB_SPRINGS, a, b);
+            /* the bake's mass is U^T M U per domain; a blob whose is not gets its products
+             * over the blocks where it is not zero */
+            s->mass_adj[a * nd + b] = a != b && sw_blob_block_nonzero(v, SW_BLOB_MASS, a, b);
+            s->mass_blockdiag &= !s->mass_adj[a * nd + b];
+        }
+    sw_block_order_min_degree(nd, s->blk_adj, s->blk_nz, s->blk_order);
+    for (int32_t e = 0; e < nd; ++e)
+        s->blk_pos[s->blk_order[e]] = e;
 }
 
 void sw_solver_take(sw_mem_plan *p, const sw_blob_view *v, int dynamic, sw_solver *s) {
@@ -54,6 +55,7 @@ void sw_solver_take(sw_mem_plan *p, const sw_blob_view *v, int dynamic, sw_solve
     TAKE(s->blk_pos, nd);
     TAKE(s->blk_nz, nd * nd);
     TAKE(s->blk_adj, nd * nd);
+    TAKE(s->mass_adj, nd * nd);
 #undef TAKE
 }
 

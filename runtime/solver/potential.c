@@ -22,12 +22,9 @@ static int step_block(const sw_solver *s, int32_t nd, int32_t a, int32_t b) {
 }
 
 /* y = M x: over the diagonal blocks when the blob's mass is block diagonal (the bake's
- * always is; a blob whose is not takes the dense product). */
+ * always is), else over its nonzero blocks as well. */
 static void mass_matvec(const sw_blob_view *v, const sw_solver *s, const double *x, double *y) {
-    if (s->mass_blockdiag)
-        sw_reduced_blocks_matvec(v, v->mass, NULL, x, y);
-    else
-        sw_matvec(v->mass, v->rank_total, x, y);
+    sw_reduced_blocks_matvec(v, SW_BLOB_BLOCKS(SW_BLOB_MASS), s->mass_adj, x, y);
 }
 
 /* H += cm M + cd (alpha M + beta H(q_s)) over the blocks where M or H(q_s) may be nonzero
@@ -40,11 +37,13 @@ static void add_dynamic_hessian(sw_reduced *red, const sw_solver *s, const sw_dy
         for (int32_t b = 0; b < nd; ++b) {
             if (s->mass_blockdiag && !step_block(s, nd, a, b)) continue;
             sw_reduced_mark(red, &v->domains[a], &v->domains[b]);
-            for (int32_t i = s->blk_off[a]; i < s->blk_off[a] + s->blk_size[a]; ++i)
-                for (int32_t j = s->blk_off[b]; j < s->blk_off[b] + s->blk_size[b]; ++j) {
-                    int64_t k = (int64_t)i * R + j;
-                    H[k] += dc->cm * v->mass[k] +
-                            dc->cd * (dc->alpha * v->mass[k] + dc->beta * s->Hn[k]);
+            int64_t ld;
+            const double *M = sw_blob_block(v, SW_BLOB_MASS, a, b, &ld);
+            for (int32_t i = 0; i < s->blk_size[a]; ++i)
+                for (int32_t j = 0; j < s->blk_size[b]; ++j) {
+                    int64_t k = (int64_t)(s->blk_off[a] + i) * R + s->blk_off[b] + j;
+                    double m = M ? M[i * ld + j] : 0.0;
+                    H[k] += dc->cm * m + dc->cd * (dc->alpha * m + dc->beta * s->Hn[k]);
                 }
         }
 }
@@ -54,7 +53,9 @@ double sw_potential_material(sw_reduced *red, const sw_pose_space *ps, const dou
     int32_t R = red->R;
     const sw_blob_view *v = red->v;
     if (want_grad) memset(red->g, 0, (size_t)R * sizeof(double));
-    if (want_hess) sw_reduced_blocks_copy(v, red->H, red->H_nz, v->spring_hessian, red->spring_adj);
+    if (want_hess)
+        sw_reduced_blocks_copy(v, red->H, red->H_nz, SW_BLOB_BLOCKS(SW_BLOB_SPRINGS),
+                               red->spring_adj);
     double phi = sw_cubature_eval(red, q, want_grad, want_hess);
     double t0 = self_seconds ? sw_now_seconds() : 0;
     phi += sw_pose_contact_eval(red, ps, q, want_grad, want_hess);
@@ -76,7 +77,7 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
     }
     if (ct->wc) phi += sw_world_contact_eval(red, ct->wc, q, want_grad, want_hess);
     phi += sw_pose_space_force(ct->ps, R, q, want_grad ? red->g : NULL);
-    sw_reduced_blocks_matvec(v, v->spring_hessian, s->blk_adj, q, s->tmp);
+    sw_reduced_blocks_matvec(v, SW_BLOB_BLOCKS(SW_BLOB_SPRINGS), s->blk_adj, q, s->tmp);
     phi += 0.5 * sw_dot(q, s->tmp, R);
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
@@ -99,7 +100,7 @@ double sw_potential_rest(sw_reduced *red, const sw_step_contacts *ct, const sw_s
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
             red->g[i] += dc->cd * dc->alpha * s->tmp[i];
-    sw_reduced_blocks_matvec(v, s->Hn, s->Hn_nz, e, s->tmp);
+    sw_reduced_blocks_matvec(v, SW_DENSE_BLOCKS(s->Hn), s->Hn_nz, e, s->tmp);
     double dk = sw_dot(e, s->tmp, R);
     if (want_grad)
         for (int32_t i = 0; i < R; ++i)
@@ -123,7 +124,7 @@ double sw_potential_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver
     s->mat_at_start = 0;
     *cubature_pass = !at;
     if (!at) return sw_potential(red, ct, s, s->q, dc, 1, want_hess);
-    sw_reduced_blocks_copy(red->v, red->H, red->H_nz, s->Hn, s->Hn_nz);
+    sw_reduced_blocks_copy(red->v, red->H, red->H_nz, SW_DENSE_BLOCKS(s->Hn), s->Hn_nz);
     memcpy(red->g, s->g_mat, (size_t)R * sizeof(double));
     return sw_potential_rest(red, ct, s, s->q, dc, s->phi_mat, 1, want_hess);
 }

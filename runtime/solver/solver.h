@@ -48,6 +48,7 @@ typedef struct sw_solver {
     int32_t *blk_pos;                        /* domain -> its place in blk_order */
     unsigned char *blk_nz;                   /* ndomains^2: the factor's block pattern */
     unsigned char *blk_adj;                  /* ndomains^2: spring-coupled domain pairs */
+    unsigned char *mass_adj;                 /* ndomains^2: mass-coupled domain pairs */
     int mass_blockdiag;  /* the blob's reduced mass is zero outside the domains' blocks */
     uint32_t max_newton; /* Newton updates a step at most */
     int rest_first;      /* steps start on the reference Hessian (red->h_ref) */

@@ -33,11 +33,16 @@ static void terms(sinew_instance *in, const double *q, double o[4]) {
         o[2] +=
             sw_contact_pairs_eval(&in->red, &set, NULL, NULL, in->sc.npairs, NULL, NULL, q, 0, 0);
     }
-    int32_t R = v->rank_total;
     o[3] = 0;
-    for (int32_t i = 0; i < R; ++i)
-        for (int32_t j = 0; j < R; ++j)
-            o[3] += 0.5 * q[i] * v->spring_hessian[(int64_t)i * R + j] * q[j];
+    for (int32_t a = 0; a < v->ndomains; ++a)
+        for (int32_t b = 0; b < v->ndomains; ++b) {
+            int64_t ld;
+            const double *B = sw_blob_block(v, SW_BLOB_SPRINGS, a, b, &ld);
+            const double *qa = q + v->domains[a].q_offset, *qb = q + v->domains[b].q_offset;
+            for (int32_t i = 0; B && i < v->domains[a].rank; ++i)
+                for (int32_t j = 0; j < v->domains[b].rank; ++j)
+                    o[3] += 0.5 * qa[i] * B[i * ld + j] * qb[j];
+        }
 }
 
 /* q = U^T d per domain, d the un-skinned displacement of x (3 nverts) at the instance's

@@ -21,6 +21,8 @@
  *                 `meta` names no view field); every other section is an array, a row
  *                 of SINEW_BLOB_ARRAY_SECTIONS
  *   DOMAINS       one sinew_blob_domain_record a domain
+ *   SPRING_HESSIAN, MASS  the constant reduced matrices: their nonzero domain blocks in
+ *                 version 4 (placed by REDUCED_BLOCKS, below), dense before
  *   TRAIN_Q       reduced solutions of the training poses
  *   TRAIN_POSE    pose features (unit quaternions), in the order solved: a pose stored
  *                 twice is two branches, told apart by pose t - 1
@@ -123,6 +125,18 @@
  *   LOD_BASIS      lod_rank modes, each 3 floats per output vertex (in [-1, 1]: the
  *                  modes are orthonormal)
  *   LOD_MAP        W, lod_rank rows of 9 nbones + 1 (finite)
+ *
+ * The reduced matrices by domain blocks (SINEW_BLOB_BLOCKS_SECTIONS, id 65; in every blob
+ * of version 4 and in none before). Block (a, b) of MASS or SPRING_HESSIAN is the rank_a x
+ * rank_b block at rows q_offset_a, columns q_offset_b. In version 4 each section holds
+ * only its stored blocks, back to back in (a, b) row-major order, each rank_a x rank_b
+ * row-major; a block not stored is zero. In versions 2 and 3 each is the dense rank_total
+ * x rank_total matrix, row-major, and REDUCED_BLOCKS is absent.
+ *   REDUCED_BLOCKS  [m][a][b], m 0 for MASS and 1 for SPRING_HESSIAN: the block's first
+ *                   element in its section, or -1 for a zero block; every diagonal block
+ *                   is stored, and the stored blocks' offsets run on without gaps (the
+ *                   first at 0, each next one where the one before ends, the section's
+ *                   count where the last ends)
  */
 #ifndef SINEW_BLOB_FORMAT_H
 #define SINEW_BLOB_FORMAT_H
@@ -132,8 +146,12 @@
 #define SINEW_BLOB_MAGIC "SINEWBLB" /* 8 bytes, no terminator in the file */
 /* 2: pose features measure roots from the first root; 3: the blob has painted material
  * (SINEW_BLOB_STIFFNESS_SECTIONS), which a version-2 runtime would skip and step the
- * character as if unpainted. A blob without painted material is written as version 2. */
-#define SINEW_BLOB_VERSION 3u
+ * character as if unpainted. A blob without painted material is written as version 2.
+ * 4: MASS and SPRING_HESSIAN hold only their nonzero domain blocks, placed by
+ * REDUCED_BLOCKS (SINEW_BLOB_BLOCKS_SECTIONS), which a version-3 runtime would read as
+ * dense matrices; painted material is optional in version 4. A blob whose reduced
+ * matrices are dense is written as version 2 or 3, as before. */
+#define SINEW_BLOB_VERSION 4u
 #define SINEW_BLOB_VERSION_MIN 2u
 #define SINEW_BLOB_ALIGN 64u
 #define SINEW_BLOB_ENDIAN_TAG 0x01020304u
@@ -160,17 +178,20 @@ typedef struct sinew_blob_section {
     uint64_t reserved;  /**< zero */
 } sinew_blob_section;
 
-/* The names a section's count is written in: META's counts (sinew_blob_meta), and three
- * counts that the sections' own sizes give and the domain records and the copy pointers
- * must match:
+/* The names a section's count is written in: META's counts (sinew_blob_meta), and five
+ * counts that the sections' own sizes give and the domain records, the copy pointers and
+ * the block placement must match:
  *   nbasis       = sum_d vert_count_d * 3 * rank_d  (doubles in BASIS)
  *   ninertia_u   = sum_d 9 rank_d^2                  (doubles in INERTIA_U)
- *   nsurf_copies = surf_copy_ptr[nsurf_verts]        ((domain, vertex) pairs in SURF_COPIES) */
+ *   nsurf_copies = surf_copy_ptr[nsurf_verts]        ((domain, vertex) pairs in SURF_COPIES)
+ *   nspring_hessian, nmass  = the stored blocks' sizes summed (version 4), rank_total^2
+ *                             (versions 2 and 3) */
 /* clang-format off */
 #define SINEW_BLOB_META_COUNTS(X)                                                                  \
     X(nverts) X(nbones) X(ndomains) X(rank_total) X(ndomain_verts) X(ncub) X(nsurf_verts)          \
     X(nsurf_tris) X(ntrain) X(ncontacts)
-#define SINEW_BLOB_COUNTS(X) SINEW_BLOB_META_COUNTS(X) X(nbasis) X(ninertia_u) X(nsurf_copies)
+#define SINEW_BLOB_COUNTS(X)                                                                       \
+    SINEW_BLOB_META_COUNTS(X) X(nbasis) X(ninertia_u) X(nsurf_copies) X(nspring_hessian) X(nmass)
 
 /* The sections, one row each: X(id, NAME, elem_size, type, field, by_meta, count, formula)
  *   id         section id (SINEW_SECTION_<NAME>); rows in id order, ids 1, 2, ... no gaps
@@ -178,7 +199,8 @@ typedef struct sinew_blob_section {
  *   elem_size  bytes per element in the file; type: the C type of one element (that size)
  *   field      the array's name (the sw_blob_view field the runtime points at it)
  *   by_meta    1 when META's counts alone fix the count: the loader checks it against them;
- *              0 when the section's count gives nbasis, ninertia_u or nsurf_copies
+ *              0 when the section's count gives nbasis, ninertia_u, nsurf_copies,
+ *              nspring_hessian or nmass
  *   count      elements: a C expression in the names of SINEW_BLOB_COUNTS
  *   formula    the count as messages write it */
 #define SINEW_BLOB_SECTIONS(X)                                                                     \
@@ -198,8 +220,8 @@ typedef struct sinew_blob_section {
     X(11, CUB_WEIGHT,      8, double,  cub_weight,     1, ncub,                "ncub")             \
     X(12, CUB_DMINV,       8, double,  cub_dminv,      1, 9 * ncub,            "9 ncub")           \
     X(13, CUB_VOL,         8, double,  cub_vol,        1, ncub,                "ncub")             \
-    X(14, SPRING_HESSIAN,  8, double,  spring_hessian, 1, rank_total * rank_total, "rank_total^2") \
-    X(15, MASS,            8, double,  mass,           1, rank_total * rank_total, "rank_total^2") \
+    X(14, SPRING_HESSIAN,  8, double,  spring_hessian, 0, nspring_hessian,     "nspring_hessian")  \
+    X(15, MASS,            8, double,  mass,           0, nmass,               "nmass")            \
     X(16, INERTIA_S,       8, double,  inertia_s,      1, 3 * rank_total,      "3 rank_total")     \
     X(17, INERTIA_X,       8, double,  inertia_x,      1, 9 * rank_total,      "9 rank_total")     \
     X(18, INERTIA_U,       8, double,  inertia_u,      0, ninertia_u,          "ninertia_u")       \
@@ -299,6 +321,12 @@ typedef struct sinew_blob_section {
     X(64, LOD_MAP,            8, double,  lod_map,    1, lod_rank * (9 * nbones + 1),          \
       "lod_rank (9 nbones + 1)")
 
+/* The reduced matrices' block placement (id 65; version 4, where it is required): its count
+ * from META. */
+#define SINEW_BLOB_BLOCKS_SECTIONS(X)                                                              \
+    X(65, REDUCED_BLOCKS,     4, int32_t, reduced_blocks, 1, 2 * ndomains * ndomains,             \
+      "2 ndomains^2")
+
 /* Not variadic: C++98 hosts compile this header without warnings. */
 #define SINEW_BLOB_ENUM_ROW_(id, NAME, elem_size, type, field, by_meta, count, formula)           \
     SINEW_SECTION_##NAME = id,
@@ -310,7 +338,8 @@ typedef struct sinew_blob_section {
  * SINEW_SECTION_TRAIN_FORCE the optional pose-space equilibrium force,
  * SINEW_SECTION_ASSET_FIRST .. _ASSET_LAST the optional asset description,
  * SINEW_SECTION_CUB_STIFFNESS and _TET_STIFFNESS the optional painted material,
- * SINEW_SECTION_LOD_FIRST .. _LOD_LAST the optional pose-space level of detail;
+ * SINEW_SECTION_LOD_FIRST .. _LOD_LAST the optional pose-space level of detail,
+ * SINEW_SECTION_REDUCED_BLOCKS the reduced matrices' block placement (version 4);
  * SINEW_SECTION_ID_MAX is the largest known id. */
 enum sinew_blob_section_id {
     SINEW_BLOB_SECTIONS(SINEW_BLOB_ENUM_ROW_)
@@ -335,7 +364,8 @@ enum sinew_blob_section_id {
     SINEW_BLOB_LOD_SECTIONS(SINEW_BLOB_ENUM_ROW_)
     SINEW_SECTION_LOD_FIRST = SINEW_SECTION_LOD_META,
     SINEW_SECTION_LOD_LAST = SINEW_SECTION_LOD_MAP,
-    SINEW_SECTION_ID_MAX = SINEW_SECTION_LOD_MAP
+    SINEW_BLOB_BLOCKS_SECTIONS(SINEW_BLOB_ENUM_ROW_)
+    SINEW_SECTION_ID_MAX = SINEW_SECTION_REDUCED_BLOCKS
 };
 #undef SINEW_BLOB_ENUM_ROW_
 #undef SINEW_BLOB_PLUS_ONE_

@@ -344,7 +344,7 @@ typedef struct sinew_blob_provenance {
     uint32_t sinew_version;  /**< SINEW_VERSION of the bake that wrote the blob */
     uint64_t source_hash;    /**< of the source asset file's bytes (0: no file) */
     uint64_t options_hash;   /**< of the bake options that shape the blob */
-    uint32_t format_version; /**< the blob's format version (SINEW_BLOB_VERSION) */
+    uint32_t format_version; /**< the blob's format version (its header's) */
     uint32_t reserved;       /**< zero */
 } sinew_blob_provenance;
 
