@@ -447,7 +447,9 @@ static inline const char *view_diff(const sw_blob_view *a, const sw_blob_view *b
 #undef SAME_BITS
     SW_BLOB_COUNT_LOCALS(a);
 #define SAME_ARRAY(id, NAME, elem_size, type, field, by_meta, count, formula)                      \
-    if (memcmp(a->field, b->field, (size_t)(count) * sizeof a->field[0]) != 0) return #field;
+    if (!a->field != !b->field ||                                                                  \
+        (a->field && memcmp(a->field, b->field, (size_t)(count) * sizeof a->field[0]) != 0))       \
+        return #field; /* (COND_TET_DMINV may be left out) */
     SINEW_BLOB_ARRAY_SECTIONS(SAME_ARRAY)
     if (a->nrender_verts > 0) {
         SW_BLOB_GROUP_COUNT_LOCALS(a, SINEW_BLOB_RENDER_COUNTS);

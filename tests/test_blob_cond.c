@@ -24,12 +24,13 @@ static int capsule_fixture(void) {
 
 /* ---- the baked tet mesh ----------------------------------------------------------- */
 
-/* Tet t's rest data recomputed from the blob's rest positions equals its stored one. */
+/* Tet t's rest data recomputed from the blob's rest positions equals what the runtime reads
+ * (sw_blob_tet_dminv: derived, as the bake leaves COND_TET_DMINV out) and the stored volume. */
 static int same_rest_data(const sw_blob_view *v, int32_t t) {
-    double Xe[12], Dm[9], vol;
+    double Xe[12], Dm[9], buf[9], vol;
     for (int k = 0; k < 4; ++k)
         memcpy(Xe + 3 * k, v->rest + 3 * (int64_t)v->tets[4 * (int64_t)t + k], 3 * sizeof(double));
-    return sw_tet_rest(Xe, Dm, &vol) && memcmp(Dm, v->tet_dminv + 9 * (int64_t)t, sizeof Dm) == 0 &&
+    return sw_tet_rest(Xe, Dm, &vol) && memcmp(Dm, sw_blob_tet_dminv(v, t, buf), sizeof Dm) == 0 &&
            vol == v->tet_vol[t];
 }
 
@@ -38,10 +39,11 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     const sw_blob_view *v = sw_blob_get_view(fx.blob);
     const sw_tetmesh *m = &fx.ch.mesh;
     ENSURE(hdr(fx.data)->section_count ==
-           SINEW_SECTION_COUNT_V1 + NCOND + (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
+           SINEW_SECTION_COUNT_V1 + NCOND - 1 + (v->npair_groups > 0 ? (uint32_t)NPAIR : 0u) +
                (v->train_force ? 1u : 0u) + (v->bone_names ? 5u : 0u) +
                (v->lod_rank > 0 ? 6u : 0u) + (v->reduced_blocks ? 1u : 0u));
     ENSURE(v->ntets == m->ntets && v->nvert_tets == 4 * m->ntets && v->nverts == m->nverts);
+    ENSURE(!v->tet_dminv && !entry(fx.data, SINEW_SECTION_COND_TET_DMINV)); /* left out */
     ENSURE(v->ndomains >= 2); /* tets in more than one domain, vertices with several copies */
     ENSURE(memcmp(v->tets, m->tets, 4 * sizeof(int32_t) * (size_t)m->ntets) == 0);
     const char *diff = view_diff(v, &fx.res.view);
@@ -73,7 +75,8 @@ TEST(the_bake_writes_the_whole_tet_mesh) {
     for (int32_t c = 0; c < v->ncub; ++c) {
         const int32_t t = v->cub_tet_id[c];
         ENSURE(memcmp(v->tet_local + 4 * t, v->cub_tets + 4 * c, 4 * sizeof(int32_t)) == 0);
-        ENSURE(memcmp(v->tet_dminv + 9 * t, v->cub_dminv + 9 * c, 9 * sizeof(double)) == 0);
+        double buf[9];
+        ENSURE(memcmp(sw_blob_tet_dminv(v, t, buf), v->cub_dminv + 9 * c, 9 * sizeof(double)) == 0);
         ENSURE(v->tet_vol[t] == v->cub_vol[c]);
         ENSURE(c >= v->domains[v->tet_domain[t]].cub_begin &&
                c < v->domains[v->tet_domain[t]].cub_begin + v->domains[v->tet_domain[t]].cub_count);
@@ -246,16 +249,18 @@ TEST(the_loader_refuses_a_damaged_tet_mesh) {
     ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_TET_LOCAL", "tet 4 corner 3"));
     FRESH(), I32(COND_TET_LOCAL)[4 * 6] = v->tet_local[4 * 6] == 0 ? 1 : 0;
     ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_TET_LOCAL", "is vertex"));
-    FRESH(), F64(COND_TET_DMINV)[9 * 8 + 4] = NAN;
-    ENSURE(parse_refuses(b, n, SINEW_ERROR_NOT_FINITE, "COND_TET_DMINV", "element 76"));
-    FRESH(), F64(COND_TET_DMINV)[9 * c0 + 4] += 1;
-    ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_CUB_TET_ID", "Dm^-1"));
+    /* no COND_TET_DMINV: a corner moved changes a tet's derived rest data, and its volume
+       says so; a cubature tet's CUB_DMINV must be its corners' too */
+    FRESH(), F64(REST)[3 * v->tets[4 * 8] + 1] += 0.01;
+    ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_TET_VOL", "its REST corners"));
+    FRESH(), F64(CUB_DMINV)[4] += 1;
+    ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_CUB_TET_ID", "REST corners' against"));
     FRESH(), F64(COND_TET_VOL)[9] = 0;
     ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_TET_VOL", "element 9 is 0"));
     FRESH(), F64(COND_TET_VOL)[9] = INFINITY;
     ENSURE(parse_refuses(b, n, SINEW_ERROR_NOT_FINITE, "COND_TET_VOL", "element 9"));
     FRESH(), F64(COND_TET_VOL)[c0] *= 2;
-    ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_CUB_TET_ID", "volume"));
+    ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_TET_VOL", "its REST corners"));
     FRESH(), I32(COND_VERT_TET_PTR)[0] = 1;
     ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_VERT_TET_PTR", "runs from 1"));
     FRESH(), I32(COND_VERT_TET_PTR)[y + 1] = v->vert_tet_ptr[y] - 1;
@@ -278,9 +283,9 @@ TEST(the_loader_refuses_a_damaged_tet_mesh) {
     ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_VERT_MASS", "needs nverts"));
     FRESH(), entry(b, SINEW_SECTION_COND_VERT_MASS)->id = 200;
     ENSURE(parse_refuses(b, n, SINEW_ERROR_CORRUPT, "COND_VERT_MASS", "all or none"));
-    FRESH(); /* all ten unknown: the blob an older bake wrote, read as one without them */
+    FRESH(); /* all nine unknown: the blob an older bake wrote, read as one without them */
     for (uint32_t id = SINEW_SECTION_COND_FIRST; id <= SINEW_SECTION_COND_LAST; ++id)
-        entry(b, id)->id = 100 + id;
+        if (id != SINEW_SECTION_COND_TET_DMINV) entry(b, id)->id = 100 + id;
     fix_checksum(b, n);
     sw_blob_view plain;
     char msg[512];
@@ -322,6 +327,12 @@ TEST(the_synthetic_tet_mesh_round_trips_and_seeds_the_fuzzer) {
     uint8_t *forged = copy_exact(b, size);
     ((double *)section(forged, SINEW_SECTION_COND_VERT_MASS))[lone] = 1.0;
     ENSURE(parse_refuses(forged, size, SINEW_ERROR_CORRUPT, "COND_VERT_MASS", "must be 0"));
+    free(forged);
+    /* a stored COND_TET_DMINV (this one's are not its corners') is read and checked */
+    ENSURE(v.tet_dminv);
+    forged = copy_exact(b, size);
+    ((double *)section(forged, SINEW_SECTION_COND_TET_DMINV))[9 * 2 + 4] = NAN;
+    ENSURE(parse_refuses(forged, size, SINEW_ERROR_NOT_FINITE, "COND_TET_DMINV", "element 22"));
     free(forged);
     ENSURE(seed_is("synth_cond.blob", b, size));
     free(b);

@@ -115,11 +115,11 @@ TEST(coupled_gradient_matches_finite_differences_and_its_hessian_is_psd) {
             double brute = 0;
             for (int32_t e = c->nt + c->np; e < c->nt + c->np + nrest; ++e) {
                 int32_t t = c->ft[e];
-                double x12[12], f12[12];
+                double x12[12], f12[12], dm[9];
                 for (int k = 0; k < 4; ++k)
                     sw_cond_copy_position(&in->red, v->tets[4 * t + k], v->tet_domain[t],
                                           v->tet_local[4 * t + k], q, x12 + 3 * k, NULL);
-                brute += sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu,
+                brute += sw_corot_eval(x12, sw_blob_tet_dminv(v, t, dm), v->tet_vol[t], v->mu,
                                        v->lambda, f12, NULL, SW_COROT_PROJECT_PSD);
             }
             fprintf(stderr, "    Phi %.9g, of it the rest's %d tets %.9g (by brute force %.9g)\n",
@@ -179,7 +179,8 @@ static void project_tet(sinew_instance *in, const double *q, const double *x, in
         else
             sw_cond_copy_position(&in->red, gv, d, v->tet_local[4 * t + k], q, x12 + 3 * k, J[k]);
     }
-    sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], v->mu, v->lambda, f12, NULL,
+    double dm[9];
+    sw_corot_eval(x12, sw_blob_tet_dminv(v, t, dm), v->tet_vol[t], v->mu, v->lambda, f12, NULL,
                   SW_COROT_PROJECT_PSD);
     for (int k = 0; k < 4; ++k)
         for (int32_t j = 0; free_corner[k] && j < r; ++j)

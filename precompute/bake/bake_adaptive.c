@@ -65,12 +65,12 @@ static double force2(scorer *s, const double *x) {
     const sw_blob_view *v = s->v;
     memset(s->f, 0, (size_t)v->nverts * 3 * sizeof(double));
     for (int32_t t = 0; t < v->ntets; ++t) {
-        double xe[12], fe[12];
+        double xe[12], fe[12], dm[9];
         const int32_t *tv = v->tets + 4 * (int64_t)t;
         for (int k = 0; k < 4; ++k)
             memcpy(xe + 3 * k, x + 3 * (int64_t)tv[k], 3 * sizeof(double));
         const double st = sw_blob_stiffness(v->tet_stiffness, t);
-        sw_corot_eval(xe, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], st * v->mu, st * v->lambda,
+        sw_corot_eval(xe, sw_blob_tet_dminv(v, t, dm), v->tet_vol[t], st * v->mu, st * v->lambda,
                       fe, NULL, 0);
         for (int k = 0; k < 4; ++k)
             for (int i = 0; i < 3; ++i)

@@ -3,8 +3,10 @@
 /* The condensation tet mesh's blob sections : the whole simulation tet mesh, for
  * the runtime's full-space patches. Each tet is stored with the domain the bake gave it
  * (bake_domains.c: its corners all have copies there) and its corners' local indices in
- * that domain, as the cubature tets are (bake_reduce.c); its rest Dm^-1 and volume come from
- * sw_tet_rest on the same corners, so a cubature tet's equal its own bit for bit; the
+ * that domain, as the cubature tets are (bake_reduce.c); its rest volume comes from
+ * sw_tet_rest on the same corners, so a cubature tet's equals its own bit for bit, and its
+ * rest Dm^-1 is left out (COND_TET_DMINV: the runtime derives it from REST with the same
+ * function, sw_blob_tet_dminv, so 9 doubles a tet buy nothing); the
  * vertex masses are the lumped masses of prepare (sw_lumped_mass_add, the character's
  * density), whose split over each vertex's domain copies the reduced mass and inertia
  * use (sw_bake_state.copy_mass). */
@@ -52,19 +54,18 @@ sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err) 
     sw_blob_view *v = &out->view;
     const int32_t nt = s->rig.nt, nv = s->rig.nv;
     int32_t *tets, *tet_domain, *tet_local, *ptr, *vert_tets, *cub_tet_id;
-    double *dminv, *vol, *mass;
+    double *vol, *mass;
     int32_t *local_of = malloc((size_t)nv * sizeof(int32_t));
     OWN(tets, 4 * (int64_t)nt, int32_t);
     OWN(tet_domain, nt, int32_t);
     OWN(tet_local, 4 * (int64_t)nt, int32_t);
-    OWN(dminv, 9 * (int64_t)nt, double);
     OWN(vol, nt, double);
     OWN(ptr, (int64_t)nv + 1, int32_t);
     OWN(vert_tets, 4 * (int64_t)nt, int32_t);
     OWN(mass, nv, double);
     OWN(cub_tet_id, v->ncub, int32_t);
-    if (!local_of || !tets || !tet_domain || !tet_local || !dminv || !vol || !ptr || !vert_tets ||
-        !mass || !cub_tet_id) {
+    if (!local_of || !tets || !tet_domain || !tet_local || !vol || !ptr || !vert_tets || !mass ||
+        !cub_tet_id) {
         free(local_of);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY,
                             "out of memory for the condensation tet mesh's sections");
@@ -73,10 +74,10 @@ sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err) 
     memcpy(tet_domain, s->domains.tet_domain, (size_t)nt * sizeof(int32_t));
     memcpy(mass, s->rig.mass, (size_t)nv * sizeof(double));
     for (int32_t t = 0; t < nt; ++t) {
-        double Xe[12];
+        double Xe[12], dminv[9]; /* the runtime derives Dm^-1 from REST as here: not stored */
         for (int k = 0; k < 4; ++k)
             memcpy(Xe + 3 * k, s->rig.ch.mesh.X + 3 * (int64_t)tets[4 * (int64_t)t + k], 24);
-        sw_tet_rest(Xe, dminv + 9 * (int64_t)t, vol + t); /* not degenerate: prepare checked */
+        sw_tet_rest(Xe, dminv, vol + t); /* not degenerate: prepare checked */
     }
     local_corners(s, local_of, tet_local);
     incidence(s, ptr, vert_tets);
@@ -91,7 +92,7 @@ sinew_result sw_bake_cond(sw_bake_state *s, sw_bake_result *out, sw_error *err) 
     v->tets = tets;
     v->tet_domain = tet_domain;
     v->tet_local = tet_local;
-    v->tet_dminv = dminv;
+    v->tet_dminv = NULL;
     v->tet_vol = vol;
     if (s->rig.ch.tet_stiffness) { /* painted: the patches' full tets carry it too */
         double *stiff;

@@ -63,8 +63,8 @@ static int list_sections(const sw_blob_view *v, const sinew_blob_meta *meta, con
         SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_COND_COUNTS);
         const section_src cond[] = {{SINEW_SECTION_COND_META, sizeof g->cond, &g->cond, 1},
                                     SINEW_BLOB_COND_ARRAY_SECTIONS(SOURCE)};
-        memcpy(s + n, cond, sizeof cond);
-        n += (int)(sizeof cond / sizeof cond[0]);
+        for (size_t i = 0; i < sizeof cond / sizeof cond[0]; ++i)
+            if (cond[i].src) s[n++] = cond[i]; /* COND_TET_DMINV may be left out */
     }
     if (v->npair_groups > 0) {
         SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_PAIR_COUNTS);

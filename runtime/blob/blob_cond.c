@@ -24,8 +24,15 @@ static sinew_result check_counts(const sw_blob_view *v, char *msg, size_t ms) {
     return SINEW_OK;
 }
 
-sinew_result sw_blob_cond_fill(const uint8_t *bytes, const sinew_blob_section *s, const int found[],
-                               sw_blob_view *v, char *msg, size_t ms) {
+sinew_result sw_blob_cond_fill(const uint8_t *bytes, const sinew_blob_section *s,
+                               const int found_in[], sw_blob_view *v, char *msg, size_t ms) {
+    /* COND_TET_DMINV alone may be left out (the bake leaves it out: sw_blob_tet_dminv derives
+     * it from REST). Where it is, COND_META's entry stands in for it in the group's
+     * presence and count checks, and the view's field stays NULL. */
+    int found[SINEW_SECTION_ID_MAX + 1];
+    memcpy(found, found_in, sizeof found);
+    const int dminv = found[SINEW_SECTION_COND_TET_DMINV] >= 0;
+    if (!dminv) found[SINEW_SECTION_COND_TET_DMINV] = found[SINEW_SECTION_COND_META];
     sinew_blob_cond_meta m;
     int present;
     sinew_result r =
@@ -39,11 +46,14 @@ sinew_result sw_blob_cond_fill(const uint8_t *bytes, const sinew_blob_section *s
     if ((r = check_counts(v, msg, ms)) != SINEW_OK) return r;
     SW_BLOB_COUNT_LOCALS(v); /* nverts, ncub */
     SW_BLOB_GROUP_COUNT_LOCALS(v, SINEW_BLOB_COND_COUNTS);
-    const sw_blob_count_expect expect[] = {SINEW_BLOB_COND_ARRAY_SECTIONS(SW_BLOB_EXPECT_ROW)};
+    sw_blob_count_expect expect[] = {SINEW_BLOB_COND_ARRAY_SECTIONS(SW_BLOB_EXPECT_ROW)};
+    for (size_t i = 0; i < sizeof expect / sizeof expect[0]; ++i)
+        if (expect[i].id == SINEW_SECTION_COND_TET_DMINV) expect[i].by_meta &= dminv;
     if ((r = sw_blob_check_counts(s, found, expect, sizeof expect / sizeof expect[0],
                                   "COND_META and META", msg, ms)) != SINEW_OK)
         return r;
     SINEW_BLOB_COND_ARRAY_SECTIONS(SW_BLOB_POINT_ROW)
+    if (!dminv) v->tet_dminv = NULL;
     return SINEW_OK;
 }
 
@@ -139,6 +149,23 @@ static sinew_result check_mass(const sw_blob_view *v, char *msg, size_t ms) {
     return SINEW_OK;
 }
 
+/* Without COND_TET_DMINV, every tet's REST corners are invertible (sw_blob_tet_dminv
+ * derives its Dm^-1 from them) and give its stored volume, bit for bit, as the bake's do:
+ * the volume ties the derived rest data to what the bake computed. After check_tets. */
+static sinew_result check_rest(const sw_blob_view *v, char *msg, size_t ms) {
+    for (int32_t t = 0; !v->tet_dminv && t < v->ntets; ++t) {
+        double X[12], dm[9], vol = 0;
+        for (int k = 0; k < 4; ++k)
+            memcpy(X + 3 * k, v->rest + 3 * (int64_t)v->tets[4 * (int64_t)t + k], 24);
+        if (!sw_tet_rest(X, dm, &vol) || vol != v->tet_vol[t])
+            return fail(msg, ms, SINEW_ERROR_CORRUPT,
+                        "blob section COND_TET_VOL: tet %d has volume %.17g, its REST corners "
+                        "%.17g%s",
+                        t, v->tet_vol[t], vol, vol > 0 ? "" : " (degenerate)");
+    }
+    return SINEW_OK;
+}
+
 /* Cubature tet c of domain d is tet cub_tet_id[c]: of domain d, with cub_tets' row as its
  * local corners and cub_dminv / cub_vol as its rest data (the bake computes both with the
  * same function from the same corners: equal, not close). */
@@ -158,9 +185,12 @@ static sinew_result check_cubature(const sw_blob_view *v, char *msg, size_t ms) 
                 what = "local corners (COND_TET_LOCAL against CUB_TETS)";
             else if (v->tet_vol[t] != v->cub_vol[c])
                 what = "volume (COND_TET_VOL against CUB_VOL)";
+            double buf[9];
+            const double *dm = what ? NULL : sw_blob_tet_dminv(v, t, buf);
             for (int k = 0; k < 9 && !what; ++k)
-                if (v->tet_dminv[9 * (int64_t)t + k] != v->cub_dminv[9 * (int64_t)c + k])
-                    what = "rest Dm^-1 (COND_TET_DMINV against CUB_DMINV)";
+                if (dm[k] != v->cub_dminv[9 * (int64_t)c + k])
+                    what = v->tet_dminv ? "rest Dm^-1 (COND_TET_DMINV against CUB_DMINV)"
+                                        : "rest Dm^-1 (its REST corners' against CUB_DMINV)";
             if (what)
                 return fail(msg, ms, SINEW_ERROR_CORRUPT,
                             "blob section COND_CUB_TET_ID: cubature tet %d (domain %d) is tet %d "
@@ -181,15 +211,17 @@ sinew_result sw_blob_cond_validate(const sw_blob_view *v, char *msg, size_t ms) 
     }
     sinew_result r = check_counts(v, msg, ms);
     if (r != SINEW_OK) return r;
-    const sw_blob_array_ref arrays[] = {SINEW_BLOB_COND_ARRAY_SECTIONS(SW_BLOB_ARRAY_REF_ROW)};
+    sw_blob_array_ref arrays[] = {SINEW_BLOB_COND_ARRAY_SECTIONS(SW_BLOB_ARRAY_REF_ROW)};
+    for (size_t i = 0; i < sizeof arrays / sizeof arrays[0]; ++i)
+        if (arrays[i].id == SINEW_SECTION_COND_TET_DMINV) arrays[i].p = ""; /* may be NULL */
     if ((r = sw_blob_check_arrays(arrays, sizeof arrays / sizeof arrays[0], msg, ms)) ||
-        (r = sw_blob_check_finite(SINEW_SECTION_COND_TET_DMINV, v->tet_dminv, 9 * (int64_t)v->ntets,
-                                  msg, ms)) ||
+        (v->tet_dminv && (r = sw_blob_check_finite(SINEW_SECTION_COND_TET_DMINV, v->tet_dminv,
+                                                   9 * (int64_t)v->ntets, msg, ms))) ||
         (r = sw_blob_check_finite(SINEW_SECTION_COND_TET_VOL, v->tet_vol, v->ntets, msg, ms)) ||
         (r = sw_blob_check_positive(SINEW_SECTION_COND_TET_VOL, v->tet_vol, v->ntets, 1, msg,
                                     ms)) ||
         (r = check_tets(v, msg, ms)) || (r = check_incidence(v, msg, ms)) ||
-        (r = check_mass(v, msg, ms)))
+        (r = check_mass(v, msg, ms)) || (r = check_rest(v, msg, ms)))
         return r;
     return check_cubature(v, msg, ms);
 }

@@ -16,6 +16,7 @@
 #include <stdint.h>
 
 #include "sinew/sinew_blob_format.h"
+#include "tet_rest.h"
 
 #define SW_BLOB_INFLUENCES 4 /* skin influences per vertex */
 
@@ -157,8 +158,10 @@ typedef struct sw_blob_view {
     const int32_t *tets;       /* 4 ntets: global simulation vertex ids */
     const int32_t *tet_domain; /* ntets: the domain whose copies are the tet's corners */
     const int32_t *tet_local;  /* 4 ntets: the corners' domain-local indices (see above) */
-    const double *tet_dminv;   /* 9 ntets: rest Dm^-1, row-major (as cub_dminv) */
-    const double *tet_vol;     /* ntets: rest volume > 0 (as cub_vol) */
+    /* 9 ntets: rest Dm^-1, row-major (as cub_dminv); NULL when the blob leaves it out (the
+     * bake does): read it with sw_blob_tet_dminv */
+    const double *tet_dminv;
+    const double *tet_vol; /* ntets: rest volume > 0 (as cub_vol) */
     /* nverts + 1: vertex v's incident tets are vert_tets[ptr[v] .. ptr[v+1]) */
     const int32_t *vert_tet_ptr;
     const int32_t *vert_tets; /* nvert_tets (= 4 ntets): tet ids, ascending per vertex */
@@ -253,6 +256,19 @@ double sw_blob_reduced_entry(const sw_blob_view *v, int m, int32_t i, int32_t j)
 
 /* Whether block (a, b) of reduced matrix m holds a nonzero entry. */
 int sw_blob_block_nonzero(const sw_blob_view *v, int m, int32_t a, int32_t b);
+
+/* Tet t's rest Dm^-1 (of the condensation mesh): the blob's, or when it stores none, its
+ * rest corners' into buf (the same function as the bake's: the same bits; the loader
+ * proved every tet's invertible). */
+static inline const double *sw_blob_tet_dminv(const sw_blob_view *v, int32_t t, double buf[9]) {
+    if (v->tet_dminv) return v->tet_dminv + 9 * (int64_t)t;
+    double X[12], vol;
+    for (int k = 0; k < 4; ++k)
+        for (int i = 0; i < 3; ++i)
+            X[3 * k + i] = v->rest[3 * (int64_t)v->tets[4 * (int64_t)t + k] + i];
+    sw_tet_rest(X, buf, &vol);
+    return buf;
+}
 
 /* The simulation vertex of surface copy i (a (domain, local vertex) pair). */
 static inline int32_t sw_blob_surf_copy_vertex(const sw_blob_view *v, int32_t i) {

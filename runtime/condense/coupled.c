@@ -190,7 +190,8 @@ static double add_element(sw_cond *c, sw_reduced *red, const double *x, int32_t 
     if (!is_pair) {
         int32_t t = c->ft[e];
         const double st = sw_blob_stiffness(v->tet_stiffness, t); /* painted multiplier */
-        phi = sw_corot_eval(x12, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], st * v->mu,
+        double dm[9];
+        phi = sw_corot_eval(x12, sw_blob_tet_dminv(v, t, dm), v->tet_vol[t], st * v->mu,
                             st * v->lambda, f, want_hess ? K : NULL, SW_COROT_PROJECT_PSD);
     } else {
         phi = patch_pair(c, e - c->nt, x12, f, want_hess ? K : NULL);

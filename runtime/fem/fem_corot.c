@@ -29,26 +29,6 @@ void sw_lame(double youngs, double poisson, double *mu, double *lambda) {
     *lambda = youngs * poisson / ((1.0 + poisson) * (1.0 - 2.0 * poisson));
 }
 
-int sw_tet_rest(const double X[12], double DmInv[9], double *vol) {
-    double Dm[9];
-    for (int a = 0; a < 3; ++a)
-        for (int k = 0; k < 3; ++k)
-            Dm[3 * a + k] = X[3 * (k + 1) + a] - X[a];
-    double det = sw_m3_det(Dm);
-    if (!isfinite(det) || !(fabs(det) >= 1e-300)) return 0;
-    double C[9], inv[9];
-    sw_m3_cofactor(Dm, C);
-    for (int i = 0; i < 3; ++i) /* Dm^-1 = C^T / det */
-        for (int j = 0; j < 3; ++j)
-            inv[3 * i + j] = C[3 * j + i] / det;
-    for (int i = 0; i < 9; ++i)
-        if (!isfinite(inv[i])) return 0;
-    for (int i = 0; i < 9; ++i)
-        DmInv[i] = inv[i];
-    *vol = fabs(det) / 6.0;
-    return 1;
-}
-
 void sw_lumped_mass_add(const int32_t tet[4], double density, double vol, double *mass) {
     double m = density * vol * 0.25;
     for (int i = 0; i < 4; ++i)

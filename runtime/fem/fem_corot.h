@@ -17,14 +17,12 @@
 
 #include <stdint.h>
 
+#include "tet_rest.h"
+
 /* Lamé parameters from Young's modulus and Poisson ratio. */
 void sw_lame(double youngs, double poisson, double *mu, double *lambda);
 
-/* Rest-state data of one tet: Dm^-1 (9, row-major) and rest volume. Returns 0 and
- * leaves outputs untouched when the rest tet is degenerate (|det Dm| below 1e-300 or
- * non-finite); 1 on success. Negative rest volume is allowed (vol is then |vol| and
- * Dm^-1 still maps to F = I at rest). */
-int sw_tet_rest(const double X[12], double DmInv[9], double *vol);
+/* sw_tet_rest, a tet's rest Dm^-1 and volume, is tet_rest.h's (the blob derives them too). */
 
 /* Flags for sw_corot_eval. */
 enum {

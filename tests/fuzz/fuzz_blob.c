@@ -95,7 +95,7 @@ static double walk(const sw_blob_view *v) {
             if (gv != v->tets[4 * t + k]) abort();
             s += v->rest[3 * (int64_t)gv] * v->vert_mass[gv];
         }
-        s += v->tet_dminv[9 * t + 8] * v->tet_vol[t];
+        s += (v->tet_dminv ? v->tet_dminv[9 * t + 8] : 1.0) * v->tet_vol[t];
     }
     for (int32_t x = 0; x < v->nverts && v->ntets > 0; ++x)
         for (int32_t i = v->vert_tet_ptr[x]; i < v->vert_tet_ptr[x + 1]; ++i) {

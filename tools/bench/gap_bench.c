@@ -19,12 +19,12 @@ static void terms(sinew_instance *in, const double *q, double o[4]) {
     o[0] = sw_cubature_eval(&in->red, q, 0, 0);
     o[1] = 0;
     for (int32_t t = 0; t < v->ntets; ++t) {
-        double x[12];
+        double x[12], dm[9];
         for (int k = 0; k < 4; ++k)
             sw_cond_copy_position(&in->red, v->tets[4 * (int64_t)t + k], v->tet_domain[t],
                                   v->tet_local[4 * (int64_t)t + k], q, x + 3 * k, NULL);
         const double st = sw_blob_stiffness(v->tet_stiffness, t);
-        o[1] += sw_corot_eval(x, v->tet_dminv + 9 * (int64_t)t, v->tet_vol[t], st * v->mu,
+        o[1] += sw_corot_eval(x, sw_blob_tet_dminv(v, t, dm), v->tet_vol[t], st * v->mu,
                               st * v->lambda, NULL, NULL, 0);
     }
     o[2] = sw_pose_contact_eval(&in->red, &in->ps, q, 0, 0);

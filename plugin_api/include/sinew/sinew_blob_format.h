@@ -48,7 +48,10 @@
  *   RENDER_NODE_COPIES (domain, local vertex) of each copy; a node is the mean of them
  *
  * Optional sections (SINEW_BLOB_COND_SECTIONS, ids 35..44): the whole simulation tet mesh,
- * for subspace condensation's full-space patches, all ten present or none. A
+ * for subspace condensation's full-space patches, all ten present or none, but for
+ * COND_TET_DMINV, which may be left out (the bake leaves it out: a runtime derives each
+ * tet's rest Dm^-1 from its REST corners, and a runtime that predates this refuses the
+ * group without it). A
  * blob without them is byte for byte what it was before they existed; a runtime that
  * predates them skips them as unknown ids. Every tet lies in one domain (the domain the
  * bake gave it: all four corners have copies there), as a cubature tet does. Their counts
@@ -57,7 +60,9 @@
  *   COND_TET_DOMAIN   per tet, the domain whose copies are its corners
  *   COND_TET_LOCAL    4 a tet: its corners' local vertex indices in that domain
  *                     (domain_verts[vert_begin + local] is the COND_TETS corner)
- *   COND_TET_DMINV    9 a tet: rest Dm^-1, row-major (as CUB_DMINV)
+ *   COND_TET_DMINV    9 a tet: rest Dm^-1, row-major (as CUB_DMINV); when left out, every
+ *                     tet's REST corners must be invertible and give its COND_TET_VOL
+ *                     exactly, with the rest data a cubature tet's must equal (below)
  *   COND_TET_VOL      per tet, its rest volume > 0 (as CUB_VOL)
  *   COND_VERT_TET_PTR vertex v's incident tets are COND_VERT_TETS [ptr[v], ptr[v+1])
  *   COND_VERT_TETS    tet ids, ascending per vertex: every (vertex, tet) incidence once
