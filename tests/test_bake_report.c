@@ -197,12 +197,50 @@ static void check_reference_json(const char *dir, const char *solver, const char
     free(text);
 }
 
-/* DIR/report.json's ref_spread: the figures given, or null without them. */
-static void check_spread_json(const char *dir, const sw_bake_spread *s) {
+/* DIR/report.json parsed (NULL: unreadable). */
+static cJSON *parse_report_json(const char *dir) {
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);
     cJSON *j = text ? cJSON_Parse(text) : NULL;
+    free(text);
+    return j;
+}
+
+/* report.json's memory (absent when m is NULL): the blob's bytes, its parts summing to them,
+ * the instances' as measured; the HTML says it. */
+static void check_memory_json(const char *dir, const sw_blob_memory *m) {
+    cJSON *j = parse_report_json(dir);
+    ENSURE(j != NULL);
+    const cJSON *o = cJSON_GetObjectItemCaseSensitive(j, "memory");
+    if (!m) {
+        ENSURE(o == NULL);
+    } else {
+        ENSURE(cJSON_IsObject(o) && num(o, "blob_bytes") == (double)m->blob &&
+               num(o, "instance_bytes") == (double)m->instance &&
+               num(o, "instance_shared_bytes") == (double)m->instance_shared &&
+               num(o, "workspace_bytes") == (double)m->workspace);
+        ENSURE(m->instance > m->instance_shared && m->instance_shared > 0 && m->workspace > 0);
+        const cJSON *parts = cJSON_GetObjectItemCaseSensitive(o, "blob_parts");
+        double sum = 0;
+        for (int k = 0; k < SW_NPARTS; ++k) {
+            ENSURE(num(parts, sw_blob_part_keys[k]) == (double)m->part[k]);
+            sum += num(parts, sw_blob_part_keys[k]);
+        }
+        ENSUREF(sum == (double)m->blob, "parts %g of %zu bytes", sum, m->blob);
+        ENSURE(m->part[SW_PART_BASIS] > 0 && m->part[SW_PART_COND] > 0);
+    }
+    cJSON_Delete(j);
+    char path[1100];
+    snprintf(path, sizeof path, "%.1000s/report.html", dir);
+    char *text = read_text(path);
+    ENSURE(text && (strstr(text, ">memory<") != NULL) == (m != NULL));
+    free(text);
+}
+
+/* DIR/report.json's ref_spread: the figures given, or null without them. */
+static void check_spread_json(const char *dir, const sw_bake_spread *s) {
+    cJSON *j = parse_report_json(dir);
     ENSURE(j != NULL);
     const cJSON *o = cJSON_GetObjectItemCaseSensitive(j, "ref_spread");
     if (!s) {
@@ -227,7 +265,6 @@ static void check_spread_json(const char *dir, const sw_bake_spread *s) {
         }
     }
     cJSON_Delete(j);
-    free(text);
 }
 
 /* The bake's blob loaded (its bytes in *mem) and measured on the bake's poses, each
@@ -309,6 +346,10 @@ TEST(clips_of_their_own_and_the_report) {
     ENSURE(sw_bake_reference_spread(&ch, &p, blob, &res, SINEW_SELF_CONTACT_POSE_SPACE, 2, &spread,
                                     &e) == SINEW_OK);
     ENSURE(spread.poses == res.nheldout / 2);
+    /* the blob's memory by part and its instances' */
+    sw_blob_memory memory;
+    ENSURE(sw_blob_memory_measure(mem, (size_t)((const sinew_blob_header *)mem)->file_size, blob,
+                                  &memory));
     sw_bake_report_input in = {"finger",
                                &ch,
                                &res,
@@ -333,7 +374,8 @@ TEST(clips_of_their_own_and_the_report) {
                                &spread,
                                "auto",
                                "adaptive",
-                               0};
+                               0,
+                               &memory};
     /* where the error is: shares in order, and all of it when every bone is listed */
     for (int set = 0; set < 2; ++set) {
         const sw_eval_result *ev = set ? &eh : &et;
@@ -358,6 +400,7 @@ TEST(clips_of_their_own_and_the_report) {
     check_json(dir, &res, &res.view, &ch.skel, eh.correction_error, &eh, modes, flagged);
     check_spread_json(dir, &spread);
     check_reference_json(dir, "auto", "adaptive", 0);
+    check_memory_json(dir, &memory);
     ENSURE(flagged[0] == 0); /* a training clip never bends beyond itself */
     char verdict[16];
     check_verdict(dir, eh.correction_error, 0, &eh, verdict);
@@ -500,13 +543,15 @@ TEST(random_heldout_poses_in_the_report) {
                                NULL,
                                NULL,
                                NULL,
-                               0};
+                               0,
+                               NULL};
     char dir[1024];
     snprintf(dir, sizeof dir, "%s/test_bake_report_random", SINEW_BINARY_DIR);
     r = sw_bake_report_write(dir, &in, &e);
     ENSUREF(r == SINEW_OK, "%s", e.msg);
     check_spread_json(dir, NULL); /* not measured: null */
     check_reference_json(dir, NULL, NULL, 0);
+    check_memory_json(dir, NULL);
     char path[1100];
     snprintf(path, sizeof path, "%.1000s/report.json", dir);
     char *text = read_text(path);

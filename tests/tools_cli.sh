@@ -204,6 +204,21 @@ else
     fails=$((fails + 1))
 fi
 
+# the memory line and members describe the blob written (the whole clip's): its file size,
+# its parts summing to it, an instance smaller when it steps in a shared workspace
+parts_sum=$(grep -oE '"blob_parts":\{[^}]*\}' "$tmp/w.json" | grep -oE ':[0-9]+' | tr -d : |
+    awk '{s += $1} END {print s + 0}')
+if [ -s "$tmp/w.blob" ] && [ "$(key "$tmp/w.json" blob_bytes)" = "$(stat -c %s "$tmp/w.blob")" ] &&
+    [ "$parts_sum" = "$(stat -c %s "$tmp/w.blob")" ] &&
+    [ "$(key "$tmp/w.json" instance_shared_bytes)" -gt 0 ] &&
+    [ "$(key "$tmp/w.json" instance_bytes)" -gt "$(key "$tmp/w.json" instance_shared_bytes)" ] &&
+    grep -qE "memory: blob [0-9.]+ MB \(basis [0-9.]+," "$tmp/w.err"; then
+    echo "ok   bake_memory"
+else
+    echo "FAIL bake_memory: blob_bytes $(key "$tmp/w.json" blob_bytes), parts $parts_sum, file $(stat -c %s "$tmp/w.blob" 2>/dev/null)" >&2
+    fails=$((fails + 1))
+fi
+
 # a self-contact mode the blob refuses (this finger's bake kept no pose pairs) is skipped
 # with the runtime's reason, the other cases measured: the reason is logged through the
 # tools' logger after the load (it once wrote into the loader's dead stack frame)

@@ -34,6 +34,7 @@
 #include "bake.h"
 #include "bake_adaptive.h"
 #include "bake_report.h"
+#include "blob_parts.h"
 #include "blob_write.h"
 #include "character_io.h"
 #include "samples.h"
@@ -76,8 +77,9 @@ typedef struct {
     int32_t kept; /* the pose-space pairs the per-pair cubature keeps */
     sw_joint_reach beyond[BAKE_BEYOND];
     int32_t nbeyond_all, nbeyond;
-    int ship_whole;       /* the blob shipped is baked again on the whole clip */
-    sw_bake_result whole; /* that bake */
+    int ship_whole;        /* the blob shipped is baked again on the whole clip */
+    sw_blob_memory memory; /* the shipped blob's and its instances' */
+    sw_bake_result whole;  /* that bake */
 } bake;
 
 /* The character from the command line, its summary on stderr. */
@@ -165,8 +167,31 @@ static int measure(bake *b, sw_error *err) {
     return 0;
 }
 
+/* The shipped view written to the out path atomically, and its memory measured. */
+static int write_blob(bake *b, const sw_blob_view *view) {
+    void *data = NULL;
+    size_t size = 0;
+    sinew_blob *blob = NULL;
+    sw_error err;
+    sinew_result r = sw_blob_write_memory(view, &data, &size, &err);
+    if (r == SINEW_OK) r = sw_write_file_atomic(b->o.out_path, data, size, &err);
+    if (r != SINEW_OK) {
+        free(data);
+        return sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, b->o.out_path);
+    }
+    sinew_blob_def bd = sinew_blob_def_default();
+    bd.data = data;
+    bd.data_size = size;
+    int ok = sw_tool_blob_load(tool, "written", bd, &blob) == SINEW_OK &&
+             sw_blob_memory_measure(data, size, blob, &b->memory);
+    sinew_blob_destroy(blob);
+    free(data);
+    if (!ok) fprintf(stderr, "%s: cannot measure the written blob's memory\n", tool);
+    return !ok;
+}
+
 /* The blob written (unless absurd without --force) and with --report the report. */
-static int write_outputs(const bake *b) {
+static int write_outputs(bake *b) {
     const sw_bake_result *shipped = b->ship_whole ? &b->whole : &b->res;
     sw_error err;
     sinew_result r;
@@ -188,10 +213,7 @@ static int write_outputs(const bake *b) {
                 tool, b->model_err, SW_BAKE_MAX_TRAIN_ERROR, b->o.out_path);
         return 1;
     }
-    if ((r = sw_blob_write(b->o.out_path, &shipped->view, &err)) != SINEW_OK) {
-        sw_tool_failed(r, &err, "%s: cannot write %s: ", tool, b->o.out_path);
-        return 1;
-    }
+    if (write_blob(b, &shipped->view)) return 1;
     if (b->o.report_dir) {
         int scene_clips = b->o.p.ntrain_clips > 0;
         sw_bake_report_input ri = {b->source,
@@ -220,7 +242,8 @@ static int write_outputs(const bake *b) {
                                    b->o.spread_every > 0 ? &b->spread : NULL,
                                    sw_linear_solver_name(b->o.reference.solver),
                                    sw_hessian_mode_name(b->o.reference.hessian),
-                                   b->o.ad.rounds > 0 ? b->o.ad.target : 0};
+                                   b->o.ad.rounds > 0 ? b->o.ad.target : 0,
+                                   &b->memory};
         if ((r = sw_bake_report_write(b->o.report_dir, &ri, &err)) != SINEW_OK) {
             sw_tool_failed(r, &err, "%s: --report %s: ", tool, b->o.report_dir);
             return 1;
@@ -279,6 +302,7 @@ static void print_model(const bake *b) {
             "  self-contact: %d contact pairs over the training poses in %d pairs of domains; "
             "the per-pair cubature keeps %d (--contact-tol %g)\n",
             v->ncontacts, v->npair_groups, b->kept, b->o.p.contact_cubature_tol);
+    sw_blob_memory_print(&b->memory);
     if (v->nrender_verts > 0)
         fprintf(stderr,
                 "  output: the render mesh, %d vertices (%d welded duplicates), %d triangles, "
@@ -505,6 +529,7 @@ static void print_json(const bake *b) {
     json_training(b);
     json_errors(b);
     json_beyond(b);
+    sw_blob_memory_json(&b->memory);
     printf(",\"simulate_cached\":%s,\"simulate_solved\":%d,\"forced\":%s,"
            "\"shipped\":\"%s\"}\n",
            b->res.simulate_cached ? "true" : "false", b->res.simulate_solved,

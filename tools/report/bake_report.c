@@ -362,6 +362,17 @@ static void json_model_figures(cJSON *j, const sw_bake_report_input *in) {
     cJSON *lerr = cJSON_AddArrayToObject(lod, "err_heldout_surface"); /* sinew_lod's order */
     for (int l = 0; l < SW_BAKE_LODS; ++l)
         cJSON_AddItemToArray(lerr, json_number(res->lod_heldout[l]));
+    if (in->memory) {
+        const sw_blob_memory *m = in->memory;
+        cJSON *mem = cJSON_AddObjectToObject(j, "memory");
+        cJSON_AddNumberToObject(mem, "blob_bytes", (double)m->blob);
+        cJSON *parts = cJSON_AddObjectToObject(mem, "blob_parts");
+        for (int k = 0; k < SW_NPARTS; ++k)
+            cJSON_AddNumberToObject(parts, sw_blob_part_keys[k], (double)m->part[k]);
+        cJSON_AddNumberToObject(mem, "instance_bytes", (double)m->instance);
+        cJSON_AddNumberToObject(mem, "instance_shared_bytes", (double)m->instance_shared);
+        cJSON_AddNumberToObject(mem, "workspace_bytes", (double)m->workspace);
+    }
     cJSON *sp = cJSON_AddObjectToObject(j, "springs");
     cJSON_AddNumberToObject(sp, "k", res->spring_k);
     cJSON_AddNumberToObject(sp, "eh", res->spring_eh);

@@ -17,6 +17,7 @@
 
 #include <stddef.h>
 
+#include "blob_parts.h"
 #include "bake.h"
 #include "bake_adaptive.h"
 #include "sinew/sinew.h"
@@ -67,6 +68,8 @@ typedef struct sw_bake_report_input {
     const char *ref_solver, *ref_hessian;
     /* the held-out error the verdict measures against, in (0, 1); 0: SW_BAKE_REPORT_TARGET */
     double target;
+    /* the written blob's bytes by part and its instances' (blob_parts.h); NULL: not shown */
+    const sw_blob_memory *memory;
 } sw_bake_report_input;
 
 /* Creates DIR (and its parents) and writes the report there. Errors: IO (cannot create

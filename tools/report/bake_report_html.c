@@ -104,6 +104,19 @@ static void html_model(FILE *f, const sw_bake_report_input *in) {
                     res->lod_heldout[0], res->lod_heldout[1], res->lod_heldout[2],
                     res->view.lod_rank);
     }
+    if (in->memory) {
+        const sw_blob_memory *m = in->memory;
+        html_term(f, "memory",
+                  "the blob (shared by every instance of the character) by what it holds, and "
+                  "what each instance reserves; a crowd steps its instances in one shared "
+                  "workspace a thread (sinew_instance_def.shared_workspace)");
+        fprintf(f, "<td>blob %.2f MB (", (double)m->blob / 1e6);
+        for (int k = 0; k < SW_NPARTS; ++k)
+            fprintf(f, "%s%s %.2f", k ? ", " : "", sw_blob_part_names[k], (double)m->part[k] / 1e6);
+        fprintf(f, "); an instance %.2f MB, or %.2f MB in a shared workspace of %.2f MB</td></tr>",
+                (double)m->instance / 1e6, (double)m->instance_shared / 1e6,
+                (double)m->workspace / 1e6);
+    }
     html_term(f, "glue between body parts",
               "interface springs: the stiffness holding the "
               "domains' shared vertices together");
