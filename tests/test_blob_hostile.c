@@ -259,8 +259,8 @@ static void f_missing(uint8_t *b) {
 static void f_entry_reserved(uint8_t *b) {
     entry(b, SINEW_SECTION_DOMAINS)->reserved = 1;
 }
-static void f_dom_reserved(uint8_t *b) {
-    dom(b, 0)->reserved = 7;
+static void f_dom_inertia_count(uint8_t *b) {
+    dom(b, 0)->inertia_count = dom(b, 0)->rank + 1;
 }
 static void f_table_huge(uint8_t *b) {
     hdr(b)->section_count = 1000;
@@ -343,7 +343,8 @@ TEST(forged_blobs_are_rejected_by_the_semantic_checks) {
         {"duplicate id", f_duplicate, SINEW_ERROR_CORRUPT, "REST", "twice"},
         {"missing section", f_missing, SINEW_ERROR_CORRUPT, "SURF_TRIS", "missing"},
         {"table entry reserved", f_entry_reserved, SINEW_ERROR_CORRUPT, "DOMAINS", "reserved"},
-        {"domain reserved", f_dom_reserved, SINEW_ERROR_CORRUPT, "DOMAINS", "reserved"},
+        {"domain inertia count", f_dom_inertia_count, SINEW_ERROR_CORRUPT, "DOMAINS",
+         "inertia_count"},
         {"huge section_count", f_table_huge, SINEW_ERROR_CORRUPT, "table", "1000"},
         {"newer version", f_version_new, SINEW_ERROR_VERSION, "header", "versions 2 to 4"},
         {"older version", f_version_old, SINEW_ERROR_VERSION, "header", "version 0"},

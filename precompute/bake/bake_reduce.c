@@ -98,6 +98,8 @@ static void fill_domains(const sw_bake_state *s, sw_blob_domain *doms, double *b
         D->vert_begin = base;
         D->vert_count = n;
         D->rank = r_d;
+        /* the inertia modes come last (bake_basis.c): held in quasistatic steps */
+        D->inertia_count = s->p->inertia_modes ? r_d - s->basis.rank_dynamic[d] : 0;
         D->q_offset = qoff;
         D->cub_begin = cub;
         D->cub_count = s->cubature.n[d];

@@ -211,7 +211,8 @@ static sinew_result check_domain(const sw_blob_view *v, int32_t d, const int64_t
     if (dom->inertia_offset != sum[4])
         return DFAIL("inertia_offset %lld, expected %lld", d, (long long)dom->inertia_offset,
                      (long long)sum[4]);
-    if (dom->reserved != 0) return DFAIL("reserved field is %d, not 0", d, dom->reserved);
+    if (dom->inertia_count < 0 || dom->inertia_count > dom->rank)
+        return DFAIL("inertia_count %d outside [0, rank %d]", d, dom->inertia_count, dom->rank);
 #undef DFAIL
     return SINEW_OK;
 }

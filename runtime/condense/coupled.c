@@ -267,6 +267,9 @@ double sw_cond_potential(sw_cond *c, sw_reduced *red, const sw_step_contacts *ct
     if (want_hess) ring_blocks_flush(c, red, 0, c->nring_patch);
     c->phi_el = phi;
     memcpy(c->gf_el, c->gf, 3 * (size_t)c->nf * sizeof(double));
+    /* a quasistatic step's inertia modes stay at their prediction (solver.h): their
+       gradient is no force on the iterate, and sw_cond_solve drops their update */
+    if (s->hold_inertia) sw_solver_hold_zero(s, c->v, red->g);
     return phi + patch_world(c, ct, x, dc, want_hess);
 }
 
@@ -491,6 +494,8 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         c->pp_active[j] = -1;
     sw_cond_system S = {c, red, s};
     sw_pcg_vectors vec = {c->cg_r, c->cg_z, c->cg_p, c->cg_Ap};
+    s->hold_inertia = sw_solver_hold_decide(s, c->v, dc, ct);
+    if (s->hold_inertia) sw_solver_hold_start(s, c->v);
     double phi = sw_cond_potential(c, red, ct, s, s->q, c->x, dc, 1);
     st->potential_evals++;
     /* a later round of the step (its contact laws refreshed) is converged to the first
@@ -525,6 +530,9 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
         sw_pcg_stats ps = sw_pcg_run(m, sw_cond_hessian_apply, &S, sys_prec, &S, c->rhs, eta,
                                      SW_COND_PCG_MAX, &vec, c->sol);
         c->pcg_iters += (uint32_t)ps.iters;
+        /* the held coordinates' update dropped: with their gradient 0 the direction still
+           descends as much (rhs . sol is unchanged), and they stay where they are held */
+        if (s->hold_inertia) sw_solver_hold_zero(s, c->v, c->sol);
         /* the update: q and x from the iterate kept in qtrial and xt */
         memcpy(s->qtrial, s->q, (size_t)R * sizeof(double));
         memcpy(c->xt, c->x, (size_t)nx * sizeof(double));
@@ -537,6 +545,7 @@ sinew_result sw_cond_solve(sw_cond *c, sw_reduced *red, const sw_step_contacts *
                decrease: the preconditioned gradient, P^-1 (-g) at the iterate (rhs holds
                -g, the preconditioner is still its), is tried before giving up. */
             sys_prec(&S, c->rhs, c->sol);
+            if (s->hold_inertia) sw_solver_hold_zero(s, c->v, c->sol);
             accepted = line_search(c, red, ct, s, dc, phi0, -sw_dot(c->rhs, c->sol, (int32_t)m), 10,
                                    &phi, st);
         }

@@ -56,6 +56,7 @@ void sw_solver_take(sw_mem_plan *p, const sw_blob_view *v, int dynamic, sw_solve
     TAKE(s->blk_nz, nd * nd);
     TAKE(s->blk_adj, nd * nd);
     TAKE(s->mass_adj, nd * nd);
+    TAKE(s->hold, nd);
 #undef TAKE
 }
 
@@ -140,7 +141,9 @@ static double evaluate(sw_reduced *red, const sw_step_contacts *ct, const sw_sol
                        const double *q, const sw_dyn_coef *dc, int want_hess,
                        sinew_step_stats *st) {
     st->potential_evals++;
-    return sw_potential(red, ct, s, q, dc, 1, want_hess);
+    double phi = sw_potential(red, ct, s, q, dc, 1, want_hess);
+    if (s->hold_inertia) sw_solver_hold_rows(s, red, want_hess);
+    return phi;
 }
 
 /* Phi, g and H (of kind want_hess) at the step's start, counted when it makes a cubature
@@ -148,7 +151,9 @@ static double evaluate(sw_reduced *red, const sw_step_contacts *ct, const sw_sol
 static double evaluate_start(sw_reduced *red, const sw_step_contacts *ct, sw_solver *s,
                              const sw_dyn_coef *dc, int want_hess, sinew_step_stats *st) {
     int pass = 0;
+    if (s->hold_inertia) sw_solver_hold_start(s, red->v);
     double phi = sw_potential_start(red, ct, s, dc, want_hess, &pass);
+    if (s->hold_inertia) sw_solver_hold_rows(s, red, want_hess);
     st->potential_evals += (uint32_t)pass;
     return phi;
 }
@@ -358,6 +363,7 @@ static int rejected_update(sw_reduced *red, const sw_step_contacts *ct, sw_solve
            starts there does. */
         s->fallback_qn = 0;
         memcpy(s->q, s->qn, (size_t)R * sizeof(double));
+        if (s->hold_inertia) sw_solver_hold_start(s, red->v);
         n->phi = evaluate(red, ct, s, s->q, dc, 1, st);
         n->gn = n->g0 = sqrt(sw_dot(red->g, red->g, R));
         n->have_h = 1;
@@ -407,6 +413,7 @@ sinew_result sw_newton_solve(sw_reduced *red, const sw_step_contacts *ct, sw_sol
     newton_iter n;
     uint32_t it0;
     int failed;
+    s->hold_inertia = sw_solver_hold_decide(s, red->v, dc, ct);
     int done = newton_start(red, ct, s, dc, st, &n, &it0, &failed);
     if (failed) return step_failed(s, R, st);
     for (uint32_t it = it0; !done; ++it) {

@@ -53,6 +53,8 @@ typedef struct sw_solver {
     uint32_t max_newton; /* Newton updates a step at most */
     int rest_first;      /* steps start on the reference Hessian (red->h_ref) */
     double dq_tiny;      /* an update shorter than this converged (1e-9 of the size) */
+    unsigned char *hold; /* ndomains: the domain's inertia modes are held (inertia_hold.c) */
+    int hold_inertia;    /* this solve holds some (sw_solver_hold_decide) */
 } sw_solver;
 
 /* Lays out the solver's vectors and its block layout; the frozen Hessian's point only for
@@ -78,6 +80,27 @@ typedef struct sw_step_contacts {
     const sw_self_contacts *sc;
     double *self_seconds;
 } sw_step_contacts;
+
+/* Inertia modes held in quasistatic steps (inertia_hold.c). A quasistatic step has no
+ * inertia for the inertia modes (each domain's last inertia_count columns,
+ * sinew_blob_format.h) to carry: left free they settle where the cubature fits least and
+ * the held-out error grows, so they are held at the pose-space prediction q_pred, where
+ * the training poses' blend places them. Not where the step has contact nobody trained
+ * (a world candidate, a detected self-contact pair on the domain's copies): there they
+ * are static responses to loads, as contact is one, and the flesh gives way through
+ * them. A dynamic step leaves them all free: they are its swing. (docs/notes/jiggle.md,
+ * The inertia modes held where nothing untrained touches.) */
+/* s->hold for this solve; returns whether any domain is held (s->hold_inertia). */
+int sw_solver_hold_decide(sw_solver *s, const sw_blob_view *v, const sw_dyn_coef *dc,
+                          const sw_step_contacts *ct);
+/* The held coordinates of s->q set to their prediction. */
+void sw_solver_hold_start(sw_solver *s, const sw_blob_view *v);
+/* x (R) zero at the held coordinates. */
+void sw_solver_hold_zero(const sw_solver *s, const sw_blob_view *v, double *x);
+/* Their rows of red->g, and with want_hess of red->H, made a fixed coordinate's: g_i = 0,
+ * H's row and column i zero but for the diagonal. Newton's update then leaves them where
+ * they are. */
+void sw_solver_hold_rows(const sw_solver *s, sw_reduced *red, int want_hess);
 
 /* Phi(q): cubature + contact (self and world) + springs [+ inertia, damping and inertial
  * forces]. With want_grad also red->g (and red->H with want_hess: the material part

@@ -430,10 +430,16 @@ typedef struct sinew_blob_lod_meta {
 /** The most displacement modes the pose-space level holds. */
 #define SINEW_BLOB_LOD_MAX_RANK 64
 
-/** Section DOMAINS: one record per domain (48 bytes). */
+/** Section DOMAINS: one record per domain (48 bytes). inertia_count (0 ..= rank) is how
+ * many of the domain's last basis columns are inertia modes (a bake with them): a
+ * quasistatic step holds those coordinates at the pose-space prediction unless contact
+ * nobody trained (the world, detected self-contact) touches the domain; a dynamic step
+ * leaves them free. It was a reserved field that had to be 0 (a runtime that predates it
+ * refuses a blob with inertia modes rather than step them free), so the format version
+ * does not change. */
 typedef struct sinew_blob_domain_record {
     int32_t bone, vert_begin, vert_count, rank;
-    int32_t q_offset, cub_begin, cub_count, reserved;
+    int32_t q_offset, cub_begin, cub_count, inertia_count;
     int64_t basis_offset, inertia_offset;
 } sinew_blob_domain_record;
 
