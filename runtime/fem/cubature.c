@@ -160,10 +160,15 @@ static double *ref_block(const sw_reduced *m, int32_t k) {
 /* Domain k's corners placed at its coordinates qd (corner_x), their summed forces zeroed. */
 static void place_corners(sw_reduced *m, int32_t k, const double *qd) {
     const sw_blob_domain *D = &m->v->domains[k];
-    for (int32_t i = m->corner_begin[k]; i < m->corner_begin[k + 1]; ++i) {
+    const int32_t end = m->corner_begin[k + 1];
+    int32_t i = m->corner_begin[k];
+    for (; i + 1 < end; i += 2)
+        sw_reduced_position_pair(m, D, m->corner_lv + i, m->corner_act + i, qd, m->corner_x + 3 * i,
+                                 m->corner_x + 3 * (i + 1));
+    if (i < end)
         sw_reduced_position(m, D, m->corner_lv[i], m->corner_act[i], qd, m->corner_x + 3 * i, NULL);
+    for (i = m->corner_begin[k]; i < end; ++i)
         m->corner_f[3 * i] = m->corner_f[3 * i + 1] = m->corner_f[3 * i + 2] = 0;
-    }
 }
 
 /* Cubature tet c of domain D: its corners' positions x from corner_x, and with tm its map. */

@@ -38,24 +38,54 @@ void sw_reduced_jacobian(const sw_reduced *m, const sw_blob_domain *D, int32_t l
                 Rm[3 * i] * U[j] + Rm[3 * i + 1] * U[r + j] + Rm[3 * i + 2] * U[2 * r + j];
 }
 
+/* x = R y + t with the skinning transform of active vertex a. */
+static void skin_point(const sw_reduced *m, int32_t a, const double y[3], double x[3]) {
+    const double *Rm = m->act_R + 9 * a, *t = m->act_t + 3 * a;
+    for (int i = 0; i < 3; ++i)
+        x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
+}
+
+/* The copy's basis rows and its rest position. */
+static const double *copy_rows(const sw_blob_view *v, const sw_blob_domain *D, int32_t lv,
+                               double y[3]) {
+    const double *X = v->rest + 3 * (int64_t)v->domain_verts[D->vert_begin + lv];
+    y[0] = X[0], y[1] = X[1], y[2] = X[2];
+    return v->basis + D->basis_offset + (int64_t)3 * lv * D->rank;
+}
+
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J) {
-    const sw_blob_view *v = m->v;
-    int32_t r = D->rank, gv = v->domain_verts[D->vert_begin + lv];
-    const double *U = v->basis + D->basis_offset + (int64_t)3 * lv * r;
-    const double *Rm = m->act_R + 9 * a, *t = m->act_t + 3 * a, *X = v->rest + 3 * (int64_t)gv;
+    int32_t r = D->rank;
+    double y[3];
+    const double *U = copy_rows(m->v, D, lv, y);
     /* the three rows' sums run side by side: three independent add chains instead of one
      * after another (each row still sums in j order, so the result is bitwise the same) */
     const double *U0 = U, *U1 = U + r, *U2 = U + 2 * r;
-    double y[3] = {X[0], X[1], X[2]};
     for (int32_t j = 0; qd && j < r; ++j) { /* qd NULL: q = 0 */
         y[0] += U0[j] * qd[j];
         y[1] += U1[j] * qd[j];
         y[2] += U2[j] * qd[j];
     }
-    for (int i = 0; i < 3; ++i)
-        x[i] = Rm[3 * i] * y[0] + Rm[3 * i + 1] * y[1] + Rm[3 * i + 2] * y[2] + t[i];
+    skin_point(m, a, y, x);
     if (J) sw_reduced_jacobian(m, D, lv, a, J);
+}
+
+void sw_reduced_position_pair(const sw_reduced *m, const sw_blob_domain *D, const int32_t lv[2],
+                              const int32_t a[2], const double *qd, double x0[3], double x1[3]) {
+    int32_t r = D->rank;
+    double y[3], z[3];
+    const double *U = copy_rows(m->v, D, lv[0], y), *V = copy_rows(m->v, D, lv[1], z);
+    const double *U0 = U, *U1 = U + r, *U2 = U + 2 * r, *V0 = V, *V1 = V + r, *V2 = V + 2 * r;
+    for (int32_t j = 0; j < r; ++j) {
+        y[0] += U0[j] * qd[j];
+        y[1] += U1[j] * qd[j];
+        y[2] += U2[j] * qd[j];
+        z[0] += V0[j] * qd[j];
+        z[1] += V1[j] * qd[j];
+        z[2] += V2[j] * qd[j];
+    }
+    skin_point(m, a[0], y, x0);
+    skin_point(m, a[1], z, x1);
 }
 
 /* Block (a, b) of A and its row step; NULL for a block the blob does not store. */

@@ -82,6 +82,12 @@ void sw_reduced_skin(sw_reduced *m, const sw_dualquat *bone_dq);
  * when J is not NULL. */
 void sw_reduced_position(const sw_reduced *m, const sw_blob_domain *D, int32_t lv, int32_t a,
                          const double *qd, double x[3], double *J);
+/* Two copies of domain D at once (local vertices lv[0], lv[1], active indices a[0], a[1];
+ * qd not NULL), bitwise as two calls of sw_reduced_position: each row still sums in its
+ * own order, six sums side by side where one call runs three, so that the adds' latency
+ * overlaps (the cubature passes place every corner this way, cubature.c). */
+void sw_reduced_position_pair(const sw_reduced *m, const sw_blob_domain *D, const int32_t lv[2],
+                              const int32_t a[2], const double *qd, double x0[3], double x1[3]);
 
 /* An R x R reduced matrix read by domain blocks: a dense row-major one (dense not NULL), or
  * else the blob's constant matrix blob_matrix (SW_BLOB_MASS or SW_BLOB_SPRINGS, which may
