@@ -40,14 +40,18 @@ static sw_move far_rigid(void) {
     return m;
 }
 
-static sw_invariance_result measure(const sw_invariance_run *run, const sw_move *m) {
-    const bake_fixture *f = finger();
+static sw_invariance_result measure_on(const bake_fixture *f, const sw_invariance_run *run,
+                                       const sw_move *m) {
     sw_invariance_result res = {0};
     if (!f) return res;
     sinew_result r = sw_invariance_measure(f->blob, f->ch.clip.T, f->ch.skel.nbones,
                                            f->ch.clip.nframes, run, m, &res);
     if (r != SINEW_OK) res.failed = -1;
     return res;
+}
+
+static sw_invariance_result measure(const sw_invariance_run *run, const sw_move *m) {
+    return measure_on(finger(), run, m);
 }
 
 #define ENSURE_INVARIANT(res, what)                                                                \
@@ -307,6 +311,42 @@ TEST(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the
     sinew_world_destroy(wg);
 }
 
+/* The finger baked with inertia modes: a quasistatic step holds them at the pose-space
+ * prediction except in the domains the world or a detected pair touches (solver.h), a
+ * choice made from the moved world's candidates and the moved pose's pairs, which must be
+ * the unmoved ones. */
+TEST(inertia_modes_held_where_nothing_untrained_touches_wherever_the_finger_is) {
+    bake_fixture held;
+    sw_bake_params p = bake_fixture_params(0, 2);
+    p.inertia_modes = 1;
+    ENSURE(bake_fixture_make_params(&held, "finger", 2000, 12, &p));
+    const sw_blob_view *v = sw_blob_get_view(held.blob);
+    int32_t marked = 0;
+    for (int32_t d = 0; d < v->ndomains; ++d)
+        marked += v->domains[d].inertia_count;
+    ENSUREF(marked > 0, "no inertia mode marked (rank %d)", v->rank_total);
+    sw_move far = far_rigid(),
+            near = {SW_MOVE_RIGID, {0.3, -0.8, 0.5}, 120 * PI / 180, {3, -2, 5}, 0, 0, 0};
+    sw_invariance_run alone = {
+        SINEW_STEP_QUASISTATIC, SINEW_SELF_CONTACT_EXHAUSTIVE, NULL, NULL, 0, 0, 0, 0};
+    sw_invariance_result res = measure_on(&held, &alone, &far);
+    ENSURE_INVARIANT(res, "held, exhaustive, far and turned");
+    ENSUREF(res.self_contacts > 0, "the fold never touched");
+    double G[12];
+    sw_move_transform(&near, 0, G);
+    sinew_world *w = shape_world(NULL), *wg = shape_world(G);
+    ENSURE(w && wg);
+    sw_invariance_run pressed = {SINEW_STEP_QUASISTATIC, 0, w, wg, 1.0f / 30, 400, 0, 0};
+    res = measure_on(&held, &pressed, &near);
+    fprintf(stderr, "  held, every collider shape, patches: %.3e of the size, patch %u\n", res.err,
+            res.patch_vertices);
+    ENSURE_INVARIANT(res, "held, every collider shape, patches");
+    ENSURE(res.world_contacts > 0);
+    sinew_world_destroy(w);
+    sinew_world_destroy(wg);
+    bake_fixture_free(&held);
+}
+
 /* ---- engine inputs ------------------------------------------------------------------ */
 
 typedef struct {
@@ -458,6 +498,7 @@ SW_TEST_MAIN(
     CASE(a_uniformly_scaled_pose_gives_the_scaled_shape),
     CASE(self_contact_nobody_trained_is_found_and_held_alike_wherever_the_finger_is),
     CASE(with_every_collider_shape_and_patches_a_world_moved_with_the_pose_gives_the_moved_flesh),
+    CASE(inertia_modes_held_where_nothing_untrained_touches_wherever_the_finger_is),
     CASE(dt_zero_is_a_paused_frame),
     CASE(a_bone_scaled_unlike_the_others_or_sheared_is_refused_naming_it),
     CASE(the_elephant_moved_rigidly_far_and_scaled_keeps_its_flesh), CASE(release_fixture))
