@@ -18,6 +18,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "assimp_trial.h"
 #include "gltf_precheck.h"
 #include "viewer.h"
 
@@ -568,6 +569,14 @@ int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *a, char 
     }
     a->impl = s, a->release = asset_release, a->pose = asset_pose;
     a->sample = asset_sample, a->compose = asset_compose;
+    sw_error e;
+    sw_error_clear(&e);
+    if (sw_assimp_trial(path, NULL, 0, NULL, flags, path, &e) != SINEW_OK) {
+        snprintf(err, errlen, "%s", e.msg);
+        vw_asset_free(a);
+        free(bytes);
+        return 0;
+    }
     s->sc = aiImportFile(path, flags);
     if (!s->sc || !s->sc->mRootNode || (s->sc->mFlags & AI_SCENE_FLAGS_INCOMPLETE)) {
         snprintf(err, errlen, "%s: assimp could not read it: %s", path, aiGetErrorString());

@@ -11,6 +11,10 @@
 #ifndef SW_FUZZ_ASSIMP_H
 #define SW_FUZZ_ASSIMP_H
 
+#include <stddef.h>
+#include <stdint.h>
+#include <string.h>
+
 const char *__asan_default_options(void);
 const char *__lsan_default_suppressions(void);
 
@@ -19,6 +23,17 @@ const char *__asan_default_options(void) {
 }
 const char *__lsan_default_suppressions(void) {
     return "leak:libassimp.so\n";
+}
+
+/* The format the input claims, for assimp's hint and the file's extension: FBX (binary,
+ * or ASCII with its header comment) or else glTF's binary container. The seeds of both
+ * formats sit in one corpus, and their mutations keep their first bytes most of the time. */
+static inline const char *sw_fuzz_assimp_hint(const uint8_t *data, size_t size) {
+    static const char bin[] = "Kaydara FBX Binary", text[] = "; FBX";
+    if ((size >= sizeof bin - 1 && !memcmp(data, bin, sizeof bin - 1)) ||
+        (size >= sizeof text - 1 && !memcmp(data, text, sizeof text - 1)))
+        return "fbx";
+    return "glb";
 }
 
 #endif

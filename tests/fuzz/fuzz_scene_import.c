@@ -21,6 +21,7 @@
  * naming "memory.glb" and a zeroed result. */
 #include <math.h>
 #include <stdint.h>
+#include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
 
@@ -69,13 +70,16 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     sw_error err;
     sw_error_clear(&err);
     const sw_import_options o = {.fps = 10};
-    sinew_result rc = sw_scene_import_memory(copy, size, "glb", &o, &c, &err);
+    const char *hint = sw_fuzz_assimp_hint(data, size);
+    sinew_result rc = sw_scene_import_memory(copy, size, hint, &o, &c, &err);
+    char name[16];
+    snprintf(name, sizeof name, "memory.%s", hint);
     if (rc == SINEW_OK)
         check(&c);
     else if (!sw_fuzz_zeroed(&c, sizeof c))
         abort();
     else
-        sw_fuzz_check_error(rc, &err, "memory.glb");
+        sw_fuzz_check_error(rc, &err, name);
     sw_imported_character_free(&c);
     free(copy);
     return 0;

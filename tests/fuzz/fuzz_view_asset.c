@@ -32,7 +32,7 @@ int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size);
 int sw_test_failed_, sw_test_skipped_; /* (blob_synth.h's checks, unused here) */
 
 static sinew_blob *blob;
-static char dir[64], path[96];
+static char dir[64], path[96], path_fbx[96];
 
 static void setup(void) {
     static fixture f;
@@ -47,6 +47,7 @@ static void setup(void) {
     if (!bytes || sinew_blob_load(&d, &blob) != SINEW_OK) abort();
     snprintf(dir, sizeof dir, "/tmp/fuzz_view_asset.%ld", (long)getpid());
     snprintf(path, sizeof path, "%s/a.glb", dir);
+    snprintf(path_fbx, sizeof path_fbx, "%s/a.fbx", dir);
     char cmd[96];
     snprintf(cmd, sizeof cmd, "mkdir -p %s", dir);
     if (system(cmd) != 0) abort();
@@ -87,12 +88,13 @@ static void play(const vw_asset *a) {
 
 int LLVMFuzzerTestOneInput(const uint8_t *data, size_t size) {
     if (!blob) setup();
-    FILE *f = fopen(path, "wb");
+    const char *file = !strcmp(sw_fuzz_assimp_hint(data, size), "fbx") ? path_fbx : path;
+    FILE *f = fopen(file, "wb");
     if (!f || fwrite(data, 1, size, f) != size || fclose(f) != 0) abort();
     vw_asset a;
     char err[512];
     err[0] = 0;
-    if (!vw_asset_import(path, blob, &a, err, sizeof err)) {
+    if (!vw_asset_import(file, blob, &a, err, sizeof err)) {
         if (!err[0] || a.impl || a.rest || a.nverts) abort(); /* a message, nothing behind */
         return 0;
     }
