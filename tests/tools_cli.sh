@@ -333,6 +333,12 @@ expect inspect_text 1 "sinew-inspect: $tmp/text\.glb: not a glTF binary" "$inspe
 printf 'not a 3D file\n' >"$tmp/text.fbx"
 expect inspect_text_fbx 1 "sinew-inspect: $tmp/text\.fbx: assimp could not read it" \
     "$inspect" "$tmp/text.fbx"
+# a file assimp aborts on (one flipped bit of a small binary FBX): refused, not a crash
+damaged=$src/tests/fuzz/corpus/scene_import/fbx_assert.fbx
+expect inspect_assimp_dies 1 "sinew-inspect: .*fbx_assert\.fbx: assimp died reading it \(signal 6" \
+    "$inspect" "$damaged"
+expect bake_assimp_dies 1 "sinew-bake: .*fbx_assert\.fbx: assimp died reading it \(signal 6" \
+    "$bake" "$damaged" --tets 1000 --out "$tmp/damaged.blob"
 # sinew-replay: exit 2 on bad arguments, 1 (message naming the file) when the blob or the
 # recording cannot be read; its bitwise replay is the CTest sinew_replay_session
 replay=$build/tools/sinew-replay
