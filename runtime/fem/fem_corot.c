@@ -116,7 +116,9 @@ static void corot_modes(const double U[9], const double s[3], const double V[9],
     }
 }
 
-/* K = sum_k w_k g_k g_k^T; the same rounding for (i, j) and (j, i): exactly symmetric. */
+/* K = sum_k w_k g_k g_k^T: the upper triangle summed, the lower its mirror. (j, i)'s own sum
+ * would round alike (the same products, in the same order), so K is exactly symmetric and
+ * the same bit for bit as the whole square summed. */
 static void corot_hessian(const double U[9], const double s[3], const double V[9],
                           const double D[12], double vol, double mu, double lambda, uint32_t flags,
                           double K[144]) {
@@ -128,9 +130,12 @@ static void corot_hessian(const double U[9], const double s[3], const double V[9
         if (w[k] == 0.0) continue;
         const double *gk = g + 12 * k;
         for (int i = 0; i < 12; ++i)
-            for (int j = 0; j < 12; ++j)
+            for (int j = i; j < 12; ++j)
                 K[12 * i + j] += w[k] * (gk[i] * gk[j]);
     }
+    for (int i = 1; i < 12; ++i)
+        for (int j = 0; j < i; ++j)
+            K[12 * i + j] = K[12 * j + i];
 }
 
 /* Energy and forces alone, from the polar rotation R of F (no SVD): psi = mu |F - R|^2 +
