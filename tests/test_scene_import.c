@@ -7,6 +7,7 @@
 #include <stdlib.h>
 #include <string.h>
 
+#include "assimp_trial.h"
 #include "scene_import.h"
 #include "sw_test.h"
 
@@ -446,9 +447,30 @@ TEST(a_file_assimp_dies_on_is_refused_and_the_process_lives) {
     }
 }
 
+/* The trial read's time limit: a read that takes longer (here the robot, about 0.1 s to
+ * read, given a millisecond) is refused as not done; given the import's own limit it
+ * passes; a limit out of range is an argument error. */
+TEST(a_trial_read_out_of_time_is_refused) {
+    NEED_DATA(assets[4].rel);
+    char path[1024];
+    snprintf(path, sizeof path, "%s/%s", SINEW_SHARED_DATA_DIR, assets[4].rel);
+    sw_error e;
+    sw_error_clear(&e);
+    sinew_result rc = sw_assimp_trial(path, NULL, 0, NULL, 0, 1e-3, "robot", &e);
+    ENSUREF(rc == SINEW_ERROR_PARSE &&
+                strstr(e.msg, "robot: assimp did not finish reading it in 0.001 s"),
+            "%d %s", rc, e.msg);
+    sw_error_clear(&e);
+    rc = sw_assimp_trial(path, NULL, 0, NULL, 0, SW_ASSIMP_TRIAL_SECONDS, "robot", &e);
+    ENSUREF(rc == SINEW_OK, "%s", e.msg);
+    rc = sw_assimp_trial(path, NULL, 0, NULL, 0, 0.0, "robot", &e);
+    ENSURE(rc == SINEW_ERROR_INVALID_ARGUMENT && strstr(e.msg, "robot: "));
+}
+
 SW_TEST_MAIN(CASE(dangling_indices_are_named_before_assimp_sees_them), CASE(simpleskin),
              CASE(riggedsimple), CASE(riggedfigure), CASE(fox), CASE(robot_quaternius),
              CASE(fbx_skeleton), CASE(simpleskin_joint_by_hand), CASE(fbx_units_and_target_height),
              CASE(rigid_prop_follows_its_joint), CASE(nan_vertex_is_an_error),
              CASE(errors_are_reported_not_crashed),
-             CASE(a_file_assimp_dies_on_is_refused_and_the_process_lives))
+             CASE(a_file_assimp_dies_on_is_refused_and_the_process_lives),
+             CASE(a_trial_read_out_of_time_is_refused))

@@ -7,6 +7,7 @@
 #include <signal.h>
 #include <stdio.h>
 #include <string.h>
+#include <sys/time.h>
 #include <sys/types.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -20,8 +21,8 @@ enum { TRIAL_SCENE = 0, TRIAL_NO_SCENE = 3 };
  * assimp's verdict as the exit code. _exit: the parent's buffers and atexit work stay the
  * parent's. */
 static void trial_child(int wfd, const char *path, const void *data, size_t len, const char *hint,
-                        unsigned flags) {
-    static const int sigs[] = {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP};
+                        unsigned flags, double seconds) {
+    static const int sigs[] = {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGALRM};
     struct sigaction dfl;
     memset(&dfl, 0, sizeof dfl);
     dfl.sa_handler = SIG_DFL;
@@ -31,6 +32,12 @@ static void trial_child(int wfd, const char *path, const void *data, size_t len,
     int null = open("/dev/null", O_WRONLY);
     if (null >= 0) dup2(null, STDOUT_FILENO);
     dup2(wfd, STDERR_FILENO);
+    struct itimerval limit; /* SIGALRM's default action ends the child */
+    memset(&limit, 0, sizeof limit);
+    limit.it_value.tv_sec = (time_t)seconds;
+    limit.it_value.tv_usec = (suseconds_t)((seconds - (double)(time_t)seconds) * 1e6);
+    if (limit.it_value.tv_sec == 0 && limit.it_value.tv_usec == 0) limit.it_value.tv_usec = 1;
+    setitimer(ITIMER_REAL, &limit, NULL);
     const struct aiScene *sc =
         path ? aiImportFile(path, flags)
              : aiImportFileFromMemory(data, (unsigned)len, flags, hint ? hint : "");
@@ -68,7 +75,10 @@ static void read_last_line(int rfd, char *line, size_t cap) {
 }
 
 sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, const char *hint,
-                             unsigned flags, const char *name, sw_error *err) {
+                             unsigned flags, double seconds, const char *name, sw_error *err) {
+    if (!(seconds > 0) || seconds > 1e6)
+        return sw_error_set(err, SINEW_ERROR_INVALID_ARGUMENT,
+                            "%s: assimp's trial read given %g s (wants (0, 1e6])", name, seconds);
     int fds[2];
     if (pipe(fds) != 0)
         return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot start assimp's trial read: %s", name,
@@ -83,7 +93,7 @@ sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, con
     }
     if (pid == 0) {
         close(fds[0]);
-        trial_child(fds[1], path, data, len, hint, flags);
+        trial_child(fds[1], path, data, len, hint, flags, seconds);
     }
     close(fds[1]);
     char last[200];
@@ -99,13 +109,19 @@ sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, con
     if (WIFEXITED(status) &&
         (WEXITSTATUS(status) == TRIAL_SCENE || WEXITSTATUS(status) == TRIAL_NO_SCENE))
         return SINEW_OK;
-    char how[64];
-    if (WIFSIGNALED(status))
-        snprintf(how, sizeof how, "signal %d, %s", WTERMSIG(status), strsignal(WTERMSIG(status)));
+    char how[80];
+    if (WIFSIGNALED(status) && WTERMSIG(status) == SIGALRM)
+        snprintf(how, sizeof how, "did not finish reading it in %g s", seconds);
+    else if (WIFSIGNALED(status))
+        snprintf(how, sizeof how, "died reading it (signal %d, %s", WTERMSIG(status),
+                 strsignal(WTERMSIG(status)));
     else
-        snprintf(how, sizeof how, "exit status %d", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+        snprintf(how, sizeof how, "died reading it (exit status %d",
+                 WIFEXITED(status) ? WEXITSTATUS(status) : -1);
+    const int died = how[0] == 'd' && how[1] == 'i' && how[2] == 'e';
     return sw_error_set(err, SINEW_ERROR_PARSE,
-                        "%s: assimp died reading it (%s%s%s%s): the file is damaged, or holds "
-                        "a structure this assimp cannot read; export it again",
-                        name, how, last[0] ? ": \"" : "", last, last[0] ? "\"" : "");
+                        "%s: assimp %s%s%s%s%s: the file is damaged, or holds a structure this "
+                        "assimp cannot read; export it again",
+                        name, how, died && last[0] ? ": \"" : "", died ? last : "",
+                        died && last[0] ? "\"" : "", died ? ")" : "");
 }

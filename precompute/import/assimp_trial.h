@@ -15,12 +15,17 @@
 
 #include "sw_error.h"
 
+/* The time a trial read may take (seconds): a file assimp loops on is refused too. Ten
+ * minutes: far beyond what a character of any size takes to import. */
+#define SW_ASSIMP_TRIAL_SECONDS 600.0
+
 /* Reads the file at `path` (data NULL), or the `len` bytes at `data` as a `hint` file
  * (path NULL; the bytes followed by a zero, as aiImportFileFromMemory wants them), with
- * assimp's post-processing `flags`, in a child process. SINEW_OK when the child returned;
- * SINEW_ERROR_PARSE when it died (the signal and assimp's last line on stderr in the
- * message, which starts "name: "); SINEW_ERROR_IO when no child could be started. */
+ * assimp's post-processing `flags`, in a child process given `seconds` (> 0). SINEW_OK
+ * when the child returned; SINEW_ERROR_PARSE when it died or ran out of time (the signal
+ * and assimp's last line on stderr in the message, which starts "name: "); SINEW_ERROR_IO
+ * when no child could be started. */
 sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, const char *hint,
-                             unsigned flags, const char *name, sw_error *err);
+                             unsigned flags, double seconds, const char *name, sw_error *err);
 
 #endif

@@ -780,7 +780,7 @@ sinew_result sw_scene_import(const char *path, const sw_import_options *o,
         free(bytes);
         return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
     }
-    rc = sw_assimp_trial(path, NULL, 0, NULL, ai_flags(gltf), name, err);
+    rc = sw_assimp_trial(path, NULL, 0, NULL, ai_flags(gltf), SW_ASSIMP_TRIAL_SECONDS, name, err);
     if (rc == SINEW_OK)
         rc = run(aiImportFile(path, ai_flags(gltf)), name, bytes, nbytes, binary, dir, &use, out,
                  err);
@@ -807,7 +807,7 @@ sinew_result sw_scene_import_memory(const void *data, size_t len, const char *hi
     if (!copy) return sw_error_set(err, SINEW_ERROR_OUT_OF_MEMORY, "%s: out of memory", name);
     memcpy(copy, data, len);
     memset(copy + len, 0, 16);
-    rc = sw_assimp_trial(NULL, copy, len, hint, ai_flags(gltf), name, err);
+    rc = sw_assimp_trial(NULL, copy, len, hint, ai_flags(gltf), SW_ASSIMP_TRIAL_SECONDS, name, err);
     if (rc == SINEW_OK)
         rc = run(aiImportFileFromMemory(copy, (unsigned)len, ai_flags(gltf), hint ? hint : ""),
                  name, gltf ? data : NULL, len, is_glb(hint), NULL, &use, out, err);

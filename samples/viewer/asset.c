@@ -571,7 +571,8 @@ int vw_asset_import(const char *path, const sinew_blob *blob, vw_asset *a, char 
     a->sample = asset_sample, a->compose = asset_compose;
     sw_error e;
     sw_error_clear(&e);
-    if (sw_assimp_trial(path, NULL, 0, NULL, flags, path, &e) != SINEW_OK) {
+    if (sw_assimp_trial(path, NULL, 0, NULL, flags, SW_ASSIMP_TRIAL_SECONDS, path, &e) !=
+        SINEW_OK) {
         snprintf(err, errlen, "%s", e.msg);
         vw_asset_free(a);
         free(bytes);
