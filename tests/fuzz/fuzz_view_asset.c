@@ -11,8 +11,12 @@
  * onto (its four joints carry the fixture's bone names and bind poses, its rigid prop and
  * skinned mesh are the fixture's two source meshes); no_inverse_bind.glb and
  * infinite_vertex.glb, what this harness found (assimp crashed on the first inside the
- * viewer; the second was accepted), refused now. An input is written to a folder
- * of the process's own as a user's file would be. A refused file must leave a message and
+ * viewer; the second was accepted), refused now. The FBX seeds (make_fbx_seed.py, Blender's
+ * exporter): four_bones.fbx, the same character, which the blob maps onto too (the FBX
+ * unit, the mesh node's placement and the weld); two_bones.fbx, a character that is not
+ * the blob's; fbx_assert.fbx, a file assimp aborts on (assimp_trial.h). An input is
+ * written to a folder of the process's own as a user's file would be, named .fbx or .glb
+ * by its first bytes. A refused file must leave a message and
  * nothing behind; an accepted one must keep the importer's promises (indices in range,
  * finite rest positions, weights summing to 1), and its clips are posed and skinned. */
 #include <math.h>
