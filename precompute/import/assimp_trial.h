@@ -1,4 +1,4 @@
-/* For scene_import.c and the viewer's asset import (samples/viewer/asset.c): assimp read in
+/* For scene_read.c and the viewer's asset import (samples/viewer/asset.c): assimp read in
  * a child process first, so that a file it dies on is refused instead of taking the bake or
  * the host with it.
  *

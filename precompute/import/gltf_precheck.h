@@ -1,4 +1,4 @@
-/* For scene_import.c and the viewer's asset import (samples/viewer/asset.c): the glTF
+/* For scene_read.c and the viewer's asset import (samples/viewer/asset.c): the glTF
  * structures that assimp 5.2.5 crashes on, rejected before assimp reads the bytes
  * (gltf_precheck.c says which and why). */
 #ifndef SW_GLTF_PRECHECK_H

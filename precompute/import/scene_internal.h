@@ -1,5 +1,6 @@
-/* Private to scene_import.c and scene_clip.c: the scene's node table and 4x4 affine
- * helpers (row-major doubles, translation in the last column, as assimp's aiMatrix4x4). */
+/* Private to scene_read.c, scene_import.c and scene_clip.c: the character built from
+ * assimp's scene, the scene's node table and 4x4 affine helpers (row-major doubles,
+ * translation in the last column, as assimp's aiMatrix4x4). */
 #ifndef SW_SCENE_INTERNAL_H
 #define SW_SCENE_INTERNAL_H
 
@@ -15,6 +16,15 @@ typedef struct sw_scene_nodes {
     double *G;                /* 16*n global transforms of the file's node pose */
     const int32_t *node_bone; /* n: the node's bone, or -1 (channels prefer joint nodes) */
 } sw_scene_nodes;
+
+/* The character in `sc` (assimp's import of the file `name`, NULL when assimp failed; its
+ * scene is released here) into `out` with the checked options `o`. `bytes`: the glTF file
+ * read again for what assimp drops (NULL for other formats; `binary` when it is a .glb);
+ * `dir`: its folder when it was read from a path. Messages start "name: "; on failure
+ * `out` is left zeroed. */
+sinew_result sw_scene_build(const struct aiScene *sc, const char *name, const void *bytes,
+                            size_t nbytes, int binary, const char *dir, const sw_import_options *o,
+                            sw_imported_character *out, sw_error *err);
 
 /* out = a * b (out may not alias a or b). */
 void sw_m4_mul(const double *a, const double *b, double *out);

@@ -1,5 +1,7 @@
 /* libFuzzer harness for the assimp import (precompute/import/scene_import.h; STYLE.md §9: a
- * fuzz harness for every loader), through sw_scene_import_memory with the hint "glb".
+ * fuzz harness for every loader), through sw_scene_import_memory with the hint "glb", or
+ * "fbx" for an input that starts as an FBX file does (two_bones.fbx, make_fbx_seed.py;
+ * fbx_assert.fbx, the file assimp aborted on).
  * tests/CMakeLists.txt builds it with clang when clang has libFuzzer and runs it for a few
  * seconds on tests/fuzz/corpus/scene_import (two_bones.glb: a hand-written 4-vertex,
  * 2-joint skin with a 2-key rotation clip, 1.8 KB; painted_two_primitives.glb:
@@ -9,8 +11,9 @@
  *
  *   clang -std=c17 -D_POSIX_C_SOURCE=200809L -g -O1 -fsanitize=fuzzer,address,undefined \
  *     -Iplugin_api/include -Iruntime/core -Iprecompute/io -Iprecompute/import \
- *     tests/fuzz/fuzz_scene_import.c precompute/import/scene_import.c \
- *     precompute/import/scene_clip.c precompute/import/gltf_precheck.c \
+ *     tests/fuzz/fuzz_scene_import.c precompute/import/scene_read.c \
+ *     precompute/import/scene_import.c precompute/import/scene_clip.c \
+ *     precompute/import/gltf_precheck.c precompute/import/assimp_trial.c \
  *     precompute/import/gltf_attribute.c precompute/io/sw_mesh.c runtime/core/sw_error.c \
  *     -lassimp -lcjson -lm -o build-fuzz-scene
  *   cp -r tests/fuzz/corpus/scene_import /tmp/scene-corpus && ./build-fuzz-scene /tmp/scene-corpus
