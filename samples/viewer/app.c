@@ -31,7 +31,7 @@ static const char *usage =
     "  --width W           window width (960)\n"
     "  --height H          window height (540)\n"
     "  --frames N          render N frames, then exit (the clock advances 1/render-hz a frame)\n"
-    "  --screenshot OUT    write the last frame to OUT.png (with --frames)\n"
+    "  --screenshot OUT    write the last frame to OUT, a PNG file (with --frames)\n"
     "  --record OUT        pipe every frame to ffmpeg, writing OUT (.mp4)\n"
     "  --debug-draw LIST   draw sinew's debug draw over its view: a comma-separated list of\n"
     "                      contacts, patch, colliders and bones (key g cycles)\n"
