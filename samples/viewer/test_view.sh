@@ -63,6 +63,14 @@ else
     "${run[@]}" "$view" --blob "$tmp/f.blob" --asset "$fox" --frames 1 2>"$tmp/err"; rc=$?
     set -e
     refused "$rc" "is no node of the file" "an asset that is not the blob's (its bones by name)"
+    # a file assimp aborts on (one flipped bit of a small binary FBX): refused, not a crash
+    set +e
+    "${run[@]}" "$view" --blob "$tmp/f.blob" \
+        --asset "$here/../../tests/fuzz/corpus/scene_import/fbx_assert.fbx" --frames 1 \
+        2>"$tmp/err"
+    rc=$?
+    set -e
+    refused "$rc" "assimp died reading it (signal 6" "a file assimp aborts on"
 fi
 
 printf '0.5 s\n0.6 s\n' >"$tmp/script" # slow motion on and off again: the script is read
