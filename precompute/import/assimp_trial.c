@@ -109,19 +109,18 @@ sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, con
     if (WIFEXITED(status) &&
         (WEXITSTATUS(status) == TRIAL_SCENE || WEXITSTATUS(status) == TRIAL_NO_SCENE))
         return SINEW_OK;
-    char how[80];
     if (WIFSIGNALED(status) && WTERMSIG(status) == SIGALRM)
-        snprintf(how, sizeof how, "did not finish reading it in %g s", seconds);
-    else if (WIFSIGNALED(status))
-        snprintf(how, sizeof how, "died reading it (signal %d, %s", WTERMSIG(status),
-                 strsignal(WTERMSIG(status)));
+        return sw_error_set(err, SINEW_ERROR_PARSE,
+                            "%s: assimp did not finish reading it in %g s: the file is damaged, "
+                            "or holds a structure this assimp cannot read; export it again",
+                            name, seconds);
+    char how[64];
+    if (WIFSIGNALED(status))
+        snprintf(how, sizeof how, "signal %d, %s", WTERMSIG(status), strsignal(WTERMSIG(status)));
     else
-        snprintf(how, sizeof how, "died reading it (exit status %d",
-                 WIFEXITED(status) ? WEXITSTATUS(status) : -1);
-    const int died = how[0] == 'd' && how[1] == 'i' && how[2] == 'e';
+        snprintf(how, sizeof how, "exit status %d", WIFEXITED(status) ? WEXITSTATUS(status) : -1);
     return sw_error_set(err, SINEW_ERROR_PARSE,
-                        "%s: assimp %s%s%s%s%s: the file is damaged, or holds a structure this "
-                        "assimp cannot read; export it again",
-                        name, how, died && last[0] ? ": \"" : "", died ? last : "",
-                        died && last[0] ? "\"" : "", died ? ")" : "");
+                        "%s: assimp died reading it (%s%s%s%s): the file is damaged, or holds "
+                        "a structure this assimp cannot read; export it again",
+                        name, how, last[0] ? ": \"" : "", last, last[0] ? "\"" : "");
 }
