@@ -83,11 +83,21 @@ sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, con
     if (pipe(fds) != 0)
         return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot start assimp's trial read: %s", name,
                             strerror(errno));
+    /* A host that ignores SIGCHLD has its children reaped at once, and waitpid would find
+       none: the default disposition while the child lives, the host's again after. */
+    struct sigaction host_chld, dfl;
+    sigaction(SIGCHLD, NULL, &host_chld);
+    const int reaps = host_chld.sa_handler == SIG_IGN || (host_chld.sa_flags & SA_NOCLDWAIT);
+    memset(&dfl, 0, sizeof dfl);
+    dfl.sa_handler = SIG_DFL;
+    sigemptyset(&dfl.sa_mask);
+    if (reaps) sigaction(SIGCHLD, &dfl, NULL);
     fflush(NULL); /* nothing buffered is written twice */
     pid_t pid = fork();
     if (pid < 0) {
         int e = errno;
         close(fds[0]), close(fds[1]);
+        if (reaps) sigaction(SIGCHLD, &host_chld, NULL);
         return sw_error_set(err, SINEW_ERROR_IO, "%s: cannot start assimp's trial read: %s", name,
                             strerror(e));
     }
@@ -103,9 +113,11 @@ sinew_result sw_assimp_trial(const char *path, const void *data, size_t len, con
     pid_t w;
     while ((w = waitpid(pid, &status, 0)) < 0 && errno == EINTR) {
     }
+    const int wait_errno = errno;
+    if (reaps) sigaction(SIGCHLD, &host_chld, NULL);
     if (w < 0)
         return sw_error_set(err, SINEW_ERROR_IO, "%s: assimp's trial read was lost: %s", name,
-                            strerror(errno));
+                            strerror(wait_errno));
     if (WIFEXITED(status) &&
         (WEXITSTATUS(status) == TRIAL_SCENE || WEXITSTATUS(status) == TRIAL_NO_SCENE))
         return SINEW_OK;
