@@ -287,9 +287,10 @@ TEST(nan_vertex_is_an_error) {
     ENSURE(b64 && rc == SINEW_ERROR_NOT_FINITE && fails(rc, &c, &e, "memory.gltf"));
 }
 
-static unsigned char *read_all(const char *rel, size_t *len) {
+/* The bytes of file `rel` under folder `dir` (the shared data's or the source tree's). */
+static unsigned char *read_all(const char *dir, const char *rel, size_t *len) {
     char path[1024];
-    snprintf(path, sizeof path, "%s/%s", SINEW_SHARED_DATA_DIR, rel);
+    snprintf(path, sizeof path, "%s/%s", dir, rel);
     FILE *f = fopen(path, "rb");
     if (!f) return NULL;
     fseek(f, 0, SEEK_END);
@@ -384,7 +385,7 @@ TEST(errors_are_reported_not_crashed) {
     rc = sw_scene_import(path, NULL, &c, &e);
     ENSURE(fails(rc, &c, &e, path));
     size_t len = 0;
-    unsigned char *glb = read_all(assets[1].rel, &len);
+    unsigned char *glb = read_all(SINEW_SHARED_DATA_DIR, assets[1].rel, &len);
     ENSURE(glb && len > 1000);
     const size_t cuts[4] = {12, 20, len / 2, len - 1};
     int ok = 1;
@@ -405,20 +406,6 @@ TEST(errors_are_reported_not_crashed) {
  * assimp 5.2.5's FBX converter: tests/fuzz/corpus/scene_import/fbx_assert.fbx) is refused
  * with what assimp said, from a path and from memory, and the process lives on; the
  * undamaged file it came from imports. */
-static unsigned char *read_source(const char *rel, size_t *len) {
-    char path[1024];
-    snprintf(path, sizeof path, "%s/%s", SINEW_SOURCE_DIR, rel);
-    FILE *f = fopen(path, "rb");
-    unsigned char *b = NULL;
-    long n = -1;
-    if (f && fseek(f, 0, SEEK_END) == 0 && (n = ftell(f)) > 0 && fseek(f, 0, SEEK_SET) == 0)
-        b = malloc((size_t)n);
-    if (b && fread(b, 1, (size_t)n, f) != (size_t)n) free(b), b = NULL;
-    if (f) fclose(f);
-    *len = b ? (size_t)n : 0;
-    return b;
-}
-
 TEST(a_file_assimp_dies_on_is_refused_and_the_process_lives) {
     static const char damaged[] = "tests/fuzz/corpus/scene_import/fbx_assert.fbx",
                       whole[] = "tests/fuzz/corpus/scene_import/two_bones.fbx";
@@ -431,7 +418,7 @@ TEST(a_file_assimp_dies_on_is_refused_and_the_process_lives) {
     ENSURE(rc == SINEW_ERROR_PARSE && fails(rc, &c, &e, path));
     ENSUREF(strstr(e.msg, "assimp died") && strstr(e.msg, "ai_assert"), "%s", e.msg);
     size_t len = 0;
-    unsigned char *bytes = read_source(damaged, &len);
+    unsigned char *bytes = read_all(SINEW_SOURCE_DIR, damaged, &len);
     ENSURE(bytes && len > 1000);
     rc = sw_scene_import_memory(bytes, len, "fbx", NULL, &c, &e);
     free(bytes);
